@@ -1,0 +1,46 @@
+"""The `uitamr` command: a thin click face over the verifier package.
+
+Each sub-command lives in its own module `verifier.commands.<name>` and exposes a click
+command object called `command`; modules are imported only when their command runs, so
+`uitamr frame` does not pay for the ST parser or the simulator.
+"""
+from __future__ import annotations
+
+import importlib
+
+import click
+
+from verifier import __version__
+
+SUBCOMMANDS = {
+    "verify": "Run PLC programs against the emulated robot and check the traffic.",
+    "check": "Parse and type-check GX Works structured text.",
+    "frame": "Print or decode the exact bytes of a robot command.",
+    "emulate": "Run the emulated robot on a real serial port or TCP socket.",
+    "export": "Write paste-ready ST bodies and label tables for GX Works.",
+}
+
+
+class LazyGroup(click.Group):
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return list(SUBCOMMANDS)
+
+    def get_command(self, ctx: click.Context, name: str) -> click.Command | None:
+        if name not in SUBCOMMANDS:
+            return None
+        module = importlib.import_module(f"verifier.commands.{name}")
+        return module.command
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        with formatter.section("Commands"):
+            formatter.write_dl(list(SUBCOMMANDS.items()))
+
+
+@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="uitamr")
+def main() -> None:
+    """UITAMR PLC toolkit: verify, emulate and export."""
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()
