@@ -1,0 +1,37 @@
+"""Structured-text front end for the GX Works dialect: parse, check, print.
+
+    from verifier import st
+    source = st.parse(text, "FB_X.st", target="gxworks2")   # never raises for bad input
+    diagnostics = st.check([source], target="gxworks2")
+
+The AST is in `verifier.st.ast`; the type system in `verifier.st.types`.
+"""
+from __future__ import annotations
+
+from verifier.st.ast import Diagnostic, SourceFile
+
+TARGETS = ("gxworks2", "gxworks3")
+
+__all__ = ["Diagnostic", "SourceFile", "TARGETS", "parse", "check", "format_source"]
+
+
+def parse(text: str, filename: str = "<string>", target: str = "gxworks2") -> SourceFile:
+    """Read ST text into an `ast.SourceFile`; syntax errors become diagnostics."""
+    from verifier.st.parser import parse as _parse
+
+    return _parse(text, filename, target)
+
+
+def check(files: list[SourceFile], target: str = "gxworks2") -> list[Diagnostic]:
+    """Semantic check of parsed files together (a POU may use POUs of other files).
+    Annotates the trees in place (expression types, resolved names and calls)."""
+    from verifier.st.check import check as _check
+
+    return _check(files, target)
+
+
+def format_source(source: SourceFile) -> str:
+    """Readable ST text of a parsed file (see `verifier.st.printer`)."""
+    from verifier.st.printer import print_source
+
+    return print_source(source)
