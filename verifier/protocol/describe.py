@@ -1,0 +1,114 @@
+"""Human text for frames: what a person reading a trace or a ladder rung needs to see."""
+from __future__ import annotations
+
+from verifier.protocol.catalogue import (
+    ERROR_TITLES,
+    EXCEPTION_TITLES,
+    QUERY_TITLES,
+    QUERY_VALUES,
+    ControlCode,
+    ExceptionCode,
+    RobotError,
+    command_title,
+    wire_code,
+    wire_query,
+)
+from verifier.protocol.codec import decode_reply, decode_request, hex_bytes
+from verifier.protocol.frames import (
+    ControlReply,
+    ControlRequest,
+    ExceptionReply,
+    Frame,
+    FrameError,
+    StatusReply,
+    StatusRequest,
+)
+from verifier.protocol.settings import DEFAULT_SETTINGS, Settings
+from verifier.protocol.stream import Direction
+
+
+def describe(
+    frame_or_bytes: Frame | bytes,
+    settings: Settings = DEFAULT_SETTINGS,
+    direction: Direction | None = None,
+) -> str:
+    """One line of plain English, e.g. ``"stop (01/A0)"`` or ``"task status: running"``.
+
+    Bytes are decoded first (as a request, then as a reply, unless ``direction`` says
+    which); bytes that decode as neither give ``"invalid frame: byte N: ..."``.
+    """
+    if isinstance(frame_or_bytes, (bytes, bytearray, memoryview)):
+        try:
+            frame_or_bytes = decode_frame(bytes(frame_or_bytes), settings, direction)
+        except FrameError as exc:
+            return f"invalid frame: {exc}"
+    return _describe_frame(frame_or_bytes, settings)
+
+
+def decode_frame(data: bytes, settings: Settings = DEFAULT_SETTINGS, direction: Direction | None = None) -> Frame:
+    """Decode as ``direction`` says, or as a request and then as a reply.
+
+    When neither works the request's error is raised, except for frames that can only be
+    replies (exception replies, FC01 replies), whose reply error is the useful one.
+    """
+    if direction == "request":
+        return decode_request(data, settings)
+    if direction == "reply":
+        return decode_reply(data, settings)
+    try:
+        return decode_request(data, settings)
+    except FrameError as request_error:
+        try:
+            return decode_reply(data, settings)
+        except FrameError as reply_error:
+            if _looks_like_reply(data):
+                raise reply_error from None
+            raise request_error from None
+
+
+def _looks_like_reply(data: bytes) -> bool:
+    return len(data) >= 3 and (data[1] & 0x80 or (data[1] == 0x01 and data[2] == 0x03))
+
+
+def _address_note(address: int, settings: Settings) -> str:
+    if address == settings.address:
+        return ""
+    if address == 0:
+        return " [broadcast address 0]"
+    return f" [address {address}, not this robot's {settings.address}]"
+
+
+def _control_text(frame: ControlRequest | ControlReply, settings: Settings) -> str:
+    if isinstance(frame.code, ControlCode):
+        return f"{command_title(frame.code, frame.command)} ({wire_code(frame.code, settings):02X}/{frame.command:02X})"
+    return f"unknown control code {frame.code} ({frame.command:02X})"
+
+
+def _describe_frame(frame: Frame, settings: Settings) -> str:
+    note = _address_note(frame.address, settings)
+    if isinstance(frame, ControlRequest):
+        return _control_text(frame, settings) + note
+    if isinstance(frame, ControlReply):
+        return "echo: " + _control_text(frame, settings) + note
+    if isinstance(frame, StatusRequest):
+        if frame.query in QUERY_TITLES:
+            return f"read {QUERY_TITLES[frame.query]} (query {wire_query(frame.query, settings)})" + note
+        return f"read unknown query {frame.query}" + note
+    if isinstance(frame, StatusReply):
+        return _status_reply_text(frame) + note
+    if isinstance(frame, ExceptionReply):
+        title = EXCEPTION_TITLES.get(frame.exception_code, "unknown exception") if isinstance(
+            frame.exception_code, ExceptionCode) else "unknown exception"
+        return f"exception {int(frame.exception_code):02X} ({title}) to function {frame.function:02X}" + note
+    raise TypeError(f"not a UITAMR frame: {frame!r}")
+
+
+def _status_reply_text(frame: StatusReply) -> str:
+    if isinstance(frame.error, RobotError):
+        error = f"error {int(frame.error):02X} {ERROR_TITLES[frame.error]}"
+    else:
+        error = f"unknown error {frame.error:02X}"
+    if frame.query is None:
+        return f"status reply: value {frame.value}, {error}"
+    meaning = QUERY_VALUES[frame.query].get(frame.value, "out of range")
+    return f"{QUERY_TITLES[frame.query]}: {meaning} ({frame.value}), {error}"

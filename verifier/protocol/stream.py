@@ -1,0 +1,72 @@
+"""Cut a byte stream into frames by function code.
+
+Every frame on this line has a fixed length once its function code is known: requests
+(FC01, FC06) are 8 bytes, normal replies 8, exception replies (function | 0x80) 5. Real
+RTU framing also uses the 3.5-character silence (the link model does that); this helper
+is for streams without timing (TCP carrying raw RTU, captured logs, tests).
+"""
+from __future__ import annotations
+
+from typing import Literal
+
+from verifier.protocol.catalogue import EXCEPTION_FLAG, FUNCTION_CODES
+from verifier.protocol.codec import EXCEPTION_REPLY_LENGTH, REPLY_LENGTHS, REQUEST_LENGTH
+
+Direction = Literal["request", "reply"]
+
+
+def frame_length(head: bytes, direction: Direction) -> int | None:
+    """Length of the frame that starts with ``head`` (needs 2 bytes), or None if unknown.
+
+    None means either fewer than two bytes are known yet or the function code is not one
+    of this protocol's, so the frame's end can only be found by the line's silence.
+    """
+    if direction not in ("request", "reply"):
+        raise ValueError(f"direction must be 'request' or 'reply', got {direction!r}")
+    if len(head) < 2:
+        return None
+    function = head[1]
+    if direction == "reply" and function & EXCEPTION_FLAG:
+        return EXCEPTION_REPLY_LENGTH
+    if function not in FUNCTION_CODES:
+        return None
+    return REQUEST_LENGTH if direction == "request" else REPLY_LENGTHS[function]
+
+
+def split_frames(data: bytes, direction: Direction) -> tuple[list[bytes], bytes]:
+    """Complete frames at the start of ``data`` and the bytes left over.
+
+    The leftover is an incomplete frame, or starts with an unknown function code (its
+    length cannot be known: end it with ``FrameSplitter.flush`` at the next silence).
+    """
+    frames: list[bytes] = []
+    start = 0
+    while True:
+        length = frame_length(data[start:start + 2], direction)
+        if length is None or len(data) - start < length:
+            return frames, bytes(data[start:])
+        frames.append(bytes(data[start:start + length]))
+        start += length
+
+
+class FrameSplitter:
+    """Incremental ``split_frames``: ``feed`` bytes as they arrive, get whole frames back."""
+
+    def __init__(self, direction: Direction) -> None:
+        frame_length(b"", direction)  # validates the direction
+        self.direction: Direction = direction
+        self._pending = b""
+
+    @property
+    def pending(self) -> bytes:
+        """Bytes received that do not yet make a whole frame."""
+        return self._pending
+
+    def feed(self, data: bytes) -> list[bytes]:
+        frames, self._pending = split_frames(self._pending + bytes(data), self.direction)
+        return frames
+
+    def flush(self) -> bytes:
+        """End of frame by silence: hand back (and forget) the incomplete bytes."""
+        rest, self._pending = self._pending, b""
+        return rest
