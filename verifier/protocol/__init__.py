@@ -29,15 +29,18 @@ from verifier.protocol.catalogue import (
 )
 from verifier.protocol.codec import (
     STOP_FRAME,
+    addressed_to_robot,
     decode_reply,
     decode_request,
     encode,
+    exception_reply_for,
     function_of,
     hex_bytes,
     is_stop_command,
 )
 from verifier.protocol.crc import crc16, crc_ok, with_crc
 from verifier.protocol.describe import decode_frame, describe
+from verifier.protocol.explain import Field, explain, explain_table
 from verifier.protocol.frames import (
     ControlReply,
     ControlRequest,

@@ -389,4 +389,24 @@ def is_stop_command(request: ControlRequest | bytes, settings: Settings = DEFAUL
     )
 
 
+def addressed_to_robot(address: int, settings: Settings = DEFAULT_SETTINGS) -> bool:
+    """Whether a request with this address byte is for the robot (broadcast 0 included).
+
+    Modbus serial line: a slave acts on its own address and on broadcast 0, answers only
+    its own address, and ignores every other address without a word.
+    """
+    return address in (0, settings.address)
+
+
+def exception_reply_for(error: FrameError, settings: Settings = DEFAULT_SETTINGS) -> ExceptionReply | None:
+    """The exception reply a Modbus slave sends for a bad request, or None for silence.
+
+    Silence when the frame is broken (length, CRC), addressed to another slave, or
+    broadcast (a slave never answers a broadcast).
+    """
+    if error.exception is None or error.address != settings.address or error.function is None:
+        return None
+    return ExceptionReply(error.address, error.function & ~EXCEPTION_FLAG, error.exception)
+
+
 STOP_FRAME = encode(ControlRequest(1, ControlCode.ROBOT, RobotCommand.STOP))

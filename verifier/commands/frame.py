@@ -1,0 +1,202 @@
+"""`uitamr frame`: the exact bytes of a robot command, or what some bytes mean.
+
+All protocol knowledge comes from verifier.protocol; this module only reads the command
+line and prints.
+"""
+from __future__ import annotations
+
+import re
+
+import click
+
+from verifier.protocol import (
+    CommandError,
+    ControlReply,
+    ControlRequest,
+    FrameError,
+    Settings,
+    StatusReply,
+    StatusRequest,
+    ExceptionReply,
+    command_from_words,
+    decode_frame,
+    decode_reply,
+    describe,
+    encode,
+    exception_reply_for,
+    explain,
+    explain_table,
+    hex_bytes,
+)
+from verifier.protocol.names import USAGE
+from verifier.protocol.settings import CODES_10_13_STYLES, FIELD_ORDERS, STATUS_ORDERS
+
+EXIT_BAD_FRAME = 1
+_HEX_WORD = re.compile(r"(0[xX])?[0-9a-fA-F]+,?")
+
+_EPILOG = "\b\nCommands:\n" + "\n".join(f"  {line}" for line in USAGE) + """
+
+\b
+Examples:
+  uitamr frame stop                      -> 01 06 01 A0 00 00 88 14
+  uitamr frame move x -2.5               (front, negative: code 07)
+  uitamr frame move rear +1              (rear, positive: code 08)
+  uitamr frame read task --explain
+  uitamr frame --decode "01 06 01 A0 00 00 88 14"
+  uitamr frame read task --decode "01 01 03 00 00 01 FD 8E"   (a reply to that read)
+"""
+
+
+def parse_hex(text: str) -> bytes:
+    """Bytes from hex text: "01 06 01 A0", "0106 01a0", "0x01,0x06" and the like."""
+    cleaned = re.sub(r"0[xX]", " ", text)
+    tokens = [t for t in re.split(r"[\s,;:\-]+", cleaned) if t]
+    if not tokens:
+        raise ValueError("no hex bytes given")
+    out = bytearray()
+    for token in tokens:
+        bad = re.search(r"[^0-9a-fA-F]", token)
+        if bad:
+            raise ValueError(f"not a hex digit: {bad.group()!r} in {token!r}")
+        if len(token) % 2 and len(token) > 1:
+            raise ValueError(f"odd number of hex digits in {token!r}: write bytes as pairs like 0A")
+        out += bytes.fromhex(token.zfill(2))
+    return bytes(out)
+
+
+def _kind(frame) -> str:
+    if isinstance(frame, ControlRequest):
+        return "FC06 request"
+    if isinstance(frame, StatusRequest):
+        return "FC01 request"
+    if isinstance(frame, ControlReply):
+        return "FC06 reply"
+    if isinstance(frame, StatusReply):
+        return "FC01 reply"
+    if isinstance(frame, ExceptionReply):
+        return "exception reply"
+    return "frame"
+
+
+@click.command(
+    "frame",
+    epilog=_EPILOG,
+    context_settings={"ignore_unknown_options": True, "help_option_names": ["-h", "--help"]},
+)
+@click.argument("words", nargs=-1, type=click.UNPROCESSED)
+@click.option("--address", type=click.IntRange(1, 247), default=1, show_default=True,
+              help="Robot (slave) address.")
+@click.option("--field-order", type=click.Choice(FIELD_ORDERS), default="code-high", show_default=True,
+              help="FC06 register field: control code in the high byte (manual text) or low byte (its examples).")
+@click.option("--codes-10-13", "codes_10_13", type=click.Choice(CODES_10_13_STYLES), default="decimal",
+              show_default=True, help="Control codes 10-13 on the wire as 0x0A-0x0D (decimal) or 0x10-0x13 (hex).")
+@click.option("--status-order", type=click.Choice(STATUS_ORDERS), default="query", show_default=True,
+              help="FC01 query numbering: 0 task,1 vehicle,2 speed,3 battery (query) or 0 speed,1 battery,2 task,3 vehicle (return).")
+@click.option("--decode", "decode_hex", metavar="HEX",
+              help="Decode these bytes instead (with COMMAND: as the reply to that command).")
+@click.option("--as", "direction", type=click.Choice(["auto", "request", "reply"]), default="auto",
+              show_default=True, help="With --decode: read the bytes as a request or a reply.")
+@click.option("--explain", "explain_fields", is_flag=True, help="Also show every field of the frame.")
+def command(words, address, field_order, codes_10_13, status_order, decode_hex, direction, explain_fields):
+    """Print the exact bytes (CRC included) of COMMAND, or decode bytes with --decode.
+
+    Prints space-separated upper-case hex, ready to type into a PLC send buffer.
+    A bad COMMAND or value exits 2; --decode of a bad frame explains it and exits 1.
+    """
+    settings = Settings(address=address, field_order=field_order, codes_10_13=codes_10_13,
+                        status_order=status_order)
+    for word in words:
+        if word.startswith("--"):
+            raise click.UsageError(f"no such option: {word}")
+    if decode_hex is not None:
+        words, decode_hex = _split_unquoted_hex(words, decode_hex, address)
+    request = _request_from(words, address) if words else None
+    if decode_hex is None:
+        if request is None:
+            raise click.UsageError("give a COMMAND (e.g. `uitamr frame stop`) or --decode HEX")
+        _print_request(request, settings, explain_fields)
+        return
+    try:
+        data = parse_hex(decode_hex)
+    except ValueError as exc:
+        raise click.BadParameter(str(exc), param_hint="--decode") from None
+    if request is not None:
+        direction = "reply"
+    _decode_and_print(data, settings, None if direction == "auto" else direction, request, explain_fields)
+
+
+def _split_unquoted_hex(words: tuple[str, ...], decode_hex: str, address: int) -> tuple[tuple[str, ...], str]:
+    """Take back the bytes of an unquoted ``--decode 01 06 ...`` that click left in WORDS.
+
+    The command is the shortest leading run of words that names one; every word after
+    it must look like hex to join the bytes.
+    """
+    for cut in range(len(words) + 1):
+        head, tail = words[:cut], words[cut:]
+        if not all(_HEX_WORD.fullmatch(w) for w in tail):
+            continue
+        if cut == 0:
+            return (), " ".join((decode_hex, *tail))
+        try:
+            command_from_words(list(head), address=address)
+        except CommandError:
+            continue
+        return head, " ".join((decode_hex, *tail))
+    return words, decode_hex
+
+
+def _request_from(words: tuple[str, ...], address: int):
+    try:
+        return command_from_words(list(words), address=address)
+    except CommandError as exc:
+        raise click.UsageError(str(exc)) from None
+
+
+def _print_request(request, settings: Settings, show_fields: bool) -> None:
+    try:
+        data = encode(request, settings)
+    except ValueError as exc:  # command_from_words already checked; settings cannot break it
+        raise click.UsageError(str(exc)) from None
+    click.echo(hex_bytes(data))
+    if show_fields:
+        click.echo(describe(request, settings))
+        click.echo(explain_table(explain(data, settings, "request")))
+
+
+def _decode_and_print(data: bytes, settings: Settings, direction, request, show_fields: bool) -> None:
+    click.echo(hex_bytes(data))
+    try:
+        if request is not None:
+            frame = decode_reply(data, settings, request)
+        else:
+            frame = decode_frame(data, settings, direction)
+    except FrameError as exc:
+        click.echo(f"invalid frame: {exc}")
+        guessed = direction or ("reply" if request is not None or _reply_shaped(data) else "request")
+        if guessed == "request":
+            click.echo("the robot would " + _robot_answer(exc, settings))
+        if show_fields:
+            click.echo(explain_table(explain(data, settings, guessed)))
+        raise SystemExit(EXIT_BAD_FRAME)
+    click.echo(f"{_kind(frame)}: {describe(frame, settings)}")
+    if isinstance(frame, ControlRequest):
+        click.echo("(a normal reply echoes these 8 bytes)")
+    click.echo(f"CRC {hex_bytes(data[-2:])} ok")
+    if show_fields:
+        kind = "request" if isinstance(frame, (ControlRequest, StatusRequest)) else "reply"
+        click.echo(explain_table(explain(data, settings, kind)))
+
+
+def _reply_shaped(data: bytes) -> bool:
+    return len(data) >= 3 and (data[1] & 0x80 or (data[1] == 0x01 and data[2] == 0x03))
+
+
+def _robot_answer(error: FrameError, settings: Settings) -> str:
+    reply = exception_reply_for(error, settings)
+    if reply is not None:
+        return f"answer with exception {int(reply.exception_code):02X}: {hex_bytes(encode(reply, settings))}"
+    if error.exception is not None and error.address == 0:
+        return "stay silent (broadcast requests get no reply)"
+    if error.exception is not None:
+        return f"stay silent (address {error.address} is not this robot's {settings.address})"
+    return "stay silent (Modbus RTU: a frame with a bad length or CRC is discarded)"
