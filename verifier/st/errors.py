@@ -1,0 +1,144 @@
+"""Turn lark's lexer/parser exceptions into messages that say what to write.
+
+A missing `;` is reported where it belongs (right after the previous token), not at the
+next line's first word; other errors name the unexpected text and what GX Works
+expects there.
+"""
+from __future__ import annotations
+
+from lark import Lark, Token
+from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
+from lark.lexer import PatternStr
+
+#: how terminals that are not plain strings are named in messages
+_TERMINAL_WORDS = {
+    "IDENT": "a name",
+    "INT": "a number",
+    "BASED_INT": "a number",
+    "REAL": "a number",
+    "TIME_LIT": "a time literal",
+    "STRING_LIT": "a string",
+    "WSTRING_LIT": "a string",
+    "BUFFER_DEVICE": "a device",
+    "VAR_KEYWORD": "VAR",
+    "$END": "end of file",
+}
+_VAR_OPENERS = ("VAR", "VAR_INPUT", "VAR_OUTPUT", "VAR_IN_OUT", "VAR_TEMP", "VAR_GLOBAL",
+                "VAR_EXTERNAL", "VAR_CONSTANT", "VAR_RETAIN", "VAR_GLOBAL_CONSTANT",
+                "VAR_GLOBAL_RETAIN", "VAR_OUTPUT_RETAIN", "VAR_PUBLIC", "VAR_PUBLIC_RETAIN",
+                "STRUCT")
+
+
+def _terminal_text(parser: Lark, name: str) -> str:
+    if name in _TERMINAL_WORDS:
+        return _TERMINAL_WORDS[name]
+    try:
+        term = parser.get_terminal(name)
+    except KeyError:
+        return name
+    if isinstance(term.pattern, PatternStr):
+        return f"'{term.pattern.value.upper()}'"
+    return name.lower()
+
+
+def _expected_list(parser: Lark, names) -> str:
+    words = sorted({_terminal_text(parser, n) for n in names})
+    if len(words) > 8:
+        words = words[:8] + ["..."]
+    return ", ".join(words)
+
+
+def _previous_token(parser: Lark, text: str, pos: int):
+    """The last significant token ending at or before `pos` (None if none), and whether
+    it sits inside a VAR...END_VAR / STRUCT block."""
+    last = None
+    depth = 0
+    try:
+        for tok in parser.lex(text[:pos]):
+            if tok.end_pos is not None and tok.end_pos > pos:
+                break
+            kind = tok.type
+            if kind in _VAR_OPENERS:
+                depth += 1
+            elif kind in ("END_VAR", "END_STRUCT"):
+                depth = max(0, depth - 1)
+            last = tok
+    except UnexpectedInput:
+        pass
+    return last, depth > 0
+
+
+def _token_text(tok) -> str:
+    if tok.type == "$END":
+        return "end of file"
+    value = str(tok.value)
+    if len(value) > 30:
+        value = value[:27] + "..."
+    return f"'{value}'"
+
+
+def _semicolon_fixes(exc: UnexpectedToken) -> bool:
+    """True when inserting ';' before the unexpected token lets the parse go on."""
+    ip = getattr(exc, "interactive_parser", None)
+    if ip is None:
+        return True
+    try:
+        trial = ip.copy()
+        trial.feed_token(Token("SEMI", ";"))
+        return exc.token.type in trial.accepts()
+    except Exception:  # noqa: BLE001 - a failed trial only means "not a missing ';'"
+        return False
+
+
+def describe_syntax_error(exc: UnexpectedInput, text: str, parser: Lark) -> tuple[int, int, str]:
+    """(line, column, message) for a lark exception raised while reading `text`."""
+    if isinstance(exc, UnexpectedCharacters):
+        rest = text[exc.pos_in_stream: exc.pos_in_stream + 2]
+        if rest == "(*" or rest == "/*":
+            closer = "*)" if rest == "(*" else "*/"
+            return exc.line, exc.column, f"comment '{rest}' is never closed; add '{closer}'"
+        if exc.char in "'\"":
+            return exc.line, exc.column, "string literal is not closed on this line; add the closing quote"
+        if exc.char == "#":
+            return exc.line, exc.column, "'#' must follow a radix (2#, 8#, 16#) or T#/TIME#"
+        char = exc.char
+        shown = repr(char) if not char.isprintable() else f"'{char}'"
+        return exc.line, exc.column, f"unexpected character {shown}; GX Works ST does not use it here"
+
+    if isinstance(exc, UnexpectedEOF):
+        expected = _expected_list(parser, exc.expected)
+        line = text.count("\n") + 1
+        col = len(text) - (text.rfind("\n") + 1) + 1
+        return line, col, f"unexpected end of file; expected {expected}"
+
+    assert isinstance(exc, UnexpectedToken)
+    tok = exc.token
+    expected = set(exc.expected)
+    if tok.type == "$END":
+        line = text.count("\n") + 1
+        col = len(text) - (text.rfind("\n") + 1) + 1
+        pos = len(text)
+    else:
+        line, col, pos = tok.line, tok.column, tok.start_pos
+    if tok.type in ("LPAR", "SLASH") and text[pos:pos + 2] in ("(*", "/*"):
+        closer = "*)" if text[pos] == "(" else "*/"
+        return line, col, f"comment '{text[pos:pos + 2]}' is never closed; add '{closer}'"
+    if "SEMI" in expected and tok.type != "SEMI" and _semicolon_fixes(exc):
+        prev, in_decl = _previous_token(parser, text, pos)
+        what = "declaration" if in_decl else "statement"
+        if prev is not None:
+            return (prev.end_line, prev.end_column,
+                    f"expected ';' after {what} (before {_token_text(tok)})")
+        return line, col, f"expected ';' after {what}"
+    if tok.type == "$END":
+        closers = sorted(n for n in expected if n.startswith("END_"))
+        if "SEMI" in expected and not closers:
+            return line, col, "unexpected end of file; expected ';' after statement, then the END_ of the block"
+        if closers:
+            return line, col, f"unexpected end of file; expected {_expected_list(parser, closers)} to close the block"
+        return line, col, f"unexpected end of file; expected {_expected_list(parser, expected)}"
+    if tok.type == "EQ" and "ASSIGN" in expected:
+        return line, col, "'=' compares; write ':=' to assign"
+    if tok.type == "ASSIGN" and "EQ" in expected:
+        return line, col, "':=' assigns; write '=' to compare"
+    return line, col, f"unexpected {_token_text(tok)}; expected {_expected_list(parser, expected)}"
