@@ -1,0 +1,116 @@
+"""Reading plain dicts (from TOML scenarios or a ``--faults`` file) into dataclasses.
+
+Every problem becomes a :class:`ConfigError` that names the offending key by its path, e.g.
+``faults[2].kind: unknown fault 'x'; expected one of anti_collision, off_tape, …`` — the
+caller adds the file name; nobody sees a traceback for a typo in a scenario.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from typing import Any
+
+
+class ConfigError(ValueError):
+    """A bad value in a robot configuration or fault list; ``path`` names the key."""
+
+    def __init__(self, path: str, message: str) -> None:
+        super().__init__(f"{path}: {message}" if path else message)
+        self.path = path
+        self.message = message
+
+
+def join(path: str, key: str | int) -> str:
+    """``path`` extended by a key (``robot.turnaround_ms``) or an index (``faults[2]``)."""
+    if isinstance(key, int):
+        return f"{path}[{key}]"
+    return f"{path}.{key}" if path else key
+
+
+def require_mapping(value: Any, path: str) -> Mapping[str, Any]:
+    if not isinstance(value, Mapping):
+        raise ConfigError(path, f"expected a table of keys, got {_shown(value)}")
+    return value
+
+
+def reject_unknown_keys(data: Mapping[str, Any], allowed: Iterable[str], path: str) -> None:
+    allowed = list(allowed)
+    for key in data:
+        if key not in allowed:
+            raise ConfigError(
+                join(path, str(key)), f"unknown key; expected one of {', '.join(allowed)}"
+            )
+
+
+def as_number(value: Any, path: str, *, minimum: float | None = None,
+              maximum: float | None = None, strictly_positive: bool = False) -> float:
+    """A finite int or float (not a bool) within the given bounds."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ConfigError(path, f"expected a number, got {_shown(value)}")
+    if strictly_positive and value <= 0:
+        raise ConfigError(path, f"must be greater than 0, got {value}")
+    if minimum is not None and value < minimum:
+        raise ConfigError(path, f"must be at least {minimum}, got {value}")
+    if maximum is not None and value > maximum:
+        raise ConfigError(path, f"must be at most {maximum}, got {value}")
+    return float(value)
+
+
+def as_int(value: Any, path: str, *, minimum: int | None = None,
+           maximum: int | None = None) -> int:
+    """An integer (not a bool) within the given bounds."""
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ConfigError(path, f"expected a whole number, got {_shown(value)}")
+    if minimum is not None and value < minimum:
+        raise ConfigError(path, f"must be at least {minimum}, got {value}")
+    if maximum is not None and value > maximum:
+        raise ConfigError(path, f"must be at most {maximum}, got {value}")
+    return value
+
+
+def as_bool(value: Any, path: str) -> bool:
+    if not isinstance(value, bool):
+        raise ConfigError(path, f"expected true or false, got {_shown(value)}")
+    return value
+
+
+def as_choice(value: Any, path: str, choices: Iterable[str], what: str = "value") -> str:
+    choices = list(choices)
+    if not isinstance(value, str) or value not in choices:
+        raise ConfigError(path, f"unknown {what} {_shown(value)}; expected one of {', '.join(choices)}")
+    return value
+
+
+def as_hex_bytes(value: Any, path: str) -> bytes:
+    """Bytes written as hex text ("A5 5A ff", "a55aff") or as a list of 0-255 numbers."""
+    if isinstance(value, str):
+        text = value.replace(" ", "").replace(":", "")
+        try:
+            data = bytes.fromhex(text)
+        except ValueError:
+            raise ConfigError(path, f"expected hex bytes like \"A5 5A FF\", got {_shown(value)}") from None
+    elif isinstance(value, list):
+        data = bytes(as_int(v, join(path, i), minimum=0, maximum=255) for i, v in enumerate(value))
+    else:
+        raise ConfigError(path, f"expected hex bytes like \"A5 5A FF\", got {_shown(value)}")
+    if not data:
+        raise ConfigError(path, "needs at least one byte")
+    return data
+
+
+def as_int_keyed(value: Any, path: str) -> dict[int, Any]:
+    """A table whose keys are whole numbers; TOML keys are strings ("3" = 3)."""
+    table = require_mapping(value, path)
+    result: dict[int, Any] = {}
+    for key, item in table.items():
+        try:
+            number = int(key)
+        except (TypeError, ValueError):
+            raise ConfigError(join(path, str(key)), "key must be a whole number") from None
+        result[number] = item
+    return result
+
+
+def _shown(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
