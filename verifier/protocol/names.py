@@ -183,7 +183,7 @@ def _scaled(text: str, step: Decimal, what: str, unit: str) -> tuple[int, int]:
             f"{what} {text}{unit and ' ' + unit} is {int(units)} units of {step}; one byte holds at most "
             f"255 ({limit}{unit and ' ' + unit})"
         )
-    return (-1 if value < 0 else 1), int(units)
+    return (-1 if value.is_signed() else 1), int(units)  # "-0" keeps its sign: code 07 with 0
 
 
 # --- the other way round ----------------------------------------------------------------

@@ -1,0 +1,149 @@
+"""`uitamr frame`: bytes for named commands, decoding with precise errors, exit codes."""
+from __future__ import annotations
+
+import shutil
+import subprocess
+
+import pytest
+from click.testing import CliRunner
+from hypothesis import given, settings as hypothesis_settings
+
+from verifier.cli import main
+from verifier.commands.frame import parse_hex
+from verifier.protocol import command_from_words, encode, hex_bytes, words_for
+from verifier.protocol.strategies import requests
+
+
+def run(*args: str):
+    return CliRunner().invoke(main, ["frame", *args])
+
+
+@pytest.mark.parametrize("args, expected", [
+    (["stop"], "01 06 01 A0 00 00 88 14"),
+    (["read", "task"], "01 01 00 00 00 16 BD C4"),
+    (["move", "x", "-2.5"], "01 06 07 19 00 00 59 79"),
+    (["move", "rear", "+1"], "01 06 08 0A 00 00 AB A8"),
+    (["rotate", "-0.5"], "01 06 0D 32 00 00 2A A9"),
+    (["--field-order", "code-low", "stop"], "01 06 A0 01 00 00 FA 0A"),
+])
+def test_prints_exact_bytes(args, expected):
+    result = run(*args)
+    assert result.exit_code == 0, result.output
+    assert result.output.strip() == expected
+
+
+def test_settings_options_change_the_bytes():
+    assert run("--codes-10-13", "hex", "rotate", "+1").output.split()[2] == "12"
+    assert run("--codes-10-13", "decimal", "rotate", "+1").output.split()[2] == "0C"
+    assert run("--status-order", "return", "read", "task").output.split()[3] == "02"
+    assert run("--address", "7", "stop").output.split()[0] == "07"
+
+
+@given(requests)
+@hypothesis_settings(max_examples=40)
+def test_every_request_prints_what_encode_gives(request):
+    args = ["--address", str(request.address), *words_for(request)]
+    result = run(*args)
+    assert result.exit_code == 0, result.output
+    assert result.output.strip() == hex_bytes(encode(request))
+
+
+@pytest.mark.parametrize("args, message", [
+    (["move", "x", "30"], "300 units of 0.1; one byte holds at most 255"),
+    (["speed", "trackless", "5"], "speed stage must be 0-3, got 5"),
+    (["frobnicate"], "unknown command 'frobnicate'"),
+    ([], "give a COMMAND"),
+    (["--adress", "2", "stop"], "no such option: --adress"),
+    (["--address", "0", "stop"], "not in the range 1<=x<=247"),
+    (["--decode", "zz"], "not a hex digit"),
+    (["--decode", "010"], "odd number of hex digits"),
+])
+def test_user_errors_exit_2_without_traceback(args, message):
+    result = run(*args)
+    assert result.exit_code == 2, result.output
+    assert message in result.output
+    assert "Traceback" not in result.output
+
+
+def test_decode_good_request():
+    result = run("--decode", "01 06 01 A0 00 00 88 14")
+    assert result.exit_code == 0
+    assert "FC06 request: stop (01/A0)" in result.output
+    assert "CRC 88 14 ok" in result.output
+
+
+def test_decode_accepts_hex_without_spaces_and_unquoted():
+    assert "stop (01/A0)" in run("--decode", "010601A0000088 14").output
+    assert "stop (01/A0)" in run("--decode", "0x01,0x06,0x01,0xA0,0x00,0x00,0x88,0x14").output
+    assert "stop (01/A0)" in run("--decode", "01", "06", "01", "A0", "00", "00", "88", "14").output
+
+
+def test_decode_bad_crc_exits_1_and_names_byte():
+    result = run("--decode", "01 06 01 A0 00 00 88 15")
+    assert result.exit_code == 1
+    assert "invalid frame: byte 6: bad CRC: expected 88 14 (CRC 0x1488), got 88 15" in result.output
+    assert "the robot would stay silent" in result.output
+
+
+def test_decode_unknown_function_says_what_robot_answers():
+    result = run("--decode", "01 03 00 00 00 01 84 0A")
+    assert result.exit_code == 1
+    assert "byte 1: unknown function code 0x03" in result.output
+    assert "answer with exception 01: 01 83 01 80 F0" in result.output
+
+
+def test_decode_short_frame():
+    result = run("--decode", "01 06 01 A0 00 01")
+    assert result.exit_code == 1
+    assert "byte 6: too short for an FC06 (write single register) request: 6 bytes, expected 8" in result.output
+
+
+def test_decode_reply_against_the_named_request():
+    result = run("read", "task", "--decode", "01 01 03 00 00 01 FD 8E")
+    assert result.exit_code == 0 and "task status: running (1)" in result.output
+    result = run("read", "battery", "--decode", "01", "01", "03", "00", "00", "01", "FD", "8E")
+    assert result.exit_code == 0 and "battery: low (1)" in result.output
+    result = run("read", "task", "--decode", "01 01 03 00 00 05 FC 4D")
+    assert result.exit_code == 1 and "byte 5: value 5 out of range for task status" in result.output
+    result = run("stop", "--decode", "01 06 01 80 00 00 89 DE")
+    assert result.exit_code == 1 and "does not echo the request" in result.output
+
+
+def test_decode_exception_reply():
+    result = run("--decode", "01 86 03 02 61")
+    assert result.exit_code == 0
+    assert "exception reply: exception 03 (illegal data value) to function 06" in result.output
+
+
+def test_explain_shows_every_field():
+    result = run("stop", "--explain")
+    assert result.exit_code == 0
+    lines = result.output.splitlines()
+    assert lines[0] == "01 06 01 A0 00 00 88 14"
+    assert lines[1] == "stop (01/A0)"
+    text = result.output
+    for needle in ("address (模塊地址)", "control code (控制代號)", "control command (控制指令)",
+                   "value (always 0)", "0x1488: ok"):
+        assert needle in text
+    bad = run("--decode", "01 01 00 00 00 08 3C 0C", "--explain")
+    assert bad.exit_code == 1 and "quantity" in bad.output and "must be 22" in bad.output
+
+
+def test_parse_hex():
+    assert parse_hex("01 06 01a0") == bytes.fromhex("010601A0")
+    assert parse_hex("1 6") == b"\x01\x06"
+    with pytest.raises(ValueError):
+        parse_hex("")
+
+
+def test_installed_entry_point_in_a_real_subprocess():
+    uitamr = shutil.which("uitamr")
+    assert uitamr, "the uitamr entry point is not installed (pip install -e '.[test]')"
+    done = subprocess.run([uitamr, "frame", "stop"], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0 and done.stdout.strip() == "01 06 01 A0 00 00 88 14"
+    bad = subprocess.run([uitamr, "frame", "move", "x", "30"], capture_output=True, text=True, timeout=60)
+    assert bad.returncode == 2 and "one byte holds at most 255" in bad.stderr
+    assert "Traceback" not in bad.stderr
+    decoded = subprocess.run([uitamr, "frame", "--decode", "01 06 01 A0 00 00 88 15"],
+                             capture_output=True, text=True, timeout=60)
+    assert decoded.returncode == 1 and "bad CRC" in decoded.stdout
