@@ -39,7 +39,13 @@ from verifier.protocol.catalogue import (
     RobotError,
     command_title,
 )
-from verifier.protocol.codec import decode_request, encode, hex_bytes, is_stop_command
+from verifier.protocol.codec import (
+    decode_request,
+    encode,
+    exception_reply_for,
+    hex_bytes,
+    is_stop_command,
+)
 from verifier.protocol.crc import crc_ok, with_crc
 from verifier.protocol.frames import (
     ControlReply,
@@ -309,12 +315,15 @@ class Robot:
             request = decode_request(frame, self.settings)
         except FrameError as err:
             self._start_request_faults(number, t_us)
-            if err.exception is None or not 1 <= function < EXCEPTION_FLAG:
+            answer = exception_reply_for(err, self.settings)
+            if answer is None or not 1 <= function < EXCEPTION_FLAG:
                 self._log(t_us, "silent", f"request {number}: {err}: no reply")
                 return None
-            code = exception_fault.code if exception_fault else int(err.exception)
+            if exception_fault is not None:
+                answer = ExceptionReply(address, function, exception_fault.code)
+            code = int(answer.exception_code)
             self._log(t_us, "exception", f"request {number}: {err}: exception {code:02X}")
-            return encode(ExceptionReply(address, function, code), self.settings)
+            return encode(answer, self.settings)
         if exception_fault is not None:
             self._start_request_faults(number, t_us)
             self._log(t_us, "fault", f"request {number}: {exception_fault.describe()}: "

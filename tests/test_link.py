@@ -1,0 +1,208 @@
+"""The virtual 9600 8N1 line: byte times, t1.5/t3.5, turnaround, collisions, the trace."""
+from __future__ import annotations
+
+import pytest
+from hypothesis import given, settings as hsettings, strategies as st
+
+from verifier.amr import Robot, RobotConfig, faults_from_list
+from verifier.link import Line, LineConfig, TraceFrame
+from verifier.protocol import STOP_FRAME, Query, StatusRequest, encode
+from verifier.protocol.timing import T1_5_US, T3_5_US
+
+STATUS = encode(StatusRequest(1, Query.TASK))
+BYTE_END = [0, 1042, 2083, 3125, 4167, 5208, 6250, 7292, 8333]  # k × 3125/3 µs, rounded
+
+
+def make_line(*faults: dict, **config) -> Line:
+    return Line(Robot(config=RobotConfig(**config), faults=faults_from_list(list(faults))))
+
+
+def test_bytes_take_one_character_time_each_without_drift():
+    line = make_line()
+    assert line.config.byte_time_us == 1042
+    assert [line.config.offset_us(k) for k in range(9)] == BYTE_END
+    assert line.config.offset_us(9600) == 10 * 1_000_000  # one second of characters, exactly
+    assert line.send(STOP_FRAME, 1_000) == 1_000 + 8_333
+
+
+def test_reply_starts_after_the_turnaround_and_arrives_byte_by_byte():
+    line = make_line()
+    line.send(STOP_FRAME, 0, origin="Main.st:12:5")
+    received = line.receive_until(100_000)
+    reply_start = 8_333 + 5_000
+    assert bytes(b for b, _ in received) == STOP_FRAME
+    assert [t for _, t in received] == [reply_start + BYTE_END[k + 1] for k in range(8)]
+    assert line.trace == [
+        TraceFrame(0, 8_333, "tx", STOP_FRAME, "Main.st:12:5"),
+        TraceFrame(reply_start, reply_start + 8_333, "rx", STOP_FRAME, None),
+    ]
+
+
+def test_receive_until_hands_each_byte_over_once_and_only_when_it_has_arrived():
+    line = make_line()
+    line.send(STOP_FRAME, 0)
+    first = line.receive_until(13_333 + 2_083)  # two bytes of the reply complete
+    assert [b for b, _ in first] == [0x01, 0x06]
+    rest = line.receive_until(50_000)
+    assert bytes(b for b, _ in first + rest) == STOP_FRAME
+    assert line.receive_until(60_000) == []
+
+
+def test_a_reply_never_starts_before_t3_5():
+    line = make_line(turnaround_ms=1.0)
+    line.send(STOP_FRAME, 0)
+    received = line.receive_until(50_000)
+    assert received[0][1] == 8_333 + T3_5_US + 1_042
+
+
+def test_late_reply_fault_shifts_the_reply():
+    line = make_line({"kind": "late_reply", "on_request": 1, "delay_ms": 40})
+    line.send(STOP_FRAME, 0)
+    assert line.receive_until(50_000) == []
+    assert line.receive_until(100_000)[0][1] == 8_333 + 45_000 + 1_042
+
+
+def test_garbage_and_no_reply_reach_the_plc_as_they_are():
+    line = make_line({"kind": "garbage", "on_request": 1, "data": "FF 00"}, {"kind": "no_reply", "on_request": 2})
+    line.send(STOP_FRAME, 0)
+    assert [b for b, _ in line.receive_until(200_000)] == [0xFF, 0x00]
+    line.send(STATUS, 400_000)
+    assert line.receive_until(600_000) == []
+
+
+def test_a_send_while_sending_follows_back_to_back_and_joins_the_frame():
+    line = make_line()
+    line.send(STATUS[:3], 0)
+    end = line.send(STATUS[3:], 1_000)  # UART still busy: queued behind the first three bytes
+    assert end == 8_333
+    line.receive_until(100_000)
+    assert [f.data for f in line.trace if f.direction == "tx"] == [STATUS]
+    assert any(f.direction == "rx" for f in line.trace)
+
+
+def test_two_requests_back_to_back_are_one_bad_frame_and_get_silence():
+    line = make_line()
+    line.send(STOP_FRAME + STATUS, 0)
+    assert line.receive_until(300_000) == []
+    assert [f.data for f in line.trace] == [STOP_FRAME + STATUS]
+    assert any(e.kind == "robot.silent" for e in line.events)
+
+
+@pytest.mark.parametrize("gap_us, answered", [
+    (T1_5_US, True),            # exactly t1.5: still one frame
+    (T1_5_US + 1, False),       # over t1.5: discarded
+    (T3_5_US - 1, False),       # just under t3.5: still the same (broken) frame
+])
+def test_a_gap_over_t1_5_inside_a_frame_discards_it(gap_us, answered):
+    line = make_line()
+    line.send(STOP_FRAME[:4], 0)
+    line.send(STOP_FRAME[4:], 4_167 + gap_us)
+    received = line.receive_until(300_000)
+    assert (received != []) is answered
+    kinds = [e.kind for e in line.events]
+    assert ("gap" in kinds) is not answered
+    assert ("discarded" in kinds) is not answered
+    if not answered:
+        discarded = next(e for e in line.events if e.kind == "discarded")
+        assert discarded.frames == (STOP_FRAME,)
+        assert "t1.5" in discarded.message
+
+
+def test_a_silence_of_t3_5_splits_frames():
+    line = make_line()
+    line.send(STOP_FRAME[:4], 0)
+    line.send(STOP_FRAME[4:], 4_167 + T3_5_US)
+    assert line.receive_until(300_000) == []
+    assert [f.data for f in line.trace] == [STOP_FRAME[:4], STOP_FRAME[4:]]
+    assert sum(e.kind == "robot.silent" for e in line.events) == 2
+
+
+def test_plc_sending_into_a_reply_is_a_collision():
+    line = make_line()
+    line.send(STATUS, 0)
+    line.advance(20_000)  # the reply (13_333..21_666) is scheduled and under way
+    line.send(STOP_FRAME, 20_000, origin="Main.st:40:3")
+    got = line.receive_until(400_000)
+    # the reply's first six bytes ended before 20 ms; the two overlapping the send are lost
+    assert [t for _, t in got] == [13_333 + BYTE_END[k + 1] for k in range(6)]
+    collision = next(e for e in line.events if e.kind == "collision")
+    assert collision.t_us == 20_000
+    assert collision.frames[0] == STOP_FRAME
+    assert collision.frames[1][:2] == b"\x01\x01"
+    assert "Main.st:40:3" in collision.message
+    discarded = next(e for e in line.events if e.kind == "discarded")
+    assert "while the robot was transmitting" in discarded.message
+    assert not line.robot.stop_seen
+
+
+def test_a_reply_scheduled_into_a_plc_send_is_a_collision_too():
+    line = make_line()
+    line.send(STATUS, 0)
+    line.send(STOP_FRAME, 12_000)  # queued before the robot even has the request
+    got = line.receive_until(400_000)
+    assert len(got) < 8  # the overlapping part of the reply never reached the PLC
+    assert [e.kind for e in line.events].count("collision") == 1
+
+
+def test_pacing_late_reply_can_collide_with_the_next_request():
+    line = make_line(pacing="late")
+    line.send(STATUS, 0)
+    line.send(STATUS, 100_000)
+    line.send(STATUS, 258_000)  # the late reply to the second request starts at 263.334 ms
+    line.receive_until(600_000)
+    assert any(e.kind == "collision" for e in line.events)
+
+
+def test_time_only_moves_forward_and_must_be_integer():
+    line = make_line()
+    line.receive_until(1_000)
+    with pytest.raises(ValueError, match="virtual time only moves forward"):
+        line.send(STATUS, 999)
+    with pytest.raises(TypeError, match="integer microseconds"):
+        line.send(STATUS, 1_500.0)
+
+
+def test_events_merge_line_and_robot_events_in_time_order():
+    line = make_line()
+    line.send(STOP_FRAME[:4], 0)
+    line.send(STOP_FRAME[4:], 6_000)
+    line.send(STOP_FRAME, 400_000)
+    line.receive_until(900_000)
+    times = [e.t_us for e in line.events]
+    assert times == sorted(times)
+    assert {"gap", "discarded", "robot.command"} <= {e.kind for e in line.events}
+
+
+def test_other_baud_rates_use_the_modbus_fixed_silences_above_19200():
+    fast = LineConfig(baud=38400)
+    assert (fast.gap_limit_us, fast.frame_gap_us) == (750, 1750)
+    slow = LineConfig(baud=4800)
+    assert slow.byte_time_us == 2083 and slow.frame_gap_us == 7292
+
+
+def test_the_robot_is_driven_by_the_line_clock():
+    line = make_line()
+    line.send(STOP_FRAME, 0)
+    line.send(encode(__import__("verifier.protocol", fromlist=["ControlRequest"]).ControlRequest(1, 1, 3)), 300_000)
+    line.advance(300_000 + 8_333 + 8 * 1_000_000)
+    assert line.robot.mode == "idle"
+    assert line.robot.now_us == line.now_us
+
+
+@hsettings(max_examples=150, deadline=None)
+@given(st.lists(st.tuples(st.binary(min_size=1, max_size=12), st.integers(0, 400_000)), max_size=10))
+def test_random_traffic_never_crashes_and_the_trace_keeps_every_plc_byte(sends):
+    line = make_line(before_stop="obey")
+    t = 0
+    sent = b""
+    received = []
+    for data, gap in sends:
+        t += gap
+        line.send(data, t)
+        sent += data
+        received += line.receive_until(t)
+    received += line.receive_until(t + 2_000_000)
+    assert b"".join(f.data for f in line.trace if f.direction == "tx") == sent
+    frames = line.trace
+    assert all(a.t_start_us <= b.t_start_us for a, b in zip(frames, frames[1:]))
+    assert [t for _, t in received] == sorted(t for _, t in received)
