@@ -1,0 +1,187 @@
+"""`uitamr verify`: run PLC programs against the emulated robot and check the traffic.
+
+Exit codes: 0 compliant, 1 violations or failed expectations, 2 unusable input.
+"""
+from __future__ import annotations
+
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import replace
+from pathlib import Path
+
+import click
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+import verifier
+from verifier.verify.durations import parse_duration_us
+from verifier.verify.result import ScenarioResult, UnusableInput
+from verifier.verify.scenario import PLATFORMS, Scenario, ScenarioError, default_scenario, load_scenario
+
+EXIT_PASS, EXIT_FAIL, EXIT_UNUSABLE = 0, 1, 2
+SHOW_PROGRESS_AFTER_S = 0.5
+
+
+def bundled_plc_dir() -> Path:
+    return Path(verifier.__file__).resolve().parents[1] / "plc"
+
+
+def bundled_scenarios() -> list[Path]:
+    return sorted((bundled_plc_dir() / "scenarios").glob("*.toml"))
+
+
+class _Duration(click.ParamType):
+    name = "duration"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, int):
+            return value
+        try:
+            return parse_duration_us(value)
+        except ValueError as exc:
+            self.fail(str(exc), param, ctx)
+
+
+def _unusable(message: str) -> None:
+    Console(stderr=True, highlight=False).print(f"[bold red]error:[/] {message}", markup=True, soft_wrap=True)
+    sys.exit(EXIT_UNUSABLE)
+
+
+def _scenarios(sources, program, platform, scenario_files, matrix, duration, scan, seed) -> list[Scenario]:
+    files = list(scenario_files)
+    if matrix or (not sources and not files):
+        found = bundled_scenarios()
+        if not found:
+            raise UnusableInput(f"no bundled scenarios in {bundled_plc_dir() / 'scenarios'}")
+        files += [f for f in found if f not in files]
+    scenarios = [load_scenario(f) for f in files] if files else [default_scenario()]
+    if sources:
+        resolved = tuple(Path(s).resolve() for s in sources)
+        scenarios = [replace(s, sources=resolved) for s in scenarios]
+    overrides = {"program": program, "platform": platform, "duration_us": duration, "scan_us": scan, "seed": seed}
+    scenarios = [s.with_overrides(**overrides) for s in scenarios]
+    for scenario in scenarios:
+        if scenario.scan_us > scenario.duration_us:
+            raise UnusableInput(f"{scenario.name}: the scan time is longer than the whole run")
+        if not scenario.sources:
+            where = scenario.path or "the default scenario"
+            raise UnusableInput(f"{where}: no ST sources: give them as arguments (uitamr verify FILE.st ...)")
+    return scenarios
+
+
+def _run_one(scenario: Scenario) -> ScenarioResult:
+    from verifier.verify.runner import run_scenario
+
+    return run_scenario(scenario)
+
+
+class _LazyProgress:
+    """A rich progress bar that appears only once the run has taken more than a moment."""
+
+    def __init__(self, console: Console, total_us: int, enabled: bool):
+        self.console, self.total, self.enabled = console, total_us, enabled
+        self.started = time.perf_counter()
+        self.bar: Progress | None = None
+        self.done_us = 0
+        self.last_update = 0.0
+
+    def update(self, done_us: int, label: str) -> None:
+        if not self.enabled:
+            return
+        now = time.perf_counter()
+        if self.bar is None:
+            if now - self.started < SHOW_PROGRESS_AFTER_S:
+                return
+            self.bar = Progress(
+                TextColumn("{task.description}"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"),
+                TimeElapsedColumn(), console=self.console, transient=True,
+            )
+            self.bar.start()
+            self.task = self.bar.add_task(label, total=self.total)
+        if now - self.last_update < 0.1 and done_us < self.total:
+            return
+        self.last_update = now
+        self.bar.update(self.task, completed=done_us, description=label)
+
+    def stop(self) -> None:
+        if self.bar is not None:
+            self.bar.stop()
+
+
+def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress) -> list[ScenarioResult]:
+    from verifier.verify.runner import run_scenario
+
+    if jobs > 1 and len(scenarios) > 1:
+        results: list[ScenarioResult | None] = [None] * len(scenarios)
+        done = 0
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            futures = {pool.submit(_run_one, s): i for i, s in enumerate(scenarios)}
+            for future in as_completed(futures):
+                index = futures[future]
+                results[index] = future.result()
+                done += scenarios[index].duration_us
+                progress.update(done, f"{sum(r is not None for r in results)}/{len(scenarios)} scenarios")
+        return [r for r in results if r is not None]
+    results = []
+    offset = 0
+    for position, scenario in enumerate(scenarios):
+        label = f"[{position + 1}/{len(scenarios)}] {scenario.name}"
+        results.append(run_scenario(scenario, lambda now, end, o=offset, l=label: progress.update(o + now, l)))
+        offset += scenario.duration_us
+    return results
+
+
+@click.command(context_settings={"help_option_names": ["-h", "--help"]})
+@click.argument("sources", nargs=-1, type=click.Path(dir_okay=False))
+@click.option("--program", help="The PROGRAM POU to run (default: the scenario's, or the only one).")
+@click.option("--platform", type=click.Choice(sorted(PLATFORMS)), help="PLC platform (sets the ST dialect and the serial port).")
+@click.option("--scenario", "scenario_files", multiple=True, type=click.Path(dir_okay=False),
+              help="Scenario file (TOML); repeat for several. Default: the bundled scenarios, or a healthy robot when SOURCES are given.")
+@click.option("--matrix", is_flag=True, help="Run every bundled scenario (with SOURCES: against those sources).")
+@click.option("--duration", type=_Duration(), help="Virtual run time, e.g. 60s (overrides the scenarios'; default 60s).")
+@click.option("--scan", type=_Duration(), help="PLC scan time, e.g. 10ms (overrides the scenarios'; default 10ms).")
+@click.option("--seed", type=int, help="Seed for everything random in the run (overrides the scenarios').")
+@click.option("--jobs", "-j", type=click.IntRange(min=1), default=1, show_default=True, help="Scenarios run in parallel processes.")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Write the verdict as JSON.")
+@click.option("--junit", "junit_path", type=click.Path(dir_okay=False), help="Write JUnit XML (one testcase per scenario).")
+@click.option("--trace", "trace_path", type=click.Path(dir_okay=False), help="Write every frame as JSON Lines.")
+@click.option("--html", "html_path", type=click.Path(dir_okay=False), help="Write a self-contained HTML report with a timing diagram.")
+@click.option("--violations", "first", type=click.IntRange(min=0), default=3, show_default=True,
+              help="Violations shown per scenario on the console.")
+def command(sources, program, platform, scenario_files, matrix, duration, scan, seed, jobs,
+            json_path, junit_path, trace_path, html_path, first):
+    """Run PLC programs against the emulated robot on a virtual RS-485 line and check
+    every frame and gap against the robot's manual.
+
+    With no arguments: the bundled library examples against the bundled scenarios.
+    Exit status: 0 compliant, 1 violations or failed expectations, 2 unusable input.
+    """
+    from verifier.verify import report_console, report_html, report_json, report_junit, report_trace
+
+    console = Console(highlight=False, soft_wrap=True)
+    for path in (json_path, junit_path, trace_path, html_path):
+        if path and not Path(path).resolve().parent.is_dir():
+            _unusable(f"cannot write {path}: the folder {Path(path).resolve().parent} does not exist")
+    try:
+        scenarios = _scenarios(sources, program, platform, scenario_files, matrix, duration, scan, seed)
+    except (ScenarioError, UnusableInput) as exc:
+        _unusable(str(exc))
+    stderr = Console(stderr=True)
+    progress = _LazyProgress(stderr, sum(s.duration_us for s in scenarios), stderr.is_terminal)
+    try:
+        results = _run_all(scenarios, jobs, progress)
+    except (ScenarioError, UnusableInput) as exc:
+        progress.stop()
+        _unusable(str(exc))
+    progress.stop()
+    report_console.render(results, console, first=first)
+    writers = ((json_path, report_json), (junit_path, report_junit), (trace_path, report_trace), (html_path, report_html))
+    for path, writer in writers:
+        if path:
+            try:
+                writer.write(results, Path(path))
+            except OSError as exc:
+                _unusable(f"cannot write {path}: {exc.strerror or exc}")
+            console.print(f"[dim]wrote {path}[/]")
+    sys.exit(EXIT_PASS if all(r.passed for r in results) else EXIT_FAIL)

@@ -1,0 +1,213 @@
+"""Conditions over PLC variables, written the way an ST programmer would write them.
+
+    o_bOK
+    o_bErr AND o_uErrId = 16#0101
+    NOT fbRobot.o_bBusy OR (o_uState >= 3 AND o_uState <> 7)
+
+Names are label paths into the program instance (`fbRobot.o_bBusy`, `wBuf[2]`); literals
+are TRUE/FALSE, decimal and 2#/8#/16# integers (with `_` separators) and decimals.
+Comparison operators: = <> < <= > >=; logic: NOT, AND (or &), OR, XOR; parentheses.
+Parsing is strict and errors carry the column, so a scenario file's message can point at
+the character that is wrong.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from typing import Callable, Mapping
+
+Value = bool | int | float
+
+
+class ConditionError(ValueError):
+    def __init__(self, message: str, column: int):
+        super().__init__(message)
+        self.message = message
+        self.column = column  # 1-based
+
+
+_TOKEN = re.compile(
+    r"""
+    (?P<space>\s+)
+  | (?P<number>(?:2|8|16)\#[0-9A-Fa-f_]+|\d[\d_]*(?:\.\d+)?)
+  | (?P<name>[A-Za-z_][A-Za-z0-9_]*(?:\[\d+\])*(?:\.[A-Za-z_][A-Za-z0-9_]*(?:\[\d+\])*)*)
+  | (?P<op><>|<=|>=|=|<|>|&|\(|\)|-)
+    """,
+    re.VERBOSE,
+)
+
+_KEYWORDS = {"AND", "OR", "XOR", "NOT", "TRUE", "FALSE"}
+
+
+@dataclass(frozen=True)
+class _Token:
+    kind: str  # number, name, op, keyword, end
+    text: str
+    column: int
+
+
+def _tokenize(text: str) -> list[_Token]:
+    tokens: list[_Token] = []
+    position = 0
+    while position < len(text):
+        match = _TOKEN.match(text, position)
+        if not match:
+            raise ConditionError(f"unexpected character {text[position]!r}", position + 1)
+        kind = match.lastgroup
+        if kind != "space":
+            word = match.group()
+            if kind == "name" and word.upper() in _KEYWORDS:
+                tokens.append(_Token("keyword", word.upper(), position + 1))
+            else:
+                tokens.append(_Token(kind, word, position + 1))
+        position = match.end()
+    tokens.append(_Token("end", "", len(text) + 1))
+    return tokens
+
+
+def _number(token: _Token) -> Value:
+    digits = token.text.replace("_", "")
+    try:
+        if "#" in digits:
+            base, body = digits.split("#", 1)
+            return int(body, int(base))
+        if "." in digits:
+            return float(digits)
+        return int(digits)
+    except ValueError:
+        raise ConditionError(f"{token.text!r} is not a number", token.column) from None
+
+
+# The parsed form: nested tuples, evaluated by `_evaluate`.
+#   ("lit", value) | ("var", name) | ("not", node) | ("neg", node)
+#   ("and"|"or"|"xor", left, right) | ("cmp", op, left, right)
+
+
+class _Parser:
+    def __init__(self, text: str):
+        self.tokens = _tokenize(text)
+        self.index = 0
+
+    @property
+    def current(self) -> _Token:
+        return self.tokens[self.index]
+
+    def take(self) -> _Token:
+        token = self.tokens[self.index]
+        self.index += 1
+        return token
+
+    def parse(self):
+        if self.current.kind == "end":
+            raise ConditionError("the condition is empty", 1)
+        node = self.logic()
+        if self.current.kind != "end":
+            raise ConditionError(f"unexpected {self.current.text!r}", self.current.column)
+        return node
+
+    def logic(self, level: int = 0):
+        operators = (("OR",), ("XOR",), ("AND", "&"))
+        if level == len(operators):
+            return self.negation()
+        node = self.logic(level + 1)
+        while self.current.text.upper() in operators[level] and self.current.kind in ("keyword", "op"):
+            name = self.take().text.upper()
+            node = ({"&": "and"}.get(name, name.lower()), node, self.logic(level + 1))
+        return node
+
+    def negation(self):
+        if self.current.kind == "keyword" and self.current.text == "NOT":
+            self.take()
+            return ("not", self.negation())
+        return self.comparison()
+
+    def comparison(self):
+        left = self.operand()
+        if self.current.kind == "op" and self.current.text in ("=", "<>", "<", "<=", ">", ">="):
+            op = self.take().text
+            right = self.operand()
+            if self.current.kind == "op" and self.current.text in ("=", "<>", "<", "<=", ">", ">="):
+                raise ConditionError(
+                    "comparisons do not chain; join them with AND", self.current.column
+                )
+            return ("cmp", op, left, right)
+        return left
+
+    def operand(self):
+        token = self.take()
+        if token.kind == "number":
+            return ("lit", _number(token))
+        if token.kind == "keyword" and token.text in ("TRUE", "FALSE"):
+            return ("lit", token.text == "TRUE")
+        if token.kind == "name":
+            return ("var", token.text)
+        if token.kind == "op" and token.text == "-":
+            return ("neg", self.operand())
+        if token.kind == "op" and token.text == "(":
+            node = self.logic()
+            closing = self.take()
+            if closing.text != ")":
+                raise ConditionError("missing ')'", closing.column)
+            return node
+        found = "the end of the condition" if token.kind == "end" else repr(token.text)
+        raise ConditionError(f"expected a label, a value or '(', found {found}", token.column)
+
+
+def _names(node) -> set[str]:
+    kind = node[0]
+    if kind == "var":
+        return {node[1]}
+    if kind == "lit":
+        return set()
+    return set().union(*(_names(child) for child in node[1:] if isinstance(child, tuple)))
+
+
+_COMPARE: dict[str, Callable[[Value, Value], bool]] = {
+    "=": lambda a, b: a == b,
+    "<>": lambda a, b: a != b,
+    "<": lambda a, b: a < b,
+    "<=": lambda a, b: a <= b,
+    ">": lambda a, b: a > b,
+    ">=": lambda a, b: a >= b,
+}
+
+
+def _evaluate(node, values: Mapping[str, Value]) -> Value:
+    kind = node[0]
+    if kind == "lit":
+        return node[1]
+    if kind == "var":
+        return values[node[1]]
+    if kind == "not":
+        return not _evaluate(node[1], values)
+    if kind == "neg":
+        return -_evaluate(node[1], values)
+    if kind == "cmp":
+        return _COMPARE[node[1]](_evaluate(node[2], values), _evaluate(node[3], values))
+    left = bool(_evaluate(node[1], values))
+    right = bool(_evaluate(node[2], values))
+    return {"and": left and right, "or": left or right, "xor": left != right}[kind]
+
+
+@dataclass(frozen=True)
+class Condition:
+    """A parsed condition: `names` are the labels it reads, `holds(values)` evaluates it."""
+
+    text: str
+    tree: tuple
+
+    @property
+    def names(self) -> frozenset[str]:
+        return frozenset(_names(self.tree))
+
+    def holds(self, values: Mapping[str, Value]) -> bool:
+        return bool(_evaluate(self.tree, values))
+
+    def __str__(self) -> str:
+        return self.text
+
+
+def parse_condition(text: str) -> Condition:
+    if not isinstance(text, str):
+        raise ConditionError(f"expected a condition as a string, got {text!r}", 1)
+    return Condition(text, _Parser(text).parse())

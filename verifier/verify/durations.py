@@ -1,0 +1,41 @@
+"""Durations as people write them in scenario files and on the command line.
+
+"60s", "250ms", "1.5 s", "2min", "500us" → integer microseconds (the virtual clock's unit).
+A bare number is rejected: a scenario that says `within = 5` is ambiguous.
+"""
+from __future__ import annotations
+
+import re
+from fractions import Fraction
+
+_UNITS_US = {
+    "us": 1,
+    "µs": 1,
+    "ms": 1_000,
+    "s": 1_000_000,
+    "min": 60_000_000,
+    "h": 3_600_000_000,
+}
+
+_PATTERN = re.compile(r"^\s*(\d+(?:\.\d+)?|\.\d+)\s*(us|µs|ms|s|min|h)\s*$")
+
+
+def parse_duration_us(text: object) -> int:
+    """Return `text` ("250ms", "1.5s") in whole microseconds; ValueError on anything else."""
+    if not isinstance(text, str):
+        raise ValueError(f"expected a duration such as \"250ms\" or \"60s\", got {text!r}")
+    match = _PATTERN.match(text)
+    if not match:
+        raise ValueError(
+            f"{text!r} is not a duration: write a number and a unit (us, ms, s, min, h), "
+            "e.g. \"250ms\" or \"60s\""
+        )
+    value = Fraction(match.group(1)) * _UNITS_US[match.group(2)]
+    if value.denominator != 1:
+        raise ValueError(f"{text!r} is finer than the virtual clock's microsecond")
+    return int(value)
+
+
+def format_seconds(t_us: int) -> str:
+    """Virtual time for people: seconds with millisecond precision ("12.345 s")."""
+    return f"{t_us / 1_000_000:.3f} s"

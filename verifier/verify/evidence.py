@@ -1,0 +1,129 @@
+"""What a run leaves behind, and what a check says about it.
+
+The rules never see the simulator: they read a `RunEvidence` — the frames on the line
+(objects shaped like `verifier.link.TraceFrame`), the line's events, the PLC variables
+sampled every scan — and return `Violation`s. Tests build evidence by hand.
+"""
+from __future__ import annotations
+
+from bisect import bisect_right
+from dataclasses import dataclass, field
+from typing import Any, Iterator, Protocol, Sequence
+
+from verifier import protocol
+
+from .conditions import Condition
+
+DEFAULT_REPLY_TIMEOUT_US = protocol.DEFAULT_REPLY_TIMEOUT_US
+DEFAULT_RESPONSE_WITHIN_US = 5_000_000
+
+
+class TraceFrameLike(Protocol):
+    t_start_us: int
+    t_end_us: int
+    direction: str  # "tx" PLC→robot, "rx" robot→PLC
+    data: bytes
+    origin: str | None
+
+
+@dataclass(frozen=True)
+class RuleOptions:
+    """The knobs of the rules; scenario files set them under [rules]."""
+
+    min_period_us: int = protocol.MIN_PERIOD_US
+    reply_timeout_us: int = DEFAULT_REPLY_TIMEOUT_US
+    # RESPONSE-HANDLING: the output that shows the program noticed a failed exchange.
+    response_signal: Condition | None = None
+    response_within_us: int = DEFAULT_RESPONSE_WITHIN_US
+
+
+@dataclass(frozen=True)
+class FrameRef:
+    """A frame as a report shows it."""
+
+    t_us: int
+    t_end_us: int
+    direction: str
+    hex: str
+    meaning: str
+    origin: str | None = None
+
+
+@dataclass(frozen=True)
+class Violation:
+    rule: str
+    t_us: int
+    message: str
+    frames: tuple[FrameRef, ...] = ()
+    origin: str | None = None
+
+
+class Samples:
+    """PLC variables over virtual time, stored as changes: name → [(t_us, value), ...]."""
+
+    def __init__(self, names: Sequence[str] = ()):
+        self.names = list(dict.fromkeys(names))
+        self.changes: dict[str, list[tuple[int, Any]]] = {name: [] for name in self.names}
+
+    def record(self, t_us: int, values: dict[str, Any]) -> None:
+        for name, value in values.items():
+            history = self.changes.setdefault(name, [])
+            if name not in self.names:
+                self.names.append(name)
+            if not history or history[-1][1] != value:
+                history.append((t_us, value))
+
+    def value_at(self, name: str, t_us: int) -> Any:
+        history = self.changes.get(name, [])
+        index = bisect_right([t for t, _ in history], t_us) - 1
+        return history[index][1] if index >= 0 else None
+
+    def states(self, names: Sequence[str] | frozenset[str]) -> Iterator[tuple[int, dict[str, Any]]]:
+        """Every moment one of `names` changed, with the values of all of them then.
+
+        Starts at the first moment all of them are known."""
+        names = list(names)
+        moments = sorted({t for name in names for t, _ in self.changes.get(name, [])})
+        for t_us in moments:
+            values = {name: self.value_at(name, t_us) for name in names}
+            if all(value is not None for value in values.values()):
+                yield t_us, values
+
+    def first_time(self, condition: Condition, start_us: int, end_us: int) -> int | None:
+        """The first moment in [start_us, end_us] at which `condition` holds, or None."""
+        at_start = {name: self.value_at(name, start_us) for name in condition.names}
+        if all(value is not None for value in at_start.values()) and condition.holds(at_start):
+            return start_us
+        for t_us, values in self.states(condition.names):
+            if t_us <= start_us:
+                continue
+            if t_us > end_us:
+                return None
+            if condition.holds(values):
+                return t_us
+        return None
+
+    def intervals(self, condition: Condition, end_us: int) -> list[tuple[int, int]]:
+        """The [start, end) stretches of virtual time during which `condition` holds."""
+        spans: list[tuple[int, int]] = []
+        began: int | None = None
+        for t_us, values in self.states(condition.names):
+            if condition.holds(values):
+                if began is None:
+                    began = t_us
+            elif began is not None:
+                spans.append((began, t_us))
+                began = None
+        if began is not None:
+            spans.append((began, end_us))
+        return spans
+
+
+@dataclass
+class RunEvidence:
+    settings: protocol.Settings
+    trace: Sequence[TraceFrameLike]
+    end_us: int
+    events: Sequence[Any] = ()
+    samples: Samples = field(default_factory=Samples)
+    options: RuleOptions = field(default_factory=RuleOptions)

@@ -1,0 +1,70 @@
+"""The console summary: one line per scenario, counts per rule, the first violations with
+their frames and ST locations, then the verdict. Plain text when not on a terminal (CI logs)."""
+from __future__ import annotations
+
+from rich.console import Console
+from rich.markup import escape
+from rich.table import Table
+
+from .durations import format_seconds
+from .result import ScenarioResult, overall_verdict
+from .rules import RULES
+
+FIRST_VIOLATIONS = 3  # per scenario
+
+
+def render(results: list[ScenarioResult], console: Console, *, first: int = FIRST_VIOLATIONS) -> None:
+    for result in results:
+        _scenario(result, console, first)
+    if len(results) > 1 or any(not r.passed for r in results):
+        console.print(_rule_table(results))
+    verdict = overall_verdict(results)
+    failed = sum(not r.passed for r in results)
+    if verdict == "pass":
+        console.print(f"[bold green]PASS[/]: {len(results)} scenario(s) compliant, every expectation met")
+    else:
+        console.print(f"[bold red]FAIL[/]: {failed} of {len(results)} scenario(s) failed")
+
+
+def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
+    mark = "[green]PASS[/]" if result.passed else "[red]FAIL[/]"
+    where = f" ({escape(result.file)})" if result.file else ""
+    tx = sum(1 for frame in result.trace if frame.direction == "tx")
+    console.print(
+        f"{mark} [bold]{escape(result.name)}[/]{where}: {tx} requests in "
+        f"{format_seconds(result.ended_us)}, {result.violation_count} violation(s), "
+        f"{len(result.failed_expectations)}/{len(result.expectations)} expectation(s) failed"
+    )
+    if result.aborted:
+        console.print(f"    [red]simulation stopped[/]: {escape(result.aborted)}")
+    for violation in result.all_violations()[:first]:
+        origin = f"  [dim]sent by {escape(violation.origin)}[/]" if violation.origin else ""
+        console.print(
+            f"    [red]{violation.rule}[/] at {format_seconds(violation.t_us)}: {escape(violation.message)}{origin}"
+        )
+        for frame in violation.frames:
+            arrow = "PLC→robot" if frame.direction == "tx" else "robot→PLC"
+            console.print(
+                f"      {format_seconds(frame.t_us)} {arrow} {frame.hex}  [dim]{escape(frame.meaning)}[/]"
+            )
+    hidden = result.violation_count - first
+    if hidden > 0:
+        console.print(f"    … and {hidden} more violation(s) (see --json or --html for all)")
+    for outcome in result.failed_expectations:
+        console.print(f"    [red]expected[/] {escape(outcome.expectation.label)}: {escape(outcome.detail)}")
+
+
+def _rule_table(results: list[ScenarioResult]) -> Table:
+    table = Table(title="violations per rule", title_justify="left")
+    table.add_column("rule")
+    table.add_column("violations", justify="right")
+    table.add_column("scenarios", justify="right")
+    for rule in RULES:
+        count = sum(len(r.violations.get(rule.id, [])) for r in results)
+        scenarios = sum(1 for r in results if r.violations.get(rule.id))
+        style = "red" if count else "green"
+        table.add_row(rule.id, f"[{style}]{count}[/]", str(scenarios))
+    expectations = sum(len(r.failed_expectations) for r in results)
+    table.add_row("expectations", f"[{'red' if expectations else 'green'}]{expectations}[/]",
+                  str(sum(1 for r in results if r.failed_expectations)))
+    return table

@@ -1,0 +1,108 @@
+"""`--json FILE`: the whole verdict for machines, with a top-level "verdict": "pass"|"fail"."""
+from __future__ import annotations
+
+import json
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+from verifier import __version__
+
+from .evidence import Violation
+from .expectations import ExpectationResult
+from .result import ScenarioResult, overall_verdict
+from .rules import RULES
+
+SCHEMA_VERSION = 1
+
+
+def _seconds(t_us: int | None) -> float | None:
+    return None if t_us is None else t_us / 1_000_000
+
+
+def violation_dict(violation: Violation) -> dict[str, Any]:
+    return {
+        "rule": violation.rule,
+        "t": _seconds(violation.t_us),
+        "message": violation.message,
+        "origin": violation.origin,
+        "frames": [
+            {
+                "t": _seconds(frame.t_us),
+                "t_end": _seconds(frame.t_end_us),
+                "dir": frame.direction,
+                "hex": frame.hex,
+                "meaning": frame.meaning,
+                "origin": frame.origin,
+            }
+            for frame in violation.frames
+        ],
+    }
+
+
+def expectation_dict(outcome: ExpectationResult) -> dict[str, Any]:
+    return {
+        "expectation": outcome.expectation.label,
+        "kind": outcome.expectation.kind,
+        "passed": outcome.passed,
+        "detail": outcome.detail,
+        "t": _seconds(outcome.t_us),
+    }
+
+
+def scenario_dict(result: ScenarioResult) -> dict[str, Any]:
+    return {
+        "name": result.name,
+        "file": result.file,
+        "description": result.description,
+        "verdict": result.verdict,
+        "program": result.program,
+        "platform": result.platform,
+        "channel": result.channel,
+        "sources": result.sources,
+        "duration": _seconds(result.duration_us),
+        "ended": _seconds(result.ended_us),
+        "scan": _seconds(result.scan_us),
+        "seed": result.seed,
+        "protocol": asdict(result.settings),
+        "faults": result.faults,
+        "frames": {
+            "tx": sum(1 for f in result.trace if f.direction == "tx"),
+            "rx": sum(1 for f in result.trace if f.direction == "rx"),
+        },
+        "rules": {
+            rule.id: {
+                "status": "fail" if result.violations.get(rule.id) else "pass",
+                "violations": len(result.violations.get(rule.id, [])),
+            }
+            for rule in RULES
+        },
+        "violations": [violation_dict(v) for v in result.all_violations()],
+        "expectations": [expectation_dict(e) for e in result.expectations],
+        "aborted": result.aborted,
+        "simulator_diagnostics": result.diagnostics,
+        "line_events": [{"t": _seconds(e.t_us), "message": e.message} for e in result.events],
+    }
+
+
+def to_dict(results: list[ScenarioResult]) -> dict[str, Any]:
+    return {
+        "verdict": overall_verdict(results),
+        "schema": SCHEMA_VERSION,
+        "tool": {"name": "uitamr verify", "version": __version__},
+        "summary": {
+            "scenarios": len(results),
+            "passed": sum(r.passed for r in results),
+            "failed": sum(not r.passed for r in results),
+            "violations": {
+                rule.id: sum(len(r.violations.get(rule.id, [])) for r in results) for rule in RULES
+            },
+            "failed_expectations": sum(len(r.failed_expectations) for r in results),
+        },
+        "rules": [{"id": r.id, "title": r.title, "explanation": r.explanation} for r in RULES],
+        "scenarios": [scenario_dict(r) for r in results],
+    }
+
+
+def write(results: list[ScenarioResult], path: Path) -> None:
+    Path(path).write_text(json.dumps(to_dict(results), indent=2, ensure_ascii=False) + "\n", encoding="utf-8")

@@ -1,0 +1,91 @@
+"""`--junit FILE`: JUnit XML as GitHub, GitLab and Jenkins read it.
+
+One <testcase> per scenario; one <failure> per broken rule (type = the rule id) and per
+failed expectation (type = "expectation"); an <error> when the simulation stopped.
+"""
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+from .durations import format_seconds
+from .result import ScenarioResult
+from .rules import RULES_BY_ID
+
+MAX_LISTED = 50  # violations written out per rule and scenario
+
+
+def _failure(parent: ET.Element, kind: str, message: str, text: str) -> None:
+    element = ET.SubElement(parent, "failure", message=message, type=kind)
+    element.text = text
+
+
+def _rule_failure_text(rule_id: str, result: ScenarioResult) -> str:
+    found = result.violations[rule_id]
+    lines = [RULES_BY_ID[rule_id].explanation, ""]
+    for violation in found[:MAX_LISTED]:
+        origin = f" [{violation.origin}]" if violation.origin else ""
+        lines.append(f"{format_seconds(violation.t_us)}: {violation.message}{origin}")
+        for frame in violation.frames:
+            arrow = "PLC->robot" if frame.direction == "tx" else "robot->PLC"
+            lines.append(f"    {format_seconds(frame.t_us)} {arrow} {frame.hex}  {frame.meaning}")
+    if len(found) > MAX_LISTED:
+        lines.append(f"... and {len(found) - MAX_LISTED} more")
+    return "\n".join(lines)
+
+
+def to_element(results: list[ScenarioResult]) -> ET.Element:
+    suites = ET.Element("testsuites", name="uitamr verify")
+    suite = ET.SubElement(suites, "testsuite", name="uitamr verify")
+    failures = errors = 0
+    for result in results:
+        case = ET.SubElement(
+            suite,
+            "testcase",
+            classname="uitamr.verify." + (result.platform or "plc"),
+            name=result.name,
+            time=f"{result.wall_s:.3f}",
+        )
+        if result.file:
+            case.set("file", result.file)
+        if result.aborted:
+            errors += 1
+            element = ET.SubElement(case, "error", message="simulation stopped", type="simulation")
+            element.text = result.aborted
+        for rule_id, found in result.violations.items():
+            if found:
+                failures += 1
+                _failure(
+                    case, rule_id,
+                    f"{rule_id}: {len(found)} violation(s); first at {format_seconds(found[0].t_us)}: {found[0].message}",
+                    _rule_failure_text(rule_id, result),
+                )
+        for outcome in result.failed_expectations:
+            failures += 1
+            _failure(case, "expectation", f"expected {outcome.expectation.label}: {outcome.detail}", outcome.detail)
+        out = ET.SubElement(case, "system-out")
+        tx = sum(1 for frame in result.trace if frame.direction == "tx")
+        rx = len(result.trace) - tx
+        out.text = "\n".join(
+            [
+                result.description,
+                f"program {result.program} on {result.platform} ({result.channel}), "
+                f"{format_seconds(result.ended_us)} of virtual time, scan {result.scan_us / 1000:g} ms, seed {result.seed}",
+                f"{tx} requests, {rx} replies",
+                *(f"fault: {fault}" for fault in result.faults),
+                *(f"expectation met: {e.expectation.label}: {e.detail}" for e in result.expectations if e.passed),
+            ]
+        )
+    suite.set("tests", str(len(results)))
+    suite.set("failures", str(failures))
+    suite.set("errors", str(errors))
+    suites.set("tests", str(len(results)))
+    suites.set("failures", str(failures))
+    suites.set("errors", str(errors))
+    return suites
+
+
+def write(results: list[ScenarioResult], path: Path) -> None:
+    tree = ET.ElementTree(to_element(results))
+    ET.indent(tree)
+    tree.write(path, encoding="utf-8", xml_declaration=True)

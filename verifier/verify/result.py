@@ -1,0 +1,86 @@
+"""The outcome of one scenario run: everything the reports print, and the verdict.
+
+Plain dataclasses so that results travel between worker processes (`--jobs`) and every
+report reads the same thing.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from verifier import protocol
+
+from .evidence import Violation
+from .expectations import ExpectationResult
+
+
+class UnusableInput(Exception):
+    """Input the verifier cannot run (bad scenario, ST that does not load, unknown program).
+
+    The message is complete and meant for people; the command exits 2 with it."""
+
+
+@dataclass(frozen=True)
+class TraceRecord:
+    t_start_us: int
+    t_end_us: int
+    direction: str
+    data: bytes
+    origin: str | None = None
+
+
+@dataclass(frozen=True)
+class LineEvent:
+    t_us: int
+    kind: str  # "collision", "gap", "discarded", "robot.<kind>" (see verifier.link)
+    message: str
+
+
+@dataclass
+class ScenarioResult:
+    name: str
+    file: str | None
+    description: str
+    program: str | None
+    platform: str
+    channel: str
+    sources: list[str]
+    duration_us: int
+    scan_us: int
+    seed: int
+    settings: protocol.Settings
+    min_period_us: int = protocol.MIN_PERIOD_US
+    reply_timeout_us: int = protocol.DEFAULT_REPLY_TIMEOUT_US
+    faults: list[str] = field(default_factory=list)
+    trace: list[TraceRecord] = field(default_factory=list)
+    events: list[LineEvent] = field(default_factory=list)
+    violations: dict[str, list[Violation]] = field(default_factory=dict)
+    expectations: list[ExpectationResult] = field(default_factory=list)
+    diagnostics: list[str] = field(default_factory=list)
+    watched: dict[str, list[tuple[int, Any]]] = field(default_factory=dict)
+    aborted: str | None = None  # the program stopped the simulation (ST location inside)
+    ended_us: int = 0
+    wall_s: float = 0.0  # real time the run took (for people; nothing judges it)
+
+    @property
+    def violation_count(self) -> int:
+        return sum(len(found) for found in self.violations.values())
+
+    @property
+    def failed_expectations(self) -> list[ExpectationResult]:
+        return [result for result in self.expectations if not result.passed]
+
+    @property
+    def passed(self) -> bool:
+        return self.aborted is None and self.violation_count == 0 and not self.failed_expectations
+
+    @property
+    def verdict(self) -> str:
+        return "pass" if self.passed else "fail"
+
+    def all_violations(self) -> list[Violation]:
+        return sorted((v for found in self.violations.values() for v in found), key=lambda v: (v.t_us, v.rule))
+
+
+def overall_verdict(results: list[ScenarioResult]) -> str:
+    return "pass" if results and all(result.passed for result in results) else "fail"

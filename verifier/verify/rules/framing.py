@@ -1,0 +1,61 @@
+"""UITAMR-CRC and UITAMR-FORMAT: every frame the PLC sends, byte by byte."""
+from __future__ import annotations
+
+from verifier import protocol
+
+from ..evidence import RunEvidence, Violation
+from ..traffic import Traffic, frame_ref
+
+
+def check_crc(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
+    violations = []
+    for frame in traffic.tx:
+        data = bytes(frame.data)
+        if protocol.crc_ok(data):
+            continue
+        ref = frame_ref(frame, evidence.settings)
+        if len(data) < 3:
+            message = f"a {len(data)}-byte frame is too short to carry a CRC"
+        else:
+            expected = protocol.with_crc(data[:-2])[-2:]
+            got = protocol.hex_bytes(data[-2:])
+            message = (
+                f"CRC bytes are {got}, expected {protocol.hex_bytes(expected)} "
+                f"(CRC-16/MODBUS of the first {len(data) - 2} bytes, low byte first)"
+            )
+            if data[-2:] == expected[::-1]:
+                message += " — the two CRC bytes are swapped: send the low byte first"
+        violations.append(Violation("UITAMR-CRC", frame.t_start_us, message, (ref,), frame.origin))
+    return violations
+
+
+def check_format(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
+    """Judge the layout of each request; a bad CRC is UITAMR-CRC's business, not this rule's."""
+    settings = evidence.settings
+    violations = []
+    for frame in traffic.tx:
+        data = bytes(frame.data)
+        if len(data) >= 3 and not protocol.crc_ok(data):
+            data = protocol.with_crc(data[:-2])
+        problem = None
+        try:
+            request = protocol.decode_request(data, settings)
+        except protocol.FrameError as exc:
+            problem = str(exc)
+        else:
+            if request.address != settings.address:
+                problem = (
+                    f"byte 0: addressed to slave {request.address}, the robot is slave "
+                    f"{settings.address}"
+                )
+        if problem:
+            violations.append(
+                Violation(
+                    "UITAMR-FORMAT",
+                    frame.t_start_us,
+                    problem,
+                    (frame_ref(frame, settings),),
+                    frame.origin,
+                )
+            )
+    return violations

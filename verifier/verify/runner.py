@@ -1,0 +1,206 @@
+"""Run one scenario: the simulated PLC, the virtual RS-485 line and the robot, scan by scan
+in virtual time; then judge the evidence.
+
+This is the only module that touches the simulator, the line and the robot; everything
+after the run (rules, expectations, reports) works on plain data.
+"""
+from __future__ import annotations
+
+import re
+import time
+from dataclasses import replace
+from typing import Any, Callable
+
+from verifier.amr.robot import Robot
+from verifier.link import Line
+
+from .evidence import RunEvidence, Samples
+from .expectations import judge
+from .result import LineEvent, ScenarioResult, TraceRecord, UnusableInput
+from .rules import check_all
+from .scenario import Scenario
+from .traffic import analyse
+
+Progress = Callable[[int, int], None]  # (virtual now, virtual end) in µs
+
+#: Device names (X0, M8000, D100, SM400, ...) are read through the device memory, not labels.
+_DEVICE = re.compile(r"^(X|Y|M|L|F|B|S|T|C|D|W|R|ZR|SM|SD|SB|SW)[0-9A-F]+$", re.IGNORECASE)
+
+
+class _Plc:
+    """The simulated PLC as the runner uses it: load, attach the line, scan, read, write."""
+
+    def __init__(self, scenario: Scenario, line: Line):
+        import verifier
+        from verifier.sim.errors import LoadError
+
+        if not scenario.sources:
+            raise UnusableInput(f"{_where(scenario)}: no ST sources: name them on the command line or in 'sources'")
+        missing = [str(p) for p in scenario.sources if not p.is_file()]
+        if missing:
+            raise UnusableInput(f"{_where(scenario)}: no such ST file: {', '.join(missing)}")
+        scan_ms = scenario.scan_us / 1000
+        try:
+            self.project = verifier.load(
+                *[str(p) for p in scenario.sources],
+                target=scenario.target,
+                scan_ms=int(scan_ms) if scan_ms == int(scan_ms) else scan_ms,
+            )
+        except LoadError as exc:
+            raise UnusableInput(str(exc)) from None
+        self.project.attach_serial(scenario.serial_channel, line)
+        self.program = self._program(scenario)
+
+    def _program(self, scenario: Scenario):
+        name = scenario.program
+        programs = list(getattr(self.project, "programs", []) or [])
+        if name is None:
+            if len(programs) == 1:
+                name = programs[0]
+            else:
+                listing = ", ".join(programs) or "none"
+                raise UnusableInput(
+                    f"{_where(scenario)}: say which PROGRAM to run (--program or 'program'); the sources define: {listing}"
+                )
+        try:
+            return self.project.instance(name)
+        except (KeyError, LookupError, ValueError) as exc:
+            listing = ", ".join(programs) or "none"
+            raise UnusableInput(
+                f"{_where(scenario)}: no PROGRAM {name!r} in the sources ({exc}); they define: {listing}"
+            ) from None
+
+    @property
+    def now_us(self) -> int:
+        return self.project.now_us
+
+    def scan(self) -> None:
+        self.program.scan()
+
+    def read(self, name: str) -> Any:
+        if _DEVICE.match(name):
+            return self.project.devices[name.upper()]
+        target = self.program
+        for part in re.findall(r"[A-Za-z_][A-Za-z0-9_]*|\[\d+\]", name):
+            target = target[int(part[1:-1])] if part.startswith("[") else getattr(target, part)
+        return target
+
+    def write(self, name: str, value: Any) -> None:
+        if _DEVICE.match(name):
+            self.project.devices[name.upper()] = value
+            return
+        parts = re.findall(r"[A-Za-z_][A-Za-z0-9_]*|\[\d+\]", name)
+        target = self.program
+        for part in parts[:-1]:
+            target = target[int(part[1:-1])] if part.startswith("[") else getattr(target, part)
+        last = parts[-1]
+        if last.startswith("["):
+            target[int(last[1:-1])] = value
+        else:
+            setattr(target, last, value)
+
+    def diagnostics(self) -> list[str]:
+        return [str(d) for d in getattr(self.project, "diagnostics", [])]
+
+
+def _where(scenario: Scenario) -> str:
+    return str(scenario.path) if scenario.path else f"scenario {scenario.name!r}"
+
+
+def _plain(value: Any) -> Any:
+    """A sampled value as bool/int/float (the simulator may hand back typed wrappers)."""
+    if isinstance(value, (bool, int, float)):
+        return value
+    for cast in (int, float):
+        try:
+            return cast(value)
+        except (TypeError, ValueError):
+            continue
+    return value
+
+
+def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
+    """Every label the scenario reads or writes must exist; a missing default signal is dropped."""
+    for name in scenario.variables():
+        try:
+            plc.read(name)
+        except (AttributeError, KeyError, IndexError, TypeError, LookupError, ValueError) as exc:
+            signal = scenario.options.response_signal
+            if not scenario.response_signal_given and signal is not None and name in signal.names:
+                scenario = replace(scenario, options=replace(scenario.options, response_signal=None))
+                continue
+            raise UnusableInput(
+                f"{_where(scenario)}: the program {scenario.program or ''} has no label {name!r} ({exc})"
+            ) from None
+    return scenario
+
+
+def _input_schedule(scenario: Scenario) -> list[tuple[int, dict[str, Any]]]:
+    steps: list[tuple[int, dict[str, Any]]] = []
+    for step in scenario.inputs:
+        steps.append((step.at_us, dict(step.values)))
+        if step.pulse_us is not None:
+            steps.append((step.at_us + step.pulse_us, {name: not value for name, value in step.values.items()}))
+    return sorted(steps, key=lambda s: s[0])
+
+
+def run_scenario(scenario: Scenario, progress: Progress | None = None) -> ScenarioResult:
+    """Run `scenario` to its end and judge it. UnusableInput for input that cannot run."""
+    wall_start = time.perf_counter()
+    robot = Robot(scenario.settings, scenario.robot, list(scenario.faults))
+    line = Line(robot)
+    plc = _Plc(scenario, line)
+    scenario = _check_labels(plc, scenario)
+    names = scenario.variables()
+    samples = Samples(names)
+    schedule = _input_schedule(scenario)
+    aborted = None
+    end = scenario.duration_us
+    from verifier.sim.errors import SimulationError
+
+    try:
+        while plc.now_us < end:
+            now = plc.now_us
+            while schedule and schedule[0][0] <= now:
+                for name, value in schedule.pop(0)[1].items():
+                    plc.write(name, value)
+            plc.scan()
+            samples.record(now, {name: _plain(plc.read(name)) for name in names})
+            if progress is not None and plc.program is not None:
+                progress(plc.now_us, end)
+    except SimulationError as exc:
+        aborted = str(exc)
+        end = min(end, max(plc.now_us, 0))
+    line.advance(max(end, line.now_us))
+    trace = [TraceRecord(f.t_start_us, f.t_end_us, f.direction, bytes(f.data), f.origin) for f in line.trace]
+    trace = [f for f in trace if f.t_start_us < end]
+    events = [LineEvent(e.t_us, e.kind, e.message) for e in line.events if e.t_us <= end]
+    evidence = RunEvidence(scenario.settings, trace, end, events, samples, scenario.options)
+    traffic = analyse(trace, scenario.settings, scenario.options)
+    violations = check_all(evidence, traffic)
+    outcomes = [judge(expectation, evidence, traffic) for expectation in scenario.expectations]
+    return ScenarioResult(
+        name=scenario.name,
+        file=str(scenario.path) if scenario.path else None,
+        description=scenario.description,
+        program=scenario.program,
+        platform=scenario.platform,
+        channel=scenario.serial_channel,
+        sources=[str(p) for p in scenario.sources],
+        duration_us=scenario.duration_us,
+        scan_us=scenario.scan_us,
+        seed=scenario.seed,
+        settings=scenario.settings,
+        min_period_us=scenario.options.min_period_us,
+        reply_timeout_us=scenario.options.reply_timeout_us,
+        faults=[fault.describe() for fault in scenario.faults],
+        trace=trace,
+        events=events,
+        violations=violations,
+        expectations=outcomes,
+        diagnostics=plc.diagnostics(),
+        watched={name: list(samples.changes.get(name, [])) for name in scenario.watch},
+        aborted=aborted,
+        ended_us=end,
+        wall_s=time.perf_counter() - wall_start,
+    )

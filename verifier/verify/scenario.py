@@ -1,0 +1,412 @@
+"""Scenario files: what to run, against which robot, what to do to it, what to expect.
+
+The format is documented for people in docs/scenarios.md. Loading is strict: an unknown
+key, a wrong type or an impossible value is a `ScenarioError` naming the file, the key and,
+where it can be found, the line — never a traceback.
+"""
+from __future__ import annotations
+
+import re
+import tomllib
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from verifier import protocol
+from verifier.amr.config import RobotConfig
+from verifier.amr.faults import Fault
+from verifier.amr.schema import ConfigError
+
+from .conditions import ConditionError, parse_condition
+from .durations import parse_duration_us
+from .evidence import RuleOptions
+from .expectations import KINDS, Expectation, describe_window
+
+PLATFORMS = {
+    # platform: (ST dialect of its engineering tool, default serial channel)
+    "fx3u": ("gxworks2", "fx3:1"),
+    "fx5u": ("gxworks3", "fx5:1"),
+    "q": ("gxworks2", "q:1"),
+}
+CHANNELS = ("fx3:1", "fx3:2", "fx5:1", "q:1", "q:2", "adp:1")
+DEFAULT_DURATION_US = 60_000_000
+DEFAULT_SCAN_US = 10_000
+DEFAULT_RESPONSE_SIGNAL = "o_bErr"
+
+TOP_KEYS = (
+    "name", "description", "sources", "program", "platform", "channel", "duration", "scan",
+    "seed", "watch", "protocol", "robot", "faults", "inputs", "expect", "rules",
+    "response_handling",
+)
+PROTOCOL_KEYS = ("address", "field_order", "codes_10_13", "status_order", "manual_stop_counts_as_stop")
+INPUT_KEYS = ("at", "set", "pulse")
+EXPECT_KEYS = KINDS + ("after", "within", "name")
+RULES_KEYS = ("min_period", "reply_timeout")
+RESPONSE_KEYS = ("signal", "within")
+_LABEL_PATH = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\[\d+\])*(\.[A-Za-z_][A-Za-z0-9_]*(\[\d+\])*)*$")
+
+Value = bool | int | float
+
+
+class ScenarioError(Exception):
+    """A scenario that cannot be used, with where: `file:line: key: message`."""
+
+    def __init__(self, file: Path | str | None, key: str, message: str, line: int | None = None):
+        self.file, self.key, self.message, self.line = file, key, message, line
+        where = str(file) if file is not None else "scenario"
+        if line is not None:
+            where += f":{line}"
+        super().__init__(f"{where}: {key + ': ' if key else ''}{message}")
+
+
+@dataclass(frozen=True)
+class InputStep:
+    at_us: int
+    values: dict[str, Value]
+    pulse_us: int | None = None
+
+
+@dataclass(frozen=True)
+class Scenario:
+    name: str
+    path: Path | None = None
+    description: str = ""
+    sources: tuple[Path, ...] = ()
+    program: str | None = None
+    platform: str = "fx3u"
+    channel: str | None = None
+    duration_us: int = DEFAULT_DURATION_US
+    scan_us: int = DEFAULT_SCAN_US
+    seed: int = 0
+    watch: tuple[str, ...] = ()
+    settings: protocol.Settings = field(default_factory=protocol.Settings)
+    robot: RobotConfig = field(default_factory=RobotConfig)
+    faults: tuple[Fault, ...] = ()
+    inputs: tuple[InputStep, ...] = ()
+    expectations: tuple[Expectation, ...] = ()
+    options: RuleOptions = field(default_factory=RuleOptions)
+    response_signal_given: bool = False
+
+    @property
+    def target(self) -> str:
+        return PLATFORMS[self.platform][0]
+
+    @property
+    def serial_channel(self) -> str:
+        return self.channel or PLATFORMS[self.platform][1]
+
+    def variables(self) -> list[str]:
+        """Every PLC label the run must sample: expectations, the response signal, watch."""
+        names: list[str] = []
+        for expectation in self.expectations:
+            if expectation.condition is not None:
+                names += sorted(expectation.condition.names)
+        if self.options.response_signal is not None:
+            names += sorted(self.options.response_signal.names)
+        for step in self.inputs:
+            names += list(step.values)
+        names += list(self.watch)
+        return list(dict.fromkeys(names))
+
+    def with_overrides(self, **changes: Any) -> "Scenario":
+        return replace(self, **{k: v for k, v in changes.items() if v is not None})
+
+
+def default_scenario(name: str = "healthy robot") -> Scenario:
+    """The run without a scenario file: a healthy robot, the default rules."""
+    return Scenario(
+        name=name,
+        description="default: a healthy robot, no faults, no inputs",
+        options=RuleOptions(response_signal=parse_condition(DEFAULT_RESPONSE_SIGNAL)),
+    )
+
+
+# --- loading -------------------------------------------------------------------------------
+
+
+def load_scenario(path: Path | str) -> Scenario:
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ScenarioError(path, "", "no such scenario file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ScenarioError(path, "", f"cannot read it: {exc}") from None
+    return parse_scenario(text, path)
+
+
+def parse_scenario(text: str, path: Path | None = None) -> Scenario:
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        match = re.search(r"\(at line (\d+), column (\d+)\)", str(exc))
+        line = int(match.group(1)) if match else None
+        message = re.sub(r"\s*\(at line \d+, column \d+\)", "", str(exc))
+        if match:
+            message += f" (column {match.group(2)})"
+        raise ScenarioError(path, "", f"not valid TOML: {message}", line) from None
+    return _Reader(text, path).read(data)
+
+
+class _Reader:
+    """Turns the parsed TOML into a Scenario; every error names its key and line."""
+
+    def __init__(self, text: str, path: Path | None):
+        self.lines = text.splitlines()
+        self.path = path
+        self.base = path.parent if path is not None else Path.cwd()
+
+    # --- errors --------------------------------------------------------------------------
+
+    def fail(self, key: str, message: str) -> ScenarioError:
+        return ScenarioError(self.path, key, message, self.line_of(key))
+
+    def line_of(self, key: str) -> int | None:
+        """Best effort: the line that sets `key` (e.g. "expect[1].within", "robot.x")."""
+        parts = re.findall(r"[^.\[\]]+|\[\d+\]", key)
+        if not parts:
+            return None
+        table, index, rest = parts[0], 0, parts[1:]
+        if rest and rest[0].startswith("["):
+            index = int(rest[0][1:-1])
+            rest = rest[1:]
+        start = 0
+        header = re.compile(r"^\s*\[\[\s*" + re.escape(table) + r"\s*\]\]")
+        plain_header = re.compile(r"^\s*\[\s*" + re.escape(table) + r"\s*\]")
+        seen = -1
+        for number, line in enumerate(self.lines):
+            if header.match(line):
+                seen += 1
+                if seen == index:
+                    start = number
+                    break
+            elif plain_header.match(line):
+                start = number
+                break
+        else:
+            start = None
+        target = rest[0] if rest else table
+        if start is None:  # a top-level key
+            start = 0
+        for number in range(start, len(self.lines)):
+            line = self.lines[number]
+            if number > start and re.match(r"^\s*\[", line) and not rest:
+                break
+            if re.match(r"^\s*\"?" + re.escape(target) + r"\"?\s*=", line):
+                return number + 1
+        return start + 1 if start or rest else None
+
+    # --- helpers -------------------------------------------------------------------------
+
+    def table(self, value: Any, key: str) -> dict:
+        if not isinstance(value, dict):
+            raise self.fail(key, f"expected a table, got {_shown(value)}")
+        return value
+
+    def array_of_tables(self, value: Any, key: str) -> list[dict]:
+        if not isinstance(value, list) or not all(isinstance(item, dict) for item in value):
+            raise self.fail(key, f"expected an array of tables ([[{key}]]), got {_shown(value)}")
+        return value
+
+    def only(self, data: dict, allowed: tuple[str, ...], key: str) -> None:
+        for name in data:
+            if name not in allowed:
+                where = f"{key}.{name}" if key else name
+                raise self.fail(where, f"unknown key; expected one of {', '.join(allowed)}")
+
+    def string(self, value: Any, key: str) -> str:
+        if not isinstance(value, str):
+            raise self.fail(key, f"expected a string, got {_shown(value)}")
+        return value
+
+    def duration(self, value: Any, key: str, *, positive: bool = True) -> int:
+        try:
+            us = parse_duration_us(value)
+        except ValueError as exc:
+            raise self.fail(key, str(exc)) from None
+        if positive and us <= 0:
+            raise self.fail(key, "must be longer than 0")
+        return us
+
+    def condition(self, value: Any, key: str):
+        text = self.string(value, key)
+        try:
+            return parse_condition(text)
+        except ConditionError as exc:
+            raise self.fail(key, f"{exc.message} at column {exc.column} of {text!r}") from None
+
+    def label(self, value: Any, key: str) -> str:
+        text = self.string(value, key)
+        if not _LABEL_PATH.match(text):
+            raise self.fail(key, f"{text!r} is not a label path (e.g. o_bOK, fbRobot.o_uState, wBuf[2])")
+        return text
+
+    # --- the document ----------------------------------------------------------------------
+
+    def read(self, data: dict) -> Scenario:
+        self.only(data, TOP_KEYS, "")
+        name = self.string(data.get("name", self.path.stem if self.path else "scenario"), "name")
+        description = self.string(data.get("description", ""), "description")
+        sources = tuple(self.sources(data["sources"])) if "sources" in data else ()
+        program = self.string(data["program"], "program") if "program" in data else None
+        platform = self.string(data.get("platform", "fx3u"), "platform").lower()
+        if platform not in PLATFORMS:
+            raise self.fail("platform", f"unknown platform {platform!r}; expected one of {', '.join(PLATFORMS)}")
+        channel = None
+        if "channel" in data:
+            channel = self.string(data["channel"], "channel")
+            if channel not in CHANNELS:
+                raise self.fail("channel", f"unknown channel {channel!r}; expected one of {', '.join(CHANNELS)}")
+        duration = self.duration(data.get("duration", "60s"), "duration")
+        scan = self.duration(data.get("scan", "10ms"), "scan")
+        if scan > duration:
+            raise self.fail("scan", "the scan time is longer than the whole run")
+        seed = data.get("seed", 0)
+        if isinstance(seed, bool) or not isinstance(seed, int):
+            raise self.fail("seed", f"expected a whole number, got {_shown(seed)}")
+        watch = data.get("watch", [])
+        if not isinstance(watch, list):
+            raise self.fail("watch", "expected a list of label paths")
+        watch = tuple(self.label(item, f"watch[{i}]") for i, item in enumerate(watch))
+        settings = self.settings(data.get("protocol", {}))
+        robot = self.robot(data.get("robot", {}))
+        faults = self.faults(data.get("faults", []))
+        inputs = tuple(
+            self.input_step(item, f"inputs[{i}]", duration)
+            for i, item in enumerate(self.array_of_tables(data.get("inputs", []), "inputs"))
+        )
+        expectations = tuple(
+            self.expectation(item, f"expect[{i}]", settings)
+            for i, item in enumerate(self.array_of_tables(data.get("expect", []), "expect"))
+        )
+        options, signal_given = self.options(data.get("rules", {}), data.get("response_handling", None))
+        return Scenario(
+            name=name, path=self.path, description=description, sources=sources, program=program,
+            platform=platform, channel=channel, duration_us=duration, scan_us=scan, seed=seed,
+            watch=watch, settings=settings, robot=robot, faults=faults, inputs=inputs,
+            expectations=expectations, options=options, response_signal_given=signal_given,
+        )
+
+    def sources(self, value: Any) -> list[Path]:
+        if isinstance(value, str):
+            value = [value]
+        if not isinstance(value, list) or not value:
+            raise self.fail("sources", "expected a list of .st files or glob patterns, relative to this file")
+        found: list[Path] = []
+        for i, item in enumerate(value):
+            pattern = self.string(item, f"sources[{i}]")
+            if any(ch in pattern for ch in "*?["):
+                matches = sorted(self.base.glob(pattern))
+                if not matches:
+                    raise self.fail(f"sources[{i}]", f"{pattern!r} matches no file (relative to {self.base})")
+                found += matches
+            else:
+                path = self.base / pattern
+                if not path.is_file():
+                    raise self.fail(f"sources[{i}]", f"no such file: {path}")
+                found.append(path)
+        return list(dict.fromkeys(p.resolve() for p in found))
+
+    def settings(self, value: Any) -> protocol.Settings:
+        table = self.table(value, "protocol")
+        self.only(table, PROTOCOL_KEYS, "protocol")
+        try:
+            return protocol.Settings(**table)
+        except (ValueError, TypeError) as exc:
+            key = next((k for k in table if k in str(exc)), "")
+            raise self.fail(f"protocol.{key}" if key else "protocol", str(exc)) from None
+
+    def robot(self, value: Any) -> RobotConfig:
+        try:
+            return RobotConfig.from_dict(self.table(value, "robot"), "robot")
+        except ConfigError as exc:
+            raise self.fail(exc.path, exc.message) from None
+
+    def faults(self, value: Any) -> tuple[Fault, ...]:
+        items = self.array_of_tables(value, "faults")
+        result = []
+        for i, item in enumerate(items):
+            try:
+                result.append(Fault.from_dict(item, f"faults[{i}]"))
+            except ConfigError as exc:
+                path = exc.path if exc.path.startswith("faults[") else f"faults[{i}]"
+                raise self.fail(path, exc.message) from None
+        return tuple(result)
+
+    def input_step(self, item: dict, key: str, duration: int) -> InputStep:
+        self.only(item, INPUT_KEYS, key)
+        if "at" not in item or "set" not in item:
+            raise self.fail(key, "an input needs 'at' (when) and 'set' (labels and values)")
+        at = self.duration(item["at"], f"{key}.at", positive=False)
+        if at >= duration:
+            raise self.fail(f"{key}.at", "is at or after the end of the run")
+        values = self.table(item["set"], f"{key}.set")
+        if not values:
+            raise self.fail(f"{key}.set", "sets nothing")
+        checked: dict[str, Value] = {}
+        for name, value in values.items():
+            self.label(name, f"{key}.set")
+            if isinstance(value, (bool, int, float)):
+                checked[name] = value
+            else:
+                raise self.fail(f"{key}.set.{name}", f"expected true/false or a number, got {_shown(value)}")
+        pulse = self.duration(item["pulse"], f"{key}.pulse") if "pulse" in item else None
+        if pulse is not None and not all(isinstance(v, bool) for v in checked.values()):
+            raise self.fail(f"{key}.pulse", "a pulse sets BOOL labels for a while and clears them; use true/false")
+        return InputStep(at, checked, pulse)
+
+    def expectation(self, item: dict, key: str, settings: protocol.Settings) -> Expectation:
+        self.only(item, EXPECT_KEYS, key)
+        kinds = [kind for kind in KINDS if kind in item]
+        if len(kinds) != 1:
+            raise self.fail(key, f"give exactly one of {', '.join(KINDS)}")
+        kind = kinds[0]
+        after = self.duration(item["after"], f"{key}.after", positive=False) if "after" in item else 0
+        within = self.duration(item["within"], f"{key}.within") if "within" in item else None
+        value = item[kind]
+        fields: dict[str, Any] = {}
+        if kind in ("that", "always", "never"):
+            fields["condition"] = self.condition(value, f"{key}.{kind}")
+            what = {"that": "", "always": "always ", "never": "never "}[kind] + str(fields["condition"])
+        elif kind == "sent":
+            words = self.string(value, f"{key}.sent")
+            try:
+                fields["request"] = protocol.command_from_words(words.split(), settings.address)
+            except protocol.CommandError as exc:
+                raise self.fail(f"{key}.sent", str(exc)) from None
+            what = f"sent {words}"
+        else:
+            if isinstance(value, bool) or not isinstance(value, int) or value not in range(1, 22):
+                raise self.fail(f"{key}.reached_point", f"expected a point number 1-21, got {_shown(value)}")
+            fields["point"] = value
+            what = f"robot reached point {value}"
+        expectation = Expectation(kind=kind, label="", after_us=after, within_us=within, **fields)
+        label = item.get("name")
+        if label is None:
+            label = f"{what} {describe_window(expectation)}".strip()
+        return replace(expectation, label=self.string(label, f"{key}.name"))
+
+    def options(self, rules: Any, response: Any) -> tuple[RuleOptions, bool]:
+        rules = self.table(rules, "rules")
+        self.only(rules, RULES_KEYS, "rules")
+        options = RuleOptions(response_signal=parse_condition(DEFAULT_RESPONSE_SIGNAL))
+        if "min_period" in rules:
+            options = replace(options, min_period_us=self.duration(rules["min_period"], "rules.min_period"))
+        if "reply_timeout" in rules:
+            options = replace(options, reply_timeout_us=self.duration(rules["reply_timeout"], "rules.reply_timeout"))
+        if response is None:
+            return options, False
+        response = self.table(response, "response_handling")
+        self.only(response, RESPONSE_KEYS, "response_handling")
+        if "signal" in response:
+            options = replace(options, response_signal=self.condition(response["signal"], "response_handling.signal"))
+        if "within" in response:
+            options = replace(
+                options, response_within_us=self.duration(response["within"], "response_handling.within")
+            )
+        return options, "signal" in response
+
+
+def _shown(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."

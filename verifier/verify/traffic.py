@@ -1,0 +1,157 @@
+"""The trace read as exchanges: each request the PLC sent, and what came back.
+
+A request's reply is the first robot frame that starts after the request ended and before
+the PLC's next transmission. The reply is *in time* when it starts no later than
+`reply_timeout_us` after the request ended; after that the master is entitled to have
+given up (Modbus over Serial Line V1.02 §2.4.1, "response time-out").
+"""
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Sequence
+
+from verifier import protocol
+
+from .evidence import FrameRef, RuleOptions, TraceFrameLike
+
+
+class ReplyStatus(enum.Enum):
+    OK = "ok"
+    EXCEPTION = "exception"
+    BAD_CRC = "bad CRC"
+    WRONG_ADDRESS = "wrong address"
+    GARBLED = "garbled"
+    LATE = "late"
+    NONE = "no reply"
+
+    @property
+    def failed(self) -> bool:
+        return self is not ReplyStatus.OK
+
+
+def describe_bytes(data: bytes, settings: protocol.Settings, direction: str, *, request=None) -> str:
+    """Human meaning of a frame sent in `direction` ("tx" PLC→robot, "rx" robot→PLC).
+
+    Replies are read against their request when it is known (so a status value is named).
+    """
+    if direction == "rx" and request is not None:
+        try:
+            return protocol.describe(protocol.decode_reply(data, settings, request), settings)
+        except protocol.FrameError:
+            pass
+    return protocol.describe(data, settings, "request" if direction == "tx" else "reply")
+
+
+def frame_ref(frame: TraceFrameLike, settings: protocol.Settings, *, request=None) -> FrameRef:
+    return FrameRef(
+        t_us=frame.t_start_us,
+        t_end_us=frame.t_end_us,
+        direction=frame.direction,
+        hex=protocol.hex_bytes(frame.data),
+        meaning=describe_bytes(frame.data, settings, frame.direction, request=request),
+        origin=frame.origin,
+    )
+
+
+@dataclass
+class Exchange:
+    index: int
+    request: TraceFrameLike
+    rx: list[TraceFrameLike]  # every robot frame until the next request
+    settings: protocol.Settings
+    reply_timeout_us: int
+
+    @cached_property
+    def decoded_request(self):
+        """The request as the robot would read it, or None when it is not a valid request."""
+        try:
+            return protocol.decode_request(self.request.data, self.settings)
+        except protocol.FrameError:
+            return None
+
+    @property
+    def is_control(self) -> bool:
+        return isinstance(self.decoded_request, protocol.ControlRequest)
+
+    @property
+    def is_status(self) -> bool:
+        return isinstance(self.decoded_request, protocol.StatusRequest)
+
+    @property
+    def deadline_us(self) -> int:
+        """The latest start of an in-time reply."""
+        return self.request.t_end_us + self.reply_timeout_us
+
+    @property
+    def reply(self) -> TraceFrameLike | None:
+        return self.rx[0] if self.rx else None
+
+    @cached_property
+    def reply_status(self) -> tuple[ReplyStatus, str]:
+        reply = self.reply
+        if reply is None:
+            return ReplyStatus.NONE, "no reply"
+        if reply.t_start_us > self.deadline_us:
+            late_ms = (reply.t_start_us - self.request.t_end_us) / 1000
+            return ReplyStatus.LATE, f"reply started {late_ms:.1f} ms after the request ended"
+        data = reply.data
+        if data and data[0] != self.settings.address:
+            return ReplyStatus.WRONG_ADDRESS, f"reply from address {data[0]}, not {self.settings.address}"
+        if not protocol.crc_ok(data):
+            return ReplyStatus.BAD_CRC, "reply CRC does not match"
+        try:
+            decoded = protocol.decode_reply(data, self.settings, self.decoded_request)
+        except protocol.FrameError as exc:
+            return ReplyStatus.GARBLED, str(exc)
+        if isinstance(decoded, protocol.ExceptionReply):
+            return ReplyStatus.EXCEPTION, protocol.describe(decoded, self.settings)
+        return ReplyStatus.OK, "ok"
+
+    @property
+    def answered(self) -> bool:
+        return self.reply_status[0] is ReplyStatus.OK
+
+    @property
+    def finished_us(self) -> int:
+        """When the master may start its next request: reply received, or time-out over."""
+        reply = self.reply
+        if reply is not None and reply.t_start_us <= self.deadline_us:
+            return reply.t_end_us
+        return self.deadline_us
+
+    def refs(self) -> tuple[FrameRef, ...]:
+        request = frame_ref(self.request, self.settings)
+        if self.reply is None:
+            return (request,)
+        return (request, frame_ref(self.reply, self.settings, request=self.decoded_request))
+
+
+@dataclass
+class Traffic:
+    exchanges: list[Exchange]
+    rx_before_first_request: list[TraceFrameLike]
+    rx: list[TraceFrameLike]
+    tx: list[TraceFrameLike]
+
+
+def analyse(trace: Sequence[TraceFrameLike], settings: protocol.Settings, options: RuleOptions) -> Traffic:
+    frames = sorted(trace, key=lambda f: (f.t_start_us, f.direction != "tx"))
+    tx = [f for f in frames if f.direction == "tx"]
+    rx = [f for f in frames if f.direction == "rx"]
+    exchanges = [
+        Exchange(index, frame, [], settings, options.reply_timeout_us) for index, frame in enumerate(tx)
+    ]
+    before: list[TraceFrameLike] = []
+    position = 0
+    for frame in rx:
+        while position + 1 < len(tx) and tx[position + 1].t_start_us <= frame.t_start_us:
+            position += 1
+        if not tx or frame.t_start_us < tx[0].t_end_us:
+            before.append(frame)
+        elif frame.t_start_us >= tx[position].t_end_us:
+            exchanges[position].rx.append(frame)
+        else:  # arrived while the next request was being sent: it belongs to the one before
+            exchanges[position - 1].rx.append(frame)
+    return Traffic(exchanges, before, rx, tx)
