@@ -27,11 +27,13 @@ class _ParseContext:
         self.file = "<string>"
         self.target = "gxworks2"
         self.diagnostics: list[ast.Diagnostic] = []
+        self.open_pous: list[ast.Pou] = []
 
     def reset(self, file: str, target: str) -> None:
         self.file = file
         self.target = target
         self.diagnostics = []
+        self.open_pous = []
 
     def error(self, line: int, col: int, message: str, severity: str = "error") -> None:
         self.diagnostics.append(ast.Diagnostic(self.file, line, col, severity, message))
@@ -135,6 +137,12 @@ class AstBuilder:
     # ------------------------------------------------------------- file
     def start(self, c):
         source = ast.SourceFile(_ctx.file, target=_ctx.target)
+        for pou in _ctx.open_pous:
+            if pou is not c[-1]:
+                after = c[next(i for i, x in enumerate(c) if x is pou) + 1]
+                first = after[0] if isinstance(after, list) else after
+                _ctx.error(first.span.line, first.span.col,
+                           f"expected END_{pou.kind} to close {pou.kind} {pou.name} before this")
         for item in c:
             if isinstance(item, ast.Pou):
                 source.pous.append(item)
@@ -147,13 +155,21 @@ class AstBuilder:
     def pou(self, c):
         kind = c[0].value.upper()
         name = c[1].value
+        closed = isinstance(c[-1], Token) and c[-1].type.startswith("END_")
+        stop = -1 if closed else len(c)
         if kind == "FUNCTION":
-            return_type, rest = c[3], c[4:-1]
+            return_type, rest = c[3], c[4:stop]
         else:
-            return_type, rest = None, c[2:-1]
+            return_type, rest = None, c[2:stop]
         blocks = [x for x in rest if isinstance(x, ast.VarBlock)]
         body = rest[-1]
-        return ast.Pou(kind, name, return_type, blocks, body, span=_span(c[0], c[-1]))
+        last = c[-1]
+        if not closed:
+            last = body if body else (blocks[-1] if blocks else c[1])
+        pou = ast.Pou(kind, name, return_type, blocks, body, span=_span(c[0], last))
+        if not closed:
+            _ctx.open_pous.append(pou)
+        return pou
 
     # ------------------------------------------------------------- types
     def type_decl(self, c):

@@ -1,0 +1,926 @@
+"""Semantic check of GX Works structured text.
+
+`check(files, target)` resolves every name, type and call across the given files (a POU
+may use POUs and structures of the other files), annotates the trees in place — each
+expression gets `.type`, each `Name` its `.symbol`, each `Call` its `.resolved`
+`CallTarget` — and returns diagnostics for what GX Works would reject (errors) or what
+is suspicious (warnings). The simulator reuses the annotations and `SymbolTable`.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+from verifier.st import ast, library
+from verifier.st import types as T
+from verifier.st.devices import looks_like_device
+
+
+# ----------------------------------------------------------------------------- symbol table
+@dataclass
+class PouInfo:
+    """A POU with its resolved label types: `labels` maps upper-case names to
+    (VarDecl, Type)."""
+
+    pou: ast.Pou
+    file: str
+    labels: dict[str, tuple[ast.VarDecl, T.Type]] = field(default_factory=dict)
+    fb_type: T.FbType | None = None
+    return_type: T.Type | None = None
+
+
+@dataclass
+class SymbolTable:
+    """Everything resolved over a set of files: structures, global labels, POUs."""
+
+    target: str
+    structs: dict[str, T.StructOf] = field(default_factory=dict)
+    struct_decls: dict[str, ast.StructDecl] = field(default_factory=dict)
+    globals: dict[str, tuple[ast.VarDecl, T.Type]] = field(default_factory=dict)
+    pous: dict[str, PouInfo] = field(default_factory=dict)
+
+    def lookup(self, pou: PouInfo | None, name: str) -> tuple[ast.VarDecl, T.Type] | None:
+        key = name.upper()
+        if pou is not None and key in pou.labels:
+            return pou.labels[key]
+        return self.globals.get(key)
+
+
+class _Reporter:
+    def __init__(self) -> None:
+        self.diagnostics: list[ast.Diagnostic] = []
+
+    def at(self, node, severity: str, message: str) -> None:
+        span = getattr(node, "span", None) or ast.NO_SPAN
+        self.diagnostics.append(ast.Diagnostic(span.file, span.line, span.col, severity, message,
+                                               span.end_line, span.end_col))
+
+    def error(self, node, message: str) -> None:
+        self.at(node, "error", message)
+
+    def warning(self, node, message: str) -> None:
+        self.at(node, "warning", message)
+
+
+_MAX_NAME = 32  # GX Works label name length limit (characters)
+
+
+def label_name_problem(name: str) -> str | None:
+    """Why GX Works refuses `name` as a label, or None. Rules: docs/st-dialect.md §4."""
+    if name.startswith("_") or name.endswith("_"):
+        return "must not start or end with '_'"
+    if "__" in name:
+        return "must not contain '__'"
+    if name[0].isdigit():
+        return "must not start with a digit"
+    if re.match(r"[Kk][1-8]", name):
+        return "must not start with K1..K8 (read as a digit-specified device)"
+    if looks_like_device(name) or re.fullmatch(r"[Kk][0-9]+|[Hh][0-9A-Fa-f]+", name):
+        return "looks like a device or constant"
+    reason = library.reserved_reason(name)
+    if reason:
+        return reason
+    if len(name) > _MAX_NAME:
+        return f"is longer than {_MAX_NAME} characters"
+    return None
+
+
+# ----------------------------------------------------------------------------- the checker
+class Checker:
+    def __init__(self, files: list[ast.SourceFile], target: str) -> None:
+        self.files = [f for f in files if f.ok]
+        self.target = target
+        self.table = SymbolTable(target)
+        self.rep = _Reporter()
+        self.pou: PouInfo | None = None
+        self.loop_depth = 0
+        self.used: set[int] = set()
+
+    # ------------------------------------------------------------- declarations
+    def collect(self) -> None:
+        for f in self.files:
+            for s in f.types:
+                if s.key in self.table.struct_decls:
+                    self.rep.error(s, f"structure '{s.name}' is defined twice")
+                    continue
+                self._check_name(s, s.name, "structure")
+                self.table.struct_decls[s.key] = s
+            for p in f.pous:
+                if p.key in self.table.pous:
+                    other = self.table.pous[p.key]
+                    self.rep.error(p, f"POU '{p.name}' is already defined in {other.file}")
+                    continue
+                self._check_name(p, p.name, "POU")
+                self.table.pous[p.key] = PouInfo(p, f.filename)
+        for key, s in self.table.struct_decls.items():
+            self.table.structs[key] = T.StructOf(s.name, ())
+        for key, s in self.table.struct_decls.items():
+            fields = []
+            for v in s.fields:
+                self._check_name(v, v.name, "member")
+                fields.append((v.name, self.resolve_type(v.type)))
+            object.__setattr__(self.table.structs[key], "fields", tuple(fields))
+        # FB types first so labels of FB type resolve in any order
+        for info in self.table.pous.values():
+            if info.pou.kind == "FUNCTION_BLOCK":
+                info.fb_type = T.FbType(info.pou.name, standard=False)
+        for f in self.files:
+            for block in f.globals:
+                self._check_block_kind(block, top_level=True)
+                for v in block.variables:
+                    t = self._declare(v)
+                    if v.key in self.table.globals:
+                        self.rep.error(v, f"global label '{v.name}' is declared twice")
+                    self.table.globals[v.key] = (v, t)
+        for info in self.table.pous.values():
+            self._collect_pou(info)
+
+    def _collect_pou(self, info: PouInfo) -> None:
+        pou = info.pou
+        if pou.return_type is not None:
+            info.return_type = self.resolve_type(pou.return_type)
+        inputs, outputs, in_outs, publics = [], [], [], []
+        for block in pou.var_blocks:
+            self._check_block_kind(block, top_level=False, pou=pou)
+            for v in block.variables:
+                t = self._declare(v)
+                if v.key in info.labels:
+                    self.rep.error(v, f"label '{v.name}' is declared twice in {pou.name}")
+                    continue
+                if v.key == pou.key:
+                    self.rep.error(v, f"label '{v.name}' has the name of its POU; rename it")
+                info.labels[v.key] = (v, t)
+                if v.section == "VAR_INPUT":
+                    inputs.append((v.name, t))
+                elif v.section == "VAR_OUTPUT":
+                    outputs.append((v.name, t))
+                elif v.section == "VAR_IN_OUT":
+                    in_outs.append((v.name, t))
+                elif v.section == "VAR_PUBLIC":
+                    publics.append((v.name, t))
+                if pou.kind == "FUNCTION" and isinstance(t, T.FbType):
+                    self.rep.error(v, f"a FUNCTION cannot hold a function block instance ('{v.name}'); "
+                                      "make the POU a FUNCTION_BLOCK")
+        if info.fb_type is not None:
+            for attr, val in (("inputs", inputs), ("outputs", outputs), ("in_outs", in_outs),
+                              ("publics", publics)):
+                object.__setattr__(info.fb_type, attr, tuple(val))
+        else:
+            info.fb_type = None
+            info.extra_inputs = inputs  # type: ignore[attr-defined]
+        if pou.kind == "FUNCTION":
+            info.fn_inputs = inputs + in_outs  # type: ignore[attr-defined]
+            info.fn_outputs = outputs  # type: ignore[attr-defined]
+
+    def _check_block_kind(self, block: ast.VarBlock, top_level: bool, pou: ast.Pou | None = None) -> None:
+        kw = block.keyword
+        if top_level and not kw.startswith("VAR_GLOBAL"):
+            self.rep.error(block, f"{kw} outside a POU; only VAR_GLOBAL blocks may stand alone")
+        if not top_level and kw.startswith("VAR_GLOBAL"):
+            self.rep.error(block, f"{kw} inside {pou.kind} {pou.name}; declare globals outside POUs "
+                                  "(or use VAR_EXTERNAL)")
+        if pou is not None and pou.kind == "FUNCTION" and kw in ("VAR_OUTPUT_RETAIN", "VAR_RETAIN", "VAR_PUBLIC"):
+            self.rep.error(block, f"{kw} is not allowed in a FUNCTION")
+        if pou is not None and pou.kind == "PROGRAM" and kw in ("VAR_INPUT", "VAR_OUTPUT", "VAR_IN_OUT"):
+            self.rep.warning(block, f"{kw} in a PROGRAM: GX Works program blocks have no interface; "
+                                    "use VAR or globals")
+        if kw in ("VAR_OUTPUT_RETAIN", "VAR_PUBLIC", "VAR_PUBLIC_RETAIN") and self.target == "gxworks2":
+            self.rep.error(block, f"{kw} exists only in GX Works3; use VAR_OUTPUT/VAR (or --target gxworks3)")
+
+    def _check_name(self, node, name: str, what: str) -> None:
+        problem = label_name_problem(name)
+        if problem:
+            self.rep.error(node, f"{what} name '{name}' {problem}; rename it")
+
+    def _declare(self, v: ast.VarDecl) -> T.Type:
+        self._check_name(v, v.name, "label")
+        t = self.resolve_type(v.type)
+        if v.constant and v.init is None:
+            self.rep.error(v, f"constant '{v.name}' needs an initial value (':= value')")
+        if v.section == "VAR_IN_OUT" and v.init is not None:
+            self.rep.error(v, f"VAR_IN_OUT '{v.name}' cannot have an initial value")
+        if v.init is not None:
+            self.check_initializer(v.init, t, v)
+        return t
+
+    def resolve_type(self, ref: ast.TypeRef) -> T.Type:
+        if isinstance(ref, ast.StringType):
+            if ref.wide and self.target == "gxworks2":
+                self.rep.error(ref, library_missing("WSTRING"))
+            if ref.length is not None and not 1 <= ref.length <= 255:
+                self.rep.error(ref, f"string length {ref.length} is outside 1..255")
+            base = T.WSTRING if ref.wide else T.STRING
+            return base
+        if isinstance(ref, ast.ArrayType):
+            dims = []
+            for d in ref.dims:
+                if d.low > d.high:
+                    self.rep.error(d, f"array bounds {d.low}..{d.high}: the lower bound must not exceed the upper")
+                dims.append((d.low, d.high))
+            if len(dims) > 3:
+                self.rep.error(ref, "GX Works arrays have at most 3 dimensions")
+            element = self.resolve_type(ref.element)
+            return T.ArrayOf(f"ARRAY[{', '.join(f'{a}..{b}' for a, b in dims)}] OF {element}", element, tuple(dims))
+        assert isinstance(ref, ast.NamedType)
+        key = ref.key
+        elementary = T.ELEMENTARY_BY_TARGET[self.target]
+        if key in elementary:
+            return elementary[key]
+        if key in self.table.structs:
+            return self.table.structs[key]
+        if key in library.STANDARD_FBS:
+            return library.STANDARD_FBS[key]
+        info = self.table.pous.get(key)
+        if info is not None and info.fb_type is not None:
+            return info.fb_type
+        if info is not None:
+            self.rep.error(ref, f"'{ref.name}' is a {info.pou.kind}, not a type; only function blocks can be instantiated")
+            return T.ANY
+        if key in T.MISSING_TYPES:
+            self.rep.error(ref, library_missing(key, self.target))
+            return T.ANY
+        self.rep.error(ref, f"unknown type '{ref.name}'; declare the structure or function block, or use a GX Works type")
+        return T.ANY
+
+    def check_initializer(self, init, t: T.Type, decl: ast.VarDecl) -> None:
+        if isinstance(init, ast.ArrayInit):
+            if not isinstance(t, T.ArrayOf):
+                self.rep.error(init, f"array initial value for '{decl.name}', which is {t}")
+                return
+            count = 0
+            for item in init.items:
+                count += item.repeat if item.repeat is not None else 1
+                if item.value is not None:
+                    self.check_initializer(item.value, t.element, decl)
+            if count > t.size:
+                self.rep.error(init, f"{count} initial values for '{decl.name}', which has {t.size} elements")
+            return
+        if isinstance(init, ast.StructInit):
+            if not isinstance(t, T.StructOf):
+                self.rep.error(init, f"structure initial value for '{decl.name}', which is {t}")
+                return
+            for name, value in init.fields:
+                ft = t.field(name)
+                if ft is None:
+                    self.rep.error(init, f"structure {t} has no member '{name}'")
+                else:
+                    self.check_initializer(value, ft, decl)
+            return
+        if isinstance(t, (T.FbType, T.ArrayOf, T.StructOf)):
+            self.rep.error(init, f"'{decl.name}' is {t}; it cannot take a single initial value")
+            return
+        vt = self.expr(init)
+        if not _is_constant(init):
+            self.rep.error(init, "an initial value must be a constant")
+        self._assign_compat(init, t, vt, f"initial value of '{decl.name}'")
+
+    # ------------------------------------------------------------- bodies
+    def check_bodies(self) -> None:
+        for info in self.table.pous.values():
+            self.pou = info
+            self.loop_depth = 0
+            self.stmts(info.pou.body)
+            self._unused(info)
+        self.pou = None
+
+    def _unused(self, info: PouInfo) -> None:
+        for decl, _t in info.labels.values():
+            if decl.section in ("VAR", "VAR_TEMP") and id(decl) not in self.used:
+                self.rep.warning(decl, f"label '{decl.name}' is declared but never used")
+
+    def stmts(self, body: list[ast.Stmt]) -> None:
+        for s in body:
+            self.stmt(s)
+
+    def stmt(self, s: ast.Stmt) -> None:
+        if isinstance(s, ast.Assign):
+            tt = self.lvalue(s.target)
+            vt = self.expr(s.value)
+            if tt is not None:
+                self._assign_compat(s.value, tt, vt, "assignment")
+        elif isinstance(s, ast.CallStmt):
+            self.call(s.call, statement=True)
+        elif isinstance(s, ast.If):
+            for b in s.branches:
+                self._bool_cond(b.cond, "IF condition")
+                self.stmts(b.body)
+            if s.else_body is not None:
+                self.stmts(s.else_body)
+        elif isinstance(s, ast.Case):
+            st = self.expr(s.selector)
+            if not (T.is_group(st, "int", "int-literal", "any16", "any32", "any")):
+                self.rep.error(s.selector, f"CASE needs an integer selector (INT or DINT), not {st}; "
+                                           f"convert it, e.g. {st}_TO_INT(...)")
+            seen: dict[int, ast.Node] = {}
+            for clause in s.clauses:
+                for label in clause.labels:
+                    values = [label] if not isinstance(label, ast.CaseRange) else [label.low, label.high]
+                    for v in values:
+                        self.expr(v)
+                    if isinstance(label, ast.CaseRange):
+                        lo, hi = label.low.value, label.high.value
+                        if lo > hi:
+                            self.rep.error(label, f"CASE range {lo}..{hi} is empty; write the lower bound first")
+                        rng = range(lo, hi + 1) if hi - lo < 100_000 else range(lo, lo + 1)
+                    else:
+                        rng = range(label.value, label.value + 1)
+                    for n in rng:
+                        if n in seen:
+                            self.rep.error(label, f"CASE value {n} appears twice")
+                            break
+                        seen[n] = label
+                self.stmts(clause.body)
+            if s.else_body is not None:
+                self.stmts(s.else_body)
+        elif isinstance(s, ast.For):
+            vt = self.lvalue(s.var)
+            if vt is not None and not T.is_group(vt, "int", "any16", "any32"):
+                self.rep.error(s.var, f"FOR variable must be INT or DINT, not {vt}")
+            for part, what in ((s.start, "start"), (s.end, "end"), (s.step, "step")):
+                if part is None:
+                    continue
+                pt = self.expr(part)
+                if vt is not None:
+                    self._assign_compat(part, vt, pt, f"FOR {what} value")
+            if isinstance(s.step, ast.IntLiteral) and s.step.value == 0:
+                self.rep.error(s.step, "FOR step 0 never ends the loop")
+            self.loop_depth += 1
+            self.stmts(s.body)
+            self.loop_depth -= 1
+        elif isinstance(s, ast.While):
+            self._bool_cond(s.cond, "WHILE condition")
+            self.loop_depth += 1
+            self.stmts(s.body)
+            self.loop_depth -= 1
+        elif isinstance(s, ast.Repeat):
+            self.loop_depth += 1
+            self.stmts(s.body)
+            self.loop_depth -= 1
+            self._bool_cond(s.until, "UNTIL condition")
+        elif isinstance(s, ast.Exit):
+            if self.loop_depth == 0:
+                self.rep.error(s, "EXIT outside a FOR, WHILE or REPEAT loop")
+        elif isinstance(s, (ast.Return, ast.Empty)):
+            pass
+
+    def _bool_cond(self, e: ast.Expr, what: str) -> None:
+        t = self.expr(e)
+        if not T.is_bool(t) and t is not T.ANY:
+            self.rep.error(e, f"{what} must be BOOL, not {t}; compare it, e.g. x <> 0")
+
+    def _assign_compat(self, node: ast.Expr, target: T.Type, source: T.Type, what: str) -> None:
+        if source is T.VOID:
+            self.rep.error(node, f"{what}: this call gives no value")
+            return
+        problem = T.assignable(target, source, self.target)
+        if problem:
+            self.rep.error(node, f"{what}: {problem}")
+            return
+        if T.is_group(source, "int-literal") and source.value is not None and isinstance(target, T.Elementary):
+            if not T.fits(source.value, target):
+                lo, hi = T.INT_RANGE[target.name]
+                based = isinstance(node, ast.IntLiteral) and (node.radix != 10 or node.prefix == "H")
+                if based and target.name in ("INT", "DINT") and 0 <= source.value <= (hi * 2 + 1):
+                    self.rep.warning(node, f"{what}: {_lit_text(node)} is above {target} range ({lo}..{hi}); "
+                                           f"it is stored as the bit pattern {source.value - (hi + 1) * 2}; "
+                                           f"use a WORD/DWORD label for bit patterns")
+                else:
+                    self.rep.error(node, f"{what}: {source.value} is outside {target} range ({lo}..{hi})")
+
+    # ------------------------------------------------------------- expressions
+    def lvalue(self, e: ast.Expr) -> T.Type | None:
+        """Type of an assignment target, reporting what cannot be written."""
+        if isinstance(e, (ast.IntLiteral, ast.RealLiteral, ast.BoolLiteral, ast.TimeLiteral, ast.StringLiteral)):
+            self.expr(e)
+            self.rep.error(e, f"cannot assign to the constant {_lit_text(e)}")
+            return None
+        if isinstance(e, (ast.BinaryOp, ast.UnaryOp, ast.Call)):
+            self.expr(e)
+            self.rep.error(e, "cannot assign to an expression; the left of ':=' must be a label or device")
+            return None
+        t = self.expr(e)
+        root = e
+        while isinstance(root, (ast.Index, ast.Member, ast.BitAccess)):
+            root = root.base
+        if isinstance(root, ast.Name) and isinstance(root.symbol, ast.VarDecl):
+            decl = root.symbol
+            if decl.constant:
+                self.rep.error(e, f"'{decl.name}' is a constant (VAR CONSTANT); it cannot be assigned")
+            elif decl.section == "VAR_INPUT" and e is root and self.pou is not None and self.pou.pou.kind == "FUNCTION_BLOCK":
+                self.rep.warning(e, f"'{decl.name}' is an input; writing it inside the FB hides the caller's value")
+        if isinstance(root, ast.Name) and isinstance(root.symbol, ast.Pou):
+            pou = root.symbol
+            if self.pou is None or pou is not self.pou.pou:
+                self.rep.error(e, f"cannot assign to the POU name '{pou.name}' outside it")
+        if isinstance(e, ast.Member) and isinstance(e.base.type, T.FbType):
+            kind = e.base.type.param(e.member)
+            if kind and kind[0] == "output":
+                self.rep.error(e, f"'{e.member}' is an output of {e.base.type}; it cannot be assigned from outside")
+        if isinstance(e, ast.Device) and e.kind in ("X",) and e.bit is None:
+            self.rep.warning(e, f"writing input {e.text}: X devices are refreshed from the inputs each scan")
+        return t
+
+    def expr(self, e) -> T.Type:
+        t = self._expr(e)
+        try:
+            e.type = t
+        except AttributeError:
+            pass
+        return t
+
+    def _expr(self, e) -> T.Type:
+        if isinstance(e, ast.IntLiteral):
+            return T.int_literal(e.value)
+        if isinstance(e, ast.RealLiteral):
+            return T.real_literal(e.value)
+        if isinstance(e, ast.BoolLiteral):
+            return T.BOOL
+        if isinstance(e, ast.TimeLiteral):
+            if not -2**31 <= e.ms <= 2**31 - 1:
+                self.rep.error(e, f"{e.text} is outside the TIME range (32-bit milliseconds)")
+            return T.TIME
+        if isinstance(e, ast.StringLiteral):
+            if e.wide and self.target == "gxworks2":
+                self.rep.error(e, "GX Works2 has no WSTRING; write the string in single quotes")
+            return T.WSTRING if e.wide else T.STRING
+        if isinstance(e, ast.Name):
+            return self._name(e)
+        if isinstance(e, ast.Device):
+            return self._device(e)
+        if isinstance(e, ast.Index):
+            return self._index(e)
+        if isinstance(e, ast.Member):
+            return self._member(e)
+        if isinstance(e, ast.BitAccess):
+            bt = self.expr(e.base)
+            w = T.width(bt)
+            if T.is_group(bt, "any"):
+                return T.BOOL
+            if w < 16 or T.is_group(bt, "real", "time", "string"):
+                self.rep.error(e, f"'.{e.bit}' needs a WORD, INT, DWORD or DINT label, not {bt}")
+            elif e.bit >= w:
+                self.rep.error(e, f"bit {e.bit} does not exist in {bt} (bits 0..{w - 1})")
+            return T.BOOL
+        if isinstance(e, ast.UnaryOp):
+            ot = self.expr(e.operand)
+            if e.op == "NOT":
+                if not T.is_any_bit(ot) and ot is not T.ANY:
+                    self.rep.error(e, f"NOT needs BOOL, WORD or DWORD, not {ot}")
+                return ot
+            if not T.is_any_num(ot) or T.is_group(ot, "bits"):
+                if ot is not T.ANY:
+                    self.rep.error(e, f"'-' needs INT, DINT or REAL, not {ot}")
+            if T.is_group(ot, "int-literal"):
+                return T.int_literal(-ot.value if ot.value is not None else None)
+            if T.is_group(ot, "real-literal"):
+                return T.real_literal(-ot.value if ot.value is not None else None)
+            return ot
+        if isinstance(e, ast.BinaryOp):
+            return self._binary(e)
+        if isinstance(e, ast.Call):
+            return self.call(e, statement=False)
+        if isinstance(e, (ast.ArrayInit, ast.StructInit)):
+            self.rep.error(e, "an array or structure value is only allowed as an initial value")
+            return T.ANY
+        return T.ANY
+
+    def _name(self, e: ast.Name) -> T.Type:
+        found = self.table.lookup(self.pou, e.name)
+        if found is not None:
+            decl, t = found
+            e.symbol = decl
+            self.used.add(id(decl))
+            return t
+        if self.pou is not None and e.key == self.pou.pou.key and self.pou.pou.kind == "FUNCTION":
+            e.symbol = self.pou.pou
+            return self.pou.return_type or T.ANY
+        info = self.table.pous.get(e.key)
+        if info is not None:
+            e.symbol = info.pou
+            return T.PouRef(info.pou.name)
+        if re.fullmatch(r"H[0-9A-F]+", e.name, re.IGNORECASE):
+            self.rep.error(e, f"undefined label '{e.name}'; for the hex constant write 16#{e.name[1:]} (or H0{e.name[1:]})")
+        else:
+            self.rep.error(e, f"undefined label '{e.name}'; declare it in a VAR block")
+        return T.ANY
+
+    def _device(self, e: ast.Device) -> T.Type:
+        if e.bit is not None:
+            return T.BOOL
+        if e.digits is not None:
+            return T.ANY16 if e.digits <= 4 else T.ANY32
+        if e.kind in ("T", "C", "ST"):
+            return T.ANY
+        if e.is_bit:
+            return T.BOOL
+        return T.ANY16
+
+    def _index(self, e: ast.Index) -> T.Type:
+        bt = self.expr(e.base)
+        for i in e.indices:
+            it = self.expr(i)
+            if not T.is_group(it, "int", "int-literal", "any16", "any32", "any"):
+                self.rep.error(i, f"array index must be INT or DINT, not {it}")
+        if T.is_group(bt, "any"):
+            return T.ANY
+        if not isinstance(bt, T.ArrayOf):
+            self.rep.error(e, f"'[...]' needs an array; this is {bt}")
+            return T.ANY
+        if len(e.indices) != len(bt.dims):
+            self.rep.error(e, f"{bt} needs {len(bt.dims)} index(es), {len(e.indices)} given")
+            return bt.element
+        for i, (lo, hi) in zip(e.indices, bt.dims):
+            v = _const_int(i)
+            if v is not None and not lo <= v <= hi:
+                self.rep.error(i, f"index {v} is outside the array bounds {lo}..{hi}")
+        return bt.element
+
+    def _member(self, e: ast.Member) -> T.Type:
+        bt = self.expr(e.base)
+        if T.is_group(bt, "any"):
+            return T.ANY
+        if isinstance(bt, T.StructOf):
+            ft = bt.field(e.member)
+            if ft is None:
+                self.rep.error(e, f"structure {bt} has no member '{e.member}'")
+                return T.ANY
+            return ft
+        if isinstance(bt, T.FbType):
+            p = bt.param(e.member)
+            if p is None:
+                self.rep.error(e, f"{bt} has no input or output '{e.member}'")
+                return T.ANY
+            if p[0] == "in_out":
+                self.rep.error(e, f"'{e.member}' is a VAR_IN_OUT of {bt}; it cannot be read from outside")
+            return p[1]
+        if T.width(bt) >= 16 and re.fullmatch(r"[0-9A-Fa-f]", e.member):
+            self.rep.error(e, f"bit '.{e.member}' of a label: write the bit number in decimal, e.g. .{int(e.member, 16)}")
+            return T.BOOL
+        self.rep.error(e, f"'.{e.member}' needs a structure or FB instance; this is {bt}")
+        return T.ANY
+
+    def _binary(self, e: ast.BinaryOp) -> T.Type:
+        lt = self.expr(e.left)
+        rt = self.expr(e.right)
+        op = e.op
+        if lt is T.ANY or rt is T.ANY:
+            return T.BOOL if op in ("=", "<>", "<", ">", "<=", ">=") else (rt if lt is T.ANY else lt)
+        if op == "**":
+            if not T.is_group(lt, "real", "real-literal"):
+                self.rep.error(e.left, f"'**' needs a REAL base, not {lt}; convert it, e.g. {T.concrete(lt)}_TO_REAL(...)")
+            if not T.is_any_num(rt):
+                self.rep.error(e.right, f"'**' needs a numeric exponent, not {rt}")
+            return T.REAL if T.is_group(lt, "real-literal") else lt
+        common = T.unify(lt, rt)
+        if common is None:
+            self.rep.error(e, f"'{op}' mixes {lt} and {rt}; convert one side (e.g. {_conv_hint(lt, rt)})")
+            return T.BOOL if op in ("=", "<>", "<", ">", "<=", ">=") else lt
+        if op in ("+", "-", "*", "/"):
+            if not T.is_any_num(common) or T.is_group(common, "bits"):
+                self.rep.error(e, f"'{op}' needs INT, DINT or REAL operands, not {common}; "
+                                  f"arithmetic on bit strings is not allowed (convert with {common}_TO_INT)")
+            if op == "/" and _const_int(e.right) == 0:
+                self.rep.error(e.right, "division by zero")
+            return self._fold(e, common)
+        if op == "MOD":
+            if not T.is_any_int(common) or T.is_group(common, "bits"):
+                self.rep.error(e, f"MOD needs INT or DINT operands, not {common}")
+            if _const_int(e.right) == 0:
+                self.rep.error(e.right, "MOD by zero")
+            return self._fold(e, common)
+        if op in ("AND", "OR", "XOR"):
+            if not T.is_any_bit(common):
+                self.rep.error(e, f"{op} needs BOOL, WORD or DWORD operands, not {common}; "
+                                  f"for bit operations on integers convert with {common}_TO_WORD")
+            return self._fold(e, common)
+        # comparisons
+        if isinstance(common, (T.ArrayOf, T.StructOf, T.FbType)):
+            self.rep.error(e, f"'{op}' cannot compare {common} values")
+        if op not in ("=", "<>") and common == T.BOOL:
+            self.rep.error(e, f"'{op}' does not order BOOL values")
+        return T.BOOL
+
+    def _fold(self, e: ast.BinaryOp, common: T.Type) -> T.Type:
+        if not T.is_group(common, "int-literal"):
+            return common
+        a, b = _const_int(e.left), _const_int(e.right)
+        if a is None or b is None:
+            return T.int_literal(None)
+        try:
+            value = {"+": a + b, "-": a - b, "*": a * b,
+                     "/": int(a / b) if b else None, "MOD": a % b if b else None,
+                     "AND": a & b, "OR": a | b, "XOR": a ^ b}[e.op]
+        except KeyError:
+            value = None
+        return T.int_literal(value)
+
+    # ------------------------------------------------------------- calls
+    def call(self, c: ast.Call, statement: bool) -> T.Type:
+        name = c.key
+        if not isinstance(c.callee, ast.Name):
+            ct = self.expr(c.callee)
+            if isinstance(ct, T.FbType):
+                return self._fb_call(c, ct, statement)
+            self.rep.error(c.callee, "only labels, functions and instructions can be called")
+            self._args_only(c)
+            return T.ANY
+        found = self.table.lookup(self.pou, c.name)
+        if found is not None:
+            decl, t = found
+            c.callee.symbol = decl
+            c.callee.type = t
+            self.used.add(id(decl))
+            if isinstance(t, T.FbType):
+                return self._fb_call(c, t, statement)
+            self.rep.error(c.callee, f"'{c.name}' is a label of type {t}, not a function block instance; it cannot be called")
+            self._args_only(c)
+            return T.ANY
+        info = self.table.pous.get(name)
+        if info is not None:
+            if info.pou.kind == "FUNCTION":
+                return self._user_function(c, info, statement)
+            self.rep.error(c.callee, f"'{c.name}' is a {info.pou.kind}; declare an instance (inst : {c.name};) and call the instance")
+            self._args_only(c)
+            return T.ANY
+        if name in library.STANDARD_FBS:
+            self.rep.error(c.callee, f"'{c.name}' is a standard function block; declare an instance (tmr : {name};) and call it")
+            self._args_only(c)
+            return T.ANY
+        sig = library.STANDARD_FUNCTIONS.get(name)
+        if sig is not None:
+            if self.target not in sig.targets:
+                self.rep.error(c.callee, f"{name} does not exist in {_target_name(self.target)}")
+            return self._signature_call(c, sig, statement, "standard_function")
+        sig = library.instruction(name, self.target)
+        if sig is not None:
+            if self.target not in sig.targets:
+                self.rep.error(c.callee, f"instruction {name} is not available for {_target_name(self.target)}")
+            return self._signature_call(c, sig, statement, "instruction")
+        if name in library.INSTRUCTIONS or name == "ADPRW":
+            self.rep.error(c.callee, f"instruction {name} is not available for {_target_name(self.target)}")
+            self._args_only(c)
+            return T.ANY
+        self.rep.error(c.callee, f"unknown function or instruction '{c.name}'")
+        self._args_only(c)
+        return T.ANY
+
+    def _args_only(self, c: ast.Call) -> None:
+        for a in c.args:
+            self.expr(a.value)
+
+    def _fb_call(self, c: ast.Call, fb: T.FbType, statement: bool) -> T.Type:
+        c.resolved = T.CallTarget("fb", fb.name, fb_type=fb,
+                                  pou=self.table.pous[fb.name.upper()].pou if not fb.standard and fb.name.upper() in self.table.pous else None)
+        if not statement:
+            self.rep.error(c, f"a function block instance call is a statement: write '{c.name}(...);' on its own and read the outputs as {c.name}.Q")
+        seen = set()
+        for a in c.args:
+            if a.name is None:
+                self.expr(a.value)
+                self.rep.error(a, f"function block calls take named arguments: write 'INPUT := value' (or 'OUTPUT => label')")
+                continue
+            if a.key in seen:
+                self.rep.error(a, f"argument '{a.name}' is given twice")
+            seen.add(a.key)
+            p = fb.param(a.name)
+            if p is None:
+                self.expr(a.value)
+                self.rep.error(a, f"{fb} has no parameter '{a.name}'")
+                continue
+            kind, pt = p
+            if a.output:
+                if kind != "output":
+                    self.expr(a.value)
+                    self.rep.error(a, f"'{a.name}' is not an output of {fb}; write '{a.name} := value' to pass it in")
+                    continue
+                tt = self.lvalue(a.value)
+                if tt is not None:
+                    self._assign_compat(a.value, tt, pt, f"output {a.name}")
+            else:
+                if kind == "output":
+                    self.expr(a.value)
+                    self.rep.error(a, f"'{a.name}' is an output of {fb}; bind it with '{a.name} => label'")
+                    continue
+                if kind == "in_out":
+                    vt = self.lvalue(a.value)
+                else:
+                    vt = self.expr(a.value)
+                if vt is not None:
+                    self._assign_compat(a.value, pt, vt, f"input {a.name}")
+        for n, _t in fb.in_outs:
+            if n.upper() not in seen:
+                self.rep.error(c, f"VAR_IN_OUT '{n}' of {fb} must be connected in every call")
+        return T.VOID
+
+    def _user_function(self, c: ast.Call, info: PouInfo, statement: bool) -> T.Type:
+        c.resolved = T.CallTarget("function", info.pou.name, pou=info.pou)
+        c.callee.symbol = info.pou
+        params = getattr(info, "fn_inputs", [])
+        outputs = getattr(info, "fn_outputs", [])
+        positional = [a for a in c.args if a.name is None]
+        named = [a for a in c.args if a.name is not None]
+        if positional and named:
+            self.rep.error(c, "mix of positional and named arguments; use one style")
+        if positional:
+            if len(positional) != len(params):
+                self.rep.error(c, f"{info.pou.name} takes {len(params)} argument(s), {len(positional)} given")
+            for a, (pn, pt) in zip(positional, params):
+                vt = self.expr(a.value)
+                self._assign_compat(a.value, pt, vt, f"argument {pn} of {info.pou.name}")
+            for a in positional[len(params):]:
+                self.expr(a.value)
+        else:
+            given = set()
+            for a in named:
+                key = a.key
+                match = next(((pn, pt) for pn, pt in params if pn.upper() == key), None)
+                out = next(((pn, pt) for pn, pt in outputs if pn.upper() == key), None)
+                given.add(key)
+                if a.output and out is not None:
+                    tt = self.lvalue(a.value)
+                    if tt is not None:
+                        self._assign_compat(a.value, tt, out[1], f"output {out[0]}")
+                elif match is not None and not a.output:
+                    vt = self.expr(a.value)
+                    self._assign_compat(a.value, match[1], vt, f"argument {match[0]} of {info.pou.name}")
+                else:
+                    self.expr(a.value)
+                    self.rep.error(a, f"{info.pou.name} has no {'output' if a.output else 'input'} '{a.name}'")
+            missing = [pn for pn, _ in params if pn.upper() not in given]
+            if missing:
+                self.rep.error(c, f"{info.pou.name} needs argument(s) {', '.join(missing)}")
+        if statement:
+            self.rep.warning(c, f"the result of function {info.pou.name} is discarded")
+        return info.return_type or T.ANY
+
+    def _signature_call(self, c: ast.Call, sig: T.Signature, statement: bool, kind: str) -> T.Type:
+        c.resolved = T.CallTarget(kind, sig.name, signature=sig)
+        if any(a.name is not None for a in c.args):
+            bad = next(a for a in c.args if a.name is not None)
+            self.rep.error(bad, f"{sig.name} takes positional arguments in manual order: "
+                                f"{sig.name}({', '.join(p.name for p in sig.params)})")
+        n, np = len(c.args), len(sig.params)
+        if n < np or (n > np and not sig.variadic):
+            self.rep.error(c, f"{sig.name} takes {np}{' or more' if sig.variadic else ''} argument(s) "
+                              f"({', '.join(p.name for p in sig.params)}), {n} given")
+        generic: T.Type | None = None
+        first_type: T.Type | None = None
+        for i, a in enumerate(c.args):
+            p = sig.params[min(i, np - 1)] if i < np or sig.variadic else None
+            if p is None:
+                self.expr(a.value)
+                continue
+            if p.direction in ("out", "inout"):
+                at = self.lvalue(a.value)
+            else:
+                at = self.expr(a.value)
+            if at is None:
+                continue
+            if i == 0:
+                first_type = at
+            problem = self._accepts(p, at, a.value)
+            if problem:
+                self.rep.error(a.value, f"{sig.name} operand {p.name}: {problem}")
+            elif p.accepts.startswith("ANY_") and p.accepts != "ANY_INT" or p.accepts == "ANY" and sig.result == "SAME":
+                if sig.name in ("SHL", "SHR", "ROL", "ROR") and i > 0:
+                    continue
+                if sig.name == "MUX" and i == 0 or sig.name == "SEL" and i == 0:
+                    continue
+                if generic is None:
+                    generic = at
+                else:
+                    g = T.unify(generic, at)
+                    if g is None:
+                        self.rep.error(a.value, f"{sig.name}: {at} does not match the other operands ({generic}); convert it")
+                    else:
+                        generic = g
+            elif p.accepts == "ANY_INT" and sig.result == "SAME":
+                g = at if generic is None else T.unify(generic, at)
+                if g is None:
+                    self.rep.error(a.value, f"{sig.name}: {at} does not match the other operands ({generic}); convert it")
+                else:
+                    generic = g
+        c.resolved.generic = generic
+        if sig.result is None:  # instruction: value is ENO
+            return T.BOOL
+        if sig.result == "SAME":
+            result = generic or T.ANY
+        elif sig.result == "FIRST":
+            result = first_type or T.ANY
+        else:
+            result = sig.result
+        if statement:
+            self.rep.warning(c, f"the result of {sig.name} is discarded")
+        return result
+
+    def _accepts(self, p: T.Param, t: T.Type, node: ast.Expr) -> str | None:
+        a = p.accepts
+        if t is T.ANY:
+            return None
+        if p.direction in ("out", "inout") and isinstance(node, ast.Device) and node.kind in ("K",):
+            return "an output operand must be a label or device"
+        if a == "ANY":
+            return None
+        if a == "BOOL":
+            return None if T.is_bool(t) else f"needs BOOL, not {t}"
+        if a in ("ANY16", "ANY32"):
+            w = 16 if a == "ANY16" else 32
+            if T.is_group(t, "int-literal"):
+                if p.direction != "in":
+                    return "needs a label or device, not a constant"
+                return None
+            if T.is_group(t, "any"):
+                return None
+            if isinstance(t, T.ArrayOf):
+                return f"needs one {w}-bit value; pass an element such as x[0]"
+            if T.width(t) == w and not T.is_group(t, "real", "time", "string"):
+                return None
+            if isinstance(node, ast.Device) and w == 32 and T.width(t) == 16:
+                return None  # D0 as a 32-bit operand means D0-D1
+            return f"needs a {w}-bit integer or bit string (INT/WORD{'/DINT/DWORD' if w == 32 else ''}), not {t}"
+        if a == "BLOCK16":
+            if isinstance(t, T.ArrayOf):
+                t = t.element
+            if T.width(t) == 16 and not T.is_group(t, "real"):
+                return None
+            return f"needs the head of a block of words (an INT/WORD array or its element, or a word device), not {t}"
+        if a == "BITS":
+            if isinstance(t, T.ArrayOf):
+                t = t.element
+            return None if T.is_bool(t) else f"needs a bit (BOOL label, bit device or BOOL array), not {t}"
+        if a == "ANY_NUM":
+            return None if T.is_any_num(t) and not T.is_group(t, "bits") else f"needs INT, DINT or REAL, not {t}"
+        if a == "ANY_INT":
+            return None if T.is_any_int(t) else f"needs INT or DINT, not {t}"
+        if a == "ANY_REAL":
+            return None if T.is_group(t, "real", "real-literal") else f"needs REAL, not {t}; convert it with {T.concrete(t)}_TO_REAL"
+        if a == "ANY_BIT":
+            return None if T.is_any_bit(t) else f"needs BOOL, WORD or DWORD, not {t}; convert it with {T.concrete(t)}_TO_WORD"
+        if a == "ANY_SIMPLE":
+            return None if isinstance(t, (T.Elementary, T.Generic)) else f"needs a simple value, not {t}"
+        # an elementary type name
+        expected = T.ELEMENTARY_BY_TARGET["gxworks3"].get(a)
+        if expected is None:
+            return None
+        return T.assignable(expected, t, self.target)
+
+
+# ----------------------------------------------------------------------------- helpers
+def library_missing(name: str, target: str = "gxworks2") -> str:
+    return f"type {name} does not exist in {_target_name(target)}: " + T.MISSING_TYPES.get(name, "")
+
+
+def _target_name(target: str) -> str:
+    return {"gxworks2": "GX Works2", "gxworks3": "GX Works3"}.get(target, target)
+
+
+def _lit_text(e) -> str:
+    return getattr(e, "text", "") or str(getattr(e, "value", "this constant"))
+
+
+def _const_int(e) -> int | None:
+    if isinstance(e, ast.IntLiteral):
+        return e.value
+    if isinstance(e, ast.UnaryOp) and e.op == "-":
+        v = _const_int(e.operand)
+        return -v if v is not None else None
+    t = getattr(e, "type", None)
+    if T.is_group(t, "int-literal"):
+        return t.value
+    return None
+
+
+def _is_constant(e) -> bool:
+    if isinstance(e, (ast.IntLiteral, ast.RealLiteral, ast.BoolLiteral, ast.TimeLiteral, ast.StringLiteral)):
+        return True
+    if isinstance(e, ast.UnaryOp):
+        return _is_constant(e.operand)
+    if isinstance(e, ast.BinaryOp):
+        return _is_constant(e.left) and _is_constant(e.right)
+    if isinstance(e, ast.Name) and isinstance(e.symbol, ast.VarDecl):
+        return e.symbol.constant
+    return False
+
+
+def _conv_hint(a: T.Type, b: T.Type) -> str:
+    a, b = T.concrete(a), T.concrete(b)
+    return f"{b.name}_TO_{a.name}(...)"
+
+
+def check_project(files: list[ast.SourceFile], target: str = "gxworks2") -> tuple[list[ast.Diagnostic], SymbolTable]:
+    """Check `files` together; return the diagnostics and the symbol table."""
+    checker = Checker(files, target)
+    try:
+        checker.collect()
+        checker.check_bodies()
+    except RecursionError:
+        checker.rep.diagnostics.append(ast.Diagnostic(
+            files[0].filename if files else "<none>", 1, 1, "error",
+            "expression nested too deeply to check; split it into intermediate labels"))
+    diags = sorted(checker.rep.diagnostics, key=lambda d: (d.file, d.line, d.col))
+    return diags, checker.table
+
+
+def check(files: list[ast.SourceFile], target: str = "gxworks2") -> list[ast.Diagnostic]:
+    """Diagnostics for `files` checked together (parse diagnostics not included)."""
+    return check_project(files, target)[0]
