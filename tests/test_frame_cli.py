@@ -147,3 +147,11 @@ def test_installed_entry_point_in_a_real_subprocess():
     decoded = subprocess.run([uitamr, "frame", "--decode", "01 06 01 A0 00 00 88 15"],
                              capture_output=True, text=True, timeout=60)
     assert decoded.returncode == 1 and "bad CRC" in decoded.stdout
+
+
+def test_words_pack_two_bytes_per_register_low_byte_first():
+    result = run("stop", "--words")
+    assert result.exit_code == 0
+    assert result.output.splitlines()[1] == "words (low byte first): H0601 HA001 H0000 H1488"
+    from verifier.commands.frame import packed_words
+    assert packed_words(b"\x01\x86\x03\x02\x61") == [0x8601, 0x0203, 0x0061]

@@ -97,7 +97,11 @@ def _kind(frame) -> str:
 @click.option("--as", "direction", type=click.Choice(["auto", "request", "reply"]), default="auto",
               show_default=True, help="With --decode: read the bytes as a request or a reply.")
 @click.option("--explain", "explain_fields", is_flag=True, help="Also show every field of the frame.")
-def command(words, address, field_order, codes_10_13, status_order, decode_hex, direction, explain_fields):
+@click.option("--words", "as_words", is_flag=True,
+              help="Also print the frame as 16-bit words, two bytes per word, low byte first "
+                   "(FX RS2 16-bit mode, QJ71C24N send area).")
+def command(words, address, field_order, codes_10_13, status_order, decode_hex, direction, explain_fields,
+            as_words):
     """Print the exact bytes (CRC included) of COMMAND, or decode bytes with --decode.
 
     Prints space-separated upper-case hex, ready to type into a PLC send buffer.
@@ -114,7 +118,7 @@ def command(words, address, field_order, codes_10_13, status_order, decode_hex, 
     if decode_hex is None:
         if request is None:
             raise click.UsageError("give a COMMAND (e.g. `uitamr frame stop`) or --decode HEX")
-        _print_request(request, settings, explain_fields)
+        _print_request(request, settings, explain_fields, as_words)
         return
     try:
         data = parse_hex(decode_hex)
@@ -152,12 +156,19 @@ def _request_from(words: tuple[str, ...], address: int):
         raise click.UsageError(str(exc)) from None
 
 
-def _print_request(request, settings: Settings, show_fields: bool) -> None:
+def packed_words(data: bytes) -> list[int]:
+    """Two bytes per 16-bit word, low byte first; an odd last byte gets a 00 high byte."""
+    return [data[i] | (data[i + 1] << 8 if i + 1 < len(data) else 0) for i in range(0, len(data), 2)]
+
+
+def _print_request(request, settings: Settings, show_fields: bool, as_words: bool = False) -> None:
     try:
         data = encode(request, settings)
     except ValueError as exc:  # command_from_words already checked; settings cannot break it
         raise click.UsageError(str(exc)) from None
     click.echo(hex_bytes(data))
+    if as_words:
+        click.echo("words (low byte first): " + " ".join(f"H{w:04X}" for w in packed_words(data)))
     if show_fields:
         click.echo(describe(request, settings))
         click.echo(explain_table(explain(data, settings, "request")))
