@@ -10,7 +10,7 @@ from hypothesis import given, settings as hypothesis_settings
 
 from verifier.cli import main
 from verifier.commands.frame import parse_hex
-from verifier.protocol import command_from_words, encode, hex_bytes, words_for
+from verifier.protocol import encode, hex_bytes, words_for
 from verifier.protocol.strategies import requests
 
 

@@ -99,6 +99,11 @@ class ExceptionCode(IntEnum):
     GATEWAY_TARGET_FAILED = 0x0B
 
 
+def is_member(enum: type[IntEnum], value: object) -> bool:
+    """Whether ``value`` is the number of one of ``enum``'s members (bools are not numbers here)."""
+    return isinstance(value, int) and not isinstance(value, bool) and value in enum._value2member_map_
+
+
 # --- what each code accepts -------------------------------------------------------------
 
 #: [choice] Code 01 low bytes 1-21 run a taught point / script (0x16 is the first table-2 value).
@@ -124,11 +129,11 @@ def command_problem(code: int, command: int) -> str | None:
     """Why (logical) ``code``/``command`` is not in the catalogue, or None when it is."""
     if not 0 <= command <= 0xFF:
         return f"command {command} does not fit in one byte"
-    if code not in ControlCode.__members__.values():
+    if not is_member(ControlCode, code):
         return f"unknown control code {code}"
     code = ControlCode(code)
     if code is ControlCode.ROBOT:
-        if command in RobotCommand.__members__.values() or command in POINT_NUMBERS:
+        if is_member(RobotCommand, command) or command in POINT_NUMBERS:
             return None
         return (
             f"unknown robot command 0x{command:02X} for control code 01 "
@@ -139,7 +144,7 @@ def command_problem(code: int, command: int) -> str | None:
             return None
         return f"value {command} out of range 0-3 for control code {code:02d} ({CODE_TITLES[code]})"
     if code is ControlCode.MANUAL:
-        if command in ManualMove.__members__.values():
+        if is_member(ManualMove, command):
             return None
         return f"value {command} out of range 0-6 for control code 05 (manual move)"
     return None  # moves and rotations take any byte
@@ -286,7 +291,7 @@ def command_title(code: int, command: int) -> str:
     """Plain-English meaning of a catalogued (logical) code/command pair."""
     code = ControlCode(code)
     if code is ControlCode.ROBOT:
-        if command in RobotCommand.__members__.values():
+        if is_member(RobotCommand, command):
             return ROBOT_COMMAND_TITLES[RobotCommand(command)]
         return f"run point/script {command}"
     if code in (ControlCode.SPEED_TRACKLESS, ControlCode.SPEED_MAGNETIC):
@@ -295,7 +300,7 @@ def command_title(code: int, command: int) -> str:
         metres = COLLISION_RANGE_METRES.get(command)
         return f"anti-collision range {metres} m" if metres is not None else f"anti-collision value {command}"
     if code is ControlCode.MANUAL:
-        move = MANUAL_MOVE_TITLES.get(command, f"value {command}") if command in ManualMove.__members__.values() else f"value {command}"
+        move = MANUAL_MOVE_TITLES[ManualMove(command)] if is_member(ManualMove, command) else f"value {command}"
         return f"manual move {move}"
     sign = "-" if code in NEGATIVE_CODES else "+"
     if code in ROTATE_CODES:

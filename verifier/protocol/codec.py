@@ -10,6 +10,7 @@ function code gets exception 01; an illegal address gets 02; an illegal value ge
 from __future__ import annotations
 
 from verifier.protocol.catalogue import (
+    is_member,
     EXCEPTION_FLAG,
     FC_READ_COILS,
     FC_WRITE_SINGLE_REGISTER,
@@ -134,7 +135,7 @@ def _status_request_body(frame: StatusRequest, settings: Settings, strict: bool)
 
 
 def _check_status_reply(frame: StatusReply) -> None:
-    if frame.error not in RobotError.__members__.values():
+    if not is_member(RobotError, frame.error):
         raise ValueError(f"unknown error code {frame.error} (0-3)")
     if frame.query is not None and (problem := value_problem(frame.query, frame.value)):
         raise ValueError(problem)
@@ -328,7 +329,7 @@ def _decode_exception(data: bytes, function: int, expected_function: int | None)
             1, kind="function", address=address, function=function,
         )
     code = data[2]
-    if code not in ExceptionCode.__members__.values():
+    if not is_member(ExceptionCode, code):
         raise FrameError(
             f"unknown Modbus exception code {code:02X}", 2,
             kind="exception-code", address=address, function=function,
@@ -357,7 +358,7 @@ def _decode_status_reply(data: bytes, query) -> StatusReply:
     if data[3]:
         raise fail(f"first data byte must be 00, got {data[3]:02X}", 3, "data")
     error, value = data[4], data[5]
-    if error not in RobotError.__members__.values():
+    if not is_member(RobotError, error):
         raise fail(f"unknown error code {error:02X} (table 3: 00-03)", 4, "error-code")
     if value > 0x3F:
         raise fail(

@@ -7,13 +7,12 @@ from verifier.protocol.catalogue import (
     QUERY_TITLES,
     QUERY_VALUES,
     ControlCode,
-    ExceptionCode,
     RobotError,
     command_title,
     wire_code,
     wire_query,
 )
-from verifier.protocol.codec import decode_reply, decode_request, hex_bytes
+from verifier.protocol.codec import decode_reply, decode_request
 from verifier.protocol.frames import (
     ControlReply,
     ControlRequest,
@@ -97,8 +96,7 @@ def _describe_frame(frame: Frame, settings: Settings) -> str:
     if isinstance(frame, StatusReply):
         return _status_reply_text(frame) + note
     if isinstance(frame, ExceptionReply):
-        title = EXCEPTION_TITLES.get(frame.exception_code, "unknown exception") if isinstance(
-            frame.exception_code, ExceptionCode) else "unknown exception"
+        title = EXCEPTION_TITLES.get(frame.exception_code, "unknown exception")
         return f"exception {int(frame.exception_code):02X} ({title}) to function {frame.function:02X}" + note
     raise TypeError(f"not a UITAMR frame: {frame!r}")
 

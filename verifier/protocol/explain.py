@@ -15,7 +15,6 @@ from verifier.protocol.catalogue import (
     FC_READ_COILS,
     FC_WRITE_SINGLE_REGISTER,
     QUERY_TITLES,
-    ControlCode,
     CODE_TITLES,
     command_problem,
     command_title,
@@ -138,8 +137,7 @@ def _status_reply_layout(data: bytes) -> list[tuple[int, int, str, str]]:
     first_text = "0: ok" if data[3:4] == b"\x00" else "must be 00"
     error_text = ""
     if len(data) > 4:
-        error_text = ERROR_TITLES.get(data[4], "unknown error code") if data[4] in ERROR_TITLES else "unknown error code"
-        error_text = f"{data[4]:02X}: {error_text}"
+        error_text = f"{data[4]:02X}: {ERROR_TITLES.get(data[4], 'unknown error code')}"
     value_text = f"{data[5]}: meaning depends on the query asked" if len(data) > 5 else ""
     return [
         (2, 1, "byte count (固定值 03)", count_text),
@@ -152,8 +150,7 @@ def _status_reply_layout(data: bytes) -> list[tuple[int, int, str, str]]:
 def _exception_layout(data: bytes) -> list[tuple[int, int, str, str]]:
     text = ""
     if len(data) > 2:
-        title = EXCEPTION_TITLES.get(data[2]) if data[2] in EXCEPTION_TITLES else None
-        text = f"{data[2]:02X}: {title or 'unknown exception code'}"
+        text = f"{data[2]:02X}: {EXCEPTION_TITLES.get(data[2], 'unknown exception code')}"
     return [(2, 1, "exception code", text)]
 
 

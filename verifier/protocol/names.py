@@ -8,6 +8,7 @@ from __future__ import annotations
 from decimal import Decimal, InvalidOperation
 
 from verifier.protocol.catalogue import (
+    is_member,
     POINT_NUMBERS,
     ControlCode,
     ManualMove,
@@ -127,7 +128,7 @@ def command_from_words(words: list[str], address: int = 1) -> ControlRequest | S
         _arity(name, args, 2, "CODE CMD")
         code_number = _integer(args[0], "control code")
         command = _integer(args[1], "command")
-        if code_number not in ControlCode.__members__.values():
+        if not is_member(ControlCode, code_number):
             raise CommandError(f"control code must be 1-13, got {code_number}")
         if problem := command_problem(code_number, command):
             raise CommandError(problem)
