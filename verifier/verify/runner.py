@@ -140,7 +140,8 @@ def _input_schedule(scenario: Scenario) -> list[tuple[int, dict[str, Any]]]:
     for step in scenario.inputs:
         steps.append((step.at_us, dict(step.values)))
         if step.pulse_us is not None:
-            steps.append((step.at_us + step.pulse_us, {name: not value for name, value in step.values.items()}))
+            steps.append((step.at_us + step.pulse_us,
+                          {name: not value for name, value in step.values.items() if isinstance(value, bool)}))
     return sorted(steps, key=lambda s: s[0])
 
 

@@ -351,8 +351,8 @@ class _Reader:
             else:
                 raise self.fail(f"{key}.set.{name}", f"expected true/false or a number, got {_shown(value)}")
         pulse = self.duration(item["pulse"], f"{key}.pulse") if "pulse" in item else None
-        if pulse is not None and not all(isinstance(v, bool) for v in checked.values()):
-            raise self.fail(f"{key}.pulse", "a pulse sets BOOL labels for a while and clears them; use true/false")
+        if pulse is not None and not any(isinstance(v, bool) for v in checked.values()):
+            raise self.fail(f"{key}.pulse", "a pulse sets BOOL labels back after a while; this input sets no BOOL")
         return InputStep(at, checked, pulse)
 
     def expectation(self, item: dict, key: str, settings: protocol.Settings) -> Expectation:

@@ -136,6 +136,28 @@ class Traffic:
     tx: list[TraceFrameLike]
 
 
+def _is_reply_to(frame: TraceFrameLike, exchange: Exchange) -> bool:
+    request = exchange.decoded_request
+    if request is None:
+        return False
+    try:
+        protocol.decode_reply(frame.data, exchange.settings, request)
+    except protocol.FrameError:
+        return False
+    return True
+
+
+def _answers_earlier(frame: TraceFrameLike, earlier: Exchange, later: Exchange) -> bool:
+    """A reply that came after the PLC had already sent its next request: it belongs to the
+    earlier request when that one still awaited it and it answers that one, not the later."""
+    return (
+        not earlier.rx
+        and frame.t_start_us <= earlier.deadline_us
+        and _is_reply_to(frame, earlier)
+        and not _is_reply_to(frame, later)
+    )
+
+
 def analyse(trace: Sequence[TraceFrameLike], settings: protocol.Settings, options: RuleOptions) -> Traffic:
     frames = sorted(trace, key=lambda f: (f.t_start_us, f.direction != "tx"))
     tx = [f for f in frames if f.direction == "tx"]
@@ -151,7 +173,10 @@ def analyse(trace: Sequence[TraceFrameLike], settings: protocol.Settings, option
         if not tx or frame.t_start_us < tx[0].t_end_us:
             before.append(frame)
         elif frame.t_start_us >= tx[position].t_end_us:
-            exchanges[position].rx.append(frame)
+            owner = position
+            if position > 0 and _answers_earlier(frame, exchanges[position - 1], exchanges[position]):
+                owner = position - 1
+            exchanges[owner].rx.append(frame)
         else:  # arrived while the next request was being sent: it belongs to the one before
             exchanges[position - 1].rx.append(frame)
     return Traffic(exchanges, before, rx, tx)

@@ -1,0 +1,291 @@
+"""Scenario files, durations and conditions: strict loading with messages that point at the
+file, the line and the key; and the judgement of expectations on sampled variables."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from hypothesis import given, strategies as st
+
+from verifier import protocol
+from verifier.verify.conditions import ConditionError, parse_condition
+from verifier.verify.durations import parse_duration_us
+from verifier.verify.evidence import RunEvidence, Samples
+from verifier.verify.expectations import judge
+from verifier.verify.result import TraceRecord
+from verifier.verify.scenario import ScenarioError, load_scenario, parse_scenario
+from verifier.verify.traffic import analyse
+
+# --- durations --------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("text, us", [
+    ("250ms", 250_000), ("60s", 60_000_000), ("1.5 s", 1_500_000), ("2min", 120_000_000),
+    ("500us", 500), ("0s", 0), (".5s", 500_000),
+])
+def test_durations(text, us):
+    assert parse_duration_us(text) == us
+
+
+@pytest.mark.parametrize("bad", ["5", 5, "5 sec", "-1s", "1.0000001s", "ms", ""])
+def test_bad_durations_are_refused_with_an_example(bad):
+    with pytest.raises(ValueError):
+        parse_duration_us(bad)
+
+
+@given(st.integers(min_value=0, max_value=10**9))
+def test_milliseconds_round_trip(ms):
+    assert parse_duration_us(f"{ms}ms") == ms * 1000
+
+
+# --- conditions -------------------------------------------------------------------------------
+
+def test_conditions_read_like_st():
+    condition = parse_condition("o_bErr AND o_uErrId = 16#0101")
+    assert condition.names == {"o_bErr", "o_uErrId"}
+    assert condition.holds({"o_bErr": True, "o_uErrId": 0x0101})
+    assert not condition.holds({"o_bErr": True, "o_uErrId": 0x0102})
+    assert parse_condition("NOT fb.o_bBusy OR (x >= 3 AND x <> 7)").holds({"fb.o_bBusy": True, "x": 5})
+    assert parse_condition("a & b").holds({"a": True, "b": True})
+    assert parse_condition("a XOR b").holds({"a": True, "b": False})
+    assert parse_condition("w[2] = 2#1010").holds({"w[2]": 10})
+    assert parse_condition("t > -1.5").holds({"t": 0})
+    assert parse_condition("x = 1_000").holds({"x": 1000})
+
+
+@pytest.mark.parametrize("text, column", [
+    ("o_bOK AND", 10), ("a = = b", 5), ("(a", 3), ("a $ b", 3), ("", 1), ("a < b < c", 7),
+])
+def test_condition_errors_name_the_column(text, column):
+    with pytest.raises(ConditionError) as info:
+        parse_condition(text)
+    assert info.value.column == column
+
+
+# --- scenario files ---------------------------------------------------------------------------
+
+MINIMAL = """
+name = "t"
+program = "Main"
+"""
+
+
+def error_of(text: str, path: Path | None = None) -> ScenarioError:
+    with pytest.raises(ScenarioError) as info:
+        parse_scenario(text, path)
+    return info.value
+
+
+def test_a_minimal_scenario_takes_the_defaults():
+    scenario = parse_scenario(MINIMAL)
+    assert scenario.duration_us == 60_000_000 and scenario.scan_us == 10_000
+    assert scenario.platform == "fx3u" and scenario.serial_channel == "fx3:1" and scenario.target == "gxworks2"
+    assert str(scenario.options.response_signal) == "o_bErr" and not scenario.response_signal_given
+
+
+def test_a_full_scenario(tmp_path):
+    (tmp_path / "lib").mkdir()
+    for name in ("A.st", "B.st"):
+        (tmp_path / "lib" / name).write_text("")
+    (tmp_path / "Main.st").write_text("")
+    path = tmp_path / "s.toml"
+    path.write_text("""
+name = "full"
+sources = ["lib/*.st", "Main.st"]
+program = "Main"
+platform = "fx5u"
+duration = "30s"
+scan = "5ms"
+seed = 7
+watch = ["fb.o_wRetryCount"]
+[protocol]
+address = 3
+[robot]
+point_duration_s = 2.0
+[[faults]]
+kind = "no_reply"
+at_s = 10.0
+duration_s = 3.0
+[[inputs]]
+at = "1s"
+set = { i_bStart = true, "fb.i_uPoint" = 3 }
+pulse = "200ms"
+[[expect]]
+that = "o_bOK"
+within = "10s"
+[[expect]]
+sent = "run-point 3"
+[[expect]]
+reached_point = 3
+after = "1s"
+within = "20s"
+name = "point three"
+[rules]
+min_period = "260ms"
+reply_timeout = "400ms"
+[response_handling]
+signal = "fb.o_bErr"
+within = "3s"
+""")
+    scenario = load_scenario(path)
+    assert [p.name for p in scenario.sources] == ["A.st", "B.st", "Main.st"]
+    assert scenario.target == "gxworks3" and scenario.serial_channel == "fx5:1"
+    assert scenario.settings.address == 3 and scenario.robot.point_duration_s == 2.0
+    assert scenario.faults[0].kind == "no_reply"
+    assert scenario.inputs[0].values == {"i_bStart": True, "fb.i_uPoint": 3} and scenario.inputs[0].pulse_us == 200_000
+    labels = [e.label for e in scenario.expectations]
+    assert labels == ["o_bOK within 10 s", "sent run-point 3", "point three"]
+    assert scenario.expectations[1].request == protocol.ControlRequest(3, protocol.ControlCode.ROBOT, 3)
+    assert scenario.options.min_period_us == 260_000 and scenario.options.reply_timeout_us == 400_000
+    assert str(scenario.options.response_signal) == "fb.o_bErr" and scenario.response_signal_given
+    assert scenario.variables() == ["o_bOK", "fb.o_bErr", "i_bStart", "fb.i_uPoint", "fb.o_wRetryCount"]
+
+
+def test_toml_syntax_errors_give_the_line(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text('name = "x"\nprogram "Main"\n')
+    with pytest.raises(ScenarioError) as info:
+        load_scenario(path)
+    assert info.value.line == 2
+    assert str(info.value).startswith(f"{path}:2: not valid TOML")
+
+
+def test_unknown_keys_are_errors_with_their_line():
+    error = error_of('program = "Main"\n\n[[expect]]\nthat = "a"\nwithn = "5s"\n', Path("s.toml"))
+    assert error.key == "expect[0].withn" and error.line == 5
+    assert str(error).startswith("s.toml:5: expect[0].withn: unknown key")
+
+
+def test_the_nth_table_of_an_array_is_found():
+    text = 'program = "M"\n[[expect]]\nthat = "a"\nwithin = "1s"\n[[expect]]\nthat = "b"\nwithin = "5"\n'
+    error = error_of(text)
+    assert error.key == "expect[1].within" and error.line == 7 and "not a duration" in error.message
+
+
+@pytest.mark.parametrize("text, key, words", [
+    ('platform = "fx2n"', "platform", "unknown platform"),
+    ('channel = "com1"', "channel", "unknown channel"),
+    ('duration = 60', "duration", "duration"),
+    ('scan = "2s"\nduration = "1s"', "scan", "longer than the whole run"),
+    ('seed = "x"', "seed", "whole number"),
+    ('[protocol]\nfield_order = "sideways"', "protocol.field_order", "field_order"),
+    ('[protocol]\nparity = "E"', "protocol.parity", "unknown key"),
+    ('[robot]\nturnaround_ms = -1', "robot.turnaround_ms", "at least"),
+    ('[[faults]]\nkind = "meteor"\nat_s = 1', "faults[0].kind", "unknown fault"),
+    ('[[faults]]\nkind = "no_reply"', "faults[0]", "trigger"),
+    ('[[inputs]]\nat = "1s"', "inputs[0]", "needs 'at'"),
+    ('[[inputs]]\nat = "1s"\nset = { x = "on" }', "inputs[0].set.x", "true/false or a number"),
+    ('[[inputs]]\nat = "1s"\nset = { x = 3 }\npulse = "1s"', "inputs[0].pulse", "no BOOL"),
+    ('[[inputs]]\nat = "99s"\nset = { x = 3 }', "inputs[0].at", "after the end"),
+    ('[[expect]]\nthat = "a"\nnever = "b"', "expect[0]", "exactly one"),
+    ('[[expect]]\nthat = "a AND"', "expect[0].that", "column"),
+    ('[[expect]]\nsent = "fly 3"', "expect[0].sent", "unknown command"),
+    ('[[expect]]\nreached_point = 40', "expect[0].reached_point", "1-21"),
+    ('[rules]\nmin_period = "0ms"', "rules.min_period", "longer than 0"),
+    ('[response_handling]\nsignal = "o_bErr OR"', "response_handling.signal", "column"),
+    ('watch = ["9lives"]', "watch[0]", "label path"),
+    ('sources = ["nope/*.st"]', "sources[0]", "matches no file"),
+    ('bogus = 1', "bogus", "unknown key"),
+])
+def test_every_mistake_names_its_key(text, key, words):
+    error = error_of('program = "Main"\n' + text + "\n", Path("x.toml"))
+    assert error.key == key
+    assert words in error.message
+    assert str(error).startswith("x.toml")
+
+
+def test_a_missing_scenario_file(tmp_path):
+    with pytest.raises(ScenarioError, match="no such scenario file"):
+        load_scenario(tmp_path / "none.toml")
+
+
+# --- expectations -----------------------------------------------------------------------------
+
+S = protocol.Settings()
+
+
+def _evidence(changes: dict[str, list[tuple[int, object]]], trace=(), end_us: int = 10_000_000) -> RunEvidence:
+    samples = Samples(list(changes))
+    moments = sorted({t for history in changes.values() for t, _ in history})
+    for t in moments:
+        samples.record(t, {n: v for n, h in changes.items() for tt, v in h if tt == t})
+    return RunEvidence(S, list(trace), end_us, (), samples)
+
+
+def _judge(text: str, evidence: RunEvidence):
+    scenario = parse_scenario('program = "M"\nduration = "10s"\n' + text)
+    traffic = analyse(evidence.trace, S, evidence.options)
+    return [judge(e, evidence, traffic) for e in scenario.expectations]
+
+
+def test_that_always_never():
+    evidence = _evidence({"ok": [(0, False), (3_000_000, True), (6_000_000, False)], "n": [(0, 0), (5_000_000, 0x101)]})
+    results = _judge(
+        '[[expect]]\nthat = "ok"\nwithin = "4s"\n'
+        '[[expect]]\nthat = "ok"\nwithin = "2s"\n'
+        '[[expect]]\nalways = "ok"\nafter = "3s"\nwithin = "2s"\n'
+        '[[expect]]\nalways = "ok"\nafter = "3s"\nwithin = "4s"\n'
+        '[[expect]]\nnever = "n = 16#0101"\nwithin = "4s"\n'
+        '[[expect]]\nnever = "n = 16#0101"\n'
+        '[[expect]]\nthat = "ok"\nafter = "4s"\nwithin = "1s"\n',
+        evidence,
+    )
+    assert [r.passed for r in results] == [True, False, True, False, True, False, True]
+    assert results[0].t_us == 3_000_000
+    assert "never became true" in results[1].detail and "ok = False" in results[1].detail
+    assert "false at 6.000 s" in results[3].detail
+    assert "became true at 5.000 s" in results[5].detail
+
+
+def test_a_window_past_the_end_of_the_run_fails_with_advice():
+    (result,) = _judge('[[expect]]\nthat = "ok"\nafter = "8s"\nwithin = "5s"\n', _evidence({"ok": [(0, True)]}))
+    assert not result.passed and "make the scenario's duration longer" in result.detail
+
+
+def _tx(t_ms, request):
+    data = protocol.encode(request, S)
+    return TraceRecord(t_ms * 1000, t_ms * 1000 + protocol.frame_time_us(8), "tx", data)
+
+
+def _rx(request_frame, reply):
+    data = protocol.encode(reply, S)
+    start = request_frame.t_end_us + 5000
+    return TraceRecord(start, start + protocol.frame_time_us(len(data)), "rx", data)
+
+
+def _read(t_ms, value):
+    request = _tx(t_ms, protocol.StatusRequest(1, protocol.Query.TASK))
+    return [request, _rx(request, protocol.StatusReply(1, 0, value))]
+
+
+def _control(t_ms, request):
+    frame = _tx(t_ms, request)
+    return [frame, _rx(frame, protocol.ControlReply.echo(request))]
+
+
+STOP = protocol.ControlRequest(1, protocol.ControlCode.ROBOT, protocol.RobotCommand.STOP)
+POINT3 = protocol.ControlRequest(1, protocol.ControlCode.ROBOT, 3)
+
+
+def test_sent_and_reached_point():
+    trace = _control(0, STOP) + _read(300, 0) + _control(600, POINT3) + _read(900, 1) + _read(1200, 1) + _read(1500, 0)
+    results = _judge(
+        '[[expect]]\nsent = "stop"\nwithin = "1s"\n'
+        '[[expect]]\nsent = "run-point 4"\n'
+        '[[expect]]\nreached_point = 3\nwithin = "2s"\n'
+        '[[expect]]\nreached_point = 3\nwithin = "1s"\n',
+        _evidence({}, trace),
+    )
+    assert [r.passed for r in results] == [True, False, True, False]
+    assert "01 06 01 04 00 00" in results[1].detail
+    assert "running" in results[3].detail and "did not finish" in results[3].detail
+
+
+def test_reached_point_needs_the_task_to_run_and_end_without_error():
+    never_runs = _control(0, STOP) + _read(300, 0) + _control(600, POINT3) + _read(900, 0)
+    (result,) = _judge('[[expect]]\nreached_point = 3\n', _evidence({}, never_runs))
+    assert not result.passed and "never reported the task running" in result.detail
+    request = _tx(1500, protocol.StatusRequest(1, protocol.Query.TASK))
+    error_end = _control(0, STOP) + _control(600, POINT3) + _read(900, 1) + [
+        request, _rx(request, protocol.StatusReply(1, 1, 0))]
+    (result,) = _judge('[[expect]]\nreached_point = 3\n', _evidence({}, error_end))
+    assert not result.passed and "error 01" in result.detail
