@@ -155,3 +155,32 @@ def test_words_pack_two_bytes_per_register_low_byte_first():
     assert result.output.splitlines()[1] == "words (low byte first): H0601 HA001 H0000 H1488"
     from verifier.commands.frame import packed_words
     assert packed_words(b"\x01\x86\x03\x02\x61") == [0x8601, 0x0203, 0x0061]
+
+
+def test_decode_direction_and_settings():
+    result = run("--decode", "01 06 01 A0 00 00 88 14", "--as", "reply")
+    assert result.exit_code == 0 and "FC06 reply: echo: stop (01/A0)" in result.output
+    result = run("--decode", "01 01 00 00 00 16 BD C4", "--as", "reply")
+    assert result.exit_code == 1 and "byte 2: byte count must be 03" in result.output
+    hex_rotate = run("--codes-10-13", "hex", "rotate", "+1").output.strip()
+    assert run("--codes-10-13", "hex", "--decode", hex_rotate).exit_code == 0
+    wrong = run("--decode", hex_rotate)
+    assert wrong.exit_code == 1 and "codes_10_13=decimal" in wrong.output
+    assert "read task status (query 2)" in run("--status-order", "return", "--decode", "01 01 00 02 00 16 1C 04").output
+
+
+def test_raw_and_negative_numbers_need_no_double_dash():
+    assert run("raw", "12", "100").output.strip() == run("rotate", "+1").output.strip()
+    assert run("raw", "0x01", "0xA0").output.strip() == "01 06 01 A0 00 00 88 14"
+    assert run("move", "y", "-0.3").output.strip() == "01 06 0B 03 00 00 7B EE"
+    result = run("raw", "1", "32")
+    assert result.exit_code == 2 and "unknown robot command 0x20" in result.output
+
+
+def test_help_lists_every_command_form():
+    result = run("--help")
+    assert result.exit_code == 0
+    for form in ("run-point N", "seek-tape", "follow-tape", "rotate-on-tape", "coordinate-reset",
+                 "manual-mode", "speed trackless|magnetic", "collision-range", "jog", "move x|front|rear|y",
+                 "rotate ±VALUE", "read task|vehicle|speed|battery", "raw CODE CMD"):
+        assert form in result.output
