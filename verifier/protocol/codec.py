@@ -20,6 +20,7 @@ from verifier.protocol.catalogue import (
     ControlCode,
     ExceptionCode,
     ManualMove,
+    Query,
     RobotCommand,
     RobotError,
     command_problem,
@@ -80,7 +81,8 @@ def encode(frame: Frame, settings: Settings = DEFAULT_SETTINGS, *, strict: bool 
     """
     _check_byte("address", frame.address)
     if isinstance(frame, (ControlRequest, ControlReply)):
-        return with_crc(bytes((frame.address, FC_WRITE_SINGLE_REGISTER)) + _control_field(frame, settings, strict) + b"\x00\x00")
+        field = _control_field(frame, settings, strict)
+        return with_crc(bytes((frame.address, FC_WRITE_SINGLE_REGISTER)) + field + b"\x00\x00")
     if isinstance(frame, StatusRequest):
         return with_crc(_status_request_body(frame, settings, strict))
     if isinstance(frame, StatusReply):
@@ -123,7 +125,7 @@ def _status_request_body(frame: StatusRequest, settings: Settings, strict: bool)
         raise ValueError(f"quantity must be 0-65535, got {frame.quantity}")
     if strict and frame.quantity != STATUS_QUANTITY:
         raise ValueError(f"quantity must be {STATUS_QUANTITY}, got {frame.quantity}")
-    if frame.query in (0, 1, 2, 3) and not isinstance(frame.query, bool):
+    if is_member(Query, frame.query):
         parameter = wire_query(frame.query, settings)
     elif strict:
         raise ValueError(f"unknown query {frame.query!r} (0-3)")
