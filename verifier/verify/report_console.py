@@ -37,7 +37,7 @@ def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
     )
     if result.aborted:
         console.print(f"    [red]simulation stopped[/]: {escape(result.aborted)}")
-    for violation in result.all_violations()[:first]:
+    for violation in _first_violations(result, first):
         origin = f"  [dim]sent by {escape(violation.origin)}[/]" if violation.origin else ""
         console.print(
             f"    [red]{violation.rule}[/] at {format_seconds(violation.t_us)}: {escape(violation.message)}{origin}"
@@ -52,6 +52,22 @@ def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
         console.print(f"    … and {hidden} more violation(s) (see --json or --html for all)")
     for outcome in result.failed_expectations:
         console.print(f"    [red]expected[/] {escape(outcome.expectation.label)}: {escape(outcome.detail)}")
+
+
+def _first_violations(result: ScenarioResult, first: int) -> list:
+    """The first violation of each broken rule, then the next ones in time order, `first` in all."""
+    everything = result.all_violations()
+    chosen = []
+    for found in result.violations.values():
+        if found:
+            chosen.append(min(found, key=lambda v: v.t_us))
+    chosen = sorted(chosen, key=lambda v: v.t_us)[:first]
+    for violation in everything:
+        if len(chosen) >= first:
+            break
+        if violation not in chosen:
+            chosen.append(violation)
+    return sorted(chosen, key=lambda v: (v.t_us, v.rule))
 
 
 def _rule_table(results: list[ScenarioResult]) -> Table:

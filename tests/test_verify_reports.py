@@ -1,0 +1,228 @@
+"""The reports: JSON verdict, JUnit XML as CI servers read it, the JSON Lines trace, the console
+summary, and the HTML page rendered in headless Chromium and checked from its DOM."""
+from __future__ import annotations
+
+import io
+import re
+import json
+import shutil
+import subprocess
+import tempfile
+import xml.etree.ElementTree as ET
+from html.parser import HTMLParser
+from pathlib import Path
+
+from rich.console import Console
+
+from verifier import protocol
+from verifier.verify import report_console, report_html, report_json, report_junit, report_trace
+from verifier.verify.conditions import parse_condition
+from verifier.verify.evidence import RunEvidence
+from verifier.verify.expectations import Expectation, ExpectationResult
+from verifier.verify.result import LineEvent, ScenarioResult, TraceRecord
+from verifier.verify.rules import RULES, check_all
+
+S = protocol.Settings()
+STOP = protocol.ControlRequest(1, protocol.ControlCode.ROBOT, protocol.RobotCommand.STOP)
+POINT3 = protocol.ControlRequest(1, protocol.ControlCode.ROBOT, 3)
+READ = protocol.StatusRequest(1, protocol.Query.TASK)
+
+
+def _frames(t_us: int, request, reply) -> list[TraceRecord]:
+    data = protocol.encode(request, S)
+    end = t_us + protocol.frame_time_us(len(data))
+    out = [TraceRecord(t_us, end, "tx", data, "UITAMR_Engine.st:210:9")]
+    if reply is not None:
+        answer = protocol.encode(reply, S)
+        out.append(TraceRecord(end + 5000, end + 5000 + protocol.frame_time_us(len(answer)), "rx", answer))
+    return out
+
+
+def _result(name: str, trace: list[TraceRecord], end_us: int, expectations=()) -> ScenarioResult:
+    evidence = RunEvidence(S, trace, end_us)
+    return ScenarioResult(
+        name=name, file=f"plc/scenarios/{name}.toml", description=f"{name} <desc & more>",
+        program="Main", platform="fx3u", channel="fx3:1", sources=["Main.st"], duration_us=end_us,
+        scan_us=10_000, seed=0, settings=S, trace=trace, violations=check_all(evidence),
+        expectations=list(expectations), ended_us=end_us,
+        events=[LineEvent(1_000_000, "collision", "both sides transmitted")],
+        faults=["no_reply at 10 s for 2 s"],
+    )
+
+
+def good_result() -> ScenarioResult:
+    trace = _frames(0, STOP, protocol.ControlReply.echo(STOP))
+    for i in range(1, 20):
+        trace += _frames(300_000 * i, READ, protocol.StatusReply(1, 0, 0))
+    met = ExpectationResult(Expectation("that", "o_bOK within 2 s", condition=parse_condition("o_bOK")), True, "true at 0.400 s", 400_000)
+    return _result("healthy", trace, 6_000_000, [met])
+
+
+def bad_result() -> ScenarioResult:
+    trace = _frames(0, POINT3, protocol.ControlReply.echo(POINT3))
+    for i in range(1, 10):
+        trace += _frames(200_000 * i, READ, protocol.StatusReply(1, 0, 1))
+    missed = ExpectationResult(Expectation("reached_point", "robot reached point 3", point=3), False, "did not finish")
+    return _result("broken", trace, 2_500_000, [missed])
+
+
+def test_json_has_a_top_level_verdict_and_every_violation(tmp_path):
+    path = tmp_path / "r.json"
+    report_json.write([good_result(), bad_result()], path)
+    data = json.loads(path.read_text())
+    assert data["verdict"] == "fail"
+    healthy, broken = data["scenarios"]
+    assert healthy["verdict"] == "pass" and broken["verdict"] == "fail"
+    assert broken["rules"]["UITAMR-PACING"] == {"status": "fail", "violations": 9}
+    assert broken["rules"]["UITAMR-POWERON-STOP"]["violations"] == 1
+    first = broken["violations"][0]
+    assert first["rule"] == "UITAMR-POWERON-STOP" and first["t"] == 0.0
+    assert first["frames"][0]["hex"] == "01 06 01 03 00 00 78 36"
+    assert first["origin"] == "UITAMR_Engine.st:210:9"
+    assert broken["expectations"][0]["passed"] is False
+    assert data["summary"]["violations"]["UITAMR-PACING"] == 9
+    assert [r["id"] for r in data["rules"]] == [r.id for r in RULES]
+    report_json.write([good_result()], path)
+    assert json.loads(path.read_text())["verdict"] == "pass"
+
+
+def test_junit_has_one_testcase_per_scenario_and_a_failure_per_broken_rule(tmp_path):
+    path = tmp_path / "r.xml"
+    report_junit.write([good_result(), bad_result()], path)
+    root = ET.parse(path).getroot()
+    assert root.tag == "testsuites" and root.get("tests") == "2" and root.get("failures") == "3"
+    cases = root.findall("./testsuite/testcase")
+    assert [c.get("name") for c in cases] == ["healthy", "broken"]
+    assert cases[0].find("failure") is None
+    kinds = sorted(f.get("type") for f in cases[1].findall("failure"))
+    assert kinds == ["UITAMR-PACING", "UITAMR-POWERON-STOP", "expectation"]
+    pacing = next(f for f in cases[1].findall("failure") if f.get("type") == "UITAMR-PACING")
+    assert pacing.get("message").startswith("UITAMR-PACING: 9 violation(s); first at 0.200 s")
+    assert "01 01 00 00 00 16 BD C4" in pacing.text
+    assert cases[1].get("file") == "plc/scenarios/broken.toml"
+
+
+def test_trace_is_one_frame_per_line_with_time_direction_hex_and_meaning(tmp_path):
+    path = tmp_path / "t.jsonl"
+    report_trace.write([bad_result()], path)
+    lines = path.read_text().splitlines()
+    records = [json.loads(line) for line in lines]
+    assert len(records) == 20
+    first, reply = records[0], records[1]
+    assert first["t"] == 0.0 and first["dir"] == "tx" and first["hex"] == "01 06 01 03 00 00 78 36"
+    assert "point" in first["meaning"] and first["origin"] == "UITAMR_Engine.st:210:9"
+    assert first["rules"] == ["UITAMR-PACING", "UITAMR-POWERON-STOP"]  # evidence for both
+    assert reply["dir"] == "rx" and reply["t"] > first["t_end"]
+    assert "running" in records[3]["meaning"]
+    assert all(isinstance(r["t"], float) for r in records)
+
+
+def test_console_summary_shows_verdict_counts_and_first_violations():
+    out = io.StringIO()
+    report_console.render([good_result(), bad_result()], Console(file=out, width=200, color_system=None))
+    text = out.getvalue()
+    assert "PASS healthy" in text and "FAIL broken" in text
+    assert "UITAMR-POWERON-STOP at 0.000 s" in text
+    assert "sent by UITAMR_Engine.st:210:9" in text
+    assert "UITAMR-PACING" in text and "more violation" in text
+    assert "expected robot reached point 3: did not finish" in text
+    assert text.rstrip().endswith("FAIL: 1 of 2 scenario(s) failed")
+
+
+def test_console_shows_the_first_violation_of_every_broken_rule_before_more_of_one():
+    out = io.StringIO()
+    report_console.render([bad_result()], Console(file=out, width=200, color_system=None), first=2)
+    text = out.getvalue()
+    assert "UITAMR-POWERON-STOP at" in text and "UITAMR-PACING at 0.200 s" in text
+
+
+def _chromium() -> str:
+    found = shutil.which("chromium") or shutil.which("chromium-browser")
+    assert found, "chromium is required (CI installs it: apt-get install chromium)"
+    return found
+
+
+def _chromium_flags(profile: str) -> list[str]:
+    return [
+        "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+        "--disable-background-networking", "--disable-component-update", "--disable-sync",
+        f"--user-data-dir={profile}", "--window-size=1400,1000",
+    ]
+
+
+def test_html_report_renders_in_chromium_with_a_timing_diagram_and_violation_markers(tmp_path):
+    page = tmp_path / "report.html"
+    report_html.write([good_result(), bad_result()], page)
+    html = page.read_text()
+    assert not re.search(r"(src|href)=\"?(https?:)?//|<link|@import|url\(", html)  # self-contained
+    with tempfile.TemporaryDirectory() as profile:
+        dom = subprocess.run(
+            [_chromium(), *_chromium_flags(profile), "--dump-dom", page.as_uri()],
+            capture_output=True, text=True, timeout=120,
+        ).stdout
+    root = _parse_dom(dom)
+    sections = [s for s in root.iter("section") if "scenario" in (s.get("class") or "")]
+    assert [s.get("data-verdict") for s in sections] == ["pass", "fail"]
+    good, bad = sections
+    assert _count(good, "rect", "frame") == 40 and _count(good, "g", "violation") == 0
+    assert _count(bad, "rect", "frame") == 20
+    markers = [g for g in bad.iter("g") if "violation" in (g.get("class") or "").split()]
+    assert len(markers) == 10
+    assert {m.get("data-rule") for m in markers} == {"UITAMR-PACING", "UITAMR-POWERON-STOP"}
+    windows = [r for r in bad.iter("rect") if "window" in (r.get("class") or "").split()]
+    assert len(windows) == 10 and sum("broken" in r.get("class") for r in windows) == 9
+    # the script laid the diagram out: every frame has a position and a visible width
+    frames = [r for r in bad.iter("rect") if "frame" in (r.get("class") or "").split()]
+    assert all(float(r.get("width")) >= 2 for r in frames)
+    assert sorted(float(r.get("x")) for r in frames) == [float(r.get("x")) for r in frames]
+    assert root.find(".//*[@id='verdict']").text == "FAIL"
+
+
+def test_html_screenshot_is_taken(tmp_path):
+    page = tmp_path / "report.html"
+    report_html.write([bad_result()], page)
+    shot = tmp_path / "shot.png"
+    with tempfile.TemporaryDirectory() as profile:
+        subprocess.run([_chromium(), *_chromium_flags(profile), f"--screenshot={shot}", page.as_uri()],
+                       capture_output=True, timeout=120)
+    assert shot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and shot.stat().st_size > 10_000
+
+
+def _count(root: ET.Element, tag: str, cls: str) -> int:
+    return sum(1 for e in root.iter(tag) if cls in (e.get("class") or "").split())
+
+
+VOID = {"area", "base", "br", "col", "embed", "hr", "img", "input", "link", "meta", "source", "track", "wbr"}
+
+
+class _Dom(HTMLParser):
+    """Chromium's --dump-dom output as an ElementTree (tags and attributes; text kept)."""
+
+    def __init__(self):
+        super().__init__(convert_charrefs=True)
+        self.root = ET.Element("document")
+        self.stack = [self.root]
+
+    def handle_starttag(self, tag, attrs):
+        element = ET.SubElement(self.stack[-1], tag, {k: v or "" for k, v in attrs})
+        if tag not in VOID:
+            self.stack.append(element)
+
+    def handle_startendtag(self, tag, attrs):
+        ET.SubElement(self.stack[-1], tag, {k: v or "" for k, v in attrs})
+
+    def handle_endtag(self, tag):
+        for depth in range(len(self.stack) - 1, 0, -1):
+            if self.stack[depth].tag == tag:
+                del self.stack[depth:]
+                return
+
+    def handle_data(self, data):
+        node = self.stack[-1]
+        node.text = (node.text or "") + data
+
+
+def _parse_dom(dom: str) -> ET.Element:
+    parser = _Dom()
+    parser.feed(dom)
+    return parser.root
