@@ -1,0 +1,933 @@
+"""ST statements and expressions -> Python source, one POU at a time.
+
+The generated code works on canonical Python values (see `datatypes`): every arithmetic
+result is normalised to its ST type (INT wraps at 16 bits, REAL is rounded to single
+precision...), array indexes are checked against the declared bounds with the ST
+location of the access, and every emitted line remembers the ST statement it came from,
+so a run-time error is reported at an ST line, not a Python one.
+"""
+from __future__ import annotations
+
+import keyword
+
+from verifier.st import ast
+
+from . import datatypes, instructions, stdfuncs
+from .typesys import (ANYINT, ANYREAL, ArrayT, CompileError, FbT, PouInfo, StringT, StructT,
+                      Symbol, concrete, is_int, is_real, is_string, norm_code, unify)
+
+SEND_FLAGS = {
+    "fx3": {"M8402": "fx3:1", "M8422": "fx3:2"},
+    "fx5": {"SM8561": "fx5:1", "SM8571": "fx5:2"},
+    "q": {},
+}
+LOOP_LIMIT = 1_000_000
+
+
+def attr_name(name: str) -> str:
+    return name + "_" if keyword.iskeyword(name) or name in ("None", "True", "False") else name
+
+
+class Emitter:
+    """Indented Python lines, each tagged with the ST span it implements."""
+
+    def __init__(self):
+        self.lines: list[str] = []
+        self.spans: list[object] = []
+        self.depth = 0
+        self.span = None
+
+    def line(self, text: str) -> None:
+        self.lines.append("    " * self.depth + text)
+        self.spans.append(self.span)
+
+    def indent(self):
+        self.depth += 1
+
+    def dedent(self):
+        self.depth -= 1
+
+
+class LValue:
+    """A writable place: lines to prepare it, code to read it, a template to write it."""
+
+    def __init__(self, type_, read: str, write: str, prep=(), label: str = ""):
+        self.type = type_
+        self.read = read
+        self.write_tpl = write  # contains {v}
+        self.prep = list(prep)
+        self.label = label
+
+    def write(self, value_code: str) -> str:
+        return self.write_tpl.format(v=value_code)
+
+
+class BodyCompiler:
+    """Compiles the statements of one POU (FB/PROGRAM method body or FUNCTION)."""
+
+    def __init__(self, module, info: PouInfo, em: Emitter):
+        self.m = module  # the ModuleCompiler: symbols, types, runtime, location table
+        self.info = info
+        self.em = em
+        self.family = module.cpu.family
+        self.is_function = info.kind == "FUNCTION"
+        self.tmp = 0
+        self.static_refs: list[tuple[str, str]] = []  # (slot, code) created in __init__
+        self.pulse_slots: list[str] = []
+
+    # ------------------------------------------------------------------ helpers
+    def new_tmp(self, prefix="_t") -> str:
+        self.tmp += 1
+        return f"{prefix}{self.tmp}"
+
+    def loc(self, span) -> int:
+        return self.m.loc(span)
+
+    def lookup(self, name: str, span) -> Symbol:
+        key = name.upper()
+        sym = self.info.symbols.get(key) or self.m.globals.get(key)
+        if sym is None:
+            raise CompileError(span, f"unknown label {name!r}")
+        return sym
+
+    # ------------------------------------------------------------------ expressions
+    def expr(self, e: ast.Expr):
+        if isinstance(e, ast.IntLiteral):
+            return repr(e.value), ANYINT
+        if isinstance(e, ast.RealLiteral):
+            return repr(float(e.value)), ANYREAL
+        if isinstance(e, ast.BoolLiteral):
+            return ("True" if e.value else "False"), "BOOL"
+        if isinstance(e, ast.TimeLiteral):
+            return repr(datatypes.wrap32(e.ms)), "TIME"
+        if isinstance(e, ast.StringLiteral):
+            return repr(e.value), StringT(max(len(e.value), 1))
+        if isinstance(e, ast.Name):
+            sym = self.lookup(e.name, e.span)
+            return sym.code, sym.type
+        if isinstance(e, ast.Device):
+            lv = self.device_lvalue(e)
+            return lv.read, lv.type
+        if isinstance(e, ast.Index):
+            code, t, _ = self.index_access(e)
+            return code, t
+        if isinstance(e, ast.Member):
+            return self.member(e)
+        if isinstance(e, ast.BitAccess):
+            code, t = self.expr(e.base)
+            self.check_bit(e.bit, t, e.span)
+            return f"(({code}) >> {e.bit} & 1 == 1)", "BOOL"
+        if isinstance(e, ast.UnaryOp):
+            code, t = self.expr(e.operand)
+            return self.unary_code(e.op, code, t, e.span)
+        if isinstance(e, ast.BinaryOp):
+            lc, lt = self.expr(e.left)
+            rc, rt_ = self.expr(e.right)
+            return self.binary_code(e.op, lc, lt, rc, rt_, e.span)
+        if isinstance(e, ast.Call):
+            return self.call_expr(e)
+        raise CompileError(e.span, f"cannot simulate expression {type(e).__name__}")
+
+    def check_bit(self, bit: int, t, span) -> None:
+        width = {"WORD": 16, "INT": 16, "UINT": 16, "DWORD": 32, "DINT": 32, "UDINT": 32}.get(t)
+        if width is None:
+            raise CompileError(span, f"bit access .{bit} needs a WORD/INT/DWORD/DINT label, not {t}")
+        if not 0 <= bit < width:
+            raise CompileError(span, f"bit {bit} does not exist in a {width}-bit {t}")
+
+    def unary_code(self, op, code, t, span):
+        if op == "-":
+            if t in (ANYINT, ANYREAL) or is_real(t):
+                return f"(-({code}))", t
+            return norm_code(t, f"-({code})"), t
+        # NOT
+        if t == "BOOL":
+            return f"(not ({code}))", "BOOL"
+        if t in ("WORD", "UINT"):
+            return f"(({code}) ^ 65535)", t
+        if t in ("DWORD", "UDINT"):
+            return f"(({code}) ^ 4294967295)", t
+        if is_int(t):
+            return f"(~({code}))", t
+        raise CompileError(span, f"NOT needs BOOL or a bit string, not {t}")
+
+    def binary_code(self, op, lc, lt, rc, rt_, span):
+        if op in ("=", "<>", "<", ">", "<=", ">="):
+            py = {"=": "==", "<>": "!="}.get(op, op)
+            return f"(({lc}) {py} ({rc}))", "BOOL"
+        if op in ("AND", "OR", "XOR"):
+            py = {"AND": "&", "OR": "|", "XOR": "^"}[op]
+            if lt == "BOOL" or rt_ == "BOOL":
+                if lt != "BOOL" or rt_ != "BOOL":
+                    raise CompileError(span, f"{op} mixes BOOL with {lt if lt != 'BOOL' else rt_}")
+                return f"(({lc}) {py} ({rc}))", "BOOL"
+            t = unify(lt, rt_)
+            code = f"(({lc}) {py} ({rc}))"
+            return (norm_code(t, code) if lt != rt_ else code), t
+        t = unify(lt, rt_)
+        if is_string(t):
+            raise CompileError(span, f"operator {op} does not apply to STRING")
+        k = self.loc(span)
+        if op == "**":
+            return f"_f32(_expt({lc}, {rc}, {k}))", "REAL"
+        if t == ANYINT:  # both literals: constant arithmetic, typed later
+            if op == "/":
+                return f"_idiv({lc}, {rc}, {k})", ANYINT
+            if op == "MOD":
+                return f"_imod({lc}, {rc}, {k})", ANYINT
+            return f"(({lc}) {op} ({rc}))", ANYINT
+        if is_real(t) or t == ANYREAL:
+            real_t = concrete(t)
+            if op == "/":
+                raw = f"_rdiv({lc}, {rc}, {k})"
+            elif op == "MOD":
+                raise CompileError(span, "MOD needs integer operands")
+            else:
+                raw = f"({lc}) {op} ({rc})"
+            return norm_code(real_t, raw), real_t
+        if t == "BOOL":
+            raise CompileError(span, f"operator {op} does not apply to BOOL")
+        if op == "/":
+            return norm_code(t, f"_idiv({lc}, {rc}, {k})"), t
+        if op == "MOD":
+            return f"_imod({lc}, {rc}, {k})", t
+        return norm_code(t, f"({lc}) {op} ({rc})"), t
+
+    def coerce(self, code: str, src, dst, span) -> str:
+        """Code converting a value of type src to be stored in a dst label."""
+        if src == dst:
+            return code
+        if isinstance(dst, (ArrayT, StructT, FbT)):
+            raise CompileError(span, f"cannot assign {src} to {dst}")
+        if dst == "BOOL":
+            if src != "BOOL":
+                raise CompileError(span, f"cannot assign {src} to BOOL")
+            return code
+        if is_string(dst):
+            if not is_string(src):
+                raise CompileError(span, f"cannot assign {src} to STRING")
+            return norm_code(dst, code) if isinstance(dst, StringT) else code
+        if src == ANYINT or src == ANYREAL:
+            try:
+                value = eval(code, {"__builtins__": {}}, {})  # a folded literal expression
+            except Exception:
+                value = None
+            if isinstance(value, (int, float)) and not isinstance(value, bool):
+                if is_real(dst):
+                    return repr(datatypes.NORMALIZERS[dst](float(value)))
+                if isinstance(value, float):
+                    raise CompileError(span, f"cannot assign a REAL constant to {dst}")
+                return repr(datatypes.NORMALIZERS[dst](value))
+        if is_real(dst):
+            if is_real(src) or src == ANYREAL:
+                return norm_code(dst, code) if dst == "REAL" and src != "REAL" else code
+            return norm_code(dst, f"float({code})")
+        if is_int(dst):
+            if is_real(src) or src == ANYREAL:
+                return f"_r2i({code}, {dst!r}, {self.loc(span)})"
+            if src == "BOOL":
+                raise CompileError(span, f"cannot assign BOOL to {dst} (use BOOL_TO_{dst})")
+            return norm_code(dst, code)
+        return code
+
+    # ------------------------------------------------------------------ places
+    def device_lvalue(self, d: ast.Device) -> LValue:
+        cpu = self.m.cpu
+        label = d.text or d.key
+        if d.module is not None:
+            g = self.m.buffer_global(int(d.module, 16))
+            idx = d.number
+            return LValue("INT", f"{g}[{idx}]", f"{g}[{idx}] = (({{v}}) + 32768 & 65535) - 32768",
+                          label=label)
+        area = cpu.areas.get(d.kind)
+        if area is None:
+            raise CompileError(d.span, f"device {label}: the {cpu.name} CPU profile has no "
+                                       f"{d.kind} devices the simulator can run")
+        try:
+            index = int(d.address, area.radix)
+        except ValueError:
+            raise CompileError(d.span, f"device {label}: {d.kind} numbers are base {area.radix} "
+                                       f"on the {cpu.name}") from None
+        if index >= area.size:
+            raise CompileError(d.span, f"device {label} does not exist on the {cpu.name}")
+        cells = f"_A_{d.kind}"
+        self.m.use_area(d.kind)
+        prep = []
+        idx_code = str(index)
+        if d.index is not None:
+            if "Z" not in cpu.areas:
+                raise CompileError(d.span, f"{cpu.name} has no index registers")
+            self.m.use_area("Z")
+            t = self.new_tmp()
+            k = self.m.oob_id(d.span, label, 0, area.size - 1)
+            prep.append(f"{t} = {index} + _A_Z[{d.index}]")
+            prep.append(f"if not 0 <= {t} < {area.size}: _oob({t}, {k})")
+            idx_code = t
+        place = f"{cells}[{idx_code}]"
+        if d.digits is not None:
+            if area.kind != "bit":
+                raise CompileError(d.span, f"digit specification needs a bit device: {label}")
+            if index + d.digits * 4 > area.size:
+                raise CompileError(d.span, f"{label} runs past the end of {d.kind}")
+            t = "INT" if d.digits <= 4 else "DINT"
+            return LValue(t, f"_digits_get({cells}, {idx_code}, {d.digits})",
+                          f"_digits_set({cells}, {idx_code}, {d.digits}, {{v}})", prep, label)
+        if d.bit is not None:
+            if area.kind != "word":
+                raise CompileError(d.span, f"{label}: only word devices have addressable bits")
+            mask = 1 << d.bit
+            read = f"(({place}) >> {d.bit} & 1 == 1)"
+            write = (f"{place} = (((({place}) | {mask}) if ({{v}}) else (({place}) & ~{mask})) "
+                     f"+ 32768 & 65535) - 32768")
+            return LValue("BOOL", read, write, prep, label)
+        flag_channel = SEND_FLAGS.get(self.family, {}).get(f"{d.kind}{index}")
+        if area.kind == "bit":
+            write = f"{place} = {{v}}"
+            if flag_channel:
+                loc = self.m.loc_text(d.span)
+                write = (f"{place} = {{v}}\nif {place}: _rt.origins[{flag_channel!r}] = {loc!r}")
+            return LValue("BOOL", place, write, prep, label)
+        return LValue("INT", place, f"{place} = (({{v}}) + 32768 & 65535) - 32768", prep, label)
+
+    def index_access(self, e: ast.Index):
+        """(read code, element type, LValue) of an array element with checked bounds."""
+        base_code, base_t = self.expr(e.base)
+        if not isinstance(base_t, ArrayT):
+            raise CompileError(e.span, f"{self.label_of(e.base)} is not an array")
+        if len(e.indices) != len(base_t.dims):
+            raise CompileError(e.span, f"{self.label_of(e.base)} has {len(base_t.dims)} "
+                                       f"dimension(s), {len(e.indices)} index(es) given")
+        label = self.label_of(e.base)
+        prep = []
+        flat_parts = []
+        strides = _strides(base_t.dims)
+        const_offset = 0
+        for (lo, hi), ix, st in zip(base_t.dims, e.indices, strides):
+            code, t = self.expr(ix)
+            if not is_int(t):
+                raise CompileError(ix.span, f"array index must be an integer, not {t}")
+            value = self.m.try_const(ix, self.info)
+            if value is not None:
+                if not lo <= value <= hi:
+                    raise CompileError(ix.span, f"index {value} is outside {label}[{lo}..{hi}]")
+                const_offset += (value - lo) * st
+                continue
+            tmp = self.new_tmp()
+            k = self.m.oob_id(ix.span, label, lo, hi)
+            prep.append(f"{tmp} = {code}")
+            prep.append(f"if not {lo} <= {tmp} <= {hi}: _oob({tmp}, {k})")
+            part = f"{tmp} - {lo}" if lo else tmp
+            flat_parts.append(part if st == 1 else f"({part}) * {st}")
+        if const_offset or not flat_parts:
+            flat_parts.append(str(const_offset))
+        flat = " + ".join(flat_parts)
+        place = f"{base_code}[{flat}]"
+        elem_t = base_t.elem
+        if prep:
+            # expression form: checks folded into one conditional expression
+            read = self.checked_expr(e, base_code, base_t, label)
+        else:
+            read = place
+        lv = LValue(elem_t, place, f"{place} = {{v}}", prep, f"{label}[...]")
+        return read, elem_t, lv
+
+    def checked_expr(self, e: ast.Index, base_code, base_t: ArrayT, label: str) -> str:
+        """An array read with bounds checks as a single Python expression (walrus temps)."""
+        parts = []
+        conds = []
+        strides = _strides(base_t.dims)
+        fails = []
+        for (lo, hi), ix, st in zip(base_t.dims, e.indices, strides):
+            value = self.m.try_const(ix, self.info)
+            if value is not None:
+                parts.append(str((value - lo) * st))
+                continue
+            code, _ = self.expr(ix)
+            tmp = self.new_tmp()
+            k = self.m.oob_id(ix.span, label, lo, hi)
+            conds.append(f"{lo} <= ({tmp} := {code}) <= {hi}")
+            fails.append(f"_oob({tmp}, {k})")
+            part = f"{tmp} - {lo}" if lo else tmp
+            parts.append(part if st == 1 else f"({part}) * {st}")
+        code = f"{base_code}[{' + '.join(parts)}]"
+        for cond, fail in reversed(list(zip(conds, fails))):
+            code = f"({code} if {cond} else {fail})"
+        return code
+
+    def label_of(self, e) -> str:
+        if isinstance(e, ast.Name):
+            return e.name
+        if isinstance(e, ast.Member):
+            return f"{self.label_of(e.base)}.{e.member}"
+        if isinstance(e, ast.Index):
+            return f"{self.label_of(e.base)}[...]"
+        if isinstance(e, ast.Device):
+            return e.text or e.key
+        return "?"
+
+    def member(self, e: ast.Member):
+        base_code, base_t = self.expr(e.base)
+        t, attr = self.m.member_of(base_t, e.member, e.span)
+        return f"{base_code}.{attr}", t
+
+    def lvalue(self, e: ast.Expr) -> LValue:
+        if isinstance(e, ast.Name):
+            sym = self.lookup(e.name, e.span)
+            if sym.is_constant:
+                raise CompileError(e.span, f"{e.name} is a constant")
+            write = sym.write if sym.write else f"{sym.code} = {{v}}"
+            return LValue(sym.type, sym.code, write, label=e.name)
+        if isinstance(e, ast.Device):
+            return self.device_lvalue(e)
+        if isinstance(e, ast.Index):
+            _, _, lv = self.index_access(e)
+            return lv
+        if isinstance(e, ast.Member):
+            code, t = self.member(e)
+            return LValue(t, code, f"{code} = {{v}}", label=self.label_of(e))
+        if isinstance(e, ast.BitAccess):
+            base = self.lvalue(e.base)
+            self.check_bit(e.bit, base.type, e.span)
+            mask = 1 << e.bit
+            new = f"((({base.read}) | {mask}) if ({{v}}) else (({base.read}) & ~{mask}))"
+            write = base.write(norm_code(base.type, new))  # keeps the {v} placeholder
+            return LValue("BOOL", f"(({base.read}) >> {e.bit} & 1 == 1)", write, base.prep,
+                          f"{base.label}.{e.bit}")
+        raise CompileError(e.span, "this expression cannot be assigned to")
+
+    # ------------------------------------------------------------------ statements
+    def block(self, stmts: list[ast.Stmt]) -> None:
+        if not stmts:
+            self.em.line("pass")
+            return
+        before = len(self.em.lines)
+        for s in stmts:
+            self.stmt(s)
+        if len(self.em.lines) == before:
+            self.em.line("pass")
+
+    def stmt(self, s: ast.Stmt) -> None:
+        saved = self.em.span
+        self.em.span = s.span
+        try:
+            method = getattr(self, "stmt_" + type(s).__name__, None)
+            if method is None:
+                raise CompileError(s.span, f"cannot simulate statement {type(s).__name__}")
+            method(s)
+        finally:
+            self.em.span = saved
+
+    def emit_lines(self, text: str) -> None:
+        for ln in text.split("\n"):
+            self.em.line(ln)
+
+    def stmt_Empty(self, s):
+        pass
+
+    def stmt_Assign(self, s: ast.Assign):
+        target = self.lvalue(s.target)
+        for p in target.prep:
+            self.em.line(p)
+        if isinstance(target.type, ArrayT):
+            self.copy_array(target, s.value, s.span)
+            return
+        if isinstance(target.type, StructT):
+            code, t = self.expr(s.value)
+            if t != target.type:
+                raise CompileError(s.span, f"cannot assign {t} to {target.type}")
+            self.em.line(f"({target.read})._copy_from({code})")
+            return
+        v = s.value
+        if (isinstance(v, ast.BinaryOp) and v.op == "/"):
+            lc, lt = self.expr(v.left)
+            rc, rt_ = self.expr(v.right)
+            t = unify(lt, rt_)
+            if is_int(t) and t != ANYINT:
+                q = self.new_tmp("_q")
+                self.em.line(f"{q} = _idiv_n({lc}, {rc}, {self.loc(v.span)})")
+                self.em.line(f"if {q} is not None:")
+                self.em.indent()
+                self.emit_lines(target.write(self.coerce(norm_code(t, q), t, target.type, s.span)))
+                self.em.dedent()
+                return
+        if isinstance(v, ast.Call) and self.function_outputs(v):
+            self.call_function_stmt(v, target)
+            return
+        code, t = self.expr(v)
+        self.emit_lines(target.write(self.coerce(code, t, target.type, s.span)))
+
+    def copy_array(self, target: LValue, value: ast.Expr, span):
+        code, t = self.expr(value)
+        if not isinstance(t, ArrayT) or t.size != target.type.size or t.elem != target.type.elem:
+            raise CompileError(span, f"cannot assign {t} to {target.type}")
+        if isinstance(t.elem, StructT):
+            self.em.line(f"for _d, _s in zip({target.read}, {code}): _d._copy_from(_s)")
+        else:
+            self.em.line(f"{target.read}[:] = {code}")
+
+    def stmt_CallStmt(self, s: ast.CallStmt):
+        c = s.call
+        kind = self.m.classify_call(c, self)
+        if kind == "fb":
+            self.call_fb(c)
+        elif kind == "function":
+            self.call_function_stmt(c, None)
+        elif kind == "instruction":
+            self.call_instruction(c, as_stmt=True)
+        else:
+            code, _ = self.call_expr(c)
+            self.em.line(code)
+
+    def stmt_If(self, s: ast.If):
+        for i, br in enumerate(s.branches):
+            code, t = self.expr(br.cond)
+            if t != "BOOL":
+                raise CompileError(br.cond.span, f"condition must be BOOL, not {t}")
+            self.em.line(("if " if i == 0 else "elif ") + code + ":")
+            self.em.indent()
+            self.block(br.body)
+            self.em.dedent()
+        if s.else_body:
+            self.em.line("else:")
+            self.em.indent()
+            self.block(s.else_body)
+            self.em.dedent()
+
+    def stmt_Case(self, s: ast.Case):
+        code, t = self.expr(s.selector)
+        sel = self.new_tmp("_c")
+        self.em.line(f"{sel} = {code}")
+        first = True
+        for clause in s.clauses:
+            conds = []
+            singles = []
+            for lab in clause.labels:
+                if isinstance(lab, ast.CaseRange):
+                    lo = self.m.const(lab.low, self.info)
+                    hi = self.m.const(lab.high, self.info)
+                    conds.append(f"{lo} <= {sel} <= {hi}")
+                else:
+                    singles.append(self.m.const(lab, self.info))
+            if len(singles) == 1:
+                conds.insert(0, f"{sel} == {singles[0]!r}")
+            elif singles:
+                conds.insert(0, f"{sel} in {{{', '.join(map(repr, singles))}}}")
+            self.em.line(("if " if first else "elif ") + " or ".join(conds) + ":")
+            first = False
+            self.em.indent()
+            self.block(clause.body)
+            self.em.dedent()
+        if s.else_body:
+            if first:
+                self.block(s.else_body)
+            else:
+                self.em.line("else:")
+                self.em.indent()
+                self.block(s.else_body)
+                self.em.dedent()
+
+    def stmt_For(self, s: ast.For):
+        var = self.lvalue(s.var)
+        if var.prep or not is_int(var.type):
+            raise CompileError(s.var.span, "the FOR variable must be a plain integer label")
+        start = self.m.try_const(s.start, self.info)
+        end = self.m.try_const(s.end, self.info)
+        step = 1 if s.step is None else self.m.try_const(s.step, self.info)
+        t = var.type
+        lo_t, hi_t = _int_range(t)
+        if (start is not None and end is not None and step not in (None, 0)
+                and lo_t <= end + step <= hi_t and not _assigns(s.body, s.var)):
+            # constant bounds and a body that leaves the counter alone: a Python range
+            v = self.new_tmp("_i")
+            self.em.line(f"for {v} in range({start}, {end + (1 if step > 0 else -1)}, {step}):")
+            self.em.indent()
+            self.emit_lines(var.write(v))
+            self.block(s.body)
+            self.em.dedent()
+            n = max(0, (end - start) // step + 1) if (end - start) * step >= 0 else 0
+            self.em.line("else:")
+            self.em.indent()
+            self.emit_lines(var.write(repr(start + n * step)))
+            self.em.dedent()
+            return
+        sc, st = self.expr(s.start)
+        ec, et = self.expr(s.end)
+        self.emit_lines(var.write(self.coerce(sc, st, t, s.start.span)))
+        e_tmp = self.new_tmp("_e")
+        self.em.line(f"{e_tmp} = {ec}")
+        if s.step is None:
+            step_code, cond = "1", f"{var.read} <= {e_tmp}"
+        elif step is not None:
+            step_code = repr(step)
+            cond = f"{var.read} <= {e_tmp}" if step > 0 else f"{var.read} >= {e_tmp}"
+        else:
+            step_code = self.new_tmp("_s")
+            self.em.line(f"{step_code} = {self.expr(s.step)[0]}")
+            cond = f"({var.read} <= {e_tmp} if {step_code} >= 0 else {var.read} >= {e_tmp})"
+        self.guarded_loop(cond, s.span)
+        self.block(s.body)
+        self.emit_lines(var.write(norm_code(t, f"{var.read} + {step_code}")))
+        self.em.dedent()
+
+    def stmt_While(self, s: ast.While):
+        code, _ = self.expr(s.cond)
+        self.guarded_loop(code, s.span)
+        self.block(s.body)
+        self.em.dedent()
+
+    def guarded_loop(self, cond: str, span) -> None:
+        """`while cond:` with an iteration counter standing in for the CPU's watchdog
+        timer (a loop that never ends in the simulator stops it with the ST location)."""
+        n = self.new_tmp("_n")
+        self.em.line(f"{n} = 0")
+        self.em.line(f"while {cond}:")
+        self.em.indent()
+        self.em.line(f"{n} += 1")
+        self.em.line(f"if {n} > {LOOP_LIMIT}: _wdt({self.loc(span)})")
+
+    def stmt_Repeat(self, s: ast.Repeat):
+        self.guarded_loop("True", s.span)
+        self.block(s.body)
+        code, _ = self.expr(s.until)
+        self.em.line(f"if {code}: break")
+        self.em.dedent()
+
+    def stmt_Exit(self, s):
+        self.em.line("break")
+
+    def stmt_Return(self, s):
+        self.em.line(self.return_code())
+
+    def return_code(self) -> str:
+        if not self.is_function:
+            return "return"
+        outs = self.info.outputs
+        if outs:
+            return "return (_ret, " + ", ".join(o.code for o in outs) + ")"
+        return "return _ret"
+
+    # ------------------------------------------------------------------ calls
+    def call_expr(self, c: ast.Call):
+        kind = self.m.classify_call(c, self)
+        if kind == "function":
+            code, t = self.function_call_code(c)
+            if self.function_outputs(c):
+                raise CompileError(c.span, "a FUNCTION with outputs (=>) must be called as a "
+                                           "statement or as the whole right-hand side")
+            return code, t
+        if kind == "instruction":
+            return self.call_instruction(c, as_stmt=False)
+        if kind == "fb":
+            raise CompileError(c.span, "a function block call is a statement, not a value")
+        args = []
+        for a in c.args:
+            if a.name is not None:
+                raise CompileError(a.span, f"{c.name} takes positional arguments")
+            args.append(self.expr(a.value))
+        res = stdfuncs.generate(c.key, args, self, c.span)
+        if res is None:
+            raise CompileError(c.span, f"unknown function {c.name!r}")
+        return res
+
+    def call_fb(self, c: ast.Call):
+        code, t = self.expr(c.callee)
+        if not isinstance(t, FbT):
+            raise CompileError(c.span, f"{self.label_of(c.callee)} is not a function block instance")
+        o = self.new_tmp("_o")
+        self.em.line(f"{o} = {code}")
+        after = []
+        en_code = None
+        for a in c.args:
+            if a.name is None:
+                raise CompileError(a.span, "function block arguments must be named (IN := ...)")
+            if a.key == "EN" and not a.output:
+                en_code = self.expr(a.value)[0]
+                continue
+            mt, attr = self.m.member_of(t, a.name, a.span)
+            section = self.m.member_section(t, a.key)
+            if a.output:
+                target = self.lvalue(a.value)
+                after.append((target, f"{o}.{attr}", mt, a.span))
+                continue
+            if section == "VAR_IN_OUT":
+                if isinstance(mt, (ArrayT, StructT, FbT)):
+                    vcode, vt = self.expr(a.value)
+                    self.em.line(f"{o}.{attr} = {vcode}")
+                else:
+                    target = self.lvalue(a.value)
+                    for p in target.prep:
+                        self.em.line(p)
+                    self.em.line(f"{o}.{attr} = {target.read}")
+                    after.append((target, f"{o}.{attr}", mt, a.span))
+                continue
+            if isinstance(mt, ArrayT):
+                vcode, vt = self.expr(a.value)
+                self.em.line(f"{o}.{attr}[:] = {vcode}")
+                continue
+            if isinstance(mt, StructT):
+                vcode, vt = self.expr(a.value)
+                self.em.line(f"{o}.{attr}._copy_from({vcode})")
+                continue
+            vcode, vt = self.expr(a.value)
+            self.em.line(f"{o}.{attr} = {self.coerce(vcode, vt, mt, a.span)}")
+        if en_code is not None:
+            self.em.line(f"if {en_code}:")
+            self.em.indent()
+        self.em.line(f"{o}._body()")
+        for target, src, mt, span in after:
+            for p in target.prep:
+                self.em.line(p)
+            self.emit_lines(target.write(self.coerce(src, mt, target.type, span)))
+        if en_code is not None:
+            self.em.dedent()
+
+    def function_outputs(self, c: ast.Call) -> bool:
+        info = self.m.functions.get(c.key)
+        return bool(info and info.outputs and not self.m.is_variable(c, self))
+
+    def function_call_code(self, c: ast.Call):
+        info = self.m.functions[c.key]
+        params = info.inputs
+        values: dict[str, str] = {}
+        pos = 0
+        for a in c.args:
+            if a.output:
+                continue
+            if a.name is None:
+                if pos >= len(params):
+                    raise CompileError(a.span, f"{c.name} takes {len(params)} input(s)")
+                p = params[pos]
+                pos += 1
+            else:
+                matches = [p for p in params if p.key == a.key]
+                if not matches:
+                    raise CompileError(a.span, f"{c.name} has no input {a.name}")
+                p = matches[0]
+            vcode, vt = self.expr(a.value)
+            if isinstance(p.type, (ArrayT, StructT)):
+                if vt != p.type:
+                    raise CompileError(a.span, f"{c.name}.{p.name} is {p.type}, got {vt}")
+                values[p.key] = vcode
+            else:
+                values[p.key] = self.coerce(vcode, vt, p.type, a.span)
+        arglist = []
+        for p in params:
+            if p.key in values:
+                arglist.append(values[p.key])
+            else:
+                arglist.append(self.m.default_code(p.type))
+        return f"{info.class_name}({', '.join(arglist)})", info.return_type
+
+    def call_function_stmt(self, c: ast.Call, target: LValue | None):
+        info = self.m.functions[c.key]
+        code, rtype = self.function_call_code(c)
+        if not info.outputs:
+            if target is not None:
+                self.emit_lines(target.write(self.coerce(code, rtype, target.type, c.span)))
+            else:
+                self.em.line(code)
+            return
+        r = self.new_tmp("_r")
+        self.em.line(f"{r} = {code}")
+        if target is not None:
+            self.emit_lines(target.write(self.coerce(f"{r}[0]", rtype, target.type, c.span)))
+        by_key = {o.key: i + 1 for i, o in enumerate(info.outputs)}
+        # VAR_IN_OUT scalars are written back from the positional argument they came from
+        for i, p in enumerate(info.inputs):
+            if p.section == "VAR_IN_OUT" and p.key in by_key:
+                arg = self.arg_for(c, p, i)
+                if arg is not None:
+                    lv = self.lvalue(arg)
+                    for pr in lv.prep:
+                        self.em.line(pr)
+                    self.emit_lines(lv.write(self.coerce(f"{r}[{by_key[p.key]}]", p.type, lv.type, c.span)))
+        for a in c.args:
+            if a.output:
+                if a.key not in by_key:
+                    raise CompileError(a.span, f"{c.name} has no output {a.name}")
+                o = info.outputs[by_key[a.key] - 1]
+                lv = self.lvalue(a.value)
+                for pr in lv.prep:
+                    self.em.line(pr)
+                self.emit_lines(lv.write(self.coerce(f"{r}[{by_key[a.key]}]", o.type, lv.type, a.span)))
+
+    @staticmethod
+    def arg_for(c: ast.Call, p: Symbol, position: int):
+        pos = 0
+        for a in c.args:
+            if a.output:
+                continue
+            if a.name is None:
+                if pos == position:
+                    return a.value
+                pos += 1
+            elif a.key == p.key:
+                return a.value
+        return None
+
+    def call_instruction(self, c: ast.Call, as_stmt: bool):
+        found = instructions.lookup(c.key, self.family)
+        spec, pulse = found
+        if self.family not in spec.families:
+            raise CompileError(c.span, f"{c.name} does not exist on the {self.m.cpu.name} "
+                                       f"(it is a {'/'.join(sorted(spec.families))} instruction)")
+        want = 1 + len(spec.operands)
+        if len(c.args) != want or any(a.name is not None for a in c.args):
+            raise CompileError(c.span, f"{c.name} is called with {want} positional operands "
+                                       f"(EN first), got {len(c.args)}")
+        en_code, en_t = self.expr(c.args[0].value)
+        if en_t != "BOOL":
+            raise CompileError(c.args[0].span, f"EN of {c.name} must be BOOL, not {en_t}")
+        k = self.loc(c.span)
+        ops = []
+        after = []
+        for kind, a in zip(spec.operands, c.args[1:]):
+            if kind == "val":
+                vcode, vt = self.expr(a.value)
+                if is_real(vt):
+                    raise CompileError(a.span, f"{c.name} operand must be an integer")
+                ops.append(vcode)
+            else:
+                ref, post = self.ref_code(a.value, kind)
+                ops.append(ref)
+                after.extend(post)
+        if pulse:
+            if self.is_function:
+                raise CompileError(c.span, f"{c.name} needs memory of its last EN: not inside a FUNCTION")
+            slot = f"_p{len(self.pulse_slots)}"
+            self.pulse_slots.append(slot)
+            en_var = self.new_tmp("_en")
+            self.em.line(f"{en_var} = {en_code}")
+            en_code = f"({en_var} and not self.{slot})"
+            call = f"_I.{spec.name}({en_code}, {', '.join(ops)}, {k})"
+            if not as_stmt:
+                raise CompileError(c.span, f"{c.name} (pulse form) must be called as a statement")
+            self.em.line(call)
+            self.em.line(f"self.{slot} = {en_var}")
+        else:
+            call = f"_I.{spec.name}({en_code}, {', '.join(ops)}, {k})"
+            if not as_stmt:
+                if after:
+                    raise CompileError(c.span, f"call {c.name} as a statement here")
+                return call, "BOOL"
+            self.em.line(call)
+        for line in after:
+            self.em.line(line)
+        return None, "BOOL"
+
+    def ref_code(self, e: ast.Expr, kind: str) -> tuple[str, list[str]]:
+        """A Ref to the block an instruction operand names; lines to run after the call
+        (copy-back of FUNCTION locals)."""
+        label = self.label_of(e)
+        k = self.loc(e.span)
+        if isinstance(e, (ast.IntLiteral, ast.RealLiteral, ast.BoolLiteral, ast.TimeLiteral,
+                          ast.StringLiteral, ast.BinaryOp, ast.UnaryOp, ast.Call)):
+            raise CompileError(e.span, f"this operand must be a label, array element or device, "
+                                       "not an expression")
+        if isinstance(e, ast.Device):
+            d = e
+            if d.bit is not None or d.digits is not None or d.index is not None or d.module is not None:
+                raise CompileError(d.span, f"{label}: use a plain device as a block operand")
+            lv = self.device_lvalue(d)
+            area = self.m.cpu.areas[d.kind]
+            index = int(d.address, area.radix)
+            tname = "BOOL" if area.kind == "bit" else "INT"
+            return self.static_ref(f"_Ref(_A_{d.kind}, {index}, {tname!r}, _rt, {k}, {label!r})"), []
+        if isinstance(e, ast.Index):
+            base_code, base_t = self.expr(e.base)
+            read, elem_t, lv = self.index_access(e)
+            if not isinstance(elem_t, str):
+                raise CompileError(e.span, f"{label}: elements of {elem_t} cannot be an instruction operand")
+            for p in lv.prep:
+                self.em.line(p)
+            flat = lv.read[len(base_code) + 1:-1]
+            code = f"_Ref({base_code}, {flat}, {elem_t!r}, _rt, {k}, {label!r})"
+            if lv.prep or not self.stable(e.base):
+                return code, []
+            return self.static_ref(code), []
+        code, t = self.expr(e)
+        if isinstance(t, ArrayT):
+            if not isinstance(t.elem, str):
+                raise CompileError(e.span, f"{label}: {t} cannot be an instruction operand")
+            ref = f"_Ref({code}, 0, {t.elem!r}, _rt, {k}, {label!r})"
+            return (self.static_ref(ref) if self.stable(e) else ref), []
+        if not isinstance(t, str):
+            raise CompileError(e.span, f"{label} ({t}) cannot be an instruction operand")
+        if "." in code and not code.startswith("l_"):
+            obj, attr = code.rsplit(".", 1)
+            ref = f"_AttrRef({obj}, {attr!r}, {t!r}, _rt, {k}, {label!r})"
+            return (self.static_ref(ref) if self.stable(e) else ref), []
+        # a FUNCTION local: copy in, run, copy back
+        cell = self.new_tmp("_cell")
+        self.em.line(f"{cell} = [{code}]")
+        return f"_Ref({cell}, 0, {t!r}, _rt, {k}, {label!r})", [f"{code} = {cell}[0]"]
+
+    def stable(self, e: ast.Expr) -> bool:
+        """True when the Python object behind e never changes for this instance (so a
+        Ref to it can be built once, in __init__)."""
+        if self.is_function:
+            return False
+        if isinstance(e, ast.Name):
+            sym = self.lookup(e.name, e.span)
+            return sym.section != "VAR_IN_OUT" and sym.write is None
+        if isinstance(e, ast.Member):
+            return self.stable(e.base) and self.m.member_section_of_expr(e, self) != "VAR_IN_OUT"
+        return False
+
+    def static_ref(self, code: str) -> str:
+        if self.is_function:
+            return code
+        slot = f"_r{len(self.static_refs)}"
+        self.static_refs.append((slot, code))
+        return f"self.{slot}"
+
+
+def _strides(dims) -> list[int]:
+    """Row-major strides of a flattened multi-dimensional array."""
+    strides = []
+    stride = 1
+    for lo, hi in reversed(dims):
+        strides.append(stride)
+        stride *= hi - lo + 1
+    return strides[::-1]
+
+
+def _int_range(t):
+    t = concrete(t)
+    info = datatypes.TYPES.get(t)
+    if info is None or not info.is_integer:
+        return (-(1 << 31), (1 << 31) - 1)
+    if info.kind == "signed":
+        return (-(1 << (info.bits - 1)), (1 << (info.bits - 1)) - 1)
+    return (0, (1 << info.bits) - 1)
+
+
+def _assigns(stmts, var: ast.Expr) -> bool:
+    """Does any statement (nested) assign the label `var`?"""
+    if not isinstance(var, ast.Name):
+        return True
+    key = var.key
+
+    def visit(node) -> bool:
+        if isinstance(node, ast.Assign):
+            t = node.target
+            return isinstance(t, ast.Name) and t.key == key
+        if isinstance(node, ast.For):
+            if isinstance(node.var, ast.Name) and node.var.key == key:
+                return True
+            return any(visit(s) for s in node.body)
+        if isinstance(node, ast.If):
+            return any(visit(s) for b in node.branches for s in b.body) or any(
+                visit(s) for s in (node.else_body or []))
+        if isinstance(node, ast.Case):
+            return any(visit(s) for c in node.clauses for s in c.body) or any(
+                visit(s) for s in (node.else_body or []))
+        if isinstance(node, (ast.While, ast.Repeat)):
+            return any(visit(s) for s in node.body)
+        if isinstance(node, ast.CallStmt):
+            # an output binding or an instruction output operand may write it
+            return any(isinstance(a.value, ast.Name) and a.value.key == key
+                       and (a.output or a is not node.call.args[0]) for a in node.call.args)
+        return False
+
+    return any(visit(s) for s in stmts)

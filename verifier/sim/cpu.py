@@ -1,0 +1,125 @@
+"""CPU profiles: which devices a MELSEC CPU has, how they are numbered, and its special
+relays/registers the simulator drives (always-ON, first scan, operation error).
+
+Sources and assumptions are listed in docs/instructions.md ("CPU profiles").
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+
+@dataclass(frozen=True)
+class Area:
+    name: str
+    kind: str  # "bit" | "word"
+    size: int
+    radix: int = 10
+
+
+@dataclass(frozen=True)
+class CpuProfile:
+    name: str
+    family: str  # "fx3" | "fx5" | "q"
+    areas: dict[str, Area]
+    always_on: tuple[str, ...]
+    always_off: tuple[str, ...]
+    first_scan_on: tuple[str, ...]
+    first_scan_off: tuple[str, ...]
+    op_error_flags: tuple[str, ...]  # set on an operation error
+    op_error_code: str  # word device receiving the error code
+    div_zero_code: int
+    # clock relays: device -> period in ms (ON for half the period)
+    clocks: dict[str, int] = field(default_factory=dict)
+    # does an operation error stop the CPU by default?
+    stops_on_op_error: bool = False
+
+
+def _areas(*areas: Area) -> dict[str, Area]:
+    return {a.name: a for a in areas}
+
+
+FX3U = CpuProfile(
+    name="fx3u",
+    family="fx3",
+    areas=_areas(
+        Area("X", "bit", 0o400, 8), Area("Y", "bit", 0o400, 8),
+        Area("M", "bit", 8512), Area("S", "bit", 4096),
+        Area("D", "word", 8512), Area("R", "word", 32768),
+    ),
+    always_on=("M8000",), always_off=("M8001",),
+    first_scan_on=("M8002",), first_scan_off=("M8003",),
+    op_error_flags=("M8067", "M8068"), op_error_code="D8067",
+    div_zero_code=6706,
+    clocks={"M8011": 10, "M8012": 100, "M8013": 1000, "M8014": 60000},
+)
+
+FX3G = CpuProfile(
+    name="fx3g",
+    family="fx3",
+    areas=_areas(
+        Area("X", "bit", 0o200, 8), Area("Y", "bit", 0o200, 8),
+        Area("M", "bit", 8512), Area("S", "bit", 4096),
+        Area("D", "word", 8512), Area("R", "word", 24000),
+    ),
+    always_on=FX3U.always_on, always_off=FX3U.always_off,
+    first_scan_on=FX3U.first_scan_on, first_scan_off=FX3U.first_scan_off,
+    op_error_flags=FX3U.op_error_flags, op_error_code=FX3U.op_error_code,
+    div_zero_code=6706, clocks=FX3U.clocks,
+)
+
+_SM_CLOCKS = {"SM409": 10, "SM410": 100, "SM411": 200, "SM412": 1000, "SM413": 2000}
+
+FX5U = CpuProfile(
+    name="fx5u",
+    family="fx5",
+    areas=_areas(
+        Area("X", "bit", 1024, 8), Area("Y", "bit", 1024, 8),
+        Area("M", "bit", 32768), Area("L", "bit", 32768), Area("B", "bit", 32768, 16),
+        Area("SM", "bit", 10000), Area("D", "word", 8000), Area("R", "word", 32768),
+        Area("W", "word", 32768, 16), Area("SD", "word", 12000),
+    ),
+    # FX5 keeps the FX3-compatible SM8000/SM8002 beside SM400/SM402.
+    always_on=("SM400", "SM8000"), always_off=("SM401", "SM8001"),
+    first_scan_on=("SM402", "SM8002"), first_scan_off=("SM403", "SM8003"),
+    op_error_flags=("SM0", "SM1"), op_error_code="SD0",
+    div_zero_code=0x3405,
+    clocks=_SM_CLOCKS,
+)
+
+QCPU = CpuProfile(
+    name="q",
+    family="q",
+    areas=_areas(
+        Area("X", "bit", 8192, 16), Area("Y", "bit", 8192, 16),
+        Area("M", "bit", 8192), Area("L", "bit", 8192), Area("B", "bit", 8192, 16),
+        Area("SM", "bit", 2048), Area("D", "word", 12288), Area("R", "word", 32768),
+        Area("W", "word", 8192, 16), Area("SD", "word", 2048),
+    ),
+    always_on=("SM400",), always_off=("SM401",),
+    first_scan_on=("SM402",), first_scan_off=("SM403",),
+    op_error_flags=("SM0", "SM1"), op_error_code="SD0",
+    div_zero_code=4100,
+    clocks=_SM_CLOCKS,
+    stops_on_op_error=True,
+)
+
+PROFILES = {p.name: p for p in (FX3U, FX3G, FX5U, QCPU)}
+# Accepted spellings of a CPU, and the default CPU of each editor target.
+CPU_ALIASES = {"fx3": "fx3u", "fx3uc": "fx3u", "fx3gc": "fx3g", "fx5": "fx5u",
+               "fx5uc": "fx5u", "qcpu": "q", "qnu": "q", "l": "q"}
+TARGET_DEFAULT_CPU = {"gxworks2": "fx3u", "gxworks3": "fx5u"}
+
+
+def profile_for(target: str, cpu: str | None = None) -> CpuProfile:
+    """CPU profile for an editor target ("gxworks2", "gxworks3") or a "target:cpu" pair
+    ("gxworks2:q")."""
+    if cpu is None and ":" in target:
+        target, cpu = target.split(":", 1)
+    if cpu is None:
+        if target not in TARGET_DEFAULT_CPU:
+            raise ValueError(f"unknown target {target!r}; use one of {sorted(TARGET_DEFAULT_CPU)}")
+        cpu = TARGET_DEFAULT_CPU[target]
+    key = CPU_ALIASES.get(cpu.lower(), cpu.lower())
+    if key not in PROFILES:
+        raise ValueError(f"unknown CPU {cpu!r}; use one of {sorted(PROFILES)}")
+    return PROFILES[key]

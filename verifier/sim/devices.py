@@ -1,0 +1,136 @@
+"""Device memory shared by all programs of one simulated CPU (X, Y, M, L, B, SM, D, R, W, SD...).
+
+Bit devices hold Python bools, word devices hold signed 16-bit ints (-32768..32767: a D
+register read as INT).  Device names are parsed the way GX Works writes them: X/Y are
+octal on FX CPUs and hexadecimal on Q, B and W are hexadecimal everywhere.  Also
+understood: bit of a word device (`D100.3`, bit in hex `D100.F`) and digit specification
+of bit devices (`K4M0`: 16 consecutive bits as one word; K1..K4 -> 16-bit, K5..K8 -> 32-bit).
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from .cpu import CpuProfile
+from .datatypes import wrap16, wrap32
+
+_DEVICE_RE = re.compile(r"^(?:K([1-8]))?([A-Z]{1,2})([0-9A-F]+)(?:\.([0-9A-F]))?$")
+
+
+class DeviceError(KeyError):
+    def __str__(self) -> str:  # KeyError quotes its message; keep it readable
+        return str(self.args[0])
+
+
+@dataclass(frozen=True)
+class DeviceAddress:
+    area: str
+    index: int
+    kind: str  # "bit" | "word"
+    bit: int | None = None  # bit of a word device
+    digits: int | None = None  # K-digit specification of a bit device
+
+    @property
+    def value_kind(self) -> str:
+        if self.bit is not None:
+            return "bit"
+        if self.digits is not None:
+            return "word" if self.digits <= 4 else "dword"
+        return self.kind
+
+
+def parse_device(name: str, cpu: CpuProfile) -> DeviceAddress:
+    text = name.strip().upper()
+    m = _DEVICE_RE.match(text)
+    if not m:
+        raise DeviceError(f"{name!r} is not a device name")
+    digits, area_name, number, bit = m.groups()
+    area = cpu.areas.get(area_name)
+    if area is None:
+        raise DeviceError(f"{name!r}: the {cpu.name} has no {area_name} devices")
+    try:
+        index = int(number, area.radix)
+    except ValueError:
+        raise DeviceError(f"{name!r}: {area_name} numbers are base {area.radix}") from None
+    if index >= area.size:
+        raise DeviceError(f"{name!r}: {area_name} ends at {_fmt(area.size - 1, area.radix)} on the {cpu.name}")
+    if bit is not None:
+        if area.kind != "word" or digits:
+            raise DeviceError(f"{name!r}: only word devices have addressable bits")
+        return DeviceAddress(area_name, index, "word", bit=int(bit, 16))
+    if digits:
+        if area.kind != "bit":
+            raise DeviceError(f"{name!r}: digit specification applies to bit devices")
+        n = int(digits) * 4
+        if index + n > area.size:
+            raise DeviceError(f"{name!r}: runs past the end of {area_name}")
+        return DeviceAddress(area_name, index, "bit", digits=int(digits))
+    return DeviceAddress(area_name, index, area.kind)
+
+
+def _fmt(n: int, radix: int) -> str:
+    return {8: f"{n:o}", 16: f"{n:X}"}.get(radix, str(n))
+
+
+class DeviceMemory:
+    """All devices of one CPU.  `mem.D` is the list of D registers, `mem.M` the M relays...
+    (generated code indexes these lists directly).  `mem["D100"]` reads by name."""
+
+    def __init__(self, cpu: CpuProfile):
+        self.cpu = cpu
+        self.areas: dict[str, list] = {}
+        for area in cpu.areas.values():
+            self.areas[area.name] = [False] * area.size if area.kind == "bit" else [0] * area.size
+            setattr(self, area.name, self.areas[area.name])
+
+    def address(self, name: str) -> DeviceAddress:
+        return parse_device(name, self.cpu)
+
+    def __getitem__(self, name: str):
+        a = self.address(name)
+        return self.read(a)
+
+    def __setitem__(self, name: str, value) -> None:
+        self.write(self.address(name), value)
+
+    def read(self, a: DeviceAddress):
+        cells = self.areas[a.area]
+        if a.bit is not None:
+            return bool((cells[a.index] >> a.bit) & 1)
+        if a.digits is not None:
+            return self.read_digits(cells, a.index, a.digits)
+        return cells[a.index]
+
+    def write(self, a: DeviceAddress, value) -> None:
+        cells = self.areas[a.area]
+        if a.bit is not None:
+            word = cells[a.index] & 0xFFFF
+            word = word | (1 << a.bit) if value else word & ~(1 << a.bit)
+            cells[a.index] = wrap16(word)
+        elif a.digits is not None:
+            self.write_digits(cells, a.index, a.digits, value)
+        elif a.kind == "bit":
+            cells[a.index] = bool(value)
+        else:
+            cells[a.index] = wrap16(int(value))
+
+    @staticmethod
+    def read_digits(cells: list, start: int, digits: int) -> int:
+        value = 0
+        for i in range(digits * 4):
+            if cells[start + i]:
+                value |= 1 << i
+        return wrap16(value) if digits <= 4 else wrap32(value)
+
+    @staticmethod
+    def write_digits(cells: list, start: int, digits: int, value: int) -> None:
+        # K1..K3 write only their 4/8/12 bits; the rest of the word is not touched.
+        for i in range(digits * 4):
+            cells[start + i] = bool((value >> i) & 1)
+
+    def read_dword(self, area: str, index: int) -> int:
+        cells = self.areas[area]
+        return wrap32((cells[index] & 0xFFFF) | ((cells[index + 1] & 0xFFFF) << 16))
+
+    def snapshot(self, names: list[str]) -> dict[str, object]:
+        return {n: self[n] for n in names}

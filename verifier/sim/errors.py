@@ -1,0 +1,51 @@
+"""What the simulator reports: user-facing errors that point at ST source locations."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+class LoadError(Exception):
+    """The ST sources could not be loaded: parse or check diagnostics (file:line:col)."""
+
+    def __init__(self, diagnostics):
+        self.diagnostics = list(diagnostics)
+        lines = [_format_diag(d) for d in self.diagnostics]
+        super().__init__("ST sources have errors:\n" + "\n".join("  " + s for s in lines))
+
+
+def _format_diag(d) -> str:
+    file = getattr(d, "file", "?")
+    line = getattr(d, "line", 0)
+    col = getattr(d, "col", 0)
+    sev = getattr(d, "severity", "error")
+    msg = getattr(d, "message", str(d))
+    return f"{file}:{line}:{col}: {sev}: {msg}"
+
+
+class SimulationError(Exception):
+    """The simulated program did something the simulator must stop on (an array index out
+    of bounds, a CPU that stops on an operation error, ...). `location` is the ST source
+    location "file:line:col"; `t_us` the virtual time."""
+
+    def __init__(self, message: str, location: str | None = None, t_us: int | None = None):
+        self.message = message
+        self.location = location
+        self.t_us = t_us
+        where = f"{location}: " if location else ""
+        when = f" (at t={t_us / 1e6:.6f} s)" if t_us is not None else ""
+        super().__init__(f"{where}{message}{when}")
+
+
+@dataclass(frozen=True)
+class SimDiagnostic:
+    """Something the simulator noticed and let pass, as the CPU would (operation errors
+    flagged in SM0/M8067, ...), kept for the report."""
+
+    t_us: int
+    location: str | None
+    code: int
+    message: str
+
+    def __str__(self) -> str:
+        where = f"{self.location}: " if self.location else ""
+        return f"{where}t={self.t_us / 1e6:.6f} s: {self.message} (error code {self.code})"

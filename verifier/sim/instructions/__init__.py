@@ -1,0 +1,137 @@
+"""MELSEC instructions the simulator runs, with the operand kinds the compiler needs.
+
+Operand kinds (after EN): "val" an input value; "src" the head of a block the instruction
+reads; "dst" the head of a block it writes; "blk" a block it reads and writes (control
+data).  Block operands reach the instruction as `verifier.sim.refs.Ref` objects.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from . import basic
+from .rs2 import FX3_CHANNELS, FX5_CHANNELS, Rs2Port
+
+
+@dataclass(frozen=True)
+class InstructionSpec:
+    name: str
+    operands: tuple[str, ...]
+    families: frozenset[str]
+    pulse_form: bool = True  # has a P variant (MOVP ...)
+
+
+_ALL = frozenset({"fx3", "fx5", "q"})
+SPECS = {s.name: s for s in (
+    InstructionSpec("MOV", ("val", "dst"), _ALL),
+    InstructionSpec("BMOV", ("src", "val", "dst"), _ALL),
+    InstructionSpec("FMOV", ("val", "val", "dst"), _ALL),
+    InstructionSpec("SET", ("dst",), _ALL, pulse_form=False),
+    InstructionSpec("RST", ("dst",), _ALL, pulse_form=False),
+    InstructionSpec("CRC", ("src", "val", "dst"), frozenset({"fx3", "fx5"})),
+    InstructionSpec("RS2", ("src", "val", "val", "val", "dst"), frozenset({"fx3", "fx5"}), False),
+    InstructionSpec("ADPRW", ("val", "val", "val", "val", "blk"), frozenset({"fx3"}), False),
+    InstructionSpec("G_OUTPUT", ("val", "blk", "src", "dst"), frozenset({"q"})),
+    InstructionSpec("G_INPUT", ("val", "blk", "dst", "dst"), frozenset({"q"})),
+)}
+# FX5's ADPRW has a completion-bits operand after the data block.
+FX5_ADPRW = InstructionSpec("ADPRW", ("val", "val", "val", "val", "blk", "dst"), frozenset({"fx5"}), False)
+
+
+def lookup(name: str, family: str) -> tuple[InstructionSpec, bool] | None:
+    """(spec, is_pulse_variant) for an instruction name as called from ST, or None."""
+    key = name.upper()
+    if key == "ADPRW" and family == "fx5":
+        return FX5_ADPRW, False
+    if key in SPECS:
+        return SPECS[key], False
+    if key.startswith("GP_") and "G_" + key[3:] in SPECS:
+        return SPECS["G_" + key[3:]], True
+    if key.endswith("P") and key[:-1] in SPECS and SPECS[key[:-1]].pulse_form:
+        return SPECS[key[:-1]], True
+    return None
+
+
+class InstructionSet:
+    """The instruction implementations bound to one runtime (generated code calls
+    `_I.RS2(en, ..., loc_id)`)."""
+
+    def __init__(self, rt):
+        self.rt = rt
+        self._rs2: dict[int, Rs2Port] = {}
+        self._c24 = {}
+        self._adprw = {}
+        fam = rt.cpu.family
+        self._eight_bit = "M8161" if fam == "fx3" else "SM8161"
+
+    def MOV(self, en, s, d, loc_id):
+        return basic.mov(self.rt, en, s, d, loc_id)
+
+    def BMOV(self, en, s, n, d, loc_id):
+        return basic.bmov(self.rt, en, s, n, d, loc_id)
+
+    def FMOV(self, en, s, n, d, loc_id):
+        return basic.fmov(self.rt, en, s, n, d, loc_id)
+
+    def SET(self, en, d, loc_id):
+        return basic.set_(self.rt, en, d, loc_id)
+
+    def RST(self, en, d, loc_id):
+        return basic.rst(self.rt, en, d, loc_id)
+
+    def CRC(self, en, s, n, d, loc_id):
+        return basic.crc(self.rt, en, s, n, d, loc_id, self._eight_bit)
+
+    # -- serial ----------------------------------------------------------------------
+    def rs2_port(self, channel: int, loc_id: int | None = None) -> Rs2Port:
+        port = self._rs2.get(channel)
+        if port is None:
+            fam = self.rt.cpu.family
+            table = FX3_CHANNELS if fam == "fx3" else FX5_CHANNELS
+            if channel not in table:
+                self.rt.fail(loc_id, f"RS2: channel n1={channel} does not exist on the "
+                                     f"{self.rt.cpu.name} (use {' or '.join(map(str, table))})")
+            name = f"{fam}:{channel}"
+            port = Rs2Port(self.rt, self.rt.channel(name), table[channel], fam)
+            self._rs2[channel] = port
+        return port
+
+    def RS2(self, en, s, m, n, n1, d, loc_id):
+        if not en:
+            port = self._rs2.get(n1)
+            return False if port is None else port.call(False, s, m, n, d, loc_id)
+        return self.rs2_port(n1, loc_id).call(True, s, m, n, d, loc_id)
+
+    def c24(self, un: int):
+        from .c24 import C24Module
+
+        mod = self._c24.get(un)
+        if mod is None:
+            mod = C24Module(self.rt, un)
+            self._c24[un] = mod
+        return mod
+
+    def G_OUTPUT(self, en, un, s1, s2, d, loc_id):
+        if not en:
+            return False
+        return self.c24(un).output(s1, s2, d, loc_id)
+
+    def G_INPUT(self, en, un, s, d1, d2, loc_id):
+        if not en:
+            return False
+        return self.c24(un).input(s, d1, d2, loc_id)
+
+    def adprw_port(self, channel: int = 1):
+        from .adprw import AdprwMaster
+
+        port = self._adprw.get(channel)
+        if port is None:
+            port = AdprwMaster(self.rt, channel)
+            self._adprw[channel] = port
+        return port
+
+    def ADPRW(self, en, s, s1, s2, s3, s4d, *rest):
+        if self.rt.cpu.family == "fx5":
+            d2, loc_id = rest
+        else:
+            d2, (loc_id,) = None, rest
+        return self.adprw_port(1).call(bool(en), s, s1, s2, s3, s4d, d2, loc_id)

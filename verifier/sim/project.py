@@ -1,0 +1,352 @@
+"""The simulator's Python API: load ST, call functions, drive FB instances and programs
+scan by scan in virtual time, attach serial endpoints.  See docs/testing-st.md."""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Callable, Iterable
+
+from verifier.st import ast
+
+from .compiler import GENERATED_FILE, CompiledModule, compile_files, default_code
+from .cpu import profile_for
+from .errors import LoadError, SimulationError
+from .runtime import Runtime
+from .serial import CHANNELS
+from .typesys import ArrayT, CompileError, StringT, StructT
+from .values import InstanceProxy, to_st, to_st_list, wrap
+
+
+def load(*paths, target: str = "gxworks2", cpu: str | None = None, scan_ms: float = 10,
+         jitter_ms: float = 0, seed: int = 0, stop_on_operation_error: bool | None = None,
+         sources: dict[str, str] | None = None) -> "Project":
+    """Parse, check and compile ST files into a simulated CPU.
+
+    `paths` are .st files (or directories, whose *.st files are loaded); `sources` maps
+    file names to ST text for sources that are not on disk.  `target` is the editor
+    ("gxworks2", "gxworks3", or "gxworks2:q" to pick the CPU); `cpu` picks the CPU profile
+    ("fx3u", "fx3g", "fx5u", "q").  Raises LoadError listing file:line:col diagnostics."""
+    texts: dict[str, str] = {}
+    problems = []
+    for p in paths:
+        path = Path(p)
+        files = sorted(path.glob("*.st")) if path.is_dir() else [path]
+        for f in files:
+            try:
+                texts[str(f)] = f.read_text(encoding="utf-8-sig")
+            except UnicodeDecodeError:
+                texts[str(f)] = f.read_text(encoding="cp932", errors="replace")
+            except OSError as e:
+                problems.append(ast.Diagnostic(str(f), 0, 0, "error", f"cannot read: {e.strerror or e}"))
+    texts.update(sources or {})
+    if problems:
+        raise LoadError(problems)
+    return Project(texts, target=target, cpu=cpu, scan_ms=scan_ms, jitter_ms=jitter_ms, seed=seed,
+                   stop_on_operation_error=stop_on_operation_error)
+
+
+class Project:
+    """One simulated CPU running the loaded ST."""
+
+    def __init__(self, texts: dict[str, str], target: str = "gxworks2", cpu: str | None = None,
+                 scan_ms: float = 10, jitter_ms: float = 0, seed: int = 0,
+                 stop_on_operation_error: bool | None = None):
+        from verifier import st
+
+        editor = target.split(":", 1)[0]
+        try:
+            self.cpu = profile_for(target, cpu)
+        except ValueError as e:
+            raise LoadError([ast.Diagnostic("<target>", 0, 0, "error", str(e))]) from None
+        self.target = editor
+        files = [st.parse(text, name, target=editor) for name, text in texts.items()]
+        errors = [d for f in files for d in f.diagnostics if d.is_error]
+        if errors:
+            raise LoadError(errors)
+        self.warnings = [d for f in files for d in f.diagnostics if not d.is_error]
+        checked = _run_checker(files, editor)
+        errors = [d for d in checked if d.is_error]
+        if errors:
+            raise LoadError(errors)
+        self.warnings.extend(d for d in checked if not d.is_error)
+        self.files = files
+        self.rt = Runtime(self.cpu, scan_us=round(scan_ms * 1000), jitter_us=round(jitter_ms * 1000),
+                          seed=seed, stop_on_operation_error=stop_on_operation_error)
+        try:
+            self.module: CompiledModule = compile_files(files, self.rt, self.cpu)
+        except CompileError as e:
+            span = e.span
+            raise LoadError([ast.Diagnostic(getattr(span, "file", "<st>"), getattr(span, "line", 0),
+                                            getattr(span, "col", 0), "error", e.message)]) from None
+        self._programs: dict[str, object] = {}
+        self.before_scan: list[Callable[["Project"], None]] = []
+        self.after_scan: list[Callable[["Project"], None]] = []
+        self.touched: list[InstanceProxy] = []  # instances handed out (shown on test failure)
+        _register(self)
+
+    # ------------------------------------------------------------------ state
+    @property
+    def devices(self):
+        return self.rt.dev
+
+    @property
+    def now_us(self) -> int:
+        return self.rt.now_us
+
+    @property
+    def now_s(self) -> float:
+        return self.rt.now_us / 1e6
+
+    @property
+    def scan_count(self) -> int:
+        return self.rt.scan_count
+
+    @property
+    def diagnostics(self):
+        """Operation errors and other run-time findings the CPU let pass."""
+        return self.rt.diagnostics
+
+    @property
+    def globals(self) -> InstanceProxy:
+        return InstanceProxy(self.module.namespace["_G"], self.module, "GLOBAL", self)
+
+    def pou_names(self, kind: str | None = None) -> list[str]:
+        return [i.pou.name for i in self.module.pous.values() if kind is None or i.kind == kind]
+
+    # ------------------------------------------------------------------ functions and instances
+    def _pou(self, name: str):
+        info = self.module.pous.get(name.upper())
+        if info is None:
+            raise KeyError(f"no POU named {name!r}; loaded: {', '.join(self.pou_names())}")
+        return info
+
+    def call(self, name: str, *args, **kwargs):
+        """Call a FUNCTION with positional arguments in declaration order (Python lists for
+        arrays; named ones by keyword); returns its value."""
+        value, _ = self.call_full(name, *args, **kwargs)
+        return value
+
+    def call_full(self, name: str, *args, **kwargs):
+        """(value, {output name: value}) of a FUNCTION call."""
+        info = self._pou(name)
+        if info.kind != "FUNCTION":
+            raise TypeError(f"{info.pou.name} is a {info.kind}; use project.instance()")
+        params = info.inputs
+        if len(args) > len(params):
+            raise TypeError(f"{info.pou.name} takes {len(params)} input(s), got {len(args)}")
+        given = dict(zip([p.key for p in params], args))
+        for k, v in kwargs.items():
+            if k.upper() not in {p.key for p in params}:
+                raise TypeError(f"{info.pou.name} has no input {k}")
+            given[k.upper()] = v
+        converted = []
+        for p in params:
+            label = f"{info.pou.name}.{p.name}"
+            if p.key not in given:
+                converted.append(eval(self.module_default(p.type), self.module.namespace))
+            elif isinstance(p.type, ArrayT):
+                default = eval(self.module_default(p.type.elem), self.module.namespace)
+                converted.append(to_st_list(p.type, given[p.key], label, default))
+            else:
+                converted.append(to_st(p.type, given[p.key], label))
+        fn = self.module.namespace[info.class_name]
+        result = self._guard(lambda: fn(*converted))
+        if info.outputs:
+            ret, *outs = result
+            return (wrap(ret, info.return_type, info.pou.name, self.module),
+                    {o.name: wrap(v, o.type, o.name, self.module) for o, v in zip(info.outputs, outs)})
+        return wrap(result, info.return_type, info.pou.name, self.module), {}
+
+    def module_default(self, t) -> str:
+        return default_code(t)
+
+    def instance(self, name: str) -> "Instance":
+        """A new FUNCTION_BLOCK instance with its own memory, or the PROGRAM (programs
+        exist once per CPU)."""
+        info = self._pou(name)
+        if info.kind == "FUNCTION":
+            raise TypeError(f"{info.pou.name} is a FUNCTION; use project.call()")
+        if info.kind == "PROGRAM":
+            obj = self._program_obj(info.key)
+        else:
+            obj = self.module.namespace[info.class_name]()
+        inst = Instance(obj, self, info.pou.name)
+        self.touched.append(inst)
+        return inst
+
+    def program(self, name: str) -> "Instance":
+        info = self._pou(name)
+        if info.kind != "PROGRAM":
+            raise TypeError(f"{info.pou.name} is a {info.kind}, not a PROGRAM")
+        return self.instance(name)
+
+    def _program_obj(self, key: str):
+        obj = self._programs.get(key)
+        if obj is None:
+            obj = self._programs[key] = self.module.namespace[self.module.pous[key].class_name]()
+        return obj
+
+    def get(self, path: str):
+        """Value by dotted path: "MAIN.fbRobot.o_bBusy", "GLOBAL.bRun", or a device "D100"."""
+        head, _, rest = path.partition(".")
+        if head.upper() == "GLOBAL":
+            obj = self.globals
+        elif head.upper() in self.module.pous:
+            obj = self.program(head)
+        else:
+            return self.devices[path]
+        for part in rest.split(".") if rest else []:
+            obj = getattr(obj, part)
+        return obj
+
+    # ------------------------------------------------------------------ running
+    def scan(self, bodies: Iterable[Callable[[], None]]) -> None:
+        self._run(list(bodies), stop_us=None, scans=1)
+
+    def run_programs(self, names: list[str], ms: float | None = None, scans: int | None = None,
+                     until_us: int | None = None, on_scan: Callable[["Project"], None] | None = None):
+        """Run PROGRAMs in the given order, one scan after another: for `ms` of virtual
+        time, or `scans` scans, or until virtual time `until_us`.  `on_scan(project)` runs
+        at the start of every scan, before the programs (set inputs, sample labels)."""
+        bodies = [self._program_obj(self._pou(n).key)._body for n in names]
+        for n in names:
+            if self._pou(n).kind != "PROGRAM":
+                raise TypeError(f"{n} is not a PROGRAM")
+        stop = _stop_time(self.rt.now_us, ms, until_us)
+        if on_scan is not None:
+            self.before_scan.append(on_scan)
+        try:
+            self._run(bodies, stop, scans)
+        finally:
+            if on_scan is not None:
+                self.before_scan.remove(on_scan)
+
+    def _run(self, bodies, stop_us, scans) -> None:
+        rt = self.rt
+        begin, end = rt.begin_scan, rt.end_scan
+        before, after = self.before_scan, self.after_scan
+        remaining = scans if scans is not None else -1
+
+        def loop():
+            nonlocal remaining
+            while remaining != 0 and (stop_us is None or rt.now_us < stop_us):
+                begin()
+                for cb in before:
+                    cb(self)
+                for b in bodies:
+                    b()
+                for cb in after:
+                    cb(self)
+                end()
+                remaining -= 1
+
+        self._guard(loop)
+
+    def advance(self, ms: float) -> None:
+        """Let virtual time pass without scanning (the CPU in STOP)."""
+        self.rt.advance_to(self.rt.now_us + round(ms * 1000))
+
+    # ------------------------------------------------------------------ serial
+    def attach_serial(self, channel: str, endpoint) -> None:
+        """Connect a serial channel ("fx3:1", "fx3:2", "fx5:1", "q:1", "q:2", "adp:1") to an
+        endpoint with the verifier.link.Line master interface."""
+        if channel not in CHANNELS:
+            raise ValueError(f"unknown serial channel {channel!r}; use one of {', '.join(CHANNELS)}")
+        family = channel.split(":")[0]
+        if family not in (self.cpu.family, "adp"):
+            raise ValueError(f"channel {channel} does not exist on the {self.cpu.name} CPU")
+        self.rt.channel(channel).attach(endpoint)
+
+    def serial_log(self, channel: str):
+        """Frames the PLC sent on a channel: [SentFrame(t_start_us, t_end_us, data, origin)]."""
+        return list(self.rt.channel(channel).sent)
+
+    def c24_buffer(self, un: int = 0) -> list[int]:
+        """Buffer memory of the QJ71C24N at start I/O `un` (the same words as U0\\G...)."""
+        return self.rt.buffer(un)
+
+    # ------------------------------------------------------------------ errors
+    def _guard(self, fn):
+        try:
+            return fn()
+        except SimulationError:
+            raise
+        except RecursionError:
+            raise SimulationError("function blocks call each other without end (recursion)",
+                                  self._st_location(sys.exc_info()[2]), self.rt.now_us) from None
+        except Exception as e:  # a fault of the simulator itself: point at the ST line anyway
+            loc = self._st_location(sys.exc_info()[2])
+            raise SimulationError(f"simulator fault while running this statement: {e!r}",
+                                  loc, self.rt.now_us) from e
+
+    def _st_location(self, tb) -> str | None:
+        loc = None
+        while tb is not None:
+            if tb.tb_frame.f_code.co_filename == GENERATED_FILE:
+                span = self.module.span_at(tb.tb_lineno)
+                if span is not None:
+                    loc = str(span)
+            tb = tb.tb_next
+        return loc
+
+
+class Instance(InstanceProxy):
+    """An FB or PROGRAM instance you can drive: labels by name, `scan()`, `run(ms=...)`."""
+
+    __slots__ = ()
+
+    def __init__(self, obj, project: Project, label: str):
+        super().__init__(obj, project.module, label, project)
+
+    def scan(self, n: int = 1) -> "Instance":
+        """Run n scans in which only this instance is called."""
+        self._project._run([self._obj._body], None, n)
+        return self
+
+    def run(self, ms: float | None = None, scans: int | None = None,
+            until: Callable[["Instance"], bool] | None = None, timeout_ms: float = 60_000) -> "Instance":
+        """Scan repeatedly for `ms` of virtual time (or `scans` scans, or until
+        `until(instance)` is true — at most `timeout_ms`)."""
+        p = self._project
+        if until is not None:
+            stop = p.rt.now_us + round(timeout_ms * 1000)
+            while not until(self):
+                if p.rt.now_us >= stop:
+                    raise TimeoutError(f"{self._label}: condition not met within {timeout_ms} ms of virtual time")
+                p._run([self._obj._body], None, 1)
+            return self
+        p._run([self._obj._body], _stop_time(p.rt.now_us, ms, None), scans)
+        return self
+
+
+def _stop_time(now: int, ms, until_us):
+    if ms is not None:
+        return now + round(ms * 1000)
+    return until_us
+
+
+def _run_checker(files, target):
+    from verifier import st
+
+    try:
+        return st.check(files, target)
+    except ModuleNotFoundError as e:  # the checker is not there yet: parse diagnostics only
+        if e.name and e.name.startswith("verifier.st"):
+            return []
+        raise
+
+
+_LIVE: list = []
+
+
+def _register(project: Project) -> None:
+    """Projects created during the current test (the pytest plugin shows their state)."""
+    _LIVE.append(project)
+    del _LIVE[:-8]
+
+
+def live_projects() -> list[Project]:
+    return list(_LIVE)
+
+
+__all__ = ["load", "Project", "Instance", "LoadError", "SimulationError", "StructT", "StringT"]

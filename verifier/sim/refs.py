@@ -1,0 +1,113 @@
+"""Operand references: how an instruction model reaches the block of words or bits an ST
+call names by its head (`wSend[0]`, `wSend`, `D100`, `M10`, a scalar label).
+
+A reference knows the cells (a Python list: an array label or a device area), where the
+block starts, how to normalise what it stores (INT wraps, WORD masks...), and the ST
+location of the operand so that a block running past the end of its array is reported
+where it was written.
+"""
+from __future__ import annotations
+
+from .datatypes import NORMALIZERS
+
+
+class Ref:
+    __slots__ = ("cells", "base", "norm", "rt", "loc_id", "label")
+
+    def __init__(self, cells: list, base: int, type_name: str, rt, loc_id: int | None, label: str):
+        self.cells = cells
+        self.base = base
+        self.norm = NORMALIZERS.get(type_name, lambda v: v)
+        self.rt = rt
+        self.loc_id = loc_id
+        self.label = label
+
+    def _index(self, k: int) -> int:
+        i = self.base + k
+        if i < 0 or i >= len(self.cells):
+            self.rt.fail(self.loc_id, f"operand {self.label}: word {k} of the block is past the end "
+                                      f"({len(self.cells) - self.base} available); on the real CPU "
+                                      "this reads or overwrites whatever memory follows")
+        return i
+
+    def available(self) -> int:
+        return len(self.cells) - self.base
+
+    def get(self, k: int = 0):
+        return self.cells[self._index(k)]
+
+    def set(self, k: int, value) -> None:
+        self.cells[self._index(k)] = self.norm(value)
+
+    def get_u16(self, k: int = 0) -> int:
+        return int(self.cells[self._index(k)]) & 0xFFFF
+
+    def get_bytes(self, count: int) -> bytes:
+        """`count` bytes packed two per word, low byte first (RS2, CRC 16-bit mode, C24)."""
+        out = bytearray()
+        for k in range((count + 1) // 2):
+            w = self.get_u16(k)
+            out.append(w & 0xFF)
+            out.append(w >> 8)
+        return bytes(out[:count])
+
+    def get_low_bytes(self, count: int) -> bytes:
+        """`count` bytes from the low byte of each word (8-bit mode)."""
+        return bytes(self.get_u16(k) & 0xFF for k in range(count))
+
+    def put_bytes(self, data: bytes) -> None:
+        """Store bytes two per word, low byte first; an odd count leaves 00H in the last
+        word's high byte."""
+        for k in range((len(data) + 1) // 2):
+            lo = data[2 * k]
+            hi = data[2 * k + 1] if 2 * k + 1 < len(data) else 0
+            self.set(k, lo | (hi << 8))
+
+    def put_low_bytes(self, data: bytes) -> None:
+        for k, b in enumerate(data):
+            self.set(k, b)
+
+
+class AttrRef(Ref):
+    """A scalar label used as an operand: a block of exactly one cell."""
+
+    __slots__ = ("obj", "attr")
+
+    def __init__(self, obj, attr: str, type_name: str, rt, loc_id: int | None, label: str):
+        super().__init__([], 0, type_name, rt, loc_id, label)
+        self.obj = obj
+        self.attr = attr
+
+    def available(self) -> int:
+        return 1
+
+    def _check(self, k: int) -> None:
+        if k != 0:
+            self.rt.fail(self.loc_id, f"operand {self.label} is a single label but the instruction "
+                                      f"needs word {k} of a block; use an array")
+
+    def get(self, k: int = 0):
+        self._check(k)
+        return getattr(self.obj, self.attr)
+
+    def set(self, k: int, value) -> None:
+        self._check(k)
+        setattr(self.obj, self.attr, self.norm(value))
+
+    def get_u16(self, k: int = 0) -> int:
+        return int(self.get(k)) & 0xFFFF
+
+
+class DwordRef(Ref):
+    """A 32-bit value stored across two 16-bit device words (D100 as DINT: D100 low word,
+    D101 high word)."""
+
+    def get(self, k: int = 0):
+        lo = self.cells[self._index(2 * k)] & 0xFFFF
+        hi = self.cells[self._index(2 * k + 1)] & 0xFFFF
+        return self.norm(lo | (hi << 16))
+
+    def set(self, k: int, value) -> None:
+        v = int(value) & 0xFFFFFFFF
+        self.cells[self._index(2 * k)] = ((v & 0xFFFF) + 0x8000 & 0xFFFF) - 0x8000
+        self.cells[self._index(2 * k + 1)] = ((v >> 16) + 0x8000 & 0xFFFF) - 0x8000

@@ -1,0 +1,129 @@
+"""The simulated CPU's run-time state: virtual clock, device memory, special relays,
+operation errors and the I/O models polled between scans.
+
+Virtual time is integer microseconds.  A scan starts at `now_us`; everything the program
+does in that scan happens at that instant (the simulator does not model instruction
+execution time); the next scan starts `scan_us` (+/- seeded jitter) later.  Between two
+scans the I/O models (serial ports, modules) bring their state up to the new scan's start
+time — the CPU's END processing.
+"""
+from __future__ import annotations
+
+import random
+
+from .cpu import CpuProfile
+from .devices import DeviceMemory
+from .errors import SimDiagnostic, SimulationError
+from .serial import SerialChannel
+
+
+class Runtime:
+    def __init__(self, cpu: CpuProfile, scan_us: int = 10_000, jitter_us: int = 0,
+                 seed: int = 0, stop_on_operation_error: bool | None = None):
+        if scan_us <= 0:
+            raise ValueError("scan time must be positive")
+        if jitter_us < 0 or jitter_us >= scan_us:
+            raise ValueError("jitter must be >= 0 and smaller than the scan time")
+        self.cpu = cpu
+        self.dev = DeviceMemory(cpu)
+        self.scan_us = int(scan_us)
+        self.jitter_us = int(jitter_us)
+        self.rng = random.Random(seed)
+        self.now_us = 0
+        self.now_ms = 0
+        self.scan_count = 0
+        self.diagnostics: list[SimDiagnostic] = []
+        self.locations: list[str] = []  # location id -> "file:line:col"
+        self.pollers: list = []  # objects with poll(now_us), run before each scan
+        self.after_scan: list = []  # objects with after_scan(now_us), run after each scan
+        self.ports: dict[str, SerialChannel] = {}  # channel name ("fx3:1") -> byte stream
+        self.buffers: dict[int, list[int]] = {}  # module start I/O -> buffer memory words
+        self.origins: dict[str, str] = {}  # channel -> location of the last send-request flag write
+        self.stop_on_operation_error = (cpu.stops_on_op_error if stop_on_operation_error is None
+                                        else stop_on_operation_error)
+        self._always_on = [self.dev.address(n) for n in cpu.always_on]
+        self._always_off = [self.dev.address(n) for n in cpu.always_off]
+        self._first_on = [self.dev.address(n) for n in cpu.first_scan_on]
+        self._first_off = [self.dev.address(n) for n in cpu.first_scan_off]
+        self._op_flags = [self.dev.address(n) for n in cpu.op_error_flags]
+        self._op_code = self.dev.address(cpu.op_error_code)
+        self._clocks = [(self.dev.areas[a.area], a.index, period * 500)
+                        for a, period in ((self.dev.address(n), p) for n, p in cpu.clocks.items())]
+
+    def buffer(self, module: int) -> list[int]:
+        """Buffer memory of the intelligent module at start I/O `module` (U0\\G...)."""
+        buf = self.buffers.get(module)
+        if buf is None:
+            buf = self.buffers[module] = [0] * 0x4000
+        return buf
+
+    def channel(self, name: str) -> SerialChannel:
+        ch = self.ports.get(name)
+        if ch is None:
+            ch = self.ports[name] = SerialChannel(name)
+        return ch
+
+    # ---- locations -------------------------------------------------------------
+    def location_id(self, location: str) -> int:
+        self.locations.append(location)
+        return len(self.locations) - 1
+
+    # ---- scan framing ------------------------------------------------------------
+    def begin_scan(self) -> None:
+        dev = self.dev
+        first = self.scan_count == 0
+        for a in self._always_on:
+            dev.areas[a.area][a.index] = True
+        for a in self._always_off:
+            dev.areas[a.area][a.index] = False
+        for a in self._first_on:
+            dev.areas[a.area][a.index] = first
+        for a in self._first_off:
+            dev.areas[a.area][a.index] = not first
+        now = self.now_us
+        for cells, index, half_us in self._clocks:
+            cells[index] = (now // half_us) % 2 == 1
+        for p in self.pollers:
+            p.poll(now)
+
+    def end_scan(self) -> None:
+        for p in self.after_scan:
+            p.after_scan(self.now_us)
+        self.scan_count += 1
+        step = self.scan_us
+        if self.jitter_us:
+            step += self.rng.randint(-self.jitter_us, self.jitter_us)
+        self.now_us += step
+        self.now_ms = self.now_us // 1000
+
+    def advance_to(self, t_us: int) -> None:
+        """Move the clock without scanning (the CPU in STOP, or a test skipping time)."""
+        if t_us < self.now_us:
+            raise ValueError("virtual time cannot go backwards")
+        self.now_us = t_us
+        self.now_ms = t_us // 1000
+
+    # ---- operation errors ----------------------------------------------------------
+    def operation_error(self, loc_id: int | None, message: str, code: int | None = None) -> None:
+        """What the CPU does on an operation error (division by zero, operand out of range):
+        set SM0/M8067 (and the latched flag), store the error code, and either continue
+        (FX default) or stop (Q default: 'operation error: stop' in the PLC parameters)."""
+        code = self.cpu.div_zero_code if code is None else code
+        dev = self.dev
+        for a in self._op_flags:
+            dev.areas[a.area][a.index] = True
+        dev.areas[self._op_code.area][self._op_code.index] = ((code + 0x8000) & 0xFFFF) - 0x8000
+        loc = self.locations[loc_id] if loc_id is not None else None
+        flags = "/".join(self.cpu.op_error_flags)
+        self.diagnostics.append(SimDiagnostic(self.now_us, loc, code,
+                                              f"operation error: {message} ({flags} set)"))
+        if self.stop_on_operation_error:
+            raise SimulationError(f"operation error: {message}; the CPU stops "
+                                  f"(error code {code})", loc, self.now_us)
+
+    def fail(self, loc_id: int | None, message: str):
+        loc = self.locations[loc_id] if loc_id is not None else None
+        raise SimulationError(message, loc, self.now_us)
+
+    def warn(self, location: str | None, message: str, code: int = 0) -> None:
+        self.diagnostics.append(SimDiagnostic(self.now_us, location, code, message))

@@ -1,0 +1,76 @@
+"""The byte stream at the end of every serial instruction model.
+
+A `SerialChannel` is one physical port of the simulated PLC ("fx3:1", "q:2", ...).  Bytes
+the PLC sends go to the attached endpoint (the ROBOT engineer's `verifier.link.Line`, or
+any object with the same master interface: `send(data, t_us, origin)` and
+`receive_until(t_us) -> [(byte, arrival_t_us), ...]`) and are logged with their times.
+With no endpoint attached the line is silent: what is sent is only logged.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+
+CHANNELS = ("fx3:1", "fx3:2", "fx5:1", "fx5:2", "q:1", "q:2", "adp:1", "adp:2")
+
+
+@dataclass(frozen=True)
+class SentFrame:
+    t_start_us: int
+    t_end_us: int
+    data: bytes
+    origin: str | None
+
+
+@dataclass(frozen=True)
+class LineFormat:
+    baud: int = 9600
+    data_bits: int = 8
+    parity: str = "N"  # "N" | "O" | "E"
+    stop_bits: int = 1
+
+    @property
+    def bits_per_byte(self) -> int:
+        return 1 + self.data_bits + (0 if self.parity == "N" else 1) + self.stop_bits
+
+    @property
+    def byte_time_us(self) -> Fraction:
+        return Fraction(self.bits_per_byte * 1_000_000, self.baud)
+
+    def __str__(self) -> str:
+        return f"{self.baud} {self.data_bits}{self.parity}{self.stop_bits}"
+
+
+NINE_SIX_8N1 = LineFormat()
+
+
+class SerialChannel:
+    def __init__(self, name: str):
+        self.name = name
+        self.endpoint = None
+        self.format = NINE_SIX_8N1
+        self.sent: list[SentFrame] = []
+        self.received: list[tuple[int, int]] = []  # every byte that reached the port
+
+    def attach(self, endpoint) -> None:
+        for attr in ("send", "receive_until"):
+            if not callable(getattr(endpoint, attr, None)):
+                raise TypeError(f"serial endpoint for {self.name} needs a {attr}() method "
+                                "(the verifier.link.Line master interface)")
+        self.endpoint = endpoint
+
+    def transmit(self, data: bytes, t_us: int, origin: str | None) -> int:
+        """Start sending `data` at t_us; returns the time the last stop bit is out."""
+        data = bytes(data)
+        end = t_us + int(-(-len(data) * self.format.byte_time_us // 1))  # ceil
+        if self.endpoint is not None and data:
+            self.endpoint.send(data, t_us, origin)
+        self.sent.append(SentFrame(t_us, end, data, origin))
+        return end
+
+    def receive_until(self, t_us: int) -> list[tuple[int, int]]:
+        if self.endpoint is None:
+            return []
+        got = list(self.endpoint.receive_until(t_us))
+        self.received.extend(got)
+        return got

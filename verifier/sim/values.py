@@ -1,0 +1,178 @@
+"""Python-side views of simulated ST memory: instance proxies with case-insensitive label
+access, array views indexed by the ST bounds, and conversion of Python values into ST
+values (with the same normalisation the generated code applies)."""
+from __future__ import annotations
+
+from . import datatypes
+from .typesys import ArrayT, FbT, StringT, StructT
+
+
+def to_st(t, value, label: str, make_default=None):
+    """Convert a Python value for a label of type t (raises ValueError with the label)."""
+    if isinstance(t, StringT):
+        if not isinstance(value, str):
+            raise ValueError(f"{label} is a STRING; got {value!r}")
+        return value[: t.length]
+    if isinstance(t, str):
+        if t == "BOOL":
+            if isinstance(value, bool) or value in (0, 1):
+                return bool(value)
+            raise ValueError(f"{label} is BOOL; got {value!r}")
+        if isinstance(value, bool):
+            raise ValueError(f"{label} is {t}; got a bool")
+        if t in ("REAL", "LREAL"):
+            return datatypes.NORMALIZERS[t](float(value))
+        if isinstance(value, float):
+            raise ValueError(f"{label} is {t}; got the float {value!r}")
+        return datatypes.NORMALIZERS[t](int(value))
+    raise ValueError(f"{label} ({t}) cannot be set from {value!r}")
+
+
+def to_st_list(t: ArrayT, values, label: str, default) -> list:
+    values = list(values)
+    if len(values) > t.size:
+        raise ValueError(f"{label} has {t.size} elements; got {len(values)} values")
+    out = [to_st(t.elem, v, f"{label}[{i}]") for i, v in enumerate(values)]
+    return out + [default] * (t.size - len(out))
+
+
+def wrap(value, t, label: str, module):
+    """Python view of a stored value."""
+    if isinstance(t, ArrayT):
+        return ArrayView(value, t, label, module)
+    if isinstance(t, (StructT, FbT)):
+        return InstanceProxy(value, module, label)
+    return value
+
+
+class InstanceProxy:
+    """An FB/PROGRAM instance or structure: `fb.i_bExecute = True`, `fb.tmr.Q`."""
+
+    __slots__ = ("_obj", "_module", "_label", "_project")
+
+    def __init__(self, obj, module, label: str, project=None):
+        object.__setattr__(self, "_obj", obj)
+        object.__setattr__(self, "_module", module)
+        object.__setattr__(self, "_label", label)
+        object.__setattr__(self, "_project", project)
+
+    def _symbols(self) -> dict:
+        return self._module.class_symbols.get(type(self._obj), {})
+
+    def _find(self, name: str):
+        from .stdfbs import FB_PARAM_TYPES, StdFB
+
+        key = name.upper()
+        if isinstance(self._obj, StdFB):
+            t = FB_PARAM_TYPES[self._obj.TYPE_NAME].get(key)
+            if t is None:
+                raise AttributeError(f"{self._label} ({self._obj.TYPE_NAME}) has no input/output {name}")
+            return key, t, None
+        sym = self._symbols().get(key)
+        if sym is None:
+            raise AttributeError(f"{self._label} has no label {name!r}")
+        from .codegen import attr_name
+
+        return attr_name(sym.name), sym.type, sym
+
+    def __getattr__(self, name: str):
+        if name.startswith("__"):
+            raise AttributeError(name)
+        attr, t, sym = self._find(name)
+        if sym is not None and sym.code and not sym.code.startswith(("self.", "_G.")):
+            value = eval(sym.code, self._module.namespace)  # constants and device-backed globals
+        else:
+            value = getattr(self._obj, attr)
+        return wrap(value, t, f"{self._label}.{name}", self._module)
+
+    def __setattr__(self, name: str, value) -> None:
+        attr, t, sym = self._find(name)
+        label = f"{self._label}.{name}"
+        if sym is not None and sym.is_constant:
+            raise AttributeError(f"{label} is a constant")
+        if isinstance(t, ArrayT):
+            if not isinstance(t.elem, (str, StringT)):
+                raise AttributeError(f"{label} is an array of {t.elem}: set its members one by one")
+            default = datatypes.TYPES[t.elem].default if isinstance(t.elem, str) else ""
+            getattr(self._obj, attr)[:] = to_st_list(t, value, label, default)
+            return
+        if isinstance(t, (StructT, FbT)):
+            raise AttributeError(f"{label} is a {t}: set its members one by one")
+        st_value = to_st(t, value, label)
+        if sym is not None and sym.write:
+            ns = dict(self._module.namespace)
+            ns["_v_"] = st_value
+            exec(sym.write.format(v="_v_"), ns)
+            return
+        setattr(self._obj, attr, st_value)
+
+    def __dir__(self):
+        return [s.name for s in self._symbols().values()]
+
+    def __repr__(self) -> str:
+        parts = []
+        for sym in self._symbols().values():
+            try:
+                v = getattr(self, sym.name)
+            except Exception:
+                continue
+            if isinstance(v, (InstanceProxy,)):
+                continue
+            parts.append(f"{sym.name}={v!r}")
+        return f"<{self._label}: {', '.join(parts)}>"
+
+    def state(self) -> dict:
+        """Current values of the elementary labels and arrays (for reports)."""
+        out = {}
+        for sym in self._symbols().values():
+            v = getattr(self, sym.name)
+            out[sym.name] = list(v) if isinstance(v, ArrayView) else v
+        return out
+
+
+class ArrayView:
+    """An ST array seen from Python, indexed by its ST bounds (`arr[1]` of ARRAY[1..8] is
+    its first element); `list(view)` copies the values."""
+
+    __slots__ = ("_cells", "_t", "_label", "_module")
+
+    def __init__(self, cells, t: ArrayT, label: str, module):
+        self._cells = cells
+        self._t = t
+        self._label = label
+        self._module = module
+
+    def _flat(self, index) -> int:
+        idx = index if isinstance(index, tuple) else (index,)
+        if len(idx) != len(self._t.dims):
+            raise IndexError(f"{self._label} has {len(self._t.dims)} dimension(s)")
+        flat = 0
+        for (lo, hi), i in zip(self._t.dims, idx):
+            if not lo <= i <= hi:
+                raise IndexError(f"index {i} is outside {self._label}[{lo}..{hi}]")
+            flat = flat * (hi - lo + 1) + (i - lo)
+        return flat
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return list(self)[index]
+        return wrap(self._cells[self._flat(index)], self._t.elem, f"{self._label}[{index}]", self._module)
+
+    def __setitem__(self, index, value) -> None:
+        self._cells[self._flat(index)] = to_st(self._t.elem, value, f"{self._label}[{index}]")
+
+    def __len__(self) -> int:
+        return len(self._cells)
+
+    def __iter__(self):
+        for i, v in enumerate(self._cells):
+            yield wrap(v, self._t.elem, f"{self._label}", self._module)
+
+    def __eq__(self, other) -> bool:
+        try:
+            return list(self) == list(other)
+        except TypeError:
+            return NotImplemented
+
+    def __repr__(self) -> str:
+        return repr(list(self))
