@@ -184,3 +184,13 @@ def test_help_lists_every_command_form():
                  "manual-mode", "speed trackless|magnetic", "collision-range", "jog", "move x|front|rear|y",
                  "rotate ±VALUE", "read task|vehicle|speed|battery", "raw CODE CMD"):
         assert form in result.output
+
+
+def test_mbpoll_command_line():
+    result = run("stop", "--mbpoll", "/dev/ttyUSB0")
+    assert result.exit_code == 0
+    assert result.output.splitlines()[1] == (
+        "mbpoll -m rtu -b 9600 -d 8 -s 1 -P none -a 1 -0 -1 -t 4 -r 416 /dev/ttyUSB0 0")
+    result = run("read", "battery", "--address", "3", "--mbpoll", "/dev/ttyUSB0")
+    assert result.output.splitlines()[1] == (
+        "mbpoll -m rtu -b 9600 -d 8 -s 1 -P none -a 3 -0 -1 -t 0 -r 3 -c 22 /dev/ttyUSB0")

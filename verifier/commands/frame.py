@@ -6,6 +6,7 @@ line and prints.
 from __future__ import annotations
 
 import re
+import shlex
 
 import click
 
@@ -97,11 +98,14 @@ def _kind(frame) -> str:
 @click.option("--as", "direction", type=click.Choice(["auto", "request", "reply"]), default="auto",
               show_default=True, help="With --decode: read the bytes as a request or a reply.")
 @click.option("--explain", "explain_fields", is_flag=True, help="Also show every field of the frame.")
+@click.option("--mbpoll", "mbpoll_device", metavar="DEVICE",
+              help="Also print the mbpoll command line that sends this request on DEVICE "
+                   "(for commissioning from a laptop on the RS-485 bus).")
 @click.option("--words", "as_words", is_flag=True,
               help="Also print the frame as 16-bit words, two bytes per word, low byte first "
                    "(FX RS2 16-bit mode, QJ71C24N send area).")
 def command(words, address, field_order, codes_10_13, status_order, decode_hex, direction, explain_fields,
-            as_words):
+            mbpoll_device, as_words):
     """Print the exact bytes (CRC included) of COMMAND, or decode bytes with --decode.
 
     Prints space-separated upper-case hex, ready to type into a PLC send buffer.
@@ -119,6 +123,8 @@ def command(words, address, field_order, codes_10_13, status_order, decode_hex, 
         if request is None:
             raise click.UsageError("give a COMMAND (e.g. `uitamr frame stop`) or --decode HEX")
         _print_request(request, settings, explain_fields, as_words)
+        if mbpoll_device:
+            click.echo(shlex.join(mbpoll_command(request, settings, mbpoll_device)))
         return
     try:
         data = parse_hex(decode_hex)
@@ -154,6 +160,22 @@ def _request_from(words: tuple[str, ...], address: int):
         return command_from_words(list(words), address=address)
     except CommandError as exc:
         raise click.UsageError(str(exc)) from None
+
+
+def mbpoll_command(request, settings: Settings, device: str) -> list[str]:
+    """mbpoll (libmodbus) arguments that put exactly ``encode(request, settings)`` on the line.
+
+    FC06: one holding register (-t 4) written with one value; the register address is the
+    16-bit field holding code and command, the value 0. FC01: 22 coils (-t 0 -c 22) from the
+    query parameter. -0 makes references 0-based (PDU addresses), -1 polls once.
+    """
+    data = encode(request, settings)
+    reference = int.from_bytes(data[2:4], "big")
+    common = ["mbpoll", "-m", "rtu", "-b", "9600", "-d", "8", "-s", "1", "-P", "none",
+              "-a", str(request.address), "-0", "-1"]
+    if isinstance(request, ControlRequest):
+        return common + ["-t", "4", "-r", str(reference), device, "0"]
+    return common + ["-t", "0", "-r", str(reference), "-c", str(request.quantity), device]
 
 
 def packed_words(data: bytes) -> list[int]:

@@ -1,0 +1,109 @@
+"""libmodbus (mbpoll) as an independent Modbus master agrees with our frames.
+
+Over a real socat pty pair: the request bytes mbpoll puts on the line (from the command
+line `uitamr frame --mbpoll` prints) must equal `encode(request)`, and mbpoll must accept
+our replies (FC06 echo, FC01 22-coil status) and read back the coil bits we meant.
+"""
+from __future__ import annotations
+
+import os
+import select
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+
+from verifier.commands.frame import mbpoll_command
+from verifier.protocol import (
+    ControlReply,
+    RobotError,
+    Settings,
+    StatusReply,
+    command_from_words,
+    encode,
+)
+
+pytestmark = pytest.mark.serial
+
+IO_TIMEOUT_S = 10  # generous upper bound for a loaded machine; not a timing assertion
+
+
+@pytest.fixture
+def pty_pair(tmp_path: Path):
+    master_end, robot_end = tmp_path / "master", tmp_path / "robot"
+    socat = subprocess.Popen(
+        ["socat", f"pty,raw,echo=0,link={master_end}", f"pty,raw,echo=0,link={robot_end}"],
+        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+    )
+    deadline = time.monotonic() + IO_TIMEOUT_S
+    while not (master_end.exists() and robot_end.exists()):
+        assert socat.poll() is None, socat.stderr.read().decode()
+        assert time.monotonic() < deadline, "socat did not create the pty pair"
+        time.sleep(0.02)
+    fd = os.open(robot_end, os.O_RDWR | os.O_NOCTTY)
+    try:
+        yield str(master_end), fd
+    finally:
+        os.close(fd)
+        socat.terminate()
+        socat.wait(timeout=IO_TIMEOUT_S)
+
+
+def read_exactly(fd: int, count: int) -> bytes:
+    data = b""
+    deadline = time.monotonic() + IO_TIMEOUT_S
+    while len(data) < count:
+        ready, _, _ = select.select([fd], [], [], max(0.0, deadline - time.monotonic()))
+        assert ready, f"only {data.hex(' ')} arrived, expected {count} bytes"
+        data += os.read(fd, count - len(data))
+    return data
+
+
+def exchange(device_fd: int, argv: list[str], expected_request: bytes, reply: bytes) -> str:
+    process = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        request = read_exactly(device_fd, len(expected_request))
+        os.write(device_fd, reply)
+        output, _ = process.communicate(timeout=IO_TIMEOUT_S)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+    assert request == expected_request, f"mbpoll sent {request.hex(' ')}, we encode {expected_request.hex(' ')}"
+    assert process.returncode == 0, output
+    return output
+
+
+@pytest.mark.parametrize("settings", [Settings(), Settings(field_order="code-low"),
+                                      Settings(codes_10_13="hex", address=7)])
+@pytest.mark.parametrize("words", ["stop", "move y -0.3", "rotate +2.55", "follow-tape right"])
+def test_mbpoll_writes_the_same_fc06_frame(pty_pair, settings, words):
+    device, fd = pty_pair
+    request = command_from_words(words.split(), address=settings.address)
+    frame = encode(request, settings)
+    output = exchange(fd, mbpoll_command(request, settings, device), frame,
+                      encode(ControlReply.echo(request), settings))
+    assert "Written 1 references" in output
+
+
+@pytest.mark.parametrize("query, error, value", [("task", RobotError.NONE, 1), ("vehicle", RobotError.OFF_TAPE, 2),
+                                                 ("battery", RobotError.BATTERY_LOW, 1), ("speed", RobotError.NONE, 3)])
+def test_mbpoll_reads_our_status_reply_as_22_coils(pty_pair, query, error, value):
+    device, fd = pty_pair
+    settings = Settings(status_order="return")
+    request = command_from_words(["read", query])
+    reply = StatusReply(1, error, value, request.query)
+    output = exchange(fd, mbpoll_command(request, settings, device), encode(request, settings),
+                      encode(reply, settings))
+    coils = {}
+    for line in output.splitlines():
+        if line.startswith("[") and "]:" in line:
+            reference, bit = line.split("]:")
+            coils[int(reference.strip("[ "))] = int(bit.strip())
+    start = int.from_bytes(encode(request, settings)[2:4], "big")
+    assert sorted(coils) == list(range(start, start + 22))
+    bits = [coils[start + i] for i in range(22)]
+    assert bits[0:8] == [0] * 8
+    assert sum(bit << i for i, bit in enumerate(bits[8:16])) == error
+    assert sum(bit << i for i, bit in enumerate(bits[16:22])) == value
