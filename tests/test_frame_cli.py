@@ -57,6 +57,7 @@ def test_every_request_prints_what_encode_gives(request):
     (["--address", "0", "stop"], "not in the range 1<=x<=247"),
     (["--decode", "zz"], "not a hex digit"),
     (["--decode", "010"], "odd number of hex digits"),
+    (["--decode", "01 06", "--words"], "do not go with --decode"),
 ])
 def test_user_errors_exit_2_without_traceback(args, message):
     result = run(*args)

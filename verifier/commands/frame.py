@@ -126,6 +126,8 @@ def command(words, address, field_order, codes_10_13, status_order, decode_hex, 
         if mbpoll_device:
             click.echo(shlex.join(mbpoll_command(request, settings, mbpoll_device)))
         return
+    if mbpoll_device or as_words:
+        raise click.UsageError("--mbpoll and --words print a COMMAND's request; they do not go with --decode")
     try:
         data = parse_hex(decode_hex)
     except ValueError as exc:
