@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import re
 import time
+from pathlib import Path
 from dataclasses import replace
 from typing import Any, Callable
 
@@ -22,6 +23,7 @@ from .scenario import Scenario
 from .traffic import analyse
 
 Progress = Callable[[int, int], None]  # (virtual now, virtual end) in µs
+PROGRESS_STEP_US = 1_000_000  # report progress every virtual second
 
 #: Device names (X0, M8000, D100, SM400, ...) are read through the device memory, not labels.
 _DEVICE = re.compile(r"^(X|Y|M|L|F|B|S|T|C|D|W|R|ZR|SM|SD|SB|SW)[0-9A-F]+$", re.IGNORECASE)
@@ -39,49 +41,55 @@ class _Plc:
         missing = [str(p) for p in scenario.sources if not p.is_file()]
         if missing:
             raise UnusableInput(f"{_where(scenario)}: no such ST file: {', '.join(missing)}")
-        scan_ms = scenario.scan_us / 1000
         try:
             self.project = verifier.load(
                 *[str(p) for p in scenario.sources],
                 target=scenario.target,
-                scan_ms=int(scan_ms) if scan_ms == int(scan_ms) else scan_ms,
+                cpu=scenario.platform,
+                scan_ms=scenario.scan_us / 1000,
+                seed=scenario.seed,
             )
         except LoadError as exc:
             raise UnusableInput(str(exc)) from None
-        self.project.attach_serial(scenario.serial_channel, line)
-        self.program = self._program(scenario)
-
-    def _program(self, scenario: Scenario):
-        name = scenario.program
-        programs = list(getattr(self.project, "programs", []) or [])
-        if name is None:
-            if len(programs) == 1:
-                name = programs[0]
-            else:
-                listing = ", ".join(programs) or "none"
-                raise UnusableInput(
-                    f"{_where(scenario)}: say which PROGRAM to run (--program or 'program'); the sources define: {listing}"
-                )
         try:
-            return self.project.instance(name)
-        except (KeyError, LookupError, ValueError) as exc:
-            listing = ", ".join(programs) or "none"
+            self.project.attach_serial(scenario.serial_channel, line)
+        except ValueError as exc:
+            raise UnusableInput(f"{_where(scenario)}: {exc}") from None
+        self.name = self._program_name(scenario)
+        self.program = self.project.program(self.name)
+
+    def _program_name(self, scenario: Scenario) -> str:
+        programs = self.project.pou_names("PROGRAM")
+        listing = ", ".join(programs) or "none"
+        if scenario.program is None:
+            if len(programs) == 1:
+                return programs[0]
             raise UnusableInput(
-                f"{_where(scenario)}: no PROGRAM {name!r} in the sources ({exc}); they define: {listing}"
-            ) from None
+                f"{_where(scenario)}: say which PROGRAM to run (--program or 'program'); the sources define: {listing}"
+            )
+        for name in programs:
+            if name.upper() == scenario.program.upper():
+                return name
+        raise UnusableInput(f"{_where(scenario)}: no PROGRAM {scenario.program!r} in the sources; they define: {listing}")
 
     @property
     def now_us(self) -> int:
         return self.project.now_us
 
-    def scan(self) -> None:
-        self.program.scan()
+    def run(self, until_us: int, before_scan, after_scan) -> None:
+        """Scan the program until virtual time `until_us`, with a hook on each side of a scan."""
+        hook = lambda project: after_scan()  # noqa: E731 — the simulator passes the project
+        self.project.after_scan.append(hook)
+        try:
+            self.project.run_programs([self.name], until_us=until_us, on_scan=lambda project: before_scan())
+        finally:
+            self.project.after_scan.remove(hook)
 
     def read(self, name: str) -> Any:
         if _DEVICE.match(name):
             return self.project.devices[name.upper()]
         target = self.program
-        for part in re.findall(r"[A-Za-z_][A-Za-z0-9_]*|\[\d+\]", name):
+        for part in _path_parts(name):
             target = target[int(part[1:-1])] if part.startswith("[") else getattr(target, part)
         return target
 
@@ -89,7 +97,7 @@ class _Plc:
         if _DEVICE.match(name):
             self.project.devices[name.upper()] = value
             return
-        parts = re.findall(r"[A-Za-z_][A-Za-z0-9_]*|\[\d+\]", name)
+        parts = _path_parts(name)
         target = self.program
         for part in parts[:-1]:
             target = target[int(part[1:-1])] if part.startswith("[") else getattr(target, part)
@@ -100,11 +108,26 @@ class _Plc:
             setattr(target, last, value)
 
     def diagnostics(self) -> list[str]:
-        return [str(d) for d in getattr(self.project, "diagnostics", [])]
+        return [str(d) for d in self.project.diagnostics]
+
+
+def _path_parts(name: str) -> list[str]:
+    return re.findall(r"[A-Za-z_][A-Za-z0-9_]*|\[\d+\]", name)
 
 
 def _where(scenario: Scenario) -> str:
     return str(scenario.path) if scenario.path else f"scenario {scenario.name!r}"
+
+
+def _relative(origin: str | None) -> str | None:
+    """An ST location "file:line:col" with the file relative to the working folder when inside it."""
+    if not origin:
+        return origin
+    file, _, rest = origin.partition(":")
+    try:
+        return f"{Path(file).resolve().relative_to(Path.cwd())}:{rest}"
+    except ValueError:
+        return origin
 
 
 def _plain(value: Any) -> Any:
@@ -159,21 +182,25 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None) -> Scenar
     end = scenario.duration_us
     from verifier.sim.errors import SimulationError
 
+    def apply_inputs() -> None:
+        now = plc.now_us
+        while schedule and schedule[0][0] <= now:
+            for name, value in schedule.pop(0)[1].items():
+                plc.write(name, value)
+
+    def sample() -> None:
+        samples.record(plc.now_us, {name: _plain(plc.read(name)) for name in names})
+
     try:
         while plc.now_us < end:
-            now = plc.now_us
-            while schedule and schedule[0][0] <= now:
-                for name, value in schedule.pop(0)[1].items():
-                    plc.write(name, value)
-            plc.scan()
-            samples.record(now, {name: _plain(plc.read(name)) for name in names})
-            if progress is not None and plc.program is not None:
+            plc.run(min(end, plc.now_us + PROGRESS_STEP_US), apply_inputs, sample)
+            if progress is not None:
                 progress(plc.now_us, end)
     except SimulationError as exc:
         aborted = str(exc)
-        end = min(end, max(plc.now_us, 0))
+        end = min(end, plc.now_us)
     line.advance(max(end, line.now_us))
-    trace = [TraceRecord(f.t_start_us, f.t_end_us, f.direction, bytes(f.data), f.origin) for f in line.trace]
+    trace = [TraceRecord(f.t_start_us, f.t_end_us, f.direction, bytes(f.data), _relative(f.origin)) for f in line.trace]
     trace = [f for f in trace if f.t_start_us < end]
     events = [LineEvent(e.t_us, e.kind, e.message) for e in line.events if e.t_us <= end]
     evidence = RunEvidence(scenario.settings, trace, end, events, samples, scenario.options)
