@@ -163,6 +163,9 @@ def test_control_request_equals_pymodbus_write_single_register(settings, request
 def test_status_request_equals_pymodbus_read_coils(settings, request):
     pdu = ReadCoilsRequest(dev_id=request.address, address=wire_query(request.query, settings), count=22)
     assert encode(request, settings) == CLIENT_FRAMER.buildFrame(pdu)
+    used, decoded = SERVER_FRAMER.handleFrame(encode(request, settings), 0, 0)
+    assert used == 8 and decoded.function_code == 1 and decoded.count == 22
+    assert decoded.address == wire_query(request.query, settings)
 
 
 @given(status_replies())
