@@ -8,6 +8,10 @@ The AST is in `verifier.st.ast`; the type system in `verifier.st.types`.
 """
 from __future__ import annotations
 
+# The submodule `verifier.st.check` shares its name with the function `check` below:
+# import it first so that the function, defined afterwards, is what `verifier.st.check`
+# names on the package.
+import verifier.st.check as _check_module  # noqa: E402,F401
 from verifier.st.ast import Diagnostic, SourceFile
 
 TARGETS = ("gxworks2", "gxworks3")

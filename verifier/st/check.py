@@ -632,7 +632,8 @@ class Checker:
             self.used.add(id(decl))
             if isinstance(t, T.FbType):
                 return self._fb_call(c, t, statement)
-            self.rep.error(c.callee, f"'{c.name}' is a label of type {t}, not a function block instance; it cannot be called")
+            if t is not T.ANY:  # ANY: its type was already reported unknown
+                self.rep.error(c.callee, f"'{c.name}' is a label of type {t}, not a function block instance; it cannot be called")
             self._args_only(c)
             return T.ANY
         info = self.table.pous.get(name)
@@ -674,10 +675,13 @@ class Checker:
         if not statement:
             self.rep.error(c, f"a function block instance call is a statement: write '{c.name}(...);' on its own and read the outputs as {c.name}.Q")
         seen = set()
+        positional_reported = False
         for a in c.args:
             if a.name is None:
                 self.expr(a.value)
-                self.rep.error(a, f"function block calls take named arguments: write 'INPUT := value' (or 'OUTPUT => label')")
+                if not positional_reported:
+                    self.rep.error(a, "function block calls take named arguments: write 'INPUT := value' (or 'OUTPUT => label')")
+                    positional_reported = True
                 continue
             if a.key in seen:
                 self.rep.error(a, f"argument '{a.name}' is given twice")
@@ -710,7 +714,7 @@ class Checker:
         for n, _t in fb.in_outs:
             if n.upper() not in seen:
                 self.rep.error(c, f"VAR_IN_OUT '{n}' of {fb} must be connected in every call")
-        return T.VOID
+        return T.VOID if statement else T.ANY
 
     def _user_function(self, c: ast.Call, info: PouInfo, statement: bool) -> T.Type:
         c.resolved = T.CallTarget("function", info.pou.name, pou=info.pou)
@@ -769,6 +773,10 @@ class Checker:
             p = sig.params[min(i, np - 1)] if i < np or sig.variadic else None
             if p is None:
                 self.expr(a.value)
+                continue
+            if p.direction in ("out", "inout") and _is_literal(a.value):
+                self.expr(a.value)
+                self.rep.error(a.value, f"{sig.name} operand {p.name}: needs a label or device, not a constant")
                 continue
             if p.direction in ("out", "inout"):
                 at = self.lvalue(a.value)
@@ -888,6 +896,10 @@ def _const_int(e) -> int | None:
     if T.is_group(t, "int-literal"):
         return t.value
     return None
+
+
+def _is_literal(e) -> bool:
+    return isinstance(e, (ast.IntLiteral, ast.RealLiteral, ast.BoolLiteral, ast.TimeLiteral, ast.StringLiteral))
 
 
 def _is_constant(e) -> bool:

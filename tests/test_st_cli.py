@@ -1,0 +1,105 @@
+"""`uitamr check`: output format, exit codes, JSON, targets, several files at once."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+from click.testing import CliRunner
+
+from st_helpers import CORPUS
+from verifier.cli import main
+
+GOOD = CORPUS / "valid" / "statements.st"
+BAD = CORPUS / "invalid" / "int_from_word.st"
+SYNTAX = CORPUS / "invalid" / "missing_semicolon.st"
+WARN = CORPUS / "invalid" / "unused_warning.st"
+
+
+def run(*args: str):
+    return CliRunner().invoke(main, ["check", *map(str, args)])
+
+
+def test_clean_file_exits_0():
+    result = run(GOOD)
+    assert result.exit_code == 0, result.output
+    assert "0 error(s), 0 warning(s)" in result.output
+
+
+def test_warnings_alone_exit_0():
+    result = run(WARN)
+    assert result.exit_code == 0
+    assert f"{WARN}:4:5: warning: label 'iUnused' is declared but never used" in result.output
+
+
+def test_error_prints_location_source_line_and_caret():
+    result = run(BAD)
+    assert result.exit_code == 1
+    lines = result.output.splitlines()
+    i = lines.index(f"{BAD}:5:7: error: assignment: WORD cannot be stored in INT without conversion; use WORD_TO_INT(...)")
+    assert lines[i + 1] == "    iX := wY;"
+    assert lines[i + 2] == "          ^^"
+
+
+def test_one_bad_file_does_not_stop_the_others():
+    result = run(SYNTAX, BAD, GOOD)
+    assert result.exit_code == 1
+    assert f"{SYNTAX}:5:13: error: expected ';' after statement" in result.output
+    assert f"{BAD}:5:7: error" in result.output
+    assert f"{BAD}:6:7: error" in result.output
+    assert "3 file(s) checked" in result.output
+
+
+def test_directory_argument_checks_every_st_file_below_it():
+    result = run("--target", "gxworks3", CORPUS / "valid")
+    assert result.exit_code == 0, result.output  # multi_file_a/b resolve each other
+
+
+def test_json_format():
+    result = run("--format", "json", BAD, WARN)
+    assert result.exit_code == 1
+    report = json.loads(result.output)
+    assert report["errors"] == 2 and report["warnings"] == 1
+    first = report["diagnostics"][0]
+    assert (first["file"], first["line"], first["col"], first["severity"]) == (str(BAD), 5, 7, "error")
+
+
+def test_target_option_changes_the_dialect():
+    gx3 = CORPUS / "valid" / "gx3_only.st"
+    assert run("--target", "gxworks2", gx3).exit_code == 1
+    assert run("--target", "gxworks3", gx3).exit_code == 0
+
+
+def test_usage_errors_exit_2():
+    assert run(CORPUS / "no_such_file.st").exit_code == 2
+    assert run("--target", "gxworks9", GOOD).exit_code == 2
+    assert run("--format", "xml", GOOD).exit_code == 2
+    assert run().exit_code == 2
+
+
+def test_missing_file_is_named(tmp_path):
+    result = run(GOOD, tmp_path / "gone.st")
+    assert result.exit_code == 2
+    assert "gone.st: no such file" in result.output
+
+
+def test_undecodable_and_binary_files_are_diagnosed_not_crashed(tmp_path):
+    junk = tmp_path / "junk.st"
+    junk.write_bytes(bytes(range(256)) * 4)
+    result = run(junk)
+    assert result.exit_code == 1
+    assert "Traceback" not in result.output
+    assert str(junk) + ":" in result.output
+
+
+def test_shift_jis_file_is_read(tmp_path):
+    path = tmp_path / "sjis.st"
+    path.write_bytes("PROGRAM P\nVAR iX : INT; END_VAR\n(* 起動 *)\niX := 1;\nEND_PROGRAM\n".encode("cp932"))
+    assert run(path).exit_code == 0
+
+
+def test_installed_command_runs():
+    proc = subprocess.run([sys.executable, "-m", "verifier.cli", "check", str(BAD)],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 1
+    assert f"{BAD}:5:7: error" in proc.stdout
