@@ -29,6 +29,7 @@ from verifier.protocol import (
     explain_table,
     hex_bytes,
 )
+from verifier.protocol.describe import looks_like_reply
 from verifier.protocol.names import USAGE
 from verifier.protocol.settings import CODES_10_13_STYLES, FIELD_ORDERS, STATUS_ORDERS
 
@@ -207,7 +208,7 @@ def _decode_and_print(data: bytes, settings: Settings, direction, request, show_
             frame = decode_frame(data, settings, direction)
     except FrameError as exc:
         click.echo(f"invalid frame: {exc}")
-        guessed = direction or ("reply" if request is not None or _reply_shaped(data) else "request")
+        guessed = direction or ("reply" if request is not None or looks_like_reply(data) else "request")
         if guessed == "request":
             click.echo("the robot would " + _robot_answer(exc, settings))
         if show_fields:
@@ -220,10 +221,6 @@ def _decode_and_print(data: bytes, settings: Settings, direction, request, show_
     if show_fields:
         kind = "request" if isinstance(frame, (ControlRequest, StatusRequest)) else "reply"
         click.echo(explain_table(explain(data, settings, kind)))
-
-
-def _reply_shaped(data: bytes) -> bool:
-    return len(data) >= 3 and (data[1] & 0x80 or (data[1] == 0x01 and data[2] == 0x03))
 
 
 def _robot_answer(error: FrameError, settings: Settings) -> str:

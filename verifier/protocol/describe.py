@@ -60,12 +60,13 @@ def decode_frame(data: bytes, settings: Settings = DEFAULT_SETTINGS, direction: 
         try:
             return decode_reply(data, settings)
         except FrameError as reply_error:
-            if _looks_like_reply(data):
+            if looks_like_reply(data):
                 raise reply_error from None
             raise request_error from None
 
 
-def _looks_like_reply(data: bytes) -> bool:
+def looks_like_reply(data: bytes) -> bool:
+    """Bytes only a robot sends: an exception reply, or FC01 with byte count 03."""
     return len(data) >= 3 and (data[1] & 0x80 or (data[1] == 0x01 and data[2] == 0x03))
 
 
