@@ -145,3 +145,8 @@ def test_describe_prefers_reply_errors_for_reply_shaped_bytes():
 
 def test_hex_bytes():
     assert hex_bytes(b"\x01\xab") == "01 AB"
+
+
+def test_words_may_be_one_string():
+    assert command_from_words("move x -2.5") == command_from_words(["move", "x", "-2.5"])
+    assert command_from_words("  read   task ", address=4) == StatusRequest(4, Query.TASK)

@@ -79,8 +79,13 @@ USAGE = (
 )
 
 
-def command_from_words(words: list[str], address: int = 1) -> ControlRequest | StatusRequest:
-    """The request named by ``words`` (see ``USAGE``); CommandError says what is wrong."""
+def command_from_words(words: list[str] | str, address: int = 1) -> ControlRequest | StatusRequest:
+    """The request named by ``words`` (see ``USAGE``); CommandError says what is wrong.
+
+    ``words`` is a list (``["move", "x", "-2.5"]``) or one string (``"move x -2.5"``).
+    """
+    if isinstance(words, str):
+        words = words.split()
     words = [w.strip() for w in words if w.strip()]
     if not words:
         raise CommandError("no command given; one of: " + _forms())
