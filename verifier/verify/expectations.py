@@ -8,7 +8,8 @@ Kinds (one per `[[expect]]` table in a scenario):
 - `sent`   — the PLC sends this request (words of `uitamr frame`, e.g. "run-point 3") and
              the robot answers it, inside the window;
 - `reached_point` — the robot accepted "run point N", reported its task running and then
-             finished (idle, no error) inside the window.
+             finished (idle, with no error that stops a task: a battery warning may be on)
+             inside the window.
 
 The window is [after, after + within] (`after` defaults to 0, `within` to the end of the run).
 """
@@ -24,6 +25,8 @@ from .evidence import FrameRef, RunEvidence
 from .traffic import Traffic
 
 KINDS = ("that", "always", "never", "sent", "reached_point")
+#: Robot errors that stop a running task (a battery warning does not; docs/emulator.md).
+TASK_STOPPING_ERRORS = (protocol.RobotError.ANTI_COLLISION, protocol.RobotError.OFF_TAPE)
 
 
 @dataclass(frozen=True)
@@ -181,7 +184,7 @@ def _judge_reached_point(expectation, evidence, traffic, start, end) -> Expectat
         if reply.value == 1:
             running_seen = True
             progress = f"run-point {point} was running (since {format_seconds(accepted_at)}) but did not finish {_span(start, end)}"
-        elif running_seen and reply.error == protocol.RobotError.NONE:
+        elif running_seen and reply.error not in TASK_STOPPING_ERRORS:
             return ExpectationResult(
                 expectation, True, f"point {point} reached: task idle at {format_seconds(t)}", t, exchange.refs()
             )

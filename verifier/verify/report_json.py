@@ -79,6 +79,9 @@ def scenario_dict(result: ScenarioResult) -> dict[str, Any]:
         },
         "violations": [violation_dict(v) for v in result.all_violations()],
         "expectations": [expectation_dict(e) for e in result.expectations],
+        "watched": {
+            name: [[_seconds(t), value] for t, value in changes] for name, changes in result.watched.items()
+        },
         "aborted": result.aborted,
         "simulator_diagnostics": result.diagnostics,
         "line_events": [{"t": _seconds(e.t_us), "message": e.message} for e in result.events],
