@@ -207,6 +207,12 @@ class BodyCompiler:
             if not is_string(src):
                 raise CompileError(span, f"cannot assign {src} to STRING")
             return norm_code(dst, code) if isinstance(dst, StringT) else code
+        if _is_number(code) and isinstance(dst, str) and dst in datatypes.TYPES and src != "BOOL":
+            value = eval(code)
+            if is_real(dst):
+                return repr(datatypes.NORMALIZERS[dst](float(value)))
+            if isinstance(value, int):
+                return repr(datatypes.NORMALIZERS[dst](value))
         if src == ANYINT or src == ANYREAL:
             try:
                 value = eval(code, {"__builtins__": {}}, {})  # a folded literal expression
@@ -237,8 +243,7 @@ class BodyCompiler:
         if d.module is not None:
             g = self.m.buffer_global(int(d.module, 16))
             idx = d.number
-            return LValue("INT", f"{g}[{idx}]", f"{g}[{idx}] = (({{v}}) + 32768 & 65535) - 32768",
-                          label=label)
+            return LValue("INT", f"{g}[{idx}]", f"{g}[{idx}] = {{v}}", label=label)
         area = cpu.areas.get(d.kind)
         if area is None:
             raise CompileError(d.span, f"device {label}: the {cpu.name} CPU profile has no "
@@ -287,7 +292,8 @@ class BodyCompiler:
                 loc = self.m.loc_text(d.span)
                 write = (f"{place} = {{v}}\nif {place}: _rt.origins[{flag_channel!r}] = {loc!r}")
             return LValue("BOOL", place, write, prep, label)
-        return LValue("INT", place, f"{place} = (({{v}}) + 32768 & 65535) - 32768", prep, label)
+        # values reach a word device already converted to INT by coerce()
+        return LValue("INT", place, f"{place} = {{v}}", prep, label)
 
     def index_access(self, e: ast.Index):
         """(read code, element type, LValue) of an array element with checked bounds."""
@@ -805,12 +811,15 @@ class BodyCompiler:
             self.em.line(call)
             self.em.line(f"self.{slot} = {en_var}")
         else:
-            call = f"_I.{spec.name}({en_code}, {', '.join(ops)}, {k})"
             if not as_stmt:
                 if after:
                     raise CompileError(c.span, f"call {c.name} as a statement here")
-                return call, "BOOL"
-            self.em.line(call)
+                return f"_I.{spec.name}({en_code}, {', '.join(ops)}, {k})", "BOOL"
+            if en_code == "True":
+                self.em.line(f"_I.{spec.name}(True, {', '.join(ops)}, {k})")
+            else:
+                # EN FALSE: the instruction is not executed at all (as in ladder)
+                self.em.line(f"if {en_code}: _I.{spec.name}(True, {', '.join(ops)}, {k})")
         for line in after:
             self.em.line(line)
         return None, "BOOL"
@@ -880,6 +889,12 @@ class BodyCompiler:
         slot = f"_r{len(self.static_refs)}"
         self.static_refs.append((slot, code))
         return f"self.{slot}"
+
+
+def _is_number(code: str) -> bool:
+    """Is `code` a plain numeric literal (so a conversion can be done at compile time)?"""
+    text = code[1:] if code.startswith("-") else code
+    return text.isdigit() or text.replace(".", "", 1).isdigit()
 
 
 def _strides(dims) -> list[int]:

@@ -1,0 +1,169 @@
+"""ADPRW — MODBUS RTU master (FX3U-485ADP-MB on FX3U/FX3G; FX5 built-in RS-485 / FX5-485
+with the MODBUS master parameters).
+
+ST calls (docs/st-dialect.md): FX3 `ADPRW(EN, s, s1, s2, s3, s4d)`, FX5
+`ADPRW(EN, s, s1, s2, s3, s4d1, d2)` — s slave address, s1 function code, s2 MODBUS
+address, s3 count, s4d data head, d2 completion bits (d2[0] done, d2[1] error).
+Modelled function codes: 01 (read coils) and 06 (write single register), the two the
+robot uses.  Frames are built and checked with verifier.protocol (CRC-16/MODBUS).
+Behaviour, devices and ASSUMPTIONs: docs/instructions.md ("ADPRW").
+"""
+from __future__ import annotations
+
+from verifier.protocol import crc_ok, with_crc
+
+# simulator error codes (ASSUMPTION: the manuals' chapter-12 codes are not modelled)
+ERR_TIMEOUT = 1
+ERR_CRC = 2
+ERR_FRAME = 3
+ERR_FUNCTION = 4
+ERR_EXCEPTION = 0x100  # + MODBUS exception code
+
+
+class AdprwMaster:
+    """One MODBUS master channel: one transaction at a time."""
+
+    def __init__(self, rt, channel: int = 1):
+        self.rt = rt
+        self.family = rt.cpu.family
+        self.port = rt.channel(f"adp:{channel}")
+        dev = rt.dev
+        if self.family == "fx3":
+            # D8409 slave response time-out ms (0 = 3 s), D8412 retries (MODBUS manual p.33/34)
+            self._timeout = dev.address("D8409" if channel == 1 else "D8429")
+            self._retries = dev.address("D8412" if channel == 1 else "D8432")
+            self._err_code = dev.address("D8402" if channel == 1 else "D8422")
+            self._err_flag = dev.address("M8063" if channel == 1 else "M8438")
+            self._done_flag = dev.address("M8029")
+        else:
+            self._timeout = self._retries = None
+            self._err_code = dev.address("SD8500")
+            self._err_flag = None
+            self._done_flag = None
+        self.busy = False
+        self.request = b""
+        self.expect = 0
+        self.deadline = 0
+        self.attempts_left = 0
+        self.rx = bytearray()
+        self.job = None  # (fc, count, data ref, d2 ref)
+        self.pulses: list = []
+        self.pending: list = []
+        rt.pollers.append(self)
+
+    def _get(self, a):
+        return self.rt.dev.areas[a.area][a.index]
+
+    def _set(self, a, v):
+        self.rt.dev.areas[a.area][a.index] = v
+
+    def timeout_us(self) -> int:
+        if self._timeout is None:
+            return 3_000_000  # FX5: from the module parameters (ASSUMPTION: 3 s)
+        raw = self._get(self._timeout)
+        return (raw if raw > 0 else 3000) * 1000
+
+    # -- the instruction ---------------------------------------------------------------
+    def call(self, en, slave, fc, addr, count, data, d2, loc_id) -> bool:
+        if not en or self.busy:
+            return bool(en)
+        location = self.rt.locations[loc_id]
+        if fc == 1:
+            if not 1 <= count <= 2000:
+                return self._fail_now(d2, ERR_FRAME, location, f"ADPRW FC01 count {count} is outside 1..2000")
+            body = bytes([slave & 0xFF, 1, (addr >> 8) & 0xFF, addr & 0xFF, (count >> 8) & 0xFF, count & 0xFF])
+            self.expect = 5 + (count + 7) // 8
+        elif fc == 6:
+            value = data.get_u16(0)
+            body = bytes([slave & 0xFF, 6, (addr >> 8) & 0xFF, addr & 0xFF, value >> 8, value & 0xFF])
+            self.expect = 8
+        else:
+            return self._fail_now(d2, ERR_FUNCTION, location,
+                                  f"ADPRW function code {fc} is not modelled (01 and 06 are)")
+        self.request = with_crc(body)
+        self.job = (fc, count, data, d2)
+        self.busy = True
+        self.attempts_left = (max(0, min(self._get(self._retries), 20)) if self._retries else 0) + 1
+        self._send(location)
+        return True
+
+    def _send(self, origin) -> None:
+        self.rx.clear()
+        self.attempts_left -= 1
+        end = self.port.transmit(self.request, self.rt.now_us, origin)
+        self.deadline = end + self.timeout_us()
+
+    def _fail_now(self, d2, code, location, message) -> bool:
+        self.rt.warn(location, message)
+        self.job = (0, 0, None, d2)
+        self._complete(code, in_scan=True)
+        return True
+
+    # -- between scans -------------------------------------------------------------------
+    def _flag(self, ref, bit, value: bool) -> None:
+        if ref is None:
+            self._set(bit, value)  # a special relay (M8029)
+        else:
+            ref.set(bit, value)
+
+    def poll(self, now: int) -> None:
+        for ref, bit in self.pulses:
+            self._flag(ref, bit, False)
+        self.pulses, self.pending = self.pending, []
+        for ref, bit in self.pulses:
+            self._flag(ref, bit, True)
+        if not self.busy:
+            self.port.receive_until(now)  # nothing is expected: stray bytes are dropped
+            return
+        for value, _t in self.port.receive_until(now):
+            self.rx.append(value)
+            if len(self.rx) >= 2 and self.rx[1] & 0x80 and len(self.rx) >= 5:
+                self._reply()
+                return
+            if len(self.rx) >= self.expect:
+                self._reply()
+                return
+        if now >= self.deadline:
+            if self.attempts_left > 0:
+                self._send(None)
+            else:
+                self._complete(ERR_TIMEOUT)
+
+    def _reply(self) -> None:
+        frame = bytes(self.rx)
+        fc, count, data, _ = self.job
+        if not crc_ok(frame):
+            self._complete(ERR_CRC)
+        elif frame[0] != self.request[0] or frame[1] & 0x7F != fc:
+            self._complete(ERR_FRAME)
+        elif frame[1] & 0x80:
+            self._complete(ERR_EXCEPTION + frame[2])
+        else:
+            if fc == 1:
+                # coils packed 16 per word, the first coil in bit 0 (ASSUMPTION)
+                bits = int.from_bytes(frame[3:3 + frame[2]], "little")
+                for k in range((count + 15) // 16):
+                    data.set(k, (bits >> (16 * k)) & 0xFFFF & ((1 << min(16, count - 16 * k)) - 1))
+            self._complete(0)
+
+    def _complete(self, error: int, in_scan: bool = False) -> None:
+        """Completion bits go ON for one scan: from this scan when the END processing
+        between scans saw the reply, from the next one when the call itself failed."""
+        self.busy = False
+        _, _, _, d2 = self.job
+        self._set(self._err_code, error)
+        flags = []
+        if self.family == "fx3":
+            flags.append((None, self._done_flag))
+            if error:
+                self._set(self._err_flag, True)
+        elif d2 is not None:
+            flags.append((d2, 0))
+            if error:
+                flags.append((d2, 1))
+        if in_scan:
+            self.pending.extend(flags)
+        else:
+            for ref, bit in flags:
+                self._flag(ref, bit, True)
+            self.pulses.extend(flags)

@@ -1,0 +1,157 @@
+"""QJ71C24N(-R2/-R4) non-procedural protocol: G_OUTPUT / G_INPUT (ladder G.OUTPUT /
+G.INPUT) with the module's buffer memory and input signals.
+
+ST calls (docs/st-dialect.md): `G_OUTPUT(EN, Un, s1, s2, d)`, `G_INPUT(EN, Un, s, d1, d2)`.
+Behaviour, buffer addresses and what is an ASSUMPTION: docs/instructions.md ("QJ71C24N").
+"""
+from __future__ import annotations
+
+# buffer memory (word addresses) per channel: receive data count, receive end code,
+# word/byte unit designation
+BUFFER = {
+    1: {"recv_count": 0xA4, "end_code": 0xA5, "unit": 0x96},
+    2: {"recv_count": 0x144, "end_code": 0x145, "unit": 0x136},
+}
+DEFAULTS = {"recv_count": 511, "end_code": 0x0D0A, "unit": 0}
+# input signals (offset from the module's start I/O): reception data read request and
+# reception abnormal detection per channel
+READ_REQUEST = {1: 0x3, 2: 0xA}
+ABNORMAL = {1: 0x4, 2: 0xB}
+# result codes the simulator writes (ASSUMPTION: the module's own codes are not modelled)
+ERR_CHANNEL = 0x7FF1
+ERR_TOO_LONG = 0x7FF2
+
+
+class _Channel:
+    def __init__(self, module: "C24Module", ch: int):
+        self.module = module
+        self.ch = ch
+        self.port = module.rt.channel(f"q:{ch}")
+        self.sending_until: int | None = None
+        self.out_done = None  # (s1 ref, d ref) awaiting completion
+        self.rx = bytearray()
+        self.rx_last_t = 0
+        self.frames: list[bytes] = []
+        self.no_reception_us: int | None = None  # timer 0 (format 1), off by default
+
+
+class C24Module:
+    def __init__(self, rt, un: int):
+        self.rt = rt
+        self.un = un
+        self.buffer = rt.buffer(un)
+        for ch, addrs in BUFFER.items():
+            for name, addr in addrs.items():
+                if self.buffer[addr] == 0:
+                    self.buffer[addr] = DEFAULTS[name] - (0x10000 if DEFAULTS[name] > 0x7FFF else 0)
+        self.channels = {ch: _Channel(self, ch) for ch in (1, 2)}
+        self.pulses: list[tuple] = []  # (ref, bit offset) ON for one scan
+        self.pending: list[tuple] = []  # completion bits to turn ON at the next END
+        rt.pollers.append(self)
+
+    # -- helpers -------------------------------------------------------------------------
+    def _x(self, offset: int) -> int:
+        return self.un * 16 + offset
+
+    def _set_x(self, offset: int, value: bool) -> None:
+        xs = self.rt.dev.areas["X"]
+        i = self._x(offset)
+        if i < len(xs):
+            xs[i] = value
+
+    def _word(self, ch: int, name: str) -> int:
+        return self.buffer[BUFFER[ch][name]] & 0xFFFF
+
+    def _channel(self, ref, loc_id):
+        ch = ref.get(0)
+        if ch not in (1, 2):
+            self.rt.warn(self.rt.locations[loc_id], f"C24 at U{self.un:X}: channel {ch} does not exist "
+                                                    f"(control data word 0 must be 1 or 2)")
+            return None
+        return self.channels[ch]
+
+    def _finish(self, d_ref, ok: bool) -> None:
+        """Completion bits: d[0] done and d[1] error go ON at the END of this scan, for one scan."""
+        self.pending.append((d_ref, 0))
+        if not ok:
+            self.pending.append((d_ref, 1))
+
+    # -- G_OUTPUT ----------------------------------------------------------------------------
+    def output(self, s1, s2, d, loc_id) -> bool:
+        chan = self._channel(s1, loc_id)
+        if chan is None:
+            s1.set(1, ERR_CHANNEL)
+            self._finish(d, ok=False)
+            return True
+        if chan.sending_until is not None:
+            return True  # already sending: the running G_OUTPUT finishes first (ASSUMPTION)
+        count = s1.get(2)
+        nbytes = count if self._word(chan.ch, "unit") == 1 else 2 * count
+        data = s2.get_bytes(nbytes)
+        origin = self.rt.locations[loc_id]
+        chan.sending_until = chan.port.transmit(data, self.rt.now_us, origin)
+        chan.out_done = (s1, d)
+        return True
+
+    # -- G_INPUT -------------------------------------------------------------------------------
+    def input(self, s, d1, d2, loc_id) -> bool:
+        chan = self._channel(s, loc_id)
+        if chan is None:
+            s.set(1, ERR_CHANNEL)
+            self._finish(d2, ok=False)
+            return True
+        if not chan.frames:
+            return True  # nothing received: the instruction does nothing (ASSUMPTION)
+        data = chan.frames.pop(0)
+        words = (len(data) + 1) // 2
+        count = len(data) if self._word(chan.ch, "unit") == 1 else words
+        if count > s.get(3):
+            s.set(1, ERR_TOO_LONG)
+            self._finish(d2, ok=False)
+        else:
+            d1.put_bytes(data)
+            s.set(2, count)
+            s.set(1, 0)
+            self._finish(d2, ok=True)
+        if not chan.frames:
+            self._set_x(READ_REQUEST[chan.ch], False)
+        return True
+
+    # -- between scans ---------------------------------------------------------------------------
+    def poll(self, now: int) -> None:
+        for ref, bit in self.pulses:
+            ref.set(bit, False)
+        self.pulses = self.pending
+        self.pending = []
+        for ref, bit in self.pulses:
+            ref.set(bit, True)
+        for chan in self.channels.values():
+            if chan.sending_until is not None and now >= chan.sending_until:
+                chan.sending_until = None
+                s1, d = chan.out_done
+                s1.set(1, 0)
+                d.set(0, True)
+                self.pulses.append((d, 0))
+            self._receive(chan, now)
+
+    def _receive(self, chan: _Channel, now: int) -> None:
+        target = 2 * self._word(chan.ch, "recv_count") if self._word(chan.ch, "unit") == 0 \
+            else self._word(chan.ch, "recv_count")
+        end_code = self._word(chan.ch, "end_code")
+        for value, t in chan.port.receive_until(now):
+            if chan.rx and chan.no_reception_us is not None and t - chan.rx_last_t > chan.no_reception_us:
+                self._frame(chan)
+            chan.rx.append(value)
+            chan.rx_last_t = t
+            if (end_code != 0xFFFF and len(chan.rx) >= 2
+                    and chan.rx[-2] == end_code >> 8 and chan.rx[-1] == end_code & 0xFF):
+                self._frame(chan)
+            elif target and len(chan.rx) >= target:
+                self._frame(chan)
+        if chan.rx and chan.no_reception_us is not None and now - chan.rx_last_t > chan.no_reception_us:
+            self._frame(chan)
+
+    def _frame(self, chan: _Channel) -> None:
+        chan.frames.append(bytes(chan.rx))
+        chan.rx.clear()
+        self._set_x(READ_REQUEST[chan.ch], True)
