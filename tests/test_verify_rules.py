@@ -241,6 +241,17 @@ def test_half_duplex_needs_t3_5_of_silence_after_the_robot():
     assert check([request, reply, after_t35], options=RuleOptions(min_period_us=1))["UITAMR-HALF-DUPLEX"] == []
 
 
+def test_replies_are_paired_in_order_when_a_retry_goes_out_too_early():
+    """Robot answers each request once, in order: the first echo answers the first stop."""
+    first = tx(0, STOP)
+    retry = tx(300, STOP)
+    replies = [rx(first.t_end_us + 400 * MS, protocol.encode(protocol.ControlReply.echo(STOP), S)),
+               rx(retry.t_end_us + 400 * MS, protocol.encode(protocol.ControlReply.echo(STOP), S))]
+    found = check([first, retry, *replies], options=RuleOptions(min_period_us=1))
+    assert "was due" in found["UITAMR-HALF-DUPLEX"][0].message
+    assert len(found["UITAMR-ONE-AT-A-TIME"]) == 1
+
+
 def test_a_late_reply_colliding_with_a_retry_after_the_time_out_is_the_robots_fault():
     request = tx(0, STOP)
     retry = tx(700, STOP)
@@ -250,10 +261,10 @@ def test_a_late_reply_colliding_with_a_retry_after_the_time_out_is_the_robots_fa
 
 
 def test_one_at_a_time_waits_for_the_time_out_when_no_reply_comes():
-    impatient = [tx(0, STOP)] + exchange(300, STOP)
+    impatient = [tx(0, STOP)] + exchange(300, READ_TASK)
     (violation,) = check(impatient)["UITAMR-ONE-AT-A-TIME"]
     assert "no reply" in violation.message and "500.0 ms" in violation.message
-    patient = [tx(0, STOP)] + exchange(520, STOP)
+    patient = [tx(0, STOP)] + exchange(520, READ_TASK)
     assert check(patient)["UITAMR-ONE-AT-A-TIME"] == []
     shorter = RuleOptions(reply_timeout_us=250 * MS)
     assert check(impatient, options=shorter)["UITAMR-ONE-AT-A-TIME"] == []

@@ -8,6 +8,7 @@ given up (Modbus over Serial Line V1.02 §2.4.1, "response time-out").
 from __future__ import annotations
 
 import enum
+from bisect import bisect_right
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Sequence
@@ -147,18 +148,13 @@ def _is_reply_to(frame: TraceFrameLike, exchange: Exchange) -> bool:
     return True
 
 
-def _answers_earlier(frame: TraceFrameLike, earlier: Exchange, later: Exchange) -> bool:
-    """A reply that came after the PLC had already sent its next request: it belongs to the
-    earlier request when that one still awaited it and it answers that one, not the later."""
-    return (
-        not earlier.rx
-        and frame.t_start_us <= earlier.deadline_us
-        and _is_reply_to(frame, earlier)
-        and not _is_reply_to(frame, later)
-    )
-
-
 def analyse(trace: Sequence[TraceFrameLike], settings: protocol.Settings, options: RuleOptions) -> Traffic:
+    """Pair requests and replies the way a slave answers: once per request, in order.
+
+    A robot frame goes to the oldest request that has ended, has no reply yet and whose
+    time-out has not run out — preferring one it is a valid reply to. When no request is
+    waiting, it joins the latest request that ended before it (a late reply, garbage).
+    """
     frames = sorted(trace, key=lambda f: (f.t_start_us, f.direction != "tx"))
     tx = [f for f in frames if f.direction == "tx"]
     rx = [f for f in frames if f.direction == "rx"]
@@ -166,17 +162,20 @@ def analyse(trace: Sequence[TraceFrameLike], settings: protocol.Settings, option
         Exchange(index, frame, [], settings, options.reply_timeout_us) for index, frame in enumerate(tx)
     ]
     before: list[TraceFrameLike] = []
-    position = 0
+    ends = [e.request.t_end_us for e in exchanges]
+    oldest = 0  # exchanges before this one are answered or timed out for good
     for frame in rx:
-        while position + 1 < len(tx) and tx[position + 1].t_start_us <= frame.t_start_us:
-            position += 1
-        if not tx or frame.t_start_us < tx[0].t_end_us:
+        t = frame.t_start_us
+        count = bisect_right(ends, t)  # requests that ended before this frame began
+        if count == 0:
             before.append(frame)
-        elif frame.t_start_us >= tx[position].t_end_us:
-            owner = position
-            if position > 0 and _answers_earlier(frame, exchanges[position - 1], exchanges[position]):
-                owner = position - 1
-            exchanges[owner].rx.append(frame)
-        else:  # arrived while the next request was being sent: it belongs to the one before
-            exchanges[position - 1].rx.append(frame)
+            continue
+        while oldest < count and (exchanges[oldest].rx or exchanges[oldest].deadline_us < t):
+            oldest += 1
+        waiting = [e for e in exchanges[oldest:count] if not e.rx and t <= e.deadline_us]
+        if waiting:
+            owner = next((e for e in waiting if _is_reply_to(frame, e)), waiting[0])
+        else:
+            owner = exchanges[count - 1]
+        owner.rx.append(frame)
     return Traffic(exchanges, before, rx, tx)

@@ -1,0 +1,281 @@
+"""The whole chain: ST parsed and simulated scan by scan, bytes on the virtual RS-485 line,
+the emulated robot, the rules and the expectations.
+
+1. For each rule, a small ST program that keeps it and one that breaks it. The programs send
+   fixed frames through the library's FX3 port FB (tx request / length / bytes in the port
+   interface), so each test decides exactly what goes on the wire and when.
+2. Deliberately broken variants of our own library, made by text substitution on the PLC
+   engineer's ST files: the verifier must catch each one, and pass the unmodified library.
+"""
+from __future__ import annotations
+
+import shutil
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from verifier import protocol
+from verifier.amr.config import RobotConfig
+from verifier.amr.faults import Fault
+from verifier.verify.conditions import parse_condition
+from verifier.verify.evidence import RuleOptions
+from verifier.verify.runner import run_scenario
+from verifier.verify.scenario import InputStep, Scenario, parse_scenario
+
+REPO = Path(__file__).resolve().parents[1]
+PLC = REPO / "plc"
+S = protocol.Settings()
+STOP = protocol.ControlRequest(1, protocol.ControlCode.ROBOT, protocol.RobotCommand.STOP)
+POINT3 = protocol.ControlRequest(1, protocol.ControlCode.ROBOT, 3)
+READ = protocol.StatusRequest(1, protocol.Query.TASK)
+
+
+# --- a frame sequencer in ST -------------------------------------------------------------------
+
+SEQUENCER = """\
+(* Test program: sends FRAME_COUNT fixed frames, one every PERIOD, through the FX3 port FB.
+   Replies are received and dropped; bErr is the program's only error signal. *)
+PROGRAM SeqTest
+VAR
+    fbPort : UITAMR_PortFx3;
+    uPort : ARRAY[0..39] OF WORD;
+    uFrames : ARRAY[0..63] OF WORD;
+    tmrPeriod : TON;
+    bLoaded : BOOL;
+    bErr : BOOL;
+    wNext : INT;
+    wIndex : INT;
+END_VAR
+VAR CONSTANT
+    FRAME_COUNT : INT := {count};
+    FRAME_LEN : INT := 8;
+END_VAR
+IF NOT bLoaded THEN
+{loads}
+    bLoaded := TRUE;
+END_IF;
+fbPort(i_bEnable := TRUE, i_wChannel := 1, io_uPort := uPort);
+tmrPeriod(IN := NOT tmrPeriod.Q, PT := {period});
+IF tmrPeriod.Q AND (wNext < FRAME_COUNT) AND (uPort[0] = 0) THEN
+    FOR wIndex := 0 TO FRAME_LEN - 1 DO
+        uPort[8 + wIndex] := uFrames[wNext * FRAME_LEN + wIndex];
+    END_FOR;
+    uPort[1] := INT_TO_WORD(FRAME_LEN);
+    uPort[0] := 1;
+    wNext := wNext + 1;
+END_IF;
+uPort[2] := 0;
+"""
+
+
+def sequencer(tmp_path: Path, frames: list[bytes], period: str = "T#300ms") -> Path:
+    assert all(len(f) == 8 for f in frames) and len(frames) <= 8
+    loads = "\n".join(
+        f"    uFrames[{i * 8 + k}] := 16#{byte:02X};" for i, frame in enumerate(frames) for k, byte in enumerate(frame)
+    )
+    path = tmp_path / "SeqTest.st"
+    path.write_text(SEQUENCER.format(count=len(frames), loads=loads, period=period))
+    return path
+
+
+def run_sequence(tmp_path: Path, frames: list, *, period: str = "T#300ms", robot: dict | None = None,
+                 faults: list[dict] = (), duration_us: int | None = None, options: RuleOptions | None = None):
+    data = [f if isinstance(f, bytes) else protocol.encode(f, S) for f in frames]
+    sources = (PLC / "core" / "UITAMR_PortLink.st", PLC / "core" / "UITAMR_PortPacking.st",
+               PLC / "fx3" / "UITAMR_PortFx3.st", sequencer(tmp_path, data, period))
+    scenario = Scenario(
+        name="sequence",
+        sources=tuple(p for p in sources if p.exists()),
+        program="SeqTest",
+        duration_us=duration_us or (len(frames) + 2) * 400_000,
+        robot=RobotConfig.from_dict(robot or {}),
+        faults=tuple(Fault.from_dict(f) for f in faults),
+        options=options or RuleOptions(response_signal=parse_condition("bErr")),
+        response_signal_given=True,
+    )
+    result = run_scenario(scenario)
+    assert result.aborted is None, result.aborted
+    sent = [f.data for f in result.trace if f.direction == "tx"]
+    assert sent == data, "the sequencer did not put the frames on the line as written"
+    return result
+
+
+def broken_rules(result) -> set[str]:
+    return {rule for rule, found in result.violations.items() if found}
+
+
+def test_a_compliant_sequence_passes_every_rule(tmp_path):
+    result = run_sequence(tmp_path, [STOP, READ, POINT3, READ])
+    assert broken_rules(result) == set() and result.passed
+    assert all(f.origin and f.origin.endswith(".st:" + f.origin.rsplit(":", 2)[1] + ":" + f.origin.rsplit(":", 1)[1])
+               for f in result.trace if f.direction == "tx")
+
+
+def test_crc_rule_through_the_pipeline(tmp_path):
+    bad = bytearray(protocol.encode(READ, S))
+    bad[6] ^= 0x10
+    result = run_sequence(tmp_path, [STOP, bytes(bad)])
+    assert broken_rules(result) == {"UITAMR-CRC"}
+    (violation,) = result.violations["UITAMR-CRC"]
+    assert violation.origin and "UITAMR_PortFx3.st" in violation.origin  # the ST line that sent it
+
+
+def test_format_rule_through_the_pipeline(tmp_path):
+    wrong_quantity = protocol.with_crc(bytes.fromhex("010100000008"))
+    result = run_sequence(tmp_path, [STOP, wrong_quantity, READ])
+    assert "UITAMR-FORMAT" in broken_rules(result)
+    assert "quantity" in result.violations["UITAMR-FORMAT"][0].message
+
+
+def test_pacing_rule_through_the_pipeline(tmp_path):
+    result = run_sequence(tmp_path, [STOP, READ, READ], period="T#200ms")
+    assert broken_rules(result) == {"UITAMR-PACING"}
+    assert len(result.violations["UITAMR-PACING"]) == 2
+
+
+def test_power_on_stop_rule_through_the_pipeline(tmp_path):
+    result = run_sequence(tmp_path, [READ, POINT3, READ, STOP])
+    assert broken_rules(result) == {"UITAMR-POWERON-STOP"}
+    assert run_sequence(tmp_path, [READ, STOP, READ, POINT3, READ]).passed
+
+
+def test_cycle_rule_through_the_pipeline(tmp_path):
+    result = run_sequence(tmp_path, [STOP, POINT3, READ])
+    assert broken_rules(result) == {"UITAMR-CYCLE"}
+
+
+def test_half_duplex_and_one_at_a_time_through_the_pipeline(tmp_path):
+    # the robot takes 400 ms to answer (inside the 500 ms time-out); the program sends every 300 ms
+    result = run_sequence(tmp_path, [STOP, READ, READ], robot={"turnaround_ms": 400.0})
+    assert {"UITAMR-HALF-DUPLEX", "UITAMR-ONE-AT-A-TIME"} <= broken_rules(result)
+    assert any(e.kind == "collision" or "discarded" in e.kind for e in result.events) or \
+        "was due" in result.violations["UITAMR-HALF-DUPLEX"][0].message
+    assert run_sequence(tmp_path, [STOP, READ, READ], period="T#600ms", robot={"turnaround_ms": 400.0}).passed
+
+
+def test_response_handling_through_the_pipeline(tmp_path):
+    reads = [STOP] + [READ] * 7
+    faults = [{"kind": "no_reply", "at_s": 0.5, "duration_s": 10.0}]
+    options = RuleOptions(response_signal=parse_condition("bErr"), response_within_us=1_000_000)
+    result = run_sequence(tmp_path, reads, period="T#700ms", faults=faults, duration_us=8_000_000, options=options)
+    assert broken_rules(result) == {"UITAMR-RESPONSE-HANDLING"}
+    assert "'bErr' did not become true within 1 s" in result.violations["UITAMR-RESPONSE-HANDLING"][0].message
+
+
+# --- the library and broken variants of it ---------------------------------------------------
+
+FX3_EXAMPLE = """
+name = "fx3 example"
+sources = ["core/*.st", "fx3/*.st", "examples/common/*.st", "examples/fx3/UITAMR_ExampleFx3.st"]
+program = "UITAMR_ExampleFx3"
+platform = "fx3u"
+duration = "{duration}"
+[robot]
+point_duration_s = 3.0
+{robot}
+[[inputs]]
+at = "1s"
+set = {{ X0 = true }}
+pulse = "300ms"
+{faults}
+[[expect]]
+reached_point = 1
+within = "{point_within}"
+[response_handling]
+signal = "fbEngine.o_bErr"
+within = "4s"
+"""
+
+
+def library_copy(tmp_path: Path, edits: dict[str, list[tuple[str, str]]]) -> Path:
+    """A copy of plc/ with text substitutions applied (each must match exactly once)."""
+    copy = tmp_path / "plc"
+    shutil.copytree(PLC, copy, ignore=shutil.ignore_patterns("scenarios", "ladder"))
+    for relative, substitutions in edits.items():
+        path = copy / relative
+        text = path.read_text(encoding="utf-8")
+        for old, new in substitutions:
+            assert text.count(old) == 1, f"{relative}: {old!r} found {text.count(old)} times; update the test"
+            text = text.replace(old, new)
+        path.write_text(text, encoding="utf-8")
+    return copy
+
+
+def run_library(tmp_path: Path, edits: dict, *, duration: str = "12s", robot: str = "", faults: str = "",
+                point_within: str = "10s"):
+    copy = library_copy(tmp_path, edits)
+    text = FX3_EXAMPLE.format(duration=duration, robot=robot, faults=faults, point_within=point_within)
+    scenario = parse_scenario(text, copy / "scenario.toml")
+    return run_scenario(scenario)
+
+
+def test_the_unmodified_library_passes(tmp_path):
+    result = run_library(tmp_path, {})
+    assert broken_rules(result) == set() and result.passed
+
+
+NO_REPLY = '[[faults]]\nkind = "no_reply"\nat_s = 5.0\nduration_s = 20.0\n'
+
+VARIANTS = {
+    "crc-init-wrong": (
+        {"core/UITAMR_CRC16.st": [("CRC_INIT : WORD := 16#FFFF;", "CRC_INIT : WORD := 16#0000;")]},
+        {}, {"UITAMR-CRC"},
+    ),
+    "crc-polynomial-wrong": (
+        {"core/UITAMR_CRC16.st": [("CRC_POLY : WORD := 16#A001;", "CRC_POLY : WORD := 16#8005;")]},
+        {}, {"UITAMR-CRC"},
+    ),
+    "crc-bytes-swapped": (
+        {
+            "core/UITAMR_BuildControl.st": [(
+                "io_uFrame[6] := uCrc AND BYTE_MASK;\n    io_uFrame[7] := SHR(uCrc, BITS_PER_BYTE);",
+                "io_uFrame[7] := uCrc AND BYTE_MASK;\n    io_uFrame[6] := SHR(uCrc, BITS_PER_BYTE);",
+            )],
+            "core/UITAMR_BuildStatus.st": [(
+                "io_uFrame[6] := uCrc AND BYTE_MASK;\n    io_uFrame[7] := SHR(uCrc, BITS_PER_BYTE);",
+                "io_uFrame[7] := uCrc AND BYTE_MASK;\n    io_uFrame[6] := SHR(uCrc, BITS_PER_BYTE);",
+            )],
+        },
+        {}, {"UITAMR-CRC"},
+    ),
+    "pacing-too-short": (
+        {"core/UITAMR_Engine.st": [("PACE_TIME : TIME := T#300ms;", "PACE_TIME : TIME := T#200ms;")]},
+        {}, {"UITAMR-PACING"},
+    ),
+    "no-power-on-stop": (
+        {"core/UITAMR_Engine.st": [(
+            "wJob := JOB_INIT;\n            wKind := KIND_WAIT;\n            wCode := CODE_ROBOT;\n            wCommand := CMD_STOP;",
+            "wJob := JOB_INIT;\n            wKind := KIND_WAIT;\n            wCode := CODE_ROBOT;\n            wCommand := 1;",
+        )]},
+        {}, {"UITAMR-POWERON-STOP"},
+    ),
+    "sending-while-a-reply-is-due": (
+        {"core/UITAMR_Engine.st": [
+            ("REPLY_TIMEOUT : TIME := T#500ms;", "REPLY_TIMEOUT : TIME := T#100ms;"),
+            ("GUARD_TIME : TIME := T#200ms;", "GUARD_TIME : TIME := T#0ms;"),
+        ]},
+        {"robot": "turnaround_ms = 400.0"}, {"UITAMR-HALF-DUPLEX", "UITAMR-ONE-AT-A-TIME"},
+    ),
+    "ignoring-time-outs": (
+        {"core/UITAMR_Engine.st": [("ELSIF tmrReply.Q THEN", "ELSIF FALSE THEN")]},
+        {"faults": NO_REPLY, "duration": "14s"}, {"UITAMR-RESPONSE-HANDLING"},
+    ),
+    "status-quantity-wrong": (
+        {"core/UITAMR_BuildStatus.st": [("QUANTITY_LOW : WORD := 16#0016;", "QUANTITY_LOW : WORD := 16#0008;")]},
+        {}, {"UITAMR-FORMAT"},
+    ),
+}
+
+
+@pytest.mark.parametrize("variant", sorted(VARIANTS))
+def test_the_verifier_catches_a_broken_library(tmp_path, variant):
+    edits, options, expected = VARIANTS[variant]
+    result = run_library(tmp_path, edits, **options)
+    assert not result.passed
+    assert expected <= broken_rules(result), f"{variant}: broke {broken_rules(result)}"
+
+
+def test_the_unmodified_library_handles_the_same_silent_robot(tmp_path):
+    result = run_library(tmp_path, {}, faults=NO_REPLY, duration="14s")
+    assert broken_rules(result) == set()
