@@ -1,0 +1,349 @@
+"""``uitamr emulate`` on real ports: a socat pty pair driven by mbpoll (libmodbus, an
+independent master), and TCP driven by a pymodbus client and a raw socket.
+
+Every subprocess has a timeout and is always cleaned up; TCP binds 127.0.0.1 port 0.
+No wall-clock time is asserted: waits are bounded polls for what must appear.
+"""
+from __future__ import annotations
+
+import os
+import queue
+import random
+import re
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+import serial
+from pymodbus.client import ModbusTcpClient
+from pymodbus.framer import FramerType
+
+from verifier.protocol import STOP_FRAME, ControlRequest, Query, StatusRequest, encode, with_crc
+
+pytestmark = pytest.mark.serial
+
+STATUS_TASK = encode(StatusRequest(1, Query.TASK))
+RUN_POINT_3 = encode(ControlRequest(1, 1, 3))
+WAIT_S = 15  # upper bound for anything to show up; never a measured time
+
+
+class EmulatorProcess:
+    """``python -m verifier.cli emulate ...`` with its log lines collected as they come."""
+
+    def __init__(self, *args: str) -> None:
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "verifier.cli", "emulate", *args],
+            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, bufsize=1,
+            env={**os.environ, "PYTHONUNBUFFERED": "1"},
+        )
+        self.lines: list[str] = []
+        self._queue: queue.Queue[str | None] = queue.Queue()
+        threading.Thread(target=self._pump, daemon=True).start()
+
+    def _pump(self) -> None:
+        for line in self.proc.stdout:
+            self._queue.put(line.rstrip("\n"))
+        self._queue.put(None)
+
+    def wait_for(self, pattern: str, timeout: float = WAIT_S) -> re.Match:
+        """The first log line (old or new) matching ``pattern``."""
+        regex = re.compile(pattern)
+        for line in self.lines:
+            if m := regex.search(line):
+                return m
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            try:
+                line = self._queue.get(timeout=0.1)
+            except queue.Empty:
+                continue
+            if line is None:
+                break
+            self.lines.append(line)
+            if m := regex.search(line):
+                return m
+        raise AssertionError(f"no log line matching {pattern!r}; log so far:\n" + "\n".join(self.lines))
+
+    def stop(self, sig: int = signal.SIGTERM) -> tuple[int, str]:
+        """Signal it, wait for it to exit; (exit code, last line)."""
+        if self.proc.poll() is None:
+            self.proc.send_signal(sig)
+        try:
+            code = self.proc.wait(timeout=WAIT_S)
+        finally:
+            self.kill()
+        self.wait_for(r"uitamr emulate: stopped", timeout=5)
+        return code, self.lines[-1]
+
+    def kill(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.wait(timeout=WAIT_S)
+
+
+@pytest.fixture
+def start_emulator():
+    started: list[EmulatorProcess] = []
+
+    def start(*args: str) -> EmulatorProcess:
+        process = EmulatorProcess(*args)
+        started.append(process)
+        process.wait_for(r"listening on")
+        return process
+
+    yield start
+    for process in started:
+        process.kill()
+
+
+@pytest.fixture
+def pty_pair(tmp_path: Path):
+    """Two linked ptys from socat: (robot side, master side)."""
+    assert shutil.which("socat"), "socat is required (apt-get install socat)"
+    robot_end, master_end = tmp_path / "robot", tmp_path / "master"
+    proc = subprocess.Popen(
+        ["socat", f"pty,raw,echo=0,link={robot_end}", f"pty,raw,echo=0,link={master_end}"],
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+    )
+    try:
+        deadline = time.monotonic() + WAIT_S
+        while not (robot_end.exists() and master_end.exists()):
+            assert proc.poll() is None, "socat exited"
+            assert time.monotonic() < deadline, "socat made no ptys"
+            time.sleep(0.02)
+        yield str(robot_end), str(master_end)
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(timeout=WAIT_S)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait(timeout=WAIT_S)
+
+
+def mbpoll(port: str, *args: str, values: tuple[str, ...] = ()) -> subprocess.CompletedProcess:
+    """mbpoll once against ``port``; written values come after the device name."""
+    assert shutil.which("mbpoll"), "mbpoll is required (apt-get install mbpoll)"
+    return subprocess.run(
+        ["mbpoll", "-m", "rtu", "-b", "9600", "-P", "none", "-a", "1", "-o", "3", "-1", *args, port, *values],
+        capture_output=True, text=True, timeout=WAIT_S,
+    )
+
+
+def coils(result: subprocess.CompletedProcess, first: int) -> list[int]:
+    """The 22 coil values from mbpoll's ``[ref]: v`` lines (mbpoll labels them by reference,
+    ``first`` to ``first + 21``)."""
+    found = {int(n): int(v) for n, v in re.findall(r"^\[(\d+)\]:\s+(\d+)", result.stdout, re.M)}
+    assert sorted(found) == list(range(first, first + 22)), result.stdout
+    return [found[first + i] for i in range(22)]
+
+
+def read_status(port: str, query: int) -> tuple[int, int]:
+    """(error, value) read by mbpoll: coils 9-16 of the 22 carry the error byte, 17-22 the value.
+
+    mbpoll's -r is 1-based, so query parameter P is ``-r P+1``.
+    """
+    result = mbpoll(port, "-t", "0", "-r", str(query + 1), "-c", "22")
+    assert result.returncode == 0, result.stdout + result.stderr
+    bits = coils(result, query + 1)
+    assert not any(bits[:8])
+    error = sum(bits[8 + i] << i for i in range(8))
+    value = sum(bits[16 + i] << i for i in range(6))
+    return error, value
+
+
+def write_command(port: str, code: int, command: int) -> subprocess.CompletedProcess:
+    """FC06 with the command in the register address: register 0xCCDD is ``-r`` 0xCCDD+1."""
+    return mbpoll(port, "-t", "4", "-r", str((code << 8 | command) + 1), values=("0",))
+
+
+# ---- serial: mbpoll over a socat pty pair ------------------------------------------------------
+
+def test_mbpoll_writes_stop_and_reads_every_status(pty_pair, start_emulator):
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end)
+    result = write_command(master_end, 0x01, 0xA0)
+    assert result.returncode == 0 and "Written 1 references" in result.stdout
+    emulator.wait_for(r"<- 01 06 01 A0 00 00 88 14  stop \(01/A0\)")
+    emulator.wait_for(r"-> 01 06 01 A0 00 00 88 14")
+    assert read_status(master_end, Query.TASK) == (0, 0)
+    emulator.wait_for(r"<- 01 01 00 00 00 16 BD C4  read task status")
+    assert read_status(master_end, Query.SPEED) == (0, 0)
+    assert write_command(master_end, 0x02, 3).returncode == 0  # trackless speed stage 4
+    assert read_status(master_end, Query.SPEED) == (0, 3)
+    code, summary = emulator.stop()
+    assert code == 0
+    assert re.search(r"5 frames in, 5 replies out", summary)
+
+
+def test_mbpoll_sees_a_task_run_and_an_anti_collision_stop(pty_pair, start_emulator):
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end, "--point-duration-s", "600")
+    assert write_command(master_end, 0x01, 0xA0).returncode == 0
+    assert write_command(master_end, 0x01, 3).returncode == 0
+    assert read_status(master_end, Query.TASK) == (0, 1)
+    emulator.stop()
+    emulator = start_emulator("--serial", robot_end, "--anti-collision-at", "0")
+    assert read_status(master_end, Query.VEHICLE) == (1, 1)
+    assert emulator.stop()[0] == 0
+
+
+def test_mbpoll_gets_illegal_function_and_the_next_request_is_still_answered(pty_pair, start_emulator):
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end)
+    result = mbpoll(master_end, "-t", "3", "-r", "1", "-c", "1")  # FC04: not the robot's
+    assert "Illegal function" in result.stdout + result.stderr
+    emulator.wait_for(r"-> 01 84 01 ")
+    assert read_status(master_end, Query.TASK) == (0, 0)
+
+
+def test_mbpoll_times_out_on_a_scripted_no_reply_then_recovers(pty_pair, start_emulator):
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end, "--no-reply-on", "1")
+    result = mbpoll(master_end, "-t", "0", "-r", "1", "-c", "22")
+    assert "timed out" in (result.stdout + result.stderr).lower()
+    emulator.wait_for(r"\*\* fault: request 1: no_reply")
+    assert read_status(master_end, Query.TASK) == (0, 0)
+
+
+def test_serial_survives_noise_truncated_frames_and_floods(pty_pair, start_emulator):
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end)
+    rng = random.Random(7)
+    with serial.Serial(master_end, 9600, timeout=0.5) as port:
+        port.write(b"\xff")  # one noise byte, then a silence, then a request
+        port.flush()
+        emulator.wait_for(r"<- FF  invalid frame")
+        port.write(STOP_FRAME)
+        assert port.read(8) == STOP_FRAME
+        port.write(STATUS_TASK[:5])  # truncated frame: ended by the silence, ignored
+        port.flush()
+        time.sleep(0.1)
+        port.write(bytes(rng.randrange(256) for _ in range(20_000)))  # flood
+        port.flush()
+        emulator.wait_for(r"!! \d+ bytes without a silence")
+        time.sleep(0.1)
+        port.reset_input_buffer()
+    assert read_status(master_end, Query.TASK) == (0, 0)
+    code, _ = emulator.stop(signal.SIGINT)
+    assert code == 0
+
+
+# ---- TCP: pymodbus client and raw sockets -----------------------------------------------------
+
+def tcp_emulator(start_emulator, *args: str) -> tuple[EmulatorProcess, int]:
+    emulator = start_emulator("--tcp", "127.0.0.1:0", *args)
+    port = int(emulator.wait_for(r"listening on tcp 127\.0\.0\.1:(\d+)").group(1))
+    return emulator, port
+
+
+def exchange(sock: socket.socket, request: bytes, expect: int) -> bytes:
+    sock.sendall(request)
+    reply = b""
+    while len(reply) < expect:
+        chunk = sock.recv(expect - len(reply))
+        assert chunk, "emulator closed the connection"
+        reply += chunk
+    return reply
+
+
+def test_pymodbus_client_over_tcp_with_rtu_framing(start_emulator):
+    emulator, port = tcp_emulator(start_emulator, "--point-duration-s", "600")
+    client = ModbusTcpClient("127.0.0.1", port=port, framer=FramerType.RTU, timeout=3, retries=0)
+    try:
+        assert client.connect()
+        stop = client.write_register(0x01A0, 0, device_id=1)
+        assert not stop.isError() and stop.address == 0x01A0
+        run = client.write_register(0x0103, 0, device_id=1)
+        assert not run.isError()
+        task = client.read_coils(0, count=22, device_id=1)
+        assert not task.isError()
+        assert task.bits[16] is True and not any(task.bits[:16])
+        bad = client.write_register(0x0199, 0, device_id=1)  # no command 0x99: illegal value
+        assert bad.isError() and bad.exception_code == 3
+    finally:
+        client.close()
+    emulator.wait_for(r"-> 01 86 03 ")
+    assert emulator.stop()[0] == 0
+
+
+def test_raw_socket_faults_and_noise_over_tcp(start_emulator):
+    emulator, port = tcp_emulator(start_emulator, "--wrong-address-on", "2", "--bad-crc-on", "3",
+                                  "--garbage-on", "4")
+    with socket.create_connection(("127.0.0.1", port), timeout=5) as sock:
+        assert exchange(sock, STOP_FRAME, 8) == STOP_FRAME
+        wrong = exchange(sock, STATUS_TASK, 8)
+        assert wrong[0] == 2 and wrong[1:6] == bytes.fromhex("0103000000")
+        assert exchange(sock, STATUS_TASK, 8)[:-2] == bytes.fromhex("010103000000")
+        assert exchange(sock, STATUS_TASK, 3) == bytes.fromhex("A55AFF")
+        # unknown function code with a good CRC: exception 01, and nothing is swallowed
+        assert exchange(sock, with_crc(bytes((1, 3, 0, 0, 0, 1))), 5) == with_crc(bytes((1, 0x83, 1)))
+        assert exchange(sock, STATUS_TASK, 8) == with_crc(bytes.fromhex("010103000000"))
+        # noise glued to a request loses it; after a silence the next request is answered
+        sock.sendall(b"\x00" + STATUS_TASK)
+        emulator.wait_for(r"<- 00 01 01 00 00 00 16 BD C4")
+        assert exchange(sock, STATUS_TASK, 8) == with_crc(bytes.fromhex("010103000000"))
+        # a flood, then silence, then a request
+        rng = random.Random(11)
+        sock.sendall(bytes(rng.randrange(256) for _ in range(50_000)))
+        emulator.wait_for(r"!! \d+ bytes without a silence")
+        assert exchange(sock, STATUS_TASK, 8) == with_crc(bytes.fromhex("010103000000"))
+    emulator.wait_for(r"client 127\.0\.0\.1:\d+ disconnected")
+    code, summary = emulator.stop()
+    assert code == 0 and "3 fault events" in summary and "50000 flood bytes dropped" in summary
+
+
+def test_tcp_serves_two_clients_on_one_robot(start_emulator):
+    emulator, port = tcp_emulator(start_emulator)
+    with socket.create_connection(("127.0.0.1", port), timeout=5) as first, \
+            socket.create_connection(("127.0.0.1", port), timeout=5) as second:
+        assert exchange(first, STOP_FRAME, 8) == STOP_FRAME
+        assert exchange(second, RUN_POINT_3, 8) == RUN_POINT_3
+        assert exchange(first, STATUS_TASK, 8) == with_crc(bytes.fromhex("010103000001"))
+    assert emulator.stop()[0] == 0
+
+
+# ---- the command's own errors ------------------------------------------------------------------
+
+def run_cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "verifier.cli", "emulate", *args],
+                          capture_output=True, text=True, timeout=WAIT_S)
+
+
+def test_bad_fault_file_names_file_and_key(tmp_path):
+    path = tmp_path / "faults.toml"
+    path.write_text('[[faults]]\nkind = "no_reply"\non_request = 1\n\n[[faults]]\nkind = "x"\nat_s = 1\n')
+    result = run_cli("--tcp", "0", "--faults", str(path))
+    assert result.returncode == 2
+    assert f"{path}: faults[1].kind: unknown fault 'x'; expected one of anti_collision" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_fault_file_is_applied(tmp_path, start_emulator):
+    path = tmp_path / "faults.toml"
+    path.write_text('[robot]\nturnaround_ms = 2\n\n[[faults]]\nkind = "exception"\non_request = 1\ncode = 6\n')
+    emulator, port = tcp_emulator(start_emulator, "--faults", str(path))
+    with socket.create_connection(("127.0.0.1", port), timeout=5) as sock:
+        assert exchange(sock, STOP_FRAME, 5) == with_crc(bytes((1, 0x86, 6)))
+
+
+@pytest.mark.parametrize("args, message, code", [
+    ((), "give exactly one of --serial PORT or --tcp HOST:PORT", 2),
+    (("--tcp", "0", "--serial", "loop://"), "give exactly one of", 2),
+    (("--tcp", "here"), "expected HOST:PORT or PORT", 2),
+    (("--tcp", "0", "--late-reply-on", "3"), "expected N:MS", 2),
+    (("--tcp", "0", "--no-reply-on", "0"), "request numbers start at 1", 2),
+    (("--tcp", "0", "--address", "300"), "robot address must be 1-247", 2),
+    (("--serial", "/nonexistent/ttyUSB9"), "cannot open serial port /nonexistent/ttyUSB9", 1),
+])
+def test_cli_mistakes_get_a_clear_message(args, message, code):
+    result = run_cli(*args)
+    assert result.returncode == code
+    assert message in result.stderr
+    assert "Traceback" not in result.stderr

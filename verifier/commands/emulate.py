@@ -1,0 +1,180 @@
+"""``uitamr emulate``: the emulated robot on a real serial port or TCP socket, for bench
+tests of a real PLC (docs/emulator.md)."""
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+
+import click
+
+from verifier.amr import ConfigError, Fault, Robot, RobotConfig
+from verifier.amr.config import BEFORE_STOP_POLICIES, PACING_POLICIES
+from verifier.emulate.assembler import DEFAULT_SILENCE_US
+from verifier.emulate.core import Emulator
+from verifier.emulate.faultfile import FaultFileError, load_fault_file
+from verifier.emulate.ports import PortError, serve_serial, serve_tcp
+from verifier.protocol.settings import CODES_10_13_STYLES, FIELD_ORDERS, STATUS_ORDERS, Settings
+
+
+def _tcp_endpoint(value: str) -> tuple[str, int]:
+    host, sep, port = value.rpartition(":")
+    if not sep:
+        host, port = "127.0.0.1", value
+    host = host.strip("[]") or "127.0.0.1"
+    try:
+        number = int(port)
+    except ValueError:
+        raise click.BadParameter(f"expected HOST:PORT or PORT, got {value!r}", param_hint="--tcp") from None
+    if not 0 <= number <= 65535:
+        raise click.BadParameter(f"port must be 0-65535, got {number}", param_hint="--tcp")
+    return host, number
+
+
+def _request_number(value: str, option: str) -> tuple[int, str]:
+    number, _, rest = value.partition(":")
+    try:
+        n = int(number)
+    except ValueError:
+        raise click.BadParameter(f"expected a request number, got {value!r}", param_hint=option) from None
+    if n < 1:
+        raise click.BadParameter(f"request numbers start at 1, got {n}", param_hint=option)
+    return n, rest
+
+
+def _flag_faults(no_reply, bad_crc, garbage, wrong_address, exception, late,
+                 anti_collision, off_tape, low_battery) -> list[Fault]:
+    faults = []
+    faults += [Fault("no_reply", on_request=_request_number(v, "--no-reply-on")[0]) for v in no_reply]
+    faults += [Fault("bad_crc", on_request=_request_number(v, "--bad-crc-on")[0]) for v in bad_crc]
+    faults += [Fault("garbage", on_request=_request_number(v, "--garbage-on")[0]) for v in garbage]
+    faults += [Fault("wrong_address", on_request=_request_number(v, "--wrong-address-on")[0])
+               for v in wrong_address]
+    for value in exception:
+        n, code = _request_number(value, "--exception-on")
+        try:
+            faults.append(Fault.from_dict({"kind": "exception", "on_request": n, "code": int(code or "4", 0)}))
+        except (ValueError, ConfigError) as err:
+            raise click.BadParameter(f"{value!r}: {err}", param_hint="--exception-on") from None
+    for value in late:
+        n, ms = _request_number(value, "--late-reply-on")
+        try:
+            faults.append(Fault.from_dict({"kind": "late_reply", "on_request": n, "delay_ms": float(ms)}))
+        except (ValueError, ConfigError):
+            raise click.BadParameter(f"expected N:MS (request number and delay), got {value!r}",
+                                     param_hint="--late-reply-on") from None
+    faults += [Fault("anti_collision", at_s=s) for s in anti_collision]
+    faults += [Fault("off_tape", at_s=s) for s in off_tape]
+    faults += [Fault("low_battery", at_s=s) for s in low_battery]
+    return faults
+
+
+@click.command("emulate")
+@click.option("--serial", "serial_url", metavar="PORT",
+              help="Serial port or pyserial URL: /dev/ttyUSB0, COM3, loop://, socket://HOST:PORT.")
+@click.option("--tcp", "tcp", metavar="HOST:PORT",
+              help="Listen for raw RTU frames over TCP (PORT alone binds 127.0.0.1; port 0 = any free port).")
+@click.option("--baud", default=9600, show_default=True, help="Serial speed (the robot uses 9600 8N1).")
+@click.option("--address", default=1, show_default=True, help="The robot's Modbus slave address.")
+@click.option("--field-order", type=click.Choice(FIELD_ORDERS), default="code-high", show_default=True,
+              help="FC06 address field: control code in the high or the low byte.")
+@click.option("--codes-10-13", type=click.Choice(CODES_10_13_STYLES), default="decimal", show_default=True,
+              help="Control codes 10-13 on the wire as 0x0A-0x0D (decimal) or 0x10-0x13 (hex).")
+@click.option("--status-order", type=click.Choice(STATUS_ORDERS), default="query", show_default=True,
+              help="FC01 query numbering (query: 0 task 1 vehicle 2 speed 3 battery; return: 0 speed 1 battery 2 task 3 vehicle).")
+@click.option("--manual-stop-counts-as-stop", is_flag=True,
+              help="Accept manual stop 05/00 as the power-on stop command.")
+@click.option("--faults", "faults_file", type=click.Path(dir_okay=False), metavar="FILE.toml",
+              help="Scripted faults ([[faults]]) and robot settings ([robot]).")
+@click.option("--turnaround-ms", type=float, help="Delay from the end of a request to the reply [5].")
+@click.option("--point-duration-s", type=float, help="How long a point/script run takes [8].")
+@click.option("--pacing", type=click.Choice(PACING_POLICIES),
+              help="Requests under 250 ms apart: answer (default), ignore, or answer late.")
+@click.option("--before-stop", type=click.Choice(BEFORE_STOP_POLICIES),
+              help="Motion before the power-on stop command: ignore (default) or obey.")
+@click.option("--no-reply-on", multiple=True, metavar="N", help="No reply to request N (repeatable).")
+@click.option("--bad-crc-on", multiple=True, metavar="N", help="Corrupt the CRC of the reply to request N.")
+@click.option("--garbage-on", multiple=True, metavar="N", help="Answer request N with garbage bytes.")
+@click.option("--wrong-address-on", multiple=True, metavar="N", help="Answer request N from another address.")
+@click.option("--exception-on", multiple=True, metavar="N[:CODE]", help="Answer request N with exception CODE [4].")
+@click.option("--late-reply-on", multiple=True, metavar="N:MS", help="Answer request N MS milliseconds late.")
+@click.option("--anti-collision-at", multiple=True, type=float, metavar="S", help="Obstacle at S seconds (error 01).")
+@click.option("--off-tape-at", multiple=True, type=float, metavar="S", help="Leave the tape at S seconds (error 02).")
+@click.option("--low-battery-at", multiple=True, type=float, metavar="S", help="Battery warning from S seconds (error 03).")
+@click.option("--frame-gap-ms", type=float, default=DEFAULT_SILENCE_US / 1000, show_default=True,
+              help="Silence that ends an incomplete frame on the wall clock (USB adapters deliver in chunks).")
+@click.option("--exit-after", type=float, metavar="S", help="Stop by itself after S seconds.")
+@click.option("--quiet", is_flag=True, help="No live log, only the summary line.")
+def command(serial_url, tcp, baud, address, field_order, codes_10_13, status_order,
+            manual_stop_counts_as_stop, faults_file, turnaround_ms, point_duration_s, pacing,
+            before_stop, no_reply_on, bad_crc_on, garbage_on, wrong_address_on, exception_on,
+            late_reply_on, anti_collision_at, off_tape_at, low_battery_at, frame_gap_ms,
+            exit_after, quiet):
+    """Run the emulated robot on a serial port or a TCP socket until Ctrl-C.
+
+    Every frame is logged with its time, direction (<- request, -> reply), hex bytes and
+    meaning; robot events (tasks, faults, ignored commands) are marked **.
+    """
+    if (serial_url is None) == (tcp is None):
+        raise click.UsageError("give exactly one of --serial PORT or --tcp HOST:PORT")
+    try:
+        settings = Settings(address=address, field_order=field_order, codes_10_13=codes_10_13,
+                            status_order=status_order,
+                            manual_stop_counts_as_stop=manual_stop_counts_as_stop)
+    except ValueError as err:
+        raise click.BadParameter(str(err), param_hint="--address") from None
+    robot_table: dict = {}
+    faults: list[Fault] = []
+    if faults_file:
+        try:
+            loaded = load_fault_file(faults_file)
+        except FaultFileError as err:
+            raise click.BadParameter(str(err), param_hint="--faults") from None
+        robot_table, faults = dict(loaded.robot), list(loaded.faults)
+    for key, value in (("turnaround_ms", turnaround_ms), ("point_duration_s", point_duration_s),
+                       ("pacing", pacing), ("before_stop", before_stop)):
+        if value is not None:
+            robot_table[key] = value
+    try:
+        config = RobotConfig.from_dict(robot_table)
+    except ConfigError as err:
+        where = f"{faults_file}: " if faults_file else ""
+        raise click.BadParameter(f"{where}{err}", param_hint="--faults") from None
+    faults += _flag_faults(no_reply_on, bad_crc_on, garbage_on, wrong_address_on, exception_on,
+                           late_reply_on, anti_collision_at, off_tape_at, low_battery_at)
+    if frame_gap_ms <= 0:
+        raise click.BadParameter("must be greater than 0", param_hint="--frame-gap-ms")
+    endpoint = _tcp_endpoint(tcp) if tcp is not None else None
+
+    def log(line: str) -> None:
+        if not quiet:
+            click.echo(line)
+            sys.stdout.flush()
+
+    emulator = Emulator(Robot(settings, config, faults), log)
+    for fault in faults:
+        emulator.note(f"scripted fault: {fault.describe()}")
+    stop = threading.Event()
+
+    def on_signal(signum, _frame) -> None:
+        stop.set()
+
+    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
+    timer = threading.Timer(exit_after, stop.set) if exit_after is not None else None
+    if timer is not None:
+        timer.daemon = True
+        timer.start()
+    silence_us = round(frame_gap_ms * 1000)
+    try:
+        if endpoint is None:
+            serve_serial(serial_url, emulator, stop, silence_us, baud)
+        else:
+            serve_tcp(endpoint[0], endpoint[1], emulator, stop, silence_us)
+    except PortError as err:
+        raise click.ClickException(str(err)) from None
+    finally:
+        if timer is not None:
+            timer.cancel()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    click.echo(emulator.summary())

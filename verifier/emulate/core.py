@@ -1,0 +1,106 @@
+"""The robot on the wall clock: frames in, scheduled replies out, and the live log.
+
+Transport-free: ``ports`` feeds it the frames its assemblers cut and writes the replies
+when they fall due. Robot time is microseconds since the emulator started (monotonic).
+"""
+from __future__ import annotations
+
+import time
+from collections import Counter
+from dataclasses import dataclass
+from typing import Callable
+
+from verifier.amr import Robot
+from verifier.emulate.assembler import Dropped, ReceivedFrame
+from verifier.protocol.codec import decode_reply, decode_request, hex_bytes
+from verifier.protocol.describe import describe
+from verifier.protocol.frames import FrameError, Request
+
+
+@dataclass(frozen=True)
+class Outgoing:
+    """Reply bytes to write once the wall clock reaches ``due_us``."""
+
+    due_us: int
+    data: bytes
+    request: Request | None = None  # what it answers, to describe the reply in the log
+
+
+class Emulator:
+    """Hands received frames to the robot and logs every frame and robot event."""
+
+    def __init__(self, robot: Robot, log: Callable[[str], None],
+                 clock_ns: Callable[[], int] = time.monotonic_ns) -> None:
+        self.robot = robot
+        self._log = log
+        self._clock_ns = clock_ns
+        self._t0_ns = clock_ns()
+        self._events_seen = 0
+        self.stats: Counter[str] = Counter()
+
+    def now_us(self) -> int:
+        return (self._clock_ns() - self._t0_ns) // 1000
+
+    # ---- traffic -------------------------------------------------------------------------
+
+    def handle(self, item: ReceivedFrame | Dropped, peer: str = "") -> Outgoing | None:
+        """A frame (or a dropped flood) from a port; the reply to send, if any."""
+        where = f" [{peer}]" if peer else ""
+        if isinstance(item, Dropped):
+            self.stats["dropped bytes"] += item.data_len
+            self.line(item.t_us, "!!", f"{item.reason}{where}")
+            return None
+        self.stats["frames in"] += 1
+        settings = self.robot.settings
+        self.line(item.t_last_us, "<-", f"{hex_bytes(item.data)}  "
+                  f"{describe(item.data, settings, 'request')}{where}")
+        t = max(item.t_last_us, self.robot.now_us)
+        reply = self.robot.on_request(item.data, t)
+        self._robot_events()
+        if reply is None or not reply.data:
+            self.stats["no reply"] += 1
+            return None
+        try:
+            request = decode_request(item.data, settings)
+        except FrameError:
+            request = None
+        return Outgoing(t + reply.delay_us, reply.data, request)
+
+    def sent(self, reply: Outgoing, t_us: int, peer: str = "") -> None:
+        self.stats["replies out"] += 1
+        where = f" [{peer}]" if peer else ""
+        settings = self.robot.settings
+        try:
+            meaning = describe(decode_reply(reply.data, settings, reply.request), settings)
+        except FrameError as err:
+            meaning = f"invalid reply: {err}"
+        self.line(t_us, "->", f"{hex_bytes(reply.data)}  {meaning}{where}")
+
+    def tick(self) -> None:
+        """Let robot time pass (tasks finish, timed faults fire) and log what happened."""
+        self.robot.advance(max(self.now_us(), self.robot.now_us))
+        self._robot_events()
+
+    # ---- log -------------------------------------------------------------------------------
+
+    def note(self, text: str) -> None:
+        self.line(self.now_us(), "--", text)
+
+    def line(self, t_us: int, mark: str, text: str) -> None:
+        self._log(f"{t_us / 1e6:10.3f} s  {mark} {text}")
+
+    def _robot_events(self) -> None:
+        events = self.robot.events
+        for event in events[self._events_seen:]:
+            if event.kind == "fault":
+                self.stats["faults"] += 1
+            self.line(event.t_us, "**", f"{event.kind}: {event.message}")
+        self._events_seen = len(events)
+
+    def summary(self) -> str:
+        s = self.stats
+        return (f"uitamr emulate: stopped after {self.now_us() / 1e6:.1f} s: "
+                f"{s['frames in']} frames in, {s['replies out']} replies out, "
+                f"{s['no reply']} unanswered, {s['faults']} fault events, "
+                f"{s['dropped bytes']} flood bytes dropped; robot {self.robot.mode}, "
+                f"error {int(self.robot.error):02d}")

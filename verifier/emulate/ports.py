@@ -1,0 +1,156 @@
+"""The emulator on real ports: a serial port (any pyserial URL) or a TCP listener carrying
+raw RTU frames (as a transparent serial-to-TCP converter does).
+
+Why not pymodbus's ModbusSerialServer / ModbusTcpServer: reading pymodbus 3.16
+(``framer/rtu.py``, ``server/requesthandler.py``) shows that its RTU framer has no
+inter-frame timing (a noise byte before a request loses the request; on a CRC failure it
+drops the whole buffer; an unknown function code is hunted byte by byte and swallows the
+next request), that the server answers an undecodable request with exception 01 and a
+request for an unknown slave with exception 0B unless told to ignore it, and that replies
+are always built by its framer from a PDU, at once. The robot needs its reply bytes sent
+exactly as the model made them (garbage, corrupted CRC, another slave's address, late
+replies) and the Modbus silence rules; so the framing is ours (``assembler``) over pyserial
+and plain sockets, and pymodbus serves as an independent client in the tests.
+"""
+from __future__ import annotations
+
+import selectors
+import socket
+import threading
+from dataclasses import dataclass, field
+
+import serial
+
+from verifier.emulate.assembler import RequestAssembler
+from verifier.emulate.core import Emulator, Outgoing
+
+POLL_S = 0.005  # longest wait between looks at the clock (reply and silence deadlines)
+
+
+class PortError(RuntimeError):
+    """A port that cannot be opened or failed while in use (message for the user)."""
+
+
+@dataclass
+class _Channel:
+    """One conversation: its own assembler and its replies waiting for their time."""
+
+    assembler: RequestAssembler
+    peer: str = ""
+    outgoing: list[Outgoing] = field(default_factory=list)
+
+    def take(self, emulator: Emulator, items) -> None:
+        for item in items:
+            reply = emulator.handle(item, self.peer)
+            if reply is not None:
+                self.outgoing.append(reply)
+        self.outgoing.sort(key=lambda o: o.due_us)
+
+    def due(self, now_us: int) -> list[Outgoing]:
+        ready = [o for o in self.outgoing if o.due_us <= now_us]
+        self.outgoing = [o for o in self.outgoing if o.due_us > now_us]
+        return ready
+
+
+def serve_serial(url: str, emulator: Emulator, stop: threading.Event, silence_us: int,
+                 baudrate: int = 9600) -> None:
+    """Run until ``stop`` is set: read requests from ``url``, write replies when due."""
+    try:
+        port = serial.serial_for_url(url, baudrate=baudrate, bytesize=serial.EIGHTBITS,
+                                     parity=serial.PARITY_NONE, stopbits=serial.STOPBITS_ONE,
+                                     timeout=POLL_S)
+    except (serial.SerialException, ValueError, OSError) as err:
+        raise PortError(f"cannot open serial port {url}: {err}") from None
+    channel = _Channel(RequestAssembler(silence_us))
+    emulator.note(f"listening on serial {url} at {baudrate} 8N1, robot address {emulator.robot.settings.address}")
+    try:
+        while not stop.is_set():
+            try:
+                data = port.read(1)
+                if data and port.in_waiting:
+                    data += port.read(port.in_waiting)
+            except (serial.SerialException, OSError) as err:
+                raise PortError(f"serial port {url} failed: {err}") from None
+            now = emulator.now_us()
+            channel.take(emulator, channel.assembler.feed(data, now) if data else channel.assembler.poll(now))
+            emulator.tick()
+            for reply in channel.due(emulator.now_us()):
+                try:
+                    port.write(reply.data)
+                    port.flush()
+                except (serial.SerialException, OSError) as err:
+                    raise PortError(f"serial port {url} failed while writing: {err}") from None
+                emulator.sent(reply, emulator.now_us())
+    finally:
+        port.close()
+
+
+def serve_tcp(host: str, port: int, emulator: Emulator, stop: threading.Event, silence_us: int,
+              on_listening=None) -> None:
+    """Run until ``stop`` is set: accept clients on host:port; each has its own framing,
+    all share the one robot."""
+    try:
+        server = socket.create_server((host, port), reuse_port=False)
+    except OSError as err:
+        raise PortError(f"cannot listen on {host}:{port}: {err}") from None
+    server.setblocking(False)
+    bound_host, bound_port = server.getsockname()[:2]
+    selector = selectors.DefaultSelector()
+    selector.register(server, selectors.EVENT_READ, None)
+    clients: dict[socket.socket, _Channel] = {}
+    emulator.note(f"listening on tcp {bound_host}:{bound_port} (raw RTU frames), "
+                  f"robot address {emulator.robot.settings.address}")
+    if on_listening is not None:
+        on_listening(bound_host, bound_port)
+
+    def drop(sock: socket.socket, why: str) -> None:
+        channel = clients.pop(sock)
+        selector.unregister(sock)
+        sock.close()
+        emulator.note(f"client {channel.peer} {why}")
+
+    try:
+        while not stop.is_set():
+            for key, _ in selector.select(POLL_S):
+                if key.fileobj is server:
+                    try:
+                        sock, address = server.accept()
+                    except OSError:
+                        continue
+                    sock.setblocking(False)
+                    sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+                    peer = f"{address[0]}:{address[1]}"
+                    clients[sock] = _Channel(RequestAssembler(silence_us), peer)
+                    selector.register(sock, selectors.EVENT_READ, None)
+                    emulator.note(f"client {peer} connected")
+                    continue
+                sock = key.fileobj
+                try:
+                    data = sock.recv(4096)
+                except (BlockingIOError, InterruptedError):
+                    continue
+                except OSError as err:
+                    drop(sock, f"lost: {err}")
+                    continue
+                if not data:
+                    drop(sock, "disconnected")
+                    continue
+                channel = clients[sock]
+                channel.take(emulator, channel.assembler.feed(data, emulator.now_us()))
+            now = emulator.now_us()
+            for sock, channel in list(clients.items()):
+                channel.take(emulator, channel.assembler.poll(now))
+            emulator.tick()
+            for sock, channel in list(clients.items()):
+                for reply in channel.due(emulator.now_us()):
+                    try:
+                        sock.sendall(reply.data)
+                    except OSError as err:
+                        drop(sock, f"lost while writing: {err}")
+                        break
+                    emulator.sent(reply, emulator.now_us(), channel.peer)
+    finally:
+        for sock in list(clients):
+            sock.close()
+        selector.close()
+        server.close()
