@@ -1,0 +1,159 @@
+"""The emulator's parts without ports: frame assembly on arrival times, the fault file,
+and the wall-clock core driven by a fake clock."""
+from __future__ import annotations
+
+import pytest
+from hypothesis import given, settings as hsettings, strategies as st
+
+from verifier.amr import Robot
+from verifier.emulate import (
+    Dropped,
+    Emulator,
+    FaultFileError,
+    ReceivedFrame,
+    RequestAssembler,
+    load_fault_file,
+)
+from verifier.protocol import STOP_FRAME, Query, StatusRequest, encode, with_crc
+
+STATUS = encode(StatusRequest(1, Query.TASK))
+
+
+def frames_of(items):
+    return [i.data for i in items if isinstance(i, ReceivedFrame)]
+
+
+def test_a_whole_request_completes_at_once_even_in_pieces():
+    asm = RequestAssembler(silence_us=20_000)
+    assert asm.feed(STOP_FRAME[:3], 0) == []
+    done = asm.feed(STOP_FRAME[3:], 9_000)  # a USB chunk 9 ms later: still one frame
+    assert done == [ReceivedFrame(STOP_FRAME, 0, 9_000, "length")]
+    assert asm.deadline_us() is None
+
+
+def test_back_to_back_requests_are_cut_apart_by_length():
+    asm = RequestAssembler()
+    assert frames_of(asm.feed(STOP_FRAME + STATUS, 0)) == [STOP_FRAME, STATUS]
+
+
+def test_noise_glued_to_a_request_makes_one_bad_frame_at_the_silence():
+    asm = RequestAssembler(silence_us=20_000)
+    assert asm.feed(b"\xff" + STOP_FRAME, 0) == []
+    assert asm.deadline_us() == 20_000
+    assert asm.poll(19_999) == []
+    assert frames_of(asm.poll(20_000)) == [b"\xff" + STOP_FRAME]
+
+
+def test_a_request_after_t3_5_of_quiet_is_cut_off_the_noise_before_it():
+    asm = RequestAssembler(silence_us=20_000)
+    asm.feed(b"\xff\x00", 0)
+    done = asm.feed(STOP_FRAME, 3_700)
+    assert [(i.data, i.ended_by) for i in done] == [(b"\xff\x00", "silence"), (STOP_FRAME, "length")]
+
+
+def test_less_than_t3_5_of_quiet_keeps_noise_and_request_together():
+    asm = RequestAssembler(silence_us=20_000)
+    asm.feed(b"\xff", 0)
+    assert asm.feed(STOP_FRAME, 3_000) == []
+    assert frames_of(asm.poll(30_000)) == [b"\xff" + STOP_FRAME]
+
+
+def test_unknown_function_codes_end_by_silence_and_do_not_swallow_the_next_request():
+    asm = RequestAssembler(silence_us=20_000)
+    fc3 = with_crc(bytes((1, 3, 0, 0, 0, 1)))
+    assert asm.feed(fc3, 0) == []
+    assert frames_of(asm.feed(STATUS, 25_000)) == [fc3, STATUS]
+
+
+def test_a_flood_is_dropped_until_the_line_goes_quiet():
+    asm = RequestAssembler(silence_us=20_000)
+    assert asm.feed(bytes(200), 0) == []
+    assert asm.feed(bytes(200), 1_000) == []
+    assert asm.feed(STOP_FRAME, 2_000) == []  # still inside the flood: lost with it
+    dropped = asm.poll(22_000)
+    assert dropped == [Dropped(408, 0, dropped[0].reason)]
+    assert "more than 256" in dropped[0].reason
+    assert frames_of(asm.feed(STOP_FRAME, 30_000)) == [STOP_FRAME]
+
+
+@hsettings(max_examples=200, deadline=None)
+@given(st.lists(st.tuples(st.binary(max_size=40), st.integers(0, 30_000)), max_size=20))
+def test_noise_then_silence_then_a_request_is_always_recovered(chunks):
+    asm = RequestAssembler(silence_us=20_000)
+    t = 0
+    for data, gap in chunks:
+        t += gap
+        asm.feed(data, t)
+    t += 20_000
+    asm.poll(t)
+    assert frames_of(asm.feed(STOP_FRAME, t + 1)) == [STOP_FRAME]
+
+
+# ---- the fault file ------------------------------------------------------------------------
+
+def test_fault_file_with_robot_table(tmp_path):
+    path = tmp_path / "bench.toml"
+    path.write_text('[robot]\nturnaround_ms = 8\n\n[[faults]]\nkind = "no_reply"\non_request = 3\n')
+    loaded = load_fault_file(path)
+    assert loaded.robot == {"turnaround_ms": 8}
+    assert [f.kind for f in loaded.faults] == ["no_reply"]
+
+
+@pytest.mark.parametrize("text, message", [
+    ("[[faults]\n", "not valid TOML"),
+    ("[scenario]\nname = 'x'\n", ": scenario: unknown key; expected one of robot, faults"),
+    ("robot = 3\n", ": robot: expected a table"),
+    ("[[faults]]\nkind = 'late_reply'\non_request = 2\n", ": faults[0].delay_ms: missing"),
+])
+def test_bad_fault_files_name_the_file_and_the_key(tmp_path, text, message):
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(FaultFileError) as caught:
+        load_fault_file(path)
+    assert str(caught.value).startswith(str(path))
+    assert message in str(caught.value)
+
+
+def test_missing_fault_file(tmp_path):
+    with pytest.raises(FaultFileError, match="cannot read"):
+        load_fault_file(tmp_path / "nope.toml")
+
+
+# ---- the core on a fake clock ----------------------------------------------------------------
+
+class FakeClock:
+    def __init__(self) -> None:
+        self.ns = 1_000_000_000
+
+    def __call__(self) -> int:
+        return self.ns
+
+
+def test_core_schedules_the_reply_after_the_turnaround_and_logs_both_ways():
+    clock, lines = FakeClock(), []
+    emulator = Emulator(Robot(), lines.append, clock)
+    clock.ns += 2_000_000_000
+    reply = emulator.handle(ReceivedFrame(STOP_FRAME, 1_990_000, 2_000_000, "length"))
+    assert reply.due_us == 2_005_000 and reply.data == STOP_FRAME
+    emulator.sent(reply, 2_005_000)
+    assert lines[0] == "     2.000 s  <- 01 06 01 A0 00 00 88 14  stop (01/A0)"
+    assert lines[1].startswith("     2.000 s  ** command: stop")
+    assert lines[2] == "     2.005 s  -> 01 06 01 A0 00 00 88 14  echo: stop (01/A0)"
+    assert "1 frames in, 1 replies out" in emulator.summary()
+
+
+def test_core_describes_a_status_reply_with_its_query():
+    clock, lines = FakeClock(), []
+    emulator = Emulator(Robot(), lines.append, clock)
+    reply = emulator.handle(ReceivedFrame(STATUS, 0, 0, "length"))
+    emulator.sent(reply, 5_000)
+    assert "task status" in lines[-1] and "idle" in lines[-1]
+
+
+def test_core_counts_silence_and_floods():
+    clock, lines = FakeClock(), []
+    emulator = Emulator(Robot(), lines.append, clock)
+    assert emulator.handle(ReceivedFrame(b"\xff", 0, 0, "silence")) is None
+    assert emulator.handle(Dropped(999, 10, "999 bytes without a silence")) is None
+    assert "1 unanswered" in emulator.summary() and "999 flood bytes" in emulator.summary()
+    assert lines[-1].endswith("!! 999 bytes without a silence")
