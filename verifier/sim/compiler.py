@@ -25,7 +25,7 @@ from .refs import AttrRef, Ref
 from .stdfbs import STANDARD_FBS, FB_PARAM_TYPES
 from .stdfuncs import make_helpers
 from .typesys import (ArrayT, CompileError, FbT, PouInfo, StringT, StructT, Symbol, concrete,
-                      is_int, is_real)
+                      is_int, is_real, norm_code)
 
 GENERATED_FILE = "<st-simulation>"
 
@@ -294,7 +294,8 @@ class ModuleCompiler:
         elif t in ("INT",) and lv.type == "INT" and d.digits is None:
             sym.code, sym.write = lv.read, lv.write_tpl
         elif t in ("WORD", "UINT") and lv.type == "INT" and d.digits is None:
-            sym.code, sym.write = f"({lv.read} & 65535)", lv.write_tpl
+            sym.code = f"({lv.read} & 65535)"
+            sym.write = lv.write(norm_code("INT", "{v}"))  # the device holds the signed image
         else:
             raise CompileError(d.span, f"a {t} label assigned to {d.text or d.key} is not simulated "
                                        "(BOOL on bit devices, INT/WORD/UINT on word devices are)")

@@ -37,6 +37,10 @@ class LineFormat:
     def byte_time_us(self) -> Fraction:
         return Fraction(self.bits_per_byte * 1_000_000, self.baud)
 
+    def duration_us(self, n_bytes: int) -> int:
+        """Time n back-to-back characters take, rounded to the nearest µs (no drift)."""
+        return (n_bytes * self.bits_per_byte * 1_000_000 + self.baud // 2) // self.baud
+
     def __str__(self) -> str:
         return f"{self.baud} {self.data_bits}{self.parity}{self.stop_bits}"
 
@@ -62,7 +66,7 @@ class SerialChannel:
     def transmit(self, data: bytes, t_us: int, origin: str | None) -> int:
         """Start sending `data` at t_us; returns the time the last stop bit is out."""
         data = bytes(data)
-        end = t_us + int(-(-len(data) * self.format.byte_time_us // 1))  # ceil
+        end = t_us + self.format.duration_us(len(data))
         if self.endpoint is not None and data:
             self.endpoint.send(data, t_us, origin)
         self.sent.append(SentFrame(t_us, end, data, origin))

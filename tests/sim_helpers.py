@@ -1,0 +1,43 @@
+"""Helpers for the simulator tests: load ST from text, a fake serial endpoint."""
+from __future__ import annotations
+
+import verifier.sim
+
+
+def load_st(text: str, name: str = "t.st", **options) -> verifier.sim.Project:
+    return verifier.sim.load(sources={name: text}, **options)
+
+
+def fb_source(body: str, decls: str, name: str = "FB_T") -> str:
+    """A FUNCTION_BLOCK wrapping `body` with the given VAR declarations."""
+    return f"FUNCTION_BLOCK {name}\nVAR\n{decls}\nEND_VAR\n{body}\nEND_FUNCTION_BLOCK\n"
+
+
+def run_fb(body: str, decls: str, scans: int = 1, **options):
+    project = load_st(fb_source(body, decls), **options)
+    fb = project.instance("FB_T")
+    fb.scan(scans)
+    return project, fb
+
+
+class FakeEndpoint:
+    """The Line master interface with scripted replies: bytes are delivered at the times
+    given to `reply_at`."""
+
+    def __init__(self):
+        self.sent: list[tuple[bytes, int, str | None]] = []
+        self._incoming: list[tuple[int, int]] = []
+
+    def send(self, data: bytes, t_us: int, origin: str | None = None) -> int:
+        self.sent.append((bytes(data), t_us, origin))
+        return t_us
+
+    def reply_at(self, t_us: int, data: bytes, byte_us: int = 1042) -> None:
+        for k, b in enumerate(data):
+            self._incoming.append((b, t_us + (k + 1) * byte_us))
+        self._incoming.sort(key=lambda x: x[1])
+
+    def receive_until(self, t_us: int) -> list[tuple[int, int]]:
+        out = [x for x in self._incoming if x[1] <= t_us]
+        self._incoming = [x for x in self._incoming if x[1] > t_us]
+        return out

@@ -1,0 +1,287 @@
+"""MELSEC instruction models against the manuals' own examples and against a scripted
+endpoint: CRC, MOV/BMOV/FMOV/SET/RST, RS2 (FX3 and FX5), G_OUTPUT/G_INPUT, ADPRW."""
+from __future__ import annotations
+
+import pytest
+
+from sim_helpers import FakeEndpoint, load_st
+from verifier.protocol import crc16, with_crc
+
+MANUAL_FRAME = [0x01, 0x03, 0x03, 0x02, 0x00, 0x14]  # FX3U FNC 188 example -> 41E4H
+
+
+def packed(data: list[int]) -> list[int]:
+    """Bytes two per word, low byte first."""
+    data = data + [0] * (len(data) % 2)
+    return [data[i] | (data[i + 1] << 8) for i in range(0, len(data), 2)]
+
+
+# ----------------------------------------------------------------------------- CRC
+CRC_FB = """
+FUNCTION_BLOCK FB_CRC
+VAR_INPUT bRun : BOOL; wLen : INT; END_VAR
+VAR uBuf : ARRAY[0..7] OF WORD; uOut : ARRAY[0..1] OF WORD; END_VAR
+CRC(bRun, uBuf[0], wLen, uOut[0]);
+END_FUNCTION_BLOCK
+"""
+
+
+def test_crc_16_bit_mode_manual_example():
+    project = load_st(CRC_FB)
+    fb = project.instance("FB_CRC")
+    fb.uBuf = packed(MANUAL_FRAME)
+    fb.bRun, fb.wLen = True, 6
+    fb.scan()
+    assert fb.uOut[0] == 0x41E4
+
+
+def test_crc_8_bit_mode_uses_low_bytes_and_splits_the_result():
+    project = load_st(CRC_FB)
+    project.devices["M8161"] = True
+    fb = project.instance("FB_CRC")
+    fb.uBuf = MANUAL_FRAME
+    fb.bRun, fb.wLen = True, 6
+    fb.scan()
+    assert list(fb.uOut) == [0xE4, 0x41]
+
+
+def test_fx5_crc_with_sm8161():
+    project = load_st(CRC_FB, target="gxworks3")
+    project.devices["SM8161"] = True
+    fb = project.instance("FB_CRC")
+    fb.uBuf = MANUAL_FRAME
+    fb.bRun, fb.wLen = True, 6
+    fb.scan()
+    assert list(fb.uOut) == [0xE4, 0x41]
+
+
+def test_crc_not_executed_when_en_is_false_and_n_checked():
+    project = load_st(CRC_FB)
+    fb = project.instance("FB_CRC")
+    fb.uBuf = packed(MANUAL_FRAME)
+    fb.wLen = 6
+    fb.scan()
+    assert fb.uOut[0] == 0
+    fb.bRun, fb.wLen = True, 0
+    fb.scan()
+    assert project.devices["M8067"] is True
+    assert "outside 1..256" in project.diagnostics[0].message
+
+
+def test_crc_block_running_past_the_array_is_reported():
+    project = load_st(CRC_FB)
+    fb = project.instance("FB_CRC")
+    fb.bRun, fb.wLen = True, 17  # 9 words from an 8-word array
+    with pytest.raises(Exception) as err:
+        fb.scan()
+    assert "past the end" in str(err.value)
+    assert "t.st:5:" in str(err.value)
+
+
+def test_mov_bmov_fmov_set_rst():
+    src = """
+PROGRAM P
+VAR a : ARRAY[0..3] OF INT := [1, 2, 3, 4]; b : ARRAY[0..3] OF INT; x : INT; bit : BOOL; END_VAR
+MOV(TRUE, 42, x);
+BMOV(TRUE, a[1], 3, b[0]);
+FMOV(TRUE, 7, 2, D10);
+SET(TRUE, bit);
+SET(TRUE, M5);
+RST(TRUE, D11);
+END_PROGRAM
+"""
+    project = load_st(src)
+    project.run_programs(["P"], scans=1)
+    p = project.program("P")
+    assert p.x == 42 and list(p.b) == [2, 3, 4, 0] and p.bit is True
+    assert project.devices["D10"] == 7 and project.devices["D11"] == 0 and project.devices["M5"] is True
+
+
+# ----------------------------------------------------------------------------- RS2 (FX3)
+RS2_PROG = """
+PROGRAM P
+VAR
+    uSend : ARRAY[0..3] OF WORD;
+    uRecv : ARRAY[0..3] OF WORD;
+    bStart : BOOL;
+END_VAR
+IF M8002 THEN
+    D8400 := 16#1C81;   (* 9600 8N1 RS-485 *)
+    D8409 := 5;         (* 50 ms *)
+END_IF;
+IF bStart THEN
+    M8402 := TRUE;
+    bStart := FALSE;
+END_IF;
+RS2(NOT M8002, uSend[0], 8, 8, 1, uRecv[0]);
+END_PROGRAM
+"""
+
+
+def rs2_project(endpoint):
+    project = load_st(RS2_PROG, scan_ms=10)
+    project.attach_serial("fx3:1", endpoint)
+    project.run_programs(["P"], scans=2)
+    return project, project.program("P")
+
+
+def test_rs2_sends_low_byte_first_and_clears_m8402_after_the_last_byte():
+    ep = FakeEndpoint()
+    project, p = rs2_project(ep)
+    p.uSend = packed([0x01, 0x06, 0x01, 0xA0, 0x00, 0x00, 0x88, 0x14])
+    p.bStart = True
+    project.run_programs(["P"], scans=1)   # t = 20 ms: flag set, RS2 sends
+    (data, t_us, origin) = ep.sent[0]
+    assert data == bytes.fromhex("010601a000008814")
+    assert t_us == 20_000
+    assert origin == "t.st:13:5"             # where M8402 was set
+    assert project.devices["M8402"] is True
+    project.run_programs(["P"], scans=1)     # t = 30 ms: 8 bytes take 8.333 ms
+    assert project.devices["M8402"] is False
+    assert project.serial_log("fx3:1")[0].t_end_us == 20_000 + 8333
+
+
+def test_rs2_receives_by_count_then_waits_for_m8403_reset():
+    ep = FakeEndpoint()
+    project, p = rs2_project(ep)
+    ep.reply_at(25_000, bytes.fromhex("0101030000003c4e"))  # last byte at 33.3 ms
+    project.run_programs(["P"], scans=3)     # scans at 20, 30, 40 ms
+    assert project.devices["M8403"] is True
+    assert project.devices["D8403"] == 8
+    assert list(p.uRecv) == packed(list(bytes.fromhex("0101030000003c4e")))
+    ep.reply_at(45_000, b"\x99")             # arrives while M8403 is still ON
+    project.run_programs(["P"], scans=1)
+    assert project.devices["D8403"] == 8
+    assert "discarded" in project.diagnostics[-1].message
+    project.devices["M8403"] = False         # the program resets it...
+    project.run_programs(["P"], scans=1)
+    assert project.devices["D8403"] == 0     # ...and the count goes with it
+
+
+def test_rs2_receive_ends_on_the_d8409_time_out():
+    ep = FakeEndpoint()
+    project, p = rs2_project(ep)
+    ep.reply_at(25_000, bytes.fromhex("0181025d90"))  # 5-byte exception reply
+    project.run_programs(["P"], scans=4)     # last byte at 30.2 ms; time-out 50 ms later
+    assert project.devices["M8403"] is False
+    project.run_programs(["P"], scans=4)     # t = 80 ms: 80.2 not reached yet
+    project.run_programs(["P"], scans=1)     # t = 90 ms
+    assert project.devices["M8403"] is True
+    assert project.devices["M8409"] is True
+    assert project.devices["D8403"] == 5
+
+
+def test_rs2_warns_about_a_wrong_communication_format():
+    ep = FakeEndpoint()
+    project = load_st(RS2_PROG.replace("16#1C81", "16#1C91"))  # 19200
+    project.attach_serial("fx3:1", ep)
+    project.run_programs(["P"], scans=2)
+    project.program("P").bStart = True
+    project.run_programs(["P"], scans=1)
+    assert any("19200 8N1" in d.message for d in project.diagnostics)
+
+
+def test_fx5_rs2_uses_its_own_devices():
+    src = """
+PROGRAM P
+VAR uSend : ARRAY[0..3] OF WORD := [16#0201, 16#0403]; uRecv : ARRAY[0..3] OF WORD; END_VAR
+IF SM402 THEN SM8561 := TRUE; END_IF;
+RS2(TRUE, uSend[0], 4, 2, 1, uRecv[0]);
+END_PROGRAM
+"""
+    project = load_st(src, target="gxworks3")
+    ep = FakeEndpoint()
+    project.attach_serial("fx5:1", ep)
+    ep.reply_at(1000, b"\xAA\xBB")
+    project.run_programs(["P"], scans=2)
+    assert ep.sent[0][0] == b"\x01\x02\x03\x04"
+    assert project.devices["SM8561"] is False
+    assert project.devices["SM8562"] is True
+    assert project.program("P").uRecv[0] == 0xBBAA
+
+
+# ----------------------------------------------------------------------------- QJ71C24N
+C24_PROG = """
+PROGRAM P
+VAR
+    uOutCtl : ARRAY[0..2] OF WORD; uInCtl : ARRAY[0..3] OF WORD;
+    uSend : ARRAY[0..3] OF WORD; uRecv : ARRAY[0..3] OF WORD;
+    bOutDone, bInDone : ARRAY[0..1] OF BOOL; bGo : BOOL; nDone : INT;
+END_VAR
+uOutCtl[0] := 1; uOutCtl[2] := 4;
+uInCtl[0] := 1; uInCtl[3] := 4;
+G_OUTPUT(bGo, 16#0, uOutCtl, uSend, bOutDone);
+bGo := FALSE;
+G_INPUT(X3, 16#0, uInCtl, uRecv, bInDone);
+IF bOutDone[0] THEN nDone := nDone + 1; END_IF;
+END_PROGRAM
+"""
+
+
+def test_c24_output_and_input_with_buffer_memory_settings():
+    project = load_st(C24_PROG, cpu="q")
+    ep = FakeEndpoint()
+    project.attach_serial("q:1", ep)
+    buf = project.c24_buffer(0)
+    p = project.program("P")
+    p.uSend = packed(list(bytes.fromhex("010100000016bdc4")))
+    p.bGo = True
+    project.run_programs(["P"], scans=1)
+    assert ep.sent[0][0] == bytes.fromhex("010100000016bdc4")  # 4 words, word units
+    assert buf[0xA4] == 511 and buf[0xA5] == 0x0D0A       # the module's defaults
+    buf[0xA4] = 4                                          # receive 4 words
+    buf[0xA5] = -1                                         # FFFFH: no end code
+    ep.reply_at(15_000, bytes.fromhex("0101030000003c4e"))
+    project.run_programs(["P"], scans=3)
+    assert p.nDone == 1                                    # done bit ON for one scan
+    assert list(p.uRecv) == packed(list(bytes.fromhex("0101030000003c4e")))
+    assert p.uInCtl[2] == 4 and p.uInCtl[1] == 0
+    assert project.devices["X3"] is False                  # read request cleared
+
+
+# ----------------------------------------------------------------------------- ADPRW
+def test_adprw_fx3_fc06_sends_the_frame_and_signals_completion():
+    src = """
+PROGRAM P
+VAR uData : ARRAY[0..1] OF WORD; bRun : BOOL; nDone : INT; END_VAR
+ADPRW(bRun, 1, 6, 16#01A0, 0, uData[0]);
+IF M8029 THEN nDone := nDone + 1; bRun := FALSE; END_IF;
+END_PROGRAM
+"""
+    project = load_st(src)
+    ep = FakeEndpoint()
+    project.attach_serial("adp:1", ep)
+    p = project.program("P")
+    p.bRun = True
+    project.run_programs(["P"], scans=1)
+    assert ep.sent[0][0] == with_crc(bytes([1, 6, 1, 0xA0, 0, 0]))
+    ep.reply_at(10_000, ep.sent[0][0])
+    project.run_programs(["P"], scans=3)
+    assert p.nDone == 1 and project.devices["D8402"] == 0 and project.devices["M8063"] is False
+
+
+def test_adprw_fx5_fc01_unpacks_coils_and_reports_time_out():
+    src = """
+PROGRAM P
+VAR uData : ARRAY[0..1] OF WORD; bDone : ARRAY[0..1] OF BOOL; bRun : BOOL; nErr : INT; END_VAR
+ADPRW(bRun, 1, 1, 0, 22, uData[0], bDone[0]);
+IF bDone[1] THEN nErr := nErr + 1; END_IF;
+IF bDone[0] THEN bRun := FALSE; END_IF;
+END_PROGRAM
+"""
+    project = load_st(src, target="gxworks3")
+    ep = FakeEndpoint()
+    project.attach_serial("adp:1", ep)
+    p = project.program("P")
+    p.bRun = True
+    project.run_programs(["P"], scans=1)
+    reply = with_crc(bytes([1, 1, 3, 0x34, 0x12, 0x2A]))
+    ep.reply_at(10_000, reply)
+    project.run_programs(["P"], scans=3)
+    assert list(p.uData) == [0x1234, 0x2A & 0x3F]
+    assert p.nErr == 0
+    p.bRun = True                         # second request: nobody answers
+    project.run_programs(["P"], ms=3100)
+    assert p.nErr == 1
+    assert project.devices["SD8500"] == 1
+    assert crc16(ep.sent[-1][0][:-2]) == int.from_bytes(ep.sent[-1][0][-2:], "little")
