@@ -1,0 +1,308 @@
+"""UITAMR_Engine and the command FBs, run in the simulator against a fake port written
+here in Python: the port interface (io_uPort) is served directly, the robot's answers come
+from verifier.protocol, and every request is timed in virtual microseconds.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pytest
+
+import verifier
+from verifier.protocol import (
+    ControlReply, ControlRequest, ExceptionReply, Settings, StatusReply, StatusRequest,
+    decode_request, encode,
+)
+
+ROOT = Path(__file__).resolve().parents[1]
+CORE = ROOT / "plc" / "core"
+SETTINGS = Settings()
+TX_REQ, TX_LEN, RX_DONE, RX_LEN, TX_BASE, RX_BASE = 0, 1, 2, 3, 8, 24
+
+HARNESS = """
+PROGRAM T_Engine
+VAR
+    fbEngine : UITAMR_Engine;
+    fbRun : UITAMR_RunPoint;
+    fbStop : UITAMR_Stop;
+    fbSpeed : UITAMR_SetSpeed;
+    fbRead : UITAMR_ReadStatus;
+    fbMove : UITAMR_MoveRelative;
+    fbRange : UITAMR_SetCollisionRange;
+    uMbx : ARRAY[0..15] OF WORD;
+    uPort : ARRAY[0..39] OF WORD;
+    bEnable : BOOL;
+    bMonitor : BOOL;
+    bRun : BOOL;
+    bStop : BOOL;
+    bSpeed : BOOL;
+    bRead : BOOL;
+    bMove : BOOL;
+    bRange : BOOL;
+    wPoint : INT;
+    wStage : INT;
+    wQuery : INT;
+    wAxis : INT;
+    eValue : REAL;
+    eRange : REAL;
+END_VAR
+fbEngine(i_bEnable := bEnable, i_wAddress := 1, i_bMonitor := bMonitor, io_uMbx := uMbx, io_uPort := uPort);
+fbRun(i_bExecute := bRun, i_wPoint := wPoint, io_uMbx := uMbx);
+fbStop(i_bExecute := bStop, io_uMbx := uMbx);
+fbSpeed(i_bExecute := bSpeed, i_bMagnetic := FALSE, i_wStage := wStage, io_uMbx := uMbx);
+fbRead(i_bExecute := bRead, i_wQuery := wQuery, io_uMbx := uMbx);
+fbMove(i_bExecute := bMove, i_wAxis := wAxis, i_eValue := eValue, io_uMbx := uMbx);
+fbRange(i_bExecute := bRange, i_eRange := eRange, io_uMbx := uMbx);
+END_PROGRAM
+"""
+
+
+@dataclass
+class FakePort:
+    """Plays port and robot: takes the engine's frame, answers after `turnaround_us`."""
+
+    h: object
+    project: object
+    turnaround_us: int = 15_000
+    running_polls: int = 2          # task status 'running' answers after a point command
+    silent: bool = False            # no reply at all
+    exception_code: int | None = None
+    corrupt: bool = False
+    robot_error: int = 0
+    requests: list = field(default_factory=list)   # (t_us, bytes)
+    overlaps: list = field(default_factory=list)   # requests while a reply was due
+    due: tuple | None = None
+    busy_polls: int = 0
+
+    def step(self) -> None:
+        now = self.project.now_us
+        port = self.h.uPort
+        if port[TX_REQ]:
+            data = bytes(port[TX_BASE + i] for i in range(port[TX_LEN]))
+            port[TX_REQ] = 0
+            if self.due is not None:
+                self.overlaps.append((now, data))
+            self.requests.append((now, data))
+            reply = self.answer(data)
+            if reply is not None:
+                self.due = (now + self.turnaround_us, reply)
+        if port[5]:                      # flush request
+            port[5] = 0
+            port[RX_DONE] = 0
+        if self.due and now >= self.due[0] and not port[RX_DONE]:
+            reply = self.due[1]
+            for i in range(16):
+                port[RX_BASE + i] = reply[i] if i < len(reply) else 0
+            port[RX_LEN] = len(reply)
+            port[RX_DONE] = 1
+            self.due = None
+
+    def answer(self, data: bytes) -> bytes | None:
+        if self.silent:
+            return None
+        request = decode_request(data, SETTINGS)
+        if self.exception_code is not None:
+            function = 6 if isinstance(request, ControlRequest) else 1
+            return encode(ExceptionReply(1, function, self.exception_code), SETTINGS)
+        if isinstance(request, ControlRequest):
+            if request.code == 1 and 1 <= request.command <= 21:     # a point run takes time
+                self.busy_polls = self.running_polls
+            elif request.code == 1 and request.command == 0xA0:     # stop: at rest at once
+                self.busy_polls = 0
+            reply = encode(ControlReply.echo(request), SETTINGS, strict=False)
+        else:
+            value = 0
+            if request.query == 0 and self.busy_polls > 0:
+                self.busy_polls -= 1
+                value = 1
+            reply = encode(StatusReply(1, self.robot_error, value), SETTINGS, strict=False)
+        if self.corrupt:
+            reply = reply[:-1] + bytes([reply[-1] ^ 0xFF])
+        return reply
+
+    def run(self, ms: float, until=None) -> None:
+        stop = self.project.now_us + round(ms * 1000)
+        while self.project.now_us < stop:
+            self.h.scan()
+            self.step()
+            if until is not None and until(self.h):
+                return
+
+    def kinds(self) -> list[bytes]:
+        return [data for _, data in self.requests]
+
+
+@pytest.fixture()
+def rig():
+    project = verifier.load(CORE, sources={"T_Engine.st": HARNESS})
+    h = project.program("T_Engine")
+    port = FakePort(h, project)
+    h.bEnable = True
+    return h, port
+
+
+STOP = encode(ControlRequest(1, 1, 0xA0), SETTINGS)
+READ_TASK = encode(StatusRequest(1, 0), SETTINGS)
+
+
+def start_point(h, port, point=3):
+    port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)
+    h.wPoint, h.bRun = point, True
+
+
+def test_the_stop_command_goes_first_and_is_followed_by_a_task_poll(rig):
+    h, port = rig
+    port.run(1500)
+    assert port.kinds()[0] == STOP
+    assert port.kinds()[1] == READ_TASK
+    assert h.fbEngine.o_bInitDone and h.fbEngine.o_bOK and not h.fbEngine.o_bErr
+
+
+def test_requests_are_paced_at_least_300_ms_start_to_start(rig):
+    h, port = rig
+    port.running_polls = 20
+    start_point(h, port)
+    port.run(4000)
+    starts = [t for t, _ in port.requests]
+    assert len(starts) >= 8
+    assert min(b - a for a, b in zip(starts, starts[1:])) >= 300_000
+
+
+def test_run_point_polls_until_idle_then_ends_ok(rig):
+    h, port = rig
+    start_point(h, port, point=5)
+    port.run(5000, until=lambda x: x.fbRun.o_bOK or x.fbRun.o_bErr)
+    assert h.fbRun.o_bOK and not h.fbRun.o_bErr
+    sent = port.kinds()
+    run = encode(ControlRequest(1, 1, 5), SETTINGS)
+    i = sent.index(run)
+    assert sent[i + 1:] == [READ_TASK] * (port.running_polls + 1)
+
+
+def test_never_transmits_while_a_reply_is_due(rig):
+    h, port = rig
+    port.turnaround_us = 280_000          # slow robot: the reply comes after the pacing period
+    start_point(h, port)
+    port.run(6000)
+    assert port.requests and port.overlaps == []
+
+
+def test_no_reply_three_attempts_then_0101(rig):
+    h, port = rig
+    start_point(h, port)
+    port.silent = True
+    before = len(port.requests)
+    port.run(5000, until=lambda x: x.fbRun.o_bErr)
+    assert h.fbRun.o_bErr and h.fbRun.o_uErrId == 0x0101
+    attempts = port.requests[before:]
+    assert len(attempts) == 3 and len({d for _, d in attempts}) == 1
+    gaps = [b[0] - a[0] for a, b in zip(attempts, attempts[1:])]
+    assert all(g >= 500_000 + 200_000 for g in gaps)      # time-out + guard time
+
+
+def test_bad_crc_is_retried_and_reported_after_the_last_attempt(rig):
+    h, port = rig
+    start_point(h, port)
+    port.corrupt = True
+    port.run(5000, until=lambda x: x.fbRun.o_bErr)
+    assert h.fbRun.o_uErrId == 0x0102
+    assert h.fbEngine.o_wRetryCount >= 2
+
+
+def test_exception_reply_is_not_retried(rig):
+    h, port = rig
+    start_point(h, port)
+    port.exception_code = 4
+    before = len(port.requests)
+    port.run(3000, until=lambda x: x.fbRun.o_bErr)
+    assert h.fbRun.o_uErrId == 0x0103 and h.fbEngine.o_uErrDetail == 4
+    assert len(port.requests) - before == 1
+
+
+def test_robot_anti_collision_fails_the_waiting_command(rig):
+    h, port = rig
+    start_point(h, port)
+    port.robot_error = 1
+    port.run(3000, until=lambda x: x.fbRun.o_bErr)
+    assert h.fbRun.o_uErrId == 0x0201
+
+
+def test_commands_requested_together_are_queued_not_lost(rig):
+    h, port = rig
+    port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)
+    h.wStage, h.wQuery, h.wPoint = 3, 3, 2
+    h.bSpeed = h.bRead = h.bRun = True            # the same scan
+    port.run(8000, until=lambda x: x.fbSpeed.o_bOK and x.fbRead.o_bOK and x.fbRun.o_bOK)
+    assert h.fbSpeed.o_bOK and h.fbRead.o_bOK and h.fbRun.o_bOK
+    controls = [d for d in port.kinds() if d[1] == 6][1:]
+    # served one after the other, in the order the FBs are called (fbRun before fbSpeed)
+    assert controls == [encode(ControlRequest(1, 1, 2), SETTINGS), encode(ControlRequest(1, 2, 2), SETTINGS)]
+    assert encode(StatusRequest(1, 3), SETTINGS) in port.kinds()
+
+
+def test_stop_overtakes_a_running_point(rig):
+    h, port = rig
+    port.running_polls = 50
+    start_point(h, port)
+    port.run(1500)
+    assert h.fbRun.o_bBusy
+    count = len(port.requests)
+    h.bStop = True
+    port.run(2000, until=lambda x: x.fbStop.o_bOK)
+    assert h.fbRun.o_bErr and h.fbRun.o_uErrId == 0x0305
+    assert h.fbStop.o_bOK
+    assert port.kinds()[count] == STOP            # the very next frame
+
+
+def test_out_of_range_parameters_send_nothing(rig):
+    h, port = rig
+    port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)
+    count = len(port.requests)
+    h.wPoint, h.bRun = 22, True
+    h.wAxis, h.eValue, h.bMove = 1, 30.0, True
+    h.eRange, h.bRange = 0.3, True
+    port.run(100)
+    assert h.fbRun.o_uErrId == h.fbMove.o_uErrId == h.fbRange.o_uErrId == 0x0301
+    assert len(port.requests) == count
+
+
+@pytest.mark.parametrize("axis,value,code,units", [(1, 1.5, 6, 15), (1, -2.0, 7, 20), (2, 0.3, 8, 3),
+                                                   (3, -25.5, 11, 255), (4, -0.25, 13, 25), (4, 2.55, 12, 255)])
+def test_relative_moves_in_engineering_units(rig, axis, value, code, units):
+    h, port = rig
+    port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)
+    h.wAxis, h.eValue, h.bMove = axis, value, True
+    port.run(2000, until=lambda x: x.fbMove.o_bOK)
+    assert encode(ControlRequest(1, code, units), SETTINGS, strict=False) in port.kinds()
+
+
+@pytest.mark.parametrize("metres,step", [(0.0, 0), (0.2, 1), (0.4, 2), (0.61, 3)])
+def test_collision_range_steps(rig, metres, step):
+    h, port = rig
+    port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)
+    h.eRange, h.bRange = metres, True
+    port.run(2000, until=lambda x: x.fbRange.o_bOK)
+    assert encode(ControlRequest(1, 4, step), SETTINGS) in port.kinds()
+
+
+def test_disabling_the_engine_fails_pending_commands_and_reenabling_stops_first(rig):
+    h, port = rig
+    port.running_polls = 50
+    start_point(h, port)
+    port.run(1000)
+    h.bEnable = False
+    port.run(100)
+    assert h.fbRun.o_bErr and h.fbRun.o_uErrId == 0x0302
+    h.bEnable = True
+    count = len(port.requests)
+    port.run(1500)
+    assert port.kinds()[count] == STOP
+
+
+def test_monitor_polls_the_four_statuses(rig):
+    h, port = rig
+    h.bMonitor = True
+    port.run(3000)
+    queries = [d[3] for d in port.kinds() if d[1] == 1]
+    assert {0, 1, 2, 3} <= set(queries)
