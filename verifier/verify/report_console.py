@@ -30,10 +30,14 @@ def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
     mark = "[green]PASS[/]" if result.passed else "[red]FAIL[/]"
     where = f" ({escape(result.file)})" if result.file else ""
     tx = sum(1 for frame in result.trace if frame.direction == "tx")
+    failed = len(result.failed_expectations)
+    expectations = (
+        f"{failed} of {len(result.expectations)} expectation(s) failed" if failed
+        else f"{len(result.expectations)} expectation(s) met"
+    )
     console.print(
         f"{mark} [bold]{escape(result.name)}[/]{where}: {tx} requests in "
-        f"{format_seconds(result.ended_us)}, {result.violation_count} violation(s), "
-        f"{len(result.failed_expectations)}/{len(result.expectations)} expectation(s) failed"
+        f"{format_seconds(result.ended_us)}, {result.violation_count} violation(s), {expectations}"
     )
     if result.aborted:
         console.print(f"    [red]simulation stopped[/]: {escape(result.aborted)}")

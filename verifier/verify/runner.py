@@ -119,15 +119,22 @@ def _where(scenario: Scenario) -> str:
     return str(scenario.path) if scenario.path else f"scenario {scenario.name!r}"
 
 
+def _display_path(path: Path | None) -> str | None:
+    """A path as people want to read it: relative to the working folder when inside it."""
+    if path is None:
+        return None
+    try:
+        return str(Path(path).resolve().relative_to(Path.cwd()))
+    except ValueError:
+        return str(path)
+
+
 def _relative(origin: str | None) -> str | None:
     """An ST location "file:line:col" with the file relative to the working folder when inside it."""
     if not origin:
         return origin
     file, _, rest = origin.partition(":")
-    try:
-        return f"{Path(file).resolve().relative_to(Path.cwd())}:{rest}"
-    except ValueError:
-        return origin
+    return f"{_display_path(Path(file))}:{rest}"
 
 
 def _plain(value: Any) -> Any:
@@ -209,7 +216,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None) -> Scenar
     outcomes = [judge(expectation, evidence, traffic) for expectation in scenario.expectations]
     return ScenarioResult(
         name=scenario.name,
-        file=str(scenario.path) if scenario.path else None,
+        file=_display_path(scenario.path),
         description=scenario.description,
         program=scenario.program,
         platform=scenario.platform,

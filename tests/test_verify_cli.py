@@ -1,0 +1,127 @@
+"""`uitamr verify` as users and CI call it: exit codes 0/1/2, clear messages without
+tracebacks, the report files, parallel scenarios, and the README's main command."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+from click.testing import CliRunner
+
+from verifier.commands.verify import bundled_scenarios, command
+
+REPO = Path(__file__).resolve().parents[1]
+PLC = REPO / "plc"
+FX3_SOURCES = [
+    *sorted((PLC / "core").glob("*.st")), *sorted((PLC / "fx3").glob("*.st")),
+    *sorted((PLC / "examples" / "common").glob("*.st")), PLC / "examples" / "fx3" / "UITAMR_ExampleFx3.st",
+]
+
+
+def invoke(*args: str):
+    return CliRunner().invoke(command, [str(a) for a in args], catch_exceptions=False)
+
+
+def test_sources_without_a_scenario_run_a_healthy_robot(tmp_path):
+    report = tmp_path / "r.json"
+    result = invoke(*FX3_SOURCES, "--program", "UITAMR_ExampleFx3", "--duration", "4s", "--json", report)
+    assert result.exit_code == 0, result.output
+    data = json.loads(report.read_text())
+    assert data["verdict"] == "pass"
+    (scenario,) = data["scenarios"]
+    assert scenario["name"] == "healthy robot" and scenario["duration"] == 4.0
+    assert scenario["frames"]["tx"] >= 10  # the engine polls while idle
+
+
+def test_every_report_is_written(tmp_path):
+    paths = {kind: tmp_path / f"out.{kind}" for kind in ("json", "junit", "trace", "html")}
+    result = invoke(*FX3_SOURCES, "--program", "UITAMR_ExampleFx3", "--duration", "3s", "--scan", "5ms",
+                    "--json", paths["json"], "--junit", paths["junit"], "--trace", paths["trace"],
+                    "--html", paths["html"])
+    assert result.exit_code == 0, result.output
+    assert json.loads(paths["json"].read_text())["scenarios"][0]["scan"] == 0.005
+    assert ET.parse(paths["junit"]).getroot().get("failures") == "0"
+    first = json.loads(paths["trace"].read_text().splitlines()[0])
+    assert first["dir"] == "tx" and first["hex"] == "01 06 01 A0 00 00 88 14" and first["meaning"] == "stop (01/A0)"
+    assert "<svg" in paths["html"].read_text()
+    for path in paths.values():
+        assert f"wrote {path}" in result.output
+
+
+def test_violations_exit_1(tmp_path):
+    engine = (PLC / "core" / "UITAMR_Engine.st").read_text(encoding="utf-8")
+    broken = tmp_path / "UITAMR_Engine.st"
+    broken.write_text(engine.replace("PACE_TIME : TIME := T#300ms;", "PACE_TIME : TIME := T#150ms;"), encoding="utf-8")
+    sources = [broken if p.name == "UITAMR_Engine.st" else p for p in FX3_SOURCES]
+    junit = tmp_path / "j.xml"
+    result = invoke(*sources, "--program", "UITAMR_ExampleFx3", "--duration", "3s", "--junit", junit)
+    assert result.exit_code == 1
+    assert "UITAMR-PACING" in result.output and "FAIL" in result.output
+    failure = ET.parse(junit).getroot().find("./testsuite/testcase/failure")
+    assert failure.get("type") == "UITAMR-PACING"
+
+
+def _run_cli(*args) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "verifier.cli", "verify", *map(str, args)],
+                          capture_output=True, text=True, timeout=600, cwd=REPO)
+
+
+def test_bad_scenario_exits_2_with_file_line_and_key(tmp_path):
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('program = "UITAMR_ExampleFx3"\n[[expect]]\nthat = "o_bOK"\nwithin = "5"\n')
+    done = _run_cli("--scenario", scenario)
+    assert done.returncode == 2
+    assert f"{scenario}:4: expect[0].within" in done.stderr
+    assert "Traceback" not in done.stderr + done.stdout
+
+
+def test_st_errors_exit_2_with_file_line_and_column(tmp_path):
+    bad = tmp_path / "Bad.st"
+    bad.write_text("PROGRAM Bad\nVAR\n    x : INT;\nEND_VAR\nx := x + ;\nEND_PROGRAM\n")
+    done = _run_cli(bad, "--duration", "1s")
+    assert done.returncode == 2
+    assert f"{bad}:5:" in done.stderr
+    assert "Traceback" not in done.stderr + done.stdout
+
+
+def test_unknown_program_and_labels_exit_2(tmp_path):
+    done = _run_cli(*FX3_SOURCES, "--program", "NoSuchProgram", "--duration", "1s")
+    assert done.returncode == 2 and "no PROGRAM 'NoSuchProgram'" in done.stderr
+    assert "UITAMR_ExampleFx3" in done.stderr  # says which programs there are
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('program = "UITAMR_ExampleFx3"\nduration = "1s"\n[[expect]]\nthat = "fbEngine.o_bNope"\n')
+    done = _run_cli(*FX3_SOURCES, "--scenario", scenario)
+    assert done.returncode == 2 and "no label 'fbEngine.o_bNope'" in done.stderr
+    assert "Traceback" not in done.stderr
+
+
+def test_unusable_options_exit_2(tmp_path):
+    assert _run_cli("--duration", "soon").returncode == 2
+    done = _run_cli(*FX3_SOURCES, "--html", tmp_path / "missing" / "r.html")
+    assert done.returncode == 2 and "does not exist" in done.stderr
+    done = _run_cli(tmp_path / "none.st")
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+
+
+def test_the_bundled_scenarios_cover_every_fault_kind():
+    from verifier.amr.faults import FAULT_KINDS
+    from verifier.verify.scenario import load_scenario
+
+    kinds = {fault.kind for path in bundled_scenarios() for fault in load_scenario(path).faults}
+    assert kinds == set(FAULT_KINDS)
+    platforms = {load_scenario(path).platform for path in bundled_scenarios()}
+    assert platforms == {"fx3u", "fx5u", "q"}
+
+
+def test_the_readme_command_verifies_the_bundled_examples_in_parallel(tmp_path):
+    """`uitamr verify` with no arguments: every bundled scenario, every one compliant."""
+    junit = tmp_path / "bundled.xml"
+    done = subprocess.run(["uitamr", "verify", "--jobs", "2", "--junit", str(junit)],
+                          capture_output=True, text=True, timeout=900, cwd=tmp_path)
+    assert done.returncode == 0, done.stdout + done.stderr
+    cases = ET.parse(junit).getroot().findall("./testsuite/testcase")
+    assert len(cases) == len(bundled_scenarios()) >= 10
+    assert all(case.find("failure") is None and case.find("error") is None for case in cases)
+    assert f"PASS: {len(cases)} scenario(s) compliant" in done.stdout
