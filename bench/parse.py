@@ -1,0 +1,142 @@
+"""Parse speed of the ST front end, side by side with blark on the same IEC text.
+
+    python bench/parse.py [--lines 10000] [--blark-lines N] [--repeat 3]
+
+The corpus is generated from tests/corpus/valid and plc/: every file both parsers read
+(blark is a TwinCAT grammar, so MELSEC devices, `&`, K/H constants... are left out by
+construction), with a missing END_ keyword added (blark needs it) and POU names
+numbered so copies stay distinct, repeated until it has at least --lines lines. Both
+parsers get the same chunks (one POU each), after both have built their grammar.
+Prints lines/s of each and the ratio. blark comes from the `bench` extra
+(`pip install -e '.[bench]'`).
+"""
+from __future__ import annotations
+
+import argparse
+import re
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from verifier.st.parser import get_parser, parse  # noqa: E402
+
+_POU_START = re.compile(r"^\s*(FUNCTION_BLOCK|FUNCTION|PROGRAM)\s+(\w+)", re.IGNORECASE | re.MULTILINE)
+
+
+def _candidate_sources() -> list[str]:
+    paths = sorted((ROOT / "tests" / "corpus" / "valid").glob("*.st")) + sorted((ROOT / "plc").rglob("*.st"))
+    texts = []
+    for path in paths:
+        text = path.read_text(encoding="utf-8")
+        source = parse(text, str(path), "gxworks3")
+        if not source.ok or len(source.pous) != 1 or source.types or source.globals:
+            continue
+        kind = source.pous[0].kind
+        if not re.search(rf"END_{kind}\s*$", text.strip(), re.IGNORECASE):
+            text = text.rstrip() + f"\nEND_{kind}\n"
+        texts.append(text)
+    return texts
+
+
+def _blark_accepts(text: str, blark_parser) -> bool:
+    from blark.parse import parse_source_code
+
+    return parse_source_code(text, parser=blark_parser).exception is None
+
+
+def _rename(text: str, n: int) -> str:
+    names = [m.group(2) for m in _POU_START.finditer(text)]
+    for name in names:
+        text = re.sub(rf"\b{re.escape(name)}\b", f"{name}_{n}", text)
+    return text
+
+
+def build_corpus(min_lines: int, blark_parser) -> list[str]:
+    """Chunks (one POU each) of IEC text both parsers accept, >= min_lines in total."""
+    base = [t for t in _candidate_sources() if _blark_accepts(t, blark_parser)]
+    if not base:
+        raise SystemExit("no corpus file is accepted by both parsers")
+    chunks: list[str] = []
+    lines = 0
+    n = 0
+    while lines < min_lines:
+        for text in base:
+            chunk = _rename(text, n)
+            chunks.append(chunk)
+            lines += chunk.count("\n") + 1
+        n += 1
+    return chunks
+
+
+def count_lines(chunks: list[str]) -> int:
+    return sum(c.count("\n") + 1 for c in chunks)
+
+
+def time_ours(chunks: list[str], repeat: int) -> float:
+    best = float("inf")
+    for _ in range(repeat):
+        start = time.perf_counter()
+        for i, chunk in enumerate(chunks):
+            source = parse(chunk, f"bench{i}.st", "gxworks3")
+            if not source.ok:
+                raise SystemExit(f"our parser rejected chunk {i}: {source.diagnostics[0]}")
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
+def time_blark(chunks: list[str], blark_parser) -> float:
+    from blark.parse import parse_source_code
+
+    start = time.perf_counter()
+    for i, chunk in enumerate(chunks):
+        result = parse_source_code(chunk, parser=blark_parser)
+        if result.exception is not None:
+            raise SystemExit(f"blark rejected chunk {i}: {result.exception}")
+    return time.perf_counter() - start
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--lines", type=int, default=10_000, help="corpus size in lines (default 10000)")
+    ap.add_argument("--blark-lines", type=int, default=0,
+                    help="time blark on only the first N lines' worth of chunks (0 = all; blark is slow)")
+    ap.add_argument("--repeat", type=int, default=3, help="best of N runs for our parser")
+    args = ap.parse_args(argv)
+    try:
+        from blark.parse import get_parser as blark_get_parser
+    except ImportError:
+        print("blark is not installed: pip install -e '.[bench]'", file=sys.stderr)
+        return 2
+
+    get_parser()                      # build (or load the cached) LALR tables first
+    blark_parser = blark_get_parser()  # and blark's Earley grammar
+    chunks = build_corpus(args.lines, blark_parser)
+    total = count_lines(chunks)
+
+    ours = time_ours(chunks, args.repeat)
+    ours_rate = total / ours
+
+    blark_chunks = chunks
+    if args.blark_lines:
+        blark_chunks, acc = [], 0
+        for c in chunks:
+            if acc >= args.blark_lines:
+                break
+            blark_chunks.append(c)
+            acc += c.count("\n") + 1
+    blark_total = count_lines(blark_chunks)
+    theirs = time_blark(blark_chunks, blark_parser)
+    blark_rate = blark_total / theirs
+
+    print(f"corpus: {total} lines in {len(chunks)} POUs (IEC text both parsers accept)")
+    print(f"uitamr (lark LALR, tree-less): {total:>7} lines in {ours:8.3f} s = {ours_rate:>10.0f} lines/s")
+    print(f"blark  (lark Earley)          : {blark_total:>7} lines in {theirs:8.3f} s = {blark_rate:>10.0f} lines/s")
+    print(f"ratio: {ours_rate / blark_rate:.1f}x blark's lines/s (goal: >= 100x)")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
