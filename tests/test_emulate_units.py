@@ -60,9 +60,11 @@ def test_less_than_t3_5_of_quiet_keeps_noise_and_request_together():
 
 def test_unknown_function_codes_end_by_silence_and_do_not_swallow_the_next_request():
     asm = RequestAssembler(silence_us=20_000)
-    fc3 = with_crc(bytes((1, 3, 0, 0, 0, 1)))
-    assert asm.feed(fc3, 0) == []
-    assert frames_of(asm.feed(STATUS, 25_000)) == [fc3, STATUS]
+    fc100 = with_crc(bytes((1, 0x64, 0, 0)))  # no standard length: only a silence ends it
+    assert asm.feed(fc100, 0) == []
+    assert frames_of(asm.feed(STATUS, 25_000)) == [fc100, STATUS]
+    fc3 = with_crc(bytes((1, 3, 0, 0, 0, 1)))  # a standard request: complete at once
+    assert frames_of(asm.feed(fc3 + STATUS, 50_000)) == [fc3, STATUS]
 
 
 def test_a_flood_is_dropped_until_the_line_goes_quiet():
@@ -157,3 +159,19 @@ def test_core_counts_silence_and_floods():
     assert emulator.handle(Dropped(999, 10, "999 bytes without a silence")) is None
     assert "1 unanswered" in emulator.summary() and "999 flood bytes" in emulator.summary()
     assert lines[-1].endswith("!! 999 bytes without a silence")
+
+
+def test_standard_requests_of_other_function_codes_complete_by_length_too():
+    asm = RequestAssembler(silence_us=20_000)
+    fc16 = with_crc(bytes((1, 0x10, 0, 0, 0, 1, 2, 0, 0)))
+    assert asm.feed(fc16[:7], 0) == []
+    assert frames_of(asm.feed(fc16[7:], 1_000)) == [fc16]
+
+
+@hsettings(max_examples=300, deadline=None)
+@given(st.binary(max_size=300))
+def test_any_noise_fed_byte_by_byte_never_raises(noise):
+    asm = RequestAssembler(silence_us=20_000)
+    for i, byte in enumerate(noise):
+        asm.feed(bytes((byte,)), i * 100)
+    asm.poll(10_000_000)

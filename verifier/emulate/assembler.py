@@ -5,9 +5,10 @@ the bytes pass through USB adapters, pty pairs or TCP converters that deliver th
 chunks with their own delays (an FTDI adapter waits up to its 16 ms latency timer), so a
 literal t3.5 on arrival times would cut frames apart. The assembler therefore:
 
-* completes a frame **at once** when the bytes so far are a whole request of this
-  protocol (FC01/FC06: 8 bytes, lengths from ``verifier.protocol.stream``) with a good CRC;
-  several such requests back to back are cut apart the same way;
+* completes a frame **at once** when the bytes so far are a whole request with a good CRC:
+  FC01/FC06 by this protocol's lengths (``verifier.protocol.stream``), other standard
+  function codes by pymodbus's request decoders (so a master's FC03 gets its exception 01
+  without waiting); several requests back to back are cut apart the same way;
 * otherwise waits for ``silence_us`` without a byte (default 20 ms, ``--frame-gap-ms``) and
   hands over whatever came as one frame - the robot then applies the Modbus rules (bad CRC:
   silence; unknown function code with a good CRC: exception 01);
@@ -29,12 +30,29 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from pymodbus.pdu import DecodePDU
+
 from verifier.protocol.crc import crc_ok
 from verifier.protocol.stream import frame_length
 from verifier.protocol.timing import T3_5_US
 
 MAX_FRAME = 256  # Modbus over Serial Line V1.02 §2.5.1: RTU ADU at most 256 bytes
 DEFAULT_SILENCE_US = 20_000
+_MODBUS_REQUESTS = DecodePDU(is_server=True)
+
+
+def request_length(head: bytes) -> int | None:
+    """Length of the request frame starting with ``head``, when it can be known yet."""
+    if len(head) < 2:
+        return None
+    length = frame_length(head[:2], "request")
+    if length is not None:
+        return length
+    try:
+        pdu_class = _MODBUS_REQUESTS.lookupPduClass(head)
+        return pdu_class.calculateRtuFrameSize(head) if pdu_class is not None else None
+    except Exception:  # noqa: BLE001 - third-party decoder fed with line noise must never stop us
+        return None  # not enough bytes yet to know, or not a standard request
 
 
 @dataclass(frozen=True)
@@ -112,7 +130,7 @@ class RequestAssembler:
         starts = [(0, self._first_us, 0)] + self._boundaries
         for offset, first_us, previous_last_us in reversed(starts):
             tail = bytes(self._buffer[offset:])
-            length = frame_length(tail[:2], "request")
+            length = request_length(tail)
             if length is None or len(tail) != length or not crc_ok(tail):
                 continue
             found = []
