@@ -226,3 +226,9 @@ def _parse_dom(dom: str) -> ET.Element:
     parser = _Dom()
     parser.feed(dom)
     return parser.root
+
+
+def test_the_docs_explain_every_rule():
+    docs = (Path(__file__).resolve().parents[1] / "docs" / "verifier.md").read_text(encoding="utf-8")
+    for rule in RULES:
+        assert f"`{rule.id}`" in docs, f"docs/verifier.md does not explain {rule.id}"
