@@ -325,6 +325,14 @@ def test_bad_fault_file_names_file_and_key(tmp_path):
     assert "Traceback" not in result.stderr
 
 
+def test_bad_robot_table_in_a_fault_file_names_file_and_key(tmp_path):
+    path = tmp_path / "bench.toml"
+    path.write_text('[robot]\npacing = "sometimes"\n')
+    result = run_cli("--tcp", "0", "--faults", str(path))
+    assert result.returncode == 2
+    assert f"{path}: robot.pacing: unknown pacing policy 'sometimes'" in result.stderr
+
+
 def test_fault_file_is_applied(tmp_path, start_emulator):
     path = tmp_path / "faults.toml"
     path.write_text('[robot]\nturnaround_ms = 2\n\n[[faults]]\nkind = "exception"\non_request = 1\ncode = 6\n')
@@ -340,6 +348,9 @@ def test_fault_file_is_applied(tmp_path, start_emulator):
     (("--tcp", "0", "--late-reply-on", "3"), "expected N:MS", 2),
     (("--tcp", "0", "--no-reply-on", "0"), "request numbers start at 1", 2),
     (("--tcp", "0", "--address", "300"), "robot address must be 1-247", 2),
+    (("--tcp", "0", "--anti-collision-at", "-1"), "--anti-collision-at: must be at least 0.0", 2),
+    (("--tcp", "0", "--turnaround-ms", "-3"), "--turnaround-ms: must be at least 0.0", 2),
+    (("--tcp", "0", "--exception-on", "2:300"), "--exception-on: must be at most 255", 2),
     (("--serial", "/nonexistent/ttyUSB9"), "cannot open serial port /nonexistent/ttyUSB9", 1),
 ])
 def test_cli_mistakes_get_a_clear_message(args, message, code):

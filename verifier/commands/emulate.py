@@ -42,30 +42,39 @@ def _request_number(value: str, option: str) -> tuple[int, str]:
     return n, rest
 
 
+def _fault(option: str, table: dict) -> Fault:
+    try:
+        return Fault.from_dict(table, option)
+    except ConfigError as err:
+        raise click.BadParameter(err.message, param_hint=option) from None
+
+
 def _flag_faults(no_reply, bad_crc, garbage, wrong_address, exception, late,
                  anti_collision, off_tape, low_battery) -> list[Fault]:
     faults = []
-    faults += [Fault("no_reply", on_request=_request_number(v, "--no-reply-on")[0]) for v in no_reply]
-    faults += [Fault("bad_crc", on_request=_request_number(v, "--bad-crc-on")[0]) for v in bad_crc]
-    faults += [Fault("garbage", on_request=_request_number(v, "--garbage-on")[0]) for v in garbage]
-    faults += [Fault("wrong_address", on_request=_request_number(v, "--wrong-address-on")[0])
-               for v in wrong_address]
+    for option, kind, values in (("--no-reply-on", "no_reply", no_reply), ("--bad-crc-on", "bad_crc", bad_crc),
+                                 ("--garbage-on", "garbage", garbage),
+                                 ("--wrong-address-on", "wrong_address", wrong_address)):
+        faults += [_fault(option, {"kind": kind, "on_request": _request_number(v, option)[0]}) for v in values]
     for value in exception:
         n, code = _request_number(value, "--exception-on")
         try:
-            faults.append(Fault.from_dict({"kind": "exception", "on_request": n, "code": int(code or "4", 0)}))
-        except (ValueError, ConfigError) as err:
-            raise click.BadParameter(f"{value!r}: {err}", param_hint="--exception-on") from None
+            number = int(code or "4", 0)
+        except ValueError:
+            raise click.BadParameter(f"expected N[:CODE], got {value!r}", param_hint="--exception-on") from None
+        faults.append(_fault("--exception-on", {"kind": "exception", "on_request": n, "code": number}))
     for value in late:
         n, ms = _request_number(value, "--late-reply-on")
         try:
-            faults.append(Fault.from_dict({"kind": "late_reply", "on_request": n, "delay_ms": float(ms)}))
-        except (ValueError, ConfigError):
+            delay = float(ms)
+        except ValueError:
             raise click.BadParameter(f"expected N:MS (request number and delay), got {value!r}",
                                      param_hint="--late-reply-on") from None
-    faults += [Fault("anti_collision", at_s=s) for s in anti_collision]
-    faults += [Fault("off_tape", at_s=s) for s in off_tape]
-    faults += [Fault("low_battery", at_s=s) for s in low_battery]
+        faults.append(_fault("--late-reply-on", {"kind": "late_reply", "on_request": n, "delay_ms": delay}))
+    for option, kind, values in (("--anti-collision-at", "anti_collision", anti_collision),
+                                 ("--off-tape-at", "off_tape", off_tape),
+                                 ("--low-battery-at", "low_battery", low_battery)):
+        faults += [_fault(option, {"kind": kind, "at_s": s}) for s in values]
     return faults
 
 
@@ -89,7 +98,7 @@ def _flag_faults(no_reply, bad_crc, garbage, wrong_address, exception, late,
 @click.option("--turnaround-ms", type=float, help="Delay from the end of a request to the reply [5].")
 @click.option("--point-duration-s", type=float, help="How long a point/script run takes [8].")
 @click.option("--pacing", type=click.Choice(PACING_POLICIES),
-              help="Requests under 250 ms apart: answer (default), ignore, or answer late.")
+              help="Requests 250 ms or less apart: answer (default), ignore, or answer late.")
 @click.option("--before-stop", type=click.Choice(BEFORE_STOP_POLICIES),
               help="Motion before the power-on stop command: ignore (default) or obey.")
 @click.option("--no-reply-on", multiple=True, metavar="N", help="No reply to request N (repeatable).")
@@ -131,15 +140,21 @@ def command(serial_url, tcp, baud, address, field_order, codes_10_13, status_ord
         except FaultFileError as err:
             raise click.BadParameter(str(err), param_hint="--faults") from None
         robot_table, faults = dict(loaded.robot), list(loaded.faults)
-    for key, value in (("turnaround_ms", turnaround_ms), ("point_duration_s", point_duration_s),
-                       ("pacing", pacing), ("before_stop", before_stop)):
-        if value is not None:
-            robot_table[key] = value
+    flags = (("turnaround_ms", "--turnaround-ms", turnaround_ms),
+             ("point_duration_s", "--point-duration-s", point_duration_s),
+             ("pacing", "--pacing", pacing), ("before_stop", "--before-stop", before_stop))
+    for key, option, value in flags:
+        if value is None:
+            continue
+        try:
+            RobotConfig.from_dict({key: value})
+        except ConfigError as err:
+            raise click.BadParameter(err.message, param_hint=option) from None
+        robot_table[key] = value
     try:
         config = RobotConfig.from_dict(robot_table)
     except ConfigError as err:
-        where = f"{faults_file}: " if faults_file else ""
-        raise click.BadParameter(f"{where}{err}", param_hint="--faults") from None
+        raise click.BadParameter(f"{faults_file}: {err}", param_hint="--faults") from None
     faults += _flag_faults(no_reply_on, bad_crc_on, garbage_on, wrong_address_on, exception_on,
                            late_reply_on, anti_collision_at, off_tape_at, low_battery_at)
     if frame_gap_ms <= 0:
