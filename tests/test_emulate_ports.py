@@ -316,21 +316,18 @@ def run_cli(*args: str) -> subprocess.CompletedProcess:
                           capture_output=True, text=True, timeout=WAIT_S)
 
 
-def test_bad_fault_file_names_file_and_key(tmp_path):
+@pytest.mark.parametrize("text, message", [
+    ('[[faults]]\nkind = "no_reply"\non_request = 1\n\n[[faults]]\nkind = "x"\nat_s = 1\n',
+     "faults[1].kind: unknown fault 'x'; expected one of anti_collision"),
+    ('[robot]\npacing = "sometimes"\n', "robot.pacing: unknown pacing policy 'sometimes'"),
+])
+def test_bad_fault_file_names_file_and_key(tmp_path, text, message):
     path = tmp_path / "faults.toml"
-    path.write_text('[[faults]]\nkind = "no_reply"\non_request = 1\n\n[[faults]]\nkind = "x"\nat_s = 1\n')
+    path.write_text(text)
     result = run_cli("--tcp", "0", "--faults", str(path))
     assert result.returncode == 2
-    assert f"{path}: faults[1].kind: unknown fault 'x'; expected one of anti_collision" in result.stderr
+    assert f"{path}: {message}" in result.stderr
     assert "Traceback" not in result.stderr
-
-
-def test_bad_robot_table_in_a_fault_file_names_file_and_key(tmp_path):
-    path = tmp_path / "bench.toml"
-    path.write_text('[robot]\npacing = "sometimes"\n')
-    result = run_cli("--tcp", "0", "--faults", str(path))
-    assert result.returncode == 2
-    assert f"{path}: robot.pacing: unknown pacing policy 'sometimes'" in result.stderr
 
 
 def test_fault_file_is_applied(tmp_path, start_emulator):
