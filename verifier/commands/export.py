@@ -1,0 +1,64 @@
+"""`uitamr export --target gxworks2|gxworks3 --out DIR [SOURCES...]`: paste-ready ST bodies
+and label tables for GX Works (docs/import-gxworks2.md, docs/import-gxworks3.md).
+
+With no SOURCES it exports the bundled library (plc/core, the platform ports and the
+examples of that editor's platforms). Exit status: 0 written, 1 the sources have errors
+(listed as file:line:col), 2 usage errors.
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+from verifier.commands.check import expand_sources, read_source
+
+EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
+PLC_ROOT = Path(__file__).resolve().parents[2] / "plc"
+#: the bundled folders each editor gets by default
+BUNDLED = {
+    "gxworks2": ("core", "fx3", "q", "examples/common", "examples/fx3", "examples/q"),
+    "gxworks3": ("core", "fx5", "adp", "examples/common", "examples/fx5"),
+}
+
+
+def bundled_sources(target: str) -> list[Path]:
+    return [p for folder in BUNDLED[target] for p in sorted((PLC_ROOT / folder).glob("*.st"))]
+
+
+@click.command(name="export")
+@click.argument("sources", nargs=-1, type=click.Path())
+@click.option("--target", type=click.Choice(["gxworks2", "gxworks3"]), required=True,
+              help="The engineering tool that will import the files.")
+@click.option("--out", "out_dir", type=click.Path(file_okay=False), required=True,
+              help="Folder for <POU>.st, <POU>.labels.tsv and IMPORT_ORDER.txt.")
+def command(sources: tuple[str, ...], target: str, out_dir: str) -> None:
+    """Write, per POU, the ST body and a tab-separated label table for GX Works."""
+    from verifier.export import ExportError, export_sources
+
+    if sources:
+        missing = [s for s in sources if not Path(s).exists()]
+        if missing:
+            click.echo(f"uitamr export: no such file or folder: {', '.join(missing)}", err=True)
+            sys.exit(EXIT_USAGE)
+        paths = expand_sources(sources)
+    else:
+        paths = bundled_sources(target)
+    if not paths:
+        click.echo("uitamr export: no .st files to export", err=True)
+        sys.exit(EXIT_USAGE)
+    texts = {p: read_source(p) for p in paths}
+    try:
+        written = export_sources(paths, target, Path(out_dir), texts)
+    except ExportError as e:
+        for d in e.diagnostics:
+            click.echo(str(d), err=True)
+        click.echo(f"uitamr export: nothing written, {len(e.diagnostics)} error(s)", err=True)
+        sys.exit(EXIT_ERRORS)
+    except OSError as e:
+        click.echo(f"uitamr export: cannot write {out_dir}: {e.strerror or e}", err=True)
+        sys.exit(EXIT_USAGE)
+    pous = (len(written) - 1) // 2
+    click.echo(f"{pous} POU(s) exported for {target} into {out_dir} (import order: "
+               f"{Path(out_dir) / 'IMPORT_ORDER.txt'})")
