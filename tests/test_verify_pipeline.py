@@ -279,3 +279,26 @@ def test_the_verifier_catches_a_broken_library(tmp_path, variant):
 def test_the_unmodified_library_handles_the_same_silent_robot(tmp_path):
     result = run_library(tmp_path, {}, faults=NO_REPLY, duration="14s")
     assert broken_rules(result) == set()
+
+
+def test_a_program_that_stops_the_cpu_fails_with_its_st_location(tmp_path):
+    crash = tmp_path / "Crash.st"
+    crash.write_text("PROGRAM Crash\nVAR\n    a : ARRAY[0..3] OF INT;\n    i : INT;\nEND_VAR\ni := i + 1;\na[i] := 1;\n")
+    from verifier.verify.scenario import default_scenario
+
+    result = run_scenario(replace(default_scenario(duration_us=1_000_000), sources=(crash,), program="Crash"))
+    assert not result.passed and result.verdict == "fail"
+    assert f"{crash.name}:7:" in result.aborted and result.ended_us < 1_000_000
+    assert "simulation stopped" in result.failed_expectations[0].detail
+
+
+def test_the_default_run_expects_the_power_on_stop(tmp_path):
+    """A program that never talks to the robot must not pass by saying nothing."""
+    quiet = tmp_path / "Quiet.st"
+    quiet.write_text("PROGRAM Quiet\nVAR\n    n : INT;\nEND_VAR\nn := n + 1;\n")
+    from verifier.verify.scenario import default_scenario
+
+    result = run_scenario(replace(default_scenario(duration_us=6_000_000), sources=(quiet,), program="Quiet"))
+    assert not result.passed and broken_rules(result) == set()
+    (missed,) = result.failed_expectations
+    assert missed.expectation.label == "sent stop within 5 s" and "was not sent" in missed.detail

@@ -55,7 +55,7 @@ def _scenarios(sources, program, platform, scenario_files, matrix, duration, sca
         if not found:
             raise UnusableInput(f"no bundled scenarios in {bundled_plc_dir() / 'scenarios'}")
         files += [f for f in found if f not in files]
-    scenarios = [load_scenario(f) for f in files] if files else [default_scenario()]
+    scenarios = [load_scenario(f) for f in files] if files else [default_scenario(duration_us=duration or 60_000_000)]
     if sources:
         resolved = tuple(Path(s).resolve() for s in sources)
         scenarios = [replace(s, sources=resolved) for s in scenarios]

@@ -345,4 +345,8 @@ def live_projects() -> list[Project]:
     return list(_LIVE)
 
 
+def forget_projects() -> None:
+    _LIVE.clear()
+
+
 __all__ = ["load", "Project", "Instance", "LoadError", "SimulationError", "StructT", "StringT"]

@@ -144,6 +144,12 @@ class Checker:
             self._check_block_kind(block, top_level=False, pou=pou)
             for v in block.variables:
                 t = self._declare(v)
+                if v.section == "VAR_EXTERNAL":
+                    g = self.table.globals.get(v.key)
+                    if g is None:
+                        self.rep.error(v, f"VAR_EXTERNAL '{v.name}' has no VAR_GLOBAL declaration in the files checked")
+                    elif g[1] != t:
+                        self.rep.error(v, f"VAR_EXTERNAL '{v.name}' is {t} but the global is {g[1]}")
                 if v.key in info.labels:
                     self.rep.error(v, f"label '{v.name}' is declared twice in {pou.name}")
                     continue
@@ -416,6 +422,9 @@ class Checker:
             kind = e.base.type.param(e.member)
             if kind and kind[0] == "output":
                 self.rep.error(e, f"'{e.member}' is an output of {e.base.type}; it cannot be assigned from outside")
+        if isinstance(t, T.FbType):
+            self.rep.error(e, f"'{_text(e)}' is a function block instance; it cannot be assigned "
+                              "(assign its inputs in a call instead)")
         if isinstance(e, ast.Device) and e.kind in ("X",) and e.bit is None:
             self.rep.warning(e, f"writing input {e.text}: X devices are refreshed from the inputs each scan")
         return t
@@ -455,7 +464,7 @@ class Checker:
             bt = self.expr(e.base)
             w = T.width(bt)
             if T.is_group(bt, "any"):
-                return T.BOOL
+                return T.ANY
             if w < 16 or T.is_group(bt, "real", "time", "string"):
                 self.rep.error(e, f"'.{e.bit}' needs a WORD, INT, DWORD or DINT label, not {bt}")
             elif e.bit >= w:
@@ -498,7 +507,9 @@ class Checker:
         if info is not None:
             e.symbol = info.pou
             return T.PouRef(info.pou.name)
-        if re.fullmatch(r"H[0-9A-F]+", e.name, re.IGNORECASE):
+        if re.fullmatch(r"E[0-9]+", e.name, re.IGNORECASE):
+            self.rep.error(e, f"undefined label '{e.name}'; E constants are not read here: write the REAL as 1.5 or 1.0E3")
+        elif re.fullmatch(r"H[0-9A-F]+", e.name, re.IGNORECASE):
             self.rep.error(e, f"undefined label '{e.name}'; for the hex constant write 16#{e.name[1:]} (or H0{e.name[1:]})")
         else:
             self.rep.error(e, f"undefined label '{e.name}'; declare it in a VAR block")
@@ -880,6 +891,15 @@ def library_missing(name: str, target: str = "gxworks2") -> str:
 
 def _target_name(target: str) -> str:
     return {"gxworks2": "GX Works2", "gxworks3": "GX Works3"}.get(target, target)
+
+
+def _text(e) -> str:
+    from verifier.st.printer import expr_text
+
+    try:
+        return expr_text(e)
+    except TypeError:
+        return "this"
 
 
 def _lit_text(e) -> str:

@@ -127,3 +127,4 @@ class RunEvidence:
     events: Sequence[Any] = ()
     samples: Samples = field(default_factory=Samples)
     options: RuleOptions = field(default_factory=RuleOptions)
+    stopped_early: bool = False  # the program stopped the simulated CPU at end_us

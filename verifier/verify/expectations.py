@@ -67,11 +67,13 @@ def judge(expectation: Expectation, evidence: RunEvidence, traffic: Traffic) -> 
     start, end = expectation.window(evidence.end_us)
     short = expectation.within_us is not None and expectation.after_us + expectation.within_us > evidence.end_us
     if short:
-        return ExpectationResult(
-            expectation, False,
-            f"the run ended at {format_seconds(evidence.end_us)}, before the window closed at "
-            f"{format_seconds(expectation.after_us + expectation.within_us)}: make the scenario's duration longer",
-        )
+        closes = format_seconds(expectation.after_us + expectation.within_us)
+        if evidence.stopped_early:
+            why = f"the simulation stopped at {format_seconds(evidence.end_us)}, before the window closed at {closes}"
+        else:
+            why = (f"the run ended at {format_seconds(evidence.end_us)}, before the window closed at {closes}: "
+                   "make the scenario's duration longer")
+        return ExpectationResult(expectation, False, why)
     judge_kind = {
         "that": _judge_that,
         "always": _judge_always,

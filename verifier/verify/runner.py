@@ -210,7 +210,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None) -> Scenar
     trace = [TraceRecord(f.t_start_us, f.t_end_us, f.direction, bytes(f.data), _relative(f.origin)) for f in line.trace]
     trace = [f for f in trace if f.t_start_us < end]
     events = [LineEvent(e.t_us, e.kind, e.message) for e in line.events if e.t_us <= end]
-    evidence = RunEvidence(scenario.settings, trace, end, events, samples, scenario.options)
+    evidence = RunEvidence(scenario.settings, trace, end, events, samples, scenario.options, aborted is not None)
     traffic = analyse(trace, scenario.settings, scenario.options)
     violations = check_all(evidence, traffic)
     outcomes = [judge(expectation, evidence, traffic) for expectation in scenario.expectations]

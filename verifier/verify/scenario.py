@@ -112,11 +112,24 @@ class Scenario:
         return replace(self, **{k: v for k, v in changes.items() if v is not None})
 
 
-def default_scenario(name: str = "healthy robot") -> Scenario:
-    """The run without a scenario file: a healthy robot, the default rules."""
+DEFAULT_STOP_WITHIN_US = 5_000_000
+
+
+def default_scenario(name: str = "healthy robot", duration_us: int = DEFAULT_DURATION_US) -> Scenario:
+    """The run without a scenario file: a healthy robot, the default rules, and one
+    expectation — the power-on stop goes out and is answered within 5 s (or the run) — so
+    that a program that never talks to the robot does not pass by saying nothing."""
+    stop = Expectation(
+        kind="sent",
+        label="",
+        within_us=min(DEFAULT_STOP_WITHIN_US, duration_us),
+        request=protocol.ControlRequest(1, protocol.ControlCode.ROBOT, protocol.RobotCommand.STOP),
+    )
     return Scenario(
         name=name,
         description="default: a healthy robot, no faults, no inputs",
+        duration_us=duration_us,
+        expectations=(replace(stop, label=f"sent stop {describe_window(stop)}"),),
         options=RuleOptions(response_signal=parse_condition(DEFAULT_RESPONSE_SIGNAL)),
     )
 

@@ -1,0 +1,89 @@
+"""pytest plugin for unit tests of GX Works ST (registered as the `verifier` pytest11
+entry point; see docs/testing-st.md).
+
+Fixtures:
+- `st_load(*paths, **options)`: `verifier.load` for this test (target, cpu, scan_ms ...).
+- `st_project`: a project loaded from the test's `@pytest.mark.st(...)` paths/options.
+
+When a test fails, the report gets an "ST state" section: every FB/PROGRAM instance the
+test handed out, with its labels' values and where they are declared (file:line:col),
+the simulator's diagnostics (operation errors with their ST location) and the virtual
+time — so a failing `assert fb.o_bDone` shows what the ST was doing and where.
+"""
+from __future__ import annotations
+
+import pytest
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "st(*paths, **options): ST sources for the st_project fixture")
+
+
+def pytest_runtest_setup(item):
+    from verifier.sim.project import forget_projects
+
+    forget_projects()  # the failure report shows this test's projects only
+
+
+@pytest.fixture
+def st_load(request):
+    import verifier
+
+    loaded = []
+
+    def load(*paths, **options):
+        project = verifier.load(*paths, **options)
+        loaded.append(project)
+        return project
+
+    request.node._st_projects = loaded
+    return load
+
+
+@pytest.fixture
+def st_project(request, st_load):
+    marker = request.node.get_closest_marker("st")
+    if marker is None:
+        raise pytest.UsageError("st_project needs @pytest.mark.st('file.st', ..., target=...)")
+    return st_load(*marker.args, **marker.kwargs)
+
+
+def describe_project(project) -> str:
+    lines = [f"virtual time {project.now_us / 1e6:.6f} s after {project.scan_count} scans "
+             f"({project.cpu.name})"]
+    for inst in project.touched:
+        lines.append(f"{inst._label}:")
+        symbols = inst._symbols()
+        for sym in symbols.values():
+            try:
+                value = getattr(inst, sym.name)
+            except Exception as e:  # a label the proxy cannot show: say why
+                value = f"<{e}>"
+            if hasattr(value, "_symbols") and not hasattr(value, "__len__"):
+                value = "<instance>"
+            elif hasattr(value, "__iter__") and not isinstance(value, str):
+                value = list(value)
+            where = f"  ({sym.decl.span})" if sym.decl is not None else ""
+            lines.append(f"    {sym.name} = {value!r}{where}")
+    for d in project.diagnostics[-20:]:
+        lines.append(f"diagnostic: {d}")
+    return "\n".join(lines)
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    outcome = yield
+    report = outcome.get_result()
+    if report.when != "call" or not report.failed:
+        return
+    projects = list(getattr(item, "_st_projects", []))
+    if not projects:
+        from verifier.sim.project import live_projects
+
+        projects = [p for p in live_projects() if p.touched]
+    for i, project in enumerate(projects[-3:]):
+        report.sections.append((f"ST state {i + 1}", describe_project(project)))
+    err = getattr(call.excinfo, "value", None) if call.excinfo else None
+    location = getattr(err, "location", None)
+    if location:
+        report.sections.append(("ST location", f"{location}: {getattr(err, 'message', err)}"))
