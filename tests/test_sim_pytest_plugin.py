@@ -1,0 +1,62 @@
+"""The pytest plugin integrators use: fixtures load ST, and a failing assertion shows the
+ST labels' values with their declaration locations."""
+from __future__ import annotations
+
+import textwrap
+
+pytest_plugins = ["pytester"]
+
+FB = """
+FUNCTION_BLOCK FB_DELAY
+VAR_INPUT i_bExecute : BOOL; END_VAR
+VAR_OUTPUT o_bDone : BOOL; END_VAR
+VAR fbTimer : TON; END_VAR
+fbTimer(IN := i_bExecute, PT := T#3s);
+o_bDone := fbTimer.Q;
+END_FUNCTION_BLOCK
+"""
+
+
+def test_fixtures_run_st_and_failures_show_st_state(pytester):
+    pytester.makefile(".st", FB_DELAY=FB)
+    pytester.makepyfile(test_delay=textwrap.dedent("""
+        import pytest
+
+        @pytest.mark.st("FB_DELAY.st", target="gxworks2", scan_ms=10)
+        def test_done_after_3s(st_project):
+            fb = st_project.instance("FB_DELAY")
+            fb.i_bExecute = True
+            fb.run(ms=3000)          # scans starting at 0, 10, ..., 2990 ms
+            assert not fb.o_bDone
+            fb.scan()                # the scan starting at 3000 ms sees the timer done
+            assert fb.o_bDone
+
+        def test_wrong_expectation(st_load):
+            fb = st_load("FB_DELAY.st").instance("FB_DELAY")
+            fb.i_bExecute = True
+            fb.run(ms=1000)
+            assert fb.o_bDone
+    """))
+    result = pytester.runpytest("-p", "no:cacheprovider")
+    result.assert_outcomes(passed=1, failed=1)
+    out = result.stdout.str()
+    assert "ST state 1" in out
+    assert "o_bDone = False  (FB_DELAY.st:4:12)" in out
+    assert "virtual time 1.000000 s after 100 scans" in out
+
+
+def test_simulation_error_location_is_reported(pytester):
+    pytester.makefile(".st", FB_OOB=textwrap.dedent("""
+        FUNCTION_BLOCK FB_OOB
+        VAR i : INT; a : ARRAY[0..1] OF INT; END_VAR
+        i := i + 1;
+        a[i] := 1;
+        END_FUNCTION_BLOCK
+    """))
+    pytester.makepyfile(test_oob=textwrap.dedent("""
+        def test_oob(st_load):
+            st_load("FB_OOB.st").instance("FB_OOB").scan(3)
+    """))
+    result = pytester.runpytest("-p", "no:cacheprovider")
+    result.assert_outcomes(failed=1)
+    assert "FB_OOB.st:4:3: array index 2 is outside a[0..1]" in result.stdout.str()
