@@ -41,7 +41,7 @@ def test_fixtures_run_st_and_failures_show_st_state(pytester):
     result.assert_outcomes(passed=1, failed=1)
     out = result.stdout.str()
     assert "ST state 1" in out
-    assert "o_bDone = False  (FB_DELAY.st:4:12)" in out
+    assert "o_bDone = False  (FB_DELAY.st:3:12)" in out
     assert "virtual time 1.000000 s after 100 scans" in out
 
 
