@@ -6,7 +6,7 @@ from hypothesis import given, settings as hsettings, strategies as st
 
 from verifier.amr import Robot, RobotConfig, faults_from_list
 from verifier.link import Line, LineConfig, TraceFrame
-from verifier.protocol import STOP_FRAME, Query, StatusRequest, encode
+from verifier.protocol import STOP_FRAME, ControlRequest, Query, StatusRequest, encode, with_crc
 from verifier.protocol.timing import T1_5_US, T3_5_US
 
 STATUS = encode(StatusRequest(1, Query.TASK))
@@ -183,7 +183,7 @@ def test_other_baud_rates_use_the_modbus_fixed_silences_above_19200():
 def test_the_robot_is_driven_by_the_line_clock():
     line = make_line()
     line.send(STOP_FRAME, 0)
-    line.send(encode(__import__("verifier.protocol", fromlist=["ControlRequest"]).ControlRequest(1, 1, 3)), 300_000)
+    line.send(encode(ControlRequest(1, 1, 3)), 300_000)
     line.advance(300_000 + 8_333 + 8 * 1_000_000)
     assert line.robot.mode == "idle"
     assert line.robot.now_us == line.now_us
@@ -206,3 +206,38 @@ def test_random_traffic_never_crashes_and_the_trace_keeps_every_plc_byte(sends):
     frames = line.trace
     assert all(a.t_start_us <= b.t_start_us for a, b in zip(frames, frames[1:]))
     assert [t for _, t in received] == sorted(t for _, t in received)
+
+
+def _plc_sees(line: Line, frames: list[bytes], period_us: int = 300_000) -> list[bytes]:
+    """Send each frame one period apart; what reached the PLC after each."""
+    seen = []
+    for i, frame in enumerate(frames):
+        line.send(frame, i * period_us)
+        seen.append(bytes(b for b, _ in line.receive_until((i + 1) * period_us - 1)))
+    return seen
+
+
+VEHICLE = encode(StatusRequest(1, Query.VEHICLE))
+FOLLOW = bytes.fromhex("01 06 01 17 00 00")
+
+
+@pytest.mark.parametrize("fault, expected_second", [
+    ({"kind": "bad_crc", "on_request": 2}, lambda ok: ok[:-2] + bytes(b ^ 0xFF for b in ok[-2:])),
+    ({"kind": "exception", "on_request": 2, "code": 4}, lambda ok: with_crc(bytes.fromhex("01 81 04"))),
+    ({"kind": "wrong_address", "on_request": 2, "address": 7}, lambda ok: with_crc(b"\x07" + ok[1:-2])),
+    ({"kind": "anti_collision", "at_s": 0.1}, lambda ok: with_crc(bytes.fromhex("01 01 03 00 01 01"))),
+    ({"kind": "low_battery", "at_s": 0.1}, lambda ok: with_crc(bytes.fromhex("01 01 03 00 03 03"))),
+    ({"kind": "no_reply", "on_request": 2}, lambda ok: b""),
+    ({"kind": "late_reply", "on_request": 2, "delay_ms": 400}, lambda ok: b""),
+])
+def test_each_fault_as_the_plc_sees_it_on_the_line(fault, expected_second):
+    healthy = _plc_sees(make_line(), [STOP_FRAME, VEHICLE])
+    faulty = _plc_sees(make_line(fault), [STOP_FRAME, VEHICLE])
+    assert faulty[0] == STOP_FRAME
+    assert faulty[1] == expected_second(healthy[1])
+
+
+def test_off_tape_on_the_line_during_a_tape_follow():
+    line = make_line({"kind": "off_tape", "at_s": 0.5})
+    seen = _plc_sees(line, [STOP_FRAME, with_crc(FOLLOW), VEHICLE])
+    assert seen[2] == with_crc(bytes.fromhex("01 01 03 00 02 02"))

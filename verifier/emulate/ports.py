@@ -90,7 +90,8 @@ def serve_tcp(host: str, port: int, emulator: Emulator, stop: threading.Event, s
     """Run until ``stop`` is set: accept clients on host:port; each has its own framing,
     all share the one robot."""
     try:
-        server = socket.create_server((host, port), reuse_port=False)
+        family = socket.AF_INET6 if ":" in host else socket.AF_INET
+        server = socket.create_server((host, port), family=family)
     except OSError as err:
         raise PortError(f"cannot listen on {host}:{port}: {err}") from None
     server.setblocking(False)
