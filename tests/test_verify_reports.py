@@ -175,6 +175,8 @@ def test_html_report_renders_in_chromium_with_a_timing_diagram_and_violation_mar
     frames = [r for r in bad.iter("rect") if "frame" in (r.get("class") or "").split()]
     assert all(float(r.get("width")) >= 2 for r in frames)
     assert sorted(float(r.get("x")) for r in frames) == [float(r.get("x")) for r in frames]
+    events = [g for g in bad.iter("g") if "event" in (g.get("class") or "").split()]
+    assert [(g.get("data-kind"), g.get("class")) for g in events] == [("collision", "event line")]
     assert root.find(".//*[@id='verdict']").text == "FAIL"
 
 

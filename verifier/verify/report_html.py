@@ -36,6 +36,15 @@ def _ms(t_us: int) -> float:
     return round(t_us / 1000, 3)
 
 
+def _event_class(kind: str) -> str:
+    """Faults the scenario injected, trouble on the line, or the robot's ordinary doings."""
+    if kind == "robot.fault":
+        return "fault"
+    if not kind.startswith("robot."):
+        return "line"
+    return "info"
+
+
 def scenario_view(index: int, result: ScenarioResult) -> dict:
     frames = list(records(result))
     end_ms = max(
@@ -72,7 +81,11 @@ def scenario_view(index: int, result: ScenarioResult) -> dict:
         "frames": frames,
         "windows": windows,
         "markers": markers,
-        "events": [{"t": _ms(e.t_us), "message": e.message, "time": format_seconds(e.t_us)} for e in result.events],
+        "events": [
+            {"t": _ms(e.t_us), "message": e.message, "kind": e.kind, "class": _event_class(e.kind),
+             "time": format_seconds(e.t_us)}
+            for e in result.events
+        ],
         "ticks": ticks,
         "minor_ticks": minor,
         "end_ms": round(end_ms, 3),
