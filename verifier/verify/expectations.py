@@ -105,35 +105,32 @@ def _judge_that(expectation, evidence, traffic, start, end) -> ExpectationResult
     return ExpectationResult(expectation, True, f"true at {format_seconds(seen)}", seen)
 
 
+def _first_in_window(condition: Condition, evidence: RunEvidence, start: int, end: int) -> int | None:
+    """The first moment in [start, end] at which `condition` holds, or None."""
+    for began, stopped in evidence.samples.intervals(condition, evidence.end_us):
+        if began <= end and stopped > start:
+            return max(began, start)
+    return None
+
+
 def _judge_always(expectation, evidence, traffic, start, end) -> ExpectationResult:
-    for began, stopped in _false_spans(expectation.condition, evidence, start, end):
-        return ExpectationResult(
-            expectation, False,
-            f"'{expectation.condition}' was false at {format_seconds(began)} "
-            f"({_values_at(evidence, expectation.condition, began)})",
-            began,
-        )
-    return ExpectationResult(expectation, True, f"held {_span(start, end)}")
-
-
-def _false_spans(condition: Condition, evidence: RunEvidence, start: int, end: int):
-    negated = Condition(f"NOT ({condition.text})", ("not", condition.tree))
-    for began, stopped in evidence.samples.intervals(negated, evidence.end_us):
-        if stopped > start and began <= end:
-            yield max(began, start), stopped
+    condition = expectation.condition
+    at = _first_in_window(Condition(f"NOT ({condition.text})", ("not", condition.tree)), evidence, start, end)
+    if at is None:
+        return ExpectationResult(expectation, True, f"held {_span(start, end)}")
+    return ExpectationResult(
+        expectation, False, f"'{condition}' was false at {format_seconds(at)} ({_values_at(evidence, condition, at)})", at
+    )
 
 
 def _judge_never(expectation, evidence, traffic, start, end) -> ExpectationResult:
-    for began, _ in evidence.samples.intervals(expectation.condition, evidence.end_us):
-        if began <= end and _ > start:
-            at = max(began, start)
-            return ExpectationResult(
-                expectation, False,
-                f"'{expectation.condition}' became true at {format_seconds(at)} "
-                f"({_values_at(evidence, expectation.condition, at)})",
-                at,
-            )
-    return ExpectationResult(expectation, True, f"never true {_span(start, end)}")
+    condition = expectation.condition
+    at = _first_in_window(condition, evidence, start, end)
+    if at is None:
+        return ExpectationResult(expectation, True, f"never true {_span(start, end)}")
+    return ExpectationResult(
+        expectation, False, f"'{condition}' became true at {format_seconds(at)} ({_values_at(evidence, condition, at)})", at
+    )
 
 
 def _judge_sent(expectation, evidence, traffic, start, end) -> ExpectationResult:
