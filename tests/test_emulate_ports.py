@@ -216,7 +216,7 @@ def test_serial_survives_noise_truncated_frames_and_floods(pty_pair, start_emula
     robot_end, master_end = pty_pair
     emulator = start_emulator("--serial", robot_end)
     rng = random.Random(7)
-    with serial.Serial(master_end, 9600, timeout=0.5) as port:
+    with serial.Serial(master_end, 9600, timeout=WAIT_S) as port:
         port.write(b"\xff")  # one noise byte, then a silence, then a request
         port.flush()
         emulator.wait_for(r"<- FF  invalid frame")
@@ -255,7 +255,7 @@ def exchange(sock: socket.socket, request: bytes, expect: int) -> bytes:
 
 def test_pymodbus_client_over_tcp_with_rtu_framing(start_emulator):
     emulator, port = tcp_emulator(start_emulator, "--point-duration-s", "600")
-    client = ModbusTcpClient("127.0.0.1", port=port, framer=FramerType.RTU, timeout=3, retries=0)
+    client = ModbusTcpClient("127.0.0.1", port=port, framer=FramerType.RTU, timeout=10, retries=0)
     try:
         assert client.connect()
         stop = client.write_register(0x01A0, 0, device_id=1)
