@@ -276,6 +276,15 @@ def test_the_verifier_catches_a_broken_library(tmp_path, variant):
     assert expected <= broken_rules(result), f"{variant}: broke {broken_rules(result)}"
 
 
+@pytest.mark.parametrize("scan, jitter", [("10ms", "4ms"), ("25ms", "10ms"), ("2ms", "1ms")])
+def test_the_library_keeps_every_rule_whatever_the_scan_time(tmp_path, scan, jitter):
+    copy = library_copy(tmp_path, {})
+    text = FX3_EXAMPLE.format(duration="12s", robot="", faults="", point_within="10s")
+    scenario = parse_scenario(f'scan = "{scan}"\nscan_jitter = "{jitter}"\nseed = 3\n' + text, copy / "s.toml")
+    result = run_scenario(scenario)
+    assert result.passed, (broken_rules(result), result.failed_expectations)
+
+
 def test_the_unmodified_library_handles_the_same_silent_robot(tmp_path):
     result = run_library(tmp_path, {}, faults=NO_REPLY, duration="14s")
     assert broken_rules(result) == set()

@@ -95,6 +95,7 @@ program = "Main"
 platform = "fx5u"
 duration = "30s"
 scan = "5ms"
+scan_jitter = "2ms"
 seed = 7
 watch = ["fb.o_wRetryCount"]
 [protocol]
@@ -128,7 +129,7 @@ within = "3s"
 """)
     scenario = load_scenario(path)
     assert [p.name for p in scenario.sources] == ["A.st", "B.st", "Main.st"]
-    assert scenario.target == "gxworks3" and scenario.serial_channel == "fx5:1"
+    assert scenario.target == "gxworks3" and scenario.serial_channel == "fx5:1" and scenario.scan_jitter_us == 2000
     assert scenario.settings.address == 3 and scenario.robot.point_duration_s == 2.0
     assert scenario.faults[0].kind == "no_reply"
     assert scenario.inputs[0].values == {"i_bStart": True, "fb.i_uPoint": 3} and scenario.inputs[0].pulse_us == 200_000
@@ -167,6 +168,7 @@ def test_the_nth_table_of_an_array_is_found():
     ('duration = 60', "duration", "duration"),
     ('scan = "2s"\nduration = "1s"', "scan", "longer than the whole run"),
     ('seed = "x"', "seed", "whole number"),
+    ('scan = "10ms"\nscan_jitter = "10ms"', "scan_jitter", "shorter than the scan time"),
     ('[protocol]\nfield_order = "sideways"', "protocol.field_order", "field_order"),
     ('[protocol]\nparity = "E"', "protocol.parity", "unknown key"),
     ('[robot]\nturnaround_ms = -1', "robot.turnaround_ms", "at least"),

@@ -64,6 +64,8 @@ def _scenarios(sources, program, platform, scenario_files, matrix, duration, sca
     for scenario in scenarios:
         if scenario.scan_us > scenario.duration_us:
             raise UnusableInput(f"{scenario.name}: the scan time is longer than the whole run")
+        if scenario.scan_jitter_us >= scenario.scan_us:
+            raise UnusableInput(f"{scenario.path or scenario.name}: scan_jitter must be shorter than the scan time")
         if not scenario.sources:
             where = scenario.path or "the default scenario"
             raise UnusableInput(f"{where}: no ST sources: give them as arguments (uitamr verify FILE.st ...)")

@@ -63,6 +63,7 @@ def scenario_dict(result: ScenarioResult) -> dict[str, Any]:
         "duration": _seconds(result.duration_us),
         "ended": _seconds(result.ended_us),
         "scan": _seconds(result.scan_us),
+        "scan_jitter": _seconds(result.scan_jitter_us),
         "seed": result.seed,
         "protocol": asdict(result.settings),
         "faults": result.faults,

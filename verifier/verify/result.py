@@ -49,6 +49,7 @@ class ScenarioResult:
     scan_us: int
     seed: int
     settings: protocol.Settings
+    scan_jitter_us: int = 0
     min_period_us: int = protocol.MIN_PERIOD_US
     reply_timeout_us: int = protocol.DEFAULT_REPLY_TIMEOUT_US
     faults: list[str] = field(default_factory=list)

@@ -47,6 +47,7 @@ class _Plc:
                 target=scenario.target,
                 cpu=scenario.platform,
                 scan_ms=scenario.scan_us / 1000,
+                jitter_ms=scenario.scan_jitter_us / 1000,
                 seed=scenario.seed,
             )
         except LoadError as exc:
@@ -224,6 +225,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None) -> Scenar
         sources=[str(p) for p in scenario.sources],
         duration_us=scenario.duration_us,
         scan_us=scenario.scan_us,
+        scan_jitter_us=scenario.scan_jitter_us,
         seed=scenario.seed,
         settings=scenario.settings,
         min_period_us=scenario.options.min_period_us,

@@ -35,7 +35,7 @@ DEFAULT_RESPONSE_SIGNAL = "o_bErr"
 
 TOP_KEYS = (
     "name", "description", "sources", "program", "platform", "channel", "duration", "scan",
-    "seed", "watch", "protocol", "robot", "faults", "inputs", "expect", "rules",
+    "scan_jitter", "seed", "watch", "protocol", "robot", "faults", "inputs", "expect", "rules",
     "response_handling",
 )
 PROTOCOL_KEYS = ("address", "field_order", "codes_10_13", "status_order", "manual_stop_counts_as_stop")
@@ -77,6 +77,7 @@ class Scenario:
     channel: str | None = None
     duration_us: int = DEFAULT_DURATION_US
     scan_us: int = DEFAULT_SCAN_US
+    scan_jitter_us: int = 0
     seed: int = 0
     watch: tuple[str, ...] = ()
     settings: protocol.Settings = field(default_factory=protocol.Settings)
@@ -274,6 +275,9 @@ class _Reader:
         scan = self.duration(data.get("scan", "10ms"), "scan")
         if scan > duration:
             raise self.fail("scan", "the scan time is longer than the whole run")
+        jitter = self.duration(data["scan_jitter"], "scan_jitter", positive=False) if "scan_jitter" in data else 0
+        if jitter >= scan:
+            raise self.fail("scan_jitter", "must be shorter than the scan time")
         seed = data.get("seed", 0)
         if isinstance(seed, bool) or not isinstance(seed, int):
             raise self.fail("seed", f"expected a whole number, got {_shown(seed)}")
@@ -295,7 +299,7 @@ class _Reader:
         options, signal_given = self.options(data.get("rules", {}), data.get("response_handling", None))
         return Scenario(
             name=name, path=self.path, description=description, sources=sources, program=program,
-            platform=platform, channel=channel, duration_us=duration, scan_us=scan, seed=seed,
+            platform=platform, channel=channel, duration_us=duration, scan_us=scan, scan_jitter_us=jitter, seed=seed,
             watch=watch, settings=settings, robot=robot, faults=faults, inputs=inputs,
             expectations=expectations, options=options, response_signal_given=signal_given,
         )
