@@ -32,8 +32,7 @@ def test_example_program_talks_to_the_robot(cpu, target, files, program, channel
     line = Line(Robot())
     project.attach_serial(channel, line)
     if cpu == "q":  # the module settings docs/import-gxworks2.md asks for: byte units, 8 bytes, no end code
-        buf = project.c24_buffer(0)
-        buf[0x96], buf[0xA4], buf[0xA5] = 1, 8, -1
+        project.configure_c24(0, 1, byte_units=True, receive_count=8, end_code=0xFFFF, no_reception_ms=20)
     project.run_programs([program], ms=3000)
     tx = [f for f in line.trace if f.direction == "tx"]
     rx = [f for f in line.trace if f.direction == "rx"]

@@ -261,6 +261,29 @@ class Project:
         """Frames the PLC sent on a channel: [SentFrame(t_start_us, t_end_us, data, origin)]."""
         return list(self.rt.channel(channel).sent)
 
+    def configure_c24(self, un: int = 0, channel: int = 1, *, byte_units: bool | None = None,
+                      receive_count: int | None = None, end_code: int | None = None,
+                      no_reception_ms: float | None = None) -> None:
+        """QJ71C24N settings normally made in GX Works (switch settings / buffer memory):
+        word or byte units, received data count, receive end code (0xFFFF = none) and the
+        no-reception monitoring time that ends a message on a silent line."""
+        module = self._instructions().c24(un)
+        from .instructions.c24 import BUFFER
+
+        addr = BUFFER[channel]
+        buf = module.buffer
+        if byte_units is not None:
+            buf[addr["unit"]] = 1 if byte_units else 0
+        if receive_count is not None:
+            buf[addr["recv_count"]] = receive_count
+        if end_code is not None:
+            buf[addr["end_code"]] = ((end_code & 0xFFFF) + 0x8000 & 0xFFFF) - 0x8000
+        if no_reception_ms is not None:
+            module.channels[channel].no_reception_us = round(no_reception_ms * 1000)
+
+    def _instructions(self):
+        return self.module.namespace["_I"]
+
     def c24_buffer(self, un: int = 0) -> list[int]:
         """Buffer memory of the QJ71C24N at start I/O `un` (the same words as U0\\G...)."""
         return self.rt.buffer(un)
