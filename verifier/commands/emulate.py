@@ -80,7 +80,7 @@ def _flag_faults(no_reply, bad_crc, garbage, wrong_address, exception, late,
 
 @click.command("emulate")
 @click.option("--serial", "serial_url", metavar="PORT",
-              help="Serial port or pyserial URL: /dev/ttyUSB0, COM3, loop://, socket://HOST:PORT.")
+              help="Serial port or pyserial URL: /dev/ttyUSB0, COM3, socket://HOST:PORT, rfc2217://HOST:PORT.")
 @click.option("--tcp", "tcp", metavar="HOST:PORT",
               help="Listen for raw RTU frames over TCP (PORT alone binds 127.0.0.1; port 0 = any free port).")
 @click.option("--baud", default=9600, show_default=True, help="Serial speed (the robot uses 9600 8N1).")
