@@ -154,6 +154,18 @@ def test_format_judges_the_layout_even_when_the_crc_is_wrong_but_does_not_double
     assert broken(check([tx(0, bytes(both))])) == {"UITAMR-CRC": 1, "UITAMR-FORMAT": 1}
 
 
+def test_format_flags_a_pause_inside_a_frame():
+    from verifier.verify.result import LineEvent
+
+    request = tx(0, STOP)
+    gap = LineEvent(request.t_start_us + 4 * MS, "gap", "silence of 2.100 ms between bytes of one frame")
+    evidence = RunEvidence(S, [request], 1_000_000, [gap])
+    (violation,) = check_all(evidence)["UITAMR-FORMAT"]
+    assert "continuous stream" in violation.message and "2.100 ms" in violation.message
+    outside = LineEvent(request.t_end_us + 10 * MS, "gap", "another frame")
+    assert check_all(RunEvidence(S, [request], 1_000_000, [outside]))["UITAMR-FORMAT"] == []
+
+
 def test_format_follows_the_field_order_setting():
     code_low = protocol.Settings(field_order="code-low")
     frame = protocol.encode(STOP, code_low)

@@ -40,7 +40,8 @@ RULES: tuple[Rule, ...] = (
         "Frame format",
         f"Requests go to the robot's slave address, use only function 06 (control) or 01 "
         f"(status), a control code of table 1 with a command of table 2 / note 2, value field "
-        f"0000, query 0-3 and quantity 0016 ({MANUAL}, 功能碼 0x06 / 0x01 tables).",
+        f"0000, query 0-3 and quantity 0016, sent as one continuous stream ({MANUAL}, 功能碼 0x06 / "
+        f"0x01 tables; {MODBUS_SERIAL} §2.5.1.1).",
         framing.check_format,
     ),
     Rule(

@@ -48,6 +48,12 @@ def check_format(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
                     f"byte 0: addressed to slave {request.address}, the robot is slave "
                     f"{settings.address}"
                 )
+        gap = _gap_inside(frame, evidence.events)
+        if gap is not None and problem is None:
+            problem = (
+                f"{gap.message}; a Modbus RTU frame must be sent as one continuous stream "
+                f"(at most t1.5 = {protocol.T1_5_US / 1000:.2f} ms between bytes)"
+            )
         if problem:
             violations.append(
                 Violation(
@@ -59,3 +65,11 @@ def check_format(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
                 )
             )
     return violations
+
+
+def _gap_inside(frame, events):
+    """The line's "gap" event inside this PLC frame, if the PLC paused in mid-frame."""
+    for event in events:
+        if getattr(event, "kind", "") == "gap" and frame.t_start_us < event.t_us < frame.t_end_us:
+            return event
+    return None
