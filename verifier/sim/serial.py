@@ -74,7 +74,8 @@ class SerialChannel:
 
     def receive_until(self, t_us: int) -> list[tuple[int, int]]:
         if self.endpoint is None:
-            return []
-        got = list(self.endpoint.receive_until(t_us))
-        self.received.extend(got)
+            return ()
+        got = self.endpoint.receive_until(t_us)
+        if got:
+            self.received.extend(got)
         return got

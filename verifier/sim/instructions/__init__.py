@@ -96,10 +96,12 @@ class InstructionSet:
         return port
 
     def RS2(self, en, s, m, n, n1, d, loc_id):
-        if not en:
-            port = self._rs2.get(n1)
-            return False if port is None else port.call(False, s, m, n, d, loc_id)
-        return self.rs2_port(n1, loc_id).call(True, s, m, n, d, loc_id)
+        port = self._rs2.get(n1)
+        if port is None:
+            if not en:
+                return False
+            port = self.rs2_port(n1, loc_id)
+        return port.call(en, s, m, n, d, loc_id)
 
     def c24(self, un: int):
         from .c24 import C24Module

@@ -149,23 +149,35 @@ class Rs2Port:
 
     # -- between scans (END processing) --------------------------------------------------
     def poll(self, now: int) -> None:
+        """Called before every scan: kept lean for the common case of a quiet line."""
         if self.sending_until is not None:
-            if now >= self.sending_until:
-                self.sending_until = None
-                self._set(self._send_req, False)
-                self._set(self._send_remaining, 0)
-            else:
-                sent = int((now - self.send_started) / self.channel.format.byte_time_us)
-                self._set(self._send_remaining, max(self.send_len - sent, 0))
+            self._poll_send(now)
         if self.rx_done and not self._get(self._recv_done):
             # the program reset the receive-complete flag: the count is cleared with it
             self.rx_done = False
             self.rx.clear()
             self._set(self._recv_count, 0)
+        got = self.channel.receive_until(now)
+        if got:
+            self._take(got, now)
+        elif self.rx and not self.rx_done and now - self.rx_last_t >= self.timeout_us():
+            self._complete(timed_out=True)
+            self._set(self._recv_count, len(self.rx))
+
+    def _poll_send(self, now: int) -> None:
+        if now >= self.sending_until:
+            self.sending_until = None
+            self._set(self._send_req, False)
+            self._set(self._send_remaining, 0)
+        else:
+            sent = int((now - self.send_started) / self.channel.format.byte_time_us)
+            self._set(self._send_remaining, max(self.send_len - sent, 0))
+
+    def _take(self, got, now: int) -> None:
         driven = self.last_call_scan >= self.rt.scan_count - 1
         timeout = self.timeout_us()
         dropped = 0
-        for value, t in self.channel.receive_until(now):
+        for value, t in got:
             if self.rx and not self.rx_done and t - self.rx_last_t > timeout:
                 self._complete(timed_out=True)
             if not driven or self.rx_done or self.n <= 0:
