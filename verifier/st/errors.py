@@ -6,6 +6,8 @@ expects there.
 """
 from __future__ import annotations
 
+import re
+
 from lark import Lark, Token
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 from lark.lexer import PatternStr
@@ -137,8 +139,37 @@ def describe_syntax_error(exc: UnexpectedInput, text: str, parser: Lark) -> tupl
         if closers:
             return line, col, f"unexpected end of file; expected {_expected_list(parser, closers)} to close the block"
         return line, col, f"unexpected end of file; expected {_expected_list(parser, expected)}"
+    if tok.type == "INT" and re.match(r"[0-9]+[A-Za-z_]", text[pos:pos + 40]):
+        word = re.match(r"[0-9A-Za-z_]+", text[pos:pos + 40]).group()
+        return line, col, f"'{word}': a name must not start with a digit; rename it"
+    accepted = _accepted(exc) or expected
     if tok.type == "EQ" and "ASSIGN" in expected:
         return line, col, "'=' compares; write ':=' to assign"
     if tok.type == "ASSIGN" and "EQ" in expected:
         return line, col, "':=' assigns; write '=' to compare"
-    return line, col, f"unexpected {_token_text(tok)}; expected {_expected_list(parser, expected)}"
+    keywords = sorted(n for n in accepted if _is_keyword(parser, n))
+    if keywords and len(keywords) < len(accepted):
+        return (line, col, f"unexpected {_token_text(tok)}; expected {_expected_list(parser, keywords)} "
+                           "(or an operator continuing the expression before it)")
+    return line, col, f"unexpected {_token_text(tok)}; expected {_expected_list(parser, accepted)}"
+
+
+def _accepted(exc: UnexpectedToken) -> set[str]:
+    """Terminals the parser really accepts at the error (lark's `expected` may include
+    lookaheads of merged LALR states)."""
+    ip = getattr(exc, "interactive_parser", None)
+    if ip is None:
+        return set()
+    try:
+        return set(ip.accepts()) - {"$END"} or set()
+    except Exception:  # noqa: BLE001 - fall back to lark's expected set
+        return set()
+
+
+def _is_keyword(parser: Lark, name: str) -> bool:
+    try:
+        term = parser.get_terminal(name)
+    except KeyError:
+        return False
+    return isinstance(term.pattern, PatternStr) and term.pattern.value.replace("_", "").isalpha() \
+        and name not in ("AND", "OR", "XOR", "MOD", "NOT")
