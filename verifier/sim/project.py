@@ -168,6 +168,9 @@ class Project:
             raise TypeError(f"{info.pou.name} is a FUNCTION; use project.call()")
         if info.kind == "PROGRAM":
             obj = self._program_obj(info.key)
+            for inst in self.touched:
+                if inst._obj is obj:
+                    return inst
         else:
             obj = self.module.namespace[info.class_name]()
         inst = Instance(obj, self, info.pou.name)
