@@ -178,6 +178,8 @@ def test_html_report_renders_in_chromium_with_a_timing_diagram_and_violation_mar
     events = [g for g in bad.iter("g") if "event" in (g.get("class") or "").split()]
     assert [(g.get("data-kind"), g.get("class")) for g in events] == [("collision", "event line")]
     assert root.find(".//*[@id='verdict']").text == "FAIL"
+    index = root.find(".//*[@id='index']")
+    assert [a.get("href") for a in index.iter("a")] == ["#s0", "#s1"]
 
 
 def test_html_screenshot_is_taken(tmp_path):

@@ -50,6 +50,8 @@ def test_conditions_read_like_st():
     assert parse_condition("w[2] = 2#1010").holds({"w[2]": 10})
     assert parse_condition("t > -1.5").holds({"t": 0})
     assert parse_condition("x = 1_000").holds({"x": 1000})
+    assert parse_condition("a OR b AND c").holds({"a": True, "b": False, "c": False})  # AND binds tighter
+    assert not parse_condition("(a OR b) AND c").holds({"a": True, "b": False, "c": False})
 
 
 @pytest.mark.parametrize("text, column", [
@@ -291,3 +293,35 @@ def test_reached_point_needs_the_task_to_run_and_end_without_error():
         request, _rx(request, protocol.StatusReply(1, 1, 0))]
     (result,) = _judge('[[expect]]\nreached_point = 3\n', _evidence({}, error_end))
     assert not result.passed and "error 01" in result.detail
+
+
+# --- conditions: property test against Python's own evaluation ----------------------------------
+
+_VALUES = {"a": True, "b": False, "n": 5, "fb.m": 0x101}
+_atoms = st.sampled_from([("a", True), ("b", False), ("TRUE", True), ("FALSE", False)])
+_numbers = st.sampled_from([("n", 5), ("fb.m", 0x101), ("16#0101", 0x101), ("5", 5), ("2#11", 3), ("-2", -2)])
+
+
+@st.composite
+def _comparison(draw):
+    (left, lv), (right, rv) = draw(_numbers), draw(_numbers)
+    op, fn = draw(st.sampled_from([("=", lambda x, y: x == y), ("<>", lambda x, y: x != y), ("<", lambda x, y: x < y),
+                                   ("<=", lambda x, y: x <= y), (">", lambda x, y: x > y), (">=", lambda x, y: x >= y)]))
+    return f"{left} {op} {right}", fn(lv, rv)
+
+
+def _combine(children):
+    def build(pair, op):
+        (lt, lv), (rt, rv) = pair
+        value = {"AND": lv and rv, "OR": lv or rv, "XOR": lv != rv}[op]
+        return f"({lt} {op} {rt})", value
+
+    negate = children.map(lambda c: (f"NOT ({c[0]})", not c[1]))
+    binary = st.builds(build, st.tuples(children, children), st.sampled_from(["AND", "OR", "XOR"]))
+    return negate | binary
+
+
+@given(st.recursive(_atoms | _comparison(), _combine, max_leaves=12))
+def test_conditions_evaluate_like_their_meaning(expression):
+    text, expected = expression
+    assert parse_condition(text).holds(_VALUES) == expected
