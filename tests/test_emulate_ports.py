@@ -355,3 +355,21 @@ def test_cli_mistakes_get_a_clear_message(args, message, code):
     assert result.returncode == code
     assert message in result.stderr
     assert "Traceback" not in result.stderr
+
+
+def test_serial_pyserial_socket_url_reaches_a_serial_server(start_emulator):
+    """``--serial socket://...``: the emulator dials a serial device server (here a listening
+    socket standing in for one) and answers what comes through it."""
+    with socket.create_server(("127.0.0.1", 0)) as server:
+        server.settimeout(WAIT_S)
+        port = server.getsockname()[1]
+        emulator = start_emulator("--serial", f"socket://127.0.0.1:{port}")
+        conn, _ = server.accept()
+        with conn:
+            conn.settimeout(WAIT_S)
+            assert exchange(conn, STOP_FRAME, 8) == STOP_FRAME
+            assert exchange(conn, STATUS_TASK, 8) == with_crc(bytes.fromhex("010103000000"))
+    # the serial server went away: the emulator says so, sums up and exits with status 1
+    emulator.wait_for(r"uitamr emulate: stopped after .* 2 frames in, 2 replies out")
+    assert emulator.proc.wait(timeout=WAIT_S) == 1
+    assert "socket disconnected" in emulator.wait_for(r"Error: serial port socket://\S+ failed").string

@@ -186,6 +186,7 @@ def command(serial_url, tcp, baud, address, field_order, codes_10_13, status_ord
         else:
             serve_tcp(endpoint[0], endpoint[1], emulator, stop, silence_us)
     except PortError as err:
+        click.echo(emulator.summary())
         raise click.ClickException(str(err)) from None
     finally:
         if timer is not None:
