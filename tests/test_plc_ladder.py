@@ -1,0 +1,266 @@
+"""The FX3U ladder program (plc/ladder/UITAMR_LadderFx3.il) is verified like the ST library:
+each instruction is translated, one to one, into an ST statement with ladder semantics
+(accumulator, block and MPS stacks, edge contacts, timers T200-T245 at 10 ms) and the
+result runs under `uitamr verify` scenarios against the emulated robot. The CSV for
+GX Works2 must be the one generated from the .il file."""
+from __future__ import annotations
+
+import re
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from verifier.export.ladder import IlError, parse_il, to_csv
+from verifier.protocol import ControlRequest, StatusRequest, encode
+from verifier.verify.runner import run_scenario
+from verifier.verify.scenario import load_scenario
+
+LADDER = Path(__file__).resolve().parents[1] / "plc" / "ladder"
+IL = LADDER / "UITAMR_LadderFx3.il"
+COMPARE = {"=": "=", "<>": "<>", ">": ">", "<": "<", ">=": ">=", "<=": "<="}
+
+
+def value(operand: str) -> str:
+    if re.fullmatch(r"K-?\d+", operand):
+        return operand[1:]
+    if re.fullmatch(r"H[0-9A-F]+", operand):
+        return "16#" + operand[1:]
+    return operand
+
+
+def timer_time(name: str, preset: str) -> str:
+    unit = 10 if 200 <= int(name[1:]) <= 245 else 100     # FX3U: T200-T245 10 ms, T0-T199 100 ms
+    return f"T#{int(value(preset)) * unit}ms"
+
+
+def next_device(name: str) -> str:
+    m = re.fullmatch(r"([A-Z]+)(\d+)", name)
+    return f"{m.group(1)}{int(m.group(2)) + 1}"
+
+
+def translate(program, name: str) -> str:
+    """ST with the ladder's meaning, statement by statement."""
+    presets = {i.operands[0]: timer_time(i.operands[0], i.operands[1])
+               for i in program if i.op == "OUT" and i.operands[0].startswith("T")}
+    body: list[str] = []
+    block = mps = edges = 0
+    after_output = True
+
+    def contact(op: str) -> str:
+        return f"tmr{op}.Q" if re.fullmatch(r"T\d+", op) else op
+
+    for ins in program:
+        op, args = ins.op, ins.operands
+        cmp = re.fullmatch(r"(LD|AND|OR)(=|<>|>=|<=|>|<)", op)
+        if op in ("LD", "LDI", "LDP") or (cmp and cmp.group(1) == "LD"):
+            if not after_output:
+                body.append(f"bBlk{block} := bAcc;")
+                block += 1
+            if op == "LDP":
+                body += [f"bAcc := {args[0]} AND NOT bEdge{edges};", f"bEdge{edges} := {args[0]};"]
+                edges += 1
+            elif cmp:
+                body.append(f"bAcc := ({value(args[0])} {COMPARE[cmp.group(2)]} {value(args[1])});")
+            else:
+                body.append(f"bAcc := {'NOT ' if op == 'LDI' else ''}{contact(args[0])};")
+            after_output = False
+            continue
+        if cmp:
+            joiner = "AND" if cmp.group(1) == "AND" else "OR"
+            body.append(f"bAcc := bAcc {joiner} ({value(args[0])} {COMPARE[cmp.group(2)]} {value(args[1])});")
+            continue
+        simple = {"AND": "bAcc AND {}", "ANI": "bAcc AND NOT {}", "OR": "bAcc OR {}", "ORI": "bAcc OR NOT {}"}
+        if op in simple:
+            body.append("bAcc := " + simple[op].format(contact(args[0])) + ";")
+        elif op in ("ANB", "ORB"):
+            block -= 1
+            body.append(f"bAcc := bBlk{block} {'AND' if op == 'ANB' else 'OR'} bAcc;")
+        elif op == "MPS":
+            body.append(f"bMps{mps} := bAcc;")
+            mps += 1
+        elif op == "MRD":
+            body.append(f"bAcc := bMps{mps - 1};")
+        elif op == "MPP":
+            mps -= 1
+            body.append(f"bAcc := bMps{mps};")
+        elif op == "END":
+            pass
+        else:
+            after_output = True
+            d = args[0] if op in ("OUT", "SET", "RST", "INC") else (args[-1] if args else "")
+            if op == "OUT" and d.startswith("T"):
+                body.append(f"tmr{d}(IN := bAcc, PT := {presets[d]});")
+            elif op == "OUT":
+                body.append(f"{d} := bAcc;")
+            elif op in ("SET", "RST") and d.startswith("T"):
+                body.append(f"IF bAcc THEN tmr{d}(IN := FALSE, PT := {presets[d]}); END_IF;")
+            elif op in ("SET", "RST"):
+                body.append(f"IF bAcc THEN {d} := {'TRUE' if op == 'SET' else 'FALSE'}; END_IF;")
+            elif op == "RS2":
+                s, m, dd, n, n1 = args
+                body.append(f"RS2(bAcc, {s}, {value(m)}, {value(n)}, {value(n1)}, {dd});")
+            elif op == "CRC":
+                s, dd, n = args
+                body.append(f"CRC(bAcc, {s}, {value(n)}, {dd});")
+            else:
+                expr = {
+                    "MOV": lambda a: value(a[0]),
+                    "ADD": lambda a: f"{value(a[0])} + {value(a[1])}",
+                    "MUL": lambda a: f"{value(a[0])} * {value(a[1])}",
+                    "DIV": lambda a: f"{value(a[0])} / {value(a[1])}",
+                    "WAND": lambda a: f"{value(a[0])} AND {value(a[1])}",
+                    "INC": lambda a: f"{a[0]} + 1",
+                }[op](args)
+                extra = f" {next_device(d)} := {value(args[0])} MOD {value(args[1])};" if op == "DIV" else ""
+                body.append(f"IF bAcc THEN {d} := {expr};{extra} END_IF;")
+    decls = ["    bAcc : BOOL;"]
+    decls += [f"    bBlk{i} : BOOL;" for i in range(4)] + [f"    bMps{i} : BOOL;" for i in range(4)]
+    decls += [f"    bEdge{i} : BOOL;" for i in range(edges)] + [f"    tmr{t} : TON;" for t in presets]
+    return (f"PROGRAM {name}\nVAR\n" + "\n".join(decls) + "\nEND_VAR\n" + "\n".join(body) + "\nEND_PROGRAM\n")
+
+
+@pytest.fixture(scope="module")
+def program():
+    return parse_il(IL.read_text(), str(IL))
+
+
+def test_committed_csv_is_generated_from_the_il(program):
+    assert (LADDER / "UITAMR_LadderFx3.csv").read_bytes().decode("ascii") == to_csv(program, IL.stem)
+
+
+def test_csv_layout(program):
+    rows = to_csv(program, IL.stem).split("\r\n")
+    assert rows[0] == '"UITAMR_LadderFx3"'
+    assert rows[2].split("\t")[:4] == ['"Step Number"', '"Line Statement"', '"Instruction"', '"I/O(Device)"']
+    assert rows[3].split("\t")[:4] == ['"0"', '"R1 first scan: line format, time-out, stop owed, first point"', '"LD"', '"M8002"']
+
+
+def test_bad_il_names_its_line():
+    with pytest.raises(IlError, match=r"x.il:2:"):
+        parse_il("LD X0\n#? Y0\nEND\n", "x.il")
+    with pytest.raises(IlError, match="END"):
+        parse_il("LD X0\nOUT Y0\n", "x.il")
+
+
+def test_frame_constants_match_the_protocol(program):
+    """The words the ladder writes are the protocol's frames, two bytes per word, low first."""
+    words = lambda frame: [frame[i] | frame[i + 1] << 8 for i in range(0, 6, 2)]
+    movs = {(i.operands[1], value(i.operands[0])) for i in program if i.op == "MOV"}
+    stop = words(encode(ControlRequest(1, 1, 0xA0)))
+    read = words(encode(StatusRequest(1, 0)))
+    assert ("D200", f"16#{stop[0]:04X}") in movs and ("D227", f"16#{stop[1]:04X}") in movs
+    assert {("D200", f"16#{read[0]:04X}"), ("D202", f"16#{read[2]:04X}")} <= movs
+    assert ("D8400", "16#1C81") in movs
+
+
+SCENARIO = """
+name = "{name}"
+sources = ["UITAMR_LadderFx3.st"]
+program = "UITAMR_LadderFx3"
+platform = "fx3u"
+duration = "{duration}"
+
+[robot]
+point_duration_s = 6.0
+{faults}
+[[inputs]]
+at = "2s"
+set = {{ X0 = true }}
+pulse = "500ms"
+{extra}
+[[expect]]
+sent = "stop"
+within = "1s"
+"""
+
+
+def run_ladder(tmp_path, program, name, body="", faults="", duration="45s", extra=""):
+    (tmp_path / "UITAMR_LadderFx3.st").write_text(translate(program, "UITAMR_LadderFx3"))
+    path = tmp_path / "ladder.toml"
+    path.write_text(textwrap.dedent(SCENARIO).format(name=name, duration=duration, faults=faults,
+                                                     extra=extra) + textwrap.dedent(body))
+    result = run_scenario(load_scenario(path))
+    problems = [f"{v.rule} at {v.t_us / 1e6:.3f} s: {v.message}" for v in result.all_violations()[:5]]
+    problems += [str(getattr(e, "message", e)) for e in result.failed_expectations]
+    return result, problems
+
+
+def test_ladder_runs_the_point_cycle(tmp_path, program):
+    result, problems = run_ladder(tmp_path, program, "ladder: cycle over points 1-3", """
+        [[expect]]
+        reached_point = 3
+        within = "40s"
+
+        [[expect]]
+        never = "Y3"
+
+        [[expect]]
+        that = "Y0 AND Y1"
+        within = "3s"
+        """)
+    assert result.passed, "\n".join(problems)
+
+
+def test_ladder_reports_no_reply_and_recovers_after_acknowledge(tmp_path, program):
+    result, problems = run_ladder(tmp_path, program, "ladder: no reply", """
+        [[expect]]
+        that = "Y3 AND D225 = 16#0101"
+        after = "4s"
+        within = "4s"
+
+        [[expect]]
+        reached_point = 2
+        after = "12s"
+        within = "30s"
+
+        [response_handling]
+        signal = "Y3"
+        within = "5s"
+        """, faults="""
+        [[faults]]
+        kind = "no_reply"
+        at_s = 4.0
+        duration_s = 4.0
+        """, extra="""
+        [[inputs]]
+        at = "10s"
+        set = { X2 = true }
+        pulse = "500ms"
+
+        [[inputs]]
+        at = "12s"
+        set = { X0 = true }
+        pulse = "500ms"
+        """)
+    assert result.passed, "\n".join(problems)
+
+
+def test_ladder_stops_the_cycle_on_anti_collision(tmp_path, program):
+    result, problems = run_ladder(tmp_path, program, "ladder: anti-collision", """
+        [[expect]]
+        that = "Y3 AND D225 = 16#0201"
+        after = "5s"
+        within = "2s"
+        """, faults="""
+        [[faults]]
+        kind = "anti_collision"
+        at_s = 5.0
+        """, duration="10s")
+    assert result.passed, "\n".join(problems)
+
+
+def test_ladder_rejects_a_bad_crc_and_retries(tmp_path, program):
+    result, problems = run_ladder(tmp_path, program, "ladder: bad CRC", """
+        [[expect]]
+        reached_point = 2
+        within = "30s"
+
+        [[expect]]
+        never = "Y3"
+        """, faults="""
+        [[faults]]
+        kind = "bad_crc"
+        on_request = 6
+        """, duration="30s")
+    assert result.passed, "\n".join(problems)
