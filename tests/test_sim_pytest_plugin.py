@@ -59,4 +59,4 @@ def test_simulation_error_location_is_reported(pytester):
     """))
     result = pytester.runpytest("-p", "no:cacheprovider")
     result.assert_outcomes(failed=1)
-    assert "FB_OOB.st:4:3: array index 2 is outside a[0..1]" in result.stdout.str()
+    assert "FB_OOB.st:4:3: index 2 is outside a[0..1]" in result.stdout.str()

@@ -129,6 +129,21 @@ def test_devices_bit_of_word_and_digit_specification():
     assert dev["K4M0"] == 0x1234
 
 
+def test_index_registers_and_buffer_memory_on_q():
+    src = ("PROGRAM P\nVAR w : WORD; END_VAR\n"
+           "W1F := D0Z1;\nD10Z1 := 5;\nU0\\G164 := 8;\nw := INT_TO_WORD(U0\\G165);\nEND_PROGRAM\n")
+    project = load_st(src, cpu="q")
+    project.devices["Z1"] = 2
+    project.devices["D2"] = 77
+    project.run_programs(["P"], scans=1)
+    assert project.devices["W1F"] == 77 and project.devices["D12"] == 5
+    assert project.c24_buffer(0)[164] == 8
+    project.devices["Z1"] = 20000
+    with pytest.raises(SimulationError) as err:
+        project.run_programs(["P"], scans=1)
+    assert err.value.location == "t.st:3:8" and "outside D0Z1" in str(err.value)
+
+
 def test_fx_inputs_are_octal_and_q_inputs_hexadecimal():
     fx = load_st("PROGRAM P\nVAR b : BOOL; END_VAR\nb := X10;\nEND_PROGRAM\n")
     fx.devices["X10"] = True

@@ -269,6 +269,14 @@ class BodyCompiler:
             prep.append(f"if not 0 <= {t} < {area.size}: _oob({t}, {k})")
             idx_code = t
         place = f"{cells}[{idx_code}]"
+        if prep and (d.digits is not None or d.bit is not None):
+            raise CompileError(d.span, f"{label}: index modification of a bit/digit access is not simulated")
+        if prep:
+            # a read needs the checked index inside one expression
+            read = (f"({cells}[{idx_code}] if 0 <= ({idx_code} := {index} + _A_Z[{d.index}]) < {area.size} "
+                    f"else _oob({idx_code}, {self.m.oob_id(d.span, label, 0, area.size - 1)}))")
+            kind = "BOOL" if area.kind == "bit" else "INT"
+            return LValue(kind, read, f"{place} = {{v}}", prep, label)
         if d.digits is not None:
             if area.kind != "bit":
                 raise CompileError(d.span, f"digit specification needs a bit device: {label}")

@@ -385,7 +385,7 @@ class ModuleCompiler:
         def _oob(index, k):
             location, label, lo, hi = oob[k]
             raise SimulationError(
-                f"array index {index} is outside {label}[{lo}..{hi}]; the real CPU does not "
+                f"index {index} is outside {label}[{lo}..{hi}]; the real CPU does not "
                 "check this and would silently read or overwrite neighbouring memory",
                 location, rt.now_us)
 

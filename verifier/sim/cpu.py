@@ -44,7 +44,7 @@ FX3U = CpuProfile(
     areas=_areas(
         Area("X", "bit", 0o400, 8), Area("Y", "bit", 0o400, 8),
         Area("M", "bit", 8512), Area("S", "bit", 4096),
-        Area("D", "word", 8512), Area("R", "word", 32768),
+        Area("D", "word", 8512), Area("R", "word", 32768), Area("Z", "word", 8),
     ),
     always_on=("M8000",), always_off=("M8001",),
     first_scan_on=("M8002",), first_scan_off=("M8003",),
@@ -59,7 +59,7 @@ FX3G = CpuProfile(
     areas=_areas(
         Area("X", "bit", 0o200, 8), Area("Y", "bit", 0o200, 8),
         Area("M", "bit", 8512), Area("S", "bit", 4096),
-        Area("D", "word", 8512), Area("R", "word", 24000),
+        Area("D", "word", 8512), Area("R", "word", 24000), Area("Z", "word", 8),
     ),
     always_on=FX3U.always_on, always_off=FX3U.always_off,
     first_scan_on=FX3U.first_scan_on, first_scan_off=FX3U.first_scan_off,
@@ -76,7 +76,7 @@ FX5U = CpuProfile(
         Area("X", "bit", 1024, 8), Area("Y", "bit", 1024, 8),
         Area("M", "bit", 32768), Area("L", "bit", 32768), Area("B", "bit", 32768, 16),
         Area("SM", "bit", 10000), Area("D", "word", 8000), Area("R", "word", 32768),
-        Area("W", "word", 32768, 16), Area("SD", "word", 12000),
+        Area("W", "word", 32768, 16), Area("SD", "word", 12000), Area("Z", "word", 24),
     ),
     # FX5 keeps the FX3-compatible SM8000/SM8002 beside SM400/SM402.
     always_on=("SM400", "SM8000"), always_off=("SM401", "SM8001"),
@@ -93,7 +93,8 @@ QCPU = CpuProfile(
         Area("X", "bit", 8192, 16), Area("Y", "bit", 8192, 16),
         Area("M", "bit", 8192), Area("L", "bit", 8192), Area("B", "bit", 8192, 16),
         Area("SM", "bit", 2048), Area("D", "word", 12288), Area("R", "word", 32768),
-        Area("W", "word", 8192, 16), Area("SD", "word", 2048),
+        Area("W", "word", 8192, 16), Area("SD", "word", 2048), Area("Z", "word", 20),
+        Area("ZR", "word", 65536),
     ),
     always_on=("SM400",), always_off=("SM401",),
     first_scan_on=("SM402",), first_scan_off=("SM403",),
