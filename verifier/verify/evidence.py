@@ -64,30 +64,40 @@ class Samples:
     def __init__(self, names: Sequence[str] = ()):
         self.names = list(dict.fromkeys(names))
         self.changes: dict[str, list[tuple[int, Any]]] = {name: [] for name in self.names}
+        self._times: dict[str, list[int]] = {name: [] for name in self.names}
 
     def record(self, t_us: int, values: dict[str, Any]) -> None:
         for name, value in values.items():
-            history = self.changes.setdefault(name, [])
-            if name not in self.names:
+            if name not in self.changes:
                 self.names.append(name)
+                self.changes[name], self._times[name] = [], []
+            history = self.changes[name]
             if not history or history[-1][1] != value:
                 history.append((t_us, value))
+                self._times[name].append(t_us)
 
     def value_at(self, name: str, t_us: int) -> Any:
-        history = self.changes.get(name, [])
-        index = bisect_right([t for t, _ in history], t_us) - 1
-        return history[index][1] if index >= 0 else None
+        index = bisect_right(self._times.get(name, []), t_us) - 1
+        return self.changes[name][index][1] if index >= 0 else None
 
     def states(self, names: Sequence[str] | frozenset[str]) -> Iterator[tuple[int, dict[str, Any]]]:
         """Every moment one of `names` changed, with the values of all of them then.
 
         Starts at the first moment all of them are known."""
         names = list(names)
-        moments = sorted({t for name in names for t, _ in self.changes.get(name, [])})
+        moments = sorted({t for name in names for t in self._times.get(name, [])})
+        positions = {name: 0 for name in names}
+        current: dict[str, Any] = {}
         for t_us in moments:
-            values = {name: self.value_at(name, t_us) for name in names}
-            if all(value is not None for value in values.values()):
-                yield t_us, values
+            for name in names:
+                history = self.changes.get(name, [])
+                position = positions[name]
+                while position < len(history) and history[position][0] <= t_us:
+                    current[name] = history[position][1]
+                    position += 1
+                positions[name] = position
+            if len(current) == len(names):
+                yield t_us, dict(current)
 
     def first_time(self, condition: Condition, start_us: int, end_us: int) -> int | None:
         """The first moment in [start_us, end_us] at which `condition` holds, or None."""

@@ -9,6 +9,7 @@ time-out when nothing came).
 """
 from __future__ import annotations
 
+from bisect import bisect_right
 from collections import Counter
 from dataclasses import dataclass, field
 
@@ -55,6 +56,10 @@ def check_response_handling(evidence: RunEvidence, traffic: Traffic) -> list[Vio
     options = evidence.options
     within = options.response_within_us
     violations = []
+    spans = []  # when the signal held: [(began, stopped)], computed once for every episode
+    if options.response_signal is not None:
+        spans = evidence.samples.intervals(options.response_signal, evidence.end_us)
+    stops = [stopped for _, stopped in spans]
     for episode in episodes(traffic):
         start = episode.noticeable_us
         bound = start + within
@@ -70,8 +75,8 @@ def check_response_handling(evidence: RunEvidence, traffic: Traffic) -> list[Vio
                 f"[response_handling] signal (e.g. \"o_bErr\")"
             )
         else:
-            seen = evidence.samples.first_time(options.response_signal, start, bound)
-            if seen is not None:
+            index = bisect_right(stops, start)  # the first span still running after `start`
+            if index < len(spans) and spans[index][0] <= bound:
                 continue
             message = (
                 f"the robot's replies failed from {format_seconds(start)} {lasted} "

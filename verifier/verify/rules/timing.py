@@ -1,6 +1,8 @@
 """UITAMR-PACING, UITAMR-HALF-DUPLEX and UITAMR-ONE-AT-A-TIME: when the PLC may transmit."""
 from __future__ import annotations
 
+from bisect import bisect_right
+
 from verifier import protocol
 
 from ..evidence import RunEvidence, Violation
@@ -33,6 +35,7 @@ def check_pacing(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
 def check_half_duplex(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
     settings = evidence.settings
     violations = []
+    rx_starts = [rx.t_start_us for rx in traffic.rx]
     for position, frame in enumerate(traffic.tx):
         start = frame.t_start_us
         blamed = None
@@ -49,14 +52,12 @@ def check_half_duplex(evidence: RunEvidence, traffic: Traffic) -> list[Violation
                     blamed = (reply, f"only {_ms(start - reply.t_end_us)} after the reply ended; the "
                               f"line needs {_ms(protocol.T3_5_US)} (3.5 characters) of silence")
         if blamed is None:
-            for rx in traffic.rx:
-                if rx.t_start_us <= start < rx.t_end_us:
-                    blamed = (rx, "while a frame from the robot was arriving")
-                elif rx.t_end_us <= start < rx.t_end_us + protocol.T3_5_US:
-                    blamed = (rx, f"only {_ms(start - rx.t_end_us)} after a frame from the robot "
-                              f"ended; the line needs {_ms(protocol.T3_5_US)} of silence")
-                if blamed:
-                    break
+            rx = _last_robot_frame_before(traffic.rx, rx_starts, start)
+            if rx is not None and start < rx.t_end_us:
+                blamed = (rx, "while a frame from the robot was arriving")
+            elif rx is not None and start < rx.t_end_us + protocol.T3_5_US:
+                blamed = (rx, f"only {_ms(start - rx.t_end_us)} after a frame from the robot "
+                          f"ended; the line needs {_ms(protocol.T3_5_US)} of silence")
         if blamed:
             rx, why = blamed
             violations.append(
@@ -69,6 +70,12 @@ def check_half_duplex(evidence: RunEvidence, traffic: Traffic) -> list[Violation
                 )
             )
     return violations
+
+
+def _last_robot_frame_before(rx: list, starts: list[int], t_us: int):
+    """The robot frame that started last at or before t_us (robot frames never overlap)."""
+    index = bisect_right(starts, t_us) - 1
+    return rx[index] if index >= 0 else None
 
 
 def check_one_at_a_time(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
