@@ -344,7 +344,7 @@ def test_fault_file_is_applied(tmp_path, start_emulator):
     (("--tcp", "here"), "expected HOST:PORT or PORT", 2),
     (("--tcp", "0", "--late-reply-on", "3"), "expected N:MS", 2),
     (("--tcp", "0", "--no-reply-on", "0"), "request numbers start at 1", 2),
-    (("--tcp", "0", "--address", "300"), "robot address must be 1-247", 2),
+    (("--tcp", "0", "--address", "300"), "'--address': 300 is not in the range 1<=x<=247", 2),
     (("--tcp", "0", "--anti-collision-at", "-1"), "--anti-collision-at: must be at least 0.0", 2),
     (("--tcp", "0", "--turnaround-ms", "-3"), "--turnaround-ms: must be at least 0.0", 2),
     (("--tcp", "0", "--exception-on", "2:300"), "--exception-on: must be at most 255", 2),

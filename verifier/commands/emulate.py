@@ -14,7 +14,7 @@ from verifier.emulate.assembler import DEFAULT_SILENCE_US
 from verifier.emulate.core import Emulator
 from verifier.emulate.faultfile import FaultFileError, load_fault_file
 from verifier.emulate.ports import PortError, serve_serial, serve_tcp
-from verifier.protocol.settings import CODES_10_13_STYLES, FIELD_ORDERS, STATUS_ORDERS, Settings
+from verifier.commands.protocol_options import protocol_settings
 
 
 def _tcp_endpoint(value: str) -> tuple[str, int]:
@@ -84,15 +84,7 @@ def _flag_faults(no_reply, bad_crc, garbage, wrong_address, exception, late,
 @click.option("--tcp", "tcp", metavar="HOST:PORT",
               help="Listen for raw RTU frames over TCP (PORT alone binds 127.0.0.1; port 0 = any free port).")
 @click.option("--baud", default=9600, show_default=True, help="Serial speed (the robot uses 9600 8N1).")
-@click.option("--address", default=1, show_default=True, help="The robot's Modbus slave address.")
-@click.option("--field-order", type=click.Choice(FIELD_ORDERS), default="code-high", show_default=True,
-              help="FC06 address field: control code in the high or the low byte.")
-@click.option("--codes-10-13", type=click.Choice(CODES_10_13_STYLES), default="decimal", show_default=True,
-              help="Control codes 10-13 on the wire as 0x0A-0x0D (decimal) or 0x10-0x13 (hex).")
-@click.option("--status-order", type=click.Choice(STATUS_ORDERS), default="query", show_default=True,
-              help="FC01 query numbering (query: 0 task 1 vehicle 2 speed 3 battery; return: 0 speed 1 battery 2 task 3 vehicle).")
-@click.option("--manual-stop-counts-as-stop", is_flag=True,
-              help="Accept manual stop 05/00 as the power-on stop command.")
+@protocol_settings
 @click.option("--faults", "faults_file", type=click.Path(dir_okay=False), metavar="FILE.toml",
               help="Scripted faults ([[faults]]) and robot settings ([robot]).")
 @click.option("--turnaround-ms", type=float, help="Delay from the end of a request to the reply [5].")
@@ -114,8 +106,7 @@ def _flag_faults(no_reply, bad_crc, garbage, wrong_address, exception, late,
               help="Silence that ends an incomplete frame on the wall clock (USB adapters deliver in chunks).")
 @click.option("--exit-after", type=float, metavar="S", help="Stop by itself after S seconds.")
 @click.option("--quiet", is_flag=True, help="No live log, only the summary line.")
-def command(serial_url, tcp, baud, address, field_order, codes_10_13, status_order,
-            manual_stop_counts_as_stop, faults_file, turnaround_ms, point_duration_s, pacing,
+def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_duration_s, pacing,
             before_stop, no_reply_on, bad_crc_on, garbage_on, wrong_address_on, exception_on,
             late_reply_on, anti_collision_at, off_tape_at, low_battery_at, frame_gap_ms,
             exit_after, quiet):
@@ -126,12 +117,6 @@ def command(serial_url, tcp, baud, address, field_order, codes_10_13, status_ord
     """
     if (serial_url is None) == (tcp is None):
         raise click.UsageError("give exactly one of --serial PORT or --tcp HOST:PORT")
-    try:
-        settings = Settings(address=address, field_order=field_order, codes_10_13=codes_10_13,
-                            status_order=status_order,
-                            manual_stop_counts_as_stop=manual_stop_counts_as_stop)
-    except ValueError as err:
-        raise click.BadParameter(str(err), param_hint="--address") from None
     robot_table: dict = {}
     faults: list[Fault] = []
     if faults_file:

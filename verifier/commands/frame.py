@@ -31,7 +31,7 @@ from verifier.protocol import (
 )
 from verifier.protocol.describe import looks_like_reply
 from verifier.protocol.names import USAGE
-from verifier.protocol.settings import CODES_10_13_STYLES, FIELD_ORDERS, STATUS_ORDERS
+from verifier.commands.protocol_options import protocol_settings
 
 EXIT_BAD_FRAME = 1
 _HEX_WORD = re.compile(r"(0[xX])?[0-9a-fA-F]+,?")
@@ -86,14 +86,7 @@ def _kind(frame) -> str:
     context_settings={"ignore_unknown_options": True, "help_option_names": ["-h", "--help"]},
 )
 @click.argument("words", nargs=-1, type=click.UNPROCESSED)
-@click.option("--address", type=click.IntRange(1, 247), default=1, show_default=True,
-              help="Robot (slave) address.")
-@click.option("--field-order", type=click.Choice(FIELD_ORDERS), default="code-high", show_default=True,
-              help="FC06 register field: control code in the high byte (manual text) or low byte (its examples).")
-@click.option("--codes-10-13", "codes_10_13", type=click.Choice(CODES_10_13_STYLES), default="decimal",
-              show_default=True, help="Control codes 10-13 on the wire as 0x0A-0x0D (decimal) or 0x10-0x13 (hex).")
-@click.option("--status-order", type=click.Choice(STATUS_ORDERS), default="query", show_default=True,
-              help="FC01 query numbering: 0 task,1 vehicle,2 speed,3 battery (query) or 0 speed,1 battery,2 task,3 vehicle (return).")
+@protocol_settings
 @click.option("--decode", "decode_hex", metavar="HEX",
               help="Decode these bytes instead (with COMMAND: as the reply to that command).")
 @click.option("--as", "direction", type=click.Choice(["auto", "request", "reply"]), default="auto",
@@ -105,15 +98,14 @@ def _kind(frame) -> str:
 @click.option("--words", "as_words", is_flag=True,
               help="Also print the frame as 16-bit words, two bytes per word, low byte first "
                    "(FX RS2 16-bit mode, QJ71C24N send area).")
-def command(words, address, field_order, codes_10_13, status_order, decode_hex, direction, explain_fields,
+def command(words, settings, decode_hex, direction, explain_fields,
             mbpoll_device, as_words):
     """Print the exact bytes (CRC included) of COMMAND, or decode bytes with --decode.
 
     Prints space-separated upper-case hex, ready to type into a PLC send buffer.
     A bad COMMAND or value exits 2; --decode of a bad frame explains it and exits 1.
     """
-    settings = Settings(address=address, field_order=field_order, codes_10_13=codes_10_13,
-                        status_order=status_order)
+    address = settings.address
     for word in words:
         if word.startswith("--"):
             raise click.UsageError(f"no such option: {word}")
