@@ -74,6 +74,7 @@ class BodyCompiler:
         self.tmp = 0
         self.static_refs: list[tuple[str, str]] = []  # (slot, code) created in __init__
         self.pulse_slots: list[str] = []
+        self.fb_calls: dict[str, str] = {}  # temp holding an instance -> its user FB type
 
     # ------------------------------------------------------------------ helpers
     def new_tmp(self, prefix="_t") -> str:
@@ -649,6 +650,8 @@ class BodyCompiler:
             raise CompileError(c.span, f"{self.label_of(c.callee)} is not a function block instance")
         o = self.new_tmp("_o")
         self.em.line(f"{o} = {code}")
+        if not t.standard:
+            self.fb_calls[o] = t.name
         after = []
         en_code = None
         for a in c.args:

@@ -19,6 +19,7 @@ from . import datatypes
 from .codegen import BodyCompiler, Emitter, attr_name
 from .cpu import CpuProfile
 from .errors import SimulationError
+from .inline import Body, Inliner
 from .instructions import InstructionSet
 from .instructions import lookup as lookup_instruction
 from .refs import AttrRef, Ref
@@ -48,8 +49,9 @@ class CompiledModule:
 
 
 class ModuleCompiler:
-    def __init__(self, files: list[ast.SourceFile], rt, cpu: CpuProfile):
+    def __init__(self, files: list[ast.SourceFile], rt, cpu: CpuProfile, inline: bool = True):
         self.files = files
+        self.inline = inline
         self.rt = rt
         self.cpu = cpu
         self.structs: dict[str, ast.StructDecl] = {}
@@ -359,11 +361,16 @@ class ModuleCompiler:
         for key, sd in self.structs.items():
             self.gen_struct(key, sd)
         self.gen_globals()
+        bodies: dict[str, tuple[Body, BodyCompiler]] = {}
         for info in self.pous.values():
             if info.kind == "FUNCTION":
                 self.gen_function(info)
             else:
-                self.gen_class(info)
+                bodies[info.key] = self.gen_body(info)
+        inliner = Inliner({k: b for k, (b, _) in bodies.items()}) if self.inline else None
+        for key, (body, bc) in bodies.items():
+            lines, spans = inliner.expanded(key) if inliner else (body.lines, body.spans)
+            self.gen_class(self.pous[key], lines, spans, bc)
         source = "\n".join(em.lines) + "\n"
         ns = self.namespace()
         code = compile(source, GENERATED_FILE, "exec")
@@ -469,8 +476,7 @@ class ModuleCompiler:
             if isinstance(s.decl.init, ast.StructInit):
                 self.init_members(code, s.type, s.decl.init, info, s.decl.span)
 
-    def gen_class(self, info: PouInfo) -> None:
-        em = self.em
+    def gen_body(self, info: PouInfo) -> tuple[Body, BodyCompiler]:
         pou = info.pou
         body_em = Emitter()
         body_em.depth = 2
@@ -480,6 +486,13 @@ class ModuleCompiler:
         for s in temps:
             body_em.line(f"{s.code} = {self.value_code(s.type, s.decl.init, info, s.decl.span)}")
         bc.block(pou.body)
+        if not body_em.lines:
+            body_em.line("pass")
+        return Body(body_em.lines, body_em.spans, 2, bc.fb_calls), bc
+
+    def gen_class(self, info: PouInfo, lines: list[str], spans: list, bc: BodyCompiler) -> None:
+        em = self.em
+        pou = info.pou
         own = [s for s in info.symbols.values() if s.code.startswith("self.")]
         slots = ["_rt"] + [s.code[5:] for s in own] + bc.pulse_slots + [slot for slot, _ in bc.static_refs]
         em.span = pou.span
@@ -497,8 +510,8 @@ class ModuleCompiler:
             em.line(f"self.{slot} = {code}")
         em.dedent()
         em.line("def _body(self):")
-        em.lines.extend(body_em.lines)
-        em.spans.extend(body_em.spans)
+        em.lines.extend(lines)
+        em.spans.extend(spans)
         em.dedent()
 
     def gen_function(self, info: PouInfo) -> None:
@@ -562,8 +575,8 @@ def default_code(t) -> str:
     raise CompileError(None, f"no default for {t}")
 
 
-def compile_files(files: list[ast.SourceFile], rt, cpu: CpuProfile) -> CompiledModule:
-    return ModuleCompiler(files, rt, cpu).compile()
+def compile_files(files: list[ast.SourceFile], rt, cpu: CpuProfile, inline: bool = True) -> CompiledModule:
+    return ModuleCompiler(files, rt, cpu, inline).compile()
 
 
 __all__ = ["compile_files", "CompiledModule", "CompileError", "concrete", "is_int", "is_real"]
