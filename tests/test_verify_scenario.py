@@ -194,7 +194,8 @@ def test_every_mistake_names_its_key(text, key, words):
     error = error_of('program = "Main"\n' + text + "\n", Path("x.toml"))
     assert error.key == key
     assert words in error.message
-    assert str(error).startswith("x.toml")
+    assert error.line is not None and 2 <= error.line <= 2 + text.count("\n")
+    assert str(error).startswith(f"x.toml:{error.line}: {key}: ")
 
 
 def test_a_missing_scenario_file(tmp_path):

@@ -184,9 +184,9 @@ class _Reader:
         if rest and rest[0].startswith("["):
             index = int(rest[0][1:-1])
             rest = rest[1:]
-        start = 0
         header = re.compile(r"^\s*\[\[\s*" + re.escape(table) + r"\s*\]\]")
         plain_header = re.compile(r"^\s*\[\s*" + re.escape(table) + r"\s*\]")
+        start: int | None = None  # the line of the table's header, when the key is in a table
         seen = -1
         for number, line in enumerate(self.lines):
             if header.match(line):
@@ -197,18 +197,16 @@ class _Reader:
             elif plain_header.match(line):
                 start = number
                 break
-        else:
-            start = None
         target = rest[0] if rest else table
-        if start is None:  # a top-level key
-            start = 0
-        for number in range(start, len(self.lines)):
+        if start is not None and not rest:
+            return start + 1  # the table itself is wrong: point at its header
+        for number in range(start or 0, len(self.lines)):
             line = self.lines[number]
-            if number > start and re.match(r"^\s*\[", line) and not rest:
-                break
+            if start is None and number > 0 and re.match(r"^\s*\[", line):
+                break  # a top-level key comes before every table
             if re.match(r"^\s*\"?" + re.escape(target) + r"\"?\s*=", line):
                 return number + 1
-        return start + 1 if start or rest else None
+        return None if start is None else start + 1
 
     # --- helpers -------------------------------------------------------------------------
 
