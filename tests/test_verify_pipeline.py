@@ -311,3 +311,13 @@ def test_the_default_run_expects_the_power_on_stop(tmp_path):
     assert not result.passed and broken_rules(result) == set()
     (missed,) = result.failed_expectations
     assert missed.expectation.label == "sent stop within 5 s" and "was not sent" in missed.detail
+
+
+def test_the_complete_example_in_the_scenario_docs_runs_and_passes():
+    docs = (REPO / "docs" / "scenarios.md").read_text(encoding="utf-8")
+    section = docs[docs.index("## A complete example"):]
+    example = section[section.index("```toml") + len("```toml"):section.index("```\n", section.index("```toml") + 7)]
+    scenario = parse_scenario(example, PLC / "scenarios" / "docs-example.toml")
+    assert {e.kind for e in scenario.expectations} == {"sent", "that", "reached_point", "never"}
+    result = run_scenario(scenario)
+    assert result.passed, ([v.message for v in result.all_violations()], [e.detail for e in result.failed_expectations])
