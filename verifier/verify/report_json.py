@@ -85,7 +85,7 @@ def scenario_dict(result: ScenarioResult) -> dict[str, Any]:
         },
         "aborted": result.aborted,
         "simulator_diagnostics": result.diagnostics,
-        "line_events": [{"t": _seconds(e.t_us), "message": e.message} for e in result.events],
+        "line_events": [{"t": _seconds(e.t_us), "kind": e.kind, "message": e.message} for e in result.events],
     }
 
 
