@@ -12,6 +12,8 @@ time — so a failing `assert fb.o_bDone` shows what the ST was doing and where.
 """
 from __future__ import annotations
 
+import sys
+
 import pytest
 
 
@@ -20,9 +22,10 @@ def pytest_configure(config):
 
 
 def pytest_runtest_setup(item):
-    from verifier.sim.project import forget_projects
-
-    forget_projects()  # the failure report shows this test's projects only
+    # only if a test already loaded the simulator: other test suites do not pay for it
+    project_module = sys.modules.get("verifier.sim.project")
+    if project_module is not None:
+        project_module.forget_projects()  # the failure report shows this test's projects only
 
 
 @pytest.fixture
@@ -77,10 +80,9 @@ def pytest_runtest_makereport(item, call):
     if report.when != "call" or not report.failed:
         return
     projects = list(getattr(item, "_st_projects", []))
-    if not projects:
-        from verifier.sim.project import live_projects
-
-        projects = [p for p in live_projects() if p.touched]
+    project_module = sys.modules.get("verifier.sim.project")
+    if not projects and project_module is not None:
+        projects = [p for p in project_module.live_projects() if p.touched]
     for i, project in enumerate(projects[-3:]):
         report.sections.append((f"ST state {i + 1}", describe_project(project)))
     err = getattr(call.excinfo, "value", None) if call.excinfo else None

@@ -13,6 +13,7 @@ import keyword
 from verifier.st import ast
 
 from . import datatypes, instructions, stdfuncs
+from .stdfbs import STANDARD_FBS, body_code
 from .typesys import (ANYINT, ANYREAL, ArrayT, CompileError, FbT, PouInfo, StringT, StructT,
                       Symbol, concrete, is_int, is_real, is_string, norm_code, unify)
 
@@ -690,7 +691,11 @@ class BodyCompiler:
         if en_code is not None:
             self.em.line(f"if {en_code}:")
             self.em.indent()
-        self.em.line(f"{o}._body()")
+        std = STANDARD_FBS.get(t.name) if t.standard else None
+        if std is not None and std.BODY:
+            self.emit_lines(body_code(std, o, "_rt", self.new_tmp("_t")))  # inline, no call
+        else:
+            self.em.line(f"{o}._body()")
         for target, src, mt, span in after:
             for p in target.prep:
                 self.em.line(p)

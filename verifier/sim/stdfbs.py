@@ -17,6 +17,7 @@ from __future__ import annotations
 class StdFB:
     __slots__ = ("_rt",)
     TYPE_NAME = ""
+    BODY: str | None = None  # Python template ({o} instance, {rt} runtime, {t} a temporary)
     INPUTS: tuple[str, ...] = ()
     OUTPUTS: tuple[str, ...] = ()
     _STATE: dict = {}  # internal memory and its initial value
@@ -41,24 +42,22 @@ class TON(StdFB):
     _STATE = {"_start": None}
     INPUTS = ("IN", "PT")
     OUTPUTS = ("Q", "ET")
-
-    def _body(self):
-        if self.IN:
-            now = self._rt.now_ms
-            if self._start is None:
-                self._start = now
-            et = now - self._start
-            pt = self.PT
-            if et >= pt:
-                self.ET = pt if pt > 0 else 0
-                self.Q = True
-            else:
-                self.ET = et
-                self.Q = False
-        else:
-            self._start = None
-            self.Q = False
-            self.ET = 0
+    BODY = """
+if {o}.IN:
+    if {o}._start is None:
+        {o}._start = {rt}.now_ms
+    {t} = {rt}.now_ms - {o}._start
+    if {t} >= {o}.PT:
+        {o}.ET = {o}.PT if {o}.PT > 0 else 0
+        {o}.Q = True
+    else:
+        {o}.ET = {t}
+        {o}.Q = False
+else:
+    {o}._start = None
+    {o}.Q = False
+    {o}.ET = 0
+"""
 
 
 class TOF(StdFB):
@@ -69,23 +68,22 @@ class TOF(StdFB):
     _STATE = {"_start": None}
     INPUTS = ("IN", "PT")
     OUTPUTS = ("Q", "ET")
-
-    def _body(self):
-        if self.IN:
-            self._start = None
-            self.Q = True
-            self.ET = 0
-        elif self.Q:
-            now = self._rt.now_ms
-            if self._start is None:
-                self._start = now
-            et = now - self._start
-            if et >= self.PT:
-                self.ET = max(self.PT, 0)
-                self.Q = False
-                self._start = None
-            else:
-                self.ET = et
+    BODY = """
+if {o}.IN:
+    {o}._start = None
+    {o}.Q = True
+    {o}.ET = 0
+elif {o}.Q:
+    if {o}._start is None:
+        {o}._start = {rt}.now_ms
+    {t} = {rt}.now_ms - {o}._start
+    if {t} >= {o}.PT:
+        {o}.ET = {o}.PT if {o}.PT > 0 else 0
+        {o}.Q = False
+        {o}._start = None
+    else:
+        {o}.ET = {t}
+"""
 
 
 class TP(StdFB):
@@ -124,11 +122,10 @@ class R_TRIG(StdFB):
     _STATE = {"_m": False}
     INPUTS = ("CLK",)
     OUTPUTS = ("Q",)
-
-    def _body(self):
-        clk = self.CLK
-        self.Q = clk and not self._m
-        self._m = clk
+    BODY = """
+{o}.Q = {o}.CLK and not {o}._m
+{o}._m = {o}.CLK
+"""
 
 
 class F_TRIG(StdFB):
@@ -140,11 +137,10 @@ class F_TRIG(StdFB):
     _STATE = {"_m": False}
     INPUTS = ("CLK",)
     OUTPUTS = ("Q",)
-
-    def _body(self):
-        clk = self.CLK
-        self.Q = self._m and not clk
-        self._m = clk
+    BODY = """
+{o}.Q = {o}._m and not {o}.CLK
+{o}._m = {o}.CLK
+"""
 
 
 class CTU(StdFB):
@@ -230,6 +226,22 @@ class RS(StdFB):
         self.Q1 = not self.R1 and (self.S or self.Q1)
 
 
+def body_code(cls: type[StdFB], receiver: str, rt: str, temp: str) -> str:
+    """The FB's body as Python lines for `receiver` (generated code inlines these)."""
+    return cls.BODY.strip("\n").format(o=receiver, rt=rt, t=temp)
+
+
+def _install_bodies() -> None:
+    """`_body` methods of the FBs described by a BODY template: one text serves both the
+    method and the code the compiler inlines."""
+    for cls in (TON, TOF, R_TRIG, F_TRIG):
+        lines = body_code(cls, "self", "self._rt", "et").split("\n")
+        src = "def _body(self):\n" + "\n".join("    " + ln for ln in lines)
+        env: dict = {}
+        exec(src, env)
+        cls._body = env["_body"]
+
+
 STANDARD_FBS: dict[str, type[StdFB]] = {
     cls.TYPE_NAME: cls for cls in (TON, TOF, TP, R_TRIG, F_TRIG, CTU, CTD, CTUD, SR, RS)
 }
@@ -248,3 +260,5 @@ FB_PARAM_TYPES: dict[str, dict[str, str]] = {
     "SR": {"S1": "BOOL", "R": "BOOL", "Q1": "BOOL"},
     "RS": {"S": "BOOL", "R1": "BOOL", "Q1": "BOOL"},
 }
+
+_install_bodies()
