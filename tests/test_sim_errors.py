@@ -1,0 +1,77 @@
+"""User mistakes get clear errors naming file, line and column — never a traceback."""
+from __future__ import annotations
+
+import pytest
+
+import verifier
+from sim_helpers import FakeEndpoint, load_st
+from verifier.sim import LoadError, SimulationError
+
+
+def test_missing_file_is_a_load_error(tmp_path):
+    with pytest.raises(LoadError) as err:
+        verifier.load(str(tmp_path / "nope.st"))
+    assert "nope.st:0:0: error: cannot read" in str(err.value)
+
+
+def test_unknown_target_and_cpu():
+    with pytest.raises(LoadError) as err:
+        load_st("PROGRAM P\nEND_PROGRAM\n", target="gxworks9")
+    assert "unknown target" in str(err.value)
+    with pytest.raises(LoadError) as err:
+        load_st("PROGRAM P\nEND_PROGRAM\n", cpu="fx2n")
+    assert "unknown CPU" in str(err.value)
+
+
+def test_instruction_of_another_cpu_is_refused_at_its_location():
+    src = ("PROGRAM P\nVAR c : ARRAY[0..2] OF WORD; d : ARRAY[0..3] OF WORD; b : ARRAY[0..1] OF BOOL; END_VAR\n"
+           "G_OUTPUT(TRUE, 16#0, c, d, b);\nEND_PROGRAM\n")
+    with pytest.raises(LoadError) as err:
+        load_st(src)  # FX3U by default
+    assert "t.st:3:1: error: G_OUTPUT does not exist on the fx3u" in str(err.value)
+    load_st(src, cpu="q")  # fine on a Q CPU
+
+
+def test_rs2_on_a_channel_the_cpu_lacks():
+    src = ("PROGRAM P\nVAR s, r : ARRAY[0..3] OF WORD; END_VAR\n"
+           "RS2(TRUE, s[0], 4, 4, 3, r[0]);\nEND_PROGRAM\n")
+    project = load_st(src)
+    with pytest.raises(SimulationError) as err:
+        project.run_programs(["P"], scans=1)
+    assert err.value.location == "t.st:3:1"
+    assert "channel n1=3 does not exist" in str(err.value)
+
+
+def test_attach_serial_checks_the_channel():
+    project = load_st("PROGRAM P\nEND_PROGRAM\n")
+    with pytest.raises(ValueError, match="unknown serial channel"):
+        project.attach_serial("com1", FakeEndpoint())
+    with pytest.raises(ValueError, match="does not exist on the fx3u"):
+        project.attach_serial("q:1", FakeEndpoint())
+    with pytest.raises(TypeError, match="needs a send\(\) method"):
+        project.attach_serial("fx3:1", object())
+
+
+def test_api_misuse_names_what_exists():
+    project = load_st("FUNCTION F : INT\nVAR_INPUT a : INT; END_VAR\nF := a;\nEND_FUNCTION\n"
+                      "FUNCTION_BLOCK FB\nEND_FUNCTION_BLOCK\n")
+    with pytest.raises(KeyError, match="loaded: F, FB"):
+        project.instance("NOPE")
+    with pytest.raises(TypeError, match="use project.call"):
+        project.instance("F")
+    with pytest.raises(TypeError, match="use project.instance"):
+        project.call("FB")
+    with pytest.raises(TypeError, match="takes 1 input"):
+        project.call("F", 1, 2)
+    with pytest.raises(ValueError, match="F.a is INT"):
+        project.call("F", 1.5)
+
+
+def test_operand_block_past_an_array_through_a_function_local():
+    src = ("FUNCTION F : WORD\nVAR_INPUT n : INT; END_VAR\nVAR b : ARRAY[0..1] OF WORD; c : WORD; END_VAR\n"
+           "CRC(TRUE, b[0], n, c);\nF := c;\nEND_FUNCTION\n")
+    project = load_st(src)
+    assert project.call("F", 4) == project.call("F", 4)
+    with pytest.raises(SimulationError) as err:
+        project.call("F", 5)
+    assert err.value.location == "t.st:4:11"
