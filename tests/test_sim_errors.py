@@ -48,7 +48,7 @@ def test_attach_serial_checks_the_channel():
         project.attach_serial("com1", FakeEndpoint())
     with pytest.raises(ValueError, match="does not exist on the fx3u"):
         project.attach_serial("q:1", FakeEndpoint())
-    with pytest.raises(TypeError, match="needs a send\(\) method"):
+    with pytest.raises(TypeError, match=r"needs a send\(\) method"):
         project.attach_serial("fx3:1", object())
 
 
