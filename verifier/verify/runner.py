@@ -26,7 +26,7 @@ Progress = Callable[[int, int], None]  # (virtual now, virtual end) in µs
 PROGRESS_STEP_US = 1_000_000  # report progress every virtual second
 
 #: Device names (X0, M8000, D100, SM400, ...) are read through the device memory, not labels.
-_DEVICE = re.compile(r"^(X|Y|M|L|F|B|S|T|C|D|W|R|ZR|SM|SD|SB|SW)[0-9A-F]+$", re.IGNORECASE)
+_DEVICE = re.compile(r"^(?:(?:X|Y|B|W|SB|SW)[0-9A-F]+|(?:M|L|F|S|T|C|D|R|ZR|SM|SD)\d+)$", re.IGNORECASE)
 
 
 class _Plc:
