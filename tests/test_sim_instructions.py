@@ -88,13 +88,17 @@ FMOV(TRUE, 7, 2, D10);
 SET(TRUE, bit);
 SET(TRUE, M5);
 RST(TRUE, D11);
+SET(TRUE, D12.F);
+SET(TRUE, w.3);
+RST(TRUE, w.0);
 END_PROGRAM
-"""
+""".replace("bit : BOOL; END_VAR", "bit : BOOL; w : WORD := 1; END_VAR")
     project = load_st(src)
     project.run_programs(["P"], scans=1)
     p = project.program("P")
     assert p.x == 42 and list(p.b) == [2, 3, 4, 0] and p.bit is True
     assert project.devices["D10"] == 7 and project.devices["D11"] == 0 and project.devices["M5"] is True
+    assert project.devices["D12"] == -32768 and p.w == 8
 
 
 # ----------------------------------------------------------------------------- RS2 (FX3)

@@ -375,6 +375,8 @@ class BodyCompiler:
             return e.name
         if isinstance(e, ast.Member):
             return f"{self.label_of(e.base)}.{e.member}"
+        if isinstance(e, ast.BitAccess):
+            return f"{self.label_of(e.base)}.{e.bit}"
         if isinstance(e, ast.Index):
             return f"{self.label_of(e.base)}[...]"
         if isinstance(e, ast.Device):
@@ -849,6 +851,21 @@ class BodyCompiler:
                           ast.StringLiteral, ast.BinaryOp, ast.UnaryOp, ast.Call)):
             raise CompileError(e.span, f"this operand must be a label, array element or device, "
                                        "not an expression")
+        if isinstance(e, ast.Device) and e.bit is not None and e.index is None and e.module is None:
+            area = self.m.cpu.areas.get(e.kind)
+            self.device_lvalue(e)  # validates the device
+            index = int(e.address, area.radix)
+            return self.static_ref(f"_BitRef(_A_{e.kind}, {index}, {e.bit}, 'INT', _rt, {k}, {label!r})"), []
+        if isinstance(e, ast.BitAccess):
+            code, t = self.expr(e.base)
+            self.check_bit(e.bit, t, e.span)
+            if not (isinstance(e.base, ast.Name) and "." in code and not code.startswith("l_")
+                    and self.lookup(e.base.name, e.span).write is None):
+                raise CompileError(e.span, f"{label}: a bit of this label cannot be an instruction "
+                                           "operand in the simulator; use a BOOL label or a device bit")
+            obj, attr = code.rsplit(".", 1)
+            ref = f"_BitRef({obj}, {attr!r}, {e.bit}, {t!r}, _rt, {k}, {label!r})"
+            return (self.static_ref(ref) if self.stable(e.base) else ref), []
         if isinstance(e, ast.Device):
             d = e
             if d.bit is not None or d.digits is not None or d.index is not None or d.module is not None:

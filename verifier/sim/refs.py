@@ -111,3 +111,39 @@ class DwordRef(Ref):
         v = int(value) & 0xFFFFFFFF
         self.cells[self._index(2 * k)] = ((v & 0xFFFF) + 0x8000 & 0xFFFF) - 0x8000
         self.cells[self._index(2 * k + 1)] = ((v >> 16) + 0x8000 & 0xFFFF) - 0x8000
+
+
+class BitRef(Ref):
+    """One bit of a word used as an instruction operand (`SET(EN, D0.3)`, `RST(EN, wData.15)`):
+    a block of exactly one BOOL."""
+
+    __slots__ = ("obj", "attr", "bit", "word_norm")
+
+    def __init__(self, holder, key, bit: int, word_type: str, rt, loc_id: int | None, label: str):
+        super().__init__([], 0, "BOOL", rt, loc_id, label)
+        self.obj = holder  # a list (device cells) or an object (label owner)
+        self.attr = key  # index into the list, or attribute name
+        self.bit = bit
+        self.word_norm = NORMALIZERS[word_type]
+
+    def _word(self) -> int:
+        return self.obj[self.attr] if isinstance(self.obj, list) else getattr(self.obj, self.attr)
+
+    def available(self) -> int:
+        return 1
+
+    def get(self, k: int = 0):
+        if k != 0:
+            self.rt.fail(self.loc_id, f"operand {self.label} is a single bit")
+        return bool((self._word() >> self.bit) & 1)
+
+    def set(self, k: int, value) -> None:
+        if k != 0:
+            self.rt.fail(self.loc_id, f"operand {self.label} is a single bit")
+        word = self._word() & 0xFFFFFFFF
+        word = word | (1 << self.bit) if value else word & ~(1 << self.bit)
+        word = self.word_norm(word)
+        if isinstance(self.obj, list):
+            self.obj[self.attr] = word
+        else:
+            setattr(self.obj, self.attr, word)
