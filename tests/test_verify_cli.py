@@ -95,6 +95,9 @@ def test_unknown_program_and_labels_exit_2(tmp_path):
     done = _run_cli(*FX3_SOURCES, "--scenario", scenario)
     assert done.returncode == 2 and "no label 'fbEngine.o_bNope'" in done.stderr
     assert "Traceback" not in done.stderr
+    scenario.write_text('program = "UITAMR_ExampleFx3"\nduration = "1s"\nwatch = ["uMbx"]\n')
+    done = _run_cli(*FX3_SOURCES, "--scenario", scenario)
+    assert done.returncode == 2 and "'uMbx' in UITAMR_ExampleFx3 is not a single value" in done.stderr
 
 
 def test_unusable_options_exit_2(tmp_path):

@@ -154,15 +154,20 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
     """Every label the scenario reads or writes must exist; a missing default signal is dropped."""
     for name in scenario.variables():
         try:
-            plc.read(name)
+            value = _plain(plc.read(name))
         except (AttributeError, KeyError, IndexError, TypeError, LookupError, ValueError) as exc:
             signal = scenario.options.response_signal
             if not scenario.response_signal_given and signal is not None and name in signal.names:
                 scenario = replace(scenario, options=replace(scenario.options, response_signal=None))
                 continue
             raise UnusableInput(
-                f"{_where(scenario)}: the program {scenario.program or ''} has no label {name!r} ({exc})"
+                f"{_where(scenario)}: the program {plc.name} has no label {name!r} ({exc})"
             ) from None
+        if not isinstance(value, (bool, int, float, str)):
+            raise UnusableInput(
+                f"{_where(scenario)}: {name!r} in {plc.name} is not a single value (an array or FB instance?); "
+                "name one element or member, e.g. wBuf[2] or fbRobot.o_bBusy"
+            )
     return scenario
 
 
@@ -219,7 +224,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None) -> Scenar
         name=scenario.name,
         file=_display_path(scenario.path),
         description=scenario.description,
-        program=scenario.program,
+        program=plc.name,
         platform=scenario.platform,
         channel=scenario.serial_channel,
         sources=[str(p) for p in scenario.sources],
