@@ -122,18 +122,22 @@ def test_console_summary_shows_verdict_counts_and_first_violations():
     report_console.render([good_result(), bad_result()], Console(file=out, width=200, color_system=None))
     text = out.getvalue()
     assert "PASS healthy" in text and "FAIL broken" in text
-    assert "UITAMR-POWERON-STOP at 0.000 s" in text
+    assert "UITAMR-POWERON-STOP, first at 0.000 s: the first control command" in text
     assert "sent by UITAMR_Engine.st:210:9" in text
-    assert "UITAMR-PACING" in text and "more violation" in text
+    assert "UITAMR-PACING ×9, first at 0.200 s" in text
+    assert "also at 0.400 s, 0.600 s and 6 more" in text
     assert "expected robot reached point 3: did not finish" in text
     assert text.rstrip().endswith("FAIL: 1 of 2 scenario(s) failed")
 
 
-def test_console_shows_the_first_violation_of_every_broken_rule_before_more_of_one():
+def test_console_lists_as_many_times_per_rule_as_asked():
     out = io.StringIO()
-    report_console.render([bad_result()], Console(file=out, width=200, color_system=None), first=2)
+    report_console.render([bad_result()], Console(file=out, width=200, color_system=None), first=1)
     text = out.getvalue()
-    assert "UITAMR-POWERON-STOP at" in text and "UITAMR-PACING at 0.200 s" in text
+    assert "UITAMR-PACING ×9, first at 0.200 s" in text and "also at" not in text
+    out = io.StringIO()
+    report_console.render([bad_result()], Console(file=out, width=200, color_system=None), first=20)
+    assert "and 6 more" not in out.getvalue() and "1.800 s" in out.getvalue()
 
 
 def _chromium() -> str:

@@ -150,7 +150,7 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress) -> l
 @click.option("--trace", "trace_path", type=click.Path(dir_okay=False), help="Write every frame as JSON Lines.")
 @click.option("--html", "html_path", type=click.Path(dir_okay=False), help="Write a self-contained HTML report with a timing diagram.")
 @click.option("--violations", "first", type=click.IntRange(min=0), default=3, show_default=True,
-              help="Violations shown per scenario on the console.")
+              help="Times listed per broken rule and scenario on the console (0: counts only).")
 def command(sources, program, platform, scenario_files, matrix, duration, scan, seed, jobs,
             json_path, junit_path, trace_path, html_path, first):
     """Run PLC programs against the emulated robot on a virtual RS-485 line and check

@@ -10,7 +10,7 @@ from .durations import format_seconds
 from .result import ScenarioResult, overall_verdict
 from .rules import RULES
 
-FIRST_VIOLATIONS = 3  # per scenario
+FIRST_VIOLATIONS = 3  # times listed per broken rule and scenario
 
 
 def render(results: list[ScenarioResult], console: Console, *, first: int = FIRST_VIOLATIONS) -> None:
@@ -41,37 +41,32 @@ def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
     )
     if result.aborted:
         console.print(f"    [red]simulation stopped[/]: {escape(result.aborted)}")
-    for violation in _first_violations(result, first):
-        origin = f"  [dim]sent by {escape(violation.origin)}[/]" if violation.origin else ""
-        console.print(
-            f"    [red]{violation.rule}[/] at {format_seconds(violation.t_us)}: {escape(violation.message)}{origin}"
-        )
-        for frame in violation.frames:
-            arrow = "PLC→robot" if frame.direction == "tx" else "robot→PLC"
-            console.print(
-                f"      {format_seconds(frame.t_us)} {arrow} {frame.hex}  [dim]{escape(frame.meaning)}[/]"
-            )
-    hidden = result.violation_count - first
-    if hidden > 0:
-        console.print(f"    … and {hidden} more violation(s) (see --json or --html for all)")
+    broken = sorted((found for found in result.violations.values() if found), key=lambda found: found[0].t_us)
+    for found in broken:
+        _rule_block(found, console, first)
     for outcome in result.failed_expectations:
         console.print(f"    [red]expected[/] {escape(outcome.expectation.label)}: {escape(outcome.detail)}")
 
 
-def _first_violations(result: ScenarioResult, first: int) -> list:
-    """The first violation of each broken rule, then the next ones in time order, `first` in all."""
-    everything = result.all_violations()
-    chosen = []
-    for found in result.violations.values():
-        if found:
-            chosen.append(min(found, key=lambda v: v.t_us))
-    chosen = sorted(chosen, key=lambda v: v.t_us)[:first]
-    for violation in everything:
-        if len(chosen) >= first:
-            break
-        if violation not in chosen:
-            chosen.append(violation)
-    return sorted(chosen, key=lambda v: (v.t_us, v.rule))
+def _rule_block(found: list, console: Console, first: int) -> None:
+    """A broken rule: its count, its first violation with the frames, when the next ones were."""
+    if first == 0:
+        return
+    violation = found[0]
+    origin = f"  [dim]sent by {escape(violation.origin)}[/]" if violation.origin else ""
+    count = f" ×{len(found)}" if len(found) > 1 else ""
+    console.print(
+        f"    [red]{violation.rule}[/]{count}, first at {format_seconds(violation.t_us)}: "
+        f"{escape(violation.message)}{origin}"
+    )
+    for frame in violation.frames:
+        arrow = "PLC→robot" if frame.direction == "tx" else "robot→PLC"
+        console.print(f"      {format_seconds(frame.t_us)} {arrow} {frame.hex}  [dim]{escape(frame.meaning)}[/]")
+    more = [format_seconds(v.t_us) for v in found[1:first]]
+    if more:
+        rest = len(found) - 1 - len(more)
+        tail = f" and {rest} more (see --json or --html)" if rest else ""
+        console.print(f"      [dim]also at {', '.join(more)}{tail}[/]")
 
 
 def _rule_table(results: list[ScenarioResult]) -> Table:
