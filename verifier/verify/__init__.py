@@ -11,5 +11,6 @@ The pieces, each with one job:
 - `expectations` — the scenario's expectations on PLC variables and on the traffic;
 - `scenario` — loading and strict validation of scenario TOML files;
 - `runner` — wires the simulated PLC, the virtual RS-485 line and the robot together;
+- `result` — the outcome of one scenario, as every report reads it;
 - `report_*` — console, JSON, JUnit XML, JSON Lines trace and HTML reports.
 """
