@@ -849,7 +849,7 @@ class BodyCompiler:
         k = self.loc(e.span)
         if isinstance(e, (ast.IntLiteral, ast.RealLiteral, ast.BoolLiteral, ast.TimeLiteral,
                           ast.StringLiteral, ast.BinaryOp, ast.UnaryOp, ast.Call)):
-            raise CompileError(e.span, f"this operand must be a label, array element or device, "
+            raise CompileError(e.span, "this operand must be a label, array element or device, "
                                        "not an expression")
         if isinstance(e, ast.Device) and e.bit is not None and e.index is None and e.module is None:
             area = self.m.cpu.areas.get(e.kind)

@@ -55,10 +55,6 @@ class ElementaryType:
     def is_integer(self) -> bool:
         return self.kind in ("signed", "unsigned")
 
-    @property
-    def is_bitstring(self) -> bool:
-        return self.name in ("WORD", "DWORD")
-
     def normalize(self, value):
         return NORMALIZERS[self.name](value)
 
@@ -103,17 +99,6 @@ NORMALIZERS = {
     "LREAL": float,
     "STRING": str,
 }
-
-# Types each GX Works target offers (the checker enforces this; the simulator only needs
-# to know what it may meet).  UINT/UDINT/LREAL exist in GX Works3 (iQ-F) and GX Works2 for
-# QnU/L; the FX3 structured project has no unsigned integer types (ASSUMPTION, see
-# docs/instructions.md).
-TARGET_TYPES = {
-    "fx3": {"BOOL", "INT", "DINT", "WORD", "DWORD", "REAL", "TIME", "STRING"},
-    "fx5": set(TYPES),
-    "q": set(TYPES),
-}
-
 
 def lookup(name: str) -> ElementaryType | None:
     key = name.upper()

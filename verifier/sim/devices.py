@@ -30,14 +30,6 @@ class DeviceAddress:
     bit: int | None = None  # bit of a word device
     digits: int | None = None  # K-digit specification of a bit device
 
-    @property
-    def value_kind(self) -> str:
-        if self.bit is not None:
-            return "bit"
-        if self.digits is not None:
-            return "word" if self.digits <= 4 else "dword"
-        return self.kind
-
 
 def parse_device(name: str, cpu: CpuProfile) -> DeviceAddress:
     text = name.strip().upper()
@@ -127,10 +119,3 @@ class DeviceMemory:
         # K1..K3 write only their 4/8/12 bits; the rest of the word is not touched.
         for i in range(digits * 4):
             cells[start + i] = bool((value >> i) & 1)
-
-    def read_dword(self, area: str, index: int) -> int:
-        cells = self.areas[area]
-        return wrap32((cells[index] & 0xFFFF) | ((cells[index + 1] & 0xFFFF) << 16))
-
-    def snapshot(self, names: list[str]) -> dict[str, object]:
-        return {n: self[n] for n in names}

@@ -64,7 +64,7 @@ class Inliner:
             strip = "    " * sub.depth
             for sl, ss in zip(sub_lines, sub_spans):
                 text = sl[len(strip):] if sl.startswith(strip) else sl.lstrip()
-                text = _TEMP.sub(lambda t: t.group(1) + suffix, text)
+                text = _TEMP.sub(r"\g<1>" + suffix, text)
                 text = _SELF.sub(receiver + ".", text)
                 lines.append(indent + text)
                 spans.append(ss)

@@ -30,9 +30,6 @@ class StdFB:
         for name, value in self._STATE.items():
             setattr(self, name, value)
 
-    def _now_ms(self) -> int:
-        return self._rt.now_ms
-
 
 class TON(StdFB):
     """On-delay: Q rises PT after IN rose and stays while IN stays TRUE."""

@@ -8,7 +8,6 @@ from dataclasses import dataclass, field
 from verifier.st import ast
 
 from . import datatypes
-from .stdfbs import FB_PARAM_TYPES, STANDARD_FBS
 
 
 class CompileError(Exception):
@@ -147,10 +146,3 @@ class PouInfo:
     return_type: object = None
     class_name: str = ""
 
-
-def std_fb_member_type(fb_key: str, member_key: str):
-    return FB_PARAM_TYPES.get(fb_key, {}).get(member_key)
-
-
-def is_std_fb(key: str) -> bool:
-    return key in STANDARD_FBS

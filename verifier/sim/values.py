@@ -165,7 +165,7 @@ class ArrayView:
         return len(self._cells)
 
     def __iter__(self):
-        for i, v in enumerate(self._cells):
+        for v in self._cells:
             yield wrap(v, self._t.elem, f"{self._label}", self._module)
 
     def __eq__(self, other) -> bool:

@@ -40,7 +40,7 @@ class C24Module:
         self.rt = rt
         self.un = un
         self.buffer = rt.buffer(un)
-        for ch, addrs in BUFFER.items():
+        for addrs in BUFFER.values():
             for name, addr in addrs.items():
                 if self.buffer[addr] == 0:
                     self.buffer[addr] = DEFAULTS[name] - (0x10000 if DEFAULTS[name] > 0x7FFF else 0)
