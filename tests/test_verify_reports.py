@@ -186,6 +186,23 @@ def test_html_report_renders_in_chromium_with_a_timing_diagram_and_violation_mar
     assert [a.get("href") for a in index.iter("a")] == ["#s0", "#s1"]
 
 
+def test_html_diagram_zooms_in_the_browser(tmp_path):
+    page = tmp_path / "report.html"
+    report_html.write([bad_result()], page)
+    with tempfile.TemporaryDirectory() as profile:
+        dom = subprocess.run(
+            [_chromium(), *_chromium_flags(profile), "--dump-dom", page.as_uri() + "#zoom=8"],
+            capture_output=True, text=True, timeout=120,
+        ).stdout
+    root = _parse_dom(dom)
+    svg = root.find(".//svg[@id='s0-svg']")
+    assert svg.get("width") == str(round(2_500 * 8 + 40))  # 2.5 s of virtual time at 8 px/ms
+    assert "zoomed" in svg.get("class")  # frame labels are shown from 8 px/ms on
+    first = next(r for r in svg.iter("rect") if "frame" in (r.get("class") or "").split())
+    assert float(first.get("width")) == round(8.333 * 8, 2)
+    assert root.find(".//*[@id='s0-scale']").text == "8.0 px/ms"
+
+
 def test_html_screenshot_is_taken(tmp_path):
     page = tmp_path / "report.html"
     report_html.write([bad_result()], page)
