@@ -289,3 +289,56 @@ END_PROGRAM
     assert p.nErr == 1
     assert project.devices["SD8500"] == 1
     assert crc16(ep.sent[-1][0][:-2]) == int.from_bytes(ep.sent[-1][0][-2:], "little")
+
+
+def test_more_data_instructions():
+    src = """
+PROGRAM P
+VAR
+    w : WORD := 16#1234; v : WORD := 16#00FF; i : INT := 32767; d : DINT;
+    b : BOOL; bEdge : BOOL; nRise, nFall : INT;
+END_VAR
+DMOV(TRUE, 100000, D0);
+DMOV(TRUE, -2, d);
+CML(TRUE, v, D2);
+XCH(TRUE, w, v);
+SWAP(TRUE, D3);
+INC(TRUE, i);
+DEC(TRUE, D4);
+WAND(TRUE, 16#0FF0, 16#00FF, D5);
+WOR(TRUE, 16#0F00, 16#00F0, D6);
+WXOR(TRUE, 16#FFFF, 16#00FF, D7);
+BCD(TRUE, 1234, D8);
+BIN(TRUE, 16#0987, D9);
+ZRST(TRUE, M10, M12);
+OUT(b, M20);
+PLS(bEdge, M21);
+PLF(bEdge, M22);
+IF M21 THEN nRise := nRise + 1; END_IF;
+IF M22 THEN nFall := nFall + 1; END_IF;
+END_PROGRAM
+"""
+    project = load_st(src)
+    dev = project.devices
+    dev["D3"] = 0x1234
+    for m in ("M10", "M11", "M12", "M13"):
+        dev[m] = True
+    project.run_programs(["P"], scans=1)
+    p = project.program("P")
+    assert (dev["D0"] & 0xFFFF) | ((dev["D1"] & 0xFFFF) << 16) == 100000
+    assert p.d == -2
+    assert dev["D2"] & 0xFFFF == 0xFF00
+    assert (p.w, p.v) == (0x00FF, 0x1234)
+    assert dev["D3"] == 0x3412
+    assert p.i == -32768 and dev["D4"] == -1
+    assert (dev["D5"], dev["D6"], dev["D7"]) == (0x00F0, 0x0FF0, 0xFF00 - 0x10000)
+    assert (dev["D8"], dev["D9"]) == (0x1234, 987)
+    assert [dev[m] for m in ("M10", "M11", "M12", "M13")] == [False, False, False, True]
+    assert dev["M20"] is False
+    p.b = True
+    p.bEdge = True
+    project.run_programs(["P"], scans=3)
+    assert dev["M20"] is True and p.nRise == 1 and p.nFall == 0
+    p.bEdge = False
+    project.run_programs(["P"], scans=3)
+    assert p.nRise == 1 and p.nFall == 1

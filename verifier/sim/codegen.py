@@ -812,17 +812,20 @@ class BodyCompiler:
                     raise CompileError(a.span, f"{c.name} operand must be an integer")
                 ops.append(vcode)
             else:
-                ref, post = self.ref_code(a.value, kind)
+                ref, post = self.ref_code(a.value, kind, wide=spec.wide)
                 ops.append(ref)
                 after.extend(post)
-        if pulse:
+        if pulse or spec.edge:
             if self.is_function:
                 raise CompileError(c.span, f"{c.name} needs memory of its last EN: not inside a FUNCTION")
             slot = f"_p{len(self.pulse_slots)}"
             self.pulse_slots.append(slot)
             en_var = self.new_tmp("_en")
             self.em.line(f"{en_var} = {en_code}")
-            en_code = f"({en_var} and not self.{slot})"
+            if spec.edge == "fall":
+                en_code = f"(self.{slot} and not {en_var})"
+            else:
+                en_code = f"({en_var} and not self.{slot})"
             call = f"_I.{spec.name}({en_code}, {', '.join(ops)}, {k})"
             if not as_stmt:
                 raise CompileError(c.span, f"{c.name} (pulse form) must be called as a statement")
@@ -833,8 +836,8 @@ class BodyCompiler:
                 if after:
                     raise CompileError(c.span, f"call {c.name} as a statement here")
                 return f"_I.{spec.name}({en_code}, {', '.join(ops)}, {k})", "BOOL"
-            if en_code == "True":
-                self.em.line(f"_I.{spec.name}(True, {', '.join(ops)}, {k})")
+            if en_code == "True" or spec.always:
+                self.em.line(f"_I.{spec.name}({en_code}, {', '.join(ops)}, {k})")
             else:
                 # EN FALSE: the instruction is not executed at all (as in ladder)
                 self.em.line(f"if {en_code}: _I.{spec.name}(True, {', '.join(ops)}, {k})")
@@ -842,7 +845,7 @@ class BodyCompiler:
             self.em.line(line)
         return None, "BOOL"
 
-    def ref_code(self, e: ast.Expr, kind: str) -> tuple[str, list[str]]:
+    def ref_code(self, e: ast.Expr, kind: str, wide: bool = False) -> tuple[str, list[str]]:
         """A Ref to the block an instruction operand names; lines to run after the call
         (copy-back of FUNCTION locals)."""
         label = self.label_of(e)
@@ -874,7 +877,10 @@ class BodyCompiler:
             area = self.m.cpu.areas[d.kind]
             index = int(d.address, area.radix)
             tname = "BOOL" if area.kind == "bit" else "INT"
-            return self.static_ref(f"_Ref(_A_{d.kind}, {index}, {tname!r}, _rt, {k}, {label!r})"), []
+            cls = "_DwordRef" if wide and area.kind == "word" else "_Ref"
+            if wide and area.kind == "word":
+                tname = "DINT"
+            return self.static_ref(f"{cls}(_A_{d.kind}, {index}, {tname!r}, _rt, {k}, {label!r})"), []
         if isinstance(e, ast.Index):
             base_code, base_t = self.expr(e.base)
             read, elem_t, lv = self.index_access(e)

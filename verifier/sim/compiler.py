@@ -22,7 +22,7 @@ from .errors import SimulationError
 from .inline import Body, Inliner
 from .instructions import InstructionSet
 from .instructions import lookup as lookup_instruction
-from .refs import AttrRef, BitRef, Ref
+from .refs import AttrRef, BitRef, DwordRef, Ref
 from .stdfbs import STANDARD_FBS, FB_PARAM_TYPES
 from .stdfuncs import make_helpers
 from .typesys import (ArrayT, CompileError, FbT, PouInfo, StringT, StructT, Symbol, concrete,
@@ -397,7 +397,8 @@ class ModuleCompiler:
                 location, rt.now_us)
 
         ns = {"__name__": "verifier_sim_generated", "_rt": rt, "_I": InstructionSet(rt),
-              "_Ref": Ref, "_AttrRef": AttrRef, "_BitRef": BitRef, "_oob": _oob}
+              "_Ref": Ref, "_AttrRef": AttrRef, "_BitRef": BitRef,
+              "_DwordRef": DwordRef, "_oob": _oob}
         ns.update(make_helpers(rt))
         for name, cls in STANDARD_FBS.items():
             ns[f"_STD_{name}"] = cls

@@ -98,6 +98,21 @@ class AttrRef(Ref):
         return int(self.get(k)) & 0xFFFF
 
 
+class DwordRef(Ref):
+    """A 32-bit value held by two consecutive word devices (DMOV K100000 D0: D0 low word,
+    D1 high word)."""
+
+    def get(self, k: int = 0):
+        lo = self.cells[self._index(2 * k)] & 0xFFFF
+        hi = self.cells[self._index(2 * k + 1)] & 0xFFFF
+        return self.norm(lo | (hi << 16))
+
+    def set(self, k: int, value) -> None:
+        v = int(value) & 0xFFFFFFFF
+        self.cells[self._index(2 * k)] = ((v & 0xFFFF) + 0x8000 & 0xFFFF) - 0x8000
+        self.cells[self._index(2 * k + 1)] = ((v >> 16) + 0x8000 & 0xFFFF) - 0x8000
+
+
 class BitRef(Ref):
     """One bit of a word used as an instruction operand (`SET(EN, D0.3)`, `RST(EN, wData.15)`):
     a block of exactly one BOOL."""

@@ -18,6 +18,9 @@ class InstructionSpec:
     operands: tuple[str, ...]
     families: frozenset[str]
     pulse_form: bool = True  # has a P variant (MOVP ...)
+    always: bool = False  # executed whatever EN is (OUT writes EN; PLS/PLF watch its edges)
+    edge: str | None = None  # PLS: "rise", PLF: "fall" (compiled with a memory of EN)
+    wide: bool = False  # 32-bit operands: a word device operand spans two words
 
 
 _ALL = frozenset({"fx3", "fx5", "q"})
@@ -27,6 +30,21 @@ SPECS = {s.name: s for s in (
     InstructionSpec("FMOV", ("val", "val", "dst"), _ALL),
     InstructionSpec("SET", ("dst",), _ALL, pulse_form=False),
     InstructionSpec("RST", ("dst",), _ALL, pulse_form=False),
+    InstructionSpec("OUT", ("dst",), _ALL, pulse_form=False, always=True),
+    InstructionSpec("PLS", ("dst",), _ALL, pulse_form=False, always=True, edge="rise"),
+    InstructionSpec("PLF", ("dst",), _ALL, pulse_form=False, always=True, edge="fall"),
+    InstructionSpec("DMOV", ("val", "dst"), _ALL, wide=True),
+    InstructionSpec("CML", ("val", "dst"), _ALL),
+    InstructionSpec("XCH", ("blk", "blk"), _ALL),
+    InstructionSpec("SWAP", ("blk",), _ALL),
+    InstructionSpec("INC", ("blk",), _ALL),
+    InstructionSpec("DEC", ("blk",), _ALL),
+    InstructionSpec("WAND", ("val", "val", "dst"), _ALL),
+    InstructionSpec("WOR", ("val", "val", "dst"), _ALL),
+    InstructionSpec("WXOR", ("val", "val", "dst"), _ALL),
+    InstructionSpec("BCD", ("val", "dst"), _ALL),
+    InstructionSpec("BIN", ("val", "dst"), _ALL),
+    InstructionSpec("ZRST", ("dst", "dst"), _ALL),
     InstructionSpec("CRC", ("src", "val", "dst"), frozenset({"fx3", "fx5"})),
     InstructionSpec("RS2", ("src", "val", "val", "val", "dst"), frozenset({"fx3", "fx5"}), False),
     InstructionSpec("ADPRW", ("val", "val", "val", "val", "blk"), frozenset({"fx3"}), False),
@@ -77,6 +95,47 @@ class InstructionSet:
 
     def RST(self, en, d, loc_id):
         return basic.rst(self.rt, en, d, loc_id)
+
+    def OUT(self, en, d, loc_id):
+        return basic.out(self.rt, en, d, loc_id)
+
+    PLS = PLF = OUT  # the compiler turns EN into the one-scan pulse
+
+    def DMOV(self, en, s, d, loc_id):
+        return basic.dmov(self.rt, en, s, d, loc_id)
+
+    def CML(self, en, s, d, loc_id):
+        return basic.cml(self.rt, en, s, d, loc_id)
+
+    def XCH(self, en, d1, d2, loc_id):
+        return basic.xch(self.rt, en, d1, d2, loc_id)
+
+    def SWAP(self, en, d, loc_id):
+        return basic.swap(self.rt, en, d, loc_id)
+
+    def INC(self, en, d, loc_id):
+        return basic.inc(self.rt, en, d, loc_id, 1)
+
+    def DEC(self, en, d, loc_id):
+        return basic.inc(self.rt, en, d, loc_id, -1)
+
+    def WAND(self, en, s1, s2, d, loc_id):
+        return basic.logic(self.rt, en, s1, s2, d, loc_id, "AND")
+
+    def WOR(self, en, s1, s2, d, loc_id):
+        return basic.logic(self.rt, en, s1, s2, d, loc_id, "OR")
+
+    def WXOR(self, en, s1, s2, d, loc_id):
+        return basic.logic(self.rt, en, s1, s2, d, loc_id, "XOR")
+
+    def BCD(self, en, s, d, loc_id):
+        return basic.bcd(self.rt, en, s, d, loc_id)
+
+    def BIN(self, en, s, d, loc_id):
+        return basic.bin_(self.rt, en, s, d, loc_id)
+
+    def ZRST(self, en, d1, d2, loc_id):
+        return basic.zrst(self.rt, en, d1, d2, loc_id)
 
     def CRC(self, en, s, n, d, loc_id):
         return basic.crc(self.rt, en, s, n, d, loc_id, self._eight_bit)

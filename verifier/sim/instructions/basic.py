@@ -72,3 +72,90 @@ def crc(rt, en, s, n, d, loc_id, eight_bit_device: str):
     else:
         d.set(0, crc16(s.get_bytes(n)))
     return True
+
+
+# ----------------------------------------------------------------------------- more data instructions
+def dmov(rt, en, s, d, loc_id):
+    """DMOV s d: 32-bit move (a word device destination takes d and d+1, low word first)."""
+    if en:
+        d.set(0, s)
+    return bool(en)
+
+
+def cml(rt, en, s, d, loc_id):
+    """CML s d: bit inversion of a 16-bit value."""
+    if en:
+        d.set(0, ~int(s) & 0xFFFF)
+    return bool(en)
+
+
+def xch(rt, en, d1, d2, loc_id):
+    if en:
+        a, b = d1.get(0), d2.get(0)
+        d1.set(0, b)
+        d2.set(0, a)
+    return bool(en)
+
+
+def swap(rt, en, d, loc_id):
+    """SWAP d: exchange the high and low bytes of a word."""
+    if en:
+        w = d.get_u16(0)
+        d.set(0, ((w & 0xFF) << 8) | (w >> 8))
+    return bool(en)
+
+
+def inc(rt, en, d, loc_id, step: int = 1):
+    """INC/DEC d: +1 / -1 with 16-bit wrap (K32767 + 1 = K-32768, as the manual states)."""
+    if en:
+        d.set(0, int(d.get(0)) + step)
+    return bool(en)
+
+
+def logic(rt, en, s1, s2, d, loc_id, op: str):
+    """WAND/WOR/WXOR s1 s2 d: 16-bit logical operations."""
+    if en:
+        a, b = int(s1) & 0xFFFF, int(s2) & 0xFFFF
+        d.set(0, {"AND": a & b, "OR": a | b, "XOR": a ^ b}[op])
+    return bool(en)
+
+
+def bcd(rt, en, s, d, loc_id):
+    """BCD s d: binary 0..9999 to BCD; anything else is an operation error."""
+    if en:
+        v = int(s)
+        if not 0 <= v <= 9999:
+            rt.operation_error(loc_id, f"BCD: {v} is outside 0..9999")
+            return True
+        d.set(0, int(str(v), 16))
+    return bool(en)
+
+
+def bin_(rt, en, s, d, loc_id):
+    """BIN s d: BCD to binary; a nibble above 9 is an operation error."""
+    if en:
+        text = f"{int(s) & 0xFFFF:04X}"
+        if not text.isdigit():
+            rt.operation_error(loc_id, f"BIN: H{text} is not a BCD value")
+            return True
+        d.set(0, int(text))
+    return bool(en)
+
+
+def zrst(rt, en, d1, d2, loc_id):
+    """ZRST d1 d2: reset every device from d1 to d2 (same device type)."""
+    if en:
+        if d1.cells is not d2.cells or not d1.cells:
+            rt.operation_error(loc_id, "ZRST: d1 and d2 must be devices of the same type")
+            return True
+        lo, hi = sorted((d1.base, d2.base))
+        zero = False if isinstance(d1.cells[lo], bool) else 0
+        for i in range(lo, hi + 1):
+            d1.cells[i] = zero
+    return bool(en)
+
+
+def out(rt, en, d, loc_id):
+    """OUT d: the coil follows the execution condition (executed even when EN is FALSE)."""
+    d.set(0, bool(en))
+    return bool(en)
