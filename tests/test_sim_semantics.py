@@ -100,6 +100,12 @@ def test_time_values_are_ms():
     assert (fb.t, fb.d, fb.u) == (1500, 1500, 3000)
 
 
+def test_string_conversions():
+    _, fb = run_fb("s := INT_TO_STR(-42); i := STR_TO_INT('123'); r := STR_TO_REAL('1.5');",
+                   "s : STRING; i : INT; r : REAL;")
+    assert (fb.s, fb.i, fb.r) == ("-42", 123, 1.5)
+
+
 def test_strings():
     _, fb = run_fb("s := CONCAT(a, 'cd'); n := LEN(s); l := LEFT(s, 3); m := MID(s, 2, 2);",
                    "a : STRING := 'ab'; s, l, m : STRING; n : INT;")
@@ -369,3 +375,25 @@ def test_python_side_values_are_normalised():
         fb.b = 5
     with pytest.raises(AttributeError):
         fb.missing = 1
+
+
+def test_every_standard_function_the_checker_knows_has_an_implementation():
+    from verifier.sim import stdfuncs
+    from verifier.st import library
+
+    class Cx:
+        def loc(self, span):
+            return 0
+
+        def binary_code(self, op, lc, lt, rc, rt_, span):
+            return f"({lc} {op} {rc})", lt
+
+        def unary_code(self, op, code, t, span):
+            return code, t
+
+    missing = []
+    for name, sig in library.STANDARD_FUNCTIONS.items():
+        n = max(1, len([p for p in sig.params if p.name.upper() not in ("EN",)]))
+        if stdfuncs.generate(name, [("1", "INT")] * n, Cx(), None) is None:
+            missing.append(name)
+    assert missing == []

@@ -13,6 +13,8 @@ from . import datatypes
 from .typesys import (ANYINT, ANYREAL, CompileError, StringT, bits_of, concrete, is_int,
                       is_real, is_string, norm_code, unify)
 
+# GX Works spells STRING as STR (and WSTRING as WSTR) in conversion names: INT_TO_STR
+_STRING_NAMES = {"STR": "STRING", "WSTR": "STRING", "WSTRING": "STRING"}
 ELEMENTARY = ("BOOL", "INT", "DINT", "WORD", "DWORD", "UINT", "UDINT", "REAL", "LREAL",
               "TIME", "STRING")
 
@@ -339,7 +341,7 @@ def generate(name: str, args, cx, span):
         _arity(name, args, 2, span)
         return f"_find({args[0][0]}, {args[1][0]})", "INT"
     if "_TO_" in name:
-        src, dst = name.split("_TO_", 1)
+        src, dst = (_STRING_NAMES.get(x, x) for x in name.split("_TO_", 1))
         known = set(ELEMENTARY) | {"BCD"}
         if src in known and dst in known:
             _arity(name, args, 1, span)
