@@ -14,8 +14,7 @@ PLC = Path(__file__).resolve().parents[1] / "plc"
 SETS = {
     "fx3u": ("gxworks2", ["core", "fx3", "examples/common", "examples/fx3"]),
     "q": ("gxworks2", ["core", "q", "examples/common", "examples/q"]),
-    "fx5u": ("gxworks3", ["core", "fx5", "examples/common", "examples/fx5/UITAMR_ExampleFx5.st"]),
-    "fx5u-adprw": ("gxworks3", ["core", "adp", "examples/common", "examples/fx5/UITAMR_ExampleAdpFx5.st"]),
+    "fx5u": ("gxworks3", ["core", "fx5", "examples/common", "examples/fx5"]),
 }
 
 

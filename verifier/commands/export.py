@@ -19,7 +19,7 @@ PLC_ROOT = Path(__file__).resolve().parents[2] / "plc"
 #: the bundled folders each editor gets by default
 BUNDLED = {
     "gxworks2": ("core", "fx3", "q", "examples/common", "examples/fx3", "examples/q"),
-    "gxworks3": ("core", "fx5", "adp", "examples/common", "examples/fx5"),
+    "gxworks3": ("core", "fx5", "examples/common", "examples/fx5"),
 }
 
 

@@ -15,7 +15,7 @@ from verifier.export.labels import label_rows
 ROOT = Path(__file__).resolve().parents[2]
 DOC = ROOT / "docs" / "plc-library.md"
 MARKER = "## Catalogue of POUs"
-FOLDERS = ("core", "fx3", "fx5", "q", "adp", "examples/common", "examples/fx3", "examples/fx5", "examples/q")
+FOLDERS = ("core", "fx3", "fx5", "q", "examples/common", "examples/fx3", "examples/fx5", "examples/q")
 INTERFACE = ("VAR_INPUT", "VAR_OUTPUT", "VAR_IN_OUT")
 
 
