@@ -306,3 +306,37 @@ def test_monitor_polls_the_four_statuses(rig):
     port.run(3000)
     queries = [d[3] for d in port.kinds() if d[1] == 1]
     assert {0, 1, 2, 3} <= set(queries)
+
+
+def test_silent_robot_at_power_on_refuses_commands_then_recovers(rig):
+    h, port = rig
+    port.silent = True
+    port.run(2300)                                   # three attempts of the stop have failed
+    assert not h.fbEngine.o_bInitDone and h.fbEngine.o_uErrId == 0x0101
+    assert {d for d in port.kinds()} == {STOP}       # nothing but the stop was ever sent
+    h.wPoint, h.bRun = 1, True
+    port.run(500, until=lambda x: x.fbRun.o_bErr)
+    assert h.fbRun.o_uErrId == 0x0107
+    port.silent = False
+    port.run(6000, until=lambda x: x.fbEngine.o_bInitDone)
+    assert h.fbEngine.o_bInitDone
+    h.bRun = False
+    port.run(50)
+    h.bRun = True
+    port.run(3000, until=lambda x: x.fbRun.o_bOK)
+    assert h.fbRun.o_bOK
+
+
+def test_stray_bytes_keep_the_line_quiet_before_a_retry(rig):
+    h, port = rig
+    start_point(h, port)
+    port.silent = True
+    port.run(520)                                     # the attempt has timed out: guard time runs
+    before = len(port.requests)
+    for _ in range(3):                                # a late reply trickles in every 100 ms
+        port.run(100)
+        h.uPort[RX_LEN], h.uPort[RX_DONE] = 3, 1
+    port.run(150)
+    assert len(port.requests) == before               # still quiet: guard restarted each time
+    port.run(300)
+    assert len(port.requests) == before + 1
