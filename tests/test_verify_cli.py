@@ -128,3 +128,12 @@ def test_the_readme_command_verifies_the_bundled_examples_in_parallel(tmp_path):
     assert len(cases) == len(bundled_scenarios()) >= 10
     assert all(case.find("failure") is None and case.find("error") is None for case in cases)
     assert f"PASS: {len(cases)} scenario(s) compliant" in done.stdout
+
+
+def test_list_rules():
+    from verifier.verify.rules import RULES
+
+    result = invoke("--list-rules")
+    assert result.exit_code == 0
+    for rule in RULES:
+        assert rule.id in result.output

@@ -149,10 +149,11 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress) -> l
 @click.option("--junit", "junit_path", type=click.Path(dir_okay=False), help="Write JUnit XML (one testcase per scenario).")
 @click.option("--trace", "trace_path", type=click.Path(dir_okay=False), help="Write every frame as JSON Lines.")
 @click.option("--html", "html_path", type=click.Path(dir_okay=False), help="Write a self-contained HTML report with a timing diagram.")
+@click.option("--list-rules", is_flag=True, help="Print the rules (id, title, source) and exit.")
 @click.option("--violations", "first", type=click.IntRange(min=0), default=3, show_default=True,
               help="Times listed per broken rule and scenario on the console (0: counts only).")
 def command(sources, program, platform, scenario_files, matrix, duration, scan, seed, jobs,
-            json_path, junit_path, trace_path, html_path, first):
+            json_path, junit_path, trace_path, html_path, list_rules, first):
     """Run PLC programs against the emulated robot on a virtual RS-485 line and check
     every frame and gap against the robot's manual.
 
@@ -162,6 +163,12 @@ def command(sources, program, platform, scenario_files, matrix, duration, scan, 
     from verifier.verify import report_console, report_html, report_json, report_junit, report_trace
 
     console = Console(highlight=False, soft_wrap=True)
+    if list_rules:
+        from verifier.verify.rules import RULES
+
+        for rule in RULES:
+            console.print(f"[bold]{rule.id}[/] — {rule.title}\n    {rule.explanation}")
+        sys.exit(EXIT_PASS)
     for path in (json_path, junit_path, trace_path, html_path):
         if path and not Path(path).resolve().parent.is_dir():
             _unusable(f"cannot write {path}: the folder {Path(path).resolve().parent} does not exist")
