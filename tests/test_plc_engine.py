@@ -340,3 +340,17 @@ def test_stray_bytes_keep_the_line_quiet_before_a_retry(rig):
     assert len(port.requests) == before               # still quiet: guard restarted each time
     port.run(300)
     assert len(port.requests) == before + 1
+
+
+def test_idle_polls_to_end_is_one_constant():
+    text = (CORE / "UITAMR_Engine.st").read_text().replace(
+        "IDLE_POLLS_TO_END : INT := 1;", "IDLE_POLLS_TO_END : INT := 2;")
+    project = verifier.load(CORE, sources={str(CORE / "UITAMR_Engine.st"): text, "T_Engine.st": HARNESS})
+    h = project.program("T_Engine")
+    port = FakePort(h, project, running_polls=0)      # the robot never reports 'running'
+    h.bEnable = True
+    start_point(h, port, point=4)
+    port.run(3000, until=lambda x: x.fbRun.o_bOK)
+    sent = port.kinds()
+    after = sent[sent.index(encode(ControlRequest(1, 1, 4), SETTINGS)) + 1:]
+    assert after == [READ_TASK, READ_TASK]                # two 'idle' answers in a row
