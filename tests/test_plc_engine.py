@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, given, settings as hsettings, strategies as st
 
 import verifier
 from verifier.protocol import (
@@ -354,3 +355,37 @@ def test_idle_polls_to_end_is_one_constant():
     sent = port.kinds()
     after = sent[sent.index(encode(ControlRequest(1, 1, 4), SETTINGS)) + 1:]
     assert after == [READ_TASK, READ_TASK]                # two 'idle' answers in a row
+
+
+COMMANDS = {"bRun": "fbRun", "bStop": "fbStop", "bSpeed": "fbSpeed", "bRead": "fbRead",
+            "bMove": "fbMove", "bRange": "fbRange"}
+
+
+@hsettings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(st.lists(st.tuples(st.sampled_from(sorted(COMMANDS)), st.integers(0, 1500)), min_size=1, max_size=5),
+       st.lists(st.sampled_from(["ok", "ok", "silent", "corrupt", "exception", "error"]), min_size=8, max_size=8))
+def test_every_command_ends_in_ok_or_err_whatever_the_line_does(commands, behaviours):
+    project = verifier.load(CORE, sources={"T_Engine.st": HARNESS})
+    h = project.program("T_Engine")
+    port = FakePort(h, project)
+    h.bEnable = True
+    h.wPoint, h.wStage, h.wQuery, h.wAxis, h.eValue, h.eRange = 2, 2, 1, 3, 0.5, 0.2
+    port.run(1500)
+    started = []
+    for step, (flag, delay_ms) in enumerate(commands):
+        mode = behaviours[step % len(behaviours)]
+        port.silent, port.corrupt = mode == "silent", mode == "corrupt"
+        port.exception_code = 3 if mode == "exception" else None
+        port.robot_error = 2 if mode == "error" else 0
+        setattr(h, flag, True)
+        started.append(COMMANDS[flag])
+        port.run(delay_ms)
+    port.silent, port.corrupt, port.exception_code, port.robot_error = False, False, None, 0
+
+    def all_ended(x):
+        return all(getattr(x, fb).o_bOK or getattr(x, fb).o_bErr for fb in set(started))
+    port.run(40_000, until=all_ended)
+    assert all_ended(h), {fb: (getattr(h, fb).o_bBusy, getattr(h, fb).o_uErrId) for fb in set(started)}
+    assert port.overlaps == []
+    starts = [t for t, _ in port.requests]
+    assert all(b - a >= 300_000 for a, b in zip(starts, starts[1:]))
