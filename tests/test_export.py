@@ -96,3 +96,21 @@ def test_sources_with_errors_are_reported_with_their_place(tmp_path):
 def test_missing_source_is_a_usage_error(tmp_path):
     result = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(tmp_path), "nope.st"])
     assert result.exit_code == 2 and "nope.st" in result.output
+
+
+def test_global_labels_get_their_own_table(tmp_path):
+    src = tmp_path / "Main.st"
+    src.write_text(
+        "VAR_GLOBAL\n    bStart AT X0 : BOOL; (* start button *)\n    wCount : INT;\nEND_VAR\n"
+        "VAR_GLOBAL CONSTANT\n    MAX_COUNT : INT := 10;\nEND_VAR\n"
+        "PROGRAM Main\nVAR\n    wX : INT;\nEND_VAR\nIF bStart THEN\n    wX := MAX_COUNT;\nEND_IF;\n")
+    result = CliRunner().invoke(command, ["--target", "gxworks2", "--out", str(tmp_path / "o"), str(src)])
+    assert result.exit_code == 0, result.output
+    table = (tmp_path / "o" / "GlobalLabels.labels.tsv").read_text().splitlines()
+    assert table[0] == "Class\tLabel Name\tData Type\tConstant\tDevice\tComment"
+    assert "VAR_GLOBAL\tbStart\tBit\t\tX0\tstart button" in table
+    assert "VAR_GLOBAL_CONSTANT\tMAX_COUNT\tWord[Signed]\t10\t\t" in table
+    gw3 = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(tmp_path / "g3"), str(src)])
+    assert gw3.exit_code == 0
+    assert "bStart\tBit\tVAR_GLOBAL\tX0\t\t\tstart button" in (tmp_path / "g3" / "GlobalLabels.labels.tsv").read_text()
+    assert "1 POU(s) exported" in result.output

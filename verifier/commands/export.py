@@ -32,7 +32,7 @@ def bundled_sources(target: str) -> list[Path]:
 @click.option("--target", type=click.Choice(["gxworks2", "gxworks3"]), required=True,
               help="The engineering tool that will import the files.")
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), required=True,
-              help="Folder for <POU>.st, <POU>.labels.tsv and IMPORT_ORDER.txt.")
+              help="Folder for <POU>.st, <POU>.labels.tsv, GlobalLabels.labels.tsv and IMPORT_ORDER.txt.")
 def command(sources: tuple[str, ...], target: str, out_dir: str) -> None:
     """Write, per POU, the ST body and a tab-separated label table for GX Works."""
     from verifier.export import ExportError, export_sources
@@ -59,6 +59,6 @@ def command(sources: tuple[str, ...], target: str, out_dir: str) -> None:
     except OSError as e:
         click.echo(f"uitamr export: cannot write {out_dir}: {e.strerror or e}", err=True)
         sys.exit(EXIT_USAGE)
-    pous = (len(written) - 1) // 2
+    pous = sum(1 for p in written if p.suffix == ".st")
     click.echo(f"{pous} POU(s) exported for {target} into {out_dir} (import order: "
                f"{Path(out_dir) / 'IMPORT_ORDER.txt'})")

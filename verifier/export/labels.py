@@ -18,6 +18,7 @@ class LabelRow:
     initial: str       # initial value as written ("" when none)
     constant: str      # the value of a VAR_CONSTANT label ("" otherwise)
     comment: str
+    device: str = ""   # the device a global label is assigned to (`AT X0`)
 
 
 def label_class(decl: ast.VarDecl) -> str:
@@ -53,9 +54,13 @@ def initial_text(source_text: str, lines: list[str], decl: ast.VarDecl) -> str:
 
 
 def label_rows(pou: ast.Pou, source_text: str, target: str) -> list[LabelRow]:
+    return rows_of(pou.variables, source_text, target)
+
+
+def rows_of(decls: list[ast.VarDecl], source_text: str, target: str) -> list[LabelRow]:
     lines = source_text.splitlines()
     rows = []
-    for decl in pou.variables:
+    for decl in decls:
         value = initial_text(source_text, lines, decl)
         rows.append(LabelRow(
             label_class=label_class(decl),
@@ -64,5 +69,6 @@ def label_rows(pou: ast.Pou, source_text: str, target: str) -> list[LabelRow]:
             initial="" if decl.constant else value,
             constant=value if decl.constant else "",
             comment=trailing_comment(lines, decl),
+            device=decl.at.text if decl.at is not None else "",
         ))
     return rows

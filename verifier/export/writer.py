@@ -1,5 +1,6 @@
 """Write the export: per POU `<name>.st` (the body) and `<name>.labels.tsv` (the label
-table, tab-separated so a spreadsheet or the label editor takes it by paste), plus
+table, tab-separated so a spreadsheet or the label editor takes it by paste), the global
+labels of all files in `GlobalLabels.labels.tsv` (when there are any), plus
 `IMPORT_ORDER.txt` (functions and function blocks before their users: name, kind and, for
 a FUNCTION, its result type as the POU properties dialog asks for it)."""
 from __future__ import annotations
@@ -11,13 +12,20 @@ from pathlib import Path
 from verifier import st
 from verifier.st import ast
 from verifier.export.body import body_text
-from verifier.export.labels import LabelRow, label_rows
+from verifier.export.labels import LabelRow, label_rows, rows_of
 from verifier.export.types import type_name
 
 COLUMNS = {
     "gxworks2": ("Class", "Label Name", "Data Type", "Constant", "Comment"),
     "gxworks3": ("Label Name", "Data Type", "Class", "Initial Value", "Constant", "Comment"),
 }
+
+
+GLOBAL_COLUMNS = {
+    "gxworks2": ("Class", "Label Name", "Data Type", "Constant", "Device", "Comment"),
+    "gxworks3": ("Label Name", "Data Type", "Class", "Assign (Device/Label)", "Initial Value", "Constant", "Comment"),
+}
+GLOBAL_TABLE = "GlobalLabels.labels.tsv"
 
 
 class ExportError(Exception):
@@ -46,6 +54,16 @@ def _row_cells(row: LabelRow, target: str) -> list[str]:
 def label_table(rows: list[LabelRow], target: str) -> str:
     lines = ["\t".join(COLUMNS[target])]
     lines += ["\t".join(cell.replace("\t", " ") for cell in _row_cells(r, target)) for r in rows]
+    return "\n".join(lines) + "\n"
+
+
+def global_table(rows: list[LabelRow], target: str) -> str:
+    def cells(r: LabelRow) -> list[str]:
+        if target == "gxworks2":
+            return [r.label_class, r.name, r.data_type, r.constant, r.device, r.comment]
+        return [r.name, r.data_type, r.label_class, r.device, r.initial, r.constant, r.comment]
+    lines = ["\t".join(GLOBAL_COLUMNS[target])]
+    lines += ["\t".join(c.replace("\t", " ") for c in cells(r)) for r in rows]
     return "\n".join(lines) + "\n"
 
 
@@ -102,6 +120,11 @@ def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, 
             written += [body_path, table_path]
             result = type_name(pou.return_type, target) if pou.return_type is not None else ""
             exported.append(ExportedPou(pou.name, pou.kind, f.filename, result, _uses(pou, body, known)))
+    global_rows = [row for f in files for block in f.globals for row in rows_of(block.variables, f.text, target)]
+    if global_rows:
+        path = out / GLOBAL_TABLE
+        path.write_text(global_table(global_rows, target), encoding="utf-8")
+        written.append(path)
     order = out / "IMPORT_ORDER.txt"
     by_name = {p.name: p for p in exported}
     rows = [(name, by_name[name].kind, by_name[name].result) for name in import_order(exported)]
