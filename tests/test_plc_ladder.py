@@ -6,7 +6,6 @@ GX Works2 must be the one generated from the .il file."""
 from __future__ import annotations
 
 import re
-import textwrap
 from pathlib import Path
 
 import pytest
@@ -163,23 +162,32 @@ duration = "{duration}"
 
 [robot]
 point_duration_s = 6.0
-{faults}
-[[inputs]]
-at = "2s"
-set = {{ X0 = true }}
-pulse = "500ms"
-{extra}
-[[expect]]
-sent = "stop"
-within = "1s"
 """
 
 
-def run_ladder(tmp_path, program, name, body="", faults="", duration="45s", extra=""):
+def table(section: str, **keys) -> str:
+    """One TOML array-of-tables entry: [[section]] with its keys (strings quoted, inline tables kept)."""
+    def shown(v):
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, (int, float)) or (isinstance(v, str) and v.startswith("{")):
+            return str(v)
+        return f'"{v}"'
+    return f"\n[[{section}]]\n" + "".join(f"{k} = {shown(v)}\n" for k, v in keys.items())
+
+
+def press(device: str, at: str) -> str:
+    return table("inputs", at=at, set=f"{{ {device} = true }}", pulse="500ms")
+
+
+def run_ladder(tmp_path, program, name, *parts, duration="45s", signal=None):
     (tmp_path / "UITAMR_LadderFx3.st").write_text(translate(program, "UITAMR_LadderFx3"))
+    text = SCENARIO.format(name=name, duration=duration) + press("X0", "2s")
+    text += table("expect", sent="stop", within="1s") + "".join(parts)
+    if signal:
+        text += f'\n[response_handling]\nsignal = "{signal}"\nwithin = "5s"\n'
     path = tmp_path / "ladder.toml"
-    path.write_text(textwrap.dedent(SCENARIO).format(name=name, duration=duration, faults=faults,
-                                                     extra=extra) + textwrap.dedent(body))
+    path.write_text(text)
     result = run_scenario(load_scenario(path))
     problems = [f"{v.rule} at {v.t_us / 1e6:.3f} s: {v.message}" for v in result.all_violations()[:5]]
     problems += [str(getattr(e, "message", e)) for e in result.failed_expectations]
@@ -187,80 +195,34 @@ def run_ladder(tmp_path, program, name, body="", faults="", duration="45s", extr
 
 
 def test_ladder_runs_the_point_cycle(tmp_path, program):
-    result, problems = run_ladder(tmp_path, program, "ladder: cycle over points 1-3", """
-        [[expect]]
-        reached_point = 3
-        within = "40s"
-
-        [[expect]]
-        never = "Y3"
-
-        [[expect]]
-        that = "Y0 AND Y1"
-        within = "3s"
-        """)
+    result, problems = run_ladder(
+        tmp_path, program, "ladder: cycle over points 1-3",
+        table("expect", reached_point=3, within="40s"), table("expect", never="Y3"),
+        table("expect", that="Y0 AND Y1", within="3s"))
     assert result.passed, "\n".join(problems)
 
 
 def test_ladder_reports_no_reply_and_recovers_after_acknowledge(tmp_path, program):
-    result, problems = run_ladder(tmp_path, program, "ladder: no reply", """
-        [[expect]]
-        that = "Y3 AND D225 = 16#0101"
-        after = "4s"
-        within = "4s"
-
-        [[expect]]
-        reached_point = 2
-        after = "12s"
-        within = "30s"
-
-        [response_handling]
-        signal = "Y3"
-        within = "5s"
-        """, faults="""
-        [[faults]]
-        kind = "no_reply"
-        at_s = 4.0
-        duration_s = 4.0
-        """, extra="""
-        [[inputs]]
-        at = "10s"
-        set = { X2 = true }
-        pulse = "500ms"
-
-        [[inputs]]
-        at = "12s"
-        set = { X0 = true }
-        pulse = "500ms"
-        """)
+    result, problems = run_ladder(
+        tmp_path, program, "ladder: no reply",
+        table("faults", kind="no_reply", at_s=4.0, duration_s=4.0),
+        press("X2", "10s"), press("X0", "12s"),
+        table("expect", that="Y3 AND D225 = 16#0101", after="4s", within="4s"),
+        table("expect", reached_point=2, after="12s", within="30s"), signal="Y3")
     assert result.passed, "\n".join(problems)
 
 
 def test_ladder_stops_the_cycle_on_anti_collision(tmp_path, program):
-    result, problems = run_ladder(tmp_path, program, "ladder: anti-collision", """
-        [[expect]]
-        that = "Y3 AND D225 = 16#0201"
-        after = "5s"
-        within = "2s"
-        """, faults="""
-        [[faults]]
-        kind = "anti_collision"
-        at_s = 5.0
-        """, duration="10s")
+    result, problems = run_ladder(
+        tmp_path, program, "ladder: anti-collision",
+        table("faults", kind="anti_collision", at_s=5.0),
+        table("expect", that="Y3 AND D225 = 16#0201", after="5s", within="2s"), duration="10s")
     assert result.passed, "\n".join(problems)
 
 
 def test_ladder_rejects_a_bad_crc_and_retries(tmp_path, program):
-    result, problems = run_ladder(tmp_path, program, "ladder: bad CRC", """
-        [[expect]]
-        reached_point = 2
-        within = "30s"
-
-        [[expect]]
-        never = "Y3"
-        """, faults="""
-        [[faults]]
-        kind = "bad_crc"
-        on_request = 6
-        """, duration="30s")
+    result, problems = run_ladder(
+        tmp_path, program, "ladder: bad CRC",
+        table("faults", kind="bad_crc", on_request=6),
+        table("expect", reached_point=2, within="30s"), table("expect", never="Y3"), duration="30s")
     assert result.passed, "\n".join(problems)
