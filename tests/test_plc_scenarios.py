@@ -26,3 +26,14 @@ def test_bundled_scenario_passes(path):
     problems += [str(e.message if hasattr(e, "message") else e) for e in result.failed_expectations]
     assert result.aborted is None, result.aborted
     assert result.passed, "\n".join(problems)
+
+
+@pytest.mark.parametrize("scan_us", [1_000, 60_000])
+@pytest.mark.parametrize("name", ["fx3u-healthy", "fx3u-no-reply", "q-healthy"])
+def test_examples_hold_the_rules_at_any_scan_time(name, scan_us):
+    """Pacing, time-outs and retries are timed by TON, not by scan counting: a 1 ms and a
+    60 ms scan give the same compliant traffic."""
+    from dataclasses import replace
+    scenario = load_scenario(SCENARIOS[0].parent / f"{name}.toml")
+    result = run_scenario(replace(scenario, scan_us=scan_us))
+    assert result.passed, [v.message for v in result.all_violations()[:5]] + [str(e) for e in result.failed_expectations]
