@@ -249,7 +249,7 @@ def test_adprw_fx3_fc06_sends_the_frame_and_signals_completion():
 PROGRAM P
 VAR uData : ARRAY[0..1] OF WORD; bRun : BOOL; nDone : INT; END_VAR
 ADPRW(bRun, 1, 6, 16#01A0, 0, uData[0]);
-IF M8029 THEN nDone := nDone + 1; bRun := FALSE; END_IF;
+IF bRun AND M8029 THEN nDone := nDone + 1; bRun := FALSE; END_IF;  (* M8029 read right after the call *)
 END_PROGRAM
 """
     project = load_st(src)

@@ -17,18 +17,24 @@ ROOT = Path(__file__).resolve().parents[1]
 PLC = ROOT / "plc"
 CORE = sorted((PLC / "core").glob("*.st")) + [PLC / "examples" / "common" / "UITAMR_PointCycle.st"]
 
-PLATFORMS = [
-    ("fx3u", "gxworks2", ["fx3/UITAMR_PortFx3.st", "examples/fx3/UITAMR_ExampleFx3.st"], "UITAMR_ExampleFx3", "fx3:1"),
-    ("fx5u", "gxworks3", ["fx5/UITAMR_PortFx5.st", "examples/fx5/UITAMR_ExampleFx5.st"], "UITAMR_ExampleFx5", "fx5:1"),
-    ("fx5u", "gxworks3", ["adp/UITAMR_PortAdpFx5.st", "examples/fx5/UITAMR_ExampleAdpFx5.st"],
-     "UITAMR_ExampleAdpFx5", "adp:1"),
-    ("q", "gxworks2", ["q/UITAMR_PortQC24.st", "examples/q/UITAMR_ExampleQ.st"], "UITAMR_ExampleQ", "q:1"),
+PLATFORMS = [  # cpu, editor, the port FB, the example PROGRAM, the serial channel
+    ("fx3u", "gxworks2", "UITAMR_PortFx3", "UITAMR_ExampleFx3", "fx3:1"),
+    ("fx3u", "gxworks2", "UITAMR_PortAdpFx3", "UITAMR_ExampleAdpFx3", "adp:1"),
+    ("fx5u", "gxworks3", "UITAMR_PortFx5", "UITAMR_ExampleFx5", "fx5:1"),
+    ("fx5u", "gxworks3", "UITAMR_PortAdpFx5", "UITAMR_ExampleAdpFx5", "adp:1"),
+    ("q", "gxworks2", "UITAMR_PortQC24", "UITAMR_ExampleQ", "q:1"),
 ]
 
 
-@pytest.mark.parametrize("cpu, target, files, program, channel", PLATFORMS, ids=[p[3] for p in PLATFORMS])
-def test_example_program_talks_to_the_robot(cpu, target, files, program, channel):
-    project = verifier.load(*CORE, *(PLC / f for f in files), target=target, cpu=cpu, scan_ms=10)
+def st_file(pou: str) -> Path:
+    """The library file defining `pou` (one POU per file, named after it)."""
+    (path,) = PLC.rglob(f"{pou}.st")
+    return path
+
+
+@pytest.mark.parametrize("cpu, target, port, program, channel", PLATFORMS, ids=[p[3] for p in PLATFORMS])
+def test_example_program_talks_to_the_robot(cpu, target, port, program, channel):
+    project = verifier.load(*CORE, st_file(port), st_file(program), target=target, cpu=cpu, scan_ms=10)
     line = Line(Robot())
     project.attach_serial(channel, line)
     if cpu == "q":  # the module settings docs/import-gxworks2.md asks for: byte units, 8 bytes, no end code

@@ -76,6 +76,7 @@ class BodyCompiler:
         self.static_refs: list[tuple[str, str]] = []  # (slot, code) created in __init__
         self.pulse_slots: list[str] = []
         self.fb_calls: dict[str, str] = {}  # temp holding an instance -> its user FB type
+        self.loop_vars: dict[str, tuple[str, int, int]] = {}  # FOR counter -> (local, min, max)
 
     # ------------------------------------------------------------------ helpers
     def new_tmp(self, prefix="_t") -> str:
@@ -106,7 +107,8 @@ class BodyCompiler:
             return repr(e.value), StringT(max(len(e.value), 1))
         if isinstance(e, ast.Name):
             sym = self.lookup(e.name, e.span)
-            return sym.code, sym.type
+            loop = self.loop_vars.get(e.key)
+            return (loop[0] if loop else sym.code), sym.type
         if isinstance(e, ast.Device):
             lv = self.device_lvalue(e)
             return lv.read, lv.type
@@ -169,6 +171,11 @@ class BodyCompiler:
         t = unify(lt, rt_)
         if is_string(t):
             raise CompileError(span, f"operator {op} does not apply to STRING")
+        if t not in (ANYINT, ANYREAL) and is_int(t):
+            # a constant sub-expression meeting a typed operand is computed in that type,
+            # as the CPU's 16/32-bit instructions compute it
+            lc = _typed_literal(lc, lt, t)
+            rc = _typed_literal(rc, rt_, t)
         k = self.loc(span)
         if op == "**":
             return f"_f32(_expt({lc}, {rc}, {k}))", "REAL"
@@ -322,6 +329,12 @@ class BodyCompiler:
             code, t = self.expr(ix)
             if not is_int(t):
                 raise CompileError(ix.span, f"array index must be an integer, not {t}")
+            loop = self.loop_vars.get(ix.key) if isinstance(ix, ast.Name) else None
+            if loop is not None and lo <= loop[1] and loop[2] <= hi:
+                # a FOR counter whose whole range lies inside the bounds: no check needed
+                part = f"{loop[0]} - {lo}" if lo else loop[0]
+                flat_parts.append(part if st == 1 else f"({part}) * {st}")
+                continue
             value = self.m.try_const(ix, self.info)
             if value is not None:
                 if not lo <= value <= hi:
@@ -357,6 +370,11 @@ class BodyCompiler:
             value = self.m.try_const(ix, self.info)
             if value is not None:
                 parts.append(str((value - lo) * st))
+                continue
+            loop = self.loop_vars.get(ix.key) if isinstance(ix, ast.Name) else None
+            if loop is not None and lo <= loop[1] and loop[2] <= hi:
+                part = f"{loop[0]} - {lo}" if lo else loop[0]
+                parts.append(part if st == 1 else f"({part}) * {st}")
                 continue
             code, _ = self.expr(ix)
             tmp = self.new_tmp()
@@ -461,6 +479,7 @@ class BodyCompiler:
             rc, rt_ = self.expr(v.right)
             t = unify(lt, rt_)
             if is_int(t) and t != ANYINT:
+                lc, rc = _typed_literal(lc, lt, t), _typed_literal(rc, rt_, t)
                 q = self.new_tmp("_q")
                 self.em.line(f"{q} = _idiv_n({lc}, {rc}, {self.loc(v.span)})")
                 self.em.line(f"if {q} is not None:")
@@ -560,7 +579,15 @@ class BodyCompiler:
             self.em.line(f"for {v} in range({start}, {end + (1 if step > 0 else -1)}, {step}):")
             self.em.indent()
             self.emit_lines(var.write(v))
-            self.block(s.body)
+            last = start + ((end - start) // step) * step
+            known = isinstance(s.var, ast.Name)
+            if known:  # inside the body the counter is the Python loop variable, in a known range
+                self.loop_vars[s.var.key] = (v, min(start, last), max(start, last))
+            try:
+                self.block(s.body)
+            finally:
+                if known:
+                    self.loop_vars.pop(s.var.key, None)
             self.em.dedent()
             n = max(0, (end - start) // step + 1) if (end - start) * step >= 0 else 0
             self.em.line("else:")
@@ -928,6 +955,12 @@ class BodyCompiler:
         slot = f"_r{len(self.static_refs)}"
         self.static_refs.append((slot, code))
         return f"self.{slot}"
+
+
+def _typed_literal(code: str, src, dst) -> str:
+    if src == ANYINT and not _is_number(code):
+        return norm_code(dst, code)
+    return code
 
 
 def _is_number(code: str) -> bool:

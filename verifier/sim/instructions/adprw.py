@@ -41,6 +41,7 @@ class AdprwMaster:
             self._err_flag = None
             self._done_flag = None
         self.busy = False
+        self.completed = False  # a transaction ended and its execution has not reported it yet
         self.request = b""
         self.expect = 0
         self.deadline = 0
@@ -65,8 +66,15 @@ class AdprwMaster:
 
     # -- the instruction ---------------------------------------------------------------
     def call(self, en, slave, fc, addr, count, data, d2, loc_id) -> bool:
-        if not en or self.busy:
-            return bool(en)
+        if not en:
+            return False
+        reported = self.completed
+        self.completed = False
+        if self._done_flag is not None:
+            # FX3: the execution that reports the completion turns M8029 ON, others OFF
+            self._set(self._done_flag, reported)
+        if self.busy or reported:
+            return True  # a finished transaction is reported; the next execution starts anew
         location = self.rt.locations[loc_id]
         if fc == 1:
             if not 1 <= count <= 2000:
@@ -147,14 +155,15 @@ class AdprwMaster:
             self._complete(0)
 
     def _complete(self, error: int, in_scan: bool = False) -> None:
-        """Completion bits go ON for one scan: from this scan when the END processing
-        between scans saw the reply, from the next one when the call itself failed."""
+        """FX5 completion bits go ON for one scan: from this scan when the END processing
+        between scans saw the reply, from the next one when the call itself failed.  FX3
+        reports through M8029 at the next execution of ADPRW."""
         self.busy = False
         _, _, _, d2 = self.job
         self._set(self._err_code, error)
         flags = []
         if self.family == "fx3":
-            flags.append((None, self._done_flag))
+            self.completed = True
             if error:
                 self._set(self._err_flag, True)
         elif d2 is not None:
