@@ -90,3 +90,28 @@ def test_expressions_wrap_like_the_cpu(type_name, data):
         raise
     assert project.call("F", env["a"], env["b"], env["c"]) == expected
     assert not project.diagnostics
+
+
+def f32(x: float) -> float:
+    import struct
+
+    try:
+        return struct.unpack("<f", struct.pack("<f", x))[0]
+    except OverflowError:
+        return float("inf") if x > 0 else float("-inf")
+
+
+real_values = st.floats(min_value=-1e6, max_value=1e6, allow_nan=False, width=32)
+
+
+@settings(max_examples=150, deadline=None)
+@given(a=real_values, b=real_values, c=real_values, ops=st.lists(st.sampled_from("+-*/"), min_size=2, max_size=2))
+def test_real_expressions_round_to_single_precision_after_every_operation(a, b, c, ops):
+    assume(not (ops[0] == "/" and b == 0))
+    first = {"+": a + b, "-": a - b, "*": a * b, "/": a / b if b else 0.0}[ops[0]]
+    first = f32(first)
+    assume(not (ops[1] == "/" and c == 0))
+    expected = f32({"+": first + c, "-": first - c, "*": first * c, "/": first / c if c else 0.0}[ops[1]])
+    src = (f"FUNCTION F : REAL\nVAR_INPUT a, b, c : REAL; END_VAR\n"
+           f"F := (a {ops[0]} b) {ops[1]} c;\nEND_FUNCTION\n")
+    assert load_st(src).call("F", a, b, c) == expected
