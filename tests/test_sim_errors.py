@@ -75,3 +75,12 @@ def test_operand_block_past_an_array_through_a_function_local():
     with pytest.raises(SimulationError) as err:
         project.call("F", 5)
     assert err.value.location == "t.st:4:11"
+
+
+def test_import_verifier_stays_cheap():
+    import subprocess
+    import sys
+
+    code = "import verifier, sys; print('verifier.sim' in sys.modules, 'lark' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["False", "False"]

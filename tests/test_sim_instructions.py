@@ -342,3 +342,19 @@ END_PROGRAM
     p.bEdge = False
     project.run_programs(["P"], scans=3)
     assert p.nRise == 1 and p.nFall == 1
+
+
+def test_send_request_set_by_instruction_is_the_origin():
+    src = """
+PROGRAM P
+VAR uSend : ARRAY[0..3] OF WORD; uRecv : ARRAY[0..3] OF WORD; END_VAR
+IF M8002 THEN D8400 := 16#1C81; END_IF;
+SET(NOT M8002 AND NOT M8402, M8402);
+RS2(NOT M8002, uSend[0], 2, 2, 1, uRecv[0]);
+END_PROGRAM
+"""
+    project = load_st(src)
+    ep = FakeEndpoint()
+    project.attach_serial("fx3:1", ep)
+    project.run_programs(["P"], scans=2)
+    assert ep.sent[0][2] == "t.st:5:1"

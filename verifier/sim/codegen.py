@@ -870,7 +870,20 @@ class BodyCompiler:
                 self.em.line(f"if {en_code}: _I.{spec.name}(True, {', '.join(ops)}, {k})")
         for line in after:
             self.em.line(line)
+        self.note_send_request(spec.name, c)
         return None, "BOOL"
+
+    def note_send_request(self, name: str, c: ast.Call) -> None:
+        """SET/OUT of a send-request flag (SET(TRUE, M8402)): remember where, so the bytes
+        sent carry this ST location as their origin."""
+        if name not in ("SET", "OUT", "MOV") or not isinstance(c.args[-1].value, ast.Device):
+            return
+        d = c.args[-1].value
+        channel = SEND_FLAGS.get(self.family, {}).get(f"{d.kind}{d.address}")
+        if channel and d.bit is None:
+            area = self.m.cpu.areas[d.kind]
+            self.em.line(f"if _A_{d.kind}[{int(d.address, area.radix)}]: "
+                         f"_rt.origins[{channel!r}] = {self.m.loc_text(c.span)!r}")
 
     def ref_code(self, e: ast.Expr, kind: str, wide: bool = False) -> tuple[str, list[str]]:
         """A Ref to the block an instruction operand names; lines to run after the call
