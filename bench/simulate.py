@@ -35,9 +35,10 @@ GOAL = 1000
 
 
 def sources() -> list[Path]:
+    """The core library plus the files (one POU each, named after it) the example needs."""
     plc = ROOT / "plc"
-    return (sorted((plc / "core").glob("*.st")) + [plc / "fx3" / "UITAMR_PortFx3.st",
-            plc / "examples" / "common" / "UITAMR_PointCycle.st", plc / "examples" / "fx3" / f"{PROGRAM}.st"])
+    extra = [next(plc.rglob(f"{pou}.st")) for pou in ("UITAMR_PortFx3", "UITAMR_PointCycle", PROGRAM)]
+    return sorted((plc / "core").glob("*.st")) + extra
 
 
 def run_compiled(seconds: float, scan_ms: float, robot: bool):
