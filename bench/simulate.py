@@ -91,12 +91,16 @@ def main(argv=None) -> int:
         print(f"{name:38} {virt:10.0f} {wall:8.2f} {scans:9d} {virt / wall:12.0f} {virt / cpu:13.0f}")
     compiled = rows[0][1] / rows[0][2]
     alone = rows[1][1] / rows[1][2]
+    alone_cpu = rows[1][1] / rows[1][3]
     baseline = rows[2][1] / rows[2][2]
     print(f"compiled / baseline (line + robot): {compiled / baseline:.1f}x")
     same = traffic(line_c, round(args.baseline_s * 1e6)) == traffic(line_b, round(args.baseline_s * 1e6))
     print(f"same bytes at the same times on the line over the first {args.baseline_s:g} s: {'yes' if same else 'NO'}")
-    print(f"goal {GOAL}x real time: PLC alone {'met' if alone >= GOAL else 'NOT met'} ({alone:.0f}x), "
-          f"with line + robot {'met' if compiled >= GOAL else 'NOT met'} ({compiled:.0f}x)")
+    print(f"goal {GOAL}x real time: PLC alone {'met' if alone >= GOAL else 'NOT met'} ({alone:.0f}x wall, "
+          f"{alone_cpu:.0f}x on CPU time), with line + robot {'met' if compiled >= GOAL else 'NOT met'} "
+          f"({compiled:.0f}x wall)")
+    if alone < GOAL <= alone_cpu:
+        print("note: wall time includes waiting for a core on a loaded machine; CPU time does not")
     return 0 if same else 1
 
 
