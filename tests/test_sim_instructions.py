@@ -358,3 +358,24 @@ END_PROGRAM
     project.attach_serial("fx3:1", ep)
     project.run_programs(["P"], scans=2)
     assert ep.sent[0][2] == "t.st:5:1"
+
+
+def test_rs2_manual_example_d100_k4_d200_k20_k1():
+    """FX-COM F-66: RS2 D100 K4 D200 K20 K1 sends 31H 32H 33H 34H from D100 low, D100
+    high, D101 low, D101 high (the figure's data area, without header/terminator)."""
+    src = """
+PROGRAM P
+IF M8002 THEN D8400 := 16#1C81; D100 := 16#3231; D101 := 16#3433; M8402 := TRUE; END_IF;
+RS2(NOT M8002, D100, 4, 20, 1, D200);
+END_PROGRAM
+"""
+    project = load_st(src)
+    ep = FakeEndpoint()
+    project.attach_serial("fx3:1", ep)
+    ep.reply_at(15_000, b"5678")  # the figure's receive side: 35H 36H 37H 38H
+    project.run_programs(["P"], scans=2)
+    assert ep.sent[0][0] == b"1234"
+    project.devices["D8409"] = 2  # 20 ms time-out: fewer than n = 20 bytes arrive
+    project.run_programs(["P"], scans=4)
+    assert project.devices["M8403"] is True and project.devices["D8403"] == 4
+    assert (project.devices["D200"], project.devices["D201"]) == (0x3635, 0x3837)
