@@ -37,3 +37,21 @@ def test_baseline_and_compiled_put_the_same_bytes_on_the_line():
     assert len(frames(line_c)) >= 10
     assert frames(line_c) == frames(line_b)
     assert compiled.devices["D100"] == rt.dev["D100"]
+
+
+def test_inlined_and_called_fb_bodies_behave_the_same(monkeypatch):
+    from verifier.sim import compiler
+
+    def run(inline: bool):
+        monkeypatch.setattr(compiler.compile_files, "__defaults__", (inline,))
+        project = verifier.load(*SOURCES)
+        line = Line(Robot())
+        project.attach_serial("fx3:1", line)
+        project.devices["X0"] = True
+        project.run_programs([PROGRAM], ms=4000)
+        return [(f.t_start_us, f.direction, f.data) for f in line.trace], project.module.source
+
+    inlined, src_inlined = run(True)
+    called, src_called = run(False)
+    assert src_inlined != src_called and src_inlined.count("._body()") < src_called.count("._body()")
+    assert inlined == called and len(inlined) >= 10
