@@ -111,6 +111,15 @@ CPU_ALIASES = {"fx3": "fx3u", "fx3uc": "fx3u", "fx3gc": "fx3g", "fx5": "fx5u",
 TARGET_DEFAULT_CPU = {"gxworks2": "fx3u", "gxworks3": "fx5u"}
 
 
+# Send-request flags of the serial channels: writing TRUE to one of them is where a
+# transmission starts, so the compiler records that ST location as the bytes' origin.
+SEND_FLAGS = {
+    "fx3": {"M8402": "fx3:1", "M8422": "fx3:2"},
+    "fx5": {"SM8561": "fx5:1", "SM8571": "fx5:2"},
+    "q": {},
+}
+
+
 def profile_for(target: str, cpu: str | None = None) -> CpuProfile:
     """CPU profile for an editor target ("gxworks2", "gxworks3") or a "target:cpu" pair
     ("gxworks2:q")."""
