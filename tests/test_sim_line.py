@@ -75,3 +75,18 @@ END_PROGRAM
     project.run_programs(["P"], scans=2)          # t = 40 ms: the echo is complete
     assert project.devices["M8403"] is True       # the robot's echo arrived by count
     assert [project.program("P").uRecv[i] for i in range(4)] == [0x0601, 0xA001, 0x0000, 0x1488]
+
+
+def test_restart_sends_the_power_on_stop_again():
+    project = verifier.load(*CORE, st_file("UITAMR_PortFx3"), st_file("UITAMR_ExampleFx3"))
+    line = Line(Robot())
+    project.attach_serial("fx3:1", line)
+    project.run_programs(["UITAMR_ExampleFx3"], ms=2000)
+    assert project.get("UITAMR_ExampleFx3.fbEngine.o_bInitDone") is True
+    project.restart(off_ms=500)
+    assert project.get("UITAMR_ExampleFx3.fbEngine.o_bInitDone") is False
+    assert project.devices["D8400"] == 0                  # the port writes the format again
+    project.run_programs(["UITAMR_ExampleFx3"], ms=2000)
+    after = [f for f in line.trace if f.direction == "tx" and f.t_start_us >= 2_500_000]
+    assert after[0].data == STOP_FRAME
+    assert after[0].t_start_us > 2_500_000

@@ -11,6 +11,7 @@ from verifier.st import ast
 from .compiler import GENERATED_FILE, CompiledModule, compile_files, default_code
 from .cpu import profile_for
 from .errors import LoadError, SimulationError
+from .instructions import InstructionSet
 from .runtime import Runtime
 from .serial import CHANNELS
 from .typesys import ArrayT, CompileError, StringT, StructT
@@ -244,6 +245,30 @@ class Project:
                 remaining -= 1
 
         self._guard(loop)
+
+    def restart(self, off_ms: float = 0) -> None:
+        """Power the CPU off for `off_ms` of virtual time and on again (RUN from the
+        start): labels return to their initial values, device memory and module buffers
+        are cleared, the serial ports forget what they were doing, and the next scan is a
+        first scan again (M8002/SM402).  Attached lines and robots keep running.
+        ASSUMPTION: no latched (battery-backed) device ranges and no VAR_RETAIN labels
+        are kept — set them again from Python after the restart if your CPU keeps them."""
+        rt = self.rt
+        rt.advance_to(rt.now_us + round(off_ms * 1000))
+        for cells in rt.dev.areas.values():
+            zero = False if cells and isinstance(cells[0], bool) else 0
+            cells[:] = [zero] * len(cells)
+        for buf in rt.buffers.values():
+            buf[:] = [0] * len(buf)
+        rt.pollers.clear()
+        rt.origins.clear()
+        rt.scan_count = 0
+        ns = self.module.namespace
+        ns["_I"] = InstructionSet(rt)
+        ns["_G"] = ns["_Globals"]()
+        programs = set(map(id, self._programs.values()))
+        self.touched = [t for t in self.touched if id(t._obj) not in programs]
+        self._programs.clear()
 
     def advance(self, ms: float) -> None:
         """Let virtual time pass without scanning (the CPU in STOP)."""
