@@ -113,3 +113,23 @@ END_FUNCTION_BLOCK
     assert fb.fbSr.Q1 is True      # set dominant
     assert fb.fbRs.Q1 is False     # reset dominant
     assert fb.cu.CV == 0
+
+
+def test_timer_resolution_option_counts_in_ticks():
+    fb = load_st(TIMERS, scan_ms=10, timer_resolution_ms=100).instance("FB_T")
+    fb.bInput = True
+    fb.scan(9)          # 0 .. 80 ms: no 100 ms tick yet
+    assert fb.fbOn.ET == 0
+    fb.scan(2)          # 100 ms
+    assert fb.fbOn.ET == 100 and fb.fbOn.Q is True
+
+
+def test_bad_scan_options_are_load_errors():
+    import pytest
+
+    from verifier.sim import LoadError
+
+    with pytest.raises(LoadError, match="jitter"):
+        load_st(TIMERS, scan_ms=10, jitter_ms=10)
+    with pytest.raises(LoadError, match="timer resolution"):
+        load_st(TIMERS, timer_resolution_ms=0)

@@ -20,7 +20,7 @@ from .values import InstanceProxy, to_st, to_st_list, wrap
 
 def load(*paths, target: str = "gxworks2", cpu: str | None = None, scan_ms: float = 10,
          jitter_ms: float = 0, seed: int = 0, stop_on_operation_error: bool | None = None,
-         sources: dict[str, str] | None = None) -> "Project":
+         sources: dict[str, str] | None = None, timer_resolution_ms: int = 1) -> "Project":
     """Parse, check and compile ST files into a simulated CPU.
 
     `paths` are .st files (or directories, whose *.st files are loaded); `sources` maps
@@ -43,7 +43,7 @@ def load(*paths, target: str = "gxworks2", cpu: str | None = None, scan_ms: floa
     if problems:
         raise LoadError(problems)
     return Project(texts, target=target, cpu=cpu, scan_ms=scan_ms, jitter_ms=jitter_ms, seed=seed,
-                   stop_on_operation_error=stop_on_operation_error)
+                   stop_on_operation_error=stop_on_operation_error, timer_resolution_ms=timer_resolution_ms)
 
 
 class Project:
@@ -51,7 +51,7 @@ class Project:
 
     def __init__(self, texts: dict[str, str], target: str = "gxworks2", cpu: str | None = None,
                  scan_ms: float = 10, jitter_ms: float = 0, seed: int = 0,
-                 stop_on_operation_error: bool | None = None):
+                 stop_on_operation_error: bool | None = None, timer_resolution_ms: int = 1):
         from verifier import st
 
         editor = target.split(":", 1)[0]
@@ -71,8 +71,12 @@ class Project:
             raise LoadError(errors)
         self.warnings.extend(d for d in checked if not d.is_error)
         self.files = files
-        self.rt = Runtime(self.cpu, scan_us=round(scan_ms * 1000), jitter_us=round(jitter_ms * 1000),
-                          seed=seed, stop_on_operation_error=stop_on_operation_error)
+        try:
+            self.rt = Runtime(self.cpu, scan_us=round(scan_ms * 1000), jitter_us=round(jitter_ms * 1000),
+                              seed=seed, stop_on_operation_error=stop_on_operation_error,
+                              timer_resolution_ms=timer_resolution_ms)
+        except ValueError as e:
+            raise LoadError([ast.Diagnostic("<options>", 0, 0, "error", str(e))]) from None
         try:
             self.module: CompiledModule = compile_files(files, self.rt, self.cpu)
         except CompileError as e:

@@ -19,9 +19,15 @@ from .serial import SerialChannel
 
 class Runtime:
     def __init__(self, cpu: CpuProfile, scan_us: int = 10_000, jitter_us: int = 0,
-                 seed: int = 0, stop_on_operation_error: bool | None = None):
+                 seed: int = 0, stop_on_operation_error: bool | None = None,
+                 timer_resolution_ms: int = 1):
         if scan_us <= 0:
             raise ValueError("scan time must be positive")
+        if not isinstance(timer_resolution_ms, int) or timer_resolution_ms <= 0:
+            raise ValueError("the timer resolution is a positive whole number of ms (1, 10, 100)")
+        # timers (TON/TOF/TP) read `now_ms`: virtual time in whole ticks of the resolution
+        self.timer_resolution_ms = timer_resolution_ms
+        self._tick_us = timer_resolution_ms * 1000
         if jitter_us < 0 or jitter_us >= scan_us:
             raise ValueError("jitter must be >= 0 and smaller than the scan time")
         self.cpu = cpu
@@ -96,14 +102,14 @@ class Runtime:
         if self.jitter_us:
             step += self.rng.randint(-self.jitter_us, self.jitter_us)
         self.now_us += step
-        self.now_ms = self.now_us // 1000
+        self.now_ms = self.now_us // self._tick_us * self.timer_resolution_ms
 
     def advance_to(self, t_us: int) -> None:
         """Move the clock without scanning (the CPU in STOP, or a test skipping time)."""
         if t_us < self.now_us:
             raise ValueError("virtual time cannot go backwards")
         self.now_us = t_us
-        self.now_ms = t_us // 1000
+        self.now_ms = t_us // self._tick_us * self.timer_resolution_ms
 
     # ---- operation errors ----------------------------------------------------------
     def operation_error(self, loc_id: int | None, message: str, code: int | None = None) -> None:
