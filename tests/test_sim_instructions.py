@@ -379,3 +379,22 @@ END_PROGRAM
     project.run_programs(["P"], scans=4)
     assert project.devices["M8403"] is True and project.devices["D8403"] == 4
     assert (project.devices["D200"], project.devices["D201"]) == (0x3635, 0x3837)
+
+
+def test_rs2_channel_2_uses_the_ch2_devices():
+    src = """
+PROGRAM P
+VAR uSend : ARRAY[0..1] OF WORD := [16#0201]; uRecv : ARRAY[0..1] OF WORD; END_VAR
+IF M8002 THEN D8420 := 16#1C81; D8429 := 1; M8422 := TRUE; END_IF;
+RS2(NOT M8002, uSend[0], 2, 4, 2, uRecv[0]);
+END_PROGRAM
+"""
+    project = load_st(src, cpu="fx3g")
+    ep = FakeEndpoint()
+    project.attach_serial("fx3:2", ep)
+    ep.reply_at(12_000, b"\x07")
+    project.run_programs(["P"], scans=5)  # one byte, then 10 ms of silence: time-out
+    assert ep.sent[0][0] == b"\x01\x02"
+    dev = project.devices
+    assert (dev["M8422"], dev["M8423"], dev["M8429"], dev["D8423"]) == (False, True, True, 1)
+    assert project.program("P").uRecv[0] == 0x0007
