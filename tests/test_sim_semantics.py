@@ -199,6 +199,7 @@ def test_out_of_bounds_index_is_reported_at_its_st_location():
     assert err.value.location == "t.st:6:3"
     assert "outside a[0..3]" in str(err.value)
     assert "silently" in str(err.value)
+    assert str(err.value).endswith("\n    a[i] := 1;\n      ^")  # the ST line, marked
 
 
 def test_out_of_bounds_read_in_an_expression():

@@ -31,9 +31,17 @@ class SimulationError(Exception):
         self.message = message
         self.location = location
         self.t_us = t_us
-        where = f"{location}: " if location else ""
-        when = f" (at t={t_us / 1e6:.6f} s)" if t_us is not None else ""
-        super().__init__(f"{where}{message}{when}")
+        self.source_line: str | None = None  # the ST line, filled in by the project
+        super().__init__(message)
+
+    def __str__(self) -> str:
+        where = f"{self.location}: " if self.location else ""
+        when = f" (at t={self.t_us / 1e6:.6f} s)" if self.t_us is not None else ""
+        text = f"{where}{self.message}{when}"
+        if self.source_line is not None and self.location:
+            col = int(self.location.rsplit(":", 1)[1])
+            text += f"\n    {self.source_line}\n    {' ' * max(col - 1, 0)}^"
+        return text
 
 
 @dataclass(frozen=True)

@@ -324,15 +324,31 @@ class Project:
     def _guard(self, fn):
         try:
             return fn()
-        except SimulationError:
+        except SimulationError as err:
+            err.source_line = self._source_line(err.location)
             raise
         except RecursionError:
-            raise SimulationError("function blocks call each other without end (recursion)",
-                                  self._st_location(sys.exc_info()[2]), self.rt.now_us) from None
+            err = SimulationError("function blocks call each other without end (recursion)",
+                                  self._st_location(sys.exc_info()[2]), self.rt.now_us)
+            err.source_line = self._source_line(err.location)
+            raise err from None
         except Exception as e:  # a fault of the simulator itself: point at the ST line anyway
-            loc = self._st_location(sys.exc_info()[2])
-            raise SimulationError(f"simulator fault while running this statement: {e!r}",
-                                  loc, self.rt.now_us) from e
+            err = SimulationError(f"simulator fault while running this statement: {e!r}",
+                                  self._st_location(sys.exc_info()[2]), self.rt.now_us)
+            err.source_line = self._source_line(err.location)
+            raise err from e
+
+    def _source_line(self, location: str | None) -> str | None:
+        """The ST text of the line a location "file:line:col" points at."""
+        if not location:
+            return None
+        file, line, _ = location.rsplit(":", 2)
+        for f in self.files:
+            if f.filename == file:
+                lines = f.text.splitlines()
+                n = int(line)
+                return lines[n - 1] if 1 <= n <= len(lines) else None
+        return None
 
     def _st_location(self, tb) -> str | None:
         loc = None
