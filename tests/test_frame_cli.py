@@ -170,6 +170,40 @@ def test_decode_direction_and_settings():
     assert "read task status (query 2)" in run("--status-order", "return", "--decode", "01 01 00 02 00 16 1C 04").output
 
 
+def test_as_request_with_a_command_checks_the_bytes_are_that_commands_request():
+    same = run("read", "task", "--as", "request", "--decode", "01 01 00 00 00 16 BD C4")
+    assert same.exit_code == 0, same.output
+    assert "FC01 request: read task status (query 0)" in same.output
+    assert same.output.splitlines()[-1] == "= the request of `read task`"
+    other = run("read", "vehicle", "--as", "request", "--decode", "01 01 00 00 00 16 BD C4")
+    assert other.exit_code == 1
+    assert other.output.splitlines()[-1] == (
+        "not the request of `read vehicle` (read vehicle status (query 1)): byte 3 differs; "
+        "`read vehicle` is 01 01 00 01 00 16 EC 04")
+    # the direction is really forced: a valid reply is an invalid request
+    reply = run("read", "task", "--as", "request", "--decode", "01 01 03 00 00 01 FD 8E")
+    assert reply.exit_code == 1 and "invalid frame: byte 2: query parameter" in reply.output
+    unquoted = run("stop", "--as", "request", "--decode", "01", "06", "01", "A0", "00", "00", "88", "14")
+    assert unquoted.exit_code == 0 and unquoted.output.splitlines()[-1] == "= the request of `stop`"
+
+
+def test_a_command_with_as_reply_or_auto_reads_the_bytes_as_its_reply():
+    for direction in ("reply", "auto"):
+        result = run("read", "task", "--as", direction, "--decode", "01 01 03 00 00 01 FD 8E")
+        assert result.exit_code == 0, result.output
+        assert "FC01 reply: task status: running (1), error 00 normal" in result.output
+
+
+@given(requests)
+@hypothesis_settings(max_examples=30)
+def test_every_request_decoded_as_request_matches_its_own_command(request):
+    args = ["--address", str(request.address), *words_for(request), "--as", "request",
+            "--decode", hex_bytes(encode(request))]
+    result = run(*args)
+    assert result.exit_code == 0, result.output
+    assert result.output.splitlines()[-1].startswith("= the request of `")
+
+
 def test_raw_and_negative_numbers_need_no_double_dash():
     assert run("raw", "12", "100").output.strip() == run("rotate", "+1").output.strip()
     assert run("raw", "0x01", "0xA0").output.strip() == "01 06 01 A0 00 00 88 14"

@@ -88,9 +88,12 @@ def _kind(frame) -> str:
 @click.argument("words", nargs=-1, type=click.UNPROCESSED)
 @protocol_settings
 @click.option("--decode", "decode_hex", metavar="HEX",
-              help="Decode these bytes instead (with COMMAND: as the reply to that command).")
+              help="Decode these bytes instead (with COMMAND: as the reply to that command, "
+                   "or with --as request as that command's request).")
 @click.option("--as", "direction", type=click.Choice(["auto", "request", "reply"]), default="auto",
-              show_default=True, help="With --decode: read the bytes as a request or a reply.")
+              show_default=True,
+              help="With --decode: read the bytes as a request or a reply. With a COMMAND too, "
+                   "--as request checks that the bytes are that command's request.")
 @click.option("--explain", "explain_fields", is_flag=True, help="Also show every field of the frame.")
 @click.option("--mbpoll", "mbpoll_device", metavar="DEVICE",
               help="Also print the mbpoll command line that sends this request on DEVICE "
@@ -125,9 +128,26 @@ def command(words, settings, decode_hex, direction, explain_fields,
         data = parse_hex(decode_hex)
     except ValueError as exc:
         raise click.BadParameter(str(exc), param_hint="--decode") from None
+    if request is not None and direction == "request":
+        _decode_and_print(data, settings, "request", None, explain_fields)
+        _compare_with_command(data, request, settings, words)
+        return
     if request is not None:
         direction = "reply"
     _decode_and_print(data, settings, None if direction == "auto" else direction, request, explain_fields)
+
+
+def _compare_with_command(data: bytes, request, settings: Settings, words: tuple[str, ...]) -> None:
+    """After a valid request was decoded: is it the request COMMAND makes? Exit 1 if not."""
+    expected = encode(request, settings)
+    named = " ".join(words)
+    if data == expected:
+        click.echo(f"= the request of `{named}`")
+        return
+    differ = next(i for i in range(min(len(data), len(expected))) if data[i] != expected[i])
+    click.echo(f"not the request of `{named}` ({describe(request, settings)}): byte {differ} differs; "
+               f"`{named}` is {hex_bytes(expected)}")
+    raise SystemExit(EXIT_BAD_FRAME)
 
 
 def _split_unquoted_hex(words: tuple[str, ...], decode_hex: str, address: int) -> tuple[tuple[str, ...], str]:
