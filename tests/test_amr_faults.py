@@ -9,6 +9,7 @@ from verifier.amr import ConfigError, Fault, Robot, RobotConfig, faults_from_lis
 from verifier.amr.faults import FAULT_KINDS
 from verifier.protocol import (
     STOP_FRAME,
+    Settings,
     ControlCode,
     ControlRequest,
     Query,
@@ -295,3 +296,30 @@ def test_every_fault_kind_is_exercised_here():
     source = inspect.getsource(sys.modules[__name__])
     for kind in FAULT_KINDS:
         assert f'"kind": "{kind}"' in source, kind
+
+
+@pytest.mark.parametrize("own, fault_address", [(1, 1), (7, 7)])
+def test_a_wrong_address_fault_with_the_robots_own_address_is_a_config_error(own, fault_address):
+    faults = faults_from_list([{"kind": "no_reply", "on_request": 1},
+                               {"kind": "wrong_address", "on_request": 2, "address": fault_address}])
+    with pytest.raises(ConfigError) as caught:
+        Robot(Settings(address=own), RobotConfig(), faults)
+    assert caught.value.path == "faults[1].address"
+    assert f"{own} is the robot's own address" in caught.value.message
+
+
+def test_a_wrong_address_fault_with_another_address_is_fine():
+    faults = faults_from_list([{"kind": "wrong_address", "on_request": 1, "address": 1}])
+    robot = Robot(Settings(address=2), RobotConfig(), faults)
+    stop = encode(ControlRequest(2, ControlCode.ROBOT, RobotCommand.STOP))
+    reply = robot.on_request(stop, 300_000)
+    assert reply.data[0] == 1 and crc_ok(reply.data)
+
+
+def test_a_scenario_with_a_wrong_address_fault_on_the_robots_own_address_names_the_line():
+    from verifier.verify.scenario import ScenarioError, parse_scenario
+    text = ('name = "x"\n\n[protocol]\naddress = 4\n\n[[faults]]\nkind = "wrong_address"\n'
+            'on_request = 1\naddress = 4\n')
+    with pytest.raises(ScenarioError) as caught:
+        parse_scenario(text)
+    assert str(caught.value).startswith("scenario:9: faults[0].address: 4 is the robot's own address")

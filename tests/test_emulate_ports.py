@@ -318,16 +318,44 @@ def run_cli(*args: str) -> subprocess.CompletedProcess:
 
 @pytest.mark.parametrize("text, message", [
     ('[[faults]]\nkind = "no_reply"\non_request = 1\n\n[[faults]]\nkind = "x"\nat_s = 1\n',
-     "faults[1].kind: unknown fault 'x'; expected one of anti_collision"),
-    ('[robot]\npacing = "sometimes"\n', "robot.pacing: unknown pacing policy 'sometimes'"),
+     "6: faults[1].kind: unknown fault 'x'; expected one of anti_collision"),
+    ('[robot]\npacing = "sometimes"\n', "2: robot.pacing: unknown pacing policy 'sometimes'"),
 ])
 def test_bad_fault_file_names_file_and_key(tmp_path, text, message):
     path = tmp_path / "faults.toml"
     path.write_text(text)
     result = run_cli("--tcp", "0", "--faults", str(path))
     assert result.returncode == 2
-    assert f"{path}: {message}" in result.stderr
+    assert f"{path}:{message}" in result.stderr
     assert "Traceback" not in result.stderr
+
+
+def test_a_wrong_address_fault_on_the_robots_own_address_is_refused(tmp_path):
+    path = tmp_path / "faults.toml"
+    path.write_text('[[faults]]\nkind = "wrong_address"\non_request = 1\naddress = 5\n')
+    result = run_cli("--tcp", "0", "--address", "5", "--faults", str(path))
+    assert result.returncode == 2
+    assert f"{path}:4: faults[0].address: 5 is the robot's own address" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_the_log_says_what_a_closing_tcp_client_left_behind(start_emulator):
+    # A long frame gap and turnaround keep the half request and the reply waiting until the
+    # client has gone, whatever the machine's speed.
+    emulator, port = tcp_emulator(start_emulator, "--frame-gap-ms", "60000", "--turnaround-ms", "60000")
+    with socket.create_connection(("127.0.0.1", port), timeout=5) as sock:
+        sock.sendall(STATUS_TASK[:5])
+    emulator.wait_for(r"disconnected; 5 received bytes that were not yet a whole request dropped "
+                      r"\(01 01 00 00 00\)$")
+    with socket.create_connection(("127.0.0.1", port), timeout=5) as sock:
+        sock.sendall(STOP_FRAME)
+        emulator.wait_for(r"<- 01 06 01 A0 00 00 88 14")
+    emulator.wait_for(r"disconnected; 1 reply not sent$")
+    with socket.create_connection(("127.0.0.1", port), timeout=5):
+        pass
+    emulator.wait_for(r"disconnected$")  # nothing left behind: nothing more said
+    code, summary = emulator.stop()
+    assert code == 0 and "1 frames in, 0 replies out" in summary
 
 
 def test_fault_file_is_applied(tmp_path, start_emulator):
@@ -340,7 +368,7 @@ def test_fault_file_is_applied(tmp_path, start_emulator):
 
 @pytest.mark.parametrize("args, message, code", [
     ((), "give exactly one of --serial PORT or --tcp HOST:PORT", 2),
-    (("--tcp", "0", "--serial", "loop://"), "give exactly one of", 2),
+    (("--tcp", "0", "--serial", "/dev/ttyUSB0"), "give exactly one of", 2),
     (("--tcp", "here"), "expected HOST:PORT or PORT", 2),
     (("--tcp", "0", "--late-reply-on", "3"), "expected N:MS", 2),
     (("--tcp", "0", "--no-reply-on", "0"), "request numbers start at 1", 2),
@@ -349,6 +377,15 @@ def test_fault_file_is_applied(tmp_path, start_emulator):
     (("--tcp", "0", "--turnaround-ms", "-3"), "--turnaround-ms: must be at least 0.0", 2),
     (("--tcp", "0", "--exception-on", "2:300"), "--exception-on: must be at most 255", 2),
     (("--serial", "/nonexistent/ttyUSB9"), "cannot open serial port /nonexistent/ttyUSB9", 1),
+    (("--serial", "loop://"), "loop:// sends every byte back", 2),
+    (("--serial", "spy://loop://?logging=debug"), "loop:// sends every byte back", 2),
+    (("--serial", "/nonexistent/ttyUSB9", "--baud", "0"), "0 is not a standard serial speed", 2),
+    (("--serial", "/nonexistent/ttyUSB9", "--baud", "-9600"), "-9600 is not a standard serial speed", 2),
+    (("--serial", "/nonexistent/ttyUSB9", "--baud", "9601"), "9601 is not a standard serial speed", 2),
+    (("--tcp", "0", "--baud", "19200"), "--baud sets the speed of a --serial port", 2),
+    (("--tcp", "0", "--exit-after", "-1"), "--exit-after': must be a number of seconds greater than 0", 2),
+    (("--tcp", "0", "--exit-after", "0"), "--exit-after': must be a number of seconds greater than 0", 2),
+    (("--tcp", "0", "--exit-after", "inf"), "--exit-after': must be a number of seconds greater than 0", 2),
 ])
 def test_cli_mistakes_get_a_clear_message(args, message, code):
     result = run_cli(*args)

@@ -101,19 +101,41 @@ def test_fault_file_with_robot_table(tmp_path):
     assert [f.kind for f in loaded.faults] == ["no_reply"]
 
 
-@pytest.mark.parametrize("text, message", [
-    ("[[faults]\n", "not valid TOML"),
-    ("[scenario]\nname = 'x'\n", ": scenario: unknown key; expected one of robot, faults"),
-    ("robot = 3\n", ": robot: expected a table"),
-    ("[[faults]]\nkind = 'late_reply'\non_request = 2\n", ": faults[0].delay_ms: missing"),
+@pytest.mark.parametrize("text, where", [
+    ("[[faults]\n", ":1: not valid TOML"),
+    ("[scenario]\nname = 'x'\n", ":1: scenario: unknown key; expected one of robot, faults"),
+    ("robot = 3\n", ":1: robot: expected a table"),
+    ("[[faults]]\nkind = 'late_reply'\non_request = 2\n", ":1: faults[0].delay_ms: missing"),
+    ('[[faults]]\nkind = "no_reply"\non_request = 1\n\n[[faults]]\nkind = "x"\nat_s = 1\n',
+     ":6: faults[1].kind: unknown fault 'x'"),
+    ("# bench\n[robot]\nturnaround_ms = 8\npacing = 'sometimes'\n", ":4: robot.pacing: unknown pacing policy"),
+    ("[[faults]]\nkind = 'late_reply'\non_request = 2\n\n[[faults]]\nkind = 'late_reply'\n"
+     "on_request = 3\ndelay_ms = 5\n", ":1: faults[0].delay_ms: missing"),
+    ("[[faults]]\nkind = 'no_reply'\non_request = 1\n[[faults]\n", ":4: not valid TOML: "),
 ])
-def test_bad_fault_files_name_the_file_and_the_key(tmp_path, text, message):
+def test_bad_fault_files_name_the_file_the_line_and_the_key(tmp_path, text, where):
     path = tmp_path / "bad.toml"
     path.write_text(text)
     with pytest.raises(FaultFileError) as caught:
         load_fault_file(path)
-    assert str(caught.value).startswith(str(path))
-    assert message in str(caught.value)
+    assert str(caught.value).startswith(f"{path}{where}")
+
+
+def test_fault_file_refuses_a_wrong_address_fault_with_the_robots_own_address(tmp_path):
+    path = tmp_path / "bench.toml"
+    path.write_text("[[faults]]\nkind = 'wrong_address'\non_request = 1\naddress = 3\n")
+    with pytest.raises(FaultFileError) as caught:
+        load_fault_file(path, own_address=3)
+    assert str(caught.value).startswith(f"{path}:4: faults[0].address: 3 is the robot's own address")
+    assert load_fault_file(path, own_address=1).faults[0].address == 3
+
+
+def test_discard_returns_the_unfinished_bytes_and_forgets_them():
+    asm = RequestAssembler(silence_us=20_000)
+    assert asm.feed(STOP_FRAME[:5], 1_000) == []
+    assert asm.discard() == STOP_FRAME[:5]
+    assert asm.poll(1_000_000) == []
+    assert frames_of(asm.feed(STOP_FRAME, 2_000_000)) == [STOP_FRAME]
 
 
 def test_missing_fault_file(tmp_path):

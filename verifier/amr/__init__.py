@@ -6,11 +6,11 @@
 read scenario tables and name the bad key on error (:class:`ConfigError`).
 """
 from verifier.amr.config import BEFORE_STOP_POLICIES, PACING_POLICIES, RobotConfig
-from verifier.amr.faults import FAULT_KINDS, Fault, faults_from_list
+from verifier.amr.faults import FAULT_KINDS, Fault, check_fault_addresses, faults_from_list
 from verifier.amr.robot import Reply, Robot, RobotEvent
 from verifier.amr.schema import ConfigError
 
 __all__ = [
     "BEFORE_STOP_POLICIES", "ConfigError", "FAULT_KINDS", "Fault", "PACING_POLICIES",
-    "Reply", "Robot", "RobotConfig", "RobotEvent", "faults_from_list",
+    "Reply", "Robot", "RobotConfig", "RobotEvent", "check_fault_addresses", "faults_from_list",
 ]

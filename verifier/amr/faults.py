@@ -172,6 +172,18 @@ def faults_from_list(items: Any, path: str = "faults") -> list[Fault]:
     return [Fault.from_dict(item, schema.join(path, i)) for i, item in enumerate(items)]
 
 
+def check_fault_addresses(faults: Iterable[Fault], own_address: int, path: str = "faults") -> None:
+    """A ``wrong_address`` fault must name another address than the robot's own: a reply
+    from the robot's own address is the normal reply, so the fault would test nothing.
+    ConfigError names the fault by its place in the list (``faults[2].address``)."""
+    for index, fault in enumerate(faults):
+        if fault.kind == "wrong_address" and fault.address == own_address:
+            raise schema.ConfigError(
+                schema.join(schema.join(path, index), "address"),
+                f"{own_address} is the robot's own address, so the reply would be a normal one; "
+                "give another address (0-255), or leave address out to get the next one")
+
+
 def _unknown_kind(kind: Any) -> str:
     return f"unknown fault {kind!r}; expected one of {', '.join(FAULT_KINDS)}"
 

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 from verifier.amr import motion as motions
 from verifier.amr.config import RobotConfig
-from verifier.amr.faults import Fault
+from verifier.amr.faults import Fault, check_fault_addresses
 from verifier.amr.motion import MAGNETIC, TRACKLESS, Motion
 from verifier.protocol.catalogue import (
     EXCEPTION_FLAG,
@@ -122,6 +122,7 @@ class Robot:
 
     def __init__(self, settings: Settings = DEFAULT_SETTINGS, config: RobotConfig | None = None,
                  faults: list[Fault] | tuple[Fault, ...] = ()) -> None:
+        check_fault_addresses(faults, settings.address)
         self.settings = settings
         self.config = config if config is not None else RobotConfig()
         self.now_us = 0

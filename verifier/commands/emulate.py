@@ -31,6 +31,35 @@ def _tcp_endpoint(value: str) -> tuple[str, int]:
     return host, number
 
 
+#: Serial speeds the emulator accepts: the standard rates from 300 to 230400 bit/s that
+#: USB-RS-485 adapters offer (for a PLC set to another speed by mistake). The robot uses 9600.
+STANDARD_BAUD_RATES = (300, 600, 1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200, 230400)
+
+
+def _baud(ctx: click.Context, param: click.Parameter, value: int) -> int:
+    if value not in STANDARD_BAUD_RATES:
+        raise click.BadParameter(
+            f"{value} is not a standard serial speed; use one of "
+            f"{', '.join(map(str, STANDARD_BAUD_RATES))} (the robot uses 9600)")
+    return value
+
+
+def _serial_url(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
+    if value is not None and "loop://" in value.lower():
+        raise click.BadParameter(
+            "loop:// sends every byte back to the port itself, so the robot would read its own "
+            "replies as new requests (an FC06 reply echoes the request) and never hear a PLC; "
+            "give a real port, a pty (socat) or socket://HOST:PORT")
+    return value
+
+
+def _exit_after(ctx: click.Context, param: click.Parameter, value: float | None) -> float | None:
+    if value is not None and not 0 < value <= threading.TIMEOUT_MAX:
+        raise click.BadParameter(f"must be a number of seconds greater than 0 "
+                                 f"(and at most {threading.TIMEOUT_MAX:.0f}), got {value:g}")
+    return value
+
+
 def _request_number(value: str, option: str) -> tuple[int, str]:
     number, _, rest = value.partition(":")
     try:
@@ -79,11 +108,13 @@ def _flag_faults(no_reply, bad_crc, garbage, wrong_address, exception, late,
 
 
 @click.command("emulate")
-@click.option("--serial", "serial_url", metavar="PORT",
-              help="Serial port or pyserial URL: /dev/ttyUSB0, COM3, socket://HOST:PORT, rfc2217://HOST:PORT.")
+@click.option("--serial", "serial_url", metavar="PORT", callback=_serial_url,
+              help="Serial port or pyserial URL: /dev/ttyUSB0, COM3, socket://HOST:PORT, rfc2217://HOST:PORT "
+                   "(not loop://).")
 @click.option("--tcp", "tcp", metavar="HOST:PORT",
               help="Listen for raw RTU frames over TCP (PORT alone binds 127.0.0.1; port 0 = any free port).")
-@click.option("--baud", default=9600, show_default=True, help="Serial speed (the robot uses 9600 8N1).")
+@click.option("--baud", type=int, default=9600, show_default=True, callback=_baud,
+              help="Serial speed, a standard rate 300-230400 (the robot uses 9600 8N1); --serial only.")
 @protocol_settings
 @click.option("--faults", "faults_file", type=click.Path(dir_okay=False), metavar="FILE.toml",
               help="Scripted faults ([[faults]]) and robot settings ([robot]).")
@@ -104,7 +135,8 @@ def _flag_faults(no_reply, bad_crc, garbage, wrong_address, exception, late,
 @click.option("--low-battery-at", multiple=True, type=float, metavar="S", help="Battery warning from S seconds (error 03).")
 @click.option("--frame-gap-ms", type=float, default=DEFAULT_SILENCE_US / 1000, show_default=True,
               help="Silence that ends an incomplete frame on the wall clock (USB adapters deliver in chunks).")
-@click.option("--exit-after", type=float, metavar="S", help="Stop by itself after S seconds.")
+@click.option("--exit-after", type=float, metavar="S", callback=_exit_after,
+              help="Stop by itself after S seconds (S > 0).")
 @click.option("--quiet", is_flag=True, help="No live log, only the summary line.")
 def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_duration_s, pacing,
             before_stop, no_reply_on, bad_crc_on, garbage_on, wrong_address_on, exception_on,
@@ -117,11 +149,14 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
     """
     if (serial_url is None) == (tcp is None):
         raise click.UsageError("give exactly one of --serial PORT or --tcp HOST:PORT")
+    context = click.get_current_context()
+    if tcp is not None and context.get_parameter_source("baud") is not click.core.ParameterSource.DEFAULT:
+        raise click.UsageError("--baud sets the speed of a --serial port; --tcp carries bytes without one")
     robot_table: dict = {}
     faults: list[Fault] = []
     if faults_file:
         try:
-            loaded = load_fault_file(faults_file)
+            loaded = load_fault_file(faults_file, settings.address)
         except FaultFileError as err:
             raise click.BadParameter(str(err), param_hint="--faults") from None
         robot_table, faults = dict(loaded.robot), list(loaded.faults)
@@ -136,10 +171,9 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
         except ConfigError as err:
             raise click.BadParameter(err.message, param_hint=option) from None
         robot_table[key] = value
-    try:
-        config = RobotConfig.from_dict(robot_table)
-    except ConfigError as err:
-        raise click.BadParameter(f"{faults_file}: {err}", param_hint="--faults") from None
+    # Every key was checked on its own (file keys with their line, options with their
+    # name); together they cannot fail.
+    config = RobotConfig.from_dict(robot_table)
     faults += _flag_faults(no_reply_on, bad_crc_on, garbage_on, wrong_address_on, exception_on,
                            late_reply_on, anti_collision_at, off_tape_at, low_battery_at)
     if frame_gap_ms <= 0:

@@ -96,6 +96,14 @@ class RequestAssembler:
     def pending(self) -> bytes:
         return bytes(self._buffer)
 
+    def discard(self) -> bytes:
+        """Throw away what waits for a silence (the peer went away); returns those bytes.
+        The tail of a flood being dropped is not kept, so it is not returned either."""
+        left = bytes(self._buffer)
+        self._clear()
+        self._flooding = False
+        return left
+
     def deadline_us(self) -> int | None:
         """When :meth:`poll` can next complete something (None: nothing waits)."""
         if self._buffer or self._flooding:

@@ -18,8 +18,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from verifier.amr import ConfigError, Fault, faults_from_list
+from verifier.amr import ConfigError, Fault, RobotConfig, check_fault_addresses, faults_from_list
 from verifier.amr.schema import reject_unknown_keys
+from verifier.tomlpos import decode_error_position, line_of_key
 
 FILE_KEYS = ("robot", "faults")
 
@@ -34,7 +35,14 @@ class FaultFile:
     faults: list[Fault]
 
 
-def load_fault_file(path: str | Path) -> FaultFile:
+def load_fault_file(path: str | Path, own_address: int | None = None) -> FaultFile:
+    """Read and check a fault file. Every error names the file, the line and the key
+    (``bench.toml:7: faults[1].kind: unknown fault 'x'; …``), as a scenario's do.
+
+    ``own_address`` is the robot's address, when known: a ``wrong_address`` fault may not
+    use it. The ``[robot]`` table is checked here, key by key, and returned as a table so
+    that command-line options can still override single keys.
+    """
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
@@ -45,13 +53,22 @@ def load_fault_file(path: str | Path) -> FaultFile:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
-        raise FaultFileError(f"{path}: not valid TOML: {err}") from None
+        message, line = decode_error_position(err)
+        raise FaultFileError(f"{_where(path, line)}: not valid TOML: {message}") from None
     try:
         reject_unknown_keys(data, FILE_KEYS, "")
         robot = data.get("robot", {})
         if not isinstance(robot, dict):
             raise ConfigError("robot", "expected a table ([robot])")
+        RobotConfig.from_dict(robot, "robot")
         faults = faults_from_list(data.get("faults", []))
+        if own_address is not None:
+            check_fault_addresses(faults, own_address)
     except ConfigError as err:
-        raise FaultFileError(f"{path}: {err}") from None
+        line = line_of_key(text.splitlines(), err.path)
+        raise FaultFileError(f"{_where(path, line)}: {err}") from None
     return FaultFile(robot, faults)
+
+
+def _where(path: Path, line: int | None) -> str:
+    return f"{path}:{line}" if line is not None else str(path)

@@ -23,6 +23,7 @@ import serial
 
 from verifier.emulate.assembler import RequestAssembler
 from verifier.emulate.core import Emulator, Outgoing
+from verifier.protocol.codec import hex_bytes
 
 POLL_S = 0.005  # longest wait between looks at the clock (reply and silence deadlines)
 
@@ -45,6 +46,19 @@ class _Channel:
             if reply is not None:
                 self.outgoing.append(reply)
         self.outgoing.sort(key=lambda o: o.due_us)
+
+    def close(self) -> str:
+        """Forget what is still in flight; the words for the log, '' when nothing was."""
+        unread = self.assembler.discard()
+        lost = []
+        if unread:
+            lost.append(f"{len(unread)} received byte{'s' if len(unread) != 1 else ''} that were not yet "
+                        f"a whole request dropped ({hex_bytes(unread)})")
+        if self.outgoing:
+            count = len(self.outgoing)
+            lost.append(f"{count} repl{'ies' if count != 1 else 'y'} not sent")
+            self.outgoing = []
+        return "; " + ", ".join(lost) if lost else ""
 
     def due(self, now_us: int) -> list[Outgoing]:
         ready = [o for o in self.outgoing if o.due_us <= now_us]
@@ -108,7 +122,7 @@ def serve_tcp(host: str, port: int, emulator: Emulator, stop: threading.Event, s
         channel = clients.pop(sock)
         selector.unregister(sock)
         sock.close()
-        emulator.note(f"client {channel.peer} {why}")
+        emulator.note(f"client {channel.peer} {why}{channel.close()}")
 
     try:
         while not stop.is_set():

@@ -14,8 +14,9 @@ from typing import Any
 
 from verifier import protocol
 from verifier.amr.config import RobotConfig
-from verifier.amr.faults import Fault
+from verifier.amr.faults import Fault, check_fault_addresses
 from verifier.amr.schema import ConfigError
+from verifier.tomlpos import decode_error_position, line_of_key
 
 from .conditions import ConditionError, parse_condition
 from .durations import parse_duration_us
@@ -153,11 +154,7 @@ def parse_scenario(text: str, path: Path | None = None) -> Scenario:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        match = re.search(r"\(at line (\d+), column (\d+)\)", str(exc))
-        line = int(match.group(1)) if match else None
-        message = re.sub(r"\s*\(at line \d+, column \d+\)", "", str(exc))
-        if match:
-            message += f" (column {match.group(2)})"
+        message, line = decode_error_position(exc)
         raise ScenarioError(path, "", f"not valid TOML: {message}", line) from None
     return _Reader(text, path).read(data)
 
@@ -177,36 +174,7 @@ class _Reader:
 
     def line_of(self, key: str) -> int | None:
         """Best effort: the line that sets `key` (e.g. "expect[1].within", "robot.x")."""
-        parts = re.findall(r"[^.\[\]]+|\[\d+\]", key)
-        if not parts:
-            return None
-        table, index, rest = parts[0], 0, parts[1:]
-        if rest and rest[0].startswith("["):
-            index = int(rest[0][1:-1])
-            rest = rest[1:]
-        header = re.compile(r"^\s*\[\[\s*" + re.escape(table) + r"\s*\]\]")
-        plain_header = re.compile(r"^\s*\[\s*" + re.escape(table) + r"\s*\]")
-        start: int | None = None  # the line of the table's header, when the key is in a table
-        seen = -1
-        for number, line in enumerate(self.lines):
-            if header.match(line):
-                seen += 1
-                if seen == index:
-                    start = number
-                    break
-            elif plain_header.match(line):
-                start = number
-                break
-        target = rest[0] if rest else table
-        if start is not None and not rest:
-            return start + 1  # the table itself is wrong: point at its header
-        for number in range(start or 0, len(self.lines)):
-            line = self.lines[number]
-            if start is None and number > 0 and re.match(r"^\s*\[", line):
-                break  # a top-level key comes before every table
-            if re.match(r"^\s*\"?" + re.escape(target) + r"\"?\s*=", line):
-                return number + 1
-        return None if start is None else start + 1
+        return line_of_key(self.lines, key)
 
     # --- helpers -------------------------------------------------------------------------
 
@@ -286,6 +254,10 @@ class _Reader:
         settings = self.settings(data.get("protocol", {}))
         robot = self.robot(data.get("robot", {}))
         faults = self.faults(data.get("faults", []))
+        try:
+            check_fault_addresses(faults, settings.address)
+        except ConfigError as exc:
+            raise self.fail(exc.path, exc.message) from None
         inputs = tuple(
             self.input_step(item, f"inputs[{i}]", duration)
             for i, item in enumerate(self.array_of_tables(data.get("inputs", []), "inputs"))

@@ -1,0 +1,65 @@
+"""verifier.tomlpos: the line of a key in a TOML file, shared by every TOML loader."""
+from __future__ import annotations
+
+import tomllib
+
+import pytest
+
+from verifier.tomlpos import decode_error_position, line_of_key
+
+TEXT = """\
+name = "bench"
+duration = "60s"
+
+[robot]
+turnaround_ms = 8
+"pacing" = "late"
+
+[[faults]]
+kind = "no_reply"
+on_request = 1
+
+[[faults]]
+kind = "late_reply"
+on_request = 2
+
+[[inputs]]
+at = "1s"
+[inputs.set]
+X0 = true
+"""
+LINES = TEXT.splitlines()
+
+
+@pytest.mark.parametrize("key, line", [
+    ("name", 1),
+    ("duration", 2),
+    ("robot", 4),
+    ("robot.turnaround_ms", 5),
+    ("robot.pacing", 6),          # a quoted key
+    ("faults", 8),                # the first table of the array
+    ("faults[0]", 8),
+    ("faults[0].on_request", 10),
+    ("faults[1].kind", 13),
+    ("faults[1].delay_ms", 12),   # missing in its table: its header, not a later table's key
+    ("faults[0].delay_ms", 8),
+    ("inputs[0].set", 16),        # sub-tables belong to their table
+    ("nosuch", None),
+    ("", None),
+])
+def test_line_of_key(key, line):
+    assert line_of_key(LINES, key) == line
+
+
+def test_a_missing_key_never_points_into_a_later_table():
+    lines = ["[[faults]]", "kind = 'late_reply'", "", "[[faults]]", "kind = 'late_reply'", "delay_ms = 5"]
+    assert line_of_key(lines, "faults[0].delay_ms") == 1
+    assert line_of_key(lines, "faults[1].delay_ms") == 6
+
+
+def test_decode_error_position_moves_the_line_out_of_the_message():
+    with pytest.raises(tomllib.TOMLDecodeError) as caught:
+        tomllib.loads('a = 1\n[[faults]\nkind = "x"\n')
+    message, line = decode_error_position(caught.value)
+    assert line == 2
+    assert message == "Expected ']]' at the end of an array declaration (column 9)"
