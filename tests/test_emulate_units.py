@@ -14,6 +14,7 @@ from verifier.emulate import (
     RequestAssembler,
     load_fault_file,
 )
+from verifier.emulate.ports import serial_assembler
 from verifier.protocol import STOP_FRAME, Query, StatusRequest, encode, with_crc
 
 STATUS = encode(StatusRequest(1, Query.TASK))
@@ -136,6 +137,23 @@ def test_discard_returns_the_unfinished_bytes_and_forgets_them():
     assert asm.discard() == STOP_FRAME[:5]
     assert asm.poll(1_000_000) == []
     assert frames_of(asm.feed(STOP_FRAME, 2_000_000)) == [STOP_FRAME]
+
+
+@pytest.mark.parametrize("baud, gap_us, t3_5_us", [
+    (9600, 20_000, 3_646), (19200, 20_000, 1_823), (115200, 20_000, 1_750),
+    (1200, 29_167, 29_167), (300, 116_667, 116_667),
+])
+def test_serial_framing_follows_the_speed(baud, gap_us, t3_5_us):
+    asm = serial_assembler(baud, 20_000)
+    assert (asm.silence_us, asm.t3_5_us) == (gap_us, t3_5_us)
+    # a byte every 40 ms: one frame at 300 bit/s (a byte takes 33 ms there), one frame per
+    # byte at 9600 (20 ms of silence ends it)
+    noise = bytes.fromhex("01 03 00 00 00 01 00 00")
+    items = []
+    for k, byte in enumerate(noise):
+        items += asm.feed(bytes((byte,)), k * 40_000)
+    items += asm.poll(len(noise) * 40_000 + gap_us)
+    assert frames_of(items) == ([noise] if baud == 300 else [bytes((b,)) for b in noise])
 
 
 def test_missing_fault_file(tmp_path):

@@ -23,6 +23,7 @@ import serial
 
 from verifier.emulate.assembler import RequestAssembler
 from verifier.emulate.core import Emulator, Outgoing
+from verifier.link.line import LineConfig
 from verifier.protocol.codec import hex_bytes
 
 POLL_S = 0.005  # longest wait between looks at the clock (reply and silence deadlines)
@@ -66,6 +67,14 @@ class _Channel:
         return ready
 
 
+def serial_assembler(baudrate: int, silence_us: int) -> RequestAssembler:
+    """The assembler for a serial port at ``baudrate``. Modbus ends a frame after 3.5
+    character times: 3.65 ms at 9600 bit/s, but 117 ms at 300 bit/s, where one byte alone
+    takes longer than the default wall-clock gap - so the gap is never shorter than t3.5."""
+    t3_5_us = LineConfig(baud=baudrate).frame_gap_us
+    return RequestAssembler(max(silence_us, t3_5_us), t3_5_us=t3_5_us)
+
+
 def serve_serial(url: str, emulator: Emulator, stop: threading.Event, silence_us: int,
                  baudrate: int = 9600) -> None:
     """Run until ``stop`` is set: read requests from ``url``, write replies when due."""
@@ -75,8 +84,11 @@ def serve_serial(url: str, emulator: Emulator, stop: threading.Event, silence_us
                                      timeout=POLL_S)
     except (serial.SerialException, ValueError, OSError) as err:
         raise PortError(f"cannot open serial port {url}: {err}") from None
-    channel = _Channel(RequestAssembler(silence_us))
-    emulator.note(f"listening on serial {url} at {baudrate} 8N1, robot address {emulator.robot.settings.address}")
+    channel = _Channel(serial_assembler(baudrate, silence_us))
+    gap_us = channel.assembler.silence_us
+    longer = f", frame gap {gap_us / 1000:g} ms (t3.5 at {baudrate} bit/s)" if gap_us > silence_us else ""
+    emulator.note(f"listening on serial {url} at {baudrate} 8N1{longer}, "
+                  f"robot address {emulator.robot.settings.address}")
     try:
         while not stop.is_set():
             try:
