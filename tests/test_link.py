@@ -1,12 +1,15 @@
 """The virtual 9600 8N1 line: byte times, t1.5/t3.5, turnaround, collisions, the trace."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 from hypothesis import given, settings as hsettings, strategies as st
 
 from verifier.amr import Robot, RobotConfig, faults_from_list
 from verifier.link import Line, LineConfig, TraceFrame
 from verifier.protocol import STOP_FRAME, ControlRequest, Query, StatusRequest, encode, with_crc
+from verifier.protocol.strategies import requests
 from verifier.protocol.timing import T1_5_US, T3_5_US
 
 STATUS = encode(StatusRequest(1, Query.TASK))
@@ -241,3 +244,66 @@ def test_off_tape_on_the_line_during_a_tape_follow():
     line = make_line({"kind": "off_tape", "at_s": 0.5})
     seen = _plc_sees(line, [STOP_FRAME, with_crc(FOLLOW), VEHICLE])
     assert seen[2] == with_crc(bytes.fromhex("01 01 03 00 02 02"))
+
+
+_SCRIPTED_FAULTS = st.lists(st.one_of(
+    st.fixed_dictionaries({"kind": st.sampled_from(["no_reply", "bad_crc", "garbage", "wrong_address"]),
+                           "on_request": st.integers(1, 12)}),
+    st.fixed_dictionaries({"kind": st.just("exception"), "on_request": st.integers(1, 12),
+                           "code": st.integers(1, 11)}),
+    st.fixed_dictionaries({"kind": st.just("late_reply"), "on_request": st.integers(1, 12),
+                           "delay_ms": st.integers(1, 150)}),
+    st.fixed_dictionaries({"kind": st.sampled_from(["anti_collision", "off_tape", "low_battery"]),
+                           "at_s": st.floats(0, 6, allow_nan=False)}),
+), max_size=4)
+
+
+@hsettings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(requests, st.integers(260_000, 900_000)), min_size=1, max_size=12), _SCRIPTED_FAULTS)
+def test_well_spaced_requests_get_exactly_what_the_robot_answers_directly(script, faults):
+    """The line adds time, never content: requests more than 250 ms apart reach the robot
+    whole, and the PLC receives, byte for byte, what the same robot model (same faults)
+    answers when it is fed the same frames at the same times without a line."""
+    line = Line(Robot(config=RobotConfig(before_stop="obey"), faults=faults_from_list(faults)))
+    direct = Robot(config=RobotConfig(before_stop="obey"), faults=faults_from_list(faults))
+    t, expected, received = 0, [], []
+    for request, gap in script:
+        t += gap
+        frame = encode(replace(request, address=1))
+        end = line.send(frame, t)
+        reply = direct.on_request(frame, end, start_us=t)
+        if reply is not None:
+            first_arrival = end + max(reply.delay_us, T3_5_US) + BYTE_END[1]
+            expected.append((reply.data, first_arrival))
+        got = line.receive_until(t + 200_000)  # every reply is in long before the next send
+        if got:
+            received.append((bytes(b for b, _ in got), got[0][1]))
+    tail = line.receive_until(t + 2_000_000)
+    if tail:
+        received.append((bytes(b for b, _ in tail), tail[0][1]))
+    assert received == expected
+    assert not [e for e in line.events if e.kind in ("collision", "gap", "discarded")]
+
+
+@hsettings(max_examples=100, deadline=None)
+@given(st.lists(st.tuples(requests, st.integers(0, 30_000)), min_size=1, max_size=15))
+def test_crowded_traffic_keeps_the_half_duplex_rules(script):
+    """Requests sent too close together (collisions, merged frames): whatever happens, the
+    robot never answers before t3.5 of silence after the PLC's last byte, never talks over
+    itself, and the trace stays in time order."""
+    line = Line(Robot(config=RobotConfig(before_stop="obey", turnaround_ms=0)))
+    t = 0
+    for request, gap in script:
+        t += gap
+        line.send(encode(replace(request, address=1)), t)
+        line.receive_until(t)
+    line.receive_until(t + 2_000_000)
+    frames = line.trace
+    assert all(a.t_start_us <= b.t_start_us for a, b in zip(frames, frames[1:]))
+    replies = [f for f in frames if f.direction == "rx"]
+    assert all(a.t_end_us <= b.t_start_us for a, b in zip(replies, replies[1:]))
+    sends = [f for f in frames if f.direction == "tx"]
+    for reply in replies:
+        before = [f for f in sends if f.t_end_us <= reply.t_start_us]
+        assert before, "a reply with no request before it"
+        assert reply.t_start_us - before[-1].t_end_us >= T3_5_US
