@@ -243,6 +243,25 @@ def test_sending_while_the_reply_is_due_breaks_half_duplex():
     assert "was due" in found["UITAMR-HALF-DUPLEX"][0].message
 
 
+def test_half_duplex_evidence_is_in_time_order_and_reads_the_reply_like_the_trace():
+    """The reply that was due is listed after the earlier request, and named as its answer
+    (task status: running), exactly as --trace and the HTML name the same frame."""
+    from verifier.verify.report_trace import records
+    from verifier.verify.result import ScenarioResult
+
+    read = tx(0, READ_TASK)
+    reply = answer(read, reply=protocol.StatusReply(1, 0, 1), delay_us=50 * MS)
+    early = _frame("tx", read.t_end_us + 10 * MS, protocol.encode(READ_TASK, S))
+    trace = [read, reply, early]
+    (violation,) = check(trace, options=RuleOptions(min_period_us=1))["UITAMR-HALF-DUPLEX"]
+    times = [frame.t_us for frame in violation.frames]
+    assert times == sorted(times) and [f.direction for f in violation.frames] == ["tx", "rx"]
+    result = ScenarioResult("s", None, "", "Main", "fx3u", "fx3:1", [], 1_000_000, 10_000, 0, S, trace=trace)
+    meaning = {r["t"]: r["meaning"] for r in records(result) if r["dir"] == "rx"}
+    assert violation.frames[1].meaning == meaning[reply.t_start_us / 1_000_000]
+    assert "running" in violation.frames[1].meaning
+
+
 def test_half_duplex_needs_t3_5_of_silence_after_the_robot():
     request = tx(0, STOP)
     reply = answer(request)

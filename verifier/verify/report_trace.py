@@ -12,8 +12,9 @@ from typing import Iterator
 
 from verifier import protocol
 
+from .evidence import RuleOptions
 from .result import ScenarioResult
-from .traffic import describe_bytes
+from .traffic import analyse, describe_bytes
 
 
 def records(result: ScenarioResult) -> Iterator[dict]:
@@ -21,16 +22,9 @@ def records(result: ScenarioResult) -> Iterator[dict]:
     for violation in result.all_violations():
         for frame in violation.frames:
             blamed.setdefault((frame.t_us, frame.direction), set()).add(violation.rule)
-    last_request = None
+    traffic = analyse(result.trace, result.settings, RuleOptions(reply_timeout_us=result.reply_timeout_us))
     for frame in sorted(result.trace, key=lambda f: (f.t_start_us, f.direction != "tx")):
-        request = None
-        if frame.direction == "tx":
-            try:
-                last_request = protocol.decode_request(frame.data, result.settings)
-            except protocol.FrameError:
-                last_request = None
-        else:
-            request = last_request
+        request = traffic.request_of(frame) if frame.direction == "rx" else None
         yield {
             "scenario": result.name,
             "t": frame.t_start_us / 1_000_000,

@@ -136,6 +136,22 @@ class Traffic:
     rx: list[TraceFrameLike]
     tx: list[TraceFrameLike]
 
+    def request_of(self, frame: TraceFrameLike):
+        """The decoded request a robot frame was paired with (None before the first request,
+        or when that request is not valid), so every report describes a reply the same way."""
+        for exchange in self._owners.get(frame.t_start_us, ()):
+            if any(f is frame for f in exchange.rx):
+                return exchange.decoded_request
+        return None
+
+    @cached_property
+    def _owners(self) -> dict[int, list[Exchange]]:
+        owners: dict[int, list[Exchange]] = {}
+        for exchange in self.exchanges:
+            for frame in exchange.rx:
+                owners.setdefault(frame.t_start_us, []).append(exchange)
+        return owners
+
 
 def _is_reply_to(frame: TraceFrameLike, exchange: Exchange) -> bool:
     request = exchange.decoded_request

@@ -65,7 +65,8 @@ def check_half_duplex(evidence: RunEvidence, traffic: Traffic) -> list[Violation
                     "UITAMR-HALF-DUPLEX",
                     start,
                     f"the PLC started transmitting {why}",
-                    (frame_ref(rx, settings), frame_ref(frame, settings)),
+                    tuple(sorted((frame_ref(rx, settings, request=traffic.request_of(rx)),
+                                  frame_ref(frame, settings)), key=lambda ref: ref.t_us)),
                     frame.origin,
                 )
             )
