@@ -15,12 +15,16 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
 import verifier
-from verifier.verify.durations import parse_duration_us
+from verifier.verify.durations import format_duration, format_seconds, parse_duration_us
 from verifier.verify.result import ScenarioResult, UnusableInput
-from verifier.verify.scenario import PLATFORMS, Scenario, ScenarioError, default_scenario, load_scenario
+from verifier.verify.scenario import (
+    MAX_DURATION_US, PLATFORMS, Scenario, ScenarioError, default_scenario, load_scenario,
+)
+from verifier.verify.sources import SourceError, expand, unique
 
 EXIT_PASS, EXIT_FAIL, EXIT_UNUSABLE = 0, 1, 2
 SHOW_PROGRESS_AFTER_S = 0.5
+PLAIN_PROGRESS_EVERY_S = 30.0  # progress lines in CI logs (not a terminal)
 
 
 def bundled_plc_dir() -> Path:
@@ -32,15 +36,26 @@ def bundled_scenarios() -> list[Path]:
 
 
 class _Duration(click.ParamType):
+    """A duration option: a number with a unit, longer than 0 and at most `maximum_us`."""
+
     name = "duration"
+
+    def __init__(self, maximum_us: int | None = None):
+        self.maximum_us = maximum_us
 
     def convert(self, value, param, ctx):
         if isinstance(value, int):
             return value
         try:
-            return parse_duration_us(value)
+            us = parse_duration_us(value)
         except ValueError as exc:
             self.fail(str(exc), param, ctx)
+        if us <= 0:
+            self.fail(f"{value!r} must be longer than 0", param, ctx)
+        if self.maximum_us is not None and us > self.maximum_us:
+            self.fail(f"{value!r} is longer than the limit of {format_duration(self.maximum_us)} of virtual time; "
+                      "split a longer soak test into several runs (--seed differs per run)", param, ctx)
+        return us
 
 
 def _unusable(message: str) -> None:
@@ -57,7 +72,7 @@ def _scenarios(sources, program, platform, scenario_files, matrix, duration, sca
         files += [f for f in found if f not in files]
     scenarios = [load_scenario(f) for f in files] if files else [default_scenario(duration_us=duration or 60_000_000)]
     if sources:
-        resolved = tuple(Path(s).resolve() for s in sources)
+        resolved = _source_files(sources)
         scenarios = [replace(s, sources=resolved) for s in scenarios]
     overrides = {"program": program, "platform": platform, "duration_us": duration, "scan_us": scan, "seed": seed}
     scenarios = [s.with_overrides(**overrides) for s in scenarios]
@@ -70,6 +85,17 @@ def _scenarios(sources, program, platform, scenario_files, matrix, duration, sca
             where = scenario.path or "the default scenario"
             raise UnusableInput(f"{where}: no ST sources: give them as arguments (uitamr verify FILE.st ...)")
     return scenarios
+
+
+def _source_files(sources) -> tuple[Path, ...]:
+    """The .st files named on the command line: files, folders (recursively) or patterns."""
+    found: list[Path] = []
+    for name in sources:
+        try:
+            found += expand(name, Path.cwd())
+        except SourceError as exc:
+            raise UnusableInput(str(exc)) from None
+    return unique(found)
 
 
 def _run_one(scenario: Scenario) -> ScenarioResult:
@@ -89,9 +115,10 @@ class _LazyProgress:
         self.last_update = 0.0
 
     def update(self, done_us: int, label: str) -> None:
-        if not self.enabled:
-            return
         now = time.perf_counter()
+        if not self.enabled:
+            self._plain(now, done_us, label)
+            return
         if self.bar is None:
             if now - self.started < SHOW_PROGRESS_AFTER_S:
                 return
@@ -105,6 +132,15 @@ class _LazyProgress:
             return
         self.last_update = now
         self.bar.update(self.task, completed=done_us, description=label)
+
+    def _plain(self, now: float, done_us: int, label: str) -> None:
+        """Not a terminal (a CI log): a plain line now and then, so a long run is not a hang."""
+        if now - max(self.started, self.last_update) < PLAIN_PROGRESS_EVERY_S or done_us >= self.total:
+            return
+        self.last_update = now
+        share = 100 * done_us / self.total if self.total else 100
+        self.console.print(f"verify: {share:.0f}% of {format_seconds(self.total)} virtual time done ({label})",
+                           highlight=False, markup=False)
 
     def stop(self) -> None:
         if self.bar is not None:
@@ -135,13 +171,13 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress) -> l
 
 
 @click.command(context_settings={"help_option_names": ["-h", "--help"]})
-@click.argument("sources", nargs=-1, type=click.Path(dir_okay=False))
+@click.argument("sources", nargs=-1, type=click.Path())
 @click.option("--program", help="The PROGRAM POU to run (default: the scenario's, or the only one).")
 @click.option("--platform", type=click.Choice(sorted(PLATFORMS)), help="PLC platform (sets the ST dialect and the serial port).")
 @click.option("--scenario", "scenario_files", multiple=True, type=click.Path(dir_okay=False),
               help="Scenario file (TOML); repeat for several. Default: the bundled scenarios, or a healthy robot when SOURCES are given.")
 @click.option("--matrix", is_flag=True, help="Run every bundled scenario (with SOURCES: against those sources).")
-@click.option("--duration", type=_Duration(), help="Virtual run time, e.g. 60s (overrides the scenarios'; default 60s).")
+@click.option("--duration", type=_Duration(MAX_DURATION_US), help="Virtual run time, e.g. 60s (overrides the scenarios'; default 60s).")
 @click.option("--scan", type=_Duration(), help="PLC scan time, e.g. 10ms (overrides the scenarios'; default 10ms).")
 @click.option("--seed", type=int, help="Seed for everything random in the run (overrides the scenarios').")
 @click.option("--jobs", "-j", type=click.IntRange(min=1), default=1, show_default=True, help="Scenarios run in parallel processes.")

@@ -189,6 +189,54 @@ def _evaluate(node, values: Mapping[str, Value]) -> Value:
     return {"and": left and right, "or": left or right, "xor": left != right}[kind]
 
 
+class _TypeProblem(Exception):
+    pass
+
+
+def _shown(node) -> str:
+    if node[0] == "var":
+        return node[1]
+    if node[0] == "lit":
+        return ("TRUE" if node[1] else "FALSE") if isinstance(node[1], bool) else str(node[1])
+    return "the expression"
+
+
+def _kind(node, kinds: Mapping[str, str]) -> str:
+    """"bool" or "number" for a node; _TypeProblem when its parts do not fit together."""
+    tag = node[0]
+    if tag == "lit":
+        return "bool" if isinstance(node[1], bool) else "number"
+    if tag == "var":
+        return kinds[node[1]]
+    if tag == "not":
+        if _kind(node[1], kinds) != "bool":
+            raise _TypeProblem(f"NOT needs a BOOL, but {_shown(node[1])} is a number")
+        return "bool"
+    if tag == "neg":
+        if _kind(node[1], kinds) != "number":
+            raise _TypeProblem(f"'-' needs a number, but {_shown(node[1])} is a BOOL")
+        return "number"
+    if tag == "cmp":
+        op, left, right = node[1:]
+        sides = _kind(left, kinds), _kind(right, kinds)
+        if sides[0] != sides[1]:
+            which = left if sides[0] == "bool" else right
+            other = right if which is left else left
+            raise _TypeProblem(
+                f"{_shown(which)} is a BOOL and {_shown(other)} a number: compare a BOOL with TRUE or FALSE"
+            )
+        if sides[0] == "bool" and op not in ("=", "<>"):
+            raise _TypeProblem(f"BOOLs are compared with = or <> only, not {op}")
+        return "bool"
+    word = tag.upper()
+    for side in node[1:]:
+        if _kind(side, kinds) != "bool":
+            raise _TypeProblem(
+                f"{word} joins BOOLs, but {_shown(side)} is a number: compare it, e.g. {_shown(side)} <> 0"
+            )
+    return "bool"
+
+
 @dataclass(frozen=True)
 class Condition:
     """A parsed condition: `names` are the labels it reads, `holds(values)` evaluates it."""
@@ -202,6 +250,18 @@ class Condition:
 
     def holds(self, values: Mapping[str, Value]) -> bool:
         return bool(_evaluate(self.tree, values))
+
+    def type_error(self, kinds: Mapping[str, str]) -> str | None:
+        """Why the condition does not type-check, given each label's kind ("bool" or
+        "number"), or None. A condition must be BOOL; AND/OR/XOR/NOT join BOOLs; a
+        comparison compares two numbers, or two BOOLs with = and <>."""
+        try:
+            kind = _kind(self.tree, kinds)
+        except _TypeProblem as problem:
+            return str(problem)
+        if kind != "bool":
+            return f"{_shown(self.tree)} is a number, not a condition: compare it, e.g. {_shown(self.tree)} <> 0"
+        return None
 
     def __str__(self) -> str:
         return self.text

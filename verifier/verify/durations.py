@@ -39,3 +39,11 @@ def parse_duration_us(text: object) -> int:
 def format_seconds(t_us: int) -> str:
     """Virtual time for people: seconds with millisecond precision ("12.345 s")."""
     return f"{t_us / 1_000_000:.3f} s"
+
+
+def format_duration(us: int) -> str:
+    """A duration the way people write it in scenario files: "24h", "90s", "250ms"."""
+    for unit in ("h", "min", "s", "ms"):
+        if us % _UNITS_US[unit] == 0:
+            return f"{us // _UNITS_US[unit]}{unit}"
+    return f"{us}us"

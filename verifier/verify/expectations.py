@@ -38,6 +38,7 @@ class Expectation:
     condition: Condition | None = None
     request: protocol.ControlRequest | protocol.StatusRequest | None = None
     point: int | None = None
+    key: str = ""  # where the scenario states it, e.g. "expect[2]"
 
     def window(self, end_us: int) -> tuple[int, int]:
         if self.within_us is None:

@@ -86,6 +86,29 @@ class _Plc:
         finally:
             self.project.after_scan.remove(hook)
 
+    def problem(self, name: str) -> str | None:
+        """Why `name` is not a single value this program can read, or None."""
+        if _DEVICE.match(name):
+            try:
+                self.project.devices[name.upper()]
+            except (KeyError, ValueError) as exc:
+                return str(exc)
+            return None
+        target, shown = self.program, ""
+        for part in _path_parts(name):
+            try:
+                target = target[int(part[1:-1])] if part.startswith("[") else getattr(target, part)
+            except (AttributeError, KeyError, IndexError, TypeError, ValueError, LookupError):
+                if not shown:
+                    return f"the program {self.name} has no label {name!r}"
+                what = f"element {part}" if part.startswith("[") else f"member {part!r}"
+                return f"no label {name!r} in the program {self.name}: {shown} has no {what}"
+            shown += part if part.startswith("[") or not shown else f".{part}"
+        if not isinstance(_plain(target), (bool, int, float, str)):
+            return (f"{name!r} in {self.name} is not a single value (an array or FB instance?); "
+                    "name one element or member, e.g. wBuf[2] or fbRobot.o_bBusy")
+        return None
+
     def read(self, name: str) -> Any:
         if _DEVICE.match(name):
             return self.project.devices[name.upper()]
@@ -151,24 +174,51 @@ def _plain(value: Any) -> Any:
 
 
 def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
-    """Every label the scenario reads or writes must exist; a missing default signal is dropped."""
-    for name in scenario.variables():
-        try:
-            value = _plain(plc.read(name))
-        except (AttributeError, KeyError, IndexError, TypeError, LookupError, ValueError) as exc:
-            signal = scenario.options.response_signal
-            if not scenario.response_signal_given and signal is not None and name in signal.names:
-                scenario = replace(scenario, options=replace(scenario.options, response_signal=None))
-                continue
-            raise UnusableInput(
-                f"{_where(scenario)}: the program {plc.name} has no label {name!r} ({exc})"
-            ) from None
-        if not isinstance(value, (bool, int, float, str)):
-            raise UnusableInput(
-                f"{_where(scenario)}: {name!r} in {plc.name} is not a single value (an array or FB instance?); "
-                "name one element or member, e.g. wBuf[2] or fbRobot.o_bBusy"
-            )
+    """Every label the scenario reads or writes must exist and have the type its key needs:
+    a BOOL where a condition is expected, a value that fits the label an input writes. A
+    missing default response signal is dropped. Errors name the file, line and key."""
+    kinds: dict[str, str] = {}
+    for use in scenario.label_uses():
+        missing = next(((name, plc.problem(name)) for name in use.names if plc.problem(name)), None)
+        if missing is not None and use.optional:
+            scenario = replace(scenario, options=replace(scenario.options, response_signal=None))
+            continue
+        if missing is not None:
+            raise UnusableInput(f"{scenario.where(use.key, use.line)}: {missing[1]}")
+        for name in use.names:
+            kinds[name] = "bool" if isinstance(_plain(plc.read(name)), bool) else "number"
+        problem = use.condition.type_error(kinds) if use.condition is not None else None
+        for name, value in (use.values or {}).items():
+            problem = problem or _input_problem(plc, name, value)
+        if problem:
+            raise UnusableInput(f"{scenario.where(use.key, use.line)}: {problem}")
     return scenario
+
+
+def _input_problem(plc: _Plc, name: str, value: Any) -> str | None:
+    """Why `value` cannot be written to `name`, or None. Tried on the real label before
+    the first scan (and put back): the simulator's own conversion is the judge of range."""
+    before = _plain(plc.read(name))
+    if isinstance(before, bool) != isinstance(value, bool):
+        if isinstance(before, bool):
+            return f"{name} is a BOOL (a bit): set it to true or false, not {value!r}"
+        return f"{name} is a number: set it to a number, not {str(value).lower()}"
+    try:
+        plc.write(name, value)
+        after = _plain(plc.read(name))
+    except (ValueError, TypeError, AttributeError) as exc:
+        return str(exc)
+    finally:
+        plc.write(name, before)
+    if isinstance(value, float) and isinstance(after, float):
+        fits = abs(after - value) <= 1e-6 * max(1.0, abs(value))  # REAL keeps about 7 digits
+    elif _DEVICE.match(name) and isinstance(value, int) and -0x8000 <= value <= 0xFFFF:
+        fits = (after - value) % 0x10000 == 0  # a word device holds any 16-bit pattern (16#FFFF)
+    else:
+        fits = after == value
+    if not fits:
+        return f"{value!r} does not fit {name}: it would read back as {after!r}"
+    return None
 
 
 def _input_schedule(scenario: Scenario) -> list[tuple[int, dict[str, Any]]]:

@@ -18,10 +18,11 @@ from verifier.amr.faults import Fault, check_fault_addresses
 from verifier.amr.schema import ConfigError
 from verifier.tomlpos import decode_error_position, line_of_key
 
-from .conditions import ConditionError, parse_condition
-from .durations import parse_duration_us
+from .conditions import Condition, ConditionError, parse_condition
+from .durations import format_duration, parse_duration_us
 from .evidence import RuleOptions
 from .expectations import KINDS, Expectation, describe_window
+from .sources import SourceError, expand, unique
 
 PLATFORMS = {
     # platform: (ST dialect of its engineering tool, default serial channel)
@@ -31,6 +32,9 @@ PLATFORMS = {
 }
 CHANNELS = ("fx3:1", "fx3:2", "fx5:1", "q:1", "q:2", "adp:1")
 DEFAULT_DURATION_US = 60_000_000
+#: The longest run accepted (virtual time). A day of 10 ms scans takes the simulator about
+#: an hour; anything longer is almost always a typo ("1000h") and would look like a hang.
+MAX_DURATION_US = 24 * 3_600_000_000
 DEFAULT_SCAN_US = 10_000
 DEFAULT_RESPONSE_SIGNAL = "o_bErr"
 
@@ -65,6 +69,20 @@ class InputStep:
     at_us: int
     values: dict[str, Value]
     pulse_us: int | None = None
+    key: str = ""  # where the scenario states it, e.g. "inputs[0]"
+
+
+@dataclass(frozen=True)
+class LabelUse:
+    """Labels read or written by one key of a scenario, so that a label the program lacks,
+    or one of the wrong type, is reported at that key and its line."""
+
+    key: str  # "expect[0].that", "inputs[1].set", "watch[2]", "response_handling.signal"
+    line: int | None
+    names: tuple[str, ...]
+    condition: Condition | None = None
+    values: dict[str, Value] | None = None  # what an input writes
+    optional: bool = False  # the default response signal: dropped when the program lacks it
 
 
 @dataclass(frozen=True)
@@ -88,6 +106,7 @@ class Scenario:
     expectations: tuple[Expectation, ...] = ()
     options: RuleOptions = field(default_factory=RuleOptions)
     response_signal_given: bool = False
+    key_lines: dict[str, int | None] = field(default_factory=dict, compare=False)
 
     @property
     def target(self) -> str:
@@ -109,6 +128,33 @@ class Scenario:
             names += list(step.values)
         names += list(self.watch)
         return list(dict.fromkeys(names))
+
+    def label_uses(self) -> list[LabelUse]:
+        """Every key that names PLC labels, with its line, in the order of the file."""
+        uses: list[LabelUse] = []
+        for expectation in self.expectations:
+            if expectation.condition is not None:
+                key = f"{expectation.key}.{expectation.kind}"
+                uses.append(LabelUse(key, self.key_lines.get(key), tuple(sorted(expectation.condition.names)),
+                                     condition=expectation.condition))
+        for step in self.inputs:
+            key = f"{step.key}.set"
+            uses.append(LabelUse(key, self.key_lines.get(key), tuple(step.values), values=dict(step.values)))
+        for i, name in enumerate(self.watch):
+            uses.append(LabelUse(f"watch[{i}]", self.key_lines.get(f"watch[{i}]"), (name,)))
+        signal = self.options.response_signal
+        if signal is not None:
+            key = "response_handling.signal"
+            uses.append(LabelUse(key, self.key_lines.get(key), tuple(sorted(signal.names)), condition=signal,
+                                 optional=not self.response_signal_given))
+        return uses
+
+    def where(self, key: str = "", line: int | None = None) -> str:
+        """`file:line: key` (as much of it as is known) for messages about this scenario."""
+        text = str(self.path) if self.path is not None else f"scenario {self.name!r}"
+        if line is not None:
+            text += f":{line}"
+        return f"{text}: {key}" if key else text
 
     def with_overrides(self, **changes: Any) -> "Scenario":
         return replace(self, **{k: v for k, v in changes.items() if v is not None})
@@ -238,6 +284,9 @@ class _Reader:
             if channel not in CHANNELS:
                 raise self.fail("channel", f"unknown channel {channel!r}; expected one of {', '.join(CHANNELS)}")
         duration = self.duration(data.get("duration", "60s"), "duration")
+        if duration > MAX_DURATION_US:
+            raise self.fail("duration", f"longer than the limit of {format_duration(MAX_DURATION_US)} of virtual time; "
+                                        "split a longer soak test into several scenarios")
         scan = self.duration(data.get("scan", "10ms"), "scan")
         if scan > duration:
             raise self.fail("scan", "the scan time is longer than the whole run")
@@ -267,32 +316,30 @@ class _Reader:
             for i, item in enumerate(self.array_of_tables(data.get("expect", []), "expect"))
         )
         options, signal_given = self.options(data.get("rules", {}), data.get("response_handling", None))
+        keys = [f"{e.key}.{e.kind}" for e in expectations if e.condition is not None]
+        keys += [f"{step.key}.set" for step in inputs] + [f"watch[{i}]" for i in range(len(watch))]
+        keys += ["response_handling.signal"] if signal_given else []
         return Scenario(
             name=name, path=self.path, description=description, sources=sources, program=program,
             platform=platform, channel=channel, duration_us=duration, scan_us=scan, scan_jitter_us=jitter, seed=seed,
             watch=watch, settings=settings, robot=robot, faults=faults, inputs=inputs,
             expectations=expectations, options=options, response_signal_given=signal_given,
+            key_lines={key: self.line_of(key) for key in keys},
         )
 
     def sources(self, value: Any) -> list[Path]:
         if isinstance(value, str):
             value = [value]
         if not isinstance(value, list) or not value:
-            raise self.fail("sources", "expected a list of .st files or glob patterns, relative to this file")
+            raise self.fail("sources", "expected a list of .st files, folders or glob patterns, relative to this file")
         found: list[Path] = []
         for i, item in enumerate(value):
-            pattern = self.string(item, f"sources[{i}]")
-            if any(ch in pattern for ch in "*?["):
-                matches = sorted(self.base.glob(pattern))
-                if not matches:
-                    raise self.fail(f"sources[{i}]", f"{pattern!r} matches no file (relative to {self.base})")
-                found += matches
-            else:
-                path = self.base / pattern
-                if not path.is_file():
-                    raise self.fail(f"sources[{i}]", f"no such file: {path}")
-                found.append(path)
-        return list(dict.fromkeys(p.resolve() for p in found))
+            name = self.string(item, f"sources[{i}]")
+            try:
+                found += expand(name, self.base)
+            except SourceError as exc:
+                raise self.fail(f"sources[{i}]", str(exc)) from None
+        return list(unique(found))
 
     def settings(self, value: Any) -> protocol.Settings:
         table = self.table(value, "protocol")
@@ -340,7 +387,7 @@ class _Reader:
         pulse = self.duration(item["pulse"], f"{key}.pulse") if "pulse" in item else None
         if pulse is not None and not any(isinstance(v, bool) for v in checked.values()):
             raise self.fail(f"{key}.pulse", "a pulse sets BOOL labels back after a while; this input sets no BOOL")
-        return InputStep(at, checked, pulse)
+        return InputStep(at, checked, pulse, key)
 
     def expectation(self, item: dict, key: str, settings: protocol.Settings) -> Expectation:
         self.only(item, EXPECT_KEYS, key)
@@ -367,7 +414,7 @@ class _Reader:
                 raise self.fail(f"{key}.reached_point", f"expected a point number 1-21, got {_shown(value)}")
             fields["point"] = value
             what = f"robot reached point {value}"
-        expectation = Expectation(kind=kind, label="", after_us=after, within_us=within, **fields)
+        expectation = Expectation(kind=kind, label="", after_us=after, within_us=within, key=key, **fields)
         label = item.get("name")
         if label is None:
             label = f"{what} {describe_window(expectation)}".strip()

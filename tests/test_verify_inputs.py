@@ -1,0 +1,156 @@
+"""What users hand `uitamr verify` besides the scenario's own keys: sources as files, folders
+and (absolute) globs; labels checked against the program with file, line and key; run-time
+limits; and reports that name the program that ran. Small programs keep these fast."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from verifier.commands import verify as verify_command
+from verifier.verify.scenario import ScenarioError, load_scenario
+
+PROGRAM = """\
+PROGRAM Main
+VAR
+    w : INT;
+    u : WORD;
+    b : BOOL;
+    r : REAL;
+    arr : ARRAY[0..2] OF INT;
+    tmr : TON;
+END_VAR
+w := w + 0;
+END_PROGRAM
+"""
+
+
+def invoke(*args):
+    return CliRunner().invoke(verify_command.command, [str(a) for a in args], catch_exceptions=False)
+
+
+@pytest.fixture
+def program(tmp_path) -> Path:
+    folder = tmp_path / "src" / "app"
+    folder.mkdir(parents=True)
+    (folder / "Main.st").write_text(PROGRAM, encoding="utf-8")
+    return folder / "Main.st"
+
+
+# --- sources --------------------------------------------------------------------------------
+
+def test_sources_take_absolute_globs_and_folders(tmp_path, program):
+    other = tmp_path / "lib"
+    other.mkdir()
+    (other / "A.st").write_text("FUNCTION A : INT\nA := 1;\nEND_FUNCTION\n", encoding="utf-8")
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(f'sources = ["{tmp_path.as_posix()}/src/*/*.st", "lib"]\n', encoding="utf-8")
+    assert load_scenario(scenario).sources == (program.resolve(), (other / "A.st").resolve())
+    scenario.write_text('sources = ["src"]\n', encoding="utf-8")  # a folder: its .st files, recursively
+    assert load_scenario(scenario).sources == (program.resolve(),)
+
+
+@pytest.mark.parametrize("entry, words", [
+    ("/nowhere/at/all/*.st", "'/nowhere/at/all/*.st' matches no file"),
+    ("empty", "holds no .st file"),
+    ("missing.st", "no such file or folder"),
+])
+def test_sources_that_name_nothing_are_errors_at_their_line(tmp_path, entry, words):
+    (tmp_path / "empty").mkdir()
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(f'name = "x"\n\nsources = ["{entry}"]\n', encoding="utf-8")
+    with pytest.raises(ScenarioError) as info:
+        load_scenario(scenario)
+    assert str(info.value).startswith(f"{scenario}:3: sources[0]: ") and words in str(info.value)
+
+
+def test_the_command_line_takes_folders(tmp_path, program):
+    report = tmp_path / "r.json"
+    result = invoke(tmp_path / "src", "--duration", "1s", "--json", report)
+    assert result.exit_code == 1, result.output  # runs (and fails: Main never sends the stop)
+    scenario = json.loads(report.read_text())["scenarios"][0]
+    assert scenario["sources"] == [str(program.resolve())]
+    result = invoke(tmp_path / "nothing")
+    assert result.exit_code == 2 and "no such file or folder" in result.output
+
+
+def test_the_reports_name_the_program_chosen_for_the_user(tmp_path, program):
+    """No --program and no 'program': the only PROGRAM runs, and every report says which."""
+    json_path, html = tmp_path / "r.json", tmp_path / "r.html"
+    result = invoke(program, "--duration", "1s", "--json", json_path, "--html", html)
+    assert json.loads(json_path.read_text())["scenarios"][0]["program"] == "Main"
+    assert "program <code>Main</code>" in html.read_text()
+    assert "Main on fx3u" in result.output
+
+
+# --- labels ---------------------------------------------------------------------------------
+
+def _run_scenario(tmp_path, program, body: str):
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('program = "Main"\nduration = "1s"\n' + body, encoding="utf-8")
+    return invoke(program, "--scenario", scenario), scenario
+
+
+@pytest.mark.parametrize("body, line, key, message", [
+    ('\n[[expect]]\nthat = "nosuch.label"\n', 5, "expect[0].that", "the program Main has no label 'nosuch.label'"),
+    ('\n[[expect]]\nthat = "b"\n[[expect]]\nnever = "tmr.QQ"\n', 7, "expect[1].never",
+     "no label 'tmr.QQ' in the program Main: tmr has no member 'QQ'"),
+    ('watch = ["w", "arr[7]"]\n', 3, "watch[1]", "no label 'arr[7]' in the program Main: arr has no element [7]"),
+    ('[[inputs]]\nat = "0s"\nset = { nosuch = true }\n', 5, "inputs[0].set", "the program Main has no label 'nosuch'"),
+    ('[response_handling]\nsignal = "bErr"\n', 4, "response_handling.signal", "the program Main has no label 'bErr'"),
+])
+def test_unknown_labels_name_file_line_and_key_once(tmp_path, program, body, line, key, message):
+    result, scenario = _run_scenario(tmp_path, program, body)
+    assert result.exit_code == 2
+    assert result.output.strip().splitlines()[-1] == f"error: {scenario}:{line}: {key}: {message}"
+
+
+@pytest.mark.parametrize("body, words", [
+    ('[[expect]]\nthat = "w"\n', "w is a number, not a condition"),
+    ('[[expect]]\nalways = "b AND w"\n', "AND joins BOOLs, but w is a number"),
+    ('[[expect]]\nnever = "NOT u"\n', "NOT needs a BOOL, but u is a number"),
+    ('[[expect]]\nthat = "b = 1"\n', "b is a BOOL and 1 a number"),
+    ('[[expect]]\nthat = "b > FALSE"\n', "BOOLs are compared with = or <> only"),
+    ('[[inputs]]\nat = "0s"\nset = { X0 = 5 }\n', "X0 is a BOOL (a bit): set it to true or false, not 5"),
+    ('[[inputs]]\nat = "0s"\nset = { b = 1 }\n', "b is a BOOL (a bit)"),
+    ('[[inputs]]\nat = "0s"\nset = { w = true }\n', "w is a number: set it to a number, not true"),
+    ('[[inputs]]\nat = "0s"\nset = { D100 = 99999 }\n', "99999 does not fit D100"),
+    ('[[inputs]]\nat = "0s"\nset = { w = 40000 }\n', "40000 does not fit w"),
+    ('[[inputs]]\nat = "0s"\nset = { u = -1 }\n', "-1 does not fit u"),
+    ('[[inputs]]\nat = "0s"\nset = { w = 1.5 }\n', "got the float 1.5"),
+])
+def test_labels_of_the_wrong_type_are_refused(tmp_path, program, body, words):
+    result, scenario = _run_scenario(tmp_path, program, body)
+    assert result.exit_code == 2, result.output
+    line = 4 if body.startswith("[[expect]]") else 5  # the line of `that`/`set`
+    assert f"{scenario}:{line}: " in result.output and words in result.output
+
+
+def test_values_that_fit_are_accepted(tmp_path, program):
+    body = ('watch = ["w", "u", "D100", "r"]\n[[inputs]]\nat = "0s"\n'
+            'set = { w = -32768, u = 65535, D100 = 0xFFFF, r = 0.1, X0 = true, b = true }\n'
+            '[[expect]]\nthat = "b AND w = -32768 AND D100 = -1 AND X0 = TRUE AND NOT (u < 65535)"\nwithin = "100ms"\n')
+    result, _ = _run_scenario(tmp_path, program, body)
+    assert result.exit_code == 0, result.output
+
+
+# --- limits ---------------------------------------------------------------------------------
+
+def test_run_and_scan_times_must_make_sense(tmp_path, program):
+    result = invoke(program, "--scan", "0ms")
+    assert result.exit_code == 2 and "'0ms' must be longer than 0" in result.output
+    result = invoke(program, "--duration", "1000h")
+    assert result.exit_code == 2 and "longer than the limit of 24h" in result.output
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('duration = "25h"\n', encoding="utf-8")
+    with pytest.raises(ScenarioError, match=r"s.toml:1: duration: longer than the limit of 24h"):
+        load_scenario(scenario)
+
+
+def test_progress_lines_show_in_ci_logs(program, monkeypatch):
+    """Not on a terminal there is no progress bar, so a long run prints a line now and then."""
+    monkeypatch.setattr(verify_command, "PLAIN_PROGRESS_EVERY_S", 0.0)
+    result = invoke(program, "--duration", "3s")
+    assert "verify: 33% of 3.000 s virtual time done" in result.output

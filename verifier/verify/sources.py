@@ -1,0 +1,44 @@
+"""Which ST files a name stands for: a file, a folder (its .st files, recursively — as
+`uitamr check` and `uitamr export` read folders) or a glob pattern, relative or absolute."""
+from __future__ import annotations
+
+import glob
+from pathlib import Path
+
+GLOB_CHARACTERS = "*?["
+
+
+class SourceError(ValueError):
+    """A name that stands for no ST file; the message says why."""
+
+
+def expand(name: str, base: Path) -> list[Path]:
+    """The .st files `name` stands for, relative to `base` unless absolute, sorted."""
+    if any(ch in name for ch in GLOB_CHARACTERS):
+        pattern = name if Path(name).is_absolute() else str(base / name)
+        matches = sorted(Path(p) for p in glob.glob(pattern, recursive=True))
+        files: list[Path] = []
+        for match in matches:
+            files += _folder(match) if match.is_dir() else [match]
+        if not files:
+            where = "" if Path(name).is_absolute() else f" (relative to {base})"
+            raise SourceError(f"{name!r} matches no file{where}")
+        return files
+    path = Path(name) if Path(name).is_absolute() else base / name
+    if path.is_dir():
+        files = _folder(path)
+        if not files:
+            raise SourceError(f"the folder {path} holds no .st file")
+        return files
+    if not path.is_file():
+        raise SourceError(f"no such file or folder: {path}")
+    return [path]
+
+
+def _folder(path: Path) -> list[Path]:
+    return sorted(p for p in path.rglob("*") if p.suffix.lower() == ".st" and p.is_file())
+
+
+def unique(paths: list[Path]) -> tuple[Path, ...]:
+    """Resolved, each once, in first-seen order."""
+    return tuple(dict.fromkeys(p.resolve() for p in paths))
