@@ -93,7 +93,7 @@ SET(TRUE, w.3);
 RST(TRUE, w.0);
 END_PROGRAM
 """.replace("bit : BOOL; END_VAR", "bit : BOOL; w : WORD := 1; END_VAR")
-    project = load_st(src)
+    project = load_st(src, target="gxworks3", cpu="fx3u")  # initial values: GX Works3 dialect
     project.run_programs(["P"], scans=1)
     p = project.program("P")
     assert p.x == 42 and list(p.b) == [2, 3, 4, 0] and p.bit is True
@@ -318,7 +318,7 @@ IF M21 THEN nRise := nRise + 1; END_IF;
 IF M22 THEN nFall := nFall + 1; END_IF;
 END_PROGRAM
 """
-    project = load_st(src)
+    project = load_st(src, target="gxworks3", cpu="fx3u")  # initial values: GX Works3 dialect
     dev = project.devices
     dev["D3"] = 0x1234
     for m in ("M10", "M11", "M12", "M13"):
@@ -384,8 +384,8 @@ END_PROGRAM
 def test_rs2_channel_2_uses_the_ch2_devices():
     src = """
 PROGRAM P
-VAR uSend : ARRAY[0..1] OF WORD := [16#0201]; uRecv : ARRAY[0..1] OF WORD; END_VAR
-IF M8002 THEN D8420 := 16#1C81; D8429 := 1; M8422 := TRUE; END_IF;
+VAR uSend : ARRAY[0..1] OF WORD; uRecv : ARRAY[0..1] OF WORD; END_VAR
+IF M8002 THEN D8420 := 16#1C81; D8429 := 1; M8422 := TRUE; uSend[0] := 16#0201; END_IF;
 RS2(NOT M8002, uSend[0], 2, 4, 2, uRecv[0]);
 END_PROGRAM
 """

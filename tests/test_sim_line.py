@@ -55,8 +55,11 @@ def test_example_program_talks_to_the_robot(cpu, target, port, program, channel)
 def test_rs2_send_bytes_leave_at_9600_8n1_byte_times():
     src = """
 PROGRAM P
-VAR uSend : ARRAY[0..3] OF WORD := [16#0601, 16#A001, 16#0000, 16#1488]; uRecv : ARRAY[0..3] OF WORD; END_VAR
-IF M8002 THEN D8400 := 16#1C81; D8409 := 5; END_IF;
+VAR uSend : ARRAY[0..3] OF WORD; uRecv : ARRAY[0..3] OF WORD; END_VAR
+IF M8002 THEN
+    D8400 := 16#1C81; D8409 := 5;
+    uSend[0] := 16#0601; uSend[1] := 16#A001; uSend[2] := 16#0000; uSend[3] := 16#1488;
+END_IF;
 RS2(NOT M8002, uSend[0], 8, 8, 1, uRecv[0]);
 END_PROGRAM
 """

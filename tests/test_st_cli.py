@@ -103,3 +103,47 @@ def test_installed_command_runs():
                           capture_output=True, text=True, timeout=120)
     assert proc.returncode == 1
     assert f"{BAD}:5:7: error" in proc.stdout
+
+
+def test_device_file_gets_a_precise_message():
+    result = run("/dev/null")
+    assert result.exit_code == 2
+    assert "/dev/null: is not a regular file (a character device); give a .st file" in result.output
+    assert "no such file" not in result.output
+
+
+def test_pipe_is_not_read(tmp_path):
+    import os
+
+    fifo = tmp_path / "pipe.st"
+    os.mkfifo(fifo)
+    result = run(fifo)  # reading would block forever: it must be refused before that
+    assert result.exit_code == 2
+    assert f"{fifo}: is not a regular file (a pipe)" in result.output
+
+
+def test_empty_file_and_comment_only_file_warn_no_pou(tmp_path):
+    empty = tmp_path / "empty.st"
+    empty.write_bytes(b"")
+    comment = tmp_path / "comment.st"
+    comment.write_text("(* nothing here yet *)\n", encoding="utf-8")
+    result = run(empty, comment)
+    assert result.exit_code == 0, result.output
+    assert f"{empty}:1:1: warning: no POU in file" in result.output
+    assert f"{comment}:1:1: warning: no POU in file" in result.output
+    assert "0 error(s), 2 warning(s)" in result.output
+
+
+def test_globals_only_file_is_not_a_missing_pou(tmp_path):
+    path = tmp_path / "globals.st"
+    path.write_text("VAR_GLOBAL g_bRun : BOOL; END_VAR\n", encoding="utf-8")
+    result = run(path)
+    assert result.exit_code == 0 and "no POU" not in result.output
+
+
+def test_undecodable_bytes_are_named_with_line_and_column(tmp_path):
+    path = tmp_path / "bad.st"
+    path.write_bytes(b"PROGRAM P\nVAR x : INT; END_VAR\nx := 1; (* \x80\x81 *)\nEND_PROGRAM\n")
+    result = run(path)
+    assert result.exit_code == 1
+    assert f"{path}:3:12: error: byte 0x80 at offset 42 is neither UTF-8 nor Shift-JIS text" in result.output

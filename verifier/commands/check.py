@@ -20,15 +20,11 @@ EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
 
 
 def read_source(path: Path) -> str:
-    """The text of a .st file: UTF-8 (with or without BOM), else Shift-JIS as GX Works
-    exports it on Japanese Windows, else Latin-1."""
-    data = path.read_bytes()
-    for encoding in ("utf-8-sig", "cp932"):
-        try:
-            return data.decode(encoding)
-        except UnicodeDecodeError:
-            continue
-    return data.decode("latin-1")
+    """The text of a .st file ("" when it cannot be read); kept for callers that only
+    want the text. The reader and its encoding policy are `verifier.st.read_source`."""
+    from verifier.st import read_source as _read
+
+    return _read(path)[0]
 
 
 def expand_sources(sources: tuple[str, ...]) -> list[Path]:
@@ -43,12 +39,31 @@ def expand_sources(sources: tuple[str, ...]) -> list[Path]:
     return paths
 
 
+def _not_a_source(path: Path) -> str | None:
+    """Why `path` cannot be checked at all (missing, a device, a pipe ...), or None.
+    Files that exist but hold no text are diagnosed with file:line:col instead."""
+    from verifier.st.source import read_source as _read
+
+    if path.is_file():
+        return None
+    if not path.exists() and not path.is_symlink():
+        return "no such file"
+    problems = _read(path)[1]
+    return problems[0].message if problems else None
+
+
 def check_paths(paths: list[Path], target: str) -> tuple[list[SourceFile], list[Diagnostic]]:
     """Parse every file and check them together; all diagnostics, parse ones included."""
-    from verifier.st import check, parse
+    from verifier.st import check, parse, read_source as _read
 
-    files = [parse(read_source(p), str(p), target) for p in paths]
-    diagnostics = [d for f in files for d in f.diagnostics]
+    files: list[SourceFile] = []
+    diagnostics: list[Diagnostic] = []
+    for p in paths:
+        text, problems = _read(p)
+        diagnostics += problems
+        if not problems:  # an unreadable file is reported once, not also as empty
+            files.append(parse(text, str(p), target))
+    diagnostics += [d for f in files for d in f.diagnostics]
     diagnostics += check(files, target)
     order = {str(p): i for i, p in enumerate(paths)}
     diagnostics.sort(key=lambda d: (order.get(d.file, len(order)), d.line, d.col))
@@ -76,10 +91,11 @@ def render(diag: Diagnostic, lines: list[str] | None) -> str:
 def command(sources: tuple[str, ...], target: str, fmt: str) -> None:
     """Parse and type-check GX Works structured text (files or directories of .st)."""
     paths = expand_sources(sources)
-    missing = [p for p in paths if not p.is_file()]
-    if missing:
-        for p in missing:
-            click.echo(f"uitamr check: {p}: no such file", err=True)
+    unusable = [(p, _not_a_source(p)) for p in paths]
+    unusable = [(p, why) for p, why in unusable if why]
+    if unusable:
+        for p, why in unusable:
+            click.echo(f"uitamr check: {p}: {why}", err=True)
         sys.exit(EXIT_USAGE)
     if not paths:
         click.echo("uitamr check: no .st files found in the given directories", err=True)

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Callable, Iterable
 
 from verifier.st import ast
+from verifier.st.source import read_source
 
 from .compiler import GENERATED_FILE, CompiledModule, compile_files, default_code
 from .cpu import profile_for
@@ -33,12 +34,10 @@ def load(*paths, target: str = "gxworks2", cpu: str | None = None, scan_ms: floa
         path = Path(p)
         files = sorted(path.glob("*.st")) if path.is_dir() else [path]
         for f in files:
-            try:
-                texts[str(f)] = f.read_text(encoding="utf-8-sig")
-            except UnicodeDecodeError:
-                texts[str(f)] = f.read_text(encoding="cp932", errors="replace")
-            except OSError as e:
-                problems.append(ast.Diagnostic(str(f), 0, 0, "error", f"cannot read: {e.strerror or e}"))
+            # the one ST reader (UTF-8, else Shift-JIS), shared with check and export
+            text, unreadable = read_source(f)
+            texts[str(f)] = text
+            problems += unreadable
     texts.update(sources or {})
     if problems:
         raise LoadError(problems)

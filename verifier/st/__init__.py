@@ -1,6 +1,7 @@
 """Structured-text front end for the GX Works dialect: parse, check, print.
 
     from verifier import st
+    text, problems = st.read_source("FB_X.st")   # UTF-8, else Shift-JIS; never raises
     source = st.parse(text, "FB_X.st", target="gxworks2")   # never raises for bad input
     diagnostics = st.check([source], target="gxworks2")
 
@@ -13,10 +14,11 @@ from __future__ import annotations
 # names on the package.
 import verifier.st.check as _check_module  # noqa: E402,F401
 from verifier.st.ast import Diagnostic, SourceFile
+from verifier.st.source import read_source
 
 TARGETS = ("gxworks2", "gxworks3")
 
-__all__ = ["Diagnostic", "SourceFile", "TARGETS", "parse", "check", "format_source"]
+__all__ = ["Diagnostic", "SourceFile", "TARGETS", "parse", "check", "format_source", "read_source"]
 
 
 def parse(text: str, filename: str = "<string>", target: str = "gxworks2") -> SourceFile:

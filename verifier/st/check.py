@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from verifier.st import ast, library
+from verifier.st import ast, library, structure
 from verifier.st import types as T
 from verifier.st.devices import looks_like_device
 
@@ -63,6 +63,12 @@ class _Reporter:
 
 
 _MAX_NAME = 32  # GX Works label name length limit (characters)
+#: names GX Works reads as devices or constants the reader does not treat as data:
+#: pointers P, interrupt pointers I, nesting N, network numbers J (J1\W0), I/O numbers
+#: U (U3\G0), E real constants (E1.5), SFC blocks/transitions BL/TR, function devices
+#: FX/FY/FD, and the iQ-F/iQ-R long devices LZ, LT, LST, LC, RD (docs/st-dialect.md §4)
+_OTHER_DEVICE_RE = re.compile(r"(?:P|I|N|J|E|BL|TR|FX|FY|FD|LZ|LTN|LSTN|LCN|LT|LST|LC|RD)[0-9]+|U[0-9][0-9A-F]*",
+                              re.IGNORECASE)
 
 
 def label_name_problem(name: str) -> str | None:
@@ -75,7 +81,8 @@ def label_name_problem(name: str) -> str | None:
         return "must not start with a digit"
     if re.match(r"[Kk][1-8]", name):
         return "must not start with K1..K8 (read as a digit-specified device)"
-    if looks_like_device(name) or re.fullmatch(r"[Kk][0-9]+|[Hh][0-9A-Fa-f]+", name):
+    if looks_like_device(name) or re.fullmatch(r"[Kk][0-9]+|[Hh][0-9A-Fa-f]+", name) \
+            or _OTHER_DEVICE_RE.fullmatch(name):
         return "looks like a device or constant"
     reason = library.reserved_reason(name)
     if reason:
@@ -95,6 +102,8 @@ class Checker:
         self.pou: PouInfo | None = None
         self.loop_depth = 0
         self.used: set[int] = set()
+        #: (caller POU key, callee POU key, call) for every call of a user FB or FUNCTION
+        self.calls: list[tuple[str, str, ast.Call]] = []
 
     # ------------------------------------------------------------- declarations
     def collect(self) -> None:
@@ -118,7 +127,11 @@ class Checker:
             fields = []
             for v in s.fields:
                 self._check_name(v, v.name, "member")
-                fields.append((v.name, self.resolve_type(v.type)))
+                ft = self.resolve_type(v.type)
+                fields.append((v.name, ft))
+                if v.init is not None and self.target == "gxworks2" and not _is_zero(v.init):
+                    self.rep.error(v.init, f"GX Works2 structures have no initial values: member '{v.name}' "
+                                           "would start at 0 on the PLC; set it in the program")
             object.__setattr__(self.table.structs[key], "fields", tuple(fields))
         # FB types first so labels of FB type resolve in any order
         for info in self.table.pous.values():
@@ -207,6 +220,11 @@ class Checker:
             self.rep.error(v, f"VAR_IN_OUT '{v.name}' cannot have an initial value")
         if v.init is not None:
             self.check_initializer(v.init, t, v)
+            if self.target == "gxworks2" and not v.constant and v.section != "VAR_IN_OUT" \
+                    and not _is_zero(v.init):
+                self.rep.error(v.init, f"GX Works2 label tables have no initial value column: '{v.name}' "
+                                       "would start at 0 on the PLC; set it in the program on the first "
+                                       "scan, declare it VAR CONSTANT, or use --target gxworks3")
         return t
 
     def resolve_type(self, ref: ast.TypeRef) -> T.Type:
@@ -222,6 +240,11 @@ class Checker:
             for d in ref.dims:
                 if d.low > d.high:
                     self.rep.error(d, f"array bounds {d.low}..{d.high}: the lower bound must not exceed the upper")
+                for bound in (d.low, d.high):
+                    if not structure.INDEX_MIN <= bound <= structure.INDEX_MAX:
+                        self.rep.error(d, f"array bound {bound} is outside the index range "
+                                          f"{structure.INDEX_MIN}..{structure.INDEX_MAX} GX Works allows")
+                        break
                 dims.append((d.low, d.high))
             if len(dims) > 3:
                 self.rep.error(ref, "GX Works arrays have at most 3 dimensions")
@@ -285,9 +308,33 @@ class Checker:
         for info in self.table.pous.values():
             self.pou = info
             self.loop_depth = 0
-            self.stmts(info.pou.body)
-            self._unused(info)
+            complete = True
+            for s in info.pou.body:
+                try:
+                    self.stmt(s)
+                except RecursionError:
+                    complete = False
+                    self.rep.error(s, "statement nested too deeply to check (an expression or block "
+                                      "hundreds of levels deep); split it using intermediate labels")
+            if complete:  # an unchecked statement may use any label
+                self._unused(info)
         self.pou = None
+
+    def check_structure(self) -> None:
+        """Recursion through FB instances, structures and calls; storage sizes."""
+        findings, recursive = structure.recursive_types(self.table)
+        findings += structure.recursive_calls(self.table, self.calls, recursive)
+        findings += structure.oversized(self.table, self.target, recursive)
+        for f in findings:
+            self.rep.error(f.node, f.message)
+
+    def check_files(self) -> None:
+        """A file with nothing in it is most likely the wrong file."""
+        for f in self.files:
+            if not f.pous and not f.types and not f.globals:
+                self.rep.diagnostics.append(ast.Diagnostic(
+                    f.filename, 1, 1, "warning",
+                    "no POU in file (it is empty or holds only comments); nothing to check or export"))
 
     def _unused(self, info: PouInfo) -> None:
         for decl, _t in info.labels.values():
@@ -683,6 +730,8 @@ class Checker:
     def _fb_call(self, c: ast.Call, fb: T.FbType, statement: bool) -> T.Type:
         c.resolved = T.CallTarget("fb", fb.name, fb_type=fb,
                                   pou=self.table.pous[fb.name.upper()].pou if not fb.standard and fb.name.upper() in self.table.pous else None)
+        if c.resolved.pou is not None and self.pou is not None:
+            self.calls.append((self.pou.pou.key, c.resolved.pou.key, c))
         if not statement:
             self.rep.error(c, f"a function block instance call is a statement: write '{c.name}(...);' on its own and read the outputs as {c.name}.Q")
         seen = set()
@@ -730,6 +779,8 @@ class Checker:
     def _user_function(self, c: ast.Call, info: PouInfo, statement: bool) -> T.Type:
         c.resolved = T.CallTarget("function", info.pou.name, pou=info.pou)
         c.callee.symbol = info.pou
+        if self.pou is not None:
+            self.calls.append((self.pou.pou.key, info.pou.key, c))
         params = getattr(info, "fn_inputs", [])
         outputs = getattr(info, "fn_outputs", [])
         positional = [a for a in c.args if a.name is None]
@@ -922,6 +973,22 @@ def _is_literal(e) -> bool:
     return isinstance(e, (ast.IntLiteral, ast.RealLiteral, ast.BoolLiteral, ast.TimeLiteral, ast.StringLiteral))
 
 
+def _is_zero(init) -> bool:
+    """True for an initial value every label starts with anyway (0, FALSE, 0.0, T#0s,
+    '', and arrays/structures of those): dropping it changes nothing on the PLC."""
+    if isinstance(init, ast.ArrayInit):
+        return all(item.value is None or _is_zero(item.value) for item in init.items)
+    if isinstance(init, ast.StructInit):
+        return all(_is_zero(value) for _, value in init.fields)
+    if isinstance(init, (ast.IntLiteral, ast.RealLiteral, ast.BoolLiteral)):
+        return not init.value
+    if isinstance(init, ast.TimeLiteral):
+        return init.ms == 0
+    if isinstance(init, ast.StringLiteral):
+        return init.value == ""
+    return False
+
+
 def _is_constant(e) -> bool:
     if isinstance(e, (ast.IntLiteral, ast.RealLiteral, ast.BoolLiteral, ast.TimeLiteral, ast.StringLiteral)):
         return True
@@ -945,6 +1012,8 @@ def check_project(files: list[ast.SourceFile], target: str = "gxworks2") -> tupl
     try:
         checker.collect()
         checker.check_bodies()
+        checker.check_structure()
+        checker.check_files()
     except RecursionError:
         checker.rep.diagnostics.append(ast.Diagnostic(
             files[0].filename if files else "<none>", 1, 1, "error",

@@ -105,6 +105,10 @@ def describe_syntax_error(exc: UnexpectedInput, text: str, parser: Lark) -> tupl
             return exc.line, exc.column, "'#' must follow a radix (2#, 8#, 16#) or T#/TIME#"
         char = exc.char
         shown = repr(char) if not char.isprintable() else f"'{char}'"
+        if not char.isascii() and char.isprintable():
+            return (exc.line, exc.column,
+                    f"unexpected character {shown}: names are ASCII letters, digits and '_' "
+                    "(docs/st-dialect.md §4); other characters belong in comments and strings")
         return exc.line, exc.column, f"unexpected character {shown}; GX Works ST does not use it here"
 
     if isinstance(exc, UnexpectedEOF):

@@ -1,0 +1,65 @@
+"""The one ST file reader (`verifier.st.read_source`): UTF-8 with or without BOM, else
+Shift-JIS, else an error naming the byte — the same answer for check, export and load."""
+from __future__ import annotations
+
+import pytest
+from hypothesis import given, strategies as st_
+
+import verifier.sim
+from verifier import st
+from verifier.st.source import decode_source
+
+PROGRAM = "PROGRAM P\nVAR iX : INT; END_VAR\n(* 起動 *)\niX := 1;\nEND_PROGRAM\n"
+
+
+@pytest.mark.parametrize("data", [
+    PROGRAM.encode("utf-8"), b"\xef\xbb\xbf" + PROGRAM.encode("utf-8"), PROGRAM.encode("cp932"),
+], ids=["utf-8", "utf-8-bom", "shift-jis"])
+def test_encodings_read_to_the_same_text(tmp_path, data):
+    path = tmp_path / "p.st"
+    path.write_bytes(data)
+    assert st.read_source(path) == (PROGRAM, [])
+
+
+def test_neither_encoding_is_an_error_not_a_guess(tmp_path):
+    path = tmp_path / "junk.st"
+    path.write_bytes(b"PROGRAM P\n\xff\xfe\xfd\n")
+    text, problems = st.read_source(path)
+    assert text == ""
+    (problem,) = problems
+    assert (problem.file, problem.line, problem.col, problem.severity) == (str(path), 2, 1, "error")
+    assert "byte 0xFF at offset 10 is neither UTF-8 nor Shift-JIS" in problem.message
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda tmp: tmp / "missing.st", "cannot read: no such file"),
+    (lambda tmp: tmp, "is a folder"),
+    (lambda tmp: "/dev/null", "is not a regular file (a character device)"),
+])
+def test_what_is_not_a_file_is_said_precisely(tmp_path, make, message):
+    text, (problem,) = st.read_source(make(tmp_path))
+    assert text == "" and message in problem.message
+
+
+@given(st_.binary(max_size=200))
+def test_any_bytes_give_text_or_one_error(data):
+    text, problems = decode_source(data, "x.st")
+    assert (text == "") or not problems
+    assert len(problems) <= 1
+    if not problems:
+        assert data.decode("utf-8-sig", errors="ignore") == text or data.decode("cp932") == text
+
+
+def test_load_uses_the_same_reader(tmp_path):
+    path = tmp_path / "junk.st"
+    path.write_bytes(b"PROGRAM P\n\xff\xfe\xfd\n")
+    with pytest.raises(verifier.sim.LoadError) as err:
+        verifier.load(str(path))
+    assert f"{path}:2:1: error: byte 0xFF" in str(err.value)
+
+
+def test_multibyte_label_names_are_refused_with_the_reason():
+    source = st.parse("PROGRAM P\nVAR 速度 : INT; END_VAR\nEND_PROGRAM\n", "m.st")
+    (problem,) = source.diagnostics
+    assert (problem.line, problem.col) == (2, 5)
+    assert "names are ASCII" in problem.message

@@ -1,0 +1,92 @@
+"""Whole-project rules: recursion and storage sizes are refused by the checker with a
+location, so the simulator never meets them (no RecursionError or MemoryError)."""
+from __future__ import annotations
+
+import pytest
+
+import verifier.sim
+from verifier import st
+
+SELF_FB = """FUNCTION_BLOCK FB_Self
+VAR inner : FB_Self; bRun : BOOL; END_VAR
+inner(); bRun := NOT bRun;
+END_FUNCTION_BLOCK
+"""
+RECURSIVE_FUNCTION = """FUNCTION Fact : INT
+VAR_INPUT n : INT; END_VAR
+IF n <= 1 THEN Fact := 1; ELSE Fact := n * Fact(n - 1); END_IF;
+END_FUNCTION
+PROGRAM Main
+VAR r : INT; END_VAR
+r := Fact(5);
+END_PROGRAM
+"""
+HUGE_ARRAY = """PROGRAM Main
+VAR a : ARRAY[0..2000000000] OF INT; END_VAR
+a[0] := 1;
+END_PROGRAM
+"""
+
+
+def errors(text: str, target: str = "gxworks2") -> list[str]:
+    source = st.parse(text, "t.st", target)
+    return [str(d) for d in source.diagnostics + st.check([source], target) if d.is_error]
+
+
+def test_fb_holding_itself_is_an_error_at_the_label():
+    assert errors(SELF_FB) == ["t.st:2:5: error: function block FB_Self holds an instance of itself "
+                               "(FB_Self.inner -> FB_Self); GX Works does not allow recursion: a type "
+                               "cannot contain itself, directly or through others"]
+
+
+def test_recursive_function_is_an_error_at_the_call():
+    (message,) = errors(RECURSIVE_FUNCTION)
+    assert message.startswith("t.st:3:44: error: Fact calls itself (Fact -> Fact)")
+
+
+def test_no_cycle_no_error():
+    text = """FUNCTION_BLOCK FB_Leaf
+VAR_OUTPUT q : BOOL; END_VAR
+q := TRUE;
+END_FUNCTION_BLOCK
+FUNCTION_BLOCK FB_Tree
+VAR a, b : FB_Leaf; END_VAR
+a(); b();
+END_FUNCTION_BLOCK
+"""
+    assert errors(text) == []
+
+
+def test_long_acyclic_chain_of_fbs_is_sized_without_deep_recursion():
+    n = 3000
+    parts = [f"FUNCTION_BLOCK FB_{i}\nVAR x : FB_{i + 1}; w : WORD; END_VAR\nx(); w := 1;\nEND_FUNCTION_BLOCK\n"
+             for i in range(n)]
+    parts.append(f"FUNCTION_BLOCK FB_{n}\nVAR w : WORD; END_VAR\nw := 1;\nEND_FUNCTION_BLOCK\n")
+    assert errors("".join(parts)) == []
+
+
+def test_long_chain_of_fbs_is_checked_without_deep_recursion():
+    n = 3000  # deeper than Python's recursion limit: the graph walk must be iterative
+    parts = [f"FUNCTION_BLOCK FB_{i}\nVAR x : FB_{i + 1}; END_VAR\nx();\nEND_FUNCTION_BLOCK\n" for i in range(n)]
+    parts.append(f"FUNCTION_BLOCK FB_{n}\nVAR x : FB_0; END_VAR\nx();\nEND_FUNCTION_BLOCK\n")
+    found = errors("".join(parts))
+    assert len(found) == 1 and "FB_0 holds an instance of itself" in found[0]
+
+
+@pytest.mark.parametrize("text, where", [
+    (SELF_FB, "t.st:2:5: error: function block FB_Self holds an instance of itself"),
+    (RECURSIVE_FUNCTION, "t.st:3:44: error: Fact calls itself"),
+    (HUGE_ARRAY, "t.st:2:15: error: array bound 2000000000 is outside the index range -32768..32767"),
+])
+def test_simulator_refuses_with_the_location_never_crashes(text, where):
+    with pytest.raises(verifier.sim.LoadError) as err:
+        verifier.sim.load(sources={"t.st": text})
+    assert where in str(err.value)
+
+
+def test_flat_600_term_sum_is_reported_at_its_statement():
+    text = "PROGRAM Main\nVAR i, y : INT; END_VAR\ny := 1;\ny := " + "+".join(["i"] * 600) + ";\nEND_PROGRAM\n"
+    source = st.parse(text, "t.st")
+    found = st.check([source])
+    assert [(d.line, d.col, d.severity) for d in found] == [(4, 1, "error")]
+    assert "nested too deeply" in found[0].message
