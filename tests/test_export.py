@@ -75,7 +75,7 @@ def test_label_table_uses_the_editors_words(tmp_path):
     gw2 = (tmp_path / "2" / "UITAMR_Engine.labels.tsv").read_text()
     gw3 = (tmp_path / "3" / "UITAMR_Engine.labels.tsv").read_text()
     assert gw2.splitlines()[0] == "Class\tLabel Name\tData Type\tConstant\tComment"
-    assert "VAR_INPUT\ti_bEnable\tBit\t\trun the engine" in gw2
+    assert "VAR_INPUT\ti_bEN\tBit\t\trun the engine" in gw2
     assert "VAR_IN_OUT\tio_uPort\tWord[Unsigned]/Bit String[16-bit](0..39)\t\tport interface" in gw2
     assert "VAR_CONSTANT\tPACE_TIME\tTime\tT#300ms\t" in gw2
     assert "VAR\ttmrPace\tTON\t\tstart-to-start pacing" in gw2

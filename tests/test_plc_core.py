@@ -33,11 +33,11 @@ VAR
     wWhat : INT;
 END_VAR
 IF wWhat = 1 THEN
-    fbCtl(i_wAddress := wAddress, i_wCode := wCode, i_wCommand := wCommand, io_uFrame := uFrame);
+    fbCtl(i_bEN := TRUE, i_wAddress := wAddress, i_wCode := wCode, i_wCommand := wCommand, io_uFrame := uFrame);
 ELSIF wWhat = 2 THEN
-    fbSts(i_wAddress := wAddress, i_wQuery := wQuery, io_uFrame := uFrame);
+    fbSts(i_bEN := TRUE, i_wAddress := wAddress, i_wQuery := wQuery, io_uFrame := uFrame);
 ELSIF wWhat = 3 THEN
-    fbParse(i_wAddress := wAddress, i_wFunction := wFunction, i_wLen := wLen, io_uReply := uReply);
+    fbParse(i_bEN := TRUE, i_wAddress := wAddress, i_wFunction := wFunction, i_wLen := wLen, io_uReply := uReply);
 END_IF;
 END_PROGRAM
 """

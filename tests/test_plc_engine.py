@@ -31,10 +31,12 @@ VAR
     fbRead : UITAMR_ReadStatus;
     fbMove : UITAMR_MoveRelative;
     fbRange : UITAMR_SetCollisionRange;
+    fbRunB : UITAMR_RunPoint;
     uMbx : ARRAY[0..15] OF WORD;
     uPort : ARRAY[0..39] OF WORD;
     bEnable : BOOL;
     bMonitor : BOOL;
+    bCmdOff : BOOL;
     bRun : BOOL;
     bStop : BOOL;
     bSpeed : BOOL;
@@ -47,14 +49,17 @@ VAR
     wAxis : INT;
     eValue : REAL;
     eRange : REAL;
+    bRunB : BOOL;
+    wPointB : INT;
 END_VAR
-fbEngine(i_bEnable := bEnable, i_wAddress := 1, i_bMonitor := bMonitor, io_uMbx := uMbx, io_uPort := uPort);
-fbRun(i_bExecute := bRun, i_wPoint := wPoint, io_uMbx := uMbx);
-fbStop(i_bExecute := bStop, io_uMbx := uMbx);
-fbSpeed(i_bExecute := bSpeed, i_bMagnetic := FALSE, i_wStage := wStage, io_uMbx := uMbx);
-fbRead(i_bExecute := bRead, i_wQuery := wQuery, io_uMbx := uMbx);
-fbMove(i_bExecute := bMove, i_wAxis := wAxis, i_eValue := eValue, io_uMbx := uMbx);
-fbRange(i_bExecute := bRange, i_eRange := eRange, io_uMbx := uMbx);
+fbEngine(i_bEN := bEnable, i_wAddress := 1, i_bMonitor := bMonitor, io_uMbx := uMbx, io_uPort := uPort);
+fbRun(i_bEN := NOT bCmdOff, i_bExecute := bRun, i_wPoint := wPoint, io_uMbx := uMbx);
+fbStop(i_bEN := NOT bCmdOff, i_bExecute := bStop, io_uMbx := uMbx);
+fbSpeed(i_bEN := NOT bCmdOff, i_bExecute := bSpeed, i_bMagnetic := FALSE, i_wStage := wStage, io_uMbx := uMbx);
+fbRead(i_bEN := NOT bCmdOff, i_bExecute := bRead, i_wQuery := wQuery, io_uMbx := uMbx);
+fbMove(i_bEN := NOT bCmdOff, i_bExecute := bMove, i_wAxis := wAxis, i_eValue := eValue, io_uMbx := uMbx);
+fbRange(i_bEN := NOT bCmdOff, i_bExecute := bRange, i_eRange := eRange, io_uMbx := uMbx);
+fbRunB(i_bEN := TRUE, i_bExecute := bRunB, i_wPoint := wPointB, io_uMbx := uMbx);
 END_PROGRAM
 """
 
@@ -389,3 +394,112 @@ def test_every_command_ends_in_ok_or_err_whatever_the_line_does(commands, behavi
     assert port.overlaps == []
     starts = [t for t, _ in port.requests]
     assert all(b - a >= 300_000 for a, b in zip(starts, starts[1:]))
+
+
+# ---------------------------------------------------------------------------- latching (PLCopen)
+def test_inputs_are_latched_on_the_execute_edge_not_when_the_request_is_posted(rig):
+    """QA finding 4: a queued command must send what its inputs were at its rising edge."""
+    h, port = rig
+    port.running_polls = 6
+    start_point(h, port, point=1)                     # fbRun keeps the engine busy
+    port.run(400)
+    assert h.fbRun.o_bBusy
+    h.wPointB, h.bRunB = 2, True                      # queued behind fbRun
+    h.wStage, h.bSpeed = 2, True
+    h.wAxis, h.eValue, h.bMove = 1, 1.5, True
+    h.wQuery, h.bRead = 1, True
+    port.run(50)
+    assert h.fbRunB.o_bBusy and h.fbSpeed.o_bBusy and h.fbMove.o_bBusy and h.fbRead.o_bBusy
+    h.wPointB = 192                                   # 16#C0: coordinate reset if read late
+    h.wStage = 4
+    h.wAxis, h.eValue = 4, -0.25
+    h.wQuery = 7                                      # out of range if checked late
+    port.run(15_000, until=lambda x: all(getattr(x, fb).o_bOK or getattr(x, fb).o_bErr
+                                         for fb in ("fbRunB", "fbSpeed", "fbMove", "fbRead")))
+    assert h.fbRunB.o_bOK and h.fbSpeed.o_bOK and h.fbMove.o_bOK and h.fbRead.o_bOK
+    sent = port.kinds()
+    latched = [encode(ControlRequest(1, 1, 2), SETTINGS), encode(ControlRequest(1, 2, 1), SETTINGS),
+               encode(ControlRequest(1, 6, 15), SETTINGS), encode(StatusRequest(1, 1), SETTINGS)]
+    assert all(frame in sent for frame in latched)
+    late = [encode(ControlRequest(1, 1, 0xC0), SETTINGS), encode(ControlRequest(1, 2, 3), SETTINGS),
+            encode(ControlRequest(1, 13, 25), SETTINGS)]
+    assert not any(frame in sent for frame in late)
+
+
+def test_a_new_value_needs_a_new_edge(rig):
+    h, port = rig
+    port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)
+    h.wPointB, h.bRunB = 4, True
+    port.run(3000, until=lambda x: x.fbRunB.o_bOK)
+    h.wPointB = 6                                     # held Execute: nothing new is sent
+    port.run(1000)
+    assert encode(ControlRequest(1, 1, 6), SETTINGS) not in port.kinds()
+    h.bRunB = False
+    port.run(50)
+    h.bRunB = True
+    port.run(3000, until=lambda x: x.fbRunB.o_bOK)
+    assert encode(ControlRequest(1, 1, 6), SETTINGS) in port.kinds()
+
+
+# ---------------------------------------------------------------------------- i_bEN / o_bENO
+def test_eno_mirrors_en_on_command_fbs_and_engine(rig):
+    h, port = rig
+    port.run(100)
+    assert h.fbEngine.o_bENO and h.fbRun.o_bENO and h.fbStop.o_bENO
+    h.bCmdOff, h.bEnable = True, False
+    port.run(20)
+    assert not h.fbEngine.o_bENO
+    assert not any(getattr(h, fb).o_bENO for fb in ("fbRun", "fbStop", "fbSpeed", "fbRead", "fbMove", "fbRange"))
+
+
+def test_a_command_fb_without_en_ignores_execute(rig):
+    h, port = rig
+    port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)
+    count = len(port.requests)
+    h.bCmdOff = True
+    h.wPoint, h.bRun = 3, True
+    port.run(1000)
+    assert not (h.fbRun.o_bBusy or h.fbRun.o_bOK or h.fbRun.o_bErr)
+    assert all(d[1] == 1 or d == STOP for d in port.kinds()[count:])   # no control frame
+    h.bCmdOff = False                                 # EN back with Execute held: needs a new edge
+    port.run(500)
+    assert not h.fbRun.o_bBusy
+
+
+def test_en_off_withdraws_a_queued_request_and_frees_the_mailbox(rig):
+    h, port = rig
+    port.running_polls = 6
+    h.wPointB = 1
+    port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)
+    h.bRunB = True                                    # fbRunB keeps the engine busy (EN always on)
+    port.run(400)
+    h.wPoint, h.bRun = 9, True                        # queued behind it
+    port.run(50)
+    assert h.fbRun.o_bBusy
+    h.bCmdOff = True                                  # withdrawn before the engine took it
+    port.run(50)
+    assert not h.fbRun.o_bBusy and not h.fbRun.o_bOK and not h.fbRun.o_bErr
+    port.run(6000, until=lambda x: x.fbRunB.o_bOK)
+    assert encode(ControlRequest(1, 1, 9), SETTINGS) not in port.kinds()
+    h.bCmdOff, h.bRun = False, False
+    port.run(50)
+    h.wPoint, h.bRun = 7, True                        # the mailbox is usable again
+    port.run(6000, until=lambda x: x.fbRun.o_bOK)
+    assert h.fbRun.o_bOK
+
+
+def test_en_off_while_the_engine_serves_the_command_discards_the_result_and_frees_the_slot(rig):
+    h, port = rig
+    port.running_polls = 4
+    start_point(h, port, point=5)
+    port.run(400)                                     # sent, the engine polls its task
+    assert encode(ControlRequest(1, 1, 5), SETTINGS) in port.kinds()
+    h.bCmdOff = True
+    port.run(4000)
+    assert not (h.fbRun.o_bOK or h.fbRun.o_bErr or h.fbRun.o_bBusy)
+    assert h.uMbx[0] == 0                             # slot freed once the engine was done
+    h.bCmdOff, h.bRun = False, False
+    port.run(50)
+    h.wPoint, h.bRun = 8, True
+    port.run(6000, until=lambda x: x.fbRun.o_bOK)
+    assert h.fbRun.o_bOK and encode(ControlRequest(1, 1, 8), SETTINGS) in port.kinds()

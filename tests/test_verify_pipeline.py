@@ -55,7 +55,7 @@ IF NOT bLoaded THEN
 {loads}
     bLoaded := TRUE;
 END_IF;
-fbPort(i_bEnable := TRUE, i_wChannel := 1, io_uPort := uPort);
+fbPort(i_bEN := TRUE, i_wChannel := 1, io_uPort := uPort);
 tmrPeriod(IN := NOT tmrPeriod.Q, PT := {period});
 IF tmrPeriod.Q AND (wNext < FRAME_COUNT) AND (uPort[0] = 0) THEN
     FOR wIndex := 0 TO FRAME_LEN - 1 DO
