@@ -63,3 +63,11 @@ def test_decode_error_position_moves_the_line_out_of_the_message():
     message, line = decode_error_position(caught.value)
     assert line == 2
     assert message == "Expected ']]' at the end of an array declaration (column 9)"
+
+
+def test_keys_in_inline_tables_point_at_the_line_that_holds_them():
+    lines = ['name = "x"', 'faults = [{ kind = "no_reply", on_request = 1 },', '  { kind = "x", at_s = 1 }]',
+             'robot = { pacing = "sometimes" }']
+    assert line_of_key(lines, "faults[1].kind") == 2
+    assert line_of_key(lines, "robot.pacing") == 4
+    assert line_of_key(lines, "nosuch.key") is None

@@ -16,8 +16,8 @@ _DECODE_POSITION = re.compile(r"\s*\(at line (\d+), column (\d+)\)")
 
 def line_of_key(lines: list[str], key: str) -> int | None:
     """Best effort: the 1-based line that sets ``key`` ("expect[1].within", "robot.x",
-    "faults[0]"), or the header of its table; None when it cannot be found (for instance a
-    key written as an inline table)."""
+    "faults[0]"), or the header of its table, or the line of an inline table that holds it;
+    None when it cannot be found."""
     parts = _KEY_PART.findall(key)
     if not parts:
         return None
@@ -50,7 +50,10 @@ def line_of_key(lines: list[str], key: str) -> int | None:
             break  # past its table (and the table's sub-tables): point at the table's header
         if re.match(r"^\s*\"?" + re.escape(target) + r"\"?\s*=", line):
             return number + 1
-    return None if start is None else start + 1
+    if start is None:
+        # no header: the table may be written inline (faults = [{ kind = "x" }]); its line
+        return line_of_key(lines, table) if rest or index else None
+    return start + 1
 
 
 def decode_error_position(error: tomllib.TOMLDecodeError) -> tuple[str, int | None]:
