@@ -194,3 +194,37 @@ def test_pou_end_may_be_left_out_of_the_last_pou_only():
     diags = parse("PROGRAM A\nPROGRAM B\nEND_PROGRAM", "f.st").diagnostics
     assert [(d.line, d.col) for d in diags] == [(2, 1)]
     assert "END_PROGRAM" in diags[0].message
+
+
+def _only_error(text: str):
+    (diag,) = parse(text, "t.st").diagnostics
+    return diag.line, diag.col, diag.message
+
+
+@pytest.mark.parametrize("statement, col, after, found", [
+    ("y := 1 +;", 9, "'+'", "';'"),
+    ("y := ;", 6, "':='", "';'"),
+    ("y := MAX(1,);", 12, "','", "')'"),
+    ("y := (2 * );", 11, "'*'", "')'"),
+])
+def test_missing_operand_says_an_expression_is_expected(statement, col, after, found):
+    line, c, message = _only_error(f"PROGRAM M\nVAR y : INT; END_VAR\n{statement}\nEND_PROGRAM\n")
+    assert (line, c) == (3, col)
+    assert message == f"expected an expression (a value, label or call) after {after}, not {found}"
+
+
+def test_nested_comment_is_named_at_the_inner_opener():
+    line, col, message = _only_error("PROGRAM M\nVAR y : INT; END_VAR\n(* outer (* inner *) still *)\n"
+                                     "y := 1;\nEND_PROGRAM\n")
+    assert (line, col) == (3, 10)
+    assert message.startswith("nested comments are not supported: this '(*' is inside the comment opened at 3:1")
+
+
+def test_nested_comment_over_lines():
+    text = "PROGRAM M\n(* header\n   old: (* y := 2; *)\n   more text *)\nEND_PROGRAM\n"
+    line, col, message = _only_error(text)
+    assert (line, col) == (3, 9) and message.startswith("nested comments are not supported")
+
+
+def test_an_opener_inside_a_closed_comment_is_just_text():
+    assert parse("PROGRAM M\n(* a (* b *)\nEND_PROGRAM\n", "t.st").diagnostics == []

@@ -92,8 +92,46 @@ def _semicolon_fixes(exc: UnexpectedToken) -> bool:
         return False
 
 
+_BLOCK_COMMENT_RE = re.compile(r"\(\*[\s\S]*?\*\)")
+
+
+def _line_col(text: str, pos: int) -> tuple[int, int]:
+    return text.count("\n", 0, pos) + 1, pos - (text.rfind("\n", 0, pos) + 1) + 1
+
+
+def _error_pos(exc: UnexpectedInput, text: str) -> int:
+    if isinstance(exc, UnexpectedCharacters):
+        return exc.pos_in_stream
+    tok = getattr(exc, "token", None)
+    if tok is not None and tok.type != "$END" and tok.start_pos is not None:
+        return tok.start_pos
+    return len(text)
+
+
+def _nested_comment(text: str, pos: int) -> tuple[int, int, str] | None:
+    """When the error sits in the tail of a comment that held another '(*' (the first
+    '*)' closed it early), point at that inner '(*'."""
+    for m in _BLOCK_COMMENT_RE.finditer(text, 0, pos + 2):
+        if m.end() > pos:
+            break
+        inner = text.find("(*", m.start() + 2, m.end() - 2)
+        if inner == -1:
+            continue
+        tail_end = text.find("*)", m.end())
+        if tail_end != -1 and pos <= tail_end + 1:
+            line, col = _line_col(text, inner)
+            outer_line, outer_col = _line_col(text, m.start())
+            return (line, col, f"nested comments are not supported: this '(*' is inside the comment opened at "
+                               f"{outer_line}:{outer_col}, which the first '*)' closes; remove the inner '(*' "
+                               "and '*)'")
+    return None
+
+
 def describe_syntax_error(exc: UnexpectedInput, text: str, parser: Lark) -> tuple[int, int, str]:
     """(line, column, message) for a lark exception raised while reading `text`."""
+    nested = _nested_comment(text, _error_pos(exc, text))
+    if nested is not None:
+        return nested
     if isinstance(exc, UnexpectedCharacters):
         rest = text[exc.pos_in_stream: exc.pos_in_stream + 2]
         if rest == "(*" or rest == "/*":
@@ -147,6 +185,10 @@ def describe_syntax_error(exc: UnexpectedInput, text: str, parser: Lark) -> tupl
         word = re.match(r"[0-9A-Za-z_]+", text[pos:pos + 40]).group()
         return line, col, f"'{word}': a name must not start with a digit; rename it"
     accepted = _accepted(exc) or expected
+    if {"IDENT", "INT", "LPAR"} <= accepted and "SEMI" not in accepted:
+        prev, _ = _previous_token(parser, text, pos)
+        after = f" after {_token_text(prev)}" if prev is not None else ""
+        return line, col, f"expected an expression (a value, label or call){after}, not {_token_text(tok)}"
     if tok.type == "EQ" and "ASSIGN" in expected:
         return line, col, "'=' compares; write ':=' to assign"
     if tok.type == "ASSIGN" and "EQ" in expected:
