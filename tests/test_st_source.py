@@ -63,3 +63,22 @@ def test_multibyte_label_names_are_refused_with_the_reason():
     (problem,) = source.diagnostics
     assert (problem.line, problem.col) == (2, 5)
     assert "names are ASCII" in problem.message
+
+
+def test_export_reads_with_the_same_reader(tmp_path):
+    from click.testing import CliRunner
+
+    from verifier.cli import main
+
+    sjis = tmp_path / "P.st"
+    sjis.write_bytes(PROGRAM.encode("cp932"))
+    out = tmp_path / "out"
+    done = CliRunner().invoke(main, ["export", "--target", "gxworks2", "--out", str(out), str(sjis)])
+    assert done.exit_code == 0, done.output
+    assert "iX := 1;" in (out / "P.st").read_text(encoding="utf-8")
+    assert (out / "P.labels.tsv").read_text(encoding="utf-8").splitlines()[1].split("\t")[1] == "iX"
+    junk = tmp_path / "junk.st"
+    junk.write_bytes(b"PROGRAM P\n\xff\xfe\xfd\n")
+    refused = CliRunner().invoke(main, ["export", "--target", "gxworks2", "--out", str(out), str(junk)])
+    assert refused.exit_code == 1
+    assert f"{junk}:2:1: error: byte 0xFF" in refused.output

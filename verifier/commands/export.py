@@ -12,7 +12,7 @@ from pathlib import Path
 
 import click
 
-from verifier.commands.check import expand_sources, read_source
+from verifier.commands.check import expand_sources
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
 PLC_ROOT = Path(__file__).resolve().parents[2] / "plc"
@@ -48,7 +48,17 @@ def command(sources: tuple[str, ...], target: str, out_dir: str) -> None:
     if not paths:
         click.echo("uitamr export: no .st files to export", err=True)
         sys.exit(EXIT_USAGE)
-    texts = {p: read_source(p) for p in paths}
+    from verifier.st import read_source  # the one ST reader (UTF-8, else Shift-JIS)
+
+    texts, unreadable = {}, []
+    for p in paths:
+        texts[p], problems = read_source(p)
+        unreadable += problems
+    if unreadable:
+        for d in unreadable:
+            click.echo(str(d), err=True)
+        click.echo(f"uitamr export: nothing written, {len(unreadable)} unreadable file(s)", err=True)
+        sys.exit(EXIT_ERRORS)
     try:
         written = export_sources(paths, target, Path(out_dir), texts)
     except ExportError as e:
