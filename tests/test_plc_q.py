@@ -4,6 +4,7 @@ no-reception monitoring time ends the message; with it set, the exception is rep
 so this test wires robot, line and simulator itself."""
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import verifier
@@ -59,3 +60,54 @@ def test_requests_keep_the_pacing_on_q():
     starts = [f.t_start_us for f in line.trace if f.direction == "tx"]
     assert len(starts) > 10
     assert min(b - a for a, b in zip(starts, starts[1:])) > 250_000
+
+
+# ---------------------------------------------------------------------------- moving the module
+EXAMPLE_Q = PLC / "examples" / "q" / "UITAMR_ExampleQ.st"
+MOVE_TO_X020 = [   # the places the example's header and import-gxworks2.md §5 list
+    ("C24_UNIT : WORD := 16#0;", "C24_UNIT : WORD := 16#2;"),
+    ("i_bReadReq := X3,", "i_bReadReq := X23,"),
+    ("U0\\G150", "U2\\G150"), ("U0\\G164", "U2\\G164"), ("U0\\G165", "U2\\G165"),
+]
+
+
+def moved_example(edits):
+    text = EXAMPLE_Q.read_text()
+    for old, new in edits:
+        assert text.count(old) == 1, old
+        text = text.replace(old, new)
+    return text
+
+
+def run_at_x020(text):
+    robot = Robot(Settings(), RobotConfig(point_duration_s=1.0), [])
+    line = Line(robot)
+    project = verifier.load(*SOURCES[:-1], sources={"UITAMR_ExampleQ.st": text}, cpu="q")
+    project.attach_serial("q:1", line)
+    run(project, 5000, pulse(project, "X20", 1000))
+    return project.program("UITAMR_ExampleQ"), line
+
+
+def test_the_documented_edits_move_the_c24_to_x020():
+    prog, line = run_at_x020(moved_example(MOVE_TO_X020))
+    assert prog.fbEngine.o_bInitDone and prog.fbCycle.o_wPoint > 1
+    assert [f for f in line.trace if f.direction == "rx"]
+
+
+def test_the_example_lists_every_place_that_names_the_module():
+    text = EXAMPLE_Q.read_text()
+    body = text.split("PROGRAM UITAMR_ExampleQ", 1)[1]
+    assert set(re.findall(r"U[0-9A-F]+\\G\d+", body)) == {"U0\\G150", "U0\\G164", "U0\\G165"}
+    header = text.split("PROGRAM UITAMR_ExampleQ", 1)[0]
+    for place in ("C24_UNIT", "i_bReadReq", "U0\\G", "C24_CHANNEL", "G310 / G324 / G325"):
+        assert place in header
+    guide = (PLC.parent / "docs" / "import-gxworks2.md").read_text()
+    for place in ("`C24_UNIT`", "X(start + 3)", "`U0\\G150`", "`G310`", "`C24_CHANNEL`"):
+        assert place in guide
+
+
+def test_forgetting_the_buffer_memory_writes_breaks_the_link():
+    """Why the U\\G writes are on the list: with them left at U0 the module at X/Y020 keeps
+    word units and an end code, and the stop is never seen as answered."""
+    prog, _ = run_at_x020(moved_example(MOVE_TO_X020[:2]))
+    assert not prog.fbEngine.o_bInitDone
