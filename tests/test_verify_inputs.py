@@ -154,3 +154,76 @@ def test_progress_lines_show_in_ci_logs(program, monkeypatch):
     monkeypatch.setattr(verify_command, "PLAIN_PROGRESS_EVERY_S", 0.0)
     result = invoke(program, "--duration", "3s")
     assert "verify: 33% of 3.000 s virtual time done" in result.output
+
+
+# --- PLC-side settings before the first scan --------------------------------------------------
+
+Q_PROGRAM = """\
+PROGRAM QMain
+VAR
+    wCount : INT;
+    wEnd : INT;
+    bDone : BOOL;
+END_VAR
+IF NOT bDone THEN
+    wCount := U0\\G164;
+    wEnd := D100;
+    bDone := TRUE;
+END_IF;
+END_PROGRAM
+"""
+
+
+def test_initial_devices_and_buffer_memory_are_there_at_the_first_scan(tmp_path):
+    (tmp_path / "QMain.st").write_text(Q_PROGRAM, encoding="utf-8")
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(
+        'sources = ["QMain.st"]\nplatform = "q"\nduration = "100ms"\n'
+        '[initial]\n\'U0\\G164\' = 8\nD100 = 0xFFFF\n'
+        '[[expect]]\nalways = "wCount = 8 AND wEnd = -1 OR NOT bDone"\n'
+        '[[expect]]\nthat = "wCount = 8"\nwithin = "20ms"\n', encoding="utf-8")
+    result = invoke("--scenario", scenario)
+    assert result.exit_code == 0, result.output
+
+
+@pytest.mark.parametrize("body, key, words", [
+    ("[initial]\nlabel = 1\n", "initial.label", "is not a device"),
+    ("[initial]\n'U0\\G99999' = 1\n", "initial.U0\\G99999", "buffer memory ends at"),
+    ("[initial]\n'U0\\G1' = true\n", "initial.U0\\G1", "holds words"),
+    ("[initial]\n'U0\\G1' = 70000\n", "initial.U0\\G1", "whole number"),
+    ("[initial]\nD1 = 1.5\n", "initial.D1", "whole number"),
+    ('[[c24]]\nchannel = 3\n', "c24[0].channel", "1..2"),
+    ('[[c24]]\nno_reception = 5\n', "c24[0].no_reception", "expected a duration"),
+    ('[[c24]]\nbaud = 9600\n', "c24[0].baud", "unknown key"),
+])
+def test_plc_settings_mistakes_name_their_key(tmp_path, body, key, words):
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('platform = "q"\n' + body, encoding="utf-8")
+    with pytest.raises(ScenarioError) as info:
+        load_scenario(scenario)
+    assert info.value.key == key and words in info.value.message and info.value.line is not None
+
+
+def test_c24_settings_need_the_q_platform(tmp_path, program):
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('platform = "fx3u"\n\n[[c24]]\nno_reception = "5ms"\n', encoding="utf-8")
+    with pytest.raises(ScenarioError, match=r":3: c24\[0\]: the QJ71C24N is a Q-series module"):
+        load_scenario(scenario)
+    scenario.write_text('platform = "q"\nduration = "1s"\n\n[initial]\nD99999 = 1\n', encoding="utf-8")
+    result = invoke(program, "--scenario", scenario)  # the q has no D99999: found on the loaded CPU
+    assert result.exit_code == 2 and f"{scenario}:5: initial.D99999: 'D99999': D ends at" in result.output
+
+
+def test_the_bundled_q_exception_scenario_needs_the_no_reception_time():
+    """q-exception.toml passes (test_plc_scenarios runs it); without its [[c24]] key the
+    5-byte exception stays in the module and the scenario fails — the key does the work."""
+    from dataclasses import replace
+
+    from verifier.commands.verify import bundled_plc_dir
+    from verifier.verify.runner import run_scenario
+
+    scenario = load_scenario(bundled_plc_dir() / "scenarios" / "q-exception.toml")
+    assert scenario.c24 and scenario.c24[0].no_reception_us == 5000
+    result = run_scenario(replace(scenario, c24=(), duration_us=6_000_000,
+                                  expectations=scenario.expectations[:2]))
+    assert [e.passed for e in result.expectations] == [True, False]

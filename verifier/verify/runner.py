@@ -19,14 +19,13 @@ from .evidence import RunEvidence, Samples
 from .expectations import judge
 from .result import LineEvent, ScenarioResult, TraceRecord, UnusableInput
 from .rules import check_all
-from .scenario import Scenario
+from .scenario import BUFFER_MEMORY, DEVICE_NAME, Scenario
 from .traffic import analyse
 
 Progress = Callable[[int, int], None]  # (virtual now, virtual end) in µs
 PROGRESS_STEP_US = 1_000_000  # report progress every virtual second
 
-#: Device names (X0, M8000, D100, SM400, ...) are read through the device memory, not labels.
-_DEVICE = re.compile(r"^(?:(?:X|Y|B|W|SB|SW)[0-9A-F]+|(?:M|L|F|S|T|C|D|R|ZR|SM|SD)\d+)$", re.IGNORECASE)
+_DEVICE = DEVICE_NAME
 
 
 class _Plc:
@@ -221,6 +220,34 @@ def _input_problem(plc: _Plc, name: str, value: Any) -> str | None:
     return None
 
 
+def _apply_plc_settings(plc: _Plc, scenario: Scenario) -> None:
+    """[[c24]] module settings, then [initial] devices and buffer memory, before the first scan."""
+    for setting in scenario.c24:
+        where = scenario.where(setting.key, scenario.key_lines.get(setting.key))
+        if scenario.platform != "q":
+            raise UnusableInput(f"{where}: the QJ71C24N is a Q-series module; the platform is {scenario.platform}")
+        try:
+            plc.project.configure_c24(
+                setting.unit, setting.channel, byte_units=setting.byte_units, receive_count=setting.receive_count,
+                end_code=setting.end_code,
+                no_reception_ms=None if setting.no_reception_us is None else setting.no_reception_us / 1000,
+            )
+        except (ValueError, KeyError) as exc:
+            raise UnusableInput(f"{where}: {exc}") from None
+    for name, value in scenario.initial:
+        key = f"initial.{name}"
+        where = scenario.where(key, scenario.key_lines.get(key))
+        buffer = BUFFER_MEMORY.match(name)
+        if buffer:
+            words = plc.project.c24_buffer(int(buffer.group(1), 16))
+            words[int(buffer.group(2))] = value - 0x10000 if value > 0x7FFF else value
+            continue
+        problem = plc.problem(name) or _input_problem(plc, name, value)
+        if problem:
+            raise UnusableInput(f"{where}: {problem}")
+        plc.write(name, value)
+
+
 def _input_schedule(scenario: Scenario) -> list[tuple[int, dict[str, Any]]]:
     steps: list[tuple[int, dict[str, Any]]] = []
     for step in scenario.inputs:
@@ -238,6 +265,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None) -> Scenar
     line = Line(robot)
     plc = _Plc(scenario, line)
     scenario = _check_labels(plc, scenario)
+    _apply_plc_settings(plc, scenario)
     names = scenario.variables()
     samples = Samples(names)
     schedule = _input_schedule(scenario)

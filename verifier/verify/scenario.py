@@ -41,13 +41,21 @@ DEFAULT_RESPONSE_SIGNAL = "o_bErr"
 TOP_KEYS = (
     "name", "description", "sources", "program", "platform", "channel", "duration", "scan",
     "scan_jitter", "seed", "watch", "protocol", "robot", "faults", "inputs", "expect", "rules",
-    "response_handling",
+    "response_handling", "initial", "c24",
 )
 PROTOCOL_KEYS = ("address", "field_order", "codes_10_13", "status_order", "manual_stop_counts_as_stop")
 INPUT_KEYS = ("at", "set", "pulse")
 EXPECT_KEYS = KINDS + ("after", "within", "name")
 RULES_KEYS = ("min_period", "reply_timeout")
 RESPONSE_KEYS = ("signal", "within")
+C24_KEYS = ("unit", "channel", "no_reception", "byte_units", "receive_count", "end_code")
+#: Buffer memory of an intelligent module, as GX Works writes it: U0\G164, U3E\G10.
+BUFFER_MEMORY = re.compile(r"^U([0-9A-F]{1,3})\\G(\d+)$", re.IGNORECASE)
+#: Highest buffer-memory word the simulator models per module (16#3FFF). ASSUMPTION: enough
+#: for the QJ71C24N areas the library uses (the module's map ends at 7FFFH).
+BUFFER_WORDS = 0x4000
+#: Device names (X0, M8000, D100, SM400, ...) address the device memory, not labels.
+DEVICE_NAME = re.compile(r"^(?:(?:X|Y|B|W|SB|SW)[0-9A-F]+|(?:M|L|F|S|T|C|D|R|ZR|SM|SD)\d+)$", re.IGNORECASE)
 _LABEL_PATH = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\[\d+\])*(\.[A-Za-z_][A-Za-z0-9_]*(\[\d+\])*)*$")
 
 Value = bool | int | float
@@ -70,6 +78,20 @@ class InputStep:
     values: dict[str, Value]
     pulse_us: int | None = None
     key: str = ""  # where the scenario states it, e.g. "inputs[0]"
+
+
+@dataclass(frozen=True)
+class C24Setting:
+    """QJ71C24N settings made in GX Works (switch settings / various control specification)
+    for one channel of the module at start I/O `unit` (U0 = X/Y000, U2 = X/Y020)."""
+
+    unit: int = 0
+    channel: int = 1
+    no_reception_us: int | None = None  # no-reception monitoring time (timer 0)
+    byte_units: bool | None = None
+    receive_count: int | None = None
+    end_code: int | None = None  # 0xFFFF = no receive end code
+    key: str = ""
 
 
 @dataclass(frozen=True)
@@ -107,6 +129,8 @@ class Scenario:
     options: RuleOptions = field(default_factory=RuleOptions)
     response_signal_given: bool = False
     key_lines: dict[str, int | None] = field(default_factory=dict, compare=False)
+    initial: tuple[tuple[str, Value], ...] = ()  # devices and buffer memory before the first scan
+    c24: tuple[C24Setting, ...] = ()
 
     @property
     def target(self) -> str:
@@ -316,7 +340,13 @@ class _Reader:
             for i, item in enumerate(self.array_of_tables(data.get("expect", []), "expect"))
         )
         options, signal_given = self.options(data.get("rules", {}), data.get("response_handling", None))
-        keys = [f"{e.key}.{e.kind}" for e in expectations if e.condition is not None]
+        initial = self.initial(data.get("initial", {}))
+        c24 = tuple(
+            self.c24(item, f"c24[{i}]", platform)
+            for i, item in enumerate(self.array_of_tables(data.get("c24", []), "c24"))
+        )
+        keys = [f"initial.{name}" for name, _ in initial] + [setting.key for setting in c24]
+        keys += [f"{e.key}.{e.kind}" for e in expectations if e.condition is not None]
         keys += [f"{step.key}.set" for step in inputs] + [f"watch[{i}]" for i in range(len(watch))]
         keys += ["response_handling.signal"] if signal_given else []
         return Scenario(
@@ -324,7 +354,52 @@ class _Reader:
             platform=platform, channel=channel, duration_us=duration, scan_us=scan, scan_jitter_us=jitter, seed=seed,
             watch=watch, settings=settings, robot=robot, faults=faults, inputs=inputs,
             expectations=expectations, options=options, response_signal_given=signal_given,
-            key_lines={key: self.line_of(key) for key in keys},
+            key_lines={key: self.line_of(key) for key in keys}, initial=initial, c24=c24,
+        )
+
+    def initial(self, value: Any) -> tuple[tuple[str, Value], ...]:
+        table = self.table(value, "initial")
+        result = []
+        for name, item in table.items():
+            key = f"initial.{name}"
+            match = BUFFER_MEMORY.match(name)
+            if match and int(match.group(2)) >= BUFFER_WORDS:
+                raise self.fail(key, f"buffer memory ends at G{BUFFER_WORDS - 1} in the simulator")
+            if not match and not DEVICE_NAME.match(name):
+                raise self.fail(key, f"{name!r} is not a device (D8400, M10, X0) or buffer memory (U0\\G164); "
+                                     "labels get their initial values in ST, or from [[inputs]] at \"0s\"")
+            if isinstance(item, bool) and match:
+                raise self.fail(key, "buffer memory holds words: give a number")
+            if not isinstance(item, (bool, int)) or (match and not -0x8000 <= item <= 0xFFFF):
+                raise self.fail(key, f"expected true/false or a whole number (a word: -32768..65535), got {_shown(item)}")
+            result.append((name, item))
+        return tuple(result)
+
+    def c24(self, item: dict, key: str, platform: str) -> C24Setting:
+        self.only(item, C24_KEYS, key)
+        if platform != "q":
+            raise self.fail(key, f"the QJ71C24N is a Q-series module; this scenario's platform is {platform!r}")
+        def whole(name: str, low: int, high: int) -> int | None:
+            if name not in item:
+                return None
+            value = item[name]
+            if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
+                raise self.fail(f"{key}.{name}", f"expected a whole number {low}..{high}, got {_shown(value)}")
+            return value
+        unit = whole("unit", 0, 0xFF)
+        channel = whole("channel", 1, 2)
+        no_reception = self.duration(item["no_reception"], f"{key}.no_reception") if "no_reception" in item else None
+        byte_units = item.get("byte_units")
+        if byte_units is not None and not isinstance(byte_units, bool):
+            raise self.fail(f"{key}.byte_units", f"expected true (bytes) or false (words), got {_shown(byte_units)}")
+        end_code = item.get("end_code")
+        if end_code == "none":
+            end_code = 0xFFFF
+        elif "end_code" in item:
+            end_code = whole("end_code", 0, 0xFFFF)
+        return C24Setting(
+            unit=unit or 0, channel=channel or 1, no_reception_us=no_reception, byte_units=byte_units,
+            receive_count=whole("receive_count", 1, 0xFFFF), end_code=end_code, key=key,
         )
 
     def sources(self, value: Any) -> list[Path]:
