@@ -114,3 +114,100 @@ def test_global_labels_get_their_own_table(tmp_path):
     assert gw3.exit_code == 0
     assert "bStart\tBit\tVAR_GLOBAL\tX0\t\t\tstart button" in (tmp_path / "g3" / "GlobalLabels.labels.tsv").read_text()
     assert "1 POU(s) exported" in result.output
+
+
+# ---------------------------------------------------------------------------- nothing silently lost
+INITIALS = """FUNCTION_BLOCK FB_Init
+VAR_INPUT
+    i_wIn : INT := 3;
+END_VAR
+VAR_OUTPUT
+    o_wOut : INT := 4;
+END_VAR
+VAR
+    wCount : INT := 5;
+    bOn : BOOL := TRUE;
+    tDelay : TIME := T#2s;
+END_VAR
+VAR CONSTANT
+    MAX_COUNT : INT := 7;
+END_VAR
+o_wOut := i_wIn + wCount + MAX_COUNT;
+END_FUNCTION_BLOCK
+"""
+GLOBALS = "VAR_GLOBAL\n    gwStart : INT := 9;\nEND_VAR\n"
+STRUCT = "TYPE S_Pos :\nSTRUCT\n    wX : INT := 11;\n    wY : INT;\nEND_STRUCT\nEND_TYPE\n"
+
+
+def _sources(tmp_path):
+    paths = []
+    for name, text in (("FB_Init.st", INITIALS), ("Globals.st", GLOBALS), ("S_Pos.st", STRUCT)):
+        path = tmp_path / name
+        path.write_text(text)
+        paths.append(path)
+    return paths
+
+
+def _initials(paths):
+    """(file, line, label, value) of every non-constant initial value in the sources."""
+    found = []
+    for path in paths:
+        for number, line in enumerate(path.read_text().splitlines(), 1):
+            m = re.match(r"\s+(\w+) : \w+ := (\S+);", line)
+            if m and m.group(1) != "MAX_COUNT":
+                found.append((path, number, m.group(1), m.group(2)))
+    return found
+
+
+@pytest.mark.parametrize("target", ["gxworks2", "gxworks3"])
+def test_no_initial_value_is_dropped_silently(tmp_path, target):
+    """QA finding 7: every initial value is in a written table, or named (file:line) in the
+    output - as a refusal or as a note - never just gone."""
+    paths = _sources(tmp_path)
+    out = tmp_path / "out"
+    result = CliRunner().invoke(command, ["--target", target, "--out", str(out), *map(str, paths)])
+    tables = "".join(p.read_text() for p in out.glob("*.tsv")) if out.exists() else ""
+    for path, line, label, value in _initials(paths):
+        row = [r for r in tables.splitlines() if r.split("\t")[0] == label or label in r.split("\t")[:2]]
+        carried = any(value in r.split("\t") for r in row)
+        named = f"{path}:{line}:" in result.output
+        assert carried or named, (label, value, result.output)
+    if target == "gxworks3":
+        assert result.exit_code == 0, result.output
+        assert not (out / "DROPPED_INITIAL_VALUES.txt").exists()
+
+
+def test_dropped_initial_values_are_listed_with_their_place(tmp_path):
+    from verifier.export import dropped_initial_values
+    paths = _sources(tmp_path)
+    files = [st.parse(p.read_text(), str(p), "gxworks2") for p in paths]
+    dropped = dropped_initial_values(files, "gxworks2")
+    assert [(d.owner, d.label, d.value) for d in dropped] == [
+        ("FB_Init", "i_wIn", "3"), ("FB_Init", "o_wOut", "4"), ("FB_Init", "wCount", "5"),
+        ("FB_Init", "bOn", "TRUE"), ("FB_Init", "tDelay", "T#2s"), ("global", "gwStart", "9"),
+        ("S_Pos", "wX", "11")]
+    assert str(dropped[2]).startswith(f"{paths[0]}:9:21: note: VAR 'FB_Init.wCount' := 5 not exported")
+    files3 = [st.parse(p.read_text(), str(p), "gxworks3") for p in paths]
+    assert dropped_initial_values(files3, "gxworks3") == []
+
+
+def test_gxworks3_carries_initial_values_in_every_table(tmp_path):
+    out = tmp_path / "out"
+    run("--target", "gxworks3", "--out", str(out), *map(str, _sources(tmp_path)))
+    assert "wCount\tWord [Signed]\tVAR\t5\t" in (out / "FB_Init.labels.tsv").read_text()
+    assert "gwStart\tWord [Signed]\tVAR_GLOBAL\t\t9\t" in (out / "GlobalLabels.labels.tsv").read_text()
+    assert (out / "S_Pos.struct.tsv").read_text().splitlines() == [
+        "Label Name\tData Type\tInitial Value\tComment", "wX\tWord [Signed]\t11\t", "wY\tWord [Signed]\t\t"]
+    assert (out / "IMPORT_ORDER.txt").read_text().splitlines()[0] == "S_Pos\tSTRUCT"
+
+
+@pytest.mark.parametrize("text", ["", "(* only a comment *)\n", "\n\n"])
+def test_a_file_without_a_pou_is_a_usage_error_naming_it(tmp_path, text):
+    """QA finding 20: it used to print '0 POU(s) exported' and exit 0."""
+    empty = tmp_path / "Empty.st"
+    empty.write_text(text)
+    out = tmp_path / "out"
+    result = CliRunner().invoke(command, ["--target", "gxworks2", "--out", str(out), str(empty)])
+    assert result.exit_code == 2, result.output
+    assert f"{empty}:1:1: error: no POU" in result.output
+    assert not out.exists() or not any(out.iterdir())

@@ -3,7 +3,9 @@ and label tables for GX Works (docs/import-gxworks2.md, docs/import-gxworks3.md)
 
 With no SOURCES it exports the bundled library (plc/core, the platform ports and the
 examples of that editor's platforms). Exit status: 0 written, 1 the sources have errors
-(listed as file:line:col), 2 usage errors.
+(listed as file:line:col), 2 usage errors (no such file, a file with no POU in it).
+An initial value the target's label table cannot carry is never dropped silently: one
+note line per value (file:line:col) and DROPPED_INITIAL_VALUES.txt in the output folder.
 """
 from __future__ import annotations
 
@@ -35,7 +37,7 @@ def bundled_sources(target: str) -> list[Path]:
               help="Folder for <POU>.st, <POU>.labels.tsv, GlobalLabels.labels.tsv and IMPORT_ORDER.txt.")
 def command(sources: tuple[str, ...], target: str, out_dir: str) -> None:
     """Write, per POU, the ST body and a tab-separated label table for GX Works."""
-    from verifier.export import ExportError, export_sources
+    from verifier.export import ExportError, NothingToExport, export_sources
 
     if sources:
         missing = [s for s in sources if not Path(s).exists()]
@@ -59,8 +61,14 @@ def command(sources: tuple[str, ...], target: str, out_dir: str) -> None:
             click.echo(str(d), err=True)
         click.echo(f"uitamr export: nothing written, {len(unreadable)} unreadable file(s)", err=True)
         sys.exit(EXIT_ERRORS)
+    notes: list = []
     try:
-        written = export_sources(paths, target, Path(out_dir), texts)
+        written = export_sources(paths, target, Path(out_dir), texts, notes=notes)
+    except NothingToExport as e:
+        for d in e.diagnostics:
+            click.echo(str(d), err=True)
+        click.echo(f"uitamr export: nothing written, {len(e.diagnostics)} file(s) without a POU", err=True)
+        sys.exit(EXIT_USAGE)
     except ExportError as e:
         for d in e.diagnostics:
             click.echo(str(d), err=True)
@@ -69,6 +77,11 @@ def command(sources: tuple[str, ...], target: str, out_dir: str) -> None:
     except OSError as e:
         click.echo(f"uitamr export: cannot write {out_dir}: {e.strerror or e}", err=True)
         sys.exit(EXIT_USAGE)
+    for note in notes:
+        click.echo(str(note), err=True)
     pous = sum(1 for p in written if p.suffix == ".st")
     click.echo(f"{pous} POU(s) exported for {target} into {out_dir} (import order: "
                f"{Path(out_dir) / 'IMPORT_ORDER.txt'})")
+    if notes:
+        click.echo(f"{len(notes)} initial value(s) not carried by the {target} label tables: "
+                   f"see {Path(out_dir) / 'DROPPED_INITIAL_VALUES.txt'}")

@@ -8,6 +8,8 @@ label table (class, name, data type in the editor's own words, constant, comment
 editor does, `body` cuts the body text out of a file, `writer` writes the files.
 docs/import-gxworks2.md and docs/import-gxworks3.md say what to do with them.
 """
-from verifier.export.writer import ExportError, export_sources
+from verifier.export.writer import (
+    DroppedValue, ExportError, NothingToExport, dropped_initial_values, export_sources,
+)
 
-__all__ = ["ExportError", "export_sources"]
+__all__ = ["DroppedValue", "ExportError", "NothingToExport", "dropped_initial_values", "export_sources"]

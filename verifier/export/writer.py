@@ -2,7 +2,12 @@
 table, tab-separated so a spreadsheet or the label editor takes it by paste), the global
 labels of all files in `GlobalLabels.labels.tsv` (when there are any), plus
 `IMPORT_ORDER.txt` (functions and function blocks before their users: name, kind and, for
-a FUNCTION, its result type as the POU properties dialog asks for it)."""
+a FUNCTION, its result type as the POU properties dialog asks for it).
+
+Nothing is dropped silently: an initial value the target's label table cannot carry
+(GX Works2 has no initial-value column) is listed in `DROPPED_INITIAL_VALUES.txt` and
+returned as a `DroppedValue` note naming file, line and column; a file without any POU,
+global label or structure type is refused (`NothingToExport`)."""
 from __future__ import annotations
 
 import re
@@ -12,7 +17,7 @@ from pathlib import Path
 from verifier import st
 from verifier.st import ast
 from verifier.export.body import body_text
-from verifier.export.labels import LabelRow, label_rows, rows_of
+from verifier.export.labels import LabelRow, initial_text, label_class, label_rows, rows_of
 from verifier.export.types import type_name
 
 COLUMNS = {
@@ -26,6 +31,26 @@ GLOBAL_COLUMNS = {
     "gxworks3": ("Label Name", "Data Type", "Class", "Assign (Device/Label)", "Initial Value", "Constant", "Comment"),
 }
 GLOBAL_TABLE = "GlobalLabels.labels.tsv"
+#: structure members (`TYPE ... STRUCT`), one `<Type>.struct.tsv` per structure
+#: (UNCONFIRMED column names of the editors' structure definition tables)
+STRUCT_COLUMNS = {
+    "gxworks2": ("Label Name", "Data Type", "Comment"),
+    "gxworks3": ("Label Name", "Data Type", "Initial Value", "Comment"),
+}
+
+
+DROPPED_TABLE = "DROPPED_INITIAL_VALUES.txt"
+#: label classes whose initial value the editor's label table can hold. GX Works2's label
+#: editor has no initial-value column at all (only the Constant column of VAR_CONSTANT);
+#: GX Works3 has one for every class the checker lets carry a value (it refuses one on
+#: VAR_IN_OUT, a reference to the caller's label).
+CARRIES_INITIAL = {
+    "gxworks2": frozenset(),
+    "gxworks3": frozenset({"VAR", "VAR_RETAIN", "VAR_INPUT", "VAR_OUTPUT", "VAR_OUTPUT_RETAIN",
+                           "VAR_PUBLIC", "VAR_PUBLIC_RETAIN", "VAR_TEMP", "VAR_GLOBAL",
+                           "VAR_GLOBAL_RETAIN"}),
+}
+EDITOR = {"gxworks2": "GX Works2", "gxworks3": "GX Works3"}
 
 
 class ExportError(Exception):
@@ -34,6 +59,30 @@ class ExportError(Exception):
     def __init__(self, diagnostics: list[ast.Diagnostic]):
         super().__init__("\n".join(str(d) for d in diagnostics))
         self.diagnostics = diagnostics
+
+
+class NothingToExport(ExportError):
+    """A file holds no POU, no global label and no structure type (e.g. an empty file)."""
+
+
+@dataclass(frozen=True)
+class DroppedValue:
+    """An initial value written in the source that the target's label table cannot hold."""
+
+    file: str
+    line: int
+    col: int
+    owner: str          # the POU's name, or "global"
+    label: str
+    label_class: str
+    value: str
+    target: str
+
+    def __str__(self) -> str:
+        where = f"'{self.label}'" if self.owner == "global" else f"'{self.owner}.{self.label}'"
+        return (f"{self.file}:{self.line}:{self.col}: note: {self.label_class} {where} := {self.value} "
+                f"not exported: the {EDITOR[self.target]} label table has no initial value for it, "
+                f"so it starts at 0; assign it in the program (first scan) - listed in {DROPPED_TABLE}")
 
 
 @dataclass
@@ -67,6 +116,16 @@ def global_table(rows: list[LabelRow], target: str) -> str:
     return "\n".join(lines) + "\n"
 
 
+def struct_table(rows: list[LabelRow], target: str) -> str:
+    def cells(r: LabelRow) -> list[str]:
+        if target == "gxworks2":
+            return [r.name, r.data_type, r.comment]
+        return [r.name, r.data_type, r.initial, r.comment]
+    lines = ["\t".join(STRUCT_COLUMNS[target])]
+    lines += ["\t".join(c.replace("\t", " ") for c in cells(r)) for r in rows]
+    return "\n".join(lines) + "\n"
+
+
 def _uses(pou: ast.Pou, body: str, known: set[str]) -> set[str]:
     used = {d.type.key for d in pou.variables if isinstance(d.type, ast.NamedType) and d.type.key in known}
     used |= {w.upper() for w in re.findall(r"\b([A-Za-z][A-Za-z0-9_]*)\s*\(", body) if w.upper() in known}
@@ -88,15 +147,44 @@ def import_order(pous: list[ExportedPou]) -> list[str]:
         seen.add(key)
         done.append(by_key[key].name)
 
-    rank = {"FUNCTION": 0, "FUNCTION_BLOCK": 1, "PROGRAM": 2}
+    rank = {"STRUCT": -1, "FUNCTION": 0, "FUNCTION_BLOCK": 1, "PROGRAM": 2}
     for p in sorted(pous, key=lambda p: (rank.get(p.kind, 3), p.name.upper())):
         visit(p.name.upper(), ())
     return done
 
 
-def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, str] | None = None) -> list[Path]:
+def dropped_initial_values(files: list[ast.SourceFile], target: str) -> list[DroppedValue]:
+    """Every non-constant initial value in `files` that `target`'s label tables cannot carry."""
+    carries = CARRIES_INITIAL[target]
+    dropped = []
+    for f in files:
+        lines = f.text.splitlines()
+        scopes = [(pou.name, pou.variables) for pou in f.pous]
+        scopes += [("global", block.variables) for block in f.globals]
+        scopes += [(struct.name, struct.fields) for struct in f.types]
+        for owner, decls in scopes:
+            for decl in decls:
+                cls = label_class(decl)
+                if decl.init is None or decl.constant or cls in carries:
+                    continue
+                dropped.append(DroppedValue(f.filename, decl.init.span.line, decl.init.span.col, owner,
+                                            decl.name, cls, initial_text(f.text, lines, decl), target))
+    return dropped
+
+
+def _empty_files(files: list[ast.SourceFile]) -> list[ast.Diagnostic]:
+    return [ast.Diagnostic(f.filename, 1, 1, "error",
+                           "no POU (PROGRAM, FUNCTION_BLOCK or FUNCTION), global label or structure type "
+                           "in this file: nothing to export")
+            for f in files if not (f.pous or f.globals or f.types)]
+
+
+def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, str] | None = None,
+                   notes: list[DroppedValue] | None = None) -> list[Path]:
     """Parse and check `paths`, write the export into `out`; returns the files written.
-    Raises ExportError (with file:line:col diagnostics) when a source has errors."""
+    Raises ExportError (with file:line:col diagnostics) when a source has errors, and
+    NothingToExport when a file has nothing in it to export. Initial values the target
+    cannot carry are appended to `notes` (and written to DROPPED_INITIAL_VALUES.txt)."""
     if target not in COLUMNS:
         raise ValueError(f"unknown target {target!r}; expected gxworks2 or gxworks3")
     texts = texts or {}
@@ -105,6 +193,9 @@ def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, 
     problems += [d for d in st.check(files, target) if d.is_error]
     if problems:
         raise ExportError(problems)
+    empty = _empty_files(files)
+    if empty:
+        raise NothingToExport(empty)
     known = {p.key for f in files for p in f.pous}
     exported: list[ExportedPou] = []
     out.mkdir(parents=True, exist_ok=True)
@@ -120,11 +211,26 @@ def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, 
             written += [body_path, table_path]
             result = type_name(pou.return_type, target) if pou.return_type is not None else ""
             exported.append(ExportedPou(pou.name, pou.kind, f.filename, result, _uses(pou, body, known)))
+    for f in files:
+        for struct in f.types:
+            path = out / f"{struct.name}.struct.tsv"
+            path.write_text(struct_table(rows_of(struct.fields, f.text, target), target), encoding="utf-8")
+            written.append(path)
+            exported.append(ExportedPou(struct.name, "STRUCT", f.filename))
     global_rows = [row for f in files for block in f.globals for row in rows_of(block.variables, f.text, target)]
     if global_rows:
         path = out / GLOBAL_TABLE
         path.write_text(global_table(global_rows, target), encoding="utf-8")
         written.append(path)
+    dropped = dropped_initial_values(files, target)
+    stale = out / DROPPED_TABLE
+    if dropped:
+        stale.write_text("".join(str(d) + "\n" for d in dropped), encoding="utf-8")
+        written.append(stale)
+    elif stale.exists():
+        stale.unlink()                     # from an earlier export into the same folder
+    if notes is not None:
+        notes.extend(dropped)
     order = out / "IMPORT_ORDER.txt"
     by_name = {p.name: p for p in exported}
     rows = [(name, by_name[name].kind, by_name[name].result) for name in import_order(exported)]
