@@ -244,6 +244,17 @@ def test_c24_output_and_input_with_buffer_memory_settings():
 
 
 # ----------------------------------------------------------------------------- ADPRW
+def adprw_started(src: str, **options):
+    """Program P loaded with a scripted endpoint on adp:1, bRun set and one scan run."""
+    project = load_st(src, **options)
+    ep = FakeEndpoint()
+    project.attach_serial("adp:1", ep)
+    p = project.program("P")
+    p.bRun = True
+    project.run_programs(["P"], scans=1)
+    return project, ep, p
+
+
 def test_adprw_fx3_fc06_sends_the_frame_and_signals_completion():
     src = """
 PROGRAM P
@@ -252,16 +263,38 @@ ADPRW(bRun, 1, 6, 16#01A0, 0, uData[0]);
 IF bRun AND M8029 THEN nDone := nDone + 1; bRun := FALSE; END_IF;  (* M8029 read right after the call *)
 END_PROGRAM
 """
-    project = load_st(src)
-    ep = FakeEndpoint()
-    project.attach_serial("adp:1", ep)
-    p = project.program("P")
-    p.bRun = True
-    project.run_programs(["P"], scans=1)
+    project, ep, p = adprw_started(src)
     assert ep.sent[0][0] == with_crc(bytes([1, 6, 1, 0xA0, 0, 0]))
     ep.reply_at(10_000, ep.sent[0][0])
     project.run_programs(["P"], scans=3)
     assert p.nDone == 1 and project.devices["D8402"] == 0 and project.devices["M8063"] is False
+
+
+def test_adprw_fx3_completion_is_reported_before_anything_is_sent_again():
+    """QA 8: the scan whose ADPRW execution reports completion through M8029 must not start a
+    second transaction, or a program that drops the execution condition on M8029 (read right
+    after the call, as the FX3 port does) sends every frame twice, one scan apart."""
+    src = """
+PROGRAM P
+VAR uData : ARRAY[0..1] OF WORD; bRun : BOOL; bComplete : BOOL; nDone : INT; END_VAR
+ADPRW(bRun, 1, 6, 16#01A0, 0, uData[0]);
+bComplete := bRun AND M8029;
+IF bComplete THEN nDone := nDone + 1; bRun := FALSE; END_IF;
+END_PROGRAM
+"""
+    project, ep, p = adprw_started(src)
+    assert len(ep.sent) == 1
+    ep.reply_at(ep.sent[0][1] + 12_000, ep.sent[0][0])    # the echo, 12 ms after the request
+    for _ in range(100):                                   # one second of 10 ms scans
+        project.run_programs(["P"], scans=1)
+        if p.bComplete:
+            assert len(ep.sent) == 1                      # the completing scan sent nothing
+    assert p.nDone == 1 and len(ep.sent) == 1             # one frame, one completion
+    # an execution condition kept ON after the completion starts the next transaction at
+    # the execution after the one that reported (docs/instructions.md, ADPRW)
+    p.bRun = True
+    project.run_programs(["P"], scans=1)
+    assert len(ep.sent) == 2 and ep.sent[1][0] == ep.sent[0][0]
 
 
 def test_adprw_fx5_fc01_unpacks_coils_and_reports_time_out():
@@ -273,12 +306,7 @@ IF bDone[1] THEN nErr := nErr + 1; END_IF;
 IF bDone[0] THEN bRun := FALSE; END_IF;
 END_PROGRAM
 """
-    project = load_st(src, target="gxworks3")
-    ep = FakeEndpoint()
-    project.attach_serial("adp:1", ep)
-    p = project.program("P")
-    p.bRun = True
-    project.run_programs(["P"], scans=1)
+    project, ep, p = adprw_started(src, target="gxworks3")
     reply = with_crc(bytes([1, 1, 3, 0x34, 0x12, 0x2A]))
     ep.reply_at(10_000, reply)
     project.run_programs(["P"], scans=3)
