@@ -137,3 +137,43 @@ def test_list_rules():
     assert result.exit_code == 0
     for rule in RULES:
         assert rule.id in result.output
+
+
+FX5_SOURCES = [PLC / "core", PLC / "fx5", PLC / "examples" / "common", PLC / "examples" / "fx5" / "UITAMR_ExampleFx5.st"]
+
+
+def test_matrix_runs_user_sources_under_the_bundled_robot_and_faults_of_their_platform(tmp_path):
+    """The platform is told from the sources (FX5 RS2/SM/SD); only that platform's bundled
+    scenarios run; their example-specific inputs/expectations are left out and each result
+    says so; scenarios that became the same run (healthy via RS2 and via ADPRW) run once."""
+    from verifier.verify.scenario import load_scenario
+
+    report = tmp_path / "m.json"
+    result = invoke(*FX5_SOURCES, "--matrix", "--duration", "6s", "--json", report,
+                    "--response-signal", "fbEngine.o_bErr")
+    assert result.exit_code == 0, result.output
+    data = json.loads(report.read_text())
+    fx5 = [load_scenario(p) for p in bundled_scenarios() if load_scenario(p).platform == "fx5u"]
+    names = [s["name"] for s in data["scenarios"]]
+    assert set(names) < {s.name for s in fx5} and len(names) == len(fx5) - 1
+    for scenario in data["scenarios"]:
+        assert scenario["platform"] == "fx5u" and scenario["program"] == "UITAMR_ExampleFx5"
+        assert [e["expectation"] for e in scenario["expectations"]] == ["sent stop within 5 s"]
+        assert any("not applied" in note and "operator input(s)" in note for note in scenario["notes"])
+    assert any("also stands for" in note for s in data["scenarios"] for note in s["notes"])
+    assert "note: bundled scenario run against your sources" in result.output
+
+
+def test_matrix_needs_a_platform_it_can_tell(tmp_path):
+    plain = tmp_path / "Plain.st"
+    plain.write_text("PROGRAM Plain\nVAR\n    w : INT;\nEND_VAR\nw := w + 1;\nEND_PROGRAM\n", encoding="utf-8")
+    result = invoke(plain, "--matrix")
+    assert result.exit_code == 2
+    assert "cannot tell the platform from the sources: they load on fx3u, fx5u, q alike" in result.output
+    assert "say --platform" in result.output
+    broken = tmp_path / "Broken.st"
+    broken.write_text("PROGRAM Broken\nVAR\n    w : INT;\nEND_VAR\nw := w + ;\nEND_PROGRAM\n", encoding="utf-8")
+    result = invoke(broken, "--matrix")
+    assert result.exit_code == 2 and f"the sources do not load: {broken}:5:" in result.output
+    result = invoke(plain, "--duration", "1s", "--response-signal", "o_bErr OR")
+    assert result.exit_code == 2 and "--response-signal: " in result.output and "column" in result.output

@@ -18,7 +18,7 @@ import verifier
 from verifier.verify.durations import format_duration, format_seconds, parse_duration_us
 from verifier.verify.result import ScenarioResult, UnusableInput
 from verifier.verify.scenario import (
-    MAX_DURATION_US, PLATFORMS, Scenario, ScenarioError, default_scenario, load_scenario,
+    CHANNELS, DEFAULT_DURATION_US, MAX_DURATION_US, PLATFORMS, Scenario, ScenarioError, default_scenario, load_scenario,
 )
 from verifier.verify.sources import SourceError, expand, unique
 
@@ -63,19 +63,42 @@ def _unusable(message: str) -> None:
     sys.exit(EXIT_UNUSABLE)
 
 
-def _scenarios(sources, program, platform, scenario_files, matrix, duration, scan, seed) -> list[Scenario]:
-    files = list(scenario_files)
-    if matrix or (not sources and not files):
+def _scenarios(sources, program, platform, channel, scenario_files, matrix, duration, scan, seed) -> list[Scenario]:
+    from verifier.verify.matrix import for_user_sources, without_repeats
+    from verifier.verify.platform import infer_platform, platforms_that_load
+
+    resolved = _source_files(sources) if sources else ()
+    given = {Path(f).resolve() for f in scenario_files}
+    own = [load_scenario(f) for f in scenario_files]
+    bundled_files: list[Path] = []
+    if matrix or (not sources and not scenario_files):
         found = bundled_scenarios()
         if not found:
             raise UnusableInput(f"no bundled scenarios in {bundled_plc_dir() / 'scenarios'}")
-        files += [f for f in found if f not in files]
-    scenarios = [load_scenario(f) for f in files] if files else [default_scenario(duration_us=duration or 60_000_000)]
-    if sources:
-        resolved = _source_files(sources)
-        scenarios = [replace(s, sources=resolved) for s in scenarios]
-    overrides = {"program": program, "platform": platform, "duration_us": duration, "scan_us": scan, "seed": seed}
-    scenarios = [s.with_overrides(**overrides) for s in scenarios]
+        bundled_files = [f for f in found if f.resolve() not in given]
+    overrides = {"program": program, "platform": platform, "channel": channel,
+                 "duration_us": duration, "scan_us": scan, "seed": seed}
+    if resolved:
+        own = [replace(s, sources=resolved) for s in own]
+    if resolved and matrix:
+        # the user's program under the robot/fault set of every bundled scenario of its platform
+        platform = platform or infer_platform(resolved)
+        bundled = [load_scenario(f) for f in bundled_files]
+        bundled = [s.with_overrides(duration_us=duration, scan_us=scan, seed=seed) for s in bundled if s.platform == platform]
+        if not bundled:
+            raise UnusableInput(f"no bundled scenario is written for the {platform}")
+        scenarios = [s.with_overrides(**overrides) for s in own]
+        scenarios += without_repeats([for_user_sources(s, resolved, program, channel) for s in bundled])
+    else:
+        scenarios = own + [load_scenario(f) for f in bundled_files]
+        if not scenarios:
+            if resolved and platform is None:
+                fits, _ = platforms_that_load(resolved)
+                platform = fits[0] if len(fits) == 1 else None  # else the default, fx3u (ST errors show there)
+            scenarios = [default_scenario(duration_us=duration or DEFAULT_DURATION_US)]
+            if resolved:
+                scenarios = [replace(s, sources=resolved) for s in scenarios]
+        scenarios = [s.with_overrides(**{**overrides, "platform": platform}) for s in scenarios]
     for scenario in scenarios:
         if scenario.scan_us > scenario.duration_us:
             raise UnusableInput(f"{scenario.name}: the scan time is longer than the whole run")
@@ -85,6 +108,17 @@ def _scenarios(sources, program, platform, scenario_files, matrix, duration, sca
             where = scenario.path or "the default scenario"
             raise UnusableInput(f"{where}: no ST sources: give them as arguments (uitamr verify FILE.st ...)")
     return scenarios
+
+
+def _with_signal(scenario: Scenario, text: str) -> Scenario:
+    from verifier.verify.conditions import ConditionError, parse_condition
+
+    try:
+        signal = parse_condition(text)
+    except ConditionError as exc:
+        raise UnusableInput(f"--response-signal: {exc.message} at column {exc.column} of {text!r}") from None
+    options = replace(scenario.options, response_signal=signal)
+    return replace(scenario, options=options, response_signal_given=True, response_signal_key="--response-signal")
 
 
 def _source_files(sources) -> tuple[Path, ...]:
@@ -173,10 +207,16 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress) -> l
 @click.command(context_settings={"help_option_names": ["-h", "--help"]})
 @click.argument("sources", nargs=-1, type=click.Path())
 @click.option("--program", help="The PROGRAM POU to run (default: the scenario's, or the only one).")
-@click.option("--platform", type=click.Choice(sorted(PLATFORMS)), help="PLC platform (sets the ST dialect and the serial port).")
+@click.option("--platform", type=click.Choice(sorted(PLATFORMS)),
+              help="PLC platform (sets the ST dialect, the CPU and the serial port). Default: the scenario's; with SOURCES and no scenario, told from the devices and instructions the sources use.")
+@click.option("--channel", type=click.Choice(CHANNELS),
+              help="The PLC serial port the robot hangs on (default: the scenario's, or the platform's first port).")
 @click.option("--scenario", "scenario_files", multiple=True, type=click.Path(dir_okay=False),
               help="Scenario file (TOML); repeat for several. Default: the bundled scenarios, or a healthy robot when SOURCES are given.")
-@click.option("--matrix", is_flag=True, help="Run every bundled scenario (with SOURCES: against those sources).")
+@click.option("--response-signal", "response_signal", metavar="CONDITION",
+              help="The program's output that shows failed replies were noticed (UITAMR-RESPONSE-HANDLING), e.g. fbRobot.o_bErr; replaces the scenarios' (default: o_bErr when the program has it).")
+@click.option("--matrix", is_flag=True,
+              help="Run every bundled scenario. With SOURCES: those of the program's platform, with their robot, faults and rules but not their example-specific inputs and expectations (see docs/verifier.md).")
 @click.option("--duration", type=_Duration(MAX_DURATION_US), help="Virtual run time, e.g. 60s (overrides the scenarios'; default 60s).")
 @click.option("--scan", type=_Duration(), help="PLC scan time, e.g. 10ms (overrides the scenarios'; default 10ms).")
 @click.option("--seed", type=int, help="Seed for everything random in the run (overrides the scenarios').")
@@ -188,7 +228,7 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress) -> l
 @click.option("--list-rules", is_flag=True, help="Print the rules (id, title, source) and exit.")
 @click.option("--violations", "first", type=click.IntRange(min=0), default=3, show_default=True,
               help="Times listed per broken rule and scenario on the console (0: counts only).")
-def command(sources, program, platform, scenario_files, matrix, duration, scan, seed, jobs,
+def command(sources, program, platform, channel, response_signal, scenario_files, matrix, duration, scan, seed, jobs,
             json_path, junit_path, trace_path, html_path, list_rules, first):
     """Run PLC programs against the emulated robot on a virtual RS-485 line and check
     every frame and gap against the robot's manual.
@@ -209,7 +249,9 @@ def command(sources, program, platform, scenario_files, matrix, duration, scan, 
         if path and not Path(path).resolve().parent.is_dir():
             _unusable(f"cannot write {path}: the folder {Path(path).resolve().parent} does not exist")
     try:
-        scenarios = _scenarios(sources, program, platform, scenario_files, matrix, duration, scan, seed)
+        scenarios = _scenarios(sources, program, platform, channel, scenario_files, matrix, duration, scan, seed)
+        if response_signal is not None:
+            scenarios = [_with_signal(s, response_signal) for s in scenarios]
     except (ScenarioError, UnusableInput) as exc:
         _unusable(str(exc))
     stderr = Console(stderr=True)

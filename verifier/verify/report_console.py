@@ -39,6 +39,8 @@ def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
         f"{mark} [bold]{escape(result.name)}[/]{where}: {escape(result.program or '?')} on {result.platform}, {tx} requests in "
         f"{format_seconds(result.ended_us)}, {result.violation_count} violation(s), {expectations}"
     )
+    for note in result.notes:
+        console.print(f"    [dim]note: {escape(note)}[/]")
     if result.aborted:
         console.print(f"    [red]simulation stopped[/]: {escape(result.aborted)}")
     broken = sorted((found for found in result.violations.values() if found), key=lambda found: found[0].t_us)

@@ -84,6 +84,7 @@ def scenario_dict(result: ScenarioResult) -> dict[str, Any]:
             name: [[_seconds(t), value] for t, value in changes] for name, changes in result.watched.items()
         },
         "aborted": result.aborted,
+        "notes": list(result.notes),
         "simulator_diagnostics": result.diagnostics,
         "line_events": [{"t": _seconds(e.t_us), "kind": e.kind, "message": e.message} for e in result.events],
     }

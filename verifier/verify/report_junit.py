@@ -72,6 +72,7 @@ def to_element(results: list[ScenarioResult]) -> ET.Element:
                 f"program {result.program} on {result.platform} ({result.channel}), "
                 f"{format_seconds(result.ended_us)} of virtual time, scan {result.scan_us / 1000:g} ms, seed {result.seed}",
                 f"{tx} requests, {rx} replies",
+                *(f"note: {note}" for note in result.notes),
                 *(f"fault: {fault}" for fault in result.faults),
                 *(f"expectation met: {e.expectation.label}: {e.detail}" for e in result.expectations if e.passed),
             ]

@@ -62,6 +62,7 @@ class ScenarioResult:
     aborted: str | None = None  # the program stopped the simulation (ST location inside)
     ended_us: int = 0
     wall_s: float = 0.0  # real time the run took (for people; nothing judges it)
+    notes: list[str] = field(default_factory=list)  # how the run differs from its scenario file
 
     @property
     def violation_count(self) -> int:

@@ -323,4 +323,5 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None) -> Scenar
         aborted=aborted,
         ended_us=end,
         wall_s=time.perf_counter() - wall_start,
+        notes=list(scenario.notes),
     )

@@ -131,6 +131,8 @@ class Scenario:
     key_lines: dict[str, int | None] = field(default_factory=dict, compare=False)
     initial: tuple[tuple[str, Value], ...] = ()  # devices and buffer memory before the first scan
     c24: tuple[C24Setting, ...] = ()
+    notes: tuple[str, ...] = ()  # for the reports: how this run differs from its file
+    response_signal_key: str = "response_handling.signal"  # or "--response-signal" when given there
 
     @property
     def target(self) -> str:
@@ -168,7 +170,7 @@ class Scenario:
             uses.append(LabelUse(f"watch[{i}]", self.key_lines.get(f"watch[{i}]"), (name,)))
         signal = self.options.response_signal
         if signal is not None:
-            key = "response_handling.signal"
+            key = self.response_signal_key
             uses.append(LabelUse(key, self.key_lines.get(key), tuple(sorted(signal.names)), condition=signal,
                                  optional=not self.response_signal_given))
         return uses
@@ -191,19 +193,25 @@ def default_scenario(name: str = "healthy robot", duration_us: int = DEFAULT_DUR
     """The run without a scenario file: a healthy robot, the default rules, and one
     expectation — the power-on stop goes out and is answered within 5 s (or the run) — so
     that a program that never talks to the robot does not pass by saying nothing."""
-    stop = Expectation(
-        kind="sent",
-        label="",
-        within_us=min(DEFAULT_STOP_WITHIN_US, duration_us),
-        request=protocol.ControlRequest(1, protocol.ControlCode.ROBOT, protocol.RobotCommand.STOP),
-    )
     return Scenario(
         name=name,
         description="default: a healthy robot, no faults, no inputs",
         duration_us=duration_us,
-        expectations=(replace(stop, label=f"sent stop {describe_window(stop)}"),),
+        expectations=(power_on_stop_expectation(duration_us),),
         options=RuleOptions(response_signal=parse_condition(DEFAULT_RESPONSE_SIGNAL)),
     )
+
+
+def power_on_stop_expectation(duration_us: int, address: int = 1) -> Expectation:
+    """What every program must do: send the stop command and have it answered, within 5 s
+    of power-on (or the whole run when shorter)."""
+    stop = Expectation(
+        kind="sent",
+        label="",
+        within_us=min(DEFAULT_STOP_WITHIN_US, duration_us),
+        request=protocol.ControlRequest(address, protocol.ControlCode.ROBOT, protocol.RobotCommand.STOP),
+    )
+    return replace(stop, label=f"sent stop {describe_window(stop)}")
 
 
 # --- loading -------------------------------------------------------------------------------

@@ -72,7 +72,7 @@ def check_response_handling(evidence: RunEvidence, traffic: Traffic) -> list[Vio
             message = (
                 f"the robot's replies failed from {format_seconds(start)} {lasted} "
                 f"({episode.summary()}), and the scenario names no output to show it: set "
-                f"[response_handling] signal (e.g. \"o_bErr\")"
+                f"[response_handling] signal in the scenario or --response-signal (e.g. \"o_bErr\")"
             )
         else:
             index = bisect_right(stops, start)  # the first span still running after `start`

@@ -1,0 +1,72 @@
+"""`uitamr verify SOURCES --matrix`: the user's program under every bundled robot/fault set.
+
+A bundled scenario is written for a bundled example program: its operator inputs press
+that program's buttons (X20 starts the Q example's cycle), its expectations and watched
+labels name that program's labels, its [[c24]]/[initial] settings are that PLC's, and its
+response signal is that program's error output. None of that means anything for another
+program, so against user sources a bundled scenario keeps only what is about the robot
+and the line: the platform, the robot, the faults and their timing, the protocol settings,
+the run and scan times, and every rule. It expects what every program must do — send the
+power-on stop and have it answered within 5 s — and UITAMR-RESPONSE-HANDLING watches
+`o_bErr` when the program has it. Each result says what was left out.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+from .conditions import parse_condition
+from .scenario import DEFAULT_RESPONSE_SIGNAL, Scenario, power_on_stop_expectation
+
+
+def for_user_sources(scenario: Scenario, sources: tuple[Path, ...], program: str | None,
+                     channel: str | None) -> Scenario:
+    """`scenario` (a bundled one) re-aimed at the user's sources, with a note on what it lost."""
+    left_out = []
+    if scenario.inputs:
+        left_out.append(f"{len(scenario.inputs)} operator input(s)")
+    if scenario.expectations:
+        left_out.append(f"{len(scenario.expectations)} expectation(s)")
+    if scenario.watch:
+        left_out.append(f"{len(scenario.watch)} watched label(s)")
+    if scenario.c24 or scenario.initial:
+        left_out.append("its PLC settings ([[c24]], [initial])")
+    if scenario.response_signal_given:
+        left_out.append(f"its response signal ({scenario.options.response_signal})")
+    example = scenario.program or "the bundled example"
+    note = (
+        f"bundled scenario run against your sources: robot, faults, timing and every rule applied, "
+        f"plus the answered power-on stop; not applied, being written for {example}: "
+        f"{', '.join(left_out) or 'nothing'}"
+    )
+    return replace(
+        scenario,
+        sources=sources,
+        program=program,
+        channel=channel,
+        inputs=(),
+        expectations=(power_on_stop_expectation(scenario.duration_us, scenario.settings.address),),
+        watch=(),
+        c24=(),
+        initial=(),
+        options=replace(scenario.options, response_signal=parse_condition(DEFAULT_RESPONSE_SIGNAL)),
+        response_signal_given=False,
+        key_lines={},
+        notes=scenario.notes + (note,),
+    )
+
+
+def without_repeats(scenarios: list[Scenario]) -> list[Scenario]:
+    """Scenarios that became the same run (same robot, faults, protocol, rules and times)
+    once their example-specific parts are gone run once; the kept one names the others."""
+    kept: dict[str, Scenario] = {}
+    for scenario in scenarios:
+        identity = repr((scenario.platform, scenario.channel, scenario.settings, scenario.robot, scenario.faults,
+                         scenario.duration_us, scenario.scan_us, scenario.scan_jitter_us, scenario.seed,
+                         scenario.options))  # repr: some of these hold dicts
+        if identity in kept:
+            first = kept[identity]
+            kept[identity] = replace(first, notes=first.notes + (f"also stands for {scenario.name!r} (the same run)",))
+        else:
+            kept[identity] = scenario
+    return list(kept.values())

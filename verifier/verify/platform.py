@@ -1,0 +1,51 @@
+"""Which PLC platform a set of ST sources is written for, when the user does not say.
+
+The sources are loaded for every platform's CPU (its engineering tool's dialect, its
+devices and its instructions). Serial programs use instructions and special devices that
+exist on one CPU only — RS2 with M8402/D8403 (FX3U), RS2 with SM/SD (FX5U), G_OUTPUT /
+G_INPUT (Q with QJ71C24N) — so exactly one load succeeds. A program that uses nothing
+platform-specific loads everywhere and the platform cannot be told.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from .result import UnusableInput
+from .scenario import PLATFORMS
+
+
+class PlatformUnknown(UnusableInput):
+    """The sources load on several platforms (or none); the message says which and why."""
+
+
+def platforms_that_load(sources: tuple[Path, ...]) -> tuple[list[str], dict[str, str]]:
+    """(platforms whose CPU loads the sources, {platform: first load error} for the others)."""
+    import verifier
+    from verifier.sim.errors import LoadError
+
+    fits, errors = [], {}
+    for platform, (target, _) in PLATFORMS.items():
+        try:
+            verifier.load(*[str(p) for p in sources], target=target, cpu=platform)
+        except LoadError as exc:
+            lines = [line.strip() for line in str(exc).splitlines()[1:] if line.strip()]
+            errors[platform] = lines[0] if lines else str(exc)
+            continue
+        fits.append(platform)
+    return fits, errors
+
+
+def infer_platform(sources: tuple[Path, ...]) -> str:
+    """The one platform the sources are written for; PlatformUnknown otherwise."""
+    fits, errors = platforms_that_load(sources)
+    if len(fits) == 1:
+        return fits[0]
+    if not fits:
+        if len(set(errors.values())) == 1:  # the same mistake everywhere: an ST error
+            raise UnusableInput(f"the sources do not load: {next(iter(errors.values()))}")
+        reasons = "; ".join(f"{platform}: {error}" for platform, error in errors.items())
+        raise UnusableInput(f"the sources load on no platform ({reasons})")
+    raise PlatformUnknown(
+        f"cannot tell the platform from the sources: they load on {', '.join(fits)} alike (they use no "
+        "device or instruction of one platform only); say --platform " + "|".join(fits)
+    )
