@@ -90,3 +90,11 @@ def test_flat_600_term_sum_is_reported_at_its_statement():
     found = st.check([source])
     assert [(d.line, d.col, d.severity) for d in found] == [(4, 1, "error")]
     assert "nested too deeply" in found[0].message
+
+
+def test_too_deep_initial_value_is_reported_at_its_label():
+    text = "PROGRAM Main\nVAR CONSTANT y : INT := " + "+".join(["1"] * 700) + "; END_VAR\nEND_PROGRAM\n"
+    source = st.parse(text, "t.st")
+    found = [d for d in st.check([source]) if d.is_error]
+    assert [(d.line, d.col) for d in found] == [(2, 14)]
+    assert "initial value nested too deeply" in found[0].message

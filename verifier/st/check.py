@@ -219,7 +219,11 @@ class Checker:
         if v.section == "VAR_IN_OUT" and v.init is not None:
             self.rep.error(v, f"VAR_IN_OUT '{v.name}' cannot have an initial value")
         if v.init is not None:
-            self.check_initializer(v.init, t, v)
+            try:
+                self.check_initializer(v.init, t, v)
+            except RecursionError:
+                self.rep.error(v, "initial value nested too deeply to check; write it shorter")
+                return t
             if self.target == "gxworks2" and not v.constant and v.section != "VAR_IN_OUT" \
                     and not _is_zero(v.init):
                 self.rep.error(v.init, f"GX Works2 label tables have no initial value column: '{v.name}' "
