@@ -2,7 +2,7 @@
 
 Prints each finding as `file:line:col: error|warning: message`, the source line and a
 caret under the column. Exit status: 1 if any error, 0 otherwise (warnings allowed),
-2 for usage errors (missing file, bad option). Every file is read and checked even when
+2 for usage errors (missing file, not a regular file, bad option). Every file is read and checked even when
 another one is broken; POUs may use POUs from the other files given.
 """
 from __future__ import annotations
@@ -17,14 +17,6 @@ from verifier.st import TARGETS
 from verifier.st.ast import Diagnostic, SourceFile
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
-
-
-def read_source(path: Path) -> str:
-    """The text of a .st file ("" when it cannot be read); kept for callers that only
-    want the text. The reader and its encoding policy are `verifier.st.read_source`."""
-    from verifier.st import read_source as _read
-
-    return _read(path)[0]
 
 
 def expand_sources(sources: tuple[str, ...]) -> list[Path]:
@@ -42,24 +34,24 @@ def expand_sources(sources: tuple[str, ...]) -> list[Path]:
 def _not_a_source(path: Path) -> str | None:
     """Why `path` cannot be checked at all (missing, a device, a pipe ...), or None.
     Files that exist but hold no text are diagnosed with file:line:col instead."""
-    from verifier.st.source import read_source as _read
+    from verifier.st import read_source
 
     if path.is_file():
         return None
     if not path.exists() and not path.is_symlink():
         return "no such file"
-    problems = _read(path)[1]
+    problems = read_source(path)[1]
     return problems[0].message if problems else None
 
 
 def check_paths(paths: list[Path], target: str) -> tuple[list[SourceFile], list[Diagnostic]]:
     """Parse every file and check them together; all diagnostics, parse ones included."""
-    from verifier.st import check, parse, read_source as _read
+    from verifier.st import check, parse, read_source
 
     files: list[SourceFile] = []
     diagnostics: list[Diagnostic] = []
     for p in paths:
-        text, problems = _read(p)
+        text, problems = read_source(p)
         diagnostics += problems
         if not problems:  # an unreadable file is reported once, not also as empty
             files.append(parse(text, str(p), target))
