@@ -1,0 +1,51 @@
+"""The verifier's documents say what the code does: every scenario key is documented, the
+examples of the PLC-settings section load, and citations of protocol.md point at the
+section that holds what they cite."""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from verifier.verify.scenario import C24_KEYS, TOP_KEYS, parse_scenario
+
+DOCS = Path(__file__).resolve().parents[1] / "docs"
+SCENARIOS_MD = (DOCS / "scenarios.md").read_text(encoding="utf-8")
+VERIFIER_MD = (DOCS / "verifier.md").read_text(encoding="utf-8")
+PROTOCOL_MD = (DOCS / "protocol.md").read_text(encoding="utf-8")
+
+
+def test_every_scenario_key_is_documented():
+    for key in TOP_KEYS:
+        assert f"`{key}`" in SCENARIOS_MD or f"[{key}]" in SCENARIOS_MD or f"[[{key}]]" in SCENARIOS_MD, key
+    for key in C24_KEYS:
+        assert re.search(rf"^{key} = ", SCENARIOS_MD, re.MULTILINE), key
+
+
+def test_the_plc_settings_example_is_a_valid_scenario():
+    section = SCENARIOS_MD.split("## PLC settings", 1)[1]
+    block = section.split("```toml\n", 1)[1].split("```", 1)[0]
+    scenario = parse_scenario('platform = "q"\n' + block)
+    assert dict(scenario.initial) == {"D100": 3, "U0\\G164": 8}
+    (c24,) = scenario.c24
+    assert (c24.unit, c24.channel, c24.no_reception_us, c24.byte_units, c24.receive_count, c24.end_code) == \
+        (0, 1, 5000, True, 8, 0xFFFF)
+
+
+def _section(number: int) -> str:
+    return re.split(r"^## ", PROTOCOL_MD, flags=re.MULTILINE)[number]
+
+
+def test_protocol_citations_point_at_the_section_that_holds_them():
+    """The reply time-out is in protocol.md §1 (line and pacing), not §6 (CRC)."""
+    for text in (SCENARIOS_MD, VERIFIER_MD):
+        for number in re.findall(r"protocol\.md §(\d+)", text) + re.findall(r"protocol\.md#(\d+)-", text):
+            assert _section(int(number)).startswith(f"{number}."), number
+    row = next(line for line in SCENARIOS_MD.splitlines() if line.startswith("| `rules.reply_timeout`"))
+    number = int(re.search(r"protocol\.md §(\d+)", row).group(1))
+    assert "reply timeout" in _section(number)
+
+
+def test_sent_by_is_the_statement_that_starts_the_transmission():
+    """FX3U: the origin is the `M8402 := TRUE` statement (the send request), not the RS2 call."""
+    assert "`M8402 := TRUE`" in VERIFIER_MD
+    assert "the RS2 / G_OUTPUT /\nADPRW call" not in VERIFIER_MD
