@@ -177,3 +177,13 @@ def test_matrix_needs_a_platform_it_can_tell(tmp_path):
     assert result.exit_code == 2 and f"the sources do not load: {broken}:5:" in result.output
     result = invoke(plain, "--duration", "1s", "--response-signal", "o_bErr OR")
     assert result.exit_code == 2 and "--response-signal: " in result.output and "column" in result.output
+
+
+def test_a_plain_run_tells_the_platform_from_the_sources(tmp_path):
+    """No --platform: Q sources (G_OUTPUT) run on the Q, not on the default FX3U."""
+    q_sources = [PLC / "core", PLC / "q", PLC / "examples" / "common", PLC / "examples" / "q"]
+    report = tmp_path / "q.json"
+    result = invoke(*q_sources, "--duration", "2s", "--json", report)
+    assert result.exit_code == 0, result.output
+    (scenario,) = json.loads(report.read_text())["scenarios"]
+    assert (scenario["platform"], scenario["channel"], scenario["program"]) == ("q", "q:1", "UITAMR_ExampleQ")

@@ -72,6 +72,7 @@ def test_the_command_line_takes_folders(tmp_path, program):
     assert result.exit_code == 1, result.output  # runs (and fails: Main never sends the stop)
     scenario = json.loads(report.read_text())["scenarios"][0]
     assert scenario["sources"] == [str(program.resolve())]
+    assert scenario["notes"] == ["the program sent nothing on fx3:1 in the whole run"]
     result = invoke(tmp_path / "nothing")
     assert result.exit_code == 2 and "no such file or folder" in result.output
 

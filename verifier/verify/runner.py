@@ -323,5 +323,8 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None) -> Scenar
         aborted=aborted,
         ended_us=end,
         wall_s=time.perf_counter() - wall_start,
-        notes=list(scenario.notes),
+        notes=list(scenario.notes) + (
+            [] if any(f.direction == "tx" for f in trace)
+            else [f"the program sent nothing on {scenario.serial_channel} in the whole run"]
+        ),
     )
