@@ -15,7 +15,7 @@ SCENARIOS = sorted((Path(__file__).resolve().parents[1] / "plc" / "scenarios").g
 
 def test_there_are_bundled_scenarios_for_every_platform():
     names = [p.name for p in SCENARIOS]
-    for prefix in ("fx3u-", "fx5u-", "q-", "fx5u-adprw-"):
+    for prefix in ("fx3u-", "fx5u-", "q-", "fx5u-adprw-", "fx3u-adprw-"):
         assert any(n.startswith(prefix) for n in names), prefix
 
 
