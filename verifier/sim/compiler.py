@@ -25,6 +25,7 @@ from .instructions import lookup as lookup_instruction
 from .refs import AttrRef, BitRef, DwordRef, Ref
 from .stdfbs import STANDARD_FBS, FB_PARAM_TYPES
 from .stdfuncs import make_helpers
+from .storage import check_storage
 from .typesys import (ArrayT, CompileError, FbT, PouInfo, StringT, StructT, Symbol, concrete,
                       is_int, is_real, norm_code)
 
@@ -357,6 +358,8 @@ class ModuleCompiler:
     # ------------------------------------------------------------------ generation
     def compile(self) -> CompiledModule:
         self.build_symbols()
+        check_storage(self.struct_fields, self.pous, self.globals,
+                      {key: sd.name for key, sd in self.structs.items()})
         em = self.em
         for key, sd in self.structs.items():
             self.gen_struct(key, sd)
