@@ -187,3 +187,12 @@ def test_a_plain_run_tells_the_platform_from_the_sources(tmp_path):
     assert result.exit_code == 0, result.output
     (scenario,) = json.loads(report.read_text())["scenarios"]
     assert (scenario["platform"], scenario["channel"], scenario["program"]) == ("q", "q:1", "UITAMR_ExampleQ")
+
+
+def test_platform_without_sources_picks_the_bundled_scenarios_of_that_platform(tmp_path):
+    from verifier.verify.scenario import load_scenario
+
+    report = tmp_path / "q.json"
+    invoke("--platform", "q", "--duration", "1s", "--json", report)  # 1 s: the verdict is not the point
+    names = {s["name"] for s in json.loads(report.read_text())["scenarios"]}
+    assert names == {load_scenario(p).name for p in bundled_scenarios() if load_scenario(p).platform == "q"}

@@ -90,15 +90,20 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
         scenarios = [s.with_overrides(**overrides) for s in own]
         scenarios += without_repeats([for_user_sources(s, resolved, program, channel) for s in bundled])
     else:
-        scenarios = own + [load_scenario(f) for f in bundled_files]
-        if not scenarios:
+        bundled = [load_scenario(f) for f in bundled_files]  # only without SOURCES: their own sources
+        if platform is not None and bundled:
+            # the bundled examples are written for their platform: --platform picks them
+            bundled = [s for s in bundled if s.platform == platform]
+            if not bundled and not own:
+                raise UnusableInput(f"no bundled scenario is written for the {platform}")
+        if not own and not bundled:
             if resolved and platform is None:
                 fits, _ = platforms_that_load(resolved)
                 platform = fits[0] if len(fits) == 1 else None  # else the default, fx3u (ST errors show there)
-            scenarios = [default_scenario(duration_us=duration or DEFAULT_DURATION_US)]
-            if resolved:
-                scenarios = [replace(s, sources=resolved) for s in scenarios]
-        scenarios = [s.with_overrides(**{**overrides, "platform": platform}) for s in scenarios]
+                overrides["platform"] = platform
+            own = [replace(default_scenario(duration_us=duration or DEFAULT_DURATION_US), sources=resolved)]
+        scenarios = [s.with_overrides(**overrides) for s in own]
+        scenarios += [s.with_overrides(**{**overrides, "platform": None}) for s in bundled]
     for scenario in scenarios:
         if scenario.scan_us > scenario.duration_us:
             raise UnusableInput(f"{scenario.name}: the scan time is longer than the whole run")
