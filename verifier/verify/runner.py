@@ -178,12 +178,12 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
     missing default response signal is dropped. Errors name the file, line and key."""
     kinds: dict[str, str] = {}
     for use in scenario.label_uses():
-        missing = next(((name, plc.problem(name)) for name in use.names if plc.problem(name)), None)
+        missing = next((problem for problem in map(plc.problem, use.names) if problem), None)
         if missing is not None and use.optional:
             scenario = replace(scenario, options=replace(scenario.options, response_signal=None))
             continue
         if missing is not None:
-            raise UnusableInput(f"{scenario.where(use.key, use.line)}: {missing[1]}")
+            raise UnusableInput(f"{scenario.where(use.key, use.line)}: {missing}")
         for name in use.names:
             kinds[name] = "bool" if isinstance(_plain(plc.read(name)), bool) else "number"
         problem = use.condition.type_error(kinds) if use.condition is not None else None
