@@ -75,6 +75,14 @@ def test_the_command_line_takes_folders(tmp_path, program):
     assert scenario["notes"] == ["the program sent nothing on fx3:1 in the whole run"]
     result = invoke(tmp_path / "nothing")
     assert result.exit_code == 2 and "no such file or folder" in result.output
+    folder = tmp_path / "scenarios"
+    folder.mkdir()
+    for name in ("a", "b"):
+        (folder / f"{name}.toml").write_text(f'name = "{name}"\nduration = "1s"\n', encoding="utf-8")
+    result = invoke(tmp_path / "src", "--scenario", folder, "--json", report)  # a folder of scenarios
+    assert [s["name"] for s in json.loads(report.read_text())["scenarios"]] == ["a", "b"]
+    result = invoke(tmp_path / "src", "--scenario", tmp_path / "src")
+    assert result.exit_code == 2 and "holds no scenario (.toml) file" in result.output
 
 
 def test_the_reports_name_the_program_chosen_for_the_user(tmp_path, program):

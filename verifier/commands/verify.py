@@ -68,6 +68,7 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
     from verifier.verify.platform import infer_platform, platforms_that_load
 
     resolved = _source_files(sources) if sources else ()
+    scenario_files = _scenario_files(scenario_files)
     given = {Path(f).resolve() for f in scenario_files}
     own = [load_scenario(f) for f in scenario_files]
     bundled_files: list[Path] = []
@@ -124,6 +125,21 @@ def _with_signal(scenario: Scenario, text: str) -> Scenario:
         raise UnusableInput(f"--response-signal: {exc.message} at column {exc.column} of {text!r}") from None
     options = replace(scenario.options, response_signal=signal)
     return replace(scenario, options=options, response_signal_given=True, response_signal_key="--response-signal")
+
+
+def _scenario_files(names) -> list[Path]:
+    """--scenario values: files, and folders standing for their *.toml files."""
+    files: list[Path] = []
+    for name in names:
+        path = Path(name)
+        if path.is_dir():
+            found = sorted(path.glob("*.toml"))
+            if not found:
+                raise UnusableInput(f"the folder {path} holds no scenario (.toml) file")
+            files += found
+        else:
+            files.append(path)
+    return files
 
 
 def _source_files(sources) -> tuple[Path, ...]:
@@ -216,8 +232,8 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress) -> l
               help="PLC platform (sets the ST dialect, the CPU and the serial port). Default: the scenario's; with SOURCES and no scenario, told from the devices and instructions the sources use.")
 @click.option("--channel", type=click.Choice(CHANNELS),
               help="The PLC serial port the robot hangs on (default: the scenario's, or the platform's first port).")
-@click.option("--scenario", "scenario_files", multiple=True, type=click.Path(dir_okay=False),
-              help="Scenario file (TOML); repeat for several. Default: the bundled scenarios, or a healthy robot when SOURCES are given.")
+@click.option("--scenario", "scenario_files", multiple=True, type=click.Path(),
+              help="Scenario file (TOML), or a folder of them; repeat for several. Default: the bundled scenarios, or a healthy robot when SOURCES are given.")
 @click.option("--response-signal", "response_signal", metavar="CONDITION",
               help="The program's output that shows failed replies were noticed (UITAMR-RESPONSE-HANDLING), e.g. fbRobot.o_bErr; replaces the scenarios' (default: o_bErr when the program has it).")
 @click.option("--matrix", is_flag=True,
