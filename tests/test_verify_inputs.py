@@ -236,3 +236,17 @@ def test_the_bundled_q_exception_scenario_needs_the_no_reception_time():
     result = run_scenario(replace(scenario, c24=(), duration_us=6_000_000,
                                   expectations=scenario.expectations[:2]))
     assert [e.passed for e in result.expectations] == [True, False]
+
+
+def test_a_bundled_scenario_aimed_at_user_sources_keeps_robot_faults_and_c24_only(program):
+    from verifier.commands.verify import bundled_plc_dir
+    from verifier.verify.matrix import for_user_sources
+
+    bundled = load_scenario(bundled_plc_dir() / "scenarios" / "q-exception.toml")
+    mine = for_user_sources(bundled, (program,), None, None)
+    assert (mine.robot, mine.faults, mine.c24, mine.settings) == (bundled.robot, bundled.faults, bundled.c24, bundled.settings)
+    assert (mine.sources, mine.program, mine.inputs, mine.watch) == ((program,), None, (), ())
+    assert [e.label for e in mine.expectations] == ["sent stop within 5 s"]
+    assert str(mine.options.response_signal) == "o_bErr" and not mine.response_signal_given
+    (note,) = mine.notes
+    assert "C24 settings" in note and "3 operator input(s), 4 expectation(s)" in note

@@ -2,11 +2,12 @@
 
 A bundled scenario is written for a bundled example program: its operator inputs press
 that program's buttons (X20 starts the Q example's cycle), its expectations and watched
-labels name that program's labels, its [[c24]]/[initial] settings are that PLC's, and its
+labels name that program's labels, its [initial] device values are that program's, and its
 response signal is that program's error output. None of that means anything for another
-program, so against user sources a bundled scenario keeps only what is about the robot
-and the line: the platform, the robot, the faults and their timing, the protocol settings,
-the run and scan times, and every rule. It expects what every program must do — send the
+program, so against user sources a bundled scenario keeps only what is about the robot,
+the line and the serial module: the platform, the robot, the faults and their timing, the
+protocol settings, the run and scan times, the QJ71C24N settings ([[c24]], which every
+installation must make in GX Works — docs/import-gxworks2.md) and every rule. It expects what every program must do — send the
 power-on stop and have it answered within 5 s — and UITAMR-RESPONSE-HANDLING watches
 `o_bErr` when the program has it. Each result says what was left out.
 """
@@ -29,13 +30,14 @@ def for_user_sources(scenario: Scenario, sources: tuple[Path, ...], program: str
         left_out.append(f"{len(scenario.expectations)} expectation(s)")
     if scenario.watch:
         left_out.append(f"{len(scenario.watch)} watched label(s)")
-    if scenario.c24 or scenario.initial:
-        left_out.append("its PLC settings ([[c24]], [initial])")
+    if scenario.initial:
+        left_out.append("its [initial] device values")
     if scenario.response_signal_given:
         left_out.append(f"its response signal ({scenario.options.response_signal})")
     example = scenario.program or "the bundled example"
     note = (
-        f"bundled scenario run against your sources: robot, faults, timing and every rule applied, "
+        f"bundled scenario run against your sources: robot, faults, timing{', C24 settings' if scenario.c24 else ''} "
+        f"and every rule applied, "
         f"plus the answered power-on stop; not applied, being written for {example}: "
         f"{', '.join(left_out) or 'nothing'}"
     )
@@ -47,7 +49,6 @@ def for_user_sources(scenario: Scenario, sources: tuple[Path, ...], program: str
         inputs=(),
         expectations=(power_on_stop_expectation(scenario.duration_us, scenario.settings.address),),
         watch=(),
-        c24=(),
         initial=(),
         options=replace(scenario.options, response_signal=parse_condition(DEFAULT_RESPONSE_SIGNAL)),
         response_signal_given=False,
