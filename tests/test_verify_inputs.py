@@ -250,3 +250,12 @@ def test_a_bundled_scenario_aimed_at_user_sources_keeps_robot_faults_and_c24_onl
     assert str(mine.options.response_signal) == "o_bErr" and not mine.response_signal_given
     (note,) = mine.notes
     assert "C24 settings" in note and "3 operator input(s), 4 expectation(s)" in note
+
+
+def test_an_o_bErr_that_is_not_a_bool_is_not_taken_as_the_default_signal(tmp_path):
+    odd = tmp_path / "Odd.st"
+    odd.write_text("PROGRAM Odd\nVAR\n    o_bErr : INT;\nEND_VAR\no_bErr := 1;\nEND_PROGRAM\n", encoding="utf-8")
+    result = invoke(odd, "--duration", "1s")
+    assert result.exit_code == 1 and "error:" not in result.output  # runs; fails only on the power-on stop
+    result = invoke(odd, "--duration", "1s", "--response-signal", "o_bErr")
+    assert result.exit_code == 2 and "--response-signal: o_bErr is a number, not a condition" in result.output

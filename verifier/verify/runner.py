@@ -189,7 +189,9 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
         problem = use.condition.type_error(kinds) if use.condition is not None else None
         for name, value in (use.values or {}).items():
             problem = problem or _input_problem(plc, name, value)
-        if problem:
+        if problem and use.optional:  # the default signal: an o_bErr that is not a BOOL is not it
+            scenario = replace(scenario, options=replace(scenario.options, response_signal=None))
+        elif problem:
             raise UnusableInput(f"{scenario.where(use.key, use.line)}: {problem}")
     return scenario
 
