@@ -229,7 +229,7 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress) -> l
 @click.argument("sources", nargs=-1, type=click.Path())
 @click.option("--program", help="The PROGRAM POU to run (default: the scenario's, or the only one).")
 @click.option("--platform", type=click.Choice(sorted(PLATFORMS)),
-              help="PLC platform (sets the ST dialect, the CPU and the serial port). Default: the scenario's; with SOURCES and no scenario, told from the devices and instructions the sources use.")
+              help="PLC platform (sets the ST dialect, the CPU and the serial port). Default: the scenario's; with SOURCES and no scenario, told from the devices and instructions the sources use. Without SOURCES: runs the bundled scenarios of that platform.")
 @click.option("--channel", type=click.Choice(CHANNELS),
               help="The PLC serial port the robot hangs on (default: the scenario's, or the platform's first port).")
 @click.option("--scenario", "scenario_files", multiple=True, type=click.Path(),
