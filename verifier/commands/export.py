@@ -14,10 +14,10 @@ from pathlib import Path
 
 import click
 
+from verifier.bundled import PLC_DIR
 from verifier.commands.check import expand_sources
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
-PLC_ROOT = Path(__file__).resolve().parents[2] / "plc"
 #: the bundled folders each editor gets by default
 BUNDLED = {
     "gxworks2": ("core", "fx3", "q", "examples/common", "examples/fx3", "examples/q"),
@@ -26,7 +26,7 @@ BUNDLED = {
 
 
 def bundled_sources(target: str) -> list[Path]:
-    return [p for folder in BUNDLED[target] for p in sorted((PLC_ROOT / folder).glob("*.st"))]
+    return [p for folder in BUNDLED[target] for p in sorted((PLC_DIR / folder).glob("*.st"))]
 
 
 @click.command(name="export")

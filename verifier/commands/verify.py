@@ -14,9 +14,9 @@ import click
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-import verifier
 from verifier.verify.durations import format_duration, format_seconds, parse_duration_us
 from verifier.verify.result import ScenarioResult, UnusableInput
+from verifier.bundled import plc_dir as bundled_plc_dir
 from verifier.verify.scenario import (
     CHANNELS, DEFAULT_DURATION_US, MAX_DURATION_US, PLATFORMS, Scenario, ScenarioError, default_scenario, load_scenario,
 )
@@ -27,8 +27,6 @@ SHOW_PROGRESS_AFTER_S = 0.5
 PLAIN_PROGRESS_EVERY_S = 30.0  # progress lines in CI logs (not a terminal)
 
 
-def bundled_plc_dir() -> Path:
-    return Path(verifier.__file__).resolve().parents[1] / "plc"
 
 
 def bundled_scenarios() -> list[Path]:
