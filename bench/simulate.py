@@ -5,8 +5,11 @@
 Runs plc/examples/fx3/UITAMR_ExampleFx3 (with the core library and the FX3 RS2 port) with
 a 10 ms scan, in one process, side by side:
   1. compiled simulator, RS2 attached to the virtual line + emulated robot, for --hours;
-  2. compiled simulator, nothing attached (the PLC alone), for --hours;
-  3. the plain tree-walking interpreter (verifier/sim/baseline.py) with the line + robot,
+  2. compiled simulator, the robot's replies of run 1 replayed at the same calls without
+     a line (the PLC doing the same work; the difference to run 1 is the line + robot);
+  3. compiled simulator, nothing attached (the PLC alone: no replies, so the engine
+     times out and sends less), for --hours;
+  4. the plain tree-walking interpreter (verifier/sim/baseline.py) with the line + robot,
      for --baseline-s of virtual time (it is too slow for an hour);
 and prints simulated time / wall time for each, the compiled-vs-baseline ratio, and
 whether compiled and baseline produced the same bytes on the line.  Goal: >= 1000x real
@@ -41,12 +44,44 @@ def sources() -> list[Path]:
     return sorted((plc / "core").glob("*.st")) + extra
 
 
-def run_compiled(seconds: float, scan_ms: float, robot: bool):
+class Recorder:
+    """The line, with every non-empty receive_until answer noted (for Replay)."""
+
+    def __init__(self, line: Line):
+        self.line, self.received = line, {}
+
+    @property
+    def trace(self):
+        return self.line.trace
+
+    def send(self, data, t_us, origin=None):
+        return self.line.send(data, t_us, origin)
+
+    def receive_until(self, t_us):
+        got = self.line.receive_until(t_us)
+        if got:
+            self.received[t_us] = got
+        return got
+
+
+class Replay:
+    """The replies a Recorder saw, handed over at the same calls; sends go nowhere."""
+
+    def __init__(self, received: dict):
+        self.received = received
+
+    def send(self, data, t_us, origin=None):
+        return t_us
+
+    def receive_until(self, t_us):
+        return self.received.get(t_us, ())
+
+
+def run_compiled(seconds: float, scan_ms: float, endpoint=None):
     project = verifier.load(*sources(), target="gxworks2", scan_ms=scan_ms)
-    line = None
-    if robot:
-        line = Line(Robot())
-        project.attach_serial("fx3:1", line)
+    line = endpoint
+    if endpoint is not None:
+        project.attach_serial("fx3:1", endpoint)
     wall0, cpu0 = time.perf_counter(), time.process_time()
     project.run_programs([PROGRAM], ms=seconds * 1000)
     wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
@@ -79,27 +114,33 @@ def main(argv=None) -> int:
 
     print(f"{PROGRAM}, scan {args.scan_ms:g} ms")
     rows = []
-    wall, cpu, scans, line_c = run_compiled(seconds, args.scan_ms, robot=True)
+    wall, cpu, scans, line_c = run_compiled(seconds, args.scan_ms, Recorder(Line(Robot())))
     rows.append(("compiled, line + robot", seconds, wall, cpu, scans))
-    wall, cpu, scans, _ = run_compiled(seconds, args.scan_ms, robot=False)
+    wall, cpu, scans, _ = run_compiled(seconds, args.scan_ms, Replay(line_c.received))
+    rows.append(("compiled, same replies replayed, no line", seconds, wall, cpu, scans))
+    wall, cpu, scans, _ = run_compiled(seconds, args.scan_ms)
     rows.append(("compiled, PLC alone", seconds, wall, cpu, scans))
     wall, cpu, scans, line_b = run_baseline(args.baseline_s, args.scan_ms)
     rows.append(("tree-walking baseline, line + robot", args.baseline_s, wall, cpu, scans))
 
-    print(f"{'run':38} {'virtual s':>10} {'wall s':>8} {'scans':>9} {'x real time':>12} {'x (cpu time)':>13}")
+    print(f"{'run':42} {'virtual s':>10} {'wall s':>8} {'scans':>9} {'x real time':>12} {'x (cpu time)':>13}")
     for name, virt, wall, cpu, scans in rows:
-        print(f"{name:38} {virt:10.0f} {wall:8.2f} {scans:9d} {virt / wall:12.0f} {virt / cpu:13.0f}")
+        print(f"{name:42} {virt:10.0f} {wall:8.2f} {scans:9d} {virt / wall:12.0f} {virt / cpu:13.0f}")
     compiled = rows[0][1] / rows[0][2]
-    alone = rows[1][1] / rows[1][2]
-    alone_cpu = rows[1][1] / rows[1][3]
-    baseline = rows[2][1] / rows[2][2]
+    compiled_cpu = rows[0][1] / rows[0][3]
+    alone = rows[2][1] / rows[2][2]
+    alone_cpu = rows[2][1] / rows[2][3]
+    baseline = rows[3][1] / rows[3][2]
+    per_scan = [cpu / scans * 1e6 for _, _, _, cpu, scans in rows[:3]]
+    print(f"CPU time per scan: line + robot {per_scan[0]:.1f} us = the PLC's own work {per_scan[1]:.1f} us "
+          f"+ line and robot {per_scan[0] - per_scan[1]:.1f} us (PLC alone, no replies: {per_scan[2]:.1f} us)")
     print(f"compiled / baseline (line + robot): {compiled / baseline:.1f}x")
     same = traffic(line_c, round(args.baseline_s * 1e6)) == traffic(line_b, round(args.baseline_s * 1e6))
     print(f"same bytes at the same times on the line over the first {args.baseline_s:g} s: {'yes' if same else 'NO'}")
     print(f"goal {GOAL}x real time: PLC alone {'met' if alone >= GOAL else 'NOT met'} ({alone:.0f}x wall, "
           f"{alone_cpu:.0f}x on CPU time), with line + robot {'met' if compiled >= GOAL else 'NOT met'} "
-          f"({compiled:.0f}x wall)")
-    if alone < GOAL <= alone_cpu:
+          f"({compiled:.0f}x wall, {compiled_cpu:.0f}x on CPU time)")
+    if alone < GOAL <= alone_cpu or compiled < GOAL <= compiled_cpu:
         print("note: wall time includes waiting for a core on a loaded machine; CPU time does not")
     return 0 if same else 1
 

@@ -65,6 +65,7 @@ TAPE_COMMANDS = frozenset({
     RobotCommand.ROTATE_LEFT, RobotCommand.ROTATE_RIGHT,
 })
 MODES = ("idle", "running", "paused", "manual")
+REQUEST_KINDS = {FC_WRITE_SINGLE_REGISTER: "control", FC_READ_COILS: "status"}  # as faults name them
 
 
 @dataclass(frozen=True)
@@ -114,7 +115,10 @@ class _Pending:
     faults: list[Fault] = field(default_factory=list)
 
     def has(self, kind: str) -> Fault | None:
-        return next((f for f in self.faults if f.kind == kind), None)
+        for fault in self.faults:
+            if fault.kind == kind:
+                return fault
+        return None
 
 
 class Robot:
@@ -130,6 +134,7 @@ class Robot:
         self.motion: Motion | None = None
         self._pose = self.config.start_pose
         self.battery_pct = self.config.battery_pct
+        self._drain = (0, self.battery_pct, self.config.battery_drain_idle_pct_per_min)  # (since µs, % then, %/min)
         self.speed_stage = self.config.speed_stage
         self.magnetic_speed_stage = self.config.magnetic_speed_stage
         self.collision_range_stage = self.config.collision_range_stage
@@ -143,6 +148,8 @@ class Robot:
         self._state_faults = [_FaultState(f, i) for i, f in enumerate(faults) if f.is_state_fault]
         self._reply_faults = [_FaultState(f, i) for i, f in enumerate(faults) if not f.is_state_fault]
         self._battery_was_low = self.battery_low
+        self._decoded: dict[bytes, ControlRequest | StatusRequest] = {}
+        self._encoded: dict[ControlReply | StatusReply, bytes] = {}
 
     # ---- what the robot reports ---------------------------------------------------------
 
@@ -204,13 +211,18 @@ class Robot:
         self._run_until(t_us)
 
     def _next_due_us(self) -> int | None:
-        times = []
+        """The next time something happens by itself: a task ends, a timed fault starts
+        or ends (None: nothing is due)."""
+        due = None
         if self.mode == "running" and self.motion is not None and self.motion.remaining_us is not None:
-            times.append(self.now_us + self.motion.remaining_us)
-        times += [s.fault.at_us for s in self._state_faults
-                  if s.start_us is None and s.fault.at_us is not None]
-        times += [c.until_us for c in self._conditions.values() if c.until_us is not None]
-        return min(times) if times else None
+            due = self.now_us + self.motion.remaining_us
+        for state in self._state_faults:
+            if state.start_us is None and state.fault.at_us is not None:
+                due = state.fault.at_us if due is None else min(due, state.fault.at_us)
+        for cond in self._conditions.values():
+            if cond.until_us is not None:
+                due = cond.until_us if due is None else min(due, cond.until_us)
+        return due
 
     def _moving(self) -> bool:
         return self.motion is not None and self.mode in ("running", "manual")
@@ -224,11 +236,16 @@ class Robot:
             self.motion.elapsed_us += dt
         per_min = (self.config.battery_drain_running_pct_per_min if moving
                    else self.config.battery_drain_idle_pct_per_min)
+        # The charge is a function of time since the drain rate last changed, not a sum of
+        # steps: the same at any t whether the clock got there in one step or in many.
+        t0, pct0, rate = self._drain
+        if rate != per_min:
+            t0, pct0, rate = self._drain = (self.now_us, self.battery_pct, per_min)
         before = self.battery_pct
-        self.battery_pct = max(0.0, before - per_min * dt / 60_000_000)
+        self.battery_pct = max(0.0, pct0 - rate * (t_us - t0) / 60_000_000)
         low = self.config.battery_low_pct
         if before > low >= self.battery_pct and per_min > 0:
-            crossing = self.now_us + round((before - low) / per_min * 60_000_000)
+            crossing = t0 + round((pct0 - low) / rate * 60_000_000)
             self._log(min(crossing, t_us), "battery",
                       f"battery at {low:g} %: battery query answers 1, error 03")
         self.now_us = t_us
@@ -270,7 +287,7 @@ class Robot:
         self.requests += 1
         number = self.requests
         start = start_us if start_us is not None else t_us - frame_time_us(len(frame))
-        kind = {FC_WRITE_SINGLE_REGISTER: "control", FC_READ_COILS: "status"}.get(function, "other")
+        kind = REQUEST_KINDS.get(function, "other")
         pacing_delay = self._pacing(start, t_us, number)
         if pacing_delay is None:
             self._start_request_faults(number, t_us)
@@ -313,7 +330,7 @@ class Robot:
         address, function = frame[0], frame[1]
         exception_fault = pending.has("exception")
         try:
-            request = decode_request(frame, self.settings)
+            request = self._decode(frame)
         except FrameError as err:
             self._start_request_faults(number, t_us)
             answer = exception_reply_for(err, self.settings)
@@ -333,15 +350,31 @@ class Robot:
         if isinstance(request, ControlRequest):
             self._execute(request, t_us)
             self._start_request_faults(number, t_us)
-            return encode(ControlReply.echo(request), self.settings)
+            return self._encode(ControlReply.echo(request))
         assert isinstance(request, StatusRequest)
         self._start_request_faults(number, t_us)
         value = self.status_value(request.query)
-        return encode(StatusReply(address, self.error, value, request.query), self.settings)
+        return self._encode(StatusReply(address, self.error, value, request.query))
+
+    def _decode(self, frame: bytes) -> ControlRequest | StatusRequest:
+        """decode_request, remembered per frame: a master repeats the same few requests."""
+        request = self._decoded.get(frame)
+        if request is None:
+            request = self._decoded[frame] = decode_request(frame, self.settings)
+        return request
+
+    def _encode(self, reply: ControlReply | StatusReply) -> bytes:
+        """encode, remembered per reply (frames are frozen values)."""
+        data = self._encoded.get(reply)
+        if data is None:
+            data = self._encoded[reply] = encode(reply, self.settings)
+        return data
 
     def _disturb(self, data: bytes, extra_delay: int, pending: _Pending, number: int,
                  t_us: int) -> Reply:
         """Apply the reply faults that hit this request to the reply bytes."""
+        if not pending.faults:
+            return Reply(data, self.config.turnaround_us + extra_delay)
         notes = []
         if (fault := pending.has("wrong_address")) is not None:
             other = fault.address if fault.address is not None else self.settings.address % 247 + 1

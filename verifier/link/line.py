@@ -28,6 +28,12 @@ Semantics (Modbus over Serial Line V1.02, §2.5.1.1):
 
 The line drives the robot's clock: do not call ``robot.advance`` yourself while a line
 owns the robot; call :meth:`Line.advance` and then read ``line.robot``.
+The PLC's endpoint (:meth:`Line.send`, :meth:`Line.receive_until`) runs the robot only
+as far as a request needs: the robot never transmits on its own, so it catches up at the
+next request or :meth:`Line.advance`, through the same task and fault times. On a quiet
+line (no byte under way, no frame waiting for its t3.5, nothing due for the PLC before
+``t_us``) ``receive_until`` only moves the line's clock. That keeps the PLC's per-scan
+poll cheap.
 """
 from __future__ import annotations
 
@@ -88,7 +94,7 @@ class LineConfig:
         return 1750 if self.baud > 19200 else round(3.5 * self.bits_per_char * 1_000_000 / self.baud)
 
 
-@dataclass
+@dataclass(slots=True)
 class _Byte:
     start: int
     end: int
@@ -138,6 +144,8 @@ class Line:
         self._tx_frames: list[_OpenFrame] = []
         self._rx_frames: list[TraceFrame] = []
         self._events: list[LineEvent] = []
+        self._quiet_until = 0  # before this time nothing can happen on the line
+        self._offsets = [0]  # offset_us(k), computed once per k
 
     # ---- the PLC's endpoint ----------------------------------------------------------------
 
@@ -146,38 +154,47 @@ class Line:
         sending). Returns when the last byte's stop bit ends."""
         data = bytes(data)
         self._check_time(t_us, "send")
-        self.advance(t_us)
+        self._work_until(t_us)
         if not data:
             return max(t_us, self._plc_free_us)
         start = max(t_us, self._plc_free_us)
-        send = _Transmission(start, 0, data, origin)
-        for k, value in enumerate(data):
-            byte = _Byte(start + self.config.offset_us(k), start + self.config.offset_us(k + 1), value)
-            send.bytes_.append(byte)
-            self._plc_queue.append(byte)
+        send = _Transmission(start, 0, data, origin, self._on_line(start, data))
+        self._plc_queue.extend(send.bytes_)
         send.end = send.bytes_[-1].end
         self._plc_free_us = send.end
         self._plc_sends.append(send)
         self._trace_tx(send)
         for reply in self._replies_overlapping(send.start, send.end):
             self._collide(send, reply)
+        self._quiet_until = self._next_change_us()
         return send.end
 
     def receive_until(self, t_us: int) -> list[tuple[int, int]]:
         """(byte value, arrival µs) of the robot's bytes that reached the PLC since the last
         call, up to ``t_us``. Bytes lost in a collision are not delivered."""
+        if self.now_us <= t_us < self._quiet_until and type(t_us) is int:
+            self.now_us = t_us  # a quiet line: nothing to work out (see the module docstring)
+            return []
         self._check_time(t_us, "receive_until")
-        self.advance(t_us)
+        self._work_until(t_us)
         received = []
         while self._to_plc and self._to_plc[0].end <= t_us:
             byte = self._to_plc.popleft()
             if not byte.lost:
                 received.append((byte.value, byte.end))
+        self._quiet_until = self._next_change_us()
         return received
 
     def advance(self, t_us: int) -> None:
-        """Work out everything that happens on the line up to ``t_us``."""
+        """Work out everything that happens on the line up to ``t_us`` and bring the robot's
+        clock there (to the end of the frame it is still hearing, if any)."""
         self._check_time(t_us, "advance")
+        self._work_until(t_us)
+        self.robot.advance(self._frame[-1].end if self._frame else t_us)
+
+    def _work_until(self, t_us: int) -> None:
+        """The line up to ``t_us``: bytes heard, frames completed and answered. The robot
+        runs only as far as a request needs (see the module docstring)."""
         queue = self._plc_queue
         while queue and queue[0].end <= t_us:
             byte = queue.popleft()
@@ -188,8 +205,20 @@ class Line:
             quiet_from = self._frame[-1].end + self._t35
             if quiet_from <= t_us and (not queue or queue[0].start >= quiet_from):
                 self._complete_frame()
-        self.robot.advance(self._frame[-1].end if self._frame else t_us)
         self.now_us = t_us
+        self._quiet_until = self._next_change_us()
+
+    def _next_change_us(self) -> int | float:
+        """The first time at which the line has something to work out: a PLC byte reaching
+        the robot, an open frame's t3.5, a robot byte reaching the PLC (infinity: none)."""
+        times = []
+        if self._plc_queue:
+            times.append(self._plc_queue[0].end)
+        if self._frame:
+            times.append(self._frame[-1].end + self._t35)
+        if self._to_plc:
+            times.append(self._to_plc[0].end)
+        return min(times) if times else float("inf")
 
     # ---- what happened ---------------------------------------------------------------------
 
@@ -246,10 +275,8 @@ class Line:
             return
         start = max(end + max(reply.delay_us, self._t35), self._robot_free_us)
         tx = _Transmission(start, 0, bytes(reply.data))
-        for k, value in enumerate(tx.data):
-            byte = _Byte(start + self.config.offset_us(k), start + self.config.offset_us(k + 1), value)
-            tx.bytes_.append(byte)
-            self._to_plc.append(byte)
+        tx.bytes_ = self._on_line(start, tx.data)
+        self._to_plc.extend(tx.bytes_)
         tx.end = tx.bytes_[-1].end
         self._robot_free_us = tx.end
         self._replies.append(tx)
@@ -258,7 +285,20 @@ class Line:
             self._collide(send, tx)
 
     def _robot_transmitting(self, start: int, end: int) -> bool:
-        return any(True for _ in self._replies_overlapping(start, end))
+        for reply in reversed(self._replies):
+            if reply.end <= start:
+                return False  # replies are in time order and never overlap each other
+            if reply.start < end:
+                return True
+        return False
+
+    def _on_line(self, start: int, data: bytes) -> list[_Byte]:
+        """The characters of `data` sent back to back from `start` (byte k occupies
+        [start + offset(k), start + offset(k + 1)))."""
+        offsets = self._offsets
+        while len(offsets) <= len(data):
+            offsets.append(self.config.offset_us(len(offsets)))
+        return [_Byte(start + offsets[k], start + offsets[k + 1], value) for k, value in enumerate(data)]
 
     # ---- collisions --------------------------------------------------------------------------
 
