@@ -28,8 +28,12 @@ class CpuProfile:
     op_error_flags: tuple[str, ...]  # set on an operation error
     op_error_code: str  # word device receiving the error code
     div_zero_code: int
-    # clock relays: device -> period in ms (ON for half the period)
+    # clock relays: device -> period in ms (OFF for the first half of each period, ON for
+    # the second; docs/instructions.md §2)
     clocks: dict[str, int] = field(default_factory=dict)
+    # clock relays whose half period is n units, n read from a register every scan:
+    # relay -> (register, unit in µs, n written at power-on)
+    settable_clocks: dict[str, tuple[str, int, int]] = field(default_factory=dict)
     # does an operation error stop the CPU by default?
     stops_on_op_error: bool = False
 
@@ -68,6 +72,8 @@ FX3G = CpuProfile(
 )
 
 _SM_CLOCKS = {"SM409": 10, "SM410": 100, "SM411": 200, "SM412": 1000, "SM413": 2000}
+# SM414: 2n second clock, n in SD414; SM415: 2n ms clock, n in SD415 (both n = 30 at power-on)
+_SM_SETTABLE_CLOCKS = {"SM414": ("SD414", 1_000_000, 30), "SM415": ("SD415", 1_000, 30)}
 
 FX5U = CpuProfile(
     name="fx5u",
@@ -83,7 +89,7 @@ FX5U = CpuProfile(
     first_scan_on=("SM402", "SM8002"), first_scan_off=("SM403", "SM8003"),
     op_error_flags=("SM0", "SM1"), op_error_code="SD0",
     div_zero_code=0x3405,
-    clocks=_SM_CLOCKS,
+    clocks=_SM_CLOCKS, settable_clocks=_SM_SETTABLE_CLOCKS,
 )
 
 QCPU = CpuProfile(
@@ -100,7 +106,7 @@ QCPU = CpuProfile(
     first_scan_on=("SM402",), first_scan_off=("SM403",),
     op_error_flags=("SM0", "SM1"), op_error_code="SD0",
     div_zero_code=4100,
-    clocks=_SM_CLOCKS,
+    clocks=_SM_CLOCKS, settable_clocks=_SM_SETTABLE_CLOCKS,
     stops_on_op_error=True,
 )
 

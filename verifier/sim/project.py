@@ -263,6 +263,7 @@ class Project:
             cells[:] = [zero] * len(cells)
         for buf in rt.buffers.values():
             buf[:] = [0] * len(buf)
+        rt.power_on_devices()
         rt.pollers.clear()
         rt.origins.clear()
         rt.scan_count = 0

@@ -55,7 +55,15 @@ class Runtime:
         self._op_code = self.dev.address(cpu.op_error_code)
         self._clocks = [(self.dev.areas[a.area], a.index, period * 500)
                         for a, period in ((self.dev.address(n), p) for n, p in cpu.clocks.items())]
+        self._settable_clocks = [(self.dev.address(relay), self.dev.address(register), unit_us, n)
+                                 for relay, (register, unit_us, n) in cpu.settable_clocks.items()]
+        self.power_on_devices()
         self.begin_scan = self._make_begin_scan()
+
+    def power_on_devices(self) -> None:
+        """The values the CPU writes into special registers at power-on (SD414/SD415)."""
+        for _, register, _, n in self._settable_clocks:
+            self.dev.areas[register.area][register.index] = n
 
     def buffer(self, module: int) -> list[int]:
         """Buffer memory of the intelligent module at start I/O `module` (U0\\G...)."""
@@ -89,6 +97,12 @@ class Runtime:
         for i, (cells, index, half_us) in enumerate(self._clocks):
             env[f"clk{i}"] = cells
             lines.append(f"    clk{i}[{index}] = now // {half_us} % 2 == 1")
+        for i, (relay, register, unit_us, _) in enumerate(self._settable_clocks):
+            env[f"sclk{i}"], env[f"sreg{i}"] = self.dev.areas[relay.area], self.dev.areas[register.area]
+            # n < 1 is out of range: the relay keeps its state (ASSUMPTION)
+            lines.append(f"    n = sreg{i}[{register.index}]")
+            lines.append("    if n > 0:")
+            lines.append(f"        sclk{i}[{relay.index}] = now // (n * {unit_us}) % 2 == 1")
         lines.append("    for p in rt.pollers:")
         lines.append("        p.poll(now)")
         exec("\n".join(lines), env)
