@@ -176,11 +176,13 @@ class BodyCompiler(CallCompiler):
         if op == "**":
             return f"_f32(_expt({lc}, {rc}, {k}))", "REAL"
         if t == ANYINT:  # both literals: constant arithmetic, typed later
+            # _anyint(...) marks each step; norm_code retypes the marks to the type the
+            # expression meets, so every step wraps there as on the CPU (identity otherwise)
             if op == "/":
-                return f"_idiv({lc}, {rc}, {k})", ANYINT
+                return f"_anyint(_idiv({lc}, {rc}, {k}))", ANYINT
             if op == "MOD":
-                return f"_imod({lc}, {rc}, {k})", ANYINT
-            return f"(({lc}) {op} ({rc}))", ANYINT
+                return f"_anyint(_imod({lc}, {rc}, {k}))", ANYINT
+            return f"_anyint(({lc}) {op} ({rc}))", ANYINT
         if is_real(t) or t == ANYREAL:
             real_t = concrete(t)
             if op == "/":

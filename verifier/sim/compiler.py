@@ -26,8 +26,8 @@ from .refs import AttrRef, BitRef, DwordRef, Ref
 from .stdfbs import STANDARD_FBS, FB_PARAM_TYPES
 from .stdfuncs import make_helpers
 from .storage import check_storage
-from .typesys import (ArrayT, CompileError, FbT, PouInfo, StringT, StructT, Symbol, concrete,
-                      is_int, is_real, norm_code)
+from .typesys import (ArrayT, CompileError, FbT, PouInfo, StringT, StructT, Symbol, anyint_helpers,
+                      concrete, is_int, is_real, norm_code)
 
 GENERATED_FILE = "<st-simulation>"
 
@@ -403,6 +403,7 @@ class ModuleCompiler:
               "_Ref": Ref, "_AttrRef": AttrRef, "_BitRef": BitRef,
               "_DwordRef": DwordRef, "_oob": _oob}
         ns.update(make_helpers(rt))
+        ns.update(anyint_helpers())
         for name, cls in STANDARD_FBS.items():
             ns[f"_STD_{name}"] = cls
         for area in self.cpu.areas:

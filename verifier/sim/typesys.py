@@ -115,8 +115,24 @@ def norm_code(t, code: str) -> str:
     if isinstance(t, StringT):
         return f"({code})[:{t.length}]"
     if isinstance(t, str) and t in datatypes.TYPES:
+        if datatypes.TYPES[t].is_integer and ANYINT_STEP in code:
+            # constant arithmetic meeting type t: every step of it wraps in t
+            code = code.replace(ANYINT_STEP, f"_anyint_{t}(")
         return datatypes.TYPES[t].norm.format(x=code)
     return code
+
+
+ANYINT_STEP = "_anyint("  # marks a step of untyped constant arithmetic in generated code
+
+
+def anyint_helpers() -> dict:
+    """`_anyint` (a step not yet typed: exact) and `_anyint_<T>` (the step wrapped in T)
+    for the generated module's namespace."""
+    helpers = {"_anyint": lambda x: x}
+    for name, et in datatypes.TYPES.items():
+        if et.is_integer:
+            helpers[f"_anyint_{name}"] = et.normalize
+    return helpers
 
 
 @dataclass
