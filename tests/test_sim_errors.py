@@ -84,3 +84,19 @@ def test_import_verifier_stays_cheap():
     code = "import verifier, sys; print('verifier.sim' in sys.modules, 'lark' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["False", "False"]
+
+
+def test_load_reads_files_as_check_does(tmp_path):
+    """QA 24: one ST reader (verifier.st.read_source) for check, export and load."""
+    from verifier.st.source import read_source
+
+    good = tmp_path / "sjis.st"
+    good.write_bytes("PROGRAM P\n(* 搬送ロボット *)\nVAR n : INT; END_VAR\nn := 1;\nEND_PROGRAM\n".encode("cp932"))
+    project = verifier.load(str(good))
+    assert project.files[0].pous[0].name == "P" and not read_source(good)[1]
+    bad = tmp_path / "bad.st"
+    bad.write_bytes(b"PROGRAM P\n(* \x80\x80 *)\nEND_PROGRAM\n")
+    (expected,) = read_source(bad)[1]
+    with pytest.raises(LoadError) as err:
+        verifier.load(str(bad))
+    assert str(expected) in str(err.value) and "bad.st:2:4" in str(err.value)
