@@ -150,6 +150,7 @@ class Robot:
         self._battery_was_low = self.battery_low
         self._decoded: dict[bytes, ControlRequest | StatusRequest] = {}
         self._encoded: dict[ControlReply | StatusReply, bytes] = {}
+        self._status_replies: dict[tuple, bytes] = {}  # (address, error, value, query) -> bytes
 
     # ---- what the robot reports ---------------------------------------------------------
 
@@ -274,7 +275,7 @@ class Robot:
         """
         frame = bytes(frame)
         self.advance(t_us)
-        if len(frame) < 4 or not crc_ok(frame):
+        if frame not in self._decoded and (len(frame) < 4 or not crc_ok(frame)):  # decoded: CRC ok
             self._log(t_us, "silent", f"bad CRC or too short ({hex_bytes(frame)}): no reply")
             return None
         address, function = frame[0], frame[1]
@@ -354,7 +355,11 @@ class Robot:
         assert isinstance(request, StatusRequest)
         self._start_request_faults(number, t_us)
         value = self.status_value(request.query)
-        return self._encode(StatusReply(address, self.error, value, request.query))
+        key = (address, self.error, value, request.query)
+        data = self._status_replies.get(key)
+        if data is None:
+            data = self._status_replies[key] = self._encode(StatusReply(*key))
+        return data
 
     def _decode(self, frame: bytes) -> ControlRequest | StatusRequest:
         """decode_request, remembered per frame: a master repeats the same few requests."""
