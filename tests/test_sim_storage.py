@@ -81,3 +81,15 @@ def test_endless_function_recursion_stops_with_a_located_error():
     with pytest.raises(SimulationError) as err:
         project.run_programs(["M"], scans=1)
     assert "t.st:3:" in str(err.value) and "recursion" in str(err.value)
+
+
+def test_long_flat_expressions_run_and_deep_ones_are_refused_at_the_statement():
+    terms = 3000
+    src = (f"PROGRAM M\nVAR i : INT := 300; x : INT; b : BOOL; END_VAR\nx := {'+'.join(['i'] * terms)};\n"
+           f"b := {' AND '.join(['(i > 0)'] * terms)};\nEND_PROGRAM\n")
+    project = load_st(src, target="gxworks3", cpu="fx3u")
+    project.run_programs(["M"], scans=1)
+    assert project.program("M").x == (300 * terms + 32768) % 65536 - 32768   # wraps as INT
+    assert project.program("M").b is True
+    deep = "PROGRAM M\nVAR i, x : INT; END_VAR\nx := 1;\nx := " + "i + (" * 400 + "i" + ")" * 400 + ";\nEND_PROGRAM\n"
+    assert "t.st:4:1: error: expression nested too deeply to simulate" in refused(deep)

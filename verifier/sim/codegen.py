@@ -121,12 +121,30 @@ class BodyCompiler(CallCompiler):
             code, t = self.expr(e.operand)
             return self.unary_code(e.op, code, t, e.span)
         if isinstance(e, ast.BinaryOp):
+            spine = [e]
+            while isinstance(spine[-1].left, ast.BinaryOp):
+                spine.append(spine[-1].left)
+            if len(spine) > LONG_CHAIN:
+                return self.chain(spine)
             lc, lt = self.expr(e.left)
             rc, rt_ = self.expr(e.right)
             return self.binary_code(e.op, lc, lt, rc, rt_, e.span)
         if isinstance(e, ast.Call):
             return self.call_expr(e)
         raise CompileError(e.span, f"cannot simulate expression {type(e).__name__}")
+
+    def chain(self, spine: list[ast.BinaryOp]):
+        """A long left-deep chain (a + b + c + ...): each step is the code binary_code
+        gives, its value held in a temporary, the steps in one flat tuple evaluated left
+        to right - the same operations without the deep nesting Python cannot compile."""
+        code, t = self.expr(spine[-1].left)
+        steps = []
+        for node in reversed(spine):
+            rc, rt_ = self.expr(node.right)
+            step, t = self.binary_code(node.op, code, t, rc, rt_, node.span)
+            code = self.new_tmp("_c")
+            steps.append(f"({code} := {step})")
+        return f"({', '.join(steps)})[-1]", t
 
     def check_bit(self, bit: int, t, span) -> None:
         width = {"WORD": 16, "INT": 16, "UINT": 16, "DWORD": 32, "DINT": 32, "UDINT": 32}.get(t)
@@ -448,6 +466,9 @@ class BodyCompiler(CallCompiler):
             if method is None:
                 raise CompileError(s.span, f"cannot simulate statement {type(s).__name__}")
             method(s)
+        except RecursionError:
+            raise CompileError(s.span, "expression nested too deeply to simulate; "
+                                       "split it into several statements") from None
         finally:
             self.em.span = saved
 
@@ -648,6 +669,9 @@ class BodyCompiler(CallCompiler):
         if outs:
             return "return (_ret, " + ", ".join(o.code for o in outs) + ")"
         return "return _ret"
+
+
+LONG_CHAIN = 16  # operators in a left-deep chain compiled step by step (see chain())
 
 
 def _typed_literal(code: str, src, dst) -> str:

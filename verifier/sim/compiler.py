@@ -376,7 +376,14 @@ class ModuleCompiler:
             self.gen_class(self.pous[key], lines, spans, bc)
         source = "\n".join(em.lines) + "\n"
         ns = self.namespace()
-        code = compile(source, GENERATED_FILE, "exec")
+        try:
+            code = compile(source, GENERATED_FILE, "exec")
+        except (SyntaxError, RecursionError, MemoryError) as e:
+            # Python's own nesting limits (about 200 parentheses in one expression)
+            lineno = getattr(e, "lineno", None)
+            span = em.spans[lineno - 1] if lineno and 0 < lineno <= len(em.spans) else None
+            raise CompileError(span, "expression nested too deeply to simulate; "
+                                     "split it into several statements") from None
         exec(code, ns)
         ns["_G"] = ns["_Globals"]()
         module = CompiledModule(ns, source, list(em.spans), self.pous, self.struct_fields, self.globals)
