@@ -25,6 +25,7 @@ from .instructions import lookup as lookup_instruction
 from .refs import AttrRef, BitRef, DwordRef, Ref
 from .stdfbs import STANDARD_FBS, FB_PARAM_TYPES
 from .stdfuncs import make_helpers
+from .purity import pure_functions, remembered
 from .storage import check_storage
 from .typesys import (ArrayT, CompileError, FbT, PouInfo, StringT, StructT, Symbol, anyint_helpers,
                       concrete, is_int, is_real, norm_code)
@@ -385,6 +386,9 @@ class ModuleCompiler:
             raise CompileError(span, "expression nested too deeply to simulate; "
                                      "split it into several statements") from None
         exec(code, ns)
+        for key in pure_functions(self.functions):
+            name = self.functions[key].class_name
+            ns[name] = remembered(ns[name])
         ns["_G"] = ns["_Globals"]()
         module = CompiledModule(ns, source, list(em.spans), self.pous, self.struct_fields, self.globals)
         for info in self.pous.values():
