@@ -126,12 +126,29 @@ class BodyCompiler(CallCompiler):
                 spine.append(spine[-1].left)
             if len(spine) > LONG_CHAIN:
                 return self.chain(spine)
+            quick = self.counter_division(e)
+            if quick is not None:
+                return quick
             lc, lt = self.expr(e.left)
             rc, rt_ = self.expr(e.right)
             return self.binary_code(e.op, lc, lt, rc, rt_, e.span)
         if isinstance(e, ast.Call):
             return self.call_expr(e)
         raise CompileError(e.span, f"cannot simulate expression {type(e).__name__}")
+
+    def counter_division(self, e: ast.BinaryOp):
+        """`i / 2`, `i MOD 2` with i a FOR counter that never goes below 0 and a positive
+        literal divisor: Python's // and % give the CPU's result (truncation equals floor,
+        no division by zero to flag), without a helper call per step of the loop."""
+        if e.op not in ("/", "MOD") or not isinstance(e.left, ast.Name):
+            return None
+        loop = self.loop_vars.get(e.left.key)
+        if loop is None or loop[1] < 0 or not isinstance(e.right, ast.IntLiteral) or e.right.value <= 0:
+            return None
+        t = self.lookup(e.left.name, e.left.span).type
+        if not is_int(t) or t in ("BOOL",):
+            return None
+        return f"({loop[0]} {'//' if e.op == '/' else '%'} {e.right.value})", t
 
     def chain(self, spine: list[ast.BinaryOp]):
         """A long left-deep chain (a + b + c + ...): each step is the code binary_code
