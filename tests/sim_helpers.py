@@ -20,6 +20,13 @@ def run_fb(body: str, decls: str, scans: int = 1, **options):
     return project, fb
 
 
+def run_program(src: str, scans: int = 1, name: str = "P", **options):
+    """Load `src`, run its PROGRAM `name` for `scans` scans; the PROGRAM instance."""
+    project = load_st(src, **options)
+    project.run_programs([name], scans=scans)
+    return project.program(name)
+
+
 class FakeEndpoint:
     """The Line master interface with scripted replies: bytes are delivered at the times
     given to `reply_at`."""

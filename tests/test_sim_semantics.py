@@ -6,7 +6,7 @@ import struct
 
 import pytest
 
-from sim_helpers import load_st, run_fb
+from sim_helpers import load_st, run_fb, run_program
 from verifier.sim import LoadError, SimulationError
 
 
@@ -414,8 +414,6 @@ def test_counter_division_in_a_for_loop():
     src = ("PROGRAM P\nVAR i, j : INT; q, m : ARRAY[0..20] OF INT; n : ARRAY[0..20] OF INT; END_VAR\n"
            "FOR i := 0 TO 20 DO q[i] := i / 3; m[i] := i MOD 4; END_FOR;\n"
            "FOR j := -10 TO 10 DO n[j + 10] := j / 3; END_FOR;\nEND_PROGRAM\n")
-    project = load_st(src)
-    project.run_programs(["P"], scans=1)
-    p = project.program("P")
+    p = run_program(src)
     assert list(p.q) == [i // 3 for i in range(21)] and list(p.m) == [i % 4 for i in range(21)]
     assert list(p.n) == [int(j / 3) for j in range(-10, 11)]  # negative counters: truncation
