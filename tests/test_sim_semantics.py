@@ -2,6 +2,7 @@
 worked out by hand from the MELSEC data formats."""
 from __future__ import annotations
 
+import math
 import struct
 
 import pytest
@@ -417,3 +418,32 @@ def test_counter_division_in_a_for_loop():
     p = run_program(src)
     assert list(p.q) == [i // 3 for i in range(21)] and list(p.m) == [i % 4 for i in range(21)]
     assert list(p.n) == [int(j / 3) for j in range(-10, 11)]  # negative counters: truncation
+
+
+def test_counter_arithmetic_in_a_for_loop():
+    """Index and value arithmetic on FOR counters with constants (named ones too) compiles
+    to plain Python arithmetic when no step can wrap, go negative or divide by <= 0: the
+    results are those of the CPU's truncating, wrapping arithmetic in every case, checked
+    against Python's own arithmetic here (also for the cases that keep the helpers)."""
+    src = ("PROGRAM P\nVAR CONSTANT PAIR : INT := 2; BASE : INT := 8; END_VAR\n"
+           "VAR i : INT; a : ARRAY[0..40] OF INT; q, m, n, w : ARRAY[0..20] OF INT; END_VAR\n"
+           "FOR i := 0 TO 15 DO a[BASE + PAIR * i + 1] := i MOD PAIR + 10 * (i / PAIR); END_FOR;\n"
+           "FOR i := 0 TO 20 DO q[i] := (i - 7) / PAIR; m[i] := (i - 7) MOD 3; n[i] := i * 2000;\n"
+           "  w[20 - i] := 30000 + i * 200; END_FOR;\nEND_PROGRAM\n")
+    p = run_program(src)
+    expected_a = [0] * 41
+    for i in range(16):
+        expected_a[8 + 2 * i + 1] = i % 2 + 10 * (i // 2)
+    assert list(p.a) == expected_a
+    assert list(p.q) == [int((i - 7) / 2) for i in range(21)]  # truncation, not floor
+    assert list(p.m) == [int(math.fmod(i - 7, 3)) for i in range(21)]  # sign of the dividend
+    assert list(p.n) == [(i * 2000 + 32768) % 65536 - 32768 for i in range(21)]  # INT wraps
+    assert list(p.w) == [(30000 + (20 - i) * 200 + 32768) % 65536 - 32768 for i in range(21)]
+
+
+def test_counter_arithmetic_index_out_of_range_is_still_an_error():
+    src = ("PROGRAM P\nVAR i : INT; a : ARRAY[0..9] OF INT; END_VAR\n"
+           "FOR i := 0 TO 9 DO a[i + 1] := i; END_FOR;\nEND_PROGRAM\n")
+    with pytest.raises(SimulationError) as err:
+        run_program(src)
+    assert "outside a[0..9]" in str(err.value) and err.value.location == "t.st:3:22"

@@ -126,29 +126,63 @@ class BodyCompiler(CallCompiler):
                 spine.append(spine[-1].left)
             if len(spine) > LONG_CHAIN:
                 return self.chain(spine)
-            quick = self.counter_division(e)
-            if quick is not None:
-                return quick
             lc, lt = self.expr(e.left)
             rc, rt_ = self.expr(e.right)
-            return self.binary_code(e.op, lc, lt, rc, rt_, e.span)
+            code, t = self.binary_code(e.op, lc, lt, rc, rt_, e.span)
+            known = self.counter_arith(e) if self.loop_vars and is_int(t) and t != "BOOL" else None
+            return (known[0], t) if known is not None else (code, t)
         if isinstance(e, ast.Call):
             return self.call_expr(e)
         raise CompileError(e.span, f"cannot simulate expression {type(e).__name__}")
 
-    def counter_division(self, e: ast.BinaryOp):
-        """`i / 2`, `i MOD 2` with i a FOR counter that never goes below 0 and a positive
-        literal divisor: Python's // and % give the CPU's result (truncation equals floor,
-        no division by zero to flag), without a helper call per step of the loop."""
-        if e.op not in ("/", "MOD") or not isinstance(e.left, ast.Name):
+    def counter_arith(self, e) -> tuple[str, int, int] | None:
+        """(code, lowest, highest) of integer arithmetic over FOR counters and constants
+        (`24 + i`, `8 + 2 * i + 1`, `i / BYTES_PER_WORD`, `i MOD 2`) whose every step stays
+        within 0..32767 for the counters' whole range: no step can wrap in any integer
+        type and no divisor is zero or negative (truncation equals floor), so plain
+        Python arithmetic gives the CPU's result without a wrap or a helper call per
+        loop step.  None when that is not certain; at least one FOR counter must occur."""
+        if isinstance(e, ast.Name) and e.key in self.loop_vars:
+            v, lo, hi = self.loop_vars[e.key]
+            t = self.lookup(e.name, e.span).type
+            return (v, lo, hi) if is_int(t) and t != "BOOL" and 0 <= lo and hi <= 32767 else None
+        if not isinstance(e, ast.BinaryOp) or e.op not in ("+", "-", "*", "/", "MOD"):
             return None
-        loop = self.loop_vars.get(e.left.key)
-        if loop is None or loop[1] < 0 or not isinstance(e.right, ast.IntLiteral) or e.right.value <= 0:
+        left, right = self._arith_operand(e.left), self._arith_operand(e.right)
+        if left is None or right is None or (left[3] and right[3]):
+            return None  # both constant: not a counter expression (constants fold elsewhere)
+        (lc, llo, lhi, _), (rc, rlo, rhi, _) = left, right
+        if e.op in ("/", "MOD"):
+            if rlo != rhi or rlo <= 0 or llo < 0:
+                return None  # only a positive constant divisor
+            op = "//" if e.op == "/" else "%"
+            lo, hi = (llo // rlo, lhi // rlo) if op == "//" else ((llo, lhi) if lhi < rlo else (0, rlo - 1))
+        else:
+            op = e.op
+            apply = _ARITH[op]
+            corners = [apply(a, b) for a in (llo, lhi) for b in (rlo, rhi)]
+            lo, hi = min(corners), max(corners)
+        if lo < 0 or hi > 32767:
             return None
-        t = self.lookup(e.left.name, e.left.span).type
-        if not is_int(t) or t in ("BOOL",):
-            return None
-        return f"({loop[0]} {'//' if e.op == '/' else '%'} {e.right.value})", t
+        return f"({lc} {op} {rc})", lo, hi
+
+    def counter_index(self, ix):
+        """(code, lowest, highest) of an array index that is a FOR counter or arithmetic
+        on one (see counter_arith), else None."""
+        if isinstance(ix, ast.Name):
+            return self.loop_vars.get(ix.key)
+        if isinstance(ix, ast.BinaryOp) and self.loop_vars:
+            _, t = self.expr(ix)
+            if is_int(t) and t != "BOOL":
+                return self.counter_arith(ix)
+        return None
+
+    def _arith_operand(self, e):
+        value = self.m.try_const(e, self.info)
+        if value is not None:
+            return (repr(value), value, value, True) if 0 <= value <= 32767 else None
+        known = self.counter_arith(e)
+        return None if known is None else (*known, False)
 
     def chain(self, spine: list[ast.BinaryOp]):
         """A long left-deep chain (a + b + c + ...): each step is the code binary_code
@@ -362,9 +396,10 @@ class BodyCompiler(CallCompiler):
             code, t = self.expr(ix)
             if not is_int(t):
                 raise CompileError(ix.span, f"array index must be an integer, not {t}")
-            loop = self.loop_vars.get(ix.key) if isinstance(ix, ast.Name) else None
+            loop = self.counter_index(ix)
             if loop is not None and lo <= loop[1] and loop[2] <= hi:
-                # a FOR counter whose whole range lies inside the bounds: no check needed
+                # a FOR counter (or arithmetic on one) whose whole range lies inside the
+                # bounds: no check needed
                 part = f"{loop[0]} - {lo}" if lo else loop[0]
                 flat_parts.append(part if st == 1 else f"({part}) * {st}")
                 continue
@@ -404,7 +439,7 @@ class BodyCompiler(CallCompiler):
             if value is not None:
                 parts.append(str((value - lo) * st))
                 continue
-            loop = self.loop_vars.get(ix.key) if isinstance(ix, ast.Name) else None
+            loop = self.counter_index(ix)
             if loop is not None and lo <= loop[1] and loop[2] <= hi:
                 part = f"{loop[0]} - {lo}" if lo else loop[0]
                 parts.append(part if st == 1 else f"({part}) * {st}")
@@ -711,6 +746,9 @@ def _strides(dims) -> list[int]:
         strides.append(stride)
         stride *= hi - lo + 1
     return strides[::-1]
+
+
+_ARITH = {"+": int.__add__, "-": int.__sub__, "*": int.__mul__}
 
 
 def _int_range(t):
