@@ -447,3 +447,38 @@ def test_counter_arithmetic_index_out_of_range_is_still_an_error():
     with pytest.raises(SimulationError) as err:
         run_program(src)
     assert "outside a[0..9]" in str(err.value) and err.value.location == "t.st:3:22"
+
+
+def test_and_or_on_bools_give_every_combination_and_still_evaluate_what_can_fail():
+    """AND/OR on BOOLs skip a right side that only reads labels (short-circuit): the same
+    truth table as the CPU's; a right side that can fail (an index out of range) or do
+    something (a FUNCTION call) is still evaluated when the left side decides alone."""
+    src = ("FUNCTION F : BOOL\nVAR_INPUT x : INT; END_VAR\n"
+           "D0 := D0 + x; F := x > 0;\nEND_FUNCTION\n"
+           "PROGRAM P\nVAR a, b : ARRAY[0..3] OF BOOL; r : ARRAY[0..15] OF BOOL;\n"
+           "i, j, n : INT; q : BOOL; w : ARRAY[0..1] OF BOOL; END_VAR\n"
+           "FOR i := 0 TO 3 DO FOR j := 0 TO 3 DO\n"
+           "  r[4 * i + j] := (a[i] AND b[j]) OR (NOT a[i] AND NOT b[j]) OR (a[i] AND NOT b[j] AND i = j);\n"
+           "END_FOR; END_FOR;\n"
+           "q := FALSE AND F(1); q := TRUE OR F(2); q := q AND F(4);\n"
+           "IF FALSE AND w[i] THEN n := 100; END_IF;\nEND_PROGRAM\n")
+    project = load_st(src)
+    p = project.program("P")
+    for k in range(4):
+        p.a[k], p.b[k] = k in (1, 3), k in (2, 3)
+    with pytest.raises(SimulationError) as err:  # i = 4 after the loop: w[4] is out of range
+        project.run_programs(["P"], scans=1)
+    assert "outside w[0..1]" in str(err.value)
+    a, b = [k in (1, 3) for k in range(4)], [k in (2, 3) for k in range(4)]
+    assert list(p.r) == [(a[i] and b[j]) or (not a[i] and not b[j]) or (a[i] and not b[j] and i == j)
+                         for i in range(4) for j in range(4)]
+    assert project.devices["D0"] == 7 and p.n == 0  # every call ran (1 + 2 + 4), no IF
+    assert p.q is True
+
+
+def test_cannot_fail_accepts_only_plain_reads():
+    from verifier.sim.codegen import cannot_fail
+    assert cannot_fail("((not (_o1.bOk)) & ((_A_M[8002]) | (((self.wState) == (2)))))")
+    for code in ("_oob(_t4, 5)", "(a[_t] if 0 <= (_t := x) <= 3 else _oob(_t, 1))", "l_F(x)",
+                 "(x // 2) == 1", "a[i]", "(_t := 1)", "'text' == s", "x if y else z"):
+        assert not cannot_fail(code), code

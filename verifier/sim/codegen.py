@@ -9,6 +9,7 @@ so a run-time error is reported at an ST line, not a Python one.
 from __future__ import annotations
 
 import keyword
+import re
 
 from verifier.st import ast
 
@@ -229,6 +230,10 @@ class BodyCompiler(CallCompiler):
             if lt == "BOOL" or rt_ == "BOOL":
                 if lt != "BOOL" or rt_ != "BOOL":
                     raise CompileError(span, f"{op} mixes BOOL with {lt if lt != 'BOOL' else rt_}")
+                if op != "XOR" and cannot_fail(rc):
+                    # nothing to miss when the right side is skipped: Python's short-circuit
+                    # `and`/`or` give the same value as & and | on BOOLs, in fewer steps
+                    py = "and" if op == "AND" else "or"
                 return f"(({lc}) {py} ({rc}))", "BOOL"
             t = unify(lt, rt_)
             code = f"(({lc}) {py} ({rc}))"
@@ -746,6 +751,28 @@ def _strides(dims) -> list[int]:
         strides.append(stride)
         stride *= hi - lo + 1
     return strides[::-1]
+
+
+_PLAIN_TOKEN = re.compile(r"\s+|([A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*)(\s*\()?"
+                          r"|\d+|\[\d+\]|==|!=|<=|>=|[()<>&|^+\-~]")
+_PLAIN_WORDS = {"not", "True", "False", "and", "or"}
+
+
+def cannot_fail(code: str) -> bool:
+    """True when generated expression code only reads labels, constant-address devices
+    and literals through comparisons and bit/sign operators: no call, no computed index,
+    no division, no walrus - evaluating it or not changes nothing but its value."""
+    pos = 0
+    while pos < len(code):
+        m = _PLAIN_TOKEN.match(code, pos)
+        if m is None:
+            return False
+        name, call = m.group(1), m.group(2)
+        if name is not None and (call is not None and name != "not"
+                                 or keyword.iskeyword(name) and name not in _PLAIN_WORDS):
+            return False
+        pos = m.end()
+    return True
 
 
 _ARITH = {"+": int.__add__, "-": int.__sub__, "*": int.__mul__}
