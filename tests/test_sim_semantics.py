@@ -479,6 +479,7 @@ def test_and_or_on_bools_give_every_combination_and_still_evaluate_what_can_fail
 def test_cannot_fail_accepts_only_plain_reads():
     from verifier.sim.codegen import cannot_fail
     assert cannot_fail("((not (_o1.bOk)) & ((_A_M[8002]) | (((self.wState) == (2)))))")
+    assert cannot_fail("(((a) and (b))) or (((self.wState) == (2)))")
     for code in ("_oob(_t4, 5)", "(a[_t] if 0 <= (_t := x) <= 3 else _oob(_t, 1))", "l_F(x)",
-                 "(x // 2) == 1", "a[i]", "(_t := 1)", "'text' == s", "x if y else z"):
+                 "(x // 2) == 1", "a[i]", "(_t := 1)", "'text' == s", "x if y else z", "(a) or (l_F(x))", "True (x)"):
         assert not cannot_fail(code), code

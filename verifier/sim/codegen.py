@@ -755,7 +755,8 @@ def _strides(dims) -> list[int]:
 
 _PLAIN_TOKEN = re.compile(r"\s+|([A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*)(\s*\()?"
                           r"|\d+|\[\d+\]|==|!=|<=|>=|[()<>&|^+\-~]")
-_PLAIN_WORDS = {"not", "True", "False", "and", "or"}
+_OPERATOR_WORDS = {"not", "and", "or"}  # may stand before a parenthesis
+_PLAIN_WORDS = _OPERATOR_WORDS | {"True", "False"}
 
 
 def cannot_fail(code: str) -> bool:
@@ -768,7 +769,7 @@ def cannot_fail(code: str) -> bool:
         if m is None:
             return False
         name, call = m.group(1), m.group(2)
-        if name is not None and (call is not None and name != "not"
+        if name is not None and (call is not None and name not in _OPERATOR_WORDS
                                  or keyword.iskeyword(name) and name not in _PLAIN_WORDS):
             return False
         pos = m.end()
