@@ -44,21 +44,15 @@ def sources() -> list[Path]:
     return sorted((plc / "core").glob("*.st")) + extra
 
 
-class Recorder:
+class Recorder(Line):
     """The line, with every non-empty receive_until answer noted (for Replay)."""
 
-    def __init__(self, line: Line):
-        self.line, self.received = line, {}
-
-    @property
-    def trace(self):
-        return self.line.trace
-
-    def send(self, data, t_us, origin=None):
-        return self.line.send(data, t_us, origin)
+    def __init__(self, robot: Robot):
+        super().__init__(robot)
+        self.received = {}
 
     def receive_until(self, t_us):
-        got = self.line.receive_until(t_us)
+        got = super().receive_until(t_us)
         if got:
             self.received[t_us] = got
         return got
@@ -114,7 +108,7 @@ def main(argv=None) -> int:
 
     print(f"{PROGRAM}, scan {args.scan_ms:g} ms")
     rows = []
-    wall, cpu, scans, line_c = run_compiled(seconds, args.scan_ms, Recorder(Line(Robot())))
+    wall, cpu, scans, line_c = run_compiled(seconds, args.scan_ms, Recorder(Robot()))
     rows.append(("compiled, line + robot", seconds, wall, cpu, scans))
     wall, cpu, scans, _ = run_compiled(seconds, args.scan_ms, Replay(line_c.received))
     rows.append(("compiled, same replies replayed, no line", seconds, wall, cpu, scans))

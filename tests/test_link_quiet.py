@@ -21,7 +21,16 @@ PLC = Path(__file__).resolve().parents[1] / "plc"
 
 
 class EagerLine(Line):
-    """The line before the shortcut: every PLC call runs everything up to its time."""
+    """The line before the shortcut: every PLC call runs everything up to its time, and
+    the line never promises a quiet time (so the PLC's port calls it on every scan)."""
+
+    @property
+    def quiet_until_us(self):
+        return 0
+
+    @quiet_until_us.setter
+    def quiet_until_us(self, value):
+        pass
 
     def send(self, data, t_us, origin=None):
         self.advance(t_us)
@@ -74,18 +83,35 @@ def test_the_fx3_example_makes_the_same_trace_on_both_lines():
               {"kind": "bad_crc", "on_request": 14},
               {"kind": "anti_collision", "at_s": 9.0, "duration_s": 2.0},
               {"kind": "low_battery", "at_s": 20.0, "duration_s": 3.0}]
-    results = []
-    for line_class in (Line, EagerLine):
+    results, clocks = [], []
+    for make_line in (Line, CalledEveryScan, EagerLine):
         project = verifier.load(*sources, target="gxworks2", scan_ms=10, jitter_ms=2, seed=7)
-        line = line_class(robot_pair(faults, point_duration_s=4.0)[0])
+        line = make_line(robot_pair(faults, point_duration_s=4.0)[0])
         project.attach_serial("fx3:1", line)
         project.run_programs(["UITAMR_ExampleFx3"], ms=2000)
         project.devices["X0"] = True
         project.run_programs(["UITAMR_ExampleFx3"], ms=500)
         project.devices["X0"] = False
         project.run_programs(["UITAMR_ExampleFx3"], ms=27_500)
+        line = getattr(line, "line", line)
+        clocks.append(line.now_us)
         results.append(observed(line, project.now_us))
-    lazy, eager = results
+    lazy, called, eager = results
     assert len([f for f in lazy[0] if f[2] == "rx"]) > 50
     assert any(kind == "robot.task" for _, kind, _ in lazy[1])
-    assert lazy == eager
+    assert lazy == called == eager
+    assert clocks[0] == clocks[1]  # the port's skipped calls moved the line's clock as a call would
+
+
+class CalledEveryScan:
+    """A Line behind an endpoint that promises no quiet time: the PLC's port calls
+    receive_until on every scan instead of skipping the calls on a quiet line."""
+
+    def __init__(self, robot):
+        self.line = Line(robot)
+
+    def send(self, data, t_us, origin=None):
+        return self.line.send(data, t_us, origin)
+
+    def receive_until(self, t_us):
+        return self.line.receive_until(t_us)

@@ -33,7 +33,9 @@ as far as a request needs: the robot never transmits on its own, so it catches u
 next request or :meth:`Line.advance`, through the same task and fault times. On a quiet
 line (no byte under way, no frame waiting for its t3.5, nothing due for the PLC before
 ``t_us``) ``receive_until`` only moves the line's clock. That keeps the PLC's per-scan
-poll cheap.
+poll cheap. Contract for callers (the simulated PLC's serial port uses it to skip the
+call on every scan): for ``now_us <= t_us < quiet_until_us`` (integer ``t_us``),
+``receive_until(t_us)`` returns no bytes and only sets ``now_us = t_us``.
 """
 from __future__ import annotations
 
@@ -144,7 +146,8 @@ class Line:
         self._tx_frames: list[_OpenFrame] = []
         self._rx_frames: list[TraceFrame] = []
         self._events: list[LineEvent] = []
-        self._quiet_until = 0  # before this time nothing can happen on the line
+        # before this time nothing can happen on the line (see the module docstring)
+        self.quiet_until_us: int | float = 0
         self._offsets = [0]  # offset_us(k), computed once per k
 
     # ---- the PLC's endpoint ----------------------------------------------------------------
@@ -166,13 +169,13 @@ class Line:
         self._trace_tx(send)
         for reply in self._replies_overlapping(send.start, send.end):
             self._collide(send, reply)
-        self._quiet_until = self._next_change_us()
+        self.quiet_until_us = self._next_change_us()
         return send.end
 
     def receive_until(self, t_us: int) -> list[tuple[int, int]]:
         """(byte value, arrival µs) of the robot's bytes that reached the PLC since the last
         call, up to ``t_us``. Bytes lost in a collision are not delivered."""
-        if self.now_us <= t_us < self._quiet_until and type(t_us) is int:
+        if self.now_us <= t_us < self.quiet_until_us and type(t_us) is int:
             self.now_us = t_us  # a quiet line: nothing to work out (see the module docstring)
             return []
         self._check_time(t_us, "receive_until")
@@ -182,7 +185,7 @@ class Line:
             byte = self._to_plc.popleft()
             if not byte.lost:
                 received.append((byte.value, byte.end))
-        self._quiet_until = self._next_change_us()
+        self.quiet_until_us = self._next_change_us()
         return received
 
     def advance(self, t_us: int) -> None:
@@ -206,7 +209,7 @@ class Line:
             if quiet_from <= t_us and (not queue or queue[0].start >= quiet_from):
                 self._complete_frame()
         self.now_us = t_us
-        self._quiet_until = self._next_change_us()
+        self.quiet_until_us = self._next_change_us()
 
     def _next_change_us(self) -> int | float:
         """The first time at which the line has something to work out: a PLC byte reaching

@@ -3,7 +3,8 @@
 A `SerialChannel` is one physical port of the simulated PLC ("fx3:1", "q:2", ...).  Bytes
 the PLC sends go to the attached endpoint (the ROBOT engineer's `verifier.link.Line`, or
 any object with the same master interface: `send(data, t_us, origin)` and
-`receive_until(t_us) -> [(byte, arrival_t_us), ...]`) and are logged with their times.
+`receive_until(t_us) -> [(byte, arrival_t_us), ...]`; optionally `now_us` and
+`quiet_until_us`, see `SerialChannel.attach`) and are logged with their times.
 With no endpoint attached the line is silent: what is sent is only logged.
 """
 from __future__ import annotations
@@ -52,6 +53,7 @@ class SerialChannel:
     def __init__(self, name: str):
         self.name = name
         self.endpoint = None
+        self.knows_quiet = False
         self.format = NINE_SIX_8N1
         self.sent: list[SentFrame] = []
         self.received: list[tuple[int, int]] = []  # every byte that reached the port
@@ -62,6 +64,10 @@ class SerialChannel:
                 raise TypeError(f"serial endpoint for {self.name} needs a {attr}() method "
                                 "(the verifier.link.Line master interface)")
         self.endpoint = endpoint
+        # an endpoint with `quiet_until_us` and `now_us` (verifier.link.Line) promises that
+        # receive_until(t) for now_us <= t < quiet_until_us only sets now_us = t: the port
+        # does that itself then, without the call on every scan
+        self.knows_quiet = hasattr(endpoint, "quiet_until_us") and hasattr(endpoint, "now_us")
 
     def transmit(self, data: bytes, t_us: int, origin: str | None) -> int:
         """Start sending `data` at t_us; returns the time the last stop bit is out."""
@@ -73,9 +79,13 @@ class SerialChannel:
         return end
 
     def receive_until(self, t_us: int) -> list[tuple[int, int]]:
-        if self.endpoint is None:
+        endpoint = self.endpoint
+        if endpoint is None:
             return ()
-        got = self.endpoint.receive_until(t_us)
+        if self.knows_quiet and endpoint.now_us <= t_us < endpoint.quiet_until_us:
+            endpoint.now_us = t_us  # all a call would do on a quiet line (Line.quiet_until_us)
+            return ()
+        got = endpoint.receive_until(t_us)
         if got:
             self.received.extend(got)
         return got
