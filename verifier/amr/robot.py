@@ -161,12 +161,16 @@ class Robot:
 
     @property
     def battery_low(self) -> bool:
+        if not self._conditions:  # no scripted fault active (the usual case): the charge alone
+            return self.battery_pct <= self.config.battery_low_pct
         forced = any(c.error == RobotError.BATTERY_LOW for c in self._conditions.values())
         return forced or self.battery_pct <= self.config.battery_low_pct
 
     @property
     def error(self) -> RobotError:
         """The error byte: the most urgent active error (01 before 02 before 03), or 00."""
+        if not self._conditions:  # no scripted fault active: only the charge can raise one
+            return RobotError.BATTERY_LOW if self.battery_pct <= self.config.battery_low_pct else RobotError.NONE
         active = {c.error for c in self._conditions.values()}
         if self.battery_low:
             active.add(RobotError.BATTERY_LOW)

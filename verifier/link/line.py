@@ -96,6 +96,9 @@ class LineConfig:
         return 1750 if self.baud > 19200 else round(3.5 * self.bits_per_char * 1_000_000 / self.baud)
 
 
+_NEVER = float("inf")
+
+
 @dataclass(slots=True)
 class _Byte:
     start: int
@@ -214,14 +217,14 @@ class Line:
     def _next_change_us(self) -> int | float:
         """The first time at which the line has something to work out: a PLC byte reaching
         the robot, an open frame's t3.5, a robot byte reaching the PLC (infinity: none)."""
-        times = []
+        first = _NEVER
         if self._plc_queue:
-            times.append(self._plc_queue[0].end)
-        if self._frame:
-            times.append(self._frame[-1].end + self._t35)
-        if self._to_plc:
-            times.append(self._to_plc[0].end)
-        return min(times) if times else float("inf")
+            first = self._plc_queue[0].end
+        if self._frame and self._frame[-1].end + self._t35 < first:
+            first = self._frame[-1].end + self._t35
+        if self._to_plc and self._to_plc[0].end < first:
+            first = self._to_plc[0].end
+        return first
 
     # ---- what happened ---------------------------------------------------------------------
 
@@ -266,7 +269,7 @@ class Line:
     def _complete_frame(self) -> None:
         frame, broken = self._frame, self._frame_broken
         self._frame, self._frame_broken = [], None
-        data = bytes(b.value for b in frame)
+        data = bytes([b.value for b in frame])
         end = frame[-1].end
         if broken is not None:
             self._event(end, "discarded", f"frame {hex_bytes(data)} discarded by the robot: {broken}",
