@@ -75,6 +75,8 @@ class Rs2Port:
         dev = rt.dev
         self.d = devices
         self._send_req = dev.address(devices.send_request)
+        # the send-request flag is read on every call: its cell list and index, held
+        self._send_req_cells, self._send_req_index = dev.areas[self._send_req.area], self._send_req.index
         self._recv_done = dev.address(devices.receive_complete)
         self._timeout_flag = dev.address(devices.timeout_flag)
         self._send_remaining = dev.address(devices.send_remaining)
@@ -133,7 +135,7 @@ class Rs2Port:
         rt = self.rt
         self.last_call_scan = rt.scan_count
         self.s_ref, self.m, self.n, self.d_ref = s_ref, m, n, d_ref
-        if self._get(self._send_req) and self.sending_until is None:
+        if self.sending_until is None and self._send_req_cells[self._send_req_index]:
             location = rt.locations[loc_id]
             self._check_format(location)
             if not 0 <= m <= 4096:
