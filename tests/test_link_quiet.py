@@ -21,8 +21,12 @@ PLC = Path(__file__).resolve().parents[1] / "plc"
 
 
 class EagerLine(Line):
-    """The line before the shortcut: every PLC call runs everything up to its time, and
-    the line never promises a quiet time (so the PLC's port calls it on every scan)."""
+    """The line before the shortcuts: every PLC call runs everything up to its time, the
+    line never promises a quiet time (so the PLC's port calls it on every scan) and it
+    keeps every transmission it ever had for its overlap tests."""
+
+    def _forget_past(self):
+        pass
 
     @property
     def quiet_until_us(self):
@@ -115,3 +119,45 @@ class CalledEveryScan:
 
     def receive_until(self, t_us):
         return self.line.receive_until(t_us)
+
+
+@hsettings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(requests, st.integers(0, 40_000), st.integers(1, 3)), min_size=2, max_size=30),
+       st.integers(1_000, 12_000))
+def test_crowded_sends_collide_the_same_on_a_line_that_forgets_the_past(script, poll_us):
+    """Sends crowded into the robot's replies (collisions, lost bytes, broken frames),
+    some as several back-to-back pieces: the line that lets old transmissions go gives
+    the same trace, events and bytes as the one that keeps them all."""
+    from verifier.protocol import encode
+    robots = robot_pair([])
+    lazy, eager = Line(robots[0]), EagerLine(robots[1])
+    t = 0
+    for request, gap, pieces in script:
+        frame = encode(replace(request, address=1))
+        t += gap
+        cut = len(frame) // pieces
+        for k in range(pieces):
+            piece = frame[k * cut:] if k == pieces - 1 else frame[k * cut:(k + 1) * cut]
+            assert lazy.send(piece, t) == eager.send(piece, t)
+        for _ in range(gap // poll_us):
+            t += poll_us
+            assert lazy.receive_until(t) == eager.receive_until(t)
+    assert observed(lazy, t + 3_000_000) == observed(eager, t + 3_000_000)
+
+
+def test_crowded_sends_do_collide():
+    """The crowded-send test above reaches collisions (a fixed example of its kind)."""
+    from verifier.protocol import StatusRequest, encode
+    robots = robot_pair([])
+    lines = [Line(robots[0]), EagerLine(robots[1])]
+    frame = encode(StatusRequest(1, 1))
+    for line in lines:
+        t = 0
+        for _ in range(40):
+            line.send(frame, t)
+            t += 12_000
+            line.receive_until(t)
+    results = [observed(line, t + 3_000_000) for line in lines]
+    assert any(kind == "collision" for _, kind, _ in results[0][1])
+    assert results[0] == results[1]
+    assert len(lines[0]._replies) < 5 < len(lines[1]._replies)  # the past was let go

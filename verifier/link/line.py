@@ -116,7 +116,8 @@ class _Transmission:
     data: bytes
     origin: str | None = None
     bytes_: list[_Byte] = field(default_factory=list)
-    collided_with: set[int] = field(default_factory=set)
+    # the replies it collided with, themselves (an id() could be reused once a reply is let go)
+    collided_with: list["_Transmission"] = field(default_factory=list)
 
 
 @dataclass
@@ -172,6 +173,7 @@ class Line:
         self._trace_tx(send)
         for reply in self._replies_overlapping(send.start, send.end):
             self._collide(send, reply)
+        self._forget_past()
         self.quiet_until_us = self._next_change_us()
         return send.end
 
@@ -322,10 +324,30 @@ class Line:
             if send.start < end:
                 yield send
 
+    def _forget_past(self) -> None:
+        """Let go of transmissions no future overlap test can reach (an hour of traffic
+        kept them all, with their bytes: hundreds of thousands of objects for Python's
+        garbage collector to walk again and again).  Every later test starts at or after
+        ``horizon`` (the line's clock, the bytes still to be heard or completed) and scans
+        back from the newest transmission, stopping at the first one that ended by its
+        start: keeping the newest one that ended by ``horizon`` and everything after it
+        leaves every answer the same."""
+        horizon = self.now_us
+        if self._plc_queue and self._plc_queue[0].start < horizon:
+            horizon = self._plc_queue[0].start
+        if self._frame and self._frame[0].start < horizon:
+            horizon = self._frame[0].start
+        for done in (self._replies, self._plc_sends):
+            k = len(done) - 1
+            while k > 0 and done[k].end > horizon:
+                k -= 1
+            if k > 0:
+                del done[:k]
+
     def _collide(self, send: _Transmission, reply: _Transmission) -> None:
-        if id(reply) in send.collided_with:
+        if any(seen is reply for seen in send.collided_with):
             return
-        send.collided_with.add(id(reply))
+        send.collided_with.append(reply)
         for byte in reply.bytes_:
             if byte.start < send.end and byte.end > send.start:
                 byte.lost = True
