@@ -108,6 +108,13 @@ def test_unusable_options_exit_2(tmp_path):
     assert done.returncode == 2 and "Traceback" not in done.stderr
 
 
+def test_a_scenario_given_as_source_is_pointed_to_scenario_option():
+    scenario = PLC / "scenarios" / "fx3u-healthy.toml"
+    done = _run_cli(scenario)
+    assert done.returncode == 2
+    assert f"{scenario} is a scenario, not ST source: give it as --scenario {scenario}" in done.stderr
+
+
 def test_the_bundled_scenarios_cover_every_fault_kind():
     from verifier.amr.faults import FAULT_KINDS
     from verifier.verify.scenario import load_scenario

@@ -144,6 +144,8 @@ def _source_files(sources) -> tuple[Path, ...]:
     """The .st files named on the command line: files, folders (recursively) or patterns."""
     found: list[Path] = []
     for name in sources:
+        if Path(name).suffix.lower() == ".toml":
+            raise UnusableInput(f"{name} is a scenario, not ST source: give it as --scenario {name}")
         try:
             found += expand(name, Path.cwd())
         except SourceError as exc:
