@@ -12,6 +12,8 @@ from lark import Lark, Token
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 from lark.lexer import PatternStr
 
+from verifier.st import diagnose
+
 #: how terminals that are not plain strings are named in messages
 _TERMINAL_WORDS = {
     "IDENT": "a name",
@@ -73,10 +75,17 @@ def _previous_token(parser: Lark, text: str, pos: int):
 def _token_text(tok) -> str:
     if tok.type == "$END":
         return "end of file"
-    value = str(tok.value)
-    if len(value) > 30:
-        value = value[:27] + "..."
-    return f"'{value}'"
+    return diagnose.word(tok)
+
+
+def _token_name(tok) -> str:
+    return "the end of the file" if tok.type == "$END" else diagnose.word(tok)
+
+
+def _token_place(tok) -> str:
+    if tok.type == "$END" or tok.line is None:
+        return ""
+    return f" at {tok.line}:{tok.column}"
 
 
 def _semicolon_fixes(exc: UnexpectedToken) -> bool:
@@ -132,6 +141,8 @@ def describe_syntax_error(exc: UnexpectedInput, text: str, parser: Lark) -> tupl
     nested = _nested_comment(text, _error_pos(exc, text))
     if nested is not None:
         return nested
+    if isinstance(exc, (UnexpectedToken, UnexpectedEOF)):
+        exc = diagnose.earlier_keyword_error(parser, text, _error_pos(exc, text)) or exc
     if isinstance(exc, UnexpectedCharacters):
         rest = text[exc.pos_in_stream: exc.pos_in_stream + 2]
         if rest == "(*" or rest == "/*":
@@ -148,6 +159,16 @@ def describe_syntax_error(exc: UnexpectedInput, text: str, parser: Lark) -> tupl
                     f"unexpected character {shown}: names are ASCII letters, digits and '_' "
                     "(docs/st-dialect.md §4); other characters belong in comments and strings")
         return exc.line, exc.column, f"unexpected character {shown}; GX Works ST does not use it here"
+
+    error_pos = _error_pos(exc, text)
+    if text[error_pos:error_pos + 2] in ("(*", "/*"):
+        closer = "*)" if text[error_pos] == "(" else "*/"
+        line, col = _line_col(text, error_pos)
+        return line, col, f"comment '{text[error_pos:error_pos + 2]}' is never closed; add '{closer}'"
+    accepted = (_accepted(exc) if isinstance(exc, UnexpectedToken) else set()) or set(exc.expected or ())
+    explained = diagnose.explain(parser, text, error_pos, accepted)
+    if explained is not None:
+        return explained
 
     if isinstance(exc, UnexpectedEOF):
         expected = _expected_list(parser, exc.expected)
@@ -172,7 +193,7 @@ def describe_syntax_error(exc: UnexpectedInput, text: str, parser: Lark) -> tupl
         what = "declaration" if in_decl else "statement"
         if prev is not None:
             return (prev.end_line, prev.end_column,
-                    f"expected ';' after {what} (before {_token_text(tok)})")
+                    f"expected ';' after {what} (before {_token_name(tok)}{_token_place(tok)})")
         return line, col, f"expected ';' after {what}"
     if tok.type == "$END":
         closers = sorted(n for n in expected if n.startswith("END_"))

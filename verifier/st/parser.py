@@ -28,12 +28,20 @@ class _ParseContext:
         self.target = "gxworks2"
         self.diagnostics: list[ast.Diagnostic] = []
         self.open_pous: list[ast.Pou] = []
+        self.lines: list[str] = []
 
-    def reset(self, file: str, target: str) -> None:
+    def reset(self, file: str, target: str, text: str = "") -> None:
         self.file = file
         self.target = target
+        self.lines = text.splitlines()
         self.diagnostics = []
         self.open_pous = []
+
+    def word_at(self, line: int, col: int) -> str:
+        """The keyword or name that starts at line:col of the text being parsed."""
+        if not 1 <= line <= len(self.lines):
+            return ""
+        return re.match(r"[A-Za-z_0-9]*", self.lines[line - 1][col - 1:]).group().upper()
 
     def error(self, line: int, col: int, message: str, severity: str = "error") -> None:
         self.diagnostics.append(ast.Diagnostic(self.file, line, col, severity, message))
@@ -141,8 +149,10 @@ class AstBuilder:
             if pou is not c[-1]:
                 after = c[next(i for i, x in enumerate(c) if x is pou) + 1]
                 first = after[0] if isinstance(after, list) else after
+                before = _ctx.word_at(first.span.line, first.span.col)
                 _ctx.error(first.span.line, first.span.col,
-                           f"expected END_{pou.kind} to close {pou.kind} {pou.name} before this")
+                           f"{pou.kind} {pou.name} opened at {pou.span.line}:{pou.span.col} is not closed: "
+                           f"expected END_{pou.kind} before {before or 'the next declaration'}")
         for item in c:
             if isinstance(item, ast.Pou):
                 source.pous.append(item)
@@ -480,7 +490,7 @@ def get_parser() -> Lark:
 def parse(text: str, filename: str = "<string>", target: str = "gxworks2") -> ast.SourceFile:
     """Parse ST `text`; never raises for bad input (errors are in `.diagnostics`)."""
     parser = get_parser()
-    _ctx.reset(filename, target)
+    _ctx.reset(filename, target, text)
     try:
         source = parser.parse(text)
     except (UnexpectedCharacters, UnexpectedToken, UnexpectedEOF) as exc:
