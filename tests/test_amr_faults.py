@@ -322,4 +322,4 @@ def test_a_scenario_with_a_wrong_address_fault_on_the_robots_own_address_names_t
             'on_request = 1\naddress = 4\n')
     with pytest.raises(ScenarioError) as caught:
         parse_scenario(text)
-    assert str(caught.value).startswith("scenario:9: faults[0].address: 4 is the robot's own address")
+    assert str(caught.value).startswith("scenario:9:11: faults[0].address: 4 is the robot's own address")

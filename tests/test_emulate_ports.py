@@ -318,8 +318,8 @@ def run_cli(*args: str) -> subprocess.CompletedProcess:
 
 @pytest.mark.parametrize("text, message", [
     ('[[faults]]\nkind = "no_reply"\non_request = 1\n\n[[faults]]\nkind = "x"\nat_s = 1\n',
-     "6: faults[1].kind: unknown fault 'x'; expected one of anti_collision"),
-    ('[robot]\npacing = "sometimes"\n', "2: robot.pacing: unknown pacing policy 'sometimes'"),
+     "6:8: faults[1].kind: unknown fault 'x'; expected one of anti_collision"),
+    ('[robot]\npacing = "sometimes"\n', "2:10: robot.pacing: unknown pacing policy 'sometimes'"),
 ])
 def test_bad_fault_file_names_file_and_key(tmp_path, text, message):
     path = tmp_path / "faults.toml"
@@ -335,7 +335,7 @@ def test_a_wrong_address_fault_on_the_robots_own_address_is_refused(tmp_path):
     path.write_text('[[faults]]\nkind = "wrong_address"\non_request = 1\naddress = 5\n')
     result = run_cli("--tcp", "0", "--address", "5", "--faults", str(path))
     assert result.returncode == 2
-    assert f"{path}:4: faults[0].address: 5 is the robot's own address" in result.stderr
+    assert f"{path}:4:11: faults[0].address: 5 is the robot's own address" in result.stderr
     assert "Traceback" not in result.stderr
 
 

@@ -103,16 +103,16 @@ def test_fault_file_with_robot_table(tmp_path):
 
 
 @pytest.mark.parametrize("text, where", [
-    ("[[faults]\n", ":1: not valid TOML"),
-    ("[scenario]\nname = 'x'\n", ":1: scenario: unknown key; expected one of robot, faults"),
-    ("robot = 3\n", ":1: robot: expected a table"),
-    ("[[faults]]\nkind = 'late_reply'\non_request = 2\n", ":1: faults[0].delay_ms: missing"),
+    ("[[faults]\n", ":1:9: not valid TOML"),
+    ("[scenario]\nname = 'x'\n", ":1:1: scenario: unknown key; expected one of robot, faults"),
+    ("robot = 3\n", ":1:9: robot: expected a table"),
+    ("[[faults]]\nkind = 'late_reply'\non_request = 2\n", ":1:1: faults[0].delay_ms: missing"),
     ('[[faults]]\nkind = "no_reply"\non_request = 1\n\n[[faults]]\nkind = "x"\nat_s = 1\n',
-     ":6: faults[1].kind: unknown fault 'x'"),
-    ("# bench\n[robot]\nturnaround_ms = 8\npacing = 'sometimes'\n", ":4: robot.pacing: unknown pacing policy"),
+     ":6:8: faults[1].kind: unknown fault 'x'"),
+    ("# bench\n[robot]\nturnaround_ms = 8\npacing = 'sometimes'\n", ":4:10: robot.pacing: unknown pacing policy"),
     ("[[faults]]\nkind = 'late_reply'\non_request = 2\n\n[[faults]]\nkind = 'late_reply'\n"
-     "on_request = 3\ndelay_ms = 5\n", ":1: faults[0].delay_ms: missing"),
-    ("[[faults]]\nkind = 'no_reply'\non_request = 1\n[[faults]\n", ":4: not valid TOML: "),
+     "on_request = 3\ndelay_ms = 5\n", ":1:1: faults[0].delay_ms: missing"),
+    ("[[faults]]\nkind = 'no_reply'\non_request = 1\n[[faults]\n", ":4:9: not valid TOML: "),
 ])
 def test_bad_fault_files_name_the_file_the_line_and_the_key(tmp_path, text, where):
     path = tmp_path / "bad.toml"
@@ -127,7 +127,7 @@ def test_fault_file_refuses_a_wrong_address_fault_with_the_robots_own_address(tm
     path.write_text("[[faults]]\nkind = 'wrong_address'\non_request = 1\naddress = 3\n")
     with pytest.raises(FaultFileError) as caught:
         load_fault_file(path, own_address=3)
-    assert str(caught.value).startswith(f"{path}:4: faults[0].address: 3 is the robot's own address")
+    assert str(caught.value).startswith(f"{path}:4:11: faults[0].address: 3 is the robot's own address")
     assert load_fault_file(path, own_address=1).faults[0].address == 3
 
 

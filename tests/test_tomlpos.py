@@ -5,7 +5,7 @@ import tomllib
 
 import pytest
 
-from verifier.tomlpos import decode_error_position, line_of_key
+from verifier.tomlpos import Place, decode_error_position, line_of_key, place_of_key
 
 TEXT = """\
 name = "bench"
@@ -57,12 +57,12 @@ def test_a_missing_key_never_points_into_a_later_table():
     assert line_of_key(lines, "faults[1].delay_ms") == 6
 
 
-def test_decode_error_position_moves_the_line_out_of_the_message():
+def test_decode_error_position_moves_line_and_column_out_of_the_message():
     with pytest.raises(tomllib.TOMLDecodeError) as caught:
         tomllib.loads('a = 1\n[[faults]\nkind = "x"\n')
-    message, line = decode_error_position(caught.value)
-    assert line == 2
-    assert message == "Expected ']]' at the end of an array declaration (column 9)"
+    message, place = decode_error_position(caught.value)
+    assert (place.line, place.col) == (2, 9) and str(place) == "2:9"
+    assert message == "Expected ']]' at the end of an array declaration"
 
 
 def test_keys_in_inline_tables_point_at_the_line_that_holds_them():
@@ -71,3 +71,17 @@ def test_keys_in_inline_tables_point_at_the_line_that_holds_them():
     assert line_of_key(lines, "faults[1].kind") == 2
     assert line_of_key(lines, "robot.pacing") == 4
     assert line_of_key(lines, "nosuch.key") is None
+
+
+def test_places_point_at_the_value_the_item_or_the_key():
+    lines = ['name = "x"', 'watch = ["a", "b.c", [1, 2], { x = 1 }]', "", "[robot]", "  pacing = 'sometimes'",
+             "[[inputs]]", 'at = "1s"', "set = { X0 = true, D100 = 5 }"]
+    assert str(place_of_key(lines, "name")) == "1:8"
+    assert str(place_of_key(lines, "watch")) == "2:9"
+    assert [str(place_of_key(lines, f"watch[{i}]")) for i in range(4)] == ["2:10", "2:15", "2:22", "2:30"]
+    assert place_of_key(lines, "watch[9]") == Place(2, 9)  # no such item: the array
+    assert str(place_of_key(lines, "robot.pacing")) == "5:12"
+    assert str(place_of_key(lines, "robot.pacing", at_name=True)) == "5:3"
+    assert str(place_of_key(lines, "inputs[0].set.D100")) == "8:27"
+    assert str(place_of_key(lines, "robot")) == "4:1"
+    assert place_of_key(lines, "nowhere.at.all") is None

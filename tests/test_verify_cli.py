@@ -73,7 +73,7 @@ def test_bad_scenario_exits_2_with_file_line_and_key(tmp_path):
     scenario.write_text('program = "UITAMR_ExampleFx3"\n[[expect]]\nthat = "o_bOK"\nwithin = "5"\n')
     done = _run_cli("--scenario", scenario)
     assert done.returncode == 2
-    assert f"{scenario}:4: expect[0].within" in done.stderr
+    assert f"{scenario}:4:10: expect[0].within" in done.stderr
     assert "Traceback" not in done.stderr + done.stdout
 
 

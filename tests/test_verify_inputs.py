@@ -63,7 +63,7 @@ def test_sources_that_name_nothing_are_errors_at_their_line(tmp_path, entry, wor
     scenario.write_text(f'name = "x"\n\nsources = ["{entry}"]\n', encoding="utf-8")
     with pytest.raises(ScenarioError) as info:
         load_scenario(scenario)
-    assert str(info.value).startswith(f"{scenario}:3: sources[0]: ") and words in str(info.value)
+    assert str(info.value).startswith(f"{scenario}:3:12: sources[0]: ") and words in str(info.value)
 
 
 def test_the_command_line_takes_folders(tmp_path, program):
@@ -103,12 +103,12 @@ def _run_scenario(tmp_path, program, body: str):
 
 
 @pytest.mark.parametrize("body, line, key, message", [
-    ('\n[[expect]]\nthat = "nosuch.label"\n', 5, "expect[0].that", "the program Main has no label 'nosuch.label'"),
-    ('\n[[expect]]\nthat = "b"\n[[expect]]\nnever = "tmr.QQ"\n', 7, "expect[1].never",
+    ('\n[[expect]]\nthat = "nosuch.label"\n', "5:8", "expect[0].that", "the program Main has no label 'nosuch.label'"),
+    ('\n[[expect]]\nthat = "b"\n[[expect]]\nnever = "tmr.QQ"\n', "7:9", "expect[1].never",
      "no label 'tmr.QQ' in the program Main: tmr has no member 'QQ'"),
-    ('watch = ["w", "arr[7]"]\n', 3, "watch[1]", "no label 'arr[7]' in the program Main: arr has no element [7]"),
-    ('[[inputs]]\nat = "0s"\nset = { nosuch = true }\n', 5, "inputs[0].set", "the program Main has no label 'nosuch'"),
-    ('[response_handling]\nsignal = "bErr"\n', 4, "response_handling.signal", "the program Main has no label 'bErr'"),
+    ('watch = ["w", "arr[7]"]\n', "3:15", "watch[1]", "no label 'arr[7]' in the program Main: arr has no element [7]"),
+    ('[[inputs]]\nat = "0s"\nset = { nosuch = true }\n', "5:7", "inputs[0].set", "the program Main has no label 'nosuch'"),
+    ('[response_handling]\nsignal = "bErr"\n', "4:10", "response_handling.signal", "the program Main has no label 'bErr'"),
 ])
 def test_unknown_labels_name_file_line_and_key_once(tmp_path, program, body, line, key, message):
     result, scenario = _run_scenario(tmp_path, program, body)
@@ -134,7 +134,8 @@ def test_labels_of_the_wrong_type_are_refused(tmp_path, program, body, words):
     result, scenario = _run_scenario(tmp_path, program, body)
     assert result.exit_code == 2, result.output
     line = 4 if body.startswith("[[expect]]") else 5  # the line of `that`/`set`
-    assert f"{scenario}:{line}: " in result.output and words in result.output
+    col = body.splitlines()[-1].index("= ") + 3  # its value
+    assert f"{scenario}:{line}:{col}: " in result.output and words in result.output
 
 
 def test_values_that_fit_are_accepted(tmp_path, program):
@@ -154,7 +155,7 @@ def test_run_and_scan_times_must_make_sense(tmp_path, program):
     assert result.exit_code == 2 and "longer than the limit of 24h" in result.output
     scenario = tmp_path / "s.toml"
     scenario.write_text('duration = "25h"\n', encoding="utf-8")
-    with pytest.raises(ScenarioError, match=r"s.toml:1: duration: longer than the limit of 24h"):
+    with pytest.raises(ScenarioError, match=r"s.toml:1:12: duration: longer than the limit of 24h"):
         load_scenario(scenario)
 
 
@@ -216,11 +217,11 @@ def test_plc_settings_mistakes_name_their_key(tmp_path, body, key, words):
 def test_c24_settings_need_the_q_platform(tmp_path, program):
     scenario = tmp_path / "s.toml"
     scenario.write_text('platform = "fx3u"\n\n[[c24]]\nno_reception = "5ms"\n', encoding="utf-8")
-    with pytest.raises(ScenarioError, match=r":3: c24\[0\]: the QJ71C24N is a Q-series module"):
+    with pytest.raises(ScenarioError, match=r":3:1: c24\[0\]: the QJ71C24N is a Q-series module"):
         load_scenario(scenario)
     scenario.write_text('platform = "q"\nduration = "1s"\n\n[initial]\nD99999 = 1\n', encoding="utf-8")
     result = invoke(program, "--scenario", scenario)  # the q has no D99999: found on the loaded CPU
-    assert result.exit_code == 2 and f"{scenario}:5: initial.D99999: 'D99999': D ends at" in result.output
+    assert result.exit_code == 2 and f"{scenario}:5:10: initial.D99999: 'D99999': D ends at" in result.output
 
 
 def test_the_bundled_q_exception_scenario_needs_the_no_reception_time():

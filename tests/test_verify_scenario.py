@@ -148,20 +148,20 @@ def test_toml_syntax_errors_give_the_line(tmp_path):
     path.write_text('name = "x"\nprogram "Main"\n')
     with pytest.raises(ScenarioError) as info:
         load_scenario(path)
-    assert info.value.line == 2
-    assert str(info.value).startswith(f"{path}:2: not valid TOML")
+    assert (info.value.line, info.value.col) == (2, 9)
+    assert str(info.value).startswith(f"{path}:2:9: not valid TOML")
 
 
 def test_unknown_keys_are_errors_with_their_line():
     error = error_of('program = "Main"\n\n[[expect]]\nthat = "a"\nwithn = "5s"\n', Path("s.toml"))
-    assert error.key == "expect[0].withn" and error.line == 5
-    assert str(error).startswith("s.toml:5: expect[0].withn: unknown key")
+    assert error.key == "expect[0].withn" and (error.line, error.col) == (5, 1)
+    assert str(error).startswith("s.toml:5:1: expect[0].withn: unknown key")
 
 
 def test_the_nth_table_of_an_array_is_found():
     text = 'program = "M"\n[[expect]]\nthat = "a"\nwithin = "1s"\n[[expect]]\nthat = "b"\nwithin = "5"\n'
     error = error_of(text)
-    assert error.key == "expect[1].within" and error.line == 7 and "not a duration" in error.message
+    assert error.key == "expect[1].within" and (error.line, error.col) == (7, 10) and "not a duration" in error.message
 
 
 @pytest.mark.parametrize("text, key, words", [
@@ -191,11 +191,14 @@ def test_the_nth_table_of_an_array_is_found():
     ('bogus = 1', "bogus", "unknown key"),
 ])
 def test_every_mistake_names_its_key(text, key, words):
-    error = error_of('program = "Main"\n' + text + "\n", Path("x.toml"))
+    source = 'program = "Main"\n' + text + "\n"
+    error = error_of(source, Path("x.toml"))
     assert error.key == key
     assert words in error.message
     assert error.line is not None and 2 <= error.line <= 2 + text.count("\n")
-    assert str(error).startswith(f"x.toml:{error.line}: {key}: ")
+    line = source.splitlines()[error.line - 1]
+    assert error.col is not None and 1 <= error.col <= len(line), "the column is on the line"
+    assert str(error).startswith(f"x.toml:{error.line}:{error.col}: {key}: ")
 
 
 def test_a_missing_scenario_file(tmp_path):

@@ -9,6 +9,18 @@ from __future__ import annotations
 
 import re
 import tomllib
+from dataclasses import dataclass
+
+@dataclass(frozen=True)
+class Place:
+    """A line and column (both 1-based) in a TOML file; prints as `line:col`."""
+
+    line: int
+    col: int
+
+    def __str__(self) -> str:
+        return f"{self.line}:{self.col}"
+
 
 _KEY_PART = re.compile(r"[^.\[\]]+|\[\d+\]")
 _DECODE_POSITION = re.compile(r"\s*\(at line (\d+), column (\d+)\)")
@@ -56,13 +68,80 @@ def line_of_key(lines: list[str], key: str) -> int | None:
     return start + 1
 
 
-def decode_error_position(error: tomllib.TOMLDecodeError) -> tuple[str, int | None]:
-    """A TOML syntax error as (message with its column, line): tomllib writes the place as
-    "(at line L, column C)" at the end of its message; callers put the line after the file
+def decode_error_position(error: tomllib.TOMLDecodeError) -> tuple[str, Place | None]:
+    """A TOML syntax error as (message, place): tomllib writes the place as
+    "(at line L, column C)" at the end of its message; callers put it after the file
     name like every other error."""
     text = str(error)
     match = _DECODE_POSITION.search(text)
     if match is None:
         return text, None
-    message = _DECODE_POSITION.sub("", text) + f" (column {match.group(2)})"
-    return message, int(match.group(1))
+    return _DECODE_POSITION.sub("", text), Place(int(match.group(1)), int(match.group(2)))
+
+
+def place_of_key(lines: list[str], key: str, at_name: bool = False) -> Place | None:
+    """Best effort: line and column of what sets ``key``: the value after ``name =`` (the
+    name itself with `at_name`, for a key that should not be there), the n-th item of an
+    inline array for ``watch[2]``, the key inside an inline table, or the table's header;
+    None when the line cannot be found."""
+    line = line_of_key(lines, key)
+    if line is None:
+        return None
+    text = lines[line - 1]
+    parts = _KEY_PART.findall(key)
+    index = None
+    if parts and parts[-1].startswith("["):
+        index = int(parts[-1][1:-1])
+        parts = parts[:-1]
+    name = parts[-1] if parts else ""
+    match = re.search(r"(?:^|[{,])\s*(\"?" + re.escape(name) + r"\"?)\s*=\s*", text) if name else None
+    if match is None:
+        return Place(line, len(text) - len(text.lstrip()) + 1)
+    if at_name:
+        return Place(line, match.start(1) + 1)
+    col = match.end()
+    if index is not None and col < len(text) and text[col] == "[":
+        item = _array_item(text, col, index)
+        if item is not None:
+            col = item
+    return Place(line, col + 1)
+
+
+def _array_item(text: str, start: int, index: int) -> int | None:
+    """Offset of the index-th item of the inline array opening at text[start] ('[')."""
+    depth, count, quote = 0, 0, ""
+    i = start
+    expecting = True
+    while i < len(text):
+        ch = text[i]
+        if quote:
+            if ch == "\\" and quote == '"':
+                i += 1
+            elif ch == quote:
+                quote = ""
+        elif ch in "\"'":
+            if depth == 1 and expecting:
+                if count == index:
+                    return i
+                count, expecting = count + 1, False
+            quote = ch
+        elif ch in "[{":
+            if depth == 1 and expecting:
+                if count == index:
+                    return i
+                count, expecting = count + 1, False
+            depth += 1
+        elif ch in "]}":
+            depth -= 1
+            if depth == 0:
+                return None
+        elif ch == "," and depth == 1:
+            expecting = True
+        elif ch == "#":
+            return None
+        elif not ch.isspace() and depth == 1 and expecting:
+            if count == index:
+                return i
+            count, expecting = count + 1, False
+        i += 1
+    return None

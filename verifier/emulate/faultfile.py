@@ -20,7 +20,7 @@ from typing import Any
 
 from verifier.amr import ConfigError, Fault, RobotConfig, check_fault_addresses, faults_from_list
 from verifier.amr.schema import reject_unknown_keys
-from verifier.tomlpos import decode_error_position, line_of_key
+from verifier.tomlpos import Place, decode_error_position, place_of_key
 
 FILE_KEYS = ("robot", "faults")
 
@@ -37,7 +37,7 @@ class FaultFile:
 
 def load_fault_file(path: str | Path, own_address: int | None = None) -> FaultFile:
     """Read and check a fault file. Every error names the file, the line and the key
-    (``bench.toml:7: faults[1].kind: unknown fault 'x'; …``), as a scenario's do.
+    (``bench.toml:7:9: faults[1].kind: unknown fault 'x'; …``), as a scenario's do.
 
     ``own_address`` is the robot's address, when known: a ``wrong_address`` fault may not
     use it. The ``[robot]`` table is checked here, key by key, and returned as a table so
@@ -65,10 +65,10 @@ def load_fault_file(path: str | Path, own_address: int | None = None) -> FaultFi
         if own_address is not None:
             check_fault_addresses(faults, own_address)
     except ConfigError as err:
-        line = line_of_key(text.splitlines(), err.path)
-        raise FaultFileError(f"{_where(path, line)}: {err}") from None
+        place = place_of_key(text.splitlines(), err.path)
+        raise FaultFileError(f"{_where(path, place)}: {err}") from None
     return FaultFile(robot, faults)
 
 
-def _where(path: Path, line: int | None) -> str:
-    return f"{path}:{line}" if line is not None else str(path)
+def _where(path: Path, place: Place | None) -> str:
+    return f"{path}:{place}" if place is not None else str(path)

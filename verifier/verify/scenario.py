@@ -16,7 +16,7 @@ from verifier import protocol
 from verifier.amr.config import RobotConfig
 from verifier.amr.faults import Fault, check_fault_addresses
 from verifier.amr.schema import ConfigError
-from verifier.tomlpos import decode_error_position, line_of_key
+from verifier.tomlpos import Place, decode_error_position, place_of_key
 
 from .conditions import Condition, ConditionError, parse_condition
 from .durations import format_duration, parse_duration_us
@@ -62,13 +62,15 @@ Value = bool | int | float
 
 
 class ScenarioError(Exception):
-    """A scenario that cannot be used, with where: `file:line: key: message`."""
+    """A scenario that cannot be used, with where: `file:line:col: key: message`."""
 
-    def __init__(self, file: Path | str | None, key: str, message: str, line: int | None = None):
-        self.file, self.key, self.message, self.line = file, key, message, line
+    def __init__(self, file: Path | str | None, key: str, message: str, place: Place | None = None):
+        self.file, self.key, self.message = file, key, message
+        self.line = place.line if place is not None else None
+        self.col = place.col if place is not None else None
         where = str(file) if file is not None else "scenario"
-        if line is not None:
-            where += f":{line}"
+        if place is not None:
+            where += f":{place}"
         super().__init__(f"{where}: {key + ': ' if key else ''}{message}")
 
 
@@ -100,7 +102,7 @@ class LabelUse:
     or one of the wrong type, is reported at that key and its line."""
 
     key: str  # "expect[0].that", "inputs[1].set", "watch[2]", "response_handling.signal"
-    line: int | None
+    line: Place | None  # where the key stands in the file
     names: tuple[str, ...]
     condition: Condition | None = None
     values: dict[str, Value] | None = None  # what an input writes
@@ -128,7 +130,7 @@ class Scenario:
     expectations: tuple[Expectation, ...] = ()
     options: RuleOptions = field(default_factory=RuleOptions)
     response_signal_given: bool = False
-    key_lines: dict[str, int | None] = field(default_factory=dict, compare=False)
+    key_lines: dict[str, Place | None] = field(default_factory=dict, compare=False)
     initial: tuple[tuple[str, Value], ...] = ()  # devices and buffer memory before the first scan
     c24: tuple[C24Setting, ...] = ()
     notes: tuple[str, ...] = ()  # for the reports: how this run differs from its file
@@ -175,8 +177,8 @@ class Scenario:
                                  optional=not self.response_signal_given))
         return uses
 
-    def where(self, key: str = "", line: int | None = None) -> str:
-        """`file:line: key` (as much of it as is known) for messages about this scenario."""
+    def where(self, key: str = "", line: Place | None = None) -> str:
+        """`file:line:col: key` (as much of it as is known) for messages about this scenario."""
         text = str(self.path) if self.path is not None else f"scenario {self.name!r}"
         if line is not None:
             text += f":{line}"
@@ -232,8 +234,8 @@ def parse_scenario(text: str, path: Path | None = None) -> Scenario:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        message, line = decode_error_position(exc)
-        raise ScenarioError(path, "", f"not valid TOML: {message}", line) from None
+        message, place = decode_error_position(exc)
+        raise ScenarioError(path, "", f"not valid TOML: {message}", place) from None
     return _Reader(text, path).read(data)
 
 
@@ -247,12 +249,22 @@ class _Reader:
 
     # --- errors --------------------------------------------------------------------------
 
-    def fail(self, key: str, message: str) -> ScenarioError:
-        return ScenarioError(self.path, key, message, self.line_of(key))
+    def fail(self, key: str, message: str, offset: int = 0, at_name: bool = False) -> ScenarioError:
+        """The error at `key`'s value (at the key itself with `at_name`); `offset` moves the
+        column into a string value (a condition's own column, 1-based, past the quote)."""
+        place = place_of_key(self.lines, key, at_name)
+        if place is not None and offset:
+            place = Place(place.line, place.col + offset)
+        return ScenarioError(self.path, key, message, place)
 
-    def line_of(self, key: str) -> int | None:
-        """Best effort: the line that sets `key` (e.g. "expect[1].within", "robot.x")."""
-        return line_of_key(self.lines, key)
+    def line_of(self, key: str) -> Place | None:
+        """Best effort: line and column of what sets `key` (e.g. "expect[1].within", "robot.x")."""
+        return place_of_key(self.lines, key)
+
+    def _quoted(self, key: str) -> bool:
+        """True when `key`'s value is a one-line string starting at its column."""
+        place = self.line_of(key)
+        return place is not None and self.lines[place.line - 1][place.col - 1:place.col] in ("'", '"')
 
     # --- helpers -------------------------------------------------------------------------
 
@@ -270,7 +282,7 @@ class _Reader:
         for name in data:
             if name not in allowed:
                 where = f"{key}.{name}" if key else name
-                raise self.fail(where, f"unknown key; expected one of {', '.join(allowed)}")
+                raise self.fail(where, f"unknown key; expected one of {', '.join(allowed)}", at_name=True)
 
     def string(self, value: Any, key: str) -> str:
         if not isinstance(value, str):
@@ -291,7 +303,8 @@ class _Reader:
         try:
             return parse_condition(text)
         except ConditionError as exc:
-            raise self.fail(key, f"{exc.message} at column {exc.column} of {text!r}") from None
+            raise self.fail(key, f"{exc.message} at column {exc.column} of {text!r}",
+                            offset=exc.column if self._quoted(key) else 0) from None
 
     def label(self, value: Any, key: str) -> str:
         text = self.string(value, key)
