@@ -1,18 +1,23 @@
 """`uitamr check SOURCES...`: parse and type-check GX Works structured text.
 
 Prints each finding as `file:line:col: error|warning: message`, the source line and a
-caret under the column. Exit status: 1 if any error, 0 otherwise (warnings allowed),
-2 for usage errors (missing file, not a regular file, bad option). Every file is read and checked even when
+caret under the column (`--format text`, the default: VS Code's and most editors'
+problem matchers read it). `--format json`, `github` (GitHub Actions annotations) and
+`sarif` (SARIF 2.1.0 for code scanning) are for CI (docs/ci.md). Scenario files
+(`.toml`) given among the sources are checked as `uitamr verify` would read them.
+Exit status: 1 if any error, 0 otherwise (warnings allowed), 2 for usage errors
+(missing file, not a regular file, bad option). Every file is read and checked even when
 another one is broken; POUs may use POUs from the other files given.
 """
 from __future__ import annotations
 
-import json
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import click
 
+from verifier.commands.check_formats import Finding, to_github, to_json, to_sarif
 from verifier.st import TARGETS
 from verifier.st.ast import Diagnostic, SourceFile
 
@@ -44,22 +49,41 @@ def _not_a_source(path: Path) -> str | None:
     return problems[0].message if problems else None
 
 
-def check_paths(paths: list[Path], target: str) -> tuple[list[SourceFile], list[Diagnostic]]:
-    """Parse every file and check them together; all diagnostics, parse ones included."""
+def check_findings(paths: list[Path], target: str) -> tuple[list[SourceFile], list[Finding]]:
+    """Every finding about `paths` (ST files and scenario .toml files), in file order, each
+    under the rule it comes from (see check_formats)."""
     from verifier.st import check, parse, read_source
 
     files: list[SourceFile] = []
-    diagnostics: list[Diagnostic] = []
+    findings: list[Finding] = []
     for p in paths:
+        if p.suffix.lower() == ".toml":
+            findings += [Finding(d, "UITAMR-SCENARIO") for d in check_scenario(p)]
+            continue
         text, problems = read_source(p)
-        diagnostics += problems
+        findings += [Finding(d, "UITAMR-ST-SOURCE") for d in problems]
         if not problems:  # an unreadable file is reported once, not also as empty
             files.append(parse(text, str(p), target))
-    diagnostics += [d for f in files for d in f.diagnostics]
-    diagnostics += check(files, target)
+    findings += [Finding(d, "UITAMR-ST-SYNTAX") for f in files for d in f.diagnostics]
+    findings += [Finding(d, "UITAMR-ST-CHECK" if d.is_error else "UITAMR-ST-WARNING")
+                 for d in check(files, target)]
     order = {str(p): i for i, p in enumerate(paths)}
-    diagnostics.sort(key=lambda d: (order.get(d.file, len(order)), d.line, d.col))
-    return files, diagnostics
+    findings.sort(key=lambda f: (order.get(f.diagnostic.file, len(order)), f.diagnostic.line, f.diagnostic.col))
+    return files, findings
+
+
+def check_scenario(path: Path) -> list[Diagnostic]:
+    """A scenario file read as `uitamr verify` reads it: its TOML, keys, values and the
+    sources it names (not the labels it uses: those need the program loaded, which
+    `uitamr verify` does)."""
+    from verifier.verify.scenario import ScenarioError, load_scenario
+
+    try:
+        load_scenario(path)
+    except ScenarioError as exc:
+        message = f"{exc.key}: {exc.message}" if exc.key else exc.message
+        return [Diagnostic(str(path), exc.line or 0, exc.col or 0, "error", message)]
+    return []
 
 
 def render(diag: Diagnostic, lines: list[str] | None) -> str:
@@ -78,10 +102,13 @@ def render(diag: Diagnostic, lines: list[str] | None) -> str:
 @click.argument("sources", nargs=-1, required=True, type=click.Path())
 @click.option("--target", type=click.Choice(TARGETS), default="gxworks2", show_default=True,
               help="Which engineering tool's dialect to accept.")
-@click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
-              show_default=True, help="Human text, or JSON for CI tools.")
+@click.option("--format", "fmt", type=click.Choice(["text", "json", "github", "sarif"]), default="text",
+              show_default=True,
+              help="text: file:line:col: error: message (editors); json; github: GitHub Actions "
+                   "annotations; sarif: SARIF 2.1.0 for code scanning (docs/ci.md).")
 def command(sources: tuple[str, ...], target: str, fmt: str) -> None:
-    """Parse and type-check GX Works structured text (files or directories of .st)."""
+    """Parse and type-check GX Works structured text (files or directories of .st), and
+    scenario files (.toml) as `uitamr verify` reads them."""
     paths = expand_sources(sources)
     unusable = [(p, _not_a_source(p)) for p in paths]
     unusable = [(p, why) for p, why in unusable if why]
@@ -92,24 +119,34 @@ def command(sources: tuple[str, ...], target: str, fmt: str) -> None:
     if not paths:
         click.echo("uitamr check: no .st files found in the given directories", err=True)
         sys.exit(EXIT_USAGE)
-    files, diagnostics = check_paths(paths, target)
+    files, findings = check_findings(paths, target)
+    diagnostics = [f.diagnostic for f in findings]
     errors = sum(d.is_error for d in diagnostics)
     warnings = len(diagnostics) - errors
     if fmt == "json":
-        click.echo(json.dumps({
-            "target": target,
-            "files": [str(p) for p in paths],
-            "errors": errors,
-            "warnings": warnings,
-            "diagnostics": [
-                {"file": d.file, "line": d.line, "col": d.col, "end_line": d.end_line,
-                 "end_col": d.end_col, "severity": d.severity, "message": d.message}
-                for d in diagnostics
-            ],
-        }, indent=2))
+        click.echo(to_json(findings, target, [str(p) for p in paths]))
+    elif fmt == "github":
+        annotations = to_github(findings)
+        if annotations:
+            click.echo(annotations)
+        click.echo(f"{len(paths)} file(s) checked for {target}: {errors} error(s), {warnings} warning(s)")
+    elif fmt == "sarif":
+        from verifier import __version__
+
+        click.echo(to_sarif(findings, __version__))
     else:
         texts = {f.filename: f.text.splitlines() for f in files}
+        for p in paths:
+            if p.suffix.lower() == ".toml" and str(p) not in texts:
+                texts[str(p)] = _lines_of(p)
         for d in diagnostics:
             click.echo(render(d, texts.get(d.file)))
         click.echo(f"{len(paths)} file(s) checked for {target}: {errors} error(s), {warnings} warning(s)")
     sys.exit(EXIT_ERRORS if errors else EXIT_OK)
+
+
+def _lines_of(path: Path) -> list[str] | None:
+    try:
+        return path.read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError):
+        return None

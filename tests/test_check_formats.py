@@ -1,0 +1,130 @@
+"""`uitamr check --format json|github|sarif` and scenario files given to `uitamr check`."""
+from __future__ import annotations
+
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from st_helpers import CORPUS, ROOT
+from verifier.cli import main
+from verifier.commands.check_formats import RULES
+
+BAD = CORPUS / "invalid" / "int_from_word.st"
+WARN = CORPUS / "invalid" / "unused_warning.st"
+BROKEN = CORPUS / "broken" / "if_else_not_closed.st"
+
+
+def run(*args, cwd: Path | None = None):
+    return subprocess.run([sys.executable, "-m", "verifier.cli", "check", *map(str, args)],
+                          capture_output=True, text=True, timeout=120, cwd=cwd)
+
+
+def test_text_stays_the_editor_format():
+    done = run(BROKEN)
+    assert done.returncode == 1
+    assert done.stdout.splitlines()[0] == (
+        f"{BROKEN}:12:1: error: IF opened at 7:1 is not closed: expected END_IF before END_FUNCTION_BLOCK")
+
+
+def test_github_annotations_name_file_line_column_and_rule():
+    done = run("--format", "github", BROKEN.relative_to(ROOT), BAD.relative_to(ROOT), WARN.relative_to(ROOT),
+               cwd=ROOT)
+    assert done.returncode == 1
+    lines = done.stdout.splitlines()
+    assert lines[0] == ("::error file=tests/corpus/broken/if_else_not_closed.st,line=12,col=1,"
+                        "title=uitamr check UITAMR-ST-SYNTAX::IF opened at 7:1 is not closed: "
+                        "expected END_IF before END_FUNCTION_BLOCK")
+    assert any(line.startswith("::error file=tests/corpus/invalid/int_from_word.st,line=5,col=7,")
+               and "UITAMR-ST-CHECK" in line for line in lines)
+    assert any(line.startswith("::warning file=tests/corpus/invalid/unused_warning.st,line=4,col=5,")
+               for line in lines)
+    assert lines[-1].endswith("error(s), 1 warning(s)")
+
+
+def test_github_annotations_escape_what_would_break_the_command(tmp_path):
+    odd = tmp_path / "a,b:100%.st"
+    odd.write_text("PROGRAM P\nVAR iX : INT; END_VAR\niX := 'x\nEND_PROGRAM\n", encoding="utf-8")
+    done = run("--format", "github", odd.name, cwd=tmp_path)
+    first = done.stdout.splitlines()[0]
+    assert first.startswith("::error file=a%2Cb%3A100%25.st,line=3,col=7,")
+
+
+def test_absolute_paths_below_the_working_directory_become_relative():
+    done = run(BROKEN, "--format", "github", cwd=ROOT)
+    assert "file=tests/corpus/broken/if_else_not_closed.st," in done.stdout
+
+
+def _sarif(*args, cwd=ROOT) -> dict:
+    done = run("--format", "sarif", *args, cwd=cwd)
+    return json.loads(done.stdout)
+
+
+def test_sarif_has_what_code_scanning_requires():
+    log = _sarif(BROKEN.relative_to(ROOT), BAD.relative_to(ROOT), WARN.relative_to(ROOT))
+    assert log["version"] == "2.1.0" and log["$schema"].endswith("sarif-2.1.0.json")
+    (run_,) = log["runs"]
+    driver = run_["tool"]["driver"]
+    assert driver["name"] == "uitamr check" and re.match(r"\d+\.\d+", driver["version"])
+    rule_ids = [r["id"] for r in driver["rules"]]
+    assert set(rule_ids) == set(RULES) and all(r["shortDescription"]["text"] for r in driver["rules"])
+    results = run_["results"]
+    assert len(results) == 4
+    for result in results:
+        assert result["level"] in ("error", "warning")
+        assert result["message"]["text"]
+        assert rule_ids[result["ruleIndex"]] == result["ruleId"]
+        (location,) = result["locations"]
+        physical = location["physicalLocation"]
+        assert physical["artifactLocation"]["uriBaseId"] == "%SRCROOT%"
+        assert not Path(physical["artifactLocation"]["uri"]).is_absolute()
+        assert (ROOT / physical["artifactLocation"]["uri"]).is_file()
+        region = physical["region"]
+        assert region["startLine"] >= 1 and region["startColumn"] >= 1
+    first = results[0]
+    assert first["ruleId"] == "UITAMR-ST-SYNTAX"
+    assert first["locations"][0]["physicalLocation"]["artifactLocation"]["uri"] == \
+        "tests/corpus/broken/if_else_not_closed.st"
+    assert first["locations"][0]["physicalLocation"]["region"] == {"startLine": 12, "startColumn": 1}
+    assert run_["originalUriBaseIds"]["%SRCROOT%"]["uri"].startswith("file://")
+
+
+def test_sarif_of_a_clean_run_has_no_results():
+    log = _sarif((CORPUS / "valid" / "statements.st").relative_to(ROOT))
+    assert log["runs"][0]["results"] == []
+
+
+def test_json_names_the_rule_of_each_diagnostic():
+    done = run("--format", "json", BROKEN, WARN)
+    report = json.loads(done.stdout)
+    assert [d["rule"] for d in report["diagnostics"]] == ["UITAMR-ST-SYNTAX", "UITAMR-ST-WARNING"]
+    assert report["errors"] == 1 and report["warnings"] == 1
+
+
+@pytest.mark.parametrize("fmt", ["text", "json", "github", "sarif"])
+def test_a_scenario_file_is_checked_with_line_and_column(tmp_path, fmt):
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('program = "Main"\nduration = "60s"\nscan = "10xs"\n', encoding="utf-8")
+    done = run("--format", fmt, scenario.name, cwd=tmp_path)
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert "Traceback" not in done.stdout + done.stderr
+    if fmt == "text":
+        assert done.stdout.startswith("s.toml:3:8: error: scan: '10xs' is not a duration")
+        assert done.stdout.splitlines()[1:3] == ['    scan = "10xs"', "           ^"]
+    elif fmt == "github":
+        assert done.stdout.startswith("::error file=s.toml,line=3,col=8,title=uitamr check UITAMR-SCENARIO::scan: ")
+    elif fmt == "json":
+        (d,) = json.loads(done.stdout)["diagnostics"]
+        assert (d["file"], d["line"], d["col"], d["rule"]) == ("s.toml", 3, 8, "UITAMR-SCENARIO")
+    else:
+        (result,) = _sarif(scenario.name, cwd=tmp_path)["runs"][0]["results"]
+        assert result["locations"][0]["physicalLocation"]["region"] == {"startLine": 3, "startColumn": 8}
+
+
+def test_the_bundled_scenarios_check_clean():
+    done = run(*sorted((ROOT / "plc" / "scenarios").glob("*.toml")))
+    assert done.returncode == 0, done.stdout
