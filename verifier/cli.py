@@ -17,6 +17,8 @@ SUBCOMMANDS = {
     "check": "Parse and type-check GX Works structured text.",
     "frame": "Print or decode the exact bytes of a robot command.",
     "emulate": "Run the emulated robot on a real serial port or TCP socket.",
+    "monitor": "Listen on a real line and check its traffic against the rules, live.",
+    "replay": "Check a saved trace or capture against the rules.",
     "export": "Write paste-ready ST bodies and label tables for GX Works.",
 }
 

@@ -14,6 +14,7 @@ import click
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
+from verifier.commands.report_files import ReportError, check_folders, report_options, write_reports
 from verifier.verify.durations import format_duration, format_seconds, parse_duration_us
 from verifier.verify.result import ScenarioResult, UnusableInput
 from verifier.bundled import plc_dir as bundled_plc_dir
@@ -242,10 +243,7 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress) -> l
 @click.option("--scan", type=_Duration(), help="PLC scan time, e.g. 10ms (overrides the scenarios'; default 10ms).")
 @click.option("--seed", type=int, help="Seed for everything random in the run (overrides the scenarios').")
 @click.option("--jobs", "-j", type=click.IntRange(min=1), default=1, show_default=True, help="Scenarios run in parallel processes.")
-@click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Write the verdict as JSON.")
-@click.option("--junit", "junit_path", type=click.Path(dir_okay=False), help="Write JUnit XML (one testcase per scenario).")
-@click.option("--trace", "trace_path", type=click.Path(dir_okay=False), help="Write every frame as JSON Lines.")
-@click.option("--html", "html_path", type=click.Path(dir_okay=False), help="Write a self-contained HTML report with a timing diagram.")
+@report_options
 @click.option("--list-rules", is_flag=True, help="Print the rules (id, title, source) and exit.")
 @click.option("--violations", "first", type=click.IntRange(min=0), default=3, show_default=True,
               help="Times listed per broken rule and scenario on the console (0: counts only).")
@@ -257,7 +255,7 @@ def command(sources, program, platform, channel, response_signal, scenario_files
     With no arguments: the bundled library examples against the bundled scenarios.
     Exit status: 0 compliant, 1 violations or failed expectations, 2 unusable input.
     """
-    from verifier.verify import report_console, report_html, report_json, report_junit, report_trace
+    from verifier.verify import report_console
 
     console = Console(highlight=False, soft_wrap=True)
     if list_rules:
@@ -266,9 +264,10 @@ def command(sources, program, platform, channel, response_signal, scenario_files
         for rule in RULES:
             console.print(f"[bold]{rule.id}[/] — {rule.title}\n    {rule.explanation}")
         sys.exit(EXIT_PASS)
-    for path in (json_path, junit_path, trace_path, html_path):
-        if path and not Path(path).resolve().parent.is_dir():
-            _unusable(f"cannot write {path}: the folder {Path(path).resolve().parent} does not exist")
+    try:
+        check_folders(json_path, junit_path, trace_path, html_path)
+    except ReportError as exc:
+        _unusable(str(exc))
     try:
         scenarios = _scenarios(sources, program, platform, channel, scenario_files, matrix, duration, scan, seed)
         if response_signal is not None:
@@ -284,12 +283,8 @@ def command(sources, program, platform, channel, response_signal, scenario_files
         _unusable(str(exc))
     progress.stop()
     report_console.render(results, console, first=first)
-    writers = ((json_path, report_json), (junit_path, report_junit), (trace_path, report_trace), (html_path, report_html))
-    for path, writer in writers:
-        if path:
-            try:
-                writer.write(results, Path(path))
-            except OSError as exc:
-                _unusable(f"cannot write {path}: {exc.strerror or exc}")
-            console.print(f"[dim]wrote {path}[/]")
+    try:
+        write_reports(results, console, json_path, junit_path, trace_path, html_path)
+    except ReportError as exc:
+        _unusable(str(exc))
     sys.exit(EXIT_PASS if all(r.passed for r in results) else EXIT_FAIL)

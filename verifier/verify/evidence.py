@@ -35,6 +35,11 @@ class RuleOptions:
     # RESPONSE-HANDLING: the output that shows the program noticed a failed exchange.
     response_signal: Condition | None = None
     response_within_us: int = DEFAULT_RESPONSE_WITHIN_US
+    # Captures (`uitamr monitor`, `uitamr replay`): how far host timestamps may be off, so
+    # that timing rules do not fire on the adapter's latency; 0 for the simulator's exact times.
+    timing_tolerance_us: int = 0
+    # False for captures: the PLC's outputs are not on the line to judge RESPONSE-HANDLING by.
+    outputs_visible: bool = True
 
 
 @dataclass(frozen=True)

@@ -36,7 +36,7 @@ def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
         else f"{len(result.expectations)} expectation(s) met"
     )
     console.print(
-        f"{mark} [bold]{escape(result.name)}[/]{where}: {escape(result.program or '?')} on {result.platform}, {tx} requests in "
+        f"{mark} [bold]{escape(result.name)}[/]{where}: {escape(result.program or 'the PLC')} on {result.platform}, {tx} requests in "
         f"{format_seconds(result.ended_us)}, {result.violation_count} violation(s), {expectations}"
     )
     for note in result.notes:

@@ -68,7 +68,13 @@ def check_response_handling(evidence: RunEvidence, traffic: Traffic) -> list[Vio
             continue  # recovered in time (or the run ended before the bound: nothing to judge)
         first = episode.exchanges[0]
         lasted = "until the end of the run" if episode.end_us is None else f"until {format_seconds(end)}"
-        if options.response_signal is None:
+        if not options.outputs_visible:
+            message = (
+                f"the robot's replies failed from {format_seconds(start)} {lasted} "
+                f"({episode.summary()}); the PLC's outputs are not on the line: check that the "
+                f"program showed it (e.g. its o_bErr) within {within / 1_000_000:g} s"
+            )
+        elif options.response_signal is None:
             message = (
                 f"the robot's replies failed from {format_seconds(start)} {lasted} "
                 f"({episode.summary()}), and the scenario names no output to show it: set "

@@ -15,10 +15,11 @@ def _ms(t_us: int) -> str:
 
 def check_pacing(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
     minimum = evidence.options.min_period_us
+    tolerance = evidence.options.timing_tolerance_us
     violations = []
     for previous, frame in zip(traffic.tx, traffic.tx[1:]):
         gap = frame.t_start_us - previous.t_start_us
-        if gap <= minimum:
+        if gap + tolerance <= minimum:
             violations.append(
                 Violation(
                     "UITAMR-PACING",
@@ -36,26 +37,28 @@ def check_half_duplex(evidence: RunEvidence, traffic: Traffic) -> list[Violation
     settings = evidence.settings
     violations = []
     rx_starts = [rx.t_start_us for rx in traffic.rx]
+    tolerance = evidence.options.timing_tolerance_us
     for position, frame in enumerate(traffic.tx):
         start = frame.t_start_us
+        judged = start + tolerance  # host timestamps (captures): blame only what is certain
         blamed = None
         if position > 0:
             previous = traffic.exchanges[position - 1]
             reply = previous.reply
             if reply is not None and reply.t_start_us <= previous.deadline_us:
-                if start < reply.t_start_us:
+                if judged < reply.t_start_us:
                     blamed = (reply, "while the reply to the previous request was due "
                               f"(it began {_ms(reply.t_start_us - start)} later)")
-                elif start < reply.t_end_us:
+                elif judged < reply.t_end_us:
                     blamed = (reply, "while the reply to the previous request was arriving")
-                elif start < reply.t_end_us + protocol.T3_5_US:
+                elif judged < reply.t_end_us + protocol.T3_5_US:
                     blamed = (reply, f"only {_ms(start - reply.t_end_us)} after the reply ended; the "
                               f"line needs {_ms(protocol.T3_5_US)} (3.5 characters) of silence")
         if blamed is None:
             rx = _last_robot_frame_before(traffic.rx, rx_starts, start)
-            if rx is not None and start < rx.t_end_us:
+            if rx is not None and judged < rx.t_end_us:
                 blamed = (rx, "while a frame from the robot was arriving")
-            elif rx is not None and start < rx.t_end_us + protocol.T3_5_US:
+            elif rx is not None and judged < rx.t_end_us + protocol.T3_5_US:
                 blamed = (rx, f"only {_ms(start - rx.t_end_us)} after a frame from the robot "
                           f"ended; the line needs {_ms(protocol.T3_5_US)} of silence")
         if blamed:
@@ -82,9 +85,10 @@ def _last_robot_frame_before(rx: list, starts: list[int], t_us: int):
 def check_one_at_a_time(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
     settings = evidence.settings
     violations = []
+    tolerance = evidence.options.timing_tolerance_us
     for previous, current in zip(traffic.exchanges, traffic.exchanges[1:]):
         start = current.request.t_start_us
-        if start >= previous.finished_us:
+        if start + tolerance >= previous.finished_us:
             continue
         reply = previous.reply
         if reply is not None and reply.t_start_us <= previous.deadline_us:

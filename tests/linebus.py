@@ -1,0 +1,80 @@
+"""A two-wire RS-485 line made of real ptys, for the monitor's tests.
+
+Three socat pty pairs: the PLC's end, the robot's end and a tap (a receive-only USB
+adapter). A relay joins the far ends of the pairs the way the twisted pair joins devices:
+whatever the PLC end writes reaches the robot end and the tap, whatever the robot end
+writes reaches the PLC end and the tap. `noise` puts bytes on the line from nowhere.
+"""
+from __future__ import annotations
+
+import os
+import select
+import subprocess
+import threading
+import time
+from pathlib import Path
+
+OPEN_TIMEOUT_S = 10
+
+
+class LineBus:
+    def __init__(self, folder: Path):
+        self.folder = folder
+        self.plc = str(folder / "plc")
+        self.robot = str(folder / "robot")
+        self.tap = str(folder / "tap")
+        self._socats = []
+        self._fds: dict[str, int] = {}
+        for name in ("plc", "robot", "tap"):
+            device, bus = folder / name, folder / f"{name}-bus"
+            self._socats.append(subprocess.Popen(
+                ["socat", f"pty,raw,echo=0,link={device}", f"pty,raw,echo=0,link={bus}"],
+                stdout=subprocess.DEVNULL, stderr=subprocess.PIPE))
+            deadline = time.monotonic() + OPEN_TIMEOUT_S
+            while not (device.exists() and bus.exists()):
+                assert time.monotonic() < deadline, "socat did not create its pty pair"
+                time.sleep(0.01)
+            self._fds[name] = os.open(bus, os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK)
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._relay, daemon=True)
+        self._thread.start()
+
+    def _write(self, name: str, data: bytes) -> None:
+        view = memoryview(data)
+        while view:
+            try:
+                written = os.write(self._fds[name], view)
+            except BlockingIOError:
+                select.select([], [self._fds[name]], [], 0.05)
+                continue
+            view = view[written:]
+
+    def _relay(self) -> None:
+        sources = {self._fds["plc"]: ("robot", "tap"), self._fds["robot"]: ("plc", "tap"),
+                   self._fds["tap"]: ()}  # the tap only listens: what it writes goes nowhere
+        while not self._stop.is_set():
+            ready, _, _ = select.select(list(sources), [], [], 0.05)
+            for fd in ready:
+                try:
+                    data = os.read(fd, 4096)
+                except (BlockingIOError, OSError):
+                    continue
+                with self._lock:
+                    for name in sources[fd]:
+                        self._write(name, data)
+
+    def noise(self, data: bytes) -> None:
+        """Bytes on the line that nobody sent (a disturbance): the tap and the robot hear them."""
+        with self._lock:
+            self._write("tap", data)
+            self._write("robot", data)
+
+    def close(self) -> None:
+        self._stop.set()
+        self._thread.join(timeout=2)
+        for fd in self._fds.values():
+            os.close(fd)
+        for socat in self._socats:
+            socat.terminate()
+            socat.wait(timeout=5)

@@ -1,0 +1,102 @@
+"""Shared pieces of the monitor/replay tests: real processes on a pty line, a bad master."""
+from __future__ import annotations
+
+import json
+import os
+import select
+import subprocess
+import sys
+import time
+from collections import Counter
+from pathlib import Path
+
+from verifier import protocol
+
+SETTINGS = protocol.DEFAULT_SETTINGS
+WAIT_S = 20
+
+
+def frame(*words: str) -> bytes:
+    return protocol.encode(protocol.command_from_words(list(words), 1), SETTINGS)
+
+
+def uitamr(*args) -> list[str]:
+    return [sys.executable, "-m", "verifier.cli", *map(str, args)]
+
+
+def start(*args, **kw) -> subprocess.Popen:
+    return subprocess.Popen(uitamr(*args), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kw)
+
+
+def wait_for_line(proc: subprocess.Popen, words: str, timeout_s: float = WAIT_S) -> str:
+    """Read the process's stdout until a line holds `words` (it has started)."""
+    deadline = time.monotonic() + timeout_s
+    seen = []
+    while time.monotonic() < deadline:
+        ready, _, _ = select.select([proc.stdout], [], [], 0.1)
+        if ready:
+            line = proc.stdout.readline()
+            seen.append(line)
+            if words in line:
+                return line
+            if not line and proc.poll() is not None:
+                break
+    raise AssertionError(f"no line with {words!r}; got {''.join(seen)!r}, stderr {proc.stderr.read()!r}")
+
+
+class Master:
+    """A PLC stand-in on the line's PLC end: writes requests at chosen times, reads replies."""
+
+    def __init__(self, device: str):
+        self.fd = os.open(device, os.O_RDWR | os.O_NOCTTY)
+        self.t0 = time.monotonic()
+
+    def at(self, t_s: float) -> None:
+        delay = self.t0 + t_s - time.monotonic()
+        if delay > 0:
+            time.sleep(delay)
+
+    def send(self, data: bytes, reply_length: int | None = 8, timeout_s: float = 0.2) -> bytes:
+        os.write(self.fd, data)
+        got = b""
+        deadline = time.monotonic() + timeout_s
+        while reply_length and len(got) < reply_length and time.monotonic() < deadline:
+            ready, _, _ = select.select([self.fd], [], [], 0.01)
+            if ready:
+                got += os.read(self.fd, 64)
+        return got
+
+    def close(self) -> None:
+        os.close(self.fd)
+
+
+def bad_master(device: str) -> None:
+    """First command not stop, 100 ms pacing, one bad CRC: the findings of issue 10."""
+    master = Master(device)
+    try:
+        run_point = frame("run-point", "1")
+        read = frame("read", "task")
+        stop = frame("stop")
+        bad_stop = stop[:-1] + bytes([stop[-1] ^ 0x01])
+        master.at(0.0)
+        master.send(run_point)      # not the stop command
+        master.at(0.1)
+        master.send(read)           # 100 ms after the previous request
+        master.at(0.2)
+        master.send(read)           # 100 ms again
+        master.at(0.3)
+        master.send(bad_stop, reply_length=None)  # 100 ms again, and a wrong CRC: no reply
+        master.at(0.95)
+        master.send(stop)
+        master.at(1.3)
+        master.send(read)
+    finally:
+        master.close()
+
+
+BAD_MASTER_FINDINGS = {"UITAMR-POWERON-STOP": 1, "UITAMR-PACING": 3, "UITAMR-CRC": 1}
+
+
+def findings(report: Path) -> Counter:
+    data = json.loads(report.read_text(encoding="utf-8"))
+    return Counter(v["rule"] for scenario in data["scenarios"] for v in scenario["violations"])

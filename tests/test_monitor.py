@@ -1,0 +1,328 @@
+"""`uitamr monitor` and `uitamr replay`: the verifier's rules on a real line and on a capture.
+
+Real parts: socat pty pairs joined into one line (tests/linebus.py) carrying `uitamr
+emulate --serial` driven by mbpoll, by a deliberately bad master and by the simulated
+PLC's own requests; a TCP stream on 127.0.0.1; noise on the line. The pure core (capture
+format, framer, request/reply classification) is tested on its own, by hypothesis too.
+"""
+from __future__ import annotations
+
+import json
+import random
+import signal
+import socket
+import subprocess
+import threading
+import time
+from collections import Counter
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from linebus import LineBus
+from monitor_helpers import (BAD_MASTER_FINDINGS, SETTINGS, WAIT_S, Master, bad_master, findings, frame,
+                             start, uitamr, wait_for_line)
+from verifier import protocol
+from verifier.commands.frame import mbpoll_command
+from verifier.monitor.capture import CaptureError, Chunk, format_plain, parse_plain, read_capture
+from verifier.monitor.framer import Framer, LineTiming
+from verifier.monitor.session import CaptureInfo, MonitorSession
+from verifier.verify.runner import run_scenario
+from verifier.verify.scenario import load_scenario
+
+ROOT = Path(__file__).resolve().parent.parent
+CAPTURES = Path(__file__).resolve().parent / "captures"
+STOP, READ = frame("stop"), frame("read", "task")
+
+
+def session_of(chunks, tolerance_us: int = 20_000, **kw) -> MonitorSession:
+    session = MonitorSession(CaptureInfo("test", "test"), timing=LineTiming(tolerance_us=tolerance_us), **kw)
+    for chunk in chunks:
+        session.feed(chunk)
+    session.close()
+    return session
+
+
+def rules_of(session: MonitorSession) -> Counter:
+    return Counter(v.rule for found in session.violations().values() for v in found)
+
+
+# --------------------------------------------------------------------- the plain capture format
+def test_plain_capture_reads_chunks_and_frames_with_directions():
+    chunks = parse_plain("# a comment\n0.5 01 06 01 A0 00 00 88 14  # stop\n\n0.5083 rx 0106 01A0 0000 8814\n")
+    assert chunks == [Chunk(500_000, STOP), Chunk(508_300, STOP, "rx")]
+    assert parse_plain(format_plain(chunks, "round trip")) == chunks
+
+
+@pytest.mark.parametrize("text, where", [
+    ("0.1 01 06\nx 01\n", "c.txt:2:1: expected a time in seconds"),
+    ("0.1 01 0G\n", "c.txt:1:8: '0G' is not a byte in hex"),
+    ("0.1 01 6\n", "c.txt:1:8: '6' is not a byte in hex"),
+    ("0.2 01\n0.1 02\n", "c.txt:2:1: time 0.1 s is earlier than the line before"),
+    ("0.1   # nothing\n", "c.txt:1:4: the line has a time but no bytes"),
+])
+def test_a_bad_capture_is_named_with_file_line_and_column(text, where):
+    with pytest.raises(CaptureError) as caught:
+        parse_plain(text, "c.txt")
+    assert str(caught.value).startswith(where)
+
+
+def test_a_bad_trace_record_is_named_with_its_line(tmp_path):
+    path = tmp_path / "t.jsonl"
+    path.write_text('{"t": 0.1, "t_end": 0.108, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}\n{"t": 0.2, \n',
+                    encoding="utf-8")
+    with pytest.raises(CaptureError, match=r"t.jsonl:2:\d+: not a JSON trace record"):
+        read_capture(path)
+    done = subprocess.run(uitamr("replay", path), capture_output=True, text=True, timeout=WAIT_S)
+    assert done.returncode == 2 and "t.jsonl:2:" in done.stderr and "Traceback" not in done.stderr
+
+
+# --------------------------------------------------------------------- framing and direction
+def test_a_frame_in_two_chunks_with_a_usb_pause_is_one_frame():
+    framer = Framer(LineTiming(tolerance_us=20_000))
+    assert framer.feed(Chunk(10_000, STOP[:3])) == []
+    (whole,) = framer.feed(Chunk(26_000, STOP[3:]))  # 16 ms later: the adapter's latency timer
+    assert whole.data == STOP
+
+
+def test_a_request_and_its_reply_in_one_chunk_are_two_frames():
+    reply = protocol.encode(protocol.StatusReply(1, protocol.Query.TASK, 0, 0), SETTINGS) \
+        if hasattr(protocol, "StatusReply") and False else bytes.fromhex("01 01 03 00 00 00 3C 4E")
+    session = session_of([Chunk(30_000, READ + reply)])
+    assert [(f.direction, f.data) for f in session.frames] == [("tx", READ), ("rx", reply)]
+    assert session.frames[0].t_end_us <= session.frames[1].t_start_us
+
+
+def test_the_fc06_echo_is_the_reply_and_a_hasty_master_is_a_master():
+    session = session_of([Chunk(8_000, STOP), Chunk(20_000, STOP), Chunk(60_000, STOP)])
+    assert [f.direction for f in session.frames] == ["tx", "rx", "tx"]
+    rules = rules_of(session)
+    assert rules["UITAMR-PACING"] == 1  # the second stop request came 52 ms after the first
+
+
+def test_unknown_bytes_end_at_the_silence():
+    session = session_of([Chunk(1_000, b"\x01\x99\x00"), Chunk(50_000, STOP)])
+    assert [f.data for f in session.frames] == [b"\x01\x99\x00", STOP]
+    assert rules_of(session)["UITAMR-FORMAT"] + rules_of(session)["UITAMR-CRC"] >= 1
+
+
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(st.tuples(st.integers(0, 400_000), st.binary(min_size=1, max_size=40)), max_size=40),
+       st.integers(0, 30_000))
+def test_any_byte_stream_gives_frames_and_findings_never_a_crash(pieces, tolerance_us):
+    """Noise, broken frames, floods: every byte ends up in exactly one frame, frames do
+    not overlap, and the rules judge them (findings, never an exception)."""
+    t = 0
+    chunks = []
+    for gap, data in pieces:
+        t += gap
+        chunks.append(Chunk(t, data))
+    session = session_of(chunks, tolerance_us)
+    assert b"".join(f.data for f in session.frames) == b"".join(c.data for c in chunks)
+    for before, after in zip(session.frames, session.frames[1:]):
+        assert before.t_end_us <= after.t_start_us or before.t_end_us <= after.t_end_us
+    session.check()
+    session.result()
+
+
+# --------------------------------------------------------------------- same rules as `uitamr verify`
+@pytest.mark.parametrize("name", ["fx3u-healthy", "fx3u-no-reply", "fx3u-bad-crc", "fx3u-late-reply",
+                                  "fx3u-wrong-address", "fx3u-exception", "q-exception",
+                                  "fx3u-panel-all-commands", "fx5u-healthy"])
+def test_a_verify_trace_as_raw_bytes_gets_the_same_frames_and_verdicts(name):
+    """The simulated PLC's traffic, as the host would see it with no latency (each frame
+    a chunk): the monitor finds the same frames, sides and rule results as `verify`
+    (RESPONSE-HANDLING aside: a capture cannot see the PLC's outputs)."""
+    result = run_scenario(load_scenario(ROOT / "plc" / "scenarios" / f"{name}.toml"))
+    chunks = [Chunk(f.t_end_us, f.data) for f in sorted(result.trace, key=lambda f: f.t_start_us)]
+    session = session_of(chunks, tolerance_us=0)
+    expected = [(f.t_start_us, f.direction, f.data) for f in sorted(result.trace, key=lambda f: f.t_start_us)]
+    got = [(f.t_start_us + session._origin_us, f.direction, f.data) for f in session.frames]
+    assert [(d, x) for _, d, x in got] == [(d, x) for _, d, x in expected]
+    judged = {rule: [v.t_us for v in found] for rule, found in session.violations(result.ended_us).items()}
+    wanted = {rule: [v.t_us - session._origin_us for v in found] for rule, found in result.violations.items()}
+    judged.pop("UITAMR-RESPONSE-HANDLING")
+    wanted.pop("UITAMR-RESPONSE-HANDLING")
+    assert judged == wanted
+
+
+def test_replay_of_a_verify_trace_file(tmp_path):
+    trace = tmp_path / "t.jsonl"
+    done = subprocess.run(uitamr("verify", "--scenario", ROOT / "plc/scenarios/fx3u-healthy.toml",
+                                 "--trace", trace),
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stdout + done.stderr
+    report = tmp_path / "r.json"
+    done = subprocess.run(uitamr("replay", trace, "--json", report, "--junit", tmp_path / "r.xml",
+                                 "--html", tmp_path / "r.html", "--trace", tmp_path / "r.jsonl"),
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stdout + done.stderr
+    data = json.loads(report.read_text())
+    assert data["verdict"] == "pass" and data["scenarios"][0]["violations"] == []
+    original = [json.loads(line) for line in trace.read_text().splitlines()]
+    again = [json.loads(line) for line in (tmp_path / "r.jsonl").read_text().splitlines()]
+    assert [(r["dir"], r["hex"], r["meaning"]) for r in again] == [(r["dir"], r["hex"], r["meaning"]) for r in original]
+    assert "<svg" in (tmp_path / "r.html").read_text()
+
+
+# --------------------------------------------------------------------- the bad master
+def test_the_saved_bad_master_capture_has_exactly_its_findings(tmp_path):
+    report = tmp_path / "r.json"
+    done = subprocess.run(uitamr("replay", CAPTURES / "bad-master.txt", "--json", report),
+                          capture_output=True, text=True, timeout=WAIT_S)
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert findings(report) == Counter(BAD_MASTER_FINDINGS)
+
+
+@pytest.fixture
+def line(tmp_path):
+    bus = LineBus(tmp_path)
+    robot = start("emulate", "--serial", bus.robot)
+    try:
+        wait_for_line(robot, "listening")
+        yield bus
+    finally:
+        robot.terminate()
+        robot.communicate(timeout=WAIT_S)
+        bus.close()
+
+
+def monitor_on(bus: LineBus, tmp_path: Path, *extra) -> subprocess.Popen:
+    monitor = start("monitor", "--serial", bus.tap, "--json", tmp_path / "m.json", *extra)
+    wait_for_line(monitor, "listening")
+    return monitor
+
+
+@pytest.mark.serial
+def test_a_bad_master_on_a_real_line_gets_exactly_its_findings(line, tmp_path):
+    monitor = monitor_on(line, tmp_path, "--duration", "3s", "--capture", tmp_path / "c.txt",
+                         "--junit", tmp_path / "m.xml", "--html", tmp_path / "m.html", "--trace", tmp_path / "m.jsonl")
+    bad_master(line.plc)
+    out, err = monitor.communicate(timeout=WAIT_S)
+    assert monitor.returncode == 1, out + err
+    assert findings(tmp_path / "m.json") == Counter(BAD_MASTER_FINDINGS)
+    assert "UITAMR-POWERON-STOP" in out and "run point/script 1" in out  # the live line names it
+    assert "<testcase" in (tmp_path / "m.xml").read_text() and "<svg" in (tmp_path / "m.html").read_text()
+    done = subprocess.run(uitamr("replay", tmp_path / "c.txt", "--json", tmp_path / "r.json"),
+                          capture_output=True, text=True, timeout=WAIT_S)
+    assert done.returncode == 1 and findings(tmp_path / "r.json") == Counter(BAD_MASTER_FINDINGS)
+
+
+@pytest.mark.serial
+def test_mbpoll_and_the_emulator_seen_by_the_monitor(line, tmp_path):
+    monitor = monitor_on(line, tmp_path, "--duration", "4s")
+    for request in (protocol.command_from_words("stop"), protocol.command_from_words("read task"),
+                    protocol.command_from_words("read battery")):
+        done = subprocess.run(mbpoll_command(request, SETTINGS, line.plc), capture_output=True, text=True,
+                              timeout=WAIT_S)
+        assert done.returncode == 0, done.stdout + done.stderr
+        time.sleep(0.4)
+    out, err = monitor.communicate(timeout=WAIT_S)
+    assert monitor.returncode == 0, out + err
+    assert "PLC → robot  01 06 01 A0 00 00 88 14    stop (01/A0)" in out
+    assert "robot → PLC  01 06 01 A0 00 00 88 14    echo: stop (01/A0)" in out
+    assert "battery" in out
+    report = json.loads((tmp_path / "m.json").read_text())
+    assert report["verdict"] == "pass"
+    assert report["scenarios"][0]["frames"] == {"tx": 3, "rx": 3}
+
+
+@pytest.mark.serial
+def test_the_simulated_plc_driving_the_emulator_is_compliant(line, tmp_path):
+    """The requests of `uitamr verify`'s FX3U example, sent at their times on the real
+    line to the emulated robot: the monitor finds nothing to blame."""
+    result = run_scenario(load_scenario(ROOT / "plc" / "scenarios" / "fx3u-healthy.toml"))
+    requests = [f for f in result.trace if f.direction == "tx" and f.t_start_us < 4_000_000]
+    assert len(requests) >= 8
+    monitor = monitor_on(line, tmp_path, "--duration", "5.5s", "--tolerance", "50ms")  # host scheduling
+    master = Master(line.plc)
+    try:
+        for request in requests:
+            master.at(request.t_start_us / 1_000_000)
+            master.send(request.data)
+    finally:
+        master.close()
+    out, err = monitor.communicate(timeout=WAIT_S)
+    assert monitor.returncode == 0, out + err
+    assert findings(tmp_path / "m.json") == Counter()
+    assert out.count("PLC → robot") == len(requests)
+
+
+@pytest.mark.serial
+def test_noise_on_the_line_gives_findings_not_a_crash(line, tmp_path):
+    monitor = monitor_on(line, tmp_path, "--duration", "3s")
+    master = Master(line.plc)
+    rng = random.Random(7)
+    try:
+        master.send(STOP)
+        time.sleep(0.3)
+        line.noise(bytes(rng.randrange(256) for _ in range(37)))
+        time.sleep(0.3)
+        line.noise(STOP[:5])  # a broken frame
+        time.sleep(0.4)
+        master.send(READ)
+    finally:
+        master.close()
+    out, err = monitor.communicate(timeout=WAIT_S)
+    assert monitor.returncode == 1, out + err
+    assert "Traceback" not in out + err
+    assert findings(tmp_path / "m.json")  # something to show
+
+
+@pytest.mark.serial
+def test_ctrl_c_stops_the_monitor_and_the_reports_are_written(line, tmp_path):
+    monitor = monitor_on(line, tmp_path, "--capture", tmp_path / "c.txt")
+    master = Master(line.plc)
+    try:
+        master.send(STOP)
+    finally:
+        master.close()
+    time.sleep(0.5)
+    monitor.send_signal(signal.SIGINT)
+    out, err = monitor.communicate(timeout=WAIT_S)
+    assert monitor.returncode == 0, out + err
+    assert json.loads((tmp_path / "m.json").read_text())["verdict"] == "pass"
+    (chunks,) = read_capture(tmp_path / "c.txt").values()
+    assert b"".join(c.data for c in chunks) == STOP + STOP  # the request and its echo
+
+
+# --------------------------------------------------------------------- the converter route (TCP)
+def test_monitor_on_a_tcp_stream(tmp_path):
+    """A TCP server on 127.0.0.1 streams the bad master's line, chunk by chunk at its times
+    (what a serial-to-Ethernet converter on a second tap does); the monitor connects."""
+    (chunks,) = read_capture(CAPTURES / "bad-master.txt").values()
+    server = socket.create_server(("127.0.0.1", 0))
+    port = server.getsockname()[1]
+
+    def stream():
+        connection, _ = server.accept()
+        with connection:
+            t0 = time.monotonic()
+            first = chunks[0].t_us
+            for chunk in chunks:
+                delay = t0 + (chunk.t_us - first) / 1_000_000 - time.monotonic()
+                if delay > 0:
+                    time.sleep(delay)
+                connection.sendall(chunk.data)
+            time.sleep(0.3)
+
+    thread = threading.Thread(target=stream, daemon=True)
+    thread.start()
+    done = subprocess.run(uitamr("monitor", "--tcp", f"127.0.0.1:{port}", "--duration", "10s",
+                                 "--json", tmp_path / "m.json"), capture_output=True, text=True, timeout=60)
+    thread.join(timeout=5)
+    server.close()
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert "the server closed the connection" in done.stdout  # ended by the stream, reports still written
+    assert findings(tmp_path / "m.json") == Counter(BAD_MASTER_FINDINGS)
+
+
+def test_a_port_that_cannot_be_opened_exits_2_with_its_name(tmp_path):
+    done = subprocess.run(uitamr("monitor", "--serial", tmp_path / "nope"), capture_output=True, text=True,
+                          timeout=WAIT_S)
+    assert done.returncode == 2 and "nope" in done.stderr and "Traceback" not in done.stderr
+    done = subprocess.run(uitamr("monitor", "--tcp", "127.0.0.1:1"), capture_output=True, text=True,
+                          timeout=WAIT_S)
+    assert done.returncode == 2 and "127.0.0.1:1" in done.stderr

@@ -1,0 +1,163 @@
+"""`uitamr monitor --serial PORT | --tcp HOST:PORT`: the verifier's rules on a real line.
+
+Listens (never transmits), splits the bytes into RTU frames, tells requests from replies,
+decodes them and applies the eight rules of `uitamr verify` while the line runs; Ctrl-C
+or `--duration` stops it and writes the same reports as `verify` (and `--capture FILE`,
+the plain capture `uitamr replay` reads). Exit status: 0 no finding, 1 findings, 2 the
+port or an option is unusable. docs/commissioning.md.
+"""
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+import time
+from pathlib import Path
+
+import click
+from rich.console import Console
+
+from verifier.commands.emulate import STANDARD_BAUD_RATES, _tcp_endpoint
+from verifier.commands.protocol_options import protocol_settings
+from verifier.commands.report_files import ReportError, check_folders, report_options, write_reports
+from verifier.monitor.capture import format_plain
+from verifier.monitor.framer import DEFAULT_TOLERANCE_US, LineTiming
+from verifier.monitor.session import CaptureInfo, MonitorSession
+from verifier.monitor.sources import SerialSource, SourceError, TcpSource, now_us
+from verifier.monitor.view import MonitorView
+from verifier.verify.durations import parse_duration_us
+from verifier.verify.evidence import RuleOptions
+
+EXIT_CLEAN, EXIT_FINDINGS, EXIT_UNUSABLE = 0, 1, 2
+#: how often the rules re-judge the capture while it runs
+CHECK_EVERY_S = 0.5
+
+
+class _Duration(click.ParamType):
+    name = "DURATION"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, int):
+            return value
+        try:
+            return parse_duration_us(str(value))
+        except ValueError as exc:
+            self.fail(str(exc), param, ctx)
+
+
+def line_options(command):
+    """Options shared by monitor and replay: the line's timing, the tolerance, power-on."""
+    options = (
+        click.option("--baud", type=click.Choice([str(b) for b in STANDARD_BAUD_RATES]), default="9600",
+                     show_default=True, help="Line speed (the robot uses 9600)."),
+        click.option("--format", "line_format", type=click.Choice(["8N1", "8E1", "8O1", "8N2"]), default="8N1",
+                     show_default=True, help="Data bits, parity, stop bits (the robot uses 8N1)."),
+        click.option("--tolerance", type=_Duration(),
+                     help="How far host timestamps may be off (USB adapter latency): timing rules "
+                          f"blame only what is beyond it. Default {DEFAULT_TOLERANCE_US // 1000}ms "
+                          "(replay of a JSONL trace: 0)."),
+        click.option("--joined", is_flag=True,
+                     help="The capture began after the PLC's power-on: do not judge UITAMR-POWERON-STOP."),
+        click.option("--reply-timeout", type=_Duration(), default="500ms", show_default=True,
+                     help="The PLC's reply time-out (UITAMR-ONE-AT-A-TIME, UITAMR-RESPONSE-HANDLING)."),
+    )
+    for option in reversed(options):
+        command = option(command)
+    return command
+
+
+def line_timing(baud: str, line_format: str, tolerance_us: int | None, default_tolerance_us: int) -> LineTiming:
+    bits = 1 + 8 + (0 if line_format[1] == "N" else 1) + int(line_format[2])
+    return LineTiming(int(baud), bits, default_tolerance_us if tolerance_us is None else tolerance_us)
+
+
+@click.command("monitor")
+@click.option("--serial", "serial_url", metavar="PORT",
+              help="Serial port or pyserial URL to listen on: /dev/ttyUSB0, COM3, socket://HOST:PORT, rfc2217://...")
+@click.option("--tcp", "tcp", metavar="HOST:PORT", help="A TCP server that streams the line's bytes (converter route).")
+@line_options
+@protocol_settings
+@click.option("--duration", type=_Duration(), help="Stop by itself after this long, e.g. 10min (default: Ctrl-C).")
+@click.option("--capture", "capture_path", type=click.Path(dir_okay=False),
+              help="Also write the raw chunks as a plain capture (for `uitamr replay` and tickets).")
+@report_options
+@click.option("--quiet", is_flag=True, help="Findings only, not every frame.")
+def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout, settings, duration,
+            capture_path, json_path, junit_path, trace_path, html_path, quiet):
+    """Listen on the robot's line and check every frame and gap against the manual, live."""
+    if (serial_url is None) == (tcp is None):
+        raise click.UsageError("give exactly one of --serial PORT or --tcp HOST:PORT")
+    console = Console(highlight=False, soft_wrap=True)
+    try:
+        check_folders(json_path, junit_path, trace_path, html_path, capture_path)
+    except ReportError as exc:
+        raise click.UsageError(str(exc)) from None
+    timing = line_timing(baud, line_format, tolerance, DEFAULT_TOLERANCE_US)
+    try:
+        if serial_url is not None:
+            parity = {"N": "N", "E": "E", "O": "O"}[line_format[1]]
+            source = SerialSource(serial_url, int(baud), 8, parity, int(line_format[2]))
+            channel = "rs485"
+        else:
+            host, port = _tcp_endpoint(tcp)
+            source = TcpSource(host, port)
+            channel = "tcp"
+    except SourceError as exc:
+        click.echo(f"uitamr monitor: {exc}", err=True)
+        sys.exit(EXIT_UNUSABLE)
+    info = CaptureInfo(f"monitor {source.description}", source.description, channel)
+    session = MonitorSession(info, settings, RuleOptions(reply_timeout_us=reply_timeout), timing,
+                             from_power_on=not joined)
+    stop = threading.Event()
+    previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGINT, signal.SIGTERM)}
+    deadline = None if duration is None else time.monotonic() + duration / 1_000_000
+    lost: str | None = None
+    console.print(f"[dim]listening on {source.description} ({baud} {line_format}, tolerance "
+                  f"{timing.tolerance_us / 1000:g} ms); Ctrl-C stops[/]")
+    console.file.flush()
+    try:
+        with MonitorView(console, settings, source.description, quiet) as view:
+            next_check = time.monotonic() + CHECK_EVERY_S
+            while not stop.is_set() and (deadline is None or time.monotonic() < deadline):
+                try:
+                    chunk = source.read()
+                except SourceError as exc:
+                    lost = str(exc)
+                    break
+                frames = session.feed(chunk) if chunk is not None else session.poll(now_us())
+                for frame in frames:
+                    view.frame(frame)
+                if time.monotonic() >= next_check:
+                    for violation in session.check():
+                        view.finding(violation)
+                    next_check = time.monotonic() + CHECK_EVERY_S
+            for frame in session.close():
+                view.frame(frame)
+            for violation in session.check():
+                view.finding(violation)
+    finally:
+        source.close()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    if lost:
+        console.print(f"[yellow]stopped: {lost}[/]")
+    result = session.result()
+    if lost:
+        result.notes.append(f"the capture ended early: {lost}")
+    _finish([result], console, json_path, junit_path, trace_path, html_path)
+    if capture_path:
+        Path(capture_path).write_text(format_plain(session.chunks, f"uitamr monitor capture of {source.description}, "
+                                                                   f"{baud} {line_format}"), encoding="utf-8")
+        console.print(f"[dim]wrote {capture_path}[/]")
+    sys.exit(EXIT_FINDINGS if result.violation_count else EXIT_CLEAN)
+
+
+def _finish(results, console: Console, json_path, junit_path, trace_path, html_path) -> None:
+    from verifier.verify import report_console
+
+    report_console.render(results, console)
+    try:
+        write_reports(results, console, json_path, junit_path, trace_path, html_path)
+    except ReportError as exc:
+        click.echo(f"uitamr: {exc}", err=True)
+        sys.exit(EXIT_UNUSABLE)

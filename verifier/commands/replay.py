@@ -1,0 +1,57 @@
+"""`uitamr replay CAPTURE...`: the verifier's rules on a saved capture.
+
+Reads our JSONL trace (`uitamr verify --trace`, `uitamr monitor --trace`) or a plain
+capture (timestamped hex lines, docs/commissioning.md), runs it through the monitor's
+framing and the eight rules, and writes the same reports. Exit status: 0 no finding,
+1 findings, 2 a capture that cannot be read (named with file, line and column).
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+from rich.console import Console
+
+from verifier.commands.monitor import EXIT_CLEAN, EXIT_FINDINGS, EXIT_UNUSABLE, _finish, line_options, line_timing
+from verifier.commands.protocol_options import protocol_settings
+from verifier.commands.report_files import ReportError, check_folders, report_options
+from verifier.monitor.capture import CaptureError, read_capture
+from verifier.monitor.framer import DEFAULT_TOLERANCE_US
+from verifier.monitor.session import CaptureInfo, MonitorSession
+from verifier.verify.evidence import RuleOptions
+
+
+@click.command("replay")
+@click.argument("captures", nargs=-1, required=True, type=click.Path())
+@line_options
+@protocol_settings
+@report_options
+def command(captures, baud, line_format, tolerance, joined, reply_timeout, settings,
+            json_path, junit_path, trace_path, html_path):
+    """Re-check a saved trace or capture with the rules of `uitamr verify`."""
+    console = Console(highlight=False, soft_wrap=True)
+    try:
+        check_folders(json_path, junit_path, trace_path, html_path)
+    except ReportError as exc:
+        raise click.UsageError(str(exc)) from None
+    results = []
+    for name in captures:
+        path = Path(name)
+        try:
+            loaded = read_capture(path)
+        except CaptureError as exc:
+            click.echo(f"uitamr replay: {exc}", err=True)
+            sys.exit(EXIT_UNUSABLE)
+        is_trace = any(chunk.direction is not None for chunks in loaded.values() for chunk in chunks)
+        timing = line_timing(baud, line_format, tolerance, 0 if is_trace else DEFAULT_TOLERANCE_US)
+        for capture_name, chunks in loaded.items():
+            info = CaptureInfo(capture_name if len(loaded) > 1 else path.name, str(path), "capture")
+            session = MonitorSession(info, settings, RuleOptions(reply_timeout_us=reply_timeout), timing,
+                                     from_power_on=not joined)
+            for chunk in chunks:
+                session.feed(chunk)
+            session.close()
+            results.append(session.result())
+    _finish(results, console, json_path, junit_path, trace_path, html_path)
+    sys.exit(EXIT_FINDINGS if any(r.violation_count for r in results) else EXIT_CLEAN)

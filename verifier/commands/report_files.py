@@ -1,0 +1,49 @@
+"""The report files every judging command writes (`verify`, `monitor`, `replay`): one set
+of options, one writer loop, so a capture from site gives the same files as a CI run."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+from rich.console import Console
+
+REPORT_OPTIONS = (
+    click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Write the verdict as JSON."),
+    click.option("--junit", "junit_path", type=click.Path(dir_okay=False),
+                 help="Write JUnit XML (one testcase per scenario or capture)."),
+    click.option("--trace", "trace_path", type=click.Path(dir_okay=False), help="Write every frame as JSON Lines."),
+    click.option("--html", "html_path", type=click.Path(dir_okay=False),
+                 help="Write a self-contained HTML report with a timing diagram."),
+)
+
+
+def report_options(command):
+    for option in reversed(REPORT_OPTIONS):
+        command = option(command)
+    return command
+
+
+class ReportError(Exception):
+    """A report file that cannot be written; the message names it."""
+
+
+def check_folders(*paths: str | None) -> None:
+    """Refuse before any work when a report's folder does not exist."""
+    for path in paths:
+        if path and not Path(path).resolve().parent.is_dir():
+            raise ReportError(f"cannot write {path}: the folder {Path(path).resolve().parent} does not exist")
+
+
+def write_reports(results, console: Console, json_path=None, junit_path=None, trace_path=None,
+                  html_path=None) -> None:
+    from verifier.verify import report_html, report_json, report_junit, report_trace
+
+    writers = ((json_path, report_json), (junit_path, report_junit), (trace_path, report_trace),
+               (html_path, report_html))
+    for path, writer in writers:
+        if path:
+            try:
+                writer.write(results, Path(path))
+            except OSError as exc:
+                raise ReportError(f"cannot write {path}: {exc.strerror or exc}") from None
+            console.print(f"[dim]wrote {path}[/]")

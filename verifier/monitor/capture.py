@@ -1,0 +1,141 @@
+"""Captures: byte chunks with the host time they arrived, and the files that keep them.
+
+The plain capture format (docs/commissioning.md) is one chunk or one frame per line:
+
+    # anything after '#' is a comment
+    0.000000 01 06 01 A0 00 00 88 14
+    0.008250 rx 01 06 01 A0 00 00 88 14
+    0.300 01 01 00 00 00 16 3D C4
+
+a time in seconds (from any origin; only differences count), optionally `tx` (PLC to
+robot) or `rx` (robot to PLC), then the bytes in hex (spaces optional between bytes). A
+line without a direction is a chunk of the line's stream: the monitor splits chunks into
+frames by silence and content as it does live. A capture that cannot be read is an error
+naming file, line and column; nothing in it is skipped silently.
+"""
+from __future__ import annotations
+
+import json
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from verifier import protocol
+
+
+@dataclass(frozen=True)
+class Chunk:
+    """Bytes as the host received them; `t_us` is when the read returned (the last byte's
+    arrival, give or take the adapter's latency). `direction` is known only for captures
+    that say it (our own traces, `tx`/`rx` lines)."""
+
+    t_us: int
+    data: bytes
+    direction: str | None = None
+    t_start_us: int | None = None  # a frame whose start is known exactly (our traces)
+
+
+class CaptureError(Exception):
+    """A capture file that cannot be read; the message is `file:line:col: what`."""
+
+
+_TIME = re.compile(r"\s*(\d+(?:\.\d*)?|\.\d+)(?=\s|$)")
+_HEX_PAIR = re.compile(r"[0-9A-Fa-f]{2}")
+
+
+def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
+    chunks: list[Chunk] = []
+    last_t: int | None = None
+    for number, raw in enumerate(text.splitlines(), start=1):
+        line = raw.split("#", 1)[0].rstrip()
+        if not line.strip():
+            continue
+        time_match = _TIME.match(line)
+        if time_match is None:
+            col = len(line) - len(line.lstrip()) + 1
+            raise CaptureError(f"{name}:{number}:{col}: expected a time in seconds (e.g. 0.250) "
+                               "at the start of the line")
+        t_us = round(float(time_match.group(1)) * 1_000_000)
+        if last_t is not None and t_us < last_t:
+            raise CaptureError(f"{name}:{number}:{time_match.start(1) + 1}: time {time_match.group(1)} s is "
+                               f"earlier than the line before ({last_t / 1_000_000:.6f} s); a capture "
+                               "is in time order")
+        pos = time_match.end()
+        direction = None
+        word = re.match(r"\s+(tx|rx|TX|RX)\b", line[pos:])
+        if word is not None:
+            direction = word.group(1).lower()
+            pos += word.end()
+        data = bytearray()
+        rest = line[pos:]
+        i = 0
+        while i < len(rest):
+            if rest[i].isspace():
+                i += 1
+                continue
+            pair = _HEX_PAIR.match(rest, i)
+            if pair is None:
+                raise CaptureError(f"{name}:{number}:{pos + i + 1}: {rest[i:i + 2]!r} is not a byte in "
+                                   "hex (two digits 0-9, A-F)")
+            data.append(int(pair.group(), 16))
+            i = pair.end()
+        if not data:
+            raise CaptureError(f"{name}:{number}:{len(line) + 1}: the line has a time but no bytes")
+        chunks.append(Chunk(t_us, bytes(data), direction))
+        last_t = t_us
+    return chunks
+
+
+def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
+    """Our JSONL trace (`uitamr verify --trace`, `uitamr monitor --trace`): frames with
+    their direction, grouped by scenario, in file order."""
+    scenarios: dict[str, list[Chunk]] = {}
+    for number, raw in enumerate(text.splitlines(), start=1):
+        if not raw.strip():
+            continue
+        try:
+            record = json.loads(raw)
+        except json.JSONDecodeError as exc:
+            raise CaptureError(f"{name}:{number}:{exc.colno}: not a JSON trace record: {exc.msg}") from None
+        if not isinstance(record, dict):
+            raise CaptureError(f"{name}:{number}:1: a trace record is a JSON object")
+        for key in ("t", "dir", "hex"):
+            if key not in record:
+                raise CaptureError(f"{name}:{number}:1: the record has no {key!r}")
+        if record["dir"] not in ("tx", "rx"):
+            raise CaptureError(f"{name}:{number}:1: 'dir' is {record['dir']!r}; expected \"tx\" or \"rx\"")
+        try:
+            data = bytes.fromhex(str(record["hex"]))
+            t_start = float(record["t"])
+        except (TypeError, ValueError) as exc:
+            raise CaptureError(f"{name}:{number}:1: {exc}") from None
+        t_end = record.get("t_end")
+        t_us = round((float(t_end) if isinstance(t_end, (int, float)) else t_start) * 1_000_000)
+        scenarios.setdefault(str(record.get("scenario", name)), []).append(
+            Chunk(t_us, data, record["dir"], round(t_start * 1_000_000)))
+    return scenarios
+
+
+def read_capture(path: Path) -> dict[str, list[Chunk]]:
+    """A capture file, plain or our JSONL trace (told apart by the first character that is
+    not blank or a comment), as chunks per capture name."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise CaptureError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
+        raise CaptureError(f"{path}: byte {exc.start}: not UTF-8 text") from None
+    first = next((line.lstrip() for line in text.splitlines()
+                  if line.strip() and not line.lstrip().startswith("#")), "")
+    if first.startswith("{"):
+        return parse_trace(text, str(path))
+    return {path.stem: parse_plain(text, str(path))}
+
+
+def format_plain(chunks: list[Chunk], comment: str = "") -> str:
+    """The plain format of `chunks` (what `uitamr monitor --capture FILE` writes)."""
+    lines = [f"# {line}" for line in comment.splitlines()]
+    for chunk in chunks:
+        direction = f" {chunk.direction}" if chunk.direction else ""
+        lines.append(f"{chunk.t_us / 1_000_000:.6f}{direction} {protocol.hex_bytes(chunk.data)}")
+    return "\n".join(lines) + "\n"

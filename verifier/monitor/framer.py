@@ -1,0 +1,153 @@
+"""Bytes as the host received them, cut into RTU frames.
+
+On the wire a frame ends with 3.5 characters of silence. The host does not see the wire:
+a USB adapter hands bytes over in chunks, after its latency timer (FTDI: 16 ms by
+default) or when its buffer fills, so one frame may come in two chunks with a "gap"
+between them and a request and its reply may come in one chunk. The framer therefore
+cuts by content first — every frame of this protocol is 8 bytes, an exception reply 5,
+known from the function code — and by silence only where content cannot tell: a gap ends
+a frame of unknown length when it exceeds t3.5, and a frame of known length that is still
+incomplete only when it exceeds t3.5 plus the host's timing tolerance.
+
+Times: a chunk's bytes are taken to have arrived back to back, the last one when the read
+returned, so a frame starts one frame-time before the chunk that completes it (or at its
+first chunk's estimated start when it came in several).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+
+from verifier.protocol import timing as line_timing
+from verifier.protocol.catalogue import EXCEPTION_FLAG, FUNCTION_CODES
+from verifier.protocol.codec import EXCEPTION_REPLY_LENGTH, REQUEST_LENGTH
+
+from .capture import Chunk
+
+#: the longest frame a Modbus RTU line carries (Modbus over Serial Line V1.02 §2.5.1)
+MAX_FRAME = 256
+#: default host timing tolerance: above an FTDI adapter's default 16 ms latency timer
+DEFAULT_TOLERANCE_US = 20_000
+
+
+@dataclass(frozen=True)
+class LineTiming:
+    """The line's character timing (9600 8N1 unless told otherwise) and the host's
+    tolerance for where it cannot see gaps."""
+
+    baud: int = line_timing.BAUD
+    bits_per_char: int = line_timing.BITS_PER_CHAR
+    tolerance_us: int = DEFAULT_TOLERANCE_US
+
+    @property
+    def char_us(self) -> Fraction:
+        return Fraction(1_000_000 * self.bits_per_char, self.baud)
+
+    @property
+    def silence_us(self) -> int:
+        """t3.5 (for baud rates above 19200 the standard fixes it at 1.75 ms)."""
+        return 1750 if self.baud > 19200 else round(self.char_us * Fraction(7, 2))
+
+    def frame_us(self, length: int) -> int:
+        return round(self.char_us * length)
+
+
+@dataclass(frozen=True)
+class Frame:
+    t_start_us: int
+    t_end_us: int
+    data: bytes
+    direction: str | None = None  # known only when the capture said it
+
+
+def known_length(head: bytes) -> int | None:
+    """The frame length the first two bytes imply (None: function code not of this protocol)."""
+    if len(head) < 2:
+        return None
+    function = head[1]
+    if function & EXCEPTION_FLAG and function & ~EXCEPTION_FLAG in FUNCTION_CODES:
+        return EXCEPTION_REPLY_LENGTH
+    if function in FUNCTION_CODES:
+        return REQUEST_LENGTH
+    return None
+
+
+class Framer:
+    def __init__(self, timing: LineTiming = LineTiming()):
+        self.timing = timing
+        self._buffer = bytearray()
+        self._arrivals: list[int] = []  # estimated arrival (end) of each buffered byte
+        self._last_us: int | None = None  # arrival of the latest byte
+        self._previous_end_us: int | None = None  # end of the latest frame
+
+    @property
+    def pending(self) -> bytes:
+        return bytes(self._buffer)
+
+    def feed(self, chunk: Chunk) -> list[Frame]:
+        """The frames this chunk completes (a silence before it may end a pending one)."""
+        if chunk.direction is not None:  # a frame of a trace: whole, direction known
+            start = chunk.t_start_us if chunk.t_start_us is not None \
+                else chunk.t_us - self.timing.frame_us(len(chunk.data))
+            out = self.flush()
+            self._previous_end_us = self._last_us = chunk.t_us
+            return out + [Frame(start, chunk.t_us, bytes(chunk.data), chunk.direction)]
+        out: list[Frame] = []
+        count = len(chunk.data)
+        arrivals = [chunk.t_us - self.timing.frame_us(count - 1 - i) for i in range(count)]
+        if self._last_us is not None:  # bytes arrive in order
+            arrivals = [max(t, self._last_us) for t in arrivals]
+        if self._buffer and self._silence_ends_frame(arrivals[0] - self.timing.frame_us(1)):
+            out += self.flush()
+        self._buffer += chunk.data
+        self._arrivals += arrivals
+        self._last_us = arrivals[-1]
+        out += self._cut()
+        return out
+
+    def poll(self, now_us: int) -> list[Frame]:
+        """Frames ended by the silence up to `now_us` (live use: call when no bytes came)."""
+        if self._buffer and self._silence_ends_frame(now_us):
+            return self.flush()
+        return []
+
+    def flush(self) -> list[Frame]:
+        """The pending bytes as a frame (at the end of a capture, or after a silence)."""
+        if not self._buffer:
+            return []
+        return [self._take(len(self._buffer))]
+
+    def _take(self, length: int) -> Frame:
+        """The first `length` buffered bytes as a frame: it ends when its last byte arrived
+        and lasted its length at the line's speed, but began no earlier than its first byte
+        arrived (a pty or a fast adapter delivers faster than the line) nor before the frame
+        before it ended."""
+        data = bytes(self._buffer[:length])
+        first, end = self._arrivals[0], self._arrivals[length - 1]
+        start = max(end - self.timing.frame_us(length), first - self.timing.frame_us(1))
+        if self._previous_end_us is not None:
+            start = max(start, self._previous_end_us)
+        del self._buffer[:length]
+        del self._arrivals[:length]
+        self._previous_end_us = end
+        return Frame(start, end, data)
+
+    def _silence_ends_frame(self, t_us: int) -> bool:
+        gap = t_us - (self._last_us if self._last_us is not None else t_us)
+        length = known_length(self._buffer)
+        if length is not None and len(self._buffer) < length:
+            return gap >= self.timing.silence_us + self.timing.tolerance_us
+        return gap >= self.timing.silence_us
+
+    def _cut(self) -> list[Frame]:
+        """Whole frames at the front of the buffer, by their known length."""
+        out: list[Frame] = []
+        while True:
+            length = known_length(self._buffer)
+            if length is None:
+                if len(self._buffer) >= MAX_FRAME:  # noise with no frame in it: let it go
+                    out += self.flush()
+                return out
+            if len(self._buffer) < length:
+                return out
+            out.append(self._take(length))

@@ -1,0 +1,85 @@
+"""Where live bytes come from: a serial port (a pyserial URL too) or a TCP stream; each
+read becomes a Chunk stamped with the host's monotonic clock (µs).
+
+The monitor only listens. It opens a serial port for reading and never writes to it: on
+an RS-485 line use an adapter whose transmitter stays off (receive-only), or one that
+only drives while it is sent data — the monitor sends none. On the TCP route it connects
+to a server that streams the line's bytes (a serial-to-Ethernet converter port set to
+"TCP server" on a second RS-485 tap, or ser2net): one client among others, it reads.
+"""
+from __future__ import annotations
+
+import socket
+import time
+from typing import Protocol
+
+from .capture import Chunk
+
+#: how long one read waits for bytes before the monitor looks at the clock (silence)
+POLL_S = 0.002
+
+
+def now_us() -> int:
+    return time.monotonic_ns() // 1000
+
+
+class ByteSource(Protocol):
+    description: str
+
+    def read(self) -> Chunk | None:
+        """The next chunk, or None when nothing came within POLL_S."""
+
+    def close(self) -> None: ...
+
+
+class SourceError(Exception):
+    """A port or server that cannot be opened or read; the message names it and why."""
+
+
+class SerialSource:
+    def __init__(self, port: str, baud: int, bytesize: int, parity: str, stopbits: float):
+        import serial
+
+        try:
+            self.port = serial.serial_for_url(port, baudrate=baud, bytesize=bytesize, parity=parity,
+                                              stopbits=stopbits, timeout=POLL_S, do_not_open=False)
+        except (serial.SerialException, ValueError) as exc:
+            raise SourceError(f"cannot open {port}: {exc}") from None
+        self.description = port
+        self._error = serial.SerialException
+
+    def read(self) -> Chunk | None:
+        try:
+            data = self.port.read(self.port.in_waiting or 1)
+        except self._error as exc:
+            raise SourceError(f"{self.description}: {exc}") from None
+        if not data:
+            return None
+        return Chunk(now_us(), bytes(data))
+
+    def close(self) -> None:
+        self.port.close()
+
+
+class TcpSource:
+    def __init__(self, host: str, port: int, connect_timeout_s: float = 5.0):
+        try:
+            self.sock = socket.create_connection((host, port), timeout=connect_timeout_s)
+        except OSError as exc:
+            raise SourceError(f"cannot connect to {host}:{port}: {exc.strerror or exc}") from None
+        self.sock.settimeout(POLL_S)
+        self.description = f"tcp {host}:{port}"
+
+    def read(self) -> Chunk | None:
+        try:
+            data = self.sock.recv(4096)
+        except (TimeoutError, socket.timeout):
+            return None
+        except OSError as exc:
+            raise SourceError(f"{self.description}: {exc.strerror or exc}") from None
+        if not data:
+            raise SourceError(f"{self.description}: the server closed the connection")
+        return Chunk(now_us(), data)
+
+    def close(self) -> None:
+        self.sock.close()
