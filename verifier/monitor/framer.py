@@ -87,9 +87,12 @@ class Framer:
     def feed(self, chunk: Chunk) -> list[Frame]:
         """The frames this chunk completes (a silence before it may end a pending one)."""
         if chunk.direction is not None:  # a frame of a trace: whole, direction known
-            start = chunk.t_start_us if chunk.t_start_us is not None \
-                else chunk.t_us - self.timing.frame_us(len(chunk.data))
             out = self.flush()
+            start = chunk.t_start_us
+            if start is None:  # a tx/rx line of a plain capture: it lasted its length
+                start = chunk.t_us - self.timing.frame_us(len(chunk.data))
+                if self._previous_end_us is not None:
+                    start = max(start, self._previous_end_us)
             self._previous_end_us = self._last_us = chunk.t_us
             return out + [Frame(start, chunk.t_us, bytes(chunk.data), chunk.direction)]
         out: list[Frame] = []

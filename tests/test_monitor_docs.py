@@ -1,0 +1,56 @@
+"""docs/commissioning.md says what the monitor really does: its options exist, its defaults
+are the code's, its example capture reads, its example view is what the monitor prints."""
+from __future__ import annotations
+
+import re
+import subprocess
+from pathlib import Path
+
+from monitor_helpers import uitamr
+from verifier.monitor.capture import parse_plain, read_capture
+from verifier.monitor.framer import DEFAULT_TOLERANCE_US
+from verifier.monitor.session import CaptureInfo, MonitorSession
+from verifier.monitor.view import finding_lines, frame_line
+from verifier import protocol
+
+CAPTURES = Path(__file__).resolve().parent / "captures"
+DOC = (Path(__file__).resolve().parent.parent / "docs" / "commissioning.md").read_text(encoding="utf-8")
+
+
+def test_every_option_in_the_table_exists():
+    helps = subprocess.run(uitamr("monitor", "--help"), capture_output=True, text=True, timeout=60).stdout
+    helps += subprocess.run(uitamr("replay", "--help"), capture_output=True, text=True, timeout=60).stdout
+    options = set(re.findall(r"\| `(--[a-z-]+)`", DOC)) | set(re.findall(r"`(--[a-z-]+)`", DOC))
+    assert {"--tolerance", "--joined", "--capture", "--duration", "--reply-timeout"} <= options
+    for option in options:
+        assert option in helps, f"docs/commissioning.md names {option}, which monitor/replay do not have"
+
+
+def test_the_default_tolerance_is_the_codes():
+    assert f"**{DEFAULT_TOLERANCE_US // 1000} ms**" in DOC and f"`{DEFAULT_TOLERANCE_US // 1000}ms`" in DOC
+
+
+def test_the_example_capture_reads():
+    block = DOC.split("# uitamr monitor capture of /dev/ttyUSB0, 9600 8N1\n", 1)[1].split("```", 1)[0]
+    session = MonitorSession(CaptureInfo("doc", "doc"))
+    for chunk in parse_plain(block, "docs/commissioning.md"):
+        session.feed(chunk)
+    session.close()
+    assert [(f.direction, f.t_start_us) for f in session.frames] == [("tx", 0), ("rx", 1097)]
+
+
+def test_the_example_view_is_what_the_monitor_prints_for_the_bad_master():
+    (chunks,) = read_capture(CAPTURES / "bad-master.txt").values()
+    session = MonitorSession(CaptureInfo("doc", "doc"))
+    for chunk in chunks:
+        session.feed(chunk)
+    session.close()
+    lines, request = [], None
+    for frame in session.frames[:4]:
+        if frame.direction == "tx":
+            request = protocol.decode_request(frame.data, protocol.DEFAULT_SETTINGS)
+        lines.append(frame_line(frame, protocol.DEFAULT_SETTINGS, request if frame.direction == "rx" else None))
+    for violation in session.check()[:2]:
+        lines += finding_lines(violation)
+    block = DOC.split("```\n     0.000 s  PLC → robot", 1)[1].split("```", 1)[0]
+    assert ("     0.000 s  PLC → robot" + block).rstrip("\n").splitlines() == lines
