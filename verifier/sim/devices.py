@@ -82,6 +82,15 @@ class DeviceMemory:
         a = self.address(name)
         return self.read(a)
 
+    def reader(self, name: str):
+        """A function of no arguments reading device `name`, its address parsed once."""
+        a = self.address(name)
+        cells = self.areas[a.area]
+        if a.bit is None and a.digits is None:
+            index = a.index
+            return lambda: cells[index]
+        return lambda: self.read(a)
+
     def __setitem__(self, name: str, value) -> None:
         self.write(self.address(name), value)
 

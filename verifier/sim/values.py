@@ -176,3 +176,33 @@ class ArrayView:
 
     def __repr__(self) -> str:
         return repr(list(self))
+
+
+def reader(root: "InstanceProxy", parts: list[str]):
+    """A function of no arguments that reads the label at `parts` below `root`
+    (["fbEngine", "o_bErr"], ["wBuf", "[2]"]) as `getattr`/`[]` on the proxies would, with
+    the path resolved once: instances and arrays are stored in place (assignments copy
+    into them), so only the last step is taken on each call. Labels whose value is
+    computed on each read (constants, device-backed globals) keep the generic path."""
+    target = root
+    for part in parts[:-1]:
+        target = target[int(part[1:-1])] if part.startswith("[") else getattr(target, part)
+    last = parts[-1]
+    if isinstance(target, ArrayView):
+        if not last.startswith("["):
+            raise AttributeError(f"{target._label} is an array: index it")
+        cells, flat, elem = target._cells, target._flat(int(last[1:-1])), target._t.elem
+        if isinstance(elem, (str, StringT)):
+            return lambda: cells[flat]
+        view = target
+        index = int(last[1:-1])
+        return lambda: view[index]
+    if last.startswith("[") or not isinstance(target, InstanceProxy):
+        index = int(last[1:-1]) if last.startswith("[") else None
+        return (lambda: target[index]) if index is not None else (lambda: getattr(target, last))
+    attr, t, sym = target._find(last)
+    computed = sym is not None and sym.code and not sym.code.startswith(("self.", "_G."))
+    if computed or not isinstance(t, (str, StringT)):
+        return lambda: getattr(target, last)
+    obj = target._obj
+    return lambda: getattr(obj, attr)

@@ -116,6 +116,14 @@ class _Plc:
             target = target[int(part[1:-1])] if part.startswith("[") else getattr(target, part)
         return target
 
+    def reader(self, name: str) -> Callable[[], Any]:
+        """`read(name)` with the label path resolved once (for reading every scan)."""
+        from verifier.sim.values import reader
+
+        if _DEVICE.match(name):
+            return self.project.devices.reader(name.upper())
+        return reader(self.program, _path_parts(name))
+
     def write(self, name: str, value: Any) -> None:
         if _DEVICE.match(name):
             self.project.devices[name.upper()] = value
@@ -260,8 +268,11 @@ def _input_schedule(scenario: Scenario) -> list[tuple[int, dict[str, Any]]]:
     return sorted(steps, key=lambda s: s[0])
 
 
-def run_scenario(scenario: Scenario, progress: Progress | None = None) -> ScenarioResult:
-    """Run `scenario` to its end and judge it. UnusableInput for input that cannot run."""
+def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain: bool = False) -> ScenarioResult:
+    """Run `scenario` to its end and judge it. UnusableInput for input that cannot run.
+
+    `plain` reads the watched labels by their names on every scan and records them all
+    (the reference the fast path is tested against: same result, byte for byte)."""
     wall_start = time.perf_counter()
     robot = Robot(scenario.settings, scenario.robot, list(scenario.faults))
     line = Line(robot)
@@ -281,8 +292,20 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None) -> Scenar
             for name, value in schedule.pop(0)[1].items():
                 plc.write(name, value)
 
+    getters = [plc.reader(name) for name in names]
+    last: list[Any] = [object()]  # the values at the previous scan: record only changes
+
     def sample() -> None:
+        values = [get() for get in getters]
+        if values != last[0]:
+            last[0] = values
+            samples.record(plc.now_us, {name: _plain(value) for name, value in zip(names, values)})
+
+    def sample_plainly() -> None:
         samples.record(plc.now_us, {name: _plain(plc.read(name)) for name in names})
+
+    if plain:
+        sample = sample_plainly  # noqa: F811 - the reference path, chosen once
 
     try:
         while plc.now_us < end:

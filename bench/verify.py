@@ -1,0 +1,137 @@
+"""`uitamr verify` as users run it: whole processes, long scenarios, side by side.
+
+    python bench/verify.py [--hours 1] [--stretch 5] [--jobs 1,2] [--skip-rss]
+
+Prints, measured in one run on this machine:
+  1. fx3u-healthy at 60 s and stretched to --hours: the wall time of each whole
+     `uitamr verify --scenario` process and the simulated time per extra wall second
+     (x real time = (long - short virtual) / (long - short wall); start-up, loading and
+     compiling cancel out);
+  2. the same x-real-time figure for every bundled scenario, stretched --stretch times
+     (at least to 600 s, so that the extra time is well above the noise);
+  3. side by side in one process: the run with the watched labels read through accessors
+     resolved once and recorded on change, against the plain path (every label by name,
+     every scan) - the ratio of the two;
+  4. `uitamr verify --matrix --jobs N` for each N: wall time and speed-up against N=1;
+  5. peak RSS of a 1 h and a 10 h run of fx3u-healthy (whole processes, os.wait4).
+Wall-clock figures move with the machine's load; ratios measured side by side much less.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from verifier.verify.runner import run_scenario  # noqa: E402
+from verifier.verify.scenario import load_scenario  # noqa: E402
+
+SCENARIOS = ROOT / "plc" / "scenarios"
+UITAMR = [sys.executable, "-m", "verifier.cli"]
+
+
+def stretched(source: Path, folder: Path, seconds: float) -> Path:
+    """A copy of a bundled scenario with its duration set, its sources made absolute."""
+    text = source.read_text(encoding="utf-8").replace('"../', f'"{SCENARIOS.parent.as_posix()}/')
+    line = f'duration = "{seconds:g}s"'
+    text, count = re.subn(r'^duration = "[^"]*"', line, text, count=1, flags=re.M)
+    if count == 0:
+        text = line + "\n" + text
+    path = folder / f"{source.stem}-{seconds:g}s.toml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def duration_of(path: Path) -> float:
+    return load_scenario(path).duration_us / 1_000_000
+
+
+def run_process(*args) -> tuple[float, int]:
+    """Wall seconds and peak RSS (KiB) of one whole `uitamr` process."""
+    start = time.perf_counter()
+    proc = subprocess.Popen([*UITAMR, *map(str, args)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _, status, usage = os.wait4(proc.pid, 0)
+    wall = time.perf_counter() - start
+    code = os.waitstatus_to_exitcode(status)
+    if code not in (0, 1):
+        raise SystemExit(f"uitamr {' '.join(map(str, args))} exited {code}: {proc.stderr.read().decode()}")
+    proc.stderr.close()
+    return wall, usage.ru_maxrss
+
+
+def best_wall(*args, repeat: int = 3) -> float:
+    return min(run_process(*args)[0] for _ in range(repeat))
+
+
+def x_real_time(short: Path, long: Path, repeat: int = 3) -> tuple[float, float, float]:
+    short_wall = best_wall("verify", "--scenario", short, repeat=repeat)
+    long_wall = best_wall("verify", "--scenario", long, repeat=repeat)
+    extra = max(long_wall - short_wall, 1e-6)
+    return short_wall, long_wall, (duration_of(long) - duration_of(short)) / extra
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--hours", type=float, default=1.0)
+    parser.add_argument("--stretch", type=float, default=5.0)
+    parser.add_argument("--jobs", default=f"1,{os.cpu_count() or 1}")
+    parser.add_argument("--skip-rss", action="store_true")
+    options = parser.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        healthy = SCENARIOS / "fx3u-healthy.toml"
+        short, long = stretched(healthy, folder, 60), stretched(healthy, folder, options.hours * 3600)
+        s, l, x = x_real_time(short, long)
+        print(f"1. uitamr verify fx3u-healthy: 60 s in {s:.2f} s wall, {options.hours:g} h in {l:.2f} s wall "
+              f"-> {x:,.0f}x real time (the {options.hours:g} h costs {l - s:.2f} s more than 60 s)")
+
+        print(f"2. every bundled scenario at its duration and stretched to max({options.stretch:g}x, 600 s) "
+              "(whole processes, best of 3):")
+        worst = None
+        for source in sorted(SCENARIOS.glob("*.toml")):
+            base = duration_of(source)
+            a = stretched(source, folder, base)
+            b = stretched(source, folder, max(base * options.stretch, 600))
+            _, _, x = x_real_time(a, b, repeat=3)
+            worst = x if worst is None else min(worst, x)
+            print(f"   {source.stem:32} {x:10,.0f}x")
+        print(f"   lowest: {worst:,.0f}x")
+
+        scenario = load_scenario(stretched(healthy, folder, 600))
+        fast_start = time.perf_counter()
+        fast = run_scenario(scenario)
+        fast_wall = time.perf_counter() - fast_start
+        plain_start = time.perf_counter()
+        plain = run_scenario(scenario, plain=True)
+        plain_wall = time.perf_counter() - plain_start
+        same = (fast.trace, fast.violations, fast.watched, fast.expectations) == \
+            (plain.trace, plain.violations, plain.watched, plain.expectations)
+        print(f"3. 600 s of fx3u-healthy in one process: accessors + record on change {fast_wall:.2f} s, "
+              f"plain reads every scan {plain_wall:.2f} s -> {plain_wall / fast_wall:.1f}x; same result: {same}")
+
+        jobs = [int(j) for j in options.jobs.split(",")]
+        times = {}
+        for n in jobs:
+            times[n] = best_wall("verify", "--matrix", "--jobs", n, repeat=1)
+        base = times[jobs[0]]
+        print("4. uitamr verify --matrix: " + ", ".join(
+            f"--jobs {n}: {t:.1f} s (x{base / t:.2f})" for n, t in times.items()))
+
+        if not options.skip_rss:
+            one = stretched(healthy, folder, 3600)
+            ten = stretched(healthy, folder, 36000)
+            _, rss_one = run_process("verify", "--scenario", one)
+            _, rss_ten = run_process("verify", "--scenario", ten)
+            print(f"5. peak RSS: 1 h {rss_one / 1024:.0f} MiB, 10 h {rss_ten / 1024:.0f} MiB "
+                  f"(ratio {rss_ten / rss_one:.2f})")
+
+
+if __name__ == "__main__":
+    main()
