@@ -28,20 +28,21 @@ class _ParseContext:
         self.target = "gxworks2"
         self.diagnostics: list[ast.Diagnostic] = []
         self.open_pous: list[ast.Pou] = []
-        self.lines: list[str] = []
+        self.text = ""
 
     def reset(self, file: str, target: str, text: str = "") -> None:
         self.file = file
         self.target = target
-        self.lines = text.splitlines()
+        self.text = text  # split into lines only when a message needs a word of it
         self.diagnostics = []
         self.open_pous = []
 
     def word_at(self, line: int, col: int) -> str:
         """The keyword or name that starts at line:col of the text being parsed."""
-        if not 1 <= line <= len(self.lines):
+        lines = self.text.splitlines()
+        if not 1 <= line <= len(lines):
             return ""
-        return re.match(r"[A-Za-z_0-9]*", self.lines[line - 1][col - 1:]).group().upper()
+        return re.match(r"[A-Za-z_0-9]*", lines[line - 1][col - 1:]).group().upper()
 
     def error(self, line: int, col: int, message: str, severity: str = "error") -> None:
         self.diagnostics.append(ast.Diagnostic(self.file, line, col, severity, message))
