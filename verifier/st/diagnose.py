@@ -235,7 +235,8 @@ def explain(parser: Lark, text: str, pos: int, accepted: set[str]) -> tuple[int,
             return _misspelt(candidate, typo, open_constructs([t for t in before if t is not candidate]))
     stack = open_constructs(before)
     if not stack:
-        return _stray(here)
+        after = tokens[index + 1] if index + 1 < len(tokens) else None
+        return _stray(here, after)
     top = stack[-1]
 
     late = next((o for o in stack if o.late_section is not None), None)
@@ -377,8 +378,15 @@ def _misspelt(tok: Token, meant: str, stack: list[Open]) -> tuple[int, int, str]
     return (*where, f"'{tok.value}' is not a keyword, and nothing is open here to close")
 
 
-def _stray(here: Token | None) -> tuple[int, int, str] | None:
-    """An error outside every construct: a closer with nothing to close."""
+def _stray(here: Token | None, after: Token | None) -> tuple[int, int, str] | None:
+    """An error outside every construct: a closer with nothing to close, or a statement
+    outside a POU."""
+    statement = here is not None and (
+        here.type in BLOCK_CLOSER or here.type in ("EXIT", "RETURN")
+        or (here.type == "IDENT" and after is not None and after.type in ("ASSIGN", "LPAR")))
+    if statement:
+        return (here.line, here.column, f"a statement ({word(here)}) outside a POU: statements go in the body "
+                                        "of a PROGRAM, FUNCTION_BLOCK or FUNCTION (after its declarations)")
     if here is not None and here.type in OPENER_OF:
         opener = OPENER_OF[here.type]
         name = BRACKET_TEXT.get(opener, opener)
