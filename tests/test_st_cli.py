@@ -44,7 +44,7 @@ def test_error_prints_location_source_line_and_caret():
 def test_one_bad_file_does_not_stop_the_others():
     result = run(SYNTAX, BAD, GOOD)
     assert result.exit_code == 1
-    assert f"{SYNTAX}:5:13: error: expected ';' after statement" in result.output
+    assert f"{SYNTAX}:6:1: error: expected ';' at 5:13 to end the statement before 'iX'" in result.output
     assert f"{BAD}:5:7: error" in result.output
     assert f"{BAD}:6:7: error" in result.output
     assert "3 file(s) checked" in result.output

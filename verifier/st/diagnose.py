@@ -338,13 +338,12 @@ def explain(parser: Lark, text: str, pos: int, accepted: set[str]) -> tuple[int,
         if head.type == "FOR":
             needed = "TO" if "TO" in accepted else "DO"
         if needed is not None and needed in accepted and (here is None or here.type != needed):
-            prev = before[-1] if before else None
-            where = prev if prev is not None else here
+            # reported at the token that shows the keyword is missing, naming where it goes
+            prev = before[-1] if before else head
             what = "condition" if head.type in ("IF", "ELSIF", "WHILE") else \
                 "selector" if head.type == "CASE" else ("start value" if needed == "TO" else "end value")
-            line, col = (where.end_line, where.end_column) if prev is not None else (here.line, here.column)
-            return (line, col, f"expected {needed} after the {what} of the {head.type} at "
-                               f"{head.line}:{head.column} (before {word(here)}{_place(here)})")
+            return _at(here, text, f"expected {needed} at {prev.end_line}:{prev.end_column}, after the {what} "
+                                   f"of the {head.type} at {head.line}:{head.column}, before {word(here)}", before)
     return None
 
 
@@ -392,10 +391,6 @@ def _stray(here: Token | None, after: Token | None) -> tuple[int, int, str] | No
         name = BRACKET_TEXT.get(opener, opener)
         return here.line, here.column, f"{word(here)} has no matching {name}: nothing is open here"
     return None
-
-
-def _place(tok: Token | None) -> str:
-    return f" at {tok.line}:{tok.column}" if tok is not None else ""
 
 
 def _at(tok: Token | None, text: str, message: str,

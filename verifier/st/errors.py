@@ -82,12 +82,6 @@ def _token_name(tok) -> str:
     return "the end of the file" if tok.type == "$END" else diagnose.word(tok)
 
 
-def _token_place(tok) -> str:
-    if tok.type == "$END" or tok.line is None:
-        return ""
-    return f" at {tok.line}:{tok.column}"
-
-
 def _semicolon_fixes(exc: UnexpectedToken) -> bool:
     """True when inserting ';' before the unexpected token lets the parse go on."""
     ip = getattr(exc, "interactive_parser", None)
@@ -189,12 +183,14 @@ def describe_syntax_error(exc: UnexpectedInput, text: str, parser: Lark) -> tupl
         closer = "*)" if text[pos] == "(" else "*/"
         return line, col, f"comment '{text[pos:pos + 2]}' is never closed; add '{closer}'"
     if "SEMI" in expected and tok.type != "SEMI" and _semicolon_fixes(exc):
+        # Reported where the mistake becomes certain (the token that cannot continue the
+        # statement), naming the place the ';' goes.
         prev, in_decl = _previous_token(parser, text, pos)
         what = "declaration" if in_decl else "statement"
         if prev is not None:
-            return (prev.end_line, prev.end_column,
-                    f"expected ';' after {what} (before {_token_name(tok)}{_token_place(tok)})")
-        return line, col, f"expected ';' after {what}"
+            return (line, col, f"expected ';' at {prev.end_line}:{prev.end_column} to end the {what} "
+                               f"before {_token_name(tok)}")
+        return line, col, f"expected ';' to end the {what} before {_token_name(tok)}"
     if tok.type == "$END":
         closers = sorted(n for n in expected if n.startswith("END_"))
         if "SEMI" in expected and not closers:
