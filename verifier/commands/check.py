@@ -12,7 +12,6 @@ another one is broken; POUs may use POUs from the other files given.
 from __future__ import annotations
 
 import sys
-from dataclasses import replace
 from pathlib import Path
 
 import click

@@ -51,24 +51,14 @@ class Project:
     def __init__(self, texts: dict[str, str], target: str = "gxworks2", cpu: str | None = None,
                  scan_ms: float = 10, jitter_ms: float = 0, seed: int = 0,
                  stop_on_operation_error: bool | None = None, timer_resolution_ms: int = 1):
-        from verifier import st
-
         editor = target.split(":", 1)[0]
         try:
             self.cpu = profile_for(target, cpu)
         except ValueError as e:
             raise LoadError([ast.Diagnostic("<target>", 0, 0, "error", str(e))]) from None
         self.target = editor
-        files = [st.parse(text, name, target=editor) for name, text in texts.items()]
-        errors = [d for f in files for d in f.diagnostics if d.is_error]
-        if errors:
-            raise LoadError(errors)
-        self.warnings = [d for f in files for d in f.diagnostics if not d.is_error]
-        checked = _run_checker(files, editor)
-        errors = [d for d in checked if d.is_error]
-        if errors:
-            raise LoadError(errors)
-        self.warnings.extend(d for d in checked if not d.is_error)
+        files, warnings = _parsed_and_checked(texts, editor)
+        self.warnings = list(warnings)
         self.files = files
         try:
             self.rt = Runtime(self.cpu, scan_us=round(scan_ms * 1000), jitter_us=round(jitter_ms * 1000),
@@ -394,6 +384,36 @@ def _stop_time(now: int, ms, until_us):
     if ms is not None:
         return now + round(ms * 1000)
     return until_us
+
+
+#: parsed and checked sources by (editor, file names and texts): `uitamr verify` loads
+#: the same library for scenario after scenario; the trees are only read after the check
+_CHECKED: dict[tuple, tuple[list, list]] = {}
+_CHECKED_MAX = 8
+
+
+def _parsed_and_checked(texts: dict[str, str], editor: str) -> tuple[list, list]:
+    """The parsed files and the warnings of parsing and checking them (LoadError for errors)."""
+    from verifier import st
+
+    key = (editor, tuple(texts.items()))
+    found = _CHECKED.get(key)
+    if found is not None:
+        return found
+    files = [st.parse(text, name, target=editor) for name, text in texts.items()]
+    errors = [d for f in files for d in f.diagnostics if d.is_error]
+    if errors:
+        raise LoadError(errors)
+    warnings = [d for f in files for d in f.diagnostics if not d.is_error]
+    checked = _run_checker(files, editor)
+    errors = [d for d in checked if d.is_error]
+    if errors:
+        raise LoadError(errors)
+    warnings.extend(d for d in checked if not d.is_error)
+    if len(_CHECKED) >= _CHECKED_MAX:
+        _CHECKED.pop(next(iter(_CHECKED)))
+    _CHECKED[key] = (files, warnings)
+    return files, warnings
 
 
 def _run_checker(files, target):

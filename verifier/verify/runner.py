@@ -295,7 +295,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     getters = [plc.reader(name) for name in names]
     last: list[Any] = [object()]  # the values at the previous scan: record only changes
 
-    def sample() -> None:
+    def sample_on_change() -> None:
         values = [get() for get in getters]
         if values != last[0]:
             last[0] = values
@@ -304,8 +304,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     def sample_plainly() -> None:
         samples.record(plc.now_us, {name: _plain(plc.read(name)) for name in names})
 
-    if plain:
-        sample = sample_plainly  # noqa: F811 - the reference path, chosen once
+    sample = sample_plainly if plain else sample_on_change  # plain: the reference path
 
     try:
         while plc.now_us < end:
