@@ -20,29 +20,17 @@ from rich.console import Console
 from verifier.commands.emulate import STANDARD_BAUD_RATES, _tcp_endpoint
 from verifier.commands.protocol_options import protocol_settings
 from verifier.commands.report_files import ReportError, check_folders, report_options, write_reports
+from verifier.commands.verify import _Duration
 from verifier.monitor.capture import format_plain
 from verifier.monitor.framer import DEFAULT_TOLERANCE_US, LineTiming
 from verifier.monitor.session import CaptureInfo, MonitorSession
 from verifier.monitor.sources import SerialSource, SourceError, TcpSource, now_us
 from verifier.monitor.view import MonitorView
-from verifier.verify.durations import parse_duration_us
 from verifier.verify.evidence import RuleOptions
 
 EXIT_CLEAN, EXIT_FINDINGS, EXIT_UNUSABLE = 0, 1, 2
 #: how often the rules re-judge the capture while it runs
 CHECK_EVERY_S = 0.5
-
-
-class _Duration(click.ParamType):
-    name = "DURATION"
-
-    def convert(self, value, param, ctx):
-        if isinstance(value, int):
-            return value
-        try:
-            return parse_duration_us(str(value))
-        except ValueError as exc:
-            self.fail(str(exc), param, ctx)
 
 
 def line_options(command):
@@ -52,7 +40,7 @@ def line_options(command):
                      show_default=True, help="Line speed (the robot uses 9600)."),
         click.option("--format", "line_format", type=click.Choice(["8N1", "8E1", "8O1", "8N2"]), default="8N1",
                      show_default=True, help="Data bits, parity, stop bits (the robot uses 8N1)."),
-        click.option("--tolerance", type=_Duration(),
+        click.option("--tolerance", type=_Duration(zero_ok=True),
                      help="How far host timestamps may be off (USB adapter latency): timing rules "
                           f"blame only what is beyond it. Default {DEFAULT_TOLERANCE_US // 1000}ms "
                           "(replay of a JSONL trace: 0)."),

@@ -35,12 +35,14 @@ def bundled_scenarios() -> list[Path]:
 
 
 class _Duration(click.ParamType):
-    """A duration option: a number with a unit, longer than 0 and at most `maximum_us`."""
+    """A duration option: a number with a unit, longer than 0 (or 0 itself with
+    `zero_ok`) and at most `maximum_us`."""
 
     name = "duration"
 
-    def __init__(self, maximum_us: int | None = None):
+    def __init__(self, maximum_us: int | None = None, zero_ok: bool = False):
         self.maximum_us = maximum_us
+        self.zero_ok = zero_ok
 
     def convert(self, value, param, ctx):
         if isinstance(value, int):
@@ -49,7 +51,7 @@ class _Duration(click.ParamType):
             us = parse_duration_us(value)
         except ValueError as exc:
             self.fail(str(exc), param, ctx)
-        if us <= 0:
+        if us < 0 or (us == 0 and not self.zero_ok):
             self.fail(f"{value!r} must be longer than 0", param, ctx)
         if self.maximum_us is not None and us > self.maximum_us:
             self.fail(f"{value!r} is longer than the limit of {format_duration(self.maximum_us)} of virtual time; "
