@@ -87,6 +87,18 @@ def test_a_frame_in_two_chunks_with_a_usb_pause_is_one_frame():
     assert whole.data == STOP
 
 
+def test_a_chunk_that_ends_one_byte_into_the_reply_does_not_break_it():
+    reply = bytes.fromhex("01 01 03 00 00 00 3C 4E")
+    session = session_of([Chunk(20_000, READ + reply[:1]), Chunk(36_000, reply[1:])])  # 16 ms latency
+    assert [(f.direction, f.data) for f in session.frames] == [("tx", READ), ("rx", reply)]
+
+
+def test_a_valid_frame_with_garbage_after_it_is_one_frame_as_on_the_wire():
+    reply = bytes.fromhex("01 01 03 00 00 00 3C 4E")
+    session = session_of([Chunk(20_000, READ), Chunk(40_000, reply + b"\xA5\x5A\xFF")])
+    assert [f.data for f in session.frames] == [READ, reply + b"\xA5\x5A\xFF"]
+
+
 def test_a_request_and_its_reply_in_one_chunk_are_two_frames():
     reply = protocol.encode(protocol.StatusReply(1, protocol.Query.TASK, 0, 0), SETTINGS) \
         if hasattr(protocol, "StatusReply") and False else bytes.fromhex("01 01 03 00 00 00 3C 4E")
@@ -129,7 +141,7 @@ def test_any_byte_stream_gives_frames_and_findings_never_a_crash(pieces, toleran
 
 # --------------------------------------------------------------------- same rules as `uitamr verify`
 @pytest.mark.parametrize("name", ["fx3u-healthy", "fx3u-no-reply", "fx3u-bad-crc", "fx3u-late-reply",
-                                  "fx3u-wrong-address", "fx3u-exception", "q-exception",
+                                  "fx3u-wrong-address", "fx3u-exception", "fx3u-garbage", "q-exception",
                                   "fx3u-panel-all-commands", "fx5u-healthy"])
 def test_a_verify_trace_as_raw_bytes_gets_the_same_frames_and_verdicts(name):
     """The simulated PLC's traffic, as the host would see it with no latency (each frame

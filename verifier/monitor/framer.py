@@ -12,6 +12,9 @@ incomplete only when it exceeds t3.5 plus the host's timing tolerance.
 Times: a chunk's bytes are taken to have arrived back to back, the last one when the read
 returned, so a frame starts one frame-time before the chunk that completes it (or at its
 first chunk's estimated start when it came in several).
+
+With a tolerance of 0 the host's times are taken as exact (a capture with the wire's
+timing): frames end by the t3.5 silence alone, exactly as Modbus RTU defines them.
 """
 from __future__ import annotations
 
@@ -138,19 +141,33 @@ class Framer:
     def _silence_ends_frame(self, t_us: int) -> bool:
         gap = t_us - (self._last_us if self._last_us is not None else t_us)
         length = known_length(self._buffer)
-        if length is not None and len(self._buffer) < length:
+        undecided = length is not None and (len(self._buffer) < length or len(self._buffer) == length + 1)
+        if undecided:  # a frame, or the next frame's first byte, still incomplete
             return gap >= self.timing.silence_us + self.timing.tolerance_us
         return gap >= self.timing.silence_us
 
     def _cut(self) -> list[Frame]:
-        """Whole frames at the front of the buffer, by their known length."""
+        """Whole frames at the front of the buffer, by their known length, where the
+        content shows where one frame ends: the bytes after it begin another frame of this
+        protocol. A frame followed by bytes that begin none (a robot appending garbage to a
+        reply, noise) is not cut: it ends at the silence, as on the wire. A frame of known
+        length with nothing after it yet is complete at once, unless the host's times are
+        exact (no tolerance): then frames end by the t3.5 silence alone, as Modbus RTU
+        defines them."""
         out: list[Frame] = []
+        exact = self.timing.tolerance_us == 0
         while True:
             length = known_length(self._buffer)
-            if length is None:
+            if length is None or len(self._buffer) < length:
                 if len(self._buffer) >= MAX_FRAME:  # noise with no frame in it: let it go
                     out += self.flush()
                 return out
-            if len(self._buffer) < length:
+            rest = self._buffer[length:length + 2]
+            if len(self._buffer) == length and not exact:
+                out.append(self._take(length))
+                continue
+            if len(rest) < 2 or known_length(rest) is None:
+                if len(self._buffer) >= MAX_FRAME:
+                    out += self.flush()
                 return out
             out.append(self._take(length))
