@@ -38,7 +38,7 @@ def line_options(command):
     options = (
         click.option("--baud", type=click.Choice([str(b) for b in STANDARD_BAUD_RATES]), default="9600",
                      show_default=True, help="Line speed (the robot uses 9600)."),
-        click.option("--format", "line_format", type=click.Choice(["8N1", "8E1", "8O1", "8N2"]), default="8N1",
+        click.option("--framing", "line_format", type=click.Choice(["8N1", "8E1", "8O1", "8N2"]), default="8N1",
                      show_default=True, help="Data bits, parity, stop bits (the robot uses 8N1)."),
         click.option("--tolerance", type=_Duration(zero_ok=True),
                      help="How far host timestamps may be off (USB adapter latency): timing rules "
