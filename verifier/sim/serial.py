@@ -56,7 +56,6 @@ class SerialChannel:
         self.knows_quiet = False
         self.format = NINE_SIX_8N1
         self.sent: list[SentFrame] = []
-        self.received: list[tuple[int, int]] = []  # every byte that reached the port
 
     def attach(self, endpoint) -> None:
         for attr in ("send", "receive_until"):
@@ -85,7 +84,4 @@ class SerialChannel:
         if self.knows_quiet and endpoint.now_us <= t_us < endpoint.quiet_until_us:
             endpoint.now_us = t_us  # all a call would do on a quiet line (Line.quiet_until_us)
             return ()
-        got = endpoint.receive_until(t_us)
-        if got:
-            self.received.extend(got)
-        return got
+        return endpoint.receive_until(t_us)

@@ -6,8 +6,10 @@ after the run (rules, expectations, reports) works on plain data.
 """
 from __future__ import annotations
 
+import os
 import re
 import time
+from functools import lru_cache
 from pathlib import Path
 from dataclasses import replace
 from typing import Any, Callable
@@ -165,7 +167,14 @@ def _relative(origin: str | None) -> str | None:
     if not origin:
         return origin
     file, _, rest = origin.partition(":")
-    return f"{_display_path(Path(file))}:{rest}"
+    return f"{_shown_file(file, os.getcwd())}:{rest}"
+
+
+@lru_cache(maxsize=1024)
+def _shown_file(file: str, cwd: str) -> str | None:
+    """`_display_path` of one ST file, worked out once per file and working folder (every
+    frame of a long run names the file that sent it)."""
+    return _display_path(Path(file))
 
 
 def _plain(value: Any) -> Any:

@@ -1,6 +1,8 @@
 """UITAMR-CRC and UITAMR-FORMAT: every frame the PLC sends, byte by byte."""
 from __future__ import annotations
 
+from bisect import bisect_right
+
 from verifier import protocol
 
 from ..evidence import RunEvidence, Violation
@@ -33,6 +35,7 @@ def check_format(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
     """Judge the layout of each request; a bad CRC is UITAMR-CRC's business, not this rule's."""
     settings = evidence.settings
     violations = []
+    gaps = _gap_events(evidence.events)
     for frame in traffic.tx:
         data = bytes(frame.data)
         if len(data) >= 3 and not protocol.crc_ok(data):
@@ -48,7 +51,7 @@ def check_format(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
                     f"byte 0: addressed to slave {request.address}, the robot is slave "
                     f"{settings.address}"
                 )
-        gap = _gap_inside(frame, evidence.events)
+        gap = _gap_inside(frame, gaps)
         if gap is not None and problem is None:
             problem = (
                 f"{gap.message}; a Modbus RTU frame must be sent as one continuous stream "
@@ -67,9 +70,17 @@ def check_format(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
     return violations
 
 
-def _gap_inside(frame, events):
-    """The line's "gap" event inside this PLC frame, if the PLC paused in mid-frame."""
-    for event in events:
-        if getattr(event, "kind", "") == "gap" and frame.t_start_us < event.t_us < frame.t_end_us:
-            return event
+def _gap_events(events) -> tuple[list[int], list]:
+    """The line's "gap" events (a pause inside a PLC frame) and their times, in time order."""
+    found = sorted((e for e in events if getattr(e, "kind", "") == "gap"), key=lambda e: e.t_us)
+    return [e.t_us for e in found], found
+
+
+def _gap_inside(frame, gaps: tuple[list[int], list]):
+    """The line's "gap" event inside this PLC frame, if the PLC paused in mid-frame (the
+    first one after the frame's start: a bisection, so a long run stays linear)."""
+    times, found = gaps
+    index = bisect_right(times, frame.t_start_us)
+    if index < len(times) and times[index] < frame.t_end_us:
+        return found[index]
     return None
