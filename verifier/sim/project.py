@@ -279,6 +279,14 @@ class Project:
             raise ValueError(f"channel {channel} does not exist on the {self.cpu.name} CPU")
         self.rt.channel(channel).attach(endpoint)
 
+    def attach_tcp(self, endpoint) -> None:
+        """Connect the PLC's Ethernet port (FX5U socket / QJ71E71 fixed buffer instructions)
+        to a peer with the verifier.link.converter.Converter interface."""
+        for attr in ("open", "send", "receive_until", "peer_closed", "close"):
+            if not callable(getattr(endpoint, attr, None)):
+                raise TypeError(f"TCP endpoint needs a {attr}() method (the verifier.link.converter.Converter interface)")
+        self.rt.tcp_endpoint = endpoint
+
     def serial_log(self, channel: str):
         """Frames the PLC sent on a channel: [SentFrame(t_start_us, t_end_us, data, origin)]."""
         return list(self.rt.channel(channel).sent)

@@ -45,6 +45,7 @@ class Runtime:
         self.ports: dict[str, SerialChannel] = {}  # channel name ("fx3:1") -> byte stream
         self.buffers: dict[int, list[int]] = {}  # module start I/O -> buffer memory words
         self.origins: dict[str, str] = {}  # channel -> location of the last send-request flag write
+        self.tcp_endpoint = None  # the Ethernet port's peer (verifier.link.converter.Converter)
         self.stop_on_operation_error = (cpu.stops_on_op_error if stop_on_operation_error is None
                                         else stop_on_operation_error)
         self._always_on = [self.dev.address(n) for n in cpu.always_on]
@@ -69,7 +70,7 @@ class Runtime:
         """Buffer memory of the intelligent module at start I/O `module` (U0\\G...)."""
         buf = self.buffers.get(module)
         if buf is None:
-            buf = self.buffers[module] = [0] * 0x4000
+            buf = self.buffers[module] = [0] * 0x6000  # up to 5FFFH (QJ71E71 status area)
         return buf
 
     def channel(self, name: str) -> SerialChannel:

@@ -16,6 +16,7 @@ from typing import Any, Callable
 
 from verifier.amr.robot import Robot
 from verifier.link import Line
+from verifier.link.converter import Converter
 
 from .evidence import RunEvidence, Samples
 from .expectations import judge
@@ -33,7 +34,7 @@ _DEVICE = DEVICE_NAME
 class _Plc:
     """The simulated PLC as the runner uses it: load, attach the line, scan, read, write."""
 
-    def __init__(self, scenario: Scenario, line: Line):
+    def __init__(self, scenario: Scenario, line: Line | Converter):
         import verifier
         from verifier.sim.errors import LoadError
 
@@ -54,7 +55,10 @@ class _Plc:
         except LoadError as exc:
             raise UnusableInput(str(exc)) from None
         try:
-            self.project.attach_serial(scenario.serial_channel, line)
+            if isinstance(line, Converter):
+                self.project.attach_tcp(line)
+            else:
+                self.project.attach_serial(scenario.serial_channel, line)
         except ValueError as exc:
             raise UnusableInput(f"{_where(scenario)}: {exc}") from None
         self.name = self._program_name(scenario)
@@ -285,7 +289,9 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     wall_start = time.perf_counter()
     robot = Robot(scenario.settings, scenario.robot, list(scenario.faults))
     line = Line(robot)
-    plc = _Plc(scenario, line)
+    # the TCP route: the PLC talks to a converter, the rules judge the line behind it
+    converter = Converter(line, scenario.converter) if scenario.converter is not None else None
+    plc = _Plc(scenario, converter or line)
     scenario = _check_labels(plc, scenario)
     _apply_plc_settings(plc, scenario)
     names = scenario.variables()
@@ -323,10 +329,14 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     except SimulationError as exc:
         aborted = str(exc)
         end = min(end, plc.now_us)
-    line.advance(max(end, line.now_us))
+    if converter is not None:
+        converter.advance(max(end, converter.now_us))
+    else:
+        line.advance(max(end, line.now_us))
     trace = [TraceRecord(f.t_start_us, f.t_end_us, f.direction, bytes(f.data), _relative(f.origin)) for f in line.trace]
     trace = [f for f in trace if f.t_start_us < end]
-    events = [LineEvent(e.t_us, e.kind, e.message) for e in line.events if e.t_us <= end]
+    line_events = line.events if converter is None else sorted(line.events + converter.events, key=lambda e: e.t_us)
+    events = [LineEvent(e.t_us, e.kind, e.message) for e in line_events if e.t_us <= end]
     evidence = RunEvidence(scenario.settings, trace, end, events, samples, scenario.options, aborted is not None)
     traffic = analyse(trace, scenario.settings, scenario.options)
     violations = check_all(evidence, traffic)
@@ -346,7 +356,8 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         settings=scenario.settings,
         min_period_us=scenario.options.min_period_us,
         reply_timeout_us=scenario.options.reply_timeout_us,
-        faults=[fault.describe() for fault in scenario.faults],
+        faults=[fault.describe() for fault in scenario.faults]
+        + ([scenario.converter.describe()] if scenario.converter is not None else []),
         trace=trace,
         events=events,
         violations=violations,
@@ -358,6 +369,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         wall_s=time.perf_counter() - wall_start,
         notes=list(scenario.notes) + (
             [] if any(f.direction == "tx" for f in trace)
-            else [f"the program sent nothing on {scenario.serial_channel} in the whole run"]
+            else [f"the program sent nothing on {scenario.serial_channel} in the whole run"
+                  + (" (nothing reached the robot's line through the converter)" if converter is not None else "")]
         ),
     )

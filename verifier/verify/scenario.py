@@ -18,6 +18,8 @@ from verifier.amr.faults import Fault, check_fault_addresses
 from verifier.amr.schema import ConfigError
 from verifier.tomlpos import Place, decode_error_position, place_of_key
 
+from verifier.link.converter import ConverterConfig
+
 from .conditions import Condition, ConditionError, parse_condition
 from .durations import format_duration, parse_duration_us
 from .evidence import RuleOptions
@@ -41,7 +43,7 @@ DEFAULT_RESPONSE_SIGNAL = "o_bErr"
 TOP_KEYS = (
     "name", "description", "sources", "program", "platform", "channel", "duration", "scan",
     "scan_jitter", "seed", "watch", "protocol", "robot", "faults", "inputs", "expect", "rules",
-    "response_handling", "initial", "c24",
+    "response_handling", "initial", "c24", "converter",
 )
 PROTOCOL_KEYS = ("address", "field_order", "codes_10_13", "status_order", "manual_stop_counts_as_stop")
 INPUT_KEYS = ("at", "set", "pulse")
@@ -49,11 +51,16 @@ EXPECT_KEYS = KINDS + ("after", "within", "name")
 RULES_KEYS = ("min_period", "reply_timeout")
 RESPONSE_KEYS = ("signal", "within")
 C24_KEYS = ("unit", "channel", "no_reception", "byte_units", "receive_count", "end_code")
+CONVERTER_KEYS = ("ip", "port", "delay", "connect", "packing", "refuse_until", "unreachable", "drops",
+                  "split_reply", "split_gap")
+#: The platforms with an Ethernet port the library drives (FX5U built-in, Q + QJ71E71-100).
+TCP_PLATFORMS = ("fx5u", "q")
+TCP_CHANNEL = "tcp"
 #: Buffer memory of an intelligent module, as GX Works writes it: U0\G164, U3E\G10.
 BUFFER_MEMORY = re.compile(r"^U([0-9A-F]{1,3})\\G(\d+)$", re.IGNORECASE)
-#: Highest buffer-memory word the simulator models per module (16#3FFF). ASSUMPTION: enough
-#: for the QJ71C24N areas the library uses (the module's map ends at 7FFFH).
-BUFFER_WORDS = 0x4000
+#: Buffer-memory words the simulator models per module (0..5FFFH). ASSUMPTION: enough for
+#: the QJ71C24N areas and the QJ71E71 status words (5000H, 5005H) the library uses.
+BUFFER_WORDS = 0x6000
 #: Device names (X0, M8000, D100, SM400, ...) address the device memory, not labels.
 DEVICE_NAME = re.compile(r"^(?:(?:X|Y|B|W|SB|SW)[0-9A-F]+|(?:M|L|F|S|T|C|D|R|ZR|SM|SD)\d+)$", re.IGNORECASE)
 _LABEL_PATH = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\[\d+\])*(\.[A-Za-z_][A-Za-z0-9_]*(\[\d+\])*)*$")
@@ -133,6 +140,7 @@ class Scenario:
     key_lines: dict[str, Place | None] = field(default_factory=dict, compare=False)
     initial: tuple[tuple[str, Value], ...] = ()  # devices and buffer memory before the first scan
     c24: tuple[C24Setting, ...] = ()
+    converter: ConverterConfig | None = None  # the TCP route: the robot behind a converter
     notes: tuple[str, ...] = ()  # for the reports: how this run differs from its file
     response_signal_key: str = "response_handling.signal"  # or "--response-signal" when given there
 
@@ -142,6 +150,8 @@ class Scenario:
 
     @property
     def serial_channel(self) -> str:
+        if self.converter is not None:
+            return TCP_CHANNEL
         return self.channel or PLATFORMS[self.platform][1]
 
     def variables(self) -> list[str]:
@@ -366,6 +376,10 @@ class _Reader:
             self.c24(item, f"c24[{i}]", platform)
             for i, item in enumerate(self.array_of_tables(data.get("c24", []), "c24"))
         )
+        converter = self.converter(data["converter"], platform) if "converter" in data else None
+        if converter is not None and channel is not None:
+            raise self.fail("channel", "a scenario with [converter] reaches the robot over TCP: "
+                                       "it has no serial channel; remove 'channel'")
         keys = [f"initial.{name}" for name, _ in initial] + [setting.key for setting in c24]
         keys += [f"{e.key}.{e.kind}" for e in expectations if e.condition is not None]
         keys += [f"{step.key}.set" for step in inputs] + [f"watch[{i}]" for i in range(len(watch))]
@@ -375,8 +389,45 @@ class _Reader:
             platform=platform, channel=channel, duration_us=duration, scan_us=scan, scan_jitter_us=jitter, seed=seed,
             watch=watch, settings=settings, robot=robot, faults=faults, inputs=inputs,
             expectations=expectations, options=options, response_signal_given=signal_given,
-            key_lines={key: self.line_of(key) for key in keys}, initial=initial, c24=c24,
+            key_lines={key: self.line_of(key) for key in keys}, initial=initial, c24=c24, converter=converter,
         )
+
+    def converter(self, value: Any, platform: str) -> ConverterConfig:
+        item = self.table(value, "converter")
+        self.only(item, CONVERTER_KEYS, "converter")
+        if platform not in TCP_PLATFORMS:
+            raise self.fail("converter", f"the TCP route needs a PLC with an Ethernet port the library drives "
+                                         f"({' or '.join(TCP_PLATFORMS)}); this scenario's platform is {platform!r}")
+        config = ConverterConfig()
+        changes: dict[str, Any] = {}
+        if "ip" in item:
+            ip = self.string(item["ip"], "converter.ip")
+            parts = ip.split(".")
+            if len(parts) != 4 or not all(p.isdigit() and int(p) <= 255 for p in parts):
+                raise self.fail("converter.ip", f"expected an IPv4 address like \"192.168.3.50\", got {ip!r}")
+            changes["ip"] = ".".join(str(int(p)) for p in parts)
+        if "port" in item:
+            port = item["port"]
+            if isinstance(port, bool) or not isinstance(port, int) or not 1 <= port <= 65535:
+                raise self.fail("converter.port", f"expected a TCP port 1..65535, got {_shown(port)}")
+            changes["port"] = port
+        for key, attr in (("delay", "delay_us"), ("connect", "connect_us"), ("packing", "pack_us"),
+                          ("refuse_until", "refuse_until_us"), ("unreachable", "unreachable_us"),
+                          ("split_gap", "split_gap_us")):
+            if key in item:
+                changes[attr] = self.duration(item[key], f"converter.{key}",
+                                              positive=key in ("unreachable", "split_gap"))
+        if "drops" in item:
+            drops = item["drops"]
+            if not isinstance(drops, list):
+                raise self.fail("converter.drops", "expected a list of times, e.g. [\"20s\", \"40s\"]")
+            changes["drops"] = tuple(self.duration(t, f"converter.drops[{i}]", positive=False)
+                                     for i, t in enumerate(drops))
+        if "split_reply" in item:
+            if not isinstance(item["split_reply"], bool):
+                raise self.fail("converter.split_reply", f"expected true or false, got {_shown(item['split_reply'])}")
+            changes["split_reply"] = item["split_reply"]
+        return replace(config, **changes)
 
     def initial(self, value: Any) -> tuple[tuple[str, Value], ...]:
         table = self.table(value, "initial")

@@ -50,6 +50,15 @@ SPECS = {s.name: s for s in (
     InstructionSpec("ADPRW", ("val", "val", "val", "val", "blk"), frozenset({"fx3"}), False),
     InstructionSpec("G_OUTPUT", ("val", "blk", "src", "dst"), frozenset({"q"})),
     InstructionSpec("G_INPUT", ("val", "blk", "dst", "dst"), frozenset({"q"})),
+    # Ethernet (tcp.py): run once on the rising edge of EN, so called on every scan
+    InstructionSpec("SP_SOCOPEN", ("val", "val", "blk", "dst"), frozenset({"fx5"}), False, always=True),
+    InstructionSpec("SP_SOCSND", ("val", "val", "blk", "src", "dst"), frozenset({"fx5"}), False, always=True),
+    InstructionSpec("SP_SOCRCV", ("val", "val", "blk", "dst", "dst"), frozenset({"fx5"}), False, always=True),
+    InstructionSpec("SP_SOCCLOSE", ("val", "val", "blk", "dst"), frozenset({"fx5"}), False, always=True),
+    InstructionSpec("ZP_OPEN", ("val", "val", "blk", "dst"), frozenset({"q"}), False, always=True),
+    InstructionSpec("ZP_BUFSND", ("val", "val", "blk", "src", "dst"), frozenset({"q"}), False, always=True),
+    InstructionSpec("ZP_BUFRCV", ("val", "val", "blk", "dst", "dst"), frozenset({"q"}), False, always=True),
+    InstructionSpec("ZP_CLOSE", ("val", "val", "blk", "dst"), frozenset({"q"}), False, always=True),
 )}
 # FX5's ADPRW has a completion-bits operand after the data block.
 FX5_ADPRW = InstructionSpec("ADPRW", ("val", "val", "val", "val", "blk", "dst"), frozenset({"fx5"}), False)
@@ -78,6 +87,8 @@ class InstructionSet:
         self._rs2: dict[int, Rs2Port] = {}
         self._c24 = {}
         self._adprw = {}
+        self._socket = None
+        self._e71 = {}
         fam = rt.cpu.family
         self._eight_bit = "M8161" if fam == "fx3" else "SM8161"
 
@@ -196,3 +207,53 @@ class InstructionSet:
         else:
             d2, (loc_id,) = None, rest
         return self.adprw_port(1).call(bool(en), s, s1, s2, s3, s4d, d2, loc_id)
+
+    # -- Ethernet ------------------------------------------------------------------------
+    def socket_port(self):
+        from .tcp import SocketPort
+
+        if self._socket is None:
+            self._socket = SocketPort(self.rt)
+        return self._socket
+
+    def e71(self, un):
+        from .tcp import FixedBufferPort
+
+        un = _module_number(un)
+        port = self._e71.get(un)
+        if port is None:
+            port = self._e71[un] = FixedBufferPort(self.rt, un)
+        return port
+
+    def SP_SOCOPEN(self, en, u, s1, s2, d, loc_id):
+        self.socket_port().sp_socopen(en, u, s1, s2, d, loc_id)
+
+    def SP_SOCSND(self, en, u, s1, s2, s3, d, loc_id):
+        self.socket_port().sp_socsnd(en, u, s1, s2, s3, d, loc_id)
+
+    def SP_SOCRCV(self, en, u, s1, s2, d1, d2, loc_id):
+        self.socket_port().sp_socrcv(en, u, s1, s2, d1, d2, loc_id)
+
+    def SP_SOCCLOSE(self, en, u, s1, s2, d, loc_id):
+        self.socket_port().sp_socclose(en, u, s1, s2, d, loc_id)
+
+    def ZP_OPEN(self, en, un, s1, s2, d, loc_id):
+        self.e71(un).zp_open(en, s1, s2, d, loc_id)
+
+    def ZP_BUFSND(self, en, un, s1, s2, s3, d, loc_id):
+        self.e71(un).zp_bufsnd(en, s1, s2, s3, d, loc_id)
+
+    def ZP_BUFRCV(self, en, un, s1, s2, d1, d2, loc_id):
+        self.e71(un).zp_bufrcv(en, s1, s2, d1, d2, loc_id)
+
+    def ZP_CLOSE(self, en, un, s1, s2, d, loc_id):
+        self.e71(un).zp_close(en, s1, s2, d, loc_id)
+
+
+def _module_number(un) -> int:
+    """The module's start I/O number / 16 from a Un operand: a number (16#2) or a string
+    'U2' / '02' as the ladder form "Un" writes it."""
+    if isinstance(un, str):
+        text = un.strip().upper()
+        return int(text[1:] if text.startswith("U") else text or "0", 16)
+    return int(un) & 0xFFFF
