@@ -108,7 +108,7 @@ class Converter:
             return OpenResult(False, t_us + cfg.unreachable_us, "unreachable", 0)
         if port != cfg.port:
             self._event(t_us, "converter.refused",
-                        f"the PLC opens a connection to {target}: refused, the converter listens on port {cfg.port}")
+                        f"the PLC opens a connection to {target}: refused, the converter listens at {cfg.ip}:{cfg.port}")
             return OpenResult(False, done, "refused", 0)
         if t_us < cfg.refuse_until_us:
             self._event(t_us, "converter.refused",
