@@ -160,7 +160,7 @@ def test_matrix_runs_user_sources_under_the_bundled_robot_and_faults_of_their_pl
                     "--response-signal", "fbEngine.o_bErr")
     assert result.exit_code == 0, result.output
     data = json.loads(report.read_text())
-    fx5 = [load_scenario(p) for p in bundled_scenarios() if load_scenario(p).platform == "fx5u"]
+    fx5 = [s for s in map(load_scenario, bundled_scenarios()) if s.platform == "fx5u" and s.converter is None]
     names = [s["name"] for s in data["scenarios"]]
     assert set(names) < {s.name for s in fx5} and len(names) == len(fx5) - 1
     for scenario in data["scenarios"]:
@@ -169,6 +169,24 @@ def test_matrix_runs_user_sources_under_the_bundled_robot_and_faults_of_their_pl
         assert any("not applied" in note and "operator input(s)" in note for note in scenario["notes"])
     assert any("also stands for" in note for s in data["scenarios"] for note in s["notes"])
     assert "note: bundled scenario run against your sources" in result.output
+
+
+def test_matrix_of_a_tcp_program_runs_the_converter_scenarios_only(tmp_path):
+    """The FX5U TCP example (its library folder also holds the serial port FBs) runs under the
+    bundled FX5U converter scenarios, not the serial ones; a converter refusing connections at
+    first moves the power-on stop's window after the refusals."""
+    from verifier.verify.scenario import load_scenario
+
+    report = tmp_path / "m.json"
+    sources = [PLC / d for d in ("core", "fx5", "examples/common")] + \
+        [PLC / "examples" / "fx5" / "UITAMR_ExampleTcpFx5.st"]
+    result = invoke(*sources, "--matrix", "--duration", "8s", "--json", report)
+    assert result.exit_code == 0, result.output
+    data = json.loads(report.read_text())
+    tcp = {s.name for s in map(load_scenario, bundled_scenarios()) if s.platform == "fx5u" and s.converter}
+    assert {s["name"] for s in data["scenarios"]} == tcp and len(tcp) == 5
+    refused = next(s for s in data["scenarios"] if "refuses" in s["name"])
+    assert [e["expectation"] for e in refused["expectations"]] == ["sent stop within 5 s after 3 s"]
 
 
 def test_matrix_needs_a_platform_it_can_tell(tmp_path):
@@ -188,7 +206,7 @@ def test_matrix_needs_a_platform_it_can_tell(tmp_path):
 
 def test_a_plain_run_tells_the_platform_from_the_sources(tmp_path):
     """No --platform: Q sources (G_OUTPUT) run on the Q, not on the default FX3U."""
-    q_sources = [PLC / "core", PLC / "q", PLC / "examples" / "common", PLC / "examples" / "q"]
+    q_sources = [PLC / "core", PLC / "q", PLC / "examples" / "common", PLC / "examples" / "q" / "UITAMR_ExampleQ.st"]
     report = tmp_path / "q.json"
     result = invoke(*q_sources, "--duration", "2s", "--json", report)
     assert result.exit_code == 0, result.output

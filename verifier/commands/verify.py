@@ -66,7 +66,7 @@ def _unusable(message: str) -> None:
 
 def _scenarios(sources, program, platform, channel, scenario_files, matrix, duration, scan, seed) -> list[Scenario]:
     from verifier.verify.matrix import for_user_sources, without_repeats
-    from verifier.verify.platform import infer_platform, platforms_that_load
+    from verifier.verify.platform import infer_platform, platforms_that_load, uses_tcp_route
 
     resolved = _source_files(sources) if sources else ()
     scenario_files = _scenario_files(scenario_files)
@@ -86,9 +86,12 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
         # the user's program under the robot/fault set of every bundled scenario of its platform
         platform = platform or infer_platform(resolved)
         bundled = [load_scenario(f) for f in bundled_files]
-        bundled = [s.with_overrides(duration_us=duration, scan_us=scan, seed=seed) for s in bundled if s.platform == platform]
+        tcp = uses_tcp_route(resolved, program)  # serial programs under serial scenarios, TCP ones behind a converter
+        bundled = [s.with_overrides(duration_us=duration, scan_us=scan, seed=seed) for s in bundled
+                   if s.platform == platform and (s.converter is not None) == tcp]
         if not bundled:
-            raise UnusableInput(f"no bundled scenario is written for the {platform}")
+            route = "over TCP" if tcp else "on a serial line"
+            raise UnusableInput(f"no bundled scenario is written for the {platform} {route}")
         scenarios = [s.with_overrides(**overrides) for s in own]
         scenarios += without_repeats([for_user_sources(s, resolved, program, channel) for s in bundled])
     else:

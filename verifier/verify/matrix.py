@@ -5,7 +5,7 @@ that program's buttons (X20 starts the Q example's cycle), its expectations and 
 labels name that program's labels, its [initial] device values are that program's, and its
 response signal is that program's error output. None of that means anything for another
 program, so against user sources a bundled scenario keeps only what is about the robot,
-the line and the serial module: the platform, the robot, the faults and their timing, the
+the line and the serial module: the platform, the converter of the TCP route, the robot, the faults and their timing, the
 protocol settings, the run and scan times, the QJ71C24N settings ([[c24]], which every
 installation must make in GX Works — docs/import-gxworks2.md) and every rule. It expects what every program must do — send the
 power-on stop and have it answered within 5 s — and UITAMR-RESPONSE-HANDLING watches
@@ -35,6 +35,8 @@ def for_user_sources(scenario: Scenario, sources: tuple[Path, ...], program: str
     if scenario.response_signal_given:
         left_out.append(f"its response signal ({scenario.options.response_signal})")
     example = scenario.program or "the bundled example"
+    # a converter that refuses connections at first: the stop can only be answered after
+    reachable_from = min(scenario.converter.refuse_until_us, scenario.duration_us // 2) if scenario.converter else 0
     note = (
         f"bundled scenario run against your sources: robot, faults, timing{', C24 settings' if scenario.c24 else ''} "
         f"and every rule applied, "
@@ -45,9 +47,9 @@ def for_user_sources(scenario: Scenario, sources: tuple[Path, ...], program: str
         scenario,
         sources=sources,
         program=program,
-        channel=channel,
+        channel=None if scenario.converter is not None else channel,
         inputs=(),
-        expectations=(power_on_stop_expectation(scenario.duration_us, scenario.settings.address),),
+        expectations=(power_on_stop_expectation(scenario.duration_us, scenario.settings.address, reachable_from),),
         watch=(),
         initial=(),
         options=replace(scenario.options, response_signal=parse_condition(DEFAULT_RESPONSE_SIGNAL)),
@@ -62,7 +64,8 @@ def without_repeats(scenarios: list[Scenario]) -> list[Scenario]:
     once their example-specific parts are gone run once; the kept one names the others."""
     kept: dict[str, Scenario] = {}
     for scenario in scenarios:
-        identity = repr((scenario.platform, scenario.channel, scenario.settings, scenario.robot, scenario.faults,
+        identity = repr((scenario.platform, scenario.channel, scenario.converter, scenario.settings, scenario.robot,
+                         scenario.faults,
                          scenario.duration_us, scenario.scan_us, scenario.scan_jitter_us, scenario.seed,
                          scenario.options))  # repr: some of these hold dicts
         if identity in kept:

@@ -8,6 +8,7 @@ platform-specific loads everywhere and the platform cannot be told.
 """
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from .result import UnusableInput
@@ -49,3 +50,48 @@ def infer_platform(sources: tuple[Path, ...]) -> str:
         f"cannot tell the platform from the sources: they load on {', '.join(fits)} alike (they use no "
         "device or instruction of one platform only); say --platform " + "|".join(fits)
     )
+
+
+
+_COMMENT = re.compile(r"\(\*.*?\*\)|//[^\n]*", re.DOTALL)
+_ETHERNET_CALL = re.compile(r"\b(?:SP_SOC(?:OPEN|SND|RCV|CLOSE)|ZP_(?:OPEN|BUFSND|BUFRCV|CLOSE))\s*\(", re.IGNORECASE)
+
+
+def uses_tcp_route(sources: tuple[Path, ...], program: str | None = None) -> bool:
+    """Does the PROGRAM that runs (`program`, else every PROGRAM in the sources) reach an
+    Ethernet instruction (FX5U socket, QJ71E71 fixed buffer), through the FB instances it
+    declares? Then it reaches the robot over TCP, through a converter (bundled `*-tcp-*`
+    scenarios). A library folder holding serial and Ethernet port FBs side by side does
+    not make a serial program a TCP one."""
+    from verifier import st
+    from verifier.st.ast import ArrayType, NamedType
+    from verifier.st.source import read_source
+
+    pous, calls = {}, set()
+    for path in sources:
+        text, _ = read_source(path)  # an unreadable file is reported where the sources load
+        lines = text.splitlines()
+        for pou in st.parse(text, str(path)).pous:
+            pous[pou.key] = pou
+            own = "\n".join(lines[pou.span.line - 1:pou.span.end_line]) if pou.span.line else text
+            if _ETHERNET_CALL.search(_COMMENT.sub(" ", own)):
+                calls.add(pou.key)
+    if program is not None:
+        todo = [program.upper()]
+    else:
+        todo = [key for key, pou in pous.items() if pou.kind == "PROGRAM"]
+    seen = set()
+    while todo:
+        key = todo.pop()
+        if key in seen or key not in pous:
+            continue
+        seen.add(key)
+        if key in calls:
+            return True
+        for var in pous[key].variables:
+            kind = var.type
+            while isinstance(kind, ArrayType):
+                kind = kind.element
+            if isinstance(kind, NamedType):
+                todo.append(kind.name.upper())
+    return False

@@ -214,13 +214,15 @@ def default_scenario(name: str = "healthy robot", duration_us: int = DEFAULT_DUR
     )
 
 
-def power_on_stop_expectation(duration_us: int, address: int = 1) -> Expectation:
+def power_on_stop_expectation(duration_us: int, address: int = 1, after_us: int = 0) -> Expectation:
     """What every program must do: send the stop command and have it answered, within 5 s
-    of power-on (or the whole run when shorter)."""
+    of power-on (or the whole run when shorter) - or of `after_us`, when the robot cannot
+    be reached before (a converter refusing connections)."""
     stop = Expectation(
         kind="sent",
         label="",
-        within_us=min(DEFAULT_STOP_WITHIN_US, duration_us),
+        after_us=after_us,
+        within_us=min(DEFAULT_STOP_WITHIN_US, duration_us - after_us),
         request=protocol.ControlRequest(address, protocol.ControlCode.ROBOT, protocol.RobotCommand.STOP),
     )
     return replace(stop, label=f"sent stop {describe_window(stop)}")

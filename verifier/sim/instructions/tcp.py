@@ -72,9 +72,17 @@ class TcpPort:
         self._active = False
         rt.pollers.append(self)
 
-    # ---- to be provided by the platform ------------------------------------------------
+    # ---- the status words (the platform names them) ---------------------------------------
+    OPEN_SIGNAL = RECEIVE_SIGNAL = 0  # word addresses in `status_cells`
+    status_cells: list = []
+
     def show_status(self, conn: _Connection) -> None:
-        raise NotImplementedError
+        """Bit n-1 of the open completion and receive status words for connection n."""
+        bit, cells = 1 << (conn.number - 1), self.status_cells
+        for address, on in ((self.OPEN_SIGNAL, conn.state == OPEN), (self.RECEIVE_SIGNAL, bool(conn.received))):
+            word = cells[address] & 0xFFFF
+            word = word | bit if on else word & ~bit
+            cells[address] = word - 0x10000 if word > 0x7FFF else word
 
     # ---- helpers -----------------------------------------------------------------------------
     @property
@@ -250,15 +258,7 @@ class SocketPort(TcpPort):
 
     def __init__(self, rt):
         super().__init__(rt, "FX5 built-in Ethernet")
-        self.sd = rt.dev.areas["SD"]
-
-    def show_status(self, conn: _Connection) -> None:
-        bit = 1 << (conn.number - 1)
-        for address, on in ((self.OPEN_SIGNAL, conn.state == OPEN),
-                            (self.RECEIVE_SIGNAL, bool(conn.received))):
-            word = self.sd[address] & 0xFFFF
-            word = word | bit if on else word & ~bit
-            self.sd[address] = word - 0x10000 if word > 0x7FFF else word
+        self.status_cells = rt.dev.areas["SD"]
 
     def sp_socopen(self, en, u, s1, s2, d, loc_id) -> None:
         if self.rising(en, loc_id):
@@ -291,16 +291,8 @@ class FixedBufferPort(TcpPort):
 
     def __init__(self, rt, un: int):
         super().__init__(rt, f"QJ71E71 at U{un:X}")
-        self.buffer = rt.buffer(un)
+        self.status_cells = rt.buffer(un)
         self.direction: dict[int, str] = {}  # connection -> "send" | "receive"
-
-    def show_status(self, conn: _Connection) -> None:
-        bit = 1 << (conn.number - 1)
-        for address, on in ((self.OPEN_SIGNAL, conn.state == OPEN),
-                            (self.RECEIVE_SIGNAL, bool(conn.received))):
-            word = self.buffer[address] & 0xFFFF
-            word = word | bit if on else word & ~bit
-            self.buffer[address] = word - 0x10000 if word > 0x7FFF else word
 
     def zp_open(self, en, s1, s2, d, loc_id) -> None:
         if not self.rising(en, loc_id):
