@@ -252,3 +252,38 @@ BASE = 'platform = "fx5u"\n'
 ])
 def test_converter_settings_errors_name_file_line_and_column(text, expected):
     assert expected in where(text)
+
+
+# ---- any converter: the rules hold on the robot's line ------------------------------------------
+
+from hypothesis import HealthCheck, example, given, settings, strategies as st  # noqa: E402
+
+
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(platform=st.sampled_from(["fx5u", "q"]),
+       delay_ms=st.integers(0, 40), packing_ms=st.integers(1, 20),
+       refuse_until_ms=st.sampled_from([0, 0, 700, 2500]),
+       drops_s=st.lists(st.integers(4, 18), max_size=3, unique=True),
+       split=st.booleans(), split_gap_ms=st.integers(1, 40))
+# found by this test: a reply in one-byte segments stalled the receive (EN on two scans in a
+# row: no rising edge) and ended early on Q (the gap timer ran from the first byte) ...
+@example(platform="fx5u", delay_ms=0, packing_ms=1, refuse_until_ms=0, drops_s=[], split=False, split_gap_ms=1)
+@example(platform="q", delay_ms=0, packing_ms=1, refuse_until_ms=0, drops_s=[], split=False, split_gap_ms=1)
+# ... and a control command repeated after its reply was lost at the converter was a CYCLE violation
+@example(platform="fx5u", delay_ms=0, packing_ms=1, refuse_until_ms=0, drops_s=[4, 9], split=False, split_gap_ms=1)
+def test_whatever_the_converter_does_the_line_keeps_every_rule(platform, delay_ms, packing_ms, refuse_until_ms,
+                                                              drops_s, split, split_gap_ms):
+    """Random converter behaviour (delays, packing, refusals, drops mid-transaction, split
+    replies within the reassembly gap): on the robot's line the stop still comes first, the
+    pacing and half duplex hold, no rule is broken; the port is connected at the end."""
+    name = "fx5u-tcp-healthy" if platform == "fx5u" else "q-tcp-healthy"
+    scenario = load_scenario(SCENARIOS / f"{name}.toml")
+    config = replace(scenario.converter, delay_us=delay_ms * 1000, pack_us=packing_ms * 1000,
+                     refuse_until_us=refuse_until_ms * 1000, drops=tuple(s * 1_000_000 for s in sorted(drops_s)),
+                     split_reply=split, split_gap_us=split_gap_ms * 1000)
+    result = run_scenario(replace(scenario, duration_us=25_000_000, expectations=(), converter=config))
+    assert result.aborted is None
+    assert not result.all_violations(), [f"{v.rule}: {v.message}" for v in result.all_violations()[:3]]
+    tx = [f for f in result.trace if f.direction == "tx"]
+    assert tx and tx[0].data == STOP
+    assert dict(result.watched)["fbPort.o_bConnected"][-1][1] is True
