@@ -3,6 +3,7 @@ tracebacks, the report files, parallel scenarios, and the README's main command.
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -221,3 +222,32 @@ def test_platform_without_sources_picks_the_bundled_scenarios_of_that_platform(t
     invoke("--platform", "q", "--duration", "1s", "--json", report)  # 1 s: the verdict is not the point
     names = {s["name"] for s in json.loads(report.read_text())["scenarios"]}
     assert names == {load_scenario(p).name for p in bundled_scenarios() if load_scenario(p).platform == "q"}
+
+
+def test_parallel_batches_group_sources_and_cover_every_scenario():
+    """--jobs: scenarios with the same sources share a batch (one worker parses them once),
+    no batch takes more than 1/(2 jobs) of the work unless it is a single scenario, every
+    scenario is in exactly one batch, longest batch first."""
+    from verifier.commands.verify import _batches
+    from verifier.verify.scenario import load_scenario
+
+    scenarios = [load_scenario(p) for p in bundled_scenarios()]
+    cost = [s.duration_us // s.scan_us for s in scenarios]
+    for jobs in (2, 3, 8):
+        batches = _batches(scenarios, jobs)
+        assert sorted(i for b in batches for i in b) == list(range(len(scenarios)))
+        for batch in batches:
+            assert len({(scenarios[i].sources, scenarios[i].target) for i in batch}) == 1
+            assert len(batch) == 1 or sum(cost[i] for i in batch) <= sum(cost) / (2 * jobs)
+        sizes = [sum(cost[i] for i in b) for b in batches]
+        assert sizes == sorted(sizes, reverse=True)
+
+
+def test_parallel_run_reports_what_a_serial_run_reports(tmp_path):
+    """The JSON report of --jobs 2 is the one of --jobs 1, in the same order (wall times aside)."""
+    def report(jobs: int):
+        out = tmp_path / f"j{jobs}.json"
+        result = invoke("--platform", "fx5u", "--duration", "4s", "--jobs", str(jobs), "--json", out)
+        assert result.exit_code in (0, 1), result.output
+        return re.sub(r'"wall[^"]*": [0-9.e+-]+', '"wall": 0', out.read_text())
+    assert report(2) == report(1)

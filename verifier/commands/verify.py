@@ -165,6 +165,34 @@ def _run_one(scenario: Scenario) -> ScenarioResult:
     return run_scenario(scenario)
 
 
+def _run_batch(batch: list[Scenario]) -> list[ScenarioResult]:
+    return [_run_one(scenario) for scenario in batch]
+
+
+def _batches(scenarios: list[Scenario], jobs: int) -> list[list[int]]:
+    """Scenarios (by index) grouped for the worker processes, longest batch first.
+
+    A worker parses and checks a set of sources once and keeps it (sim.project's cache):
+    scenarios with the same sources go in the same batch, so each set is parsed by one
+    worker instead of by every worker. A batch holds at most a 1/(2 jobs) share of the
+    scans to simulate (at least one scenario), so the workers still finish together."""
+    cost = [max(1, s.duration_us // s.scan_us) for s in scenarios]
+    limit = sum(cost) / (2 * jobs)
+    groups: dict[tuple, list[int]] = {}
+    for i, scenario in enumerate(scenarios):
+        groups.setdefault((scenario.sources, scenario.target), []).append(i)
+    batches: list[list[int]] = []
+    for members in groups.values():
+        batch: list[int] = []
+        for i in sorted(members, key=lambda k: -cost[k]):
+            if batch and sum(cost[k] for k in batch) + cost[i] > limit:
+                batches.append(batch)
+                batch = []
+            batch.append(i)
+        batches.append(batch)
+    return sorted(batches, key=lambda b: -sum(cost[k] for k in b))
+
+
 class _LazyProgress:
     """A rich progress bar that appears only once the run has taken more than a moment."""
 
@@ -215,11 +243,12 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress) -> l
         results: list[ScenarioResult | None] = [None] * len(scenarios)
         done = 0
         with ProcessPoolExecutor(max_workers=jobs) as pool:
-            futures = {pool.submit(_run_one, s): i for i, s in enumerate(scenarios)}
+            futures = {pool.submit(_run_batch, [scenarios[i] for i in batch]): batch
+                       for batch in _batches(scenarios, jobs)}
             for future in as_completed(futures):
-                index = futures[future]
-                results[index] = future.result()
-                done += scenarios[index].duration_us
+                for index, result in zip(futures[future], future.result()):
+                    results[index] = result
+                    done += scenarios[index].duration_us
                 progress.update(done, f"{sum(r is not None for r in results)}/{len(scenarios)} scenarios")
         return [r for r in results if r is not None]
     results = []
