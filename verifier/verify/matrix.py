@@ -5,7 +5,8 @@ that program's buttons (X20 starts the Q example's cycle), its expectations and 
 labels name that program's labels, its [initial] device values are that program's, and its
 response signal is that program's error output. None of that means anything for another
 program, so against user sources a bundled scenario keeps only what is about the robot,
-the line and the serial module: the platform, the converter of the TCP route, the robot, the faults and their timing, the
+the line and the serial module: the platform, the converter of the TCP route (only for
+programs that use it: `platform.uses_tcp_route`), the robot, the faults and their timing, the
 protocol settings, the run and scan times, the QJ71C24N settings ([[c24]], which every
 installation must make in GX Works — docs/import-gxworks2.md) and every rule. It expects what every program must do — send the
 power-on stop and have it answered within 5 s — and UITAMR-RESPONSE-HANDLING watches
