@@ -31,6 +31,8 @@ and on generated mutations of them):
 from __future__ import annotations
 
 import re
+from itertools import accumulate, repeat
+from operator import sub
 
 from verifier.st import ast
 from verifier.st.devices import H_CONST_RE, K_CONST_RE, parse_device
@@ -108,40 +110,48 @@ def _noncapturing(rx: str) -> str:
 
 
 class Tokenizer:
-    """lark's root lexer for `st.lark`, as one regular expression read with `findall`:
-    each match is (ignored text, token), so positions are counted, not asked for."""
+    """lark's root lexer for `st.lark`, run as C loops: `re.split` on one regular
+    expression — (ignored text)(token) — cuts the text into what lark skips (white space,
+    comments) and tokens; positions come from running sums of their lengths and newline
+    counts; kinds from a table of the token texts already seen."""
 
     def __init__(self, lark_parser) -> None:
         root = lark_parser.parser.lexer.root_lexer
         scanner = root.scanner  # builds the scanner: keywords folded into IDENT
-        ignore = root.ignore_types
-        terminals = scanner.terminals  # lark's order (priority, width, length, name)
-        skip = [t for t in terminals if t.name in ignore]
-        tokens = [t for t in terminals if t.name not in ignore]
-        # Ignored terminals must be tried before any token that can start with the same
-        # character (lark tries them in order at every position): they do, as comments
-        # have the highest priority and white space starts no token.
         assert not root.g_regex_flags
-        skip_rx = "|".join(_noncapturing(t.pattern.to_regexp()) for t in skip)
+        terminals = scanner.terminals  # lark's order (priority, width, length, name)
+        ignored = [t for t in terminals if t.name in root.ignore_types]
+        tokens = [t for t in terminals if t.name not in root.ignore_types]
+        by_name = {t.name: t for t in terminals}
+        skip_rx = "|".join(_noncapturing(t.pattern.to_regexp()) for t in ignored)
         token_rx = "|".join(_noncapturing(t.pattern.to_regexp()) for t in tokens)
-        # (skip)(token): the skip loop is possessive, as lark never gives back an ignored
-        # token; the last alternatives take the end of the text and any character no
-        # terminal reads (that is an error: the caller bails).
-        self.regex = re.compile(rf"((?:{skip_rx})*+)((?:{token_rx})|\Z|[\s\S])")
-        self.skip_regex = re.compile("|".join(f"(?P<{t.name}>{t.pattern.to_regexp()})" for t in skip))
+        white_rx = _noncapturing(by_name["WS"].pattern.to_regexp())
+        assert re.fullmatch(r"\[[^\]]*\]\+", white_rx), white_rx  # one class, repeated
+        # Lark tries its terminals in this order at every position and takes the first
+        # that matches; ignored ones (comments: highest priority; white space: starts no
+        # token) are always tried first, so (ignored text)(token) reads the same tokens.
+        # The skip loop is possessive (lark never gives an ignored token back). `\Z` takes
+        # the ignored text at the end of the text and stands for lark's end marker.
+        # A match never starts just after white space, so where the sequential reading
+        # stops (a character no terminal reads) the text between two matches is not
+        # empty: the tokenizer bails there.
+        self.split = re.compile(
+            f"(?<!{white_rx[:-1]})((?:{skip_rx})*+)({token_rx}|\\Z)").split
+        self.comment_style = re.compile(
+            "|".join(f"(?P<{t.name}>{t.pattern.to_regexp()})" for t in ignored)).finditer
         unless = root.callback["IDENT"].scanner  # the keywords an IDENT is turned into
         self.keywords = {t.pattern.value.upper(): t.name for t in unless.terminals}
         assert all(k.isascii() for k in self.keywords)
-        self.token_names = {t.name for t in tokens}
-        assert set(_PUNCT_KINDS) <= self.token_names, set(_PUNCT_KINDS) - self.token_names
+        names = {t.name for t in tokens}
+        assert set(_PUNCT_KINDS) <= names, set(_PUNCT_KINDS) - names
         self.punct = {t.pattern.value: t.name for t in tokens if t.name in _PUNCT_KINDS}
         assert len(self.punct) == len(_PUNCT_KINDS)
-        self.kinds: dict[str, str] = dict(self.punct)
-        self.comment_kinds = {"LINE_COMMENT", "C_COMMENT"}
+        self.punct[""] = _END
+        self.kinds: dict[str, str] = dict(self.punct)  # token text -> kind, as seen
 
     def classify(self, tok: str) -> str:
         """The terminal a token's text was read as (the regex alternatives are told apart
-        by their first character and what they may contain)."""
+        by their first characters and what they may contain)."""
         first = tok[0]
         if first.isascii() and (first.isalpha() or first == "_"):
             if not tok.isascii():
@@ -159,66 +169,56 @@ class Tokenizer:
             if "." in tok or "e" in tok or "E" in tok:
                 return "REAL"
             return "INT"
-        if first == "'" and len(tok) > 1:
+        if first == "'":
             return "STRING_LIT"
-        if first == '"' and len(tok) > 1:
+        if first == '"':
             return "WSTRING_LIT"
         return self.punct.get(tok, _ERR)
 
     def tokenize(self, text: str, gxworks2: bool) -> tuple[list, list, list, list]:
         """Kinds, values, lines and columns (1-based, as lark counts) of the significant
-        tokens, then an end marker. Raises Bail on a character no terminal reads and on a
-        comment GX Works2 does not accept."""
-        kinds_of = self.kinds
-        classify = self.classify
-        K: list[str] = []
-        V: list[str] = []
-        LN: list[int] = []
-        CL: list[int] = []
-        k_append = K.append
-        v_append = V.append
-        l_append = LN.append
-        c_append = CL.append
-        pos = 0
-        line = 1
-        line_start = 0
-        for skip, tok in self.regex.findall(text):
-            if skip:
-                n = skip.count("\n")
-                if n:
-                    line += n
-                    line_start = pos + skip.rindex("\n") + 1
-                if gxworks2 and "/" in skip:
-                    self._check_comments(skip)
-                pos += len(skip)
-            if not tok:
-                break
-            kind = kinds_of.get(tok)
-            if kind is None:
-                kind = classify(tok)
-                if kind == _ERR:
-                    raise Bail
-                if len(kinds_of) > 200_000:
-                    kinds_of.clear()
-                    kinds_of.update(self.punct)
-                kinds_of[tok] = kind
-            k_append(kind)
-            v_append(tok)
-            l_append(line)
-            c_append(pos - line_start + 1)
-            pos += len(tok)
-        if pos != len(text):  # cannot happen (every character is read), but be sure
+        tokens, then the end marker. Raises Bail on a character no terminal reads and on
+        a comment GX Works2 does not accept."""
+        parts = self.split(text)  # "", ignored, token, "", ignored, token, ..., "", ignored, "", ...
+        if any(parts[0::3]):  # text no terminal reads
             raise Bail
-        k_append(_END)
-        v_append("")
-        l_append(line)
-        c_append(pos - line_start + 1)
+        V = parts[2::3]
+        n = V.index("") + 1  # the \Z match: the end (empty matches may follow it)
+        del V[n:]
+        skips = parts[1:3 * n:3]
+        if gxworks2 and "/" in "".join(skips):
+            self._check_comments(skips)
+        starts = list(accumulate(map(len, parts[:3 * n])))[1::3]  # where each token starts
+        LN = list(accumulate(map(str.count, skips, repeat("\n")), initial=1))
+        del LN[0]
+        CL = list(map(sub, starts, map(text.rfind, repeat("\n"), repeat(0), starts)))
+        kinds = self.kinds
+        K = list(map(kinds.get, V))
+        if None in K:
+            j = -1
+            try:
+                while True:
+                    j = K.index(None, j + 1)
+                    tok = V[j]
+                    kind = self.classify(tok)
+                    if kind == _ERR:
+                        raise Bail
+                    if kind != "STRING_LIT" and kind != "WSTRING_LIT":
+                        if len(kinds) > 200_000:
+                            kinds.clear()
+                            kinds.update(self.punct)
+                        kinds[tok] = kind
+                    K[j] = kind
+            except ValueError:
+                pass
         return K, V, LN, CL
 
-    def _check_comments(self, skip: str) -> None:
-        for m in self.skip_regex.finditer(skip):
-            if m.lastgroup in self.comment_kinds:
-                raise Bail  # the lark path reports it
+    def _check_comments(self, skips: list[str]) -> None:
+        for skip in skips:
+            if "/" in skip:
+                for m in self.comment_style(skip):
+                    if m.lastgroup in ("LINE_COMMENT", "C_COMMENT"):
+                        raise Bail  # the lark path reports it
 
 
 # ----------------------------------------------------------------------------- parser
