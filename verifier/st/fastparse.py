@@ -44,25 +44,30 @@ class Bail(Exception):
 
 
 # ----------------------------------------------------------------------------- spans
-_new = object.__new__
-_Span = ast.Span
-_set_file = _Span.file.__set__
-_set_line = _Span.line.__set__
-_set_col = _Span.col.__set__
-_set_end_line = _Span.end_line.__set__
-_set_end_col = _Span.end_col.__set__
+class _SpanSlots:
+    """The slots of `ast.Span` without its frozen `__setattr__`: filled with plain
+    attribute stores, then made a Span by class assignment (which Python allows only
+    between classes of the same layout). A quarter of the fast path's time went into
+    the frozen dataclass's `object.__setattr__` calls."""
+
+    __slots__ = ("file", "line", "col", "end_line", "end_col")
 
 
 def make_span(file: str, line: int, col: int, end_line: int, end_col: int) -> ast.Span:
-    """`ast.Span(file, line, col, end_line, end_col)`, without the frozen dataclass's
-    `object.__setattr__` calls (the same object: slots set, nothing else)."""
-    s = _new(_Span)
-    _set_file(s, file)
-    _set_line(s, line)
-    _set_col(s, col)
-    _set_end_line(s, end_line)
-    _set_end_col(s, end_col)
+    """`ast.Span(file, line, col, end_line, end_col)`, the same object, made faster."""
+    s = _SpanSlots()
+    s.file = file
+    s.line = line
+    s.col = col
+    s.end_line = end_line
+    s.end_col = end_col
+    s.__class__ = _Span
     return s
+
+
+_Span = ast.Span
+assert _SpanSlots.__slots__ == _Span.__slots__ and _Span.__bases__ == (object,)
+assert make_span("f", 1, 2, 3, 4) == _Span("f", 1, 2, 3, 4)
 
 
 # ----------------------------------------------------------------------------- tokens
@@ -260,6 +265,22 @@ def _ident_class(text: str) -> tuple:
             _ident_cache.clear()
         _ident_cache[text] = found
     return found
+
+
+def _ident_node(text: str, span: ast.Span, cls: tuple) -> ast.Expr:
+    """The node of an identifier that is not a plain name (`_classify_ident`)."""
+    tag = cls[0]
+    if tag == _DEVICE:
+        return ast.Device(text=text, span=span, **cls[1])
+    if tag == _KCONST:
+        return ast.IntLiteral(cls[1], 10, "K", text, span=span)
+    if tag == _HCONST:
+        return ast.IntLiteral(cls[1], 16, "H", text, span=span)
+    return ast.Name(text, span=span)
+
+
+#: what may follow a name inside a longer operand (member, index, call, power)
+_AFTER_NAME = frozenset({"DOT", "LSQB", "LPAR", "POW"})
 
 
 def _decode(text: str) -> str:
@@ -670,9 +691,28 @@ class Parser:
     # ------------------------------------------------------------- expressions
     def expression(self, min_prec: int):
         """Binary operators by precedence climbing: left-associative at every level, as
-        the grammar's left-recursive rules read them."""
+        the grammar's left-recursive rules read them. A lone name or integer (the most
+        common operands) is read here; anything else by `unary`."""
         K = self.K
-        left = self.unary()
+        i = self.i
+        kind = K[i]
+        if kind == "IDENT" and K[i + 1] not in _AFTER_NAME:
+            self.i = i + 1
+            text = self.V[i]
+            line = self.LN[i]
+            col = self.CL[i]
+            span = make_span(self.file, line, col, line, col + len(text))
+            cls = _ident_cache.get(text) or _ident_class(text)
+            left = ast.Name(text, span=span) if cls[0] == _NAME else _ident_node(text, span, cls)
+        elif kind == "INT" and K[i + 1] != "POW":
+            self.i = i + 1
+            text = self.V[i]
+            line = self.LN[i]
+            col = self.CL[i]
+            left = ast.IntLiteral(int(text.replace("_", "")), 10, "", text,
+                                  span=make_span(self.file, line, col, line, col + len(text)))
+        else:
+            left = self.unary()
         while True:
             kind = K[self.i]
             prec = _PREC.get(kind)
@@ -780,16 +820,8 @@ class Parser:
         text = V[i]
         if kind == "IDENT":
             span = self.tok_span(i)
-            cls = _ident_class(text)
-            tag = cls[0]
-            if tag == _NAME:
-                node = ast.Name(text, span=span)
-            elif tag == _DEVICE:
-                node = ast.Device(text=text, span=span, **cls[1])
-            elif tag == _KCONST:
-                node = ast.IntLiteral(cls[1], 10, "K", text, span=span)
-            else:
-                node = ast.IntLiteral(cls[1], 16, "H", text, span=span)
+            cls = _ident_cache.get(text) or _ident_class(text)
+            node = ast.Name(text, span=span) if cls[0] == _NAME else _ident_node(text, span, cls)
         elif kind == "BUFFER_DEVICE":
             node = ast.Device(text=text, span=self.tok_span(i), **parse_device(text))
         else:
