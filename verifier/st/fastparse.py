@@ -30,6 +30,7 @@ and on generated mutations of them):
 """
 from __future__ import annotations
 
+import gc
 import re
 from itertools import accumulate, repeat
 from operator import sub
@@ -572,8 +573,12 @@ class Parser:
             if following == "ASSIGN":
                 self.i += 1
                 value = self.expression(1)
-                semi = self.expect("SEMI")
-                return ast.Assign(target, value, span=self.span_node_token(target, semi))
+                semi = self.i
+                if K[semi] != "SEMI":
+                    raise Bail
+                self.i = semi + 1
+                s = target.span
+                return ast.Assign(target, value, span=make_span(self.file, s.line, s.col, self.LN[semi], self.CL[semi] + 1))
             if following == "LPAR":
                 call = self.call(target)
                 semi = self.expect("SEMI")
@@ -886,7 +891,16 @@ def tokenizer(lark_parser) -> Tokenizer:
 def parse_fast(text: str, filename: str, target: str, lark_parser) -> ast.SourceFile:
     """The file as `verifier.st.parser.parse_reference` reads it, for text that reads with
     no diagnostic; raises Bail (or RecursionError) for anything else."""
-    tokens = tokenizer(lark_parser).tokenize(text, target == "gxworks2")
-    source = Parser(tokens, filename).source_file(filename, target)
+    # The tree has no reference cycles: the cyclic garbage collector has nothing to find
+    # while it is built, yet would walk the young nodes again and again (a tenth of the
+    # time); it runs as usual once the file is read.
+    collecting = gc.isenabled()
+    gc.disable()
+    try:
+        tokens = tokenizer(lark_parser).tokenize(text, target == "gxworks2")
+        source = Parser(tokens, filename).source_file(filename, target)
+    finally:
+        if collecting:
+            gc.enable()
     source.text = text
     return source
