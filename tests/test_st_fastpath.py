@@ -175,3 +175,23 @@ def test_token_soup_reads_as_the_reference_reads_it(tokens):
 def test_deep_nesting_falls_back_to_the_reference():
     text = "PROGRAM P\nVAR x : INT; END_VAR\nx := " + "(" * 3000 + "1" + ")" * 3000 + ";\nEND_PROGRAM\n"
     assert_same(text)
+
+
+def test_the_fast_path_follows_this_grammar():
+    """fastparse.py mirrors st.lark rule by rule. After a grammar change, bring its
+    parser in line (and this file's corpus with it), then set
+    fastparse.GRAMMAR_SHA256 to the digest below."""
+    parser = get_parser()
+    assert fastparse.unavailable(parser) is None, (
+        f"{fastparse.unavailable(parser)}; st.lark digest is {fastparse.grammar_digest(parser)}")
+
+
+def test_another_grammar_turns_the_fast_path_off(monkeypatch):
+    monkeypatch.setattr(fastparse, "GRAMMAR_SHA256", "0" * 64)
+    monkeypatch.setattr(fastparse, "_tokenizer", None)
+    monkeypatch.setattr(fastparse, "_unavailable", None)
+    text = (VALID[0].parent / "statements.st").read_text(encoding="utf-8")
+    with pytest.raises(fastparse.Bail):
+        fastparse.parse_fast(text, "s.st", "gxworks2", get_parser())
+    assert "not the grammar" in fastparse.unavailable(get_parser())
+    assert deep(parse(text, "s.st")) == deep(parse_reference(text, "s.st"))

@@ -31,6 +31,7 @@ and on generated mutations of them):
 from __future__ import annotations
 
 import gc
+import hashlib
 import re
 from itertools import accumulate, repeat
 from operator import sub
@@ -878,13 +879,36 @@ class Parser:
         return base
 
 
+#: sha256 of the st.lark this module follows rule by rule. Another grammar turns the fast
+#: path off (everything is read by lark) until this module is brought in line with it
+#: and the digest updated (tests/test_st_fastpath.py says so).
+GRAMMAR_SHA256 = "188ee0a0583cfcc2b268a6996c24c4cf218ea19e8043ea663a974910e6875dd0"
+
 _tokenizer: Tokenizer | None = None
+_unavailable: str | None = None  # why the fast path is off, once known
 
 
-def tokenizer(lark_parser) -> Tokenizer:
-    global _tokenizer
-    if _tokenizer is None:
-        _tokenizer = Tokenizer(lark_parser)
+def grammar_digest(lark_parser) -> str:
+    return hashlib.sha256(lark_parser.source_grammar.encode("utf-8")).hexdigest()
+
+
+def unavailable(lark_parser) -> str | None:
+    """Why the fast path is off (None when it is on): another grammar, or a lark whose
+    lexer is not built as this module expects."""
+    tokenizer(lark_parser)
+    return _unavailable
+
+
+def tokenizer(lark_parser) -> Tokenizer | None:
+    global _tokenizer, _unavailable
+    if _tokenizer is None and _unavailable is None:
+        if grammar_digest(lark_parser) != GRAMMAR_SHA256:
+            _unavailable = "st.lark is not the grammar verifier/st/fastparse.py follows"
+        else:
+            try:
+                _tokenizer = Tokenizer(lark_parser)
+            except Exception as exc:  # a lark of another make: lark reads everything
+                _unavailable = f"cannot build the tokenizer from lark's lexer: {exc!r}"
     return _tokenizer
 
 
@@ -897,7 +921,10 @@ def parse_fast(text: str, filename: str, target: str, lark_parser) -> ast.Source
     collecting = gc.isenabled()
     gc.disable()
     try:
-        tokens = tokenizer(lark_parser).tokenize(text, target == "gxworks2")
+        tok = _tokenizer or tokenizer(lark_parser)
+        if tok is None:
+            raise Bail
+        tokens = tok.tokenize(text, target == "gxworks2")
         source = Parser(tokens, filename).source_file(filename, target)
     finally:
         if collecting:
