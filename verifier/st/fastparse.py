@@ -46,6 +46,9 @@ class Bail(Exception):
 
 
 # ----------------------------------------------------------------------------- spans
+_Span = ast.Span
+
+
 class _SpanSlots:
     """The slots of `ast.Span` without its frozen `__setattr__`: filled with plain
     attribute stores, then made a Span by class assignment (which Python allows only
@@ -55,8 +58,7 @@ class _SpanSlots:
     __slots__ = ("file", "line", "col", "end_line", "end_col")
 
 
-def make_span(file: str, line: int, col: int, end_line: int, end_col: int) -> ast.Span:
-    """`ast.Span(file, line, col, end_line, end_col)`, the same object, made faster."""
+def _span_by_class_assignment(file: str, line: int, col: int, end_line: int, end_col: int) -> ast.Span:
     s = _SpanSlots()
     s.file = file
     s.line = line
@@ -67,9 +69,20 @@ def make_span(file: str, line: int, col: int, end_line: int, end_col: int) -> as
     return s
 
 
-_Span = ast.Span
-assert _SpanSlots.__slots__ == _Span.__slots__ and _Span.__bases__ == (object,)
-assert make_span("f", 1, 2, 3, 4) == _Span("f", 1, 2, 3, 4)
+def _span_by_constructor(file: str, line: int, col: int, end_line: int, end_col: int) -> ast.Span:
+    return _Span(file, line, col, end_line, end_col)
+
+
+def _same_span(make) -> bool:
+    try:
+        made = make("f", 1, 2, 3, 4)
+    except TypeError:  # ast.Span's layout changed
+        return False
+    return type(made) is _Span and made == _Span("f", 1, 2, 3, 4) and repr(made) == repr(_Span("f", 1, 2, 3, 4))
+
+
+#: `ast.Span(file, line, col, end_line, end_col)`, the same object, made faster
+make_span = _span_by_class_assignment if _same_span(_span_by_class_assignment) else _span_by_constructor
 
 
 # ----------------------------------------------------------------------------- tokens
