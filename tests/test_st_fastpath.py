@@ -46,7 +46,8 @@ def first_difference(a, b, path="tree"):
     if len(a) != len(b):
         return f"{path}: {len(a)} items != {len(b)} items ({a[:1]!r})"
     for i, (x, y) in enumerate(zip(a, b)):
-        where = first_difference(x, y, f"{path}[{i}]" if not (isinstance(x, tuple) and len(x) == 2 and isinstance(x[0], str)) else f"{path}.{x[0]}")
+        named = isinstance(x, tuple) and len(x) == 2 and isinstance(x[0], str)  # (field, value)
+        where = first_difference(x, y, f"{path}.{x[0]}" if named else f"{path}[{i}]")
         if where:
             return where
     return None
