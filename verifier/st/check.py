@@ -8,6 +8,7 @@ is suspicious (warnings). The simulator reuses the annotations and `SymbolTable`
 """
 from __future__ import annotations
 
+import functools
 import re
 from dataclasses import dataclass, field
 
@@ -71,18 +72,23 @@ _OTHER_DEVICE_RE = re.compile(r"(?:P|I|N|J|E|BL|TR|FX|FY|FD|LZ|LTN|LSTN|LCN|LT|L
                               re.IGNORECASE)
 
 
+_DIGIT_SPEC_RE = re.compile(r"[Kk][1-8]")
+_CONSTANT_RE = re.compile(r"[Kk][0-9]+|[Hh][0-9A-Fa-f]+")
+
+
+@functools.lru_cache(maxsize=8192)
 def label_name_problem(name: str) -> str | None:
-    """Why GX Works refuses `name` as a label, or None. Rules: docs/st-dialect.md §4."""
+    """Why GX Works refuses `name` as a label, or None. Rules: docs/st-dialect.md §4.
+    (A function of the name alone: remembered, as the same labels recur across POUs.)"""
     if name.startswith("_") or name.endswith("_"):
         return "must not start or end with '_'"
     if "__" in name:
         return "must not contain '__'"
     if name[0].isdigit():
         return "must not start with a digit"
-    if re.match(r"[Kk][1-8]", name):
+    if _DIGIT_SPEC_RE.match(name):
         return "must not start with K1..K8 (read as a digit-specified device)"
-    if looks_like_device(name) or re.fullmatch(r"[Kk][0-9]+|[Hh][0-9A-Fa-f]+", name) \
-            or _OTHER_DEVICE_RE.fullmatch(name):
+    if looks_like_device(name) or _CONSTANT_RE.fullmatch(name) or _OTHER_DEVICE_RE.fullmatch(name):
         return "looks like a device or constant"
     reason = library.reserved_reason(name)
     if reason:
@@ -489,6 +495,8 @@ class Checker:
         return t
 
     def _expr(self, e) -> T.Type:
+        if isinstance(e, ast.Name):  # the most common node first (node classes are disjoint)
+            return self._name(e)
         if isinstance(e, ast.IntLiteral):
             return T.int_literal(e.value)
         if isinstance(e, ast.RealLiteral):
@@ -503,8 +511,6 @@ class Checker:
             if e.wide and self.target == "gxworks2":
                 self.rep.error(e, "GX Works2 has no WSTRING; write the string in single quotes")
             return T.WSTRING if e.wide else T.STRING
-        if isinstance(e, ast.Name):
-            return self._name(e)
         if isinstance(e, ast.Device):
             return self._device(e)
         if isinstance(e, ast.Index):

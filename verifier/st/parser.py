@@ -100,7 +100,11 @@ def _decode_string(tok: Token) -> str:
 
 
 def _time_ms(tok: Token) -> int:
-    text = tok.value.split("#", 1)[1]
+    return _time_ms_text(tok.value)
+
+
+def _time_ms_text(value: str) -> int:
+    text = value.split("#", 1)[1]
     negative = text.startswith("-")
     total = 0.0
     for number, unit in _TIME_PART_RE.findall(text):
@@ -489,7 +493,22 @@ def get_parser() -> Lark:
 
 
 def parse(text: str, filename: str = "<string>", target: str = "gxworks2") -> ast.SourceFile:
-    """Parse ST `text`; never raises for bad input (errors are in `.diagnostics`)."""
+    """Parse ST `text`; never raises for bad input (errors are in `.diagnostics`).
+
+    Text that reads without a diagnostic goes through the fast path
+    (`verifier.st.fastparse`: same tokens, same tree, same spans); anything else is read
+    by `parse_reference`, the lark parser over the grammar, which words the diagnostics."""
+    from verifier.st import fastparse
+
+    parser = get_parser()
+    try:
+        return fastparse.parse_fast(text, filename, target, parser)
+    except (fastparse.Bail, RecursionError):
+        return parse_reference(text, filename, target)
+
+
+def parse_reference(text: str, filename: str = "<string>", target: str = "gxworks2") -> ast.SourceFile:
+    """`parse` with lark's LALR parser only (the reference the fast path must equal)."""
     parser = get_parser()
     _ctx.reset(filename, target, text)
     try:
