@@ -38,7 +38,7 @@ from operator import sub
 
 from verifier.st import ast
 from verifier.st.devices import H_CONST_RE, K_CONST_RE, parse_device
-from verifier.st.parser import _ESCAPE_RE, _ESCAPES, _section, _time_ms_text
+from verifier.st.parser import _section, _time_ms_text, decode_escapes
 
 
 class Bail(Exception):
@@ -301,20 +301,10 @@ _AFTER_NAME = frozenset({"DOT", "LSQB", "LPAR", "POW"})
 def _decode(text: str) -> str:
     """The value of a STRING_LIT/WSTRING_LIT token (`_decode_string` without a
     diagnostic: an unknown escape bails)."""
-    body = text[1:-1]
-    if "$" not in body:
-        return body
+    def unknown(code: str) -> str:
+        raise Bail
 
-    def escape(m: re.Match) -> str:
-        code = m.group(1)
-        if len(code) == 2:
-            return chr(int(code, 16))
-        mapped = _ESCAPES.get(code.upper())
-        if mapped is None:
-            raise Bail
-        return mapped
-
-    return _ESCAPE_RE.sub(escape, body)
+    return decode_escapes(text[1:-1], unknown)
 
 
 class Parser:

@@ -83,20 +83,28 @@ _TIME_PART_RE = re.compile(r"([0-9][0-9_]*(?:\.[0-9]+)?)(ms|d|h|m|s)_?", re.IGNO
 _TIME_UNIT_MS = {"D": 86_400_000, "H": 3_600_000, "M": 60_000, "S": 1000, "MS": 1}
 
 
-def _decode_string(tok: Token) -> str:
-    body = tok.value[1:-1]
+def decode_escapes(body: str, unknown) -> str:
+    """The text of a string literal's body with its `$` escapes decoded; `unknown(code)`
+    gives what an unknown escape stands for (or raises)."""
+    if "$" not in body:
+        return body
 
     def escape(m: re.Match) -> str:
         code = m.group(1)
         if len(code) == 2:
             return chr(int(code, 16))
         mapped = _ESCAPES.get(code.upper())
-        if mapped is None:
-            _ctx.error(tok.line, tok.column, f"unknown escape '${code}' in string; write '$$' for a dollar sign")
-            return code
-        return mapped
+        return unknown(code) if mapped is None else mapped
 
     return _ESCAPE_RE.sub(escape, body)
+
+
+def _decode_string(tok: Token) -> str:
+    def unknown(code: str) -> str:
+        _ctx.error(tok.line, tok.column, f"unknown escape '${code}' in string; write '$$' for a dollar sign")
+        return code
+
+    return decode_escapes(tok.value[1:-1], unknown)
 
 
 def _time_ms(tok: Token) -> int:
