@@ -29,3 +29,11 @@ def diagnose(*paths: Path, target: str = "gxworks2"):
     """Parse and check files together; every diagnostic, parse ones first."""
     files = [parse(p.read_text(encoding="utf-8"), str(p), target) for p in paths]
     return files, [d for f in files for d in f.diagnostics] + check(files, target)
+
+
+#: the valid corpus and the PLC library as text: seeds for mutation tests
+SEEDS = [p.read_text(encoding="utf-8") for p in VALID + PLC_FILES]
+#: pieces of ST syntax that break a program when dropped into it (fuzz tests)
+TOKENS = ["IF", "THEN", "END_IF", ";", ":=", "=>", "(", ")", "[", "]", "(*", "*)", "'", '"',
+          "VAR", "END_VAR", "FUNCTION_BLOCK", "END_FUNCTION", "..", ".", ",", "#", "16#",
+          "T#", "K4M0", "D0.F", "U0\\G", "NOT", "**", "\n", "$", "MOV(", "TON", ":", "ARRAY"]

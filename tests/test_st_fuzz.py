@@ -4,13 +4,8 @@ from __future__ import annotations
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from st_helpers import PLC_FILES, VALID
+from st_helpers import SEEDS, TOKENS
 from verifier.st import ast, check, parse
-
-SEEDS = [p.read_text(encoding="utf-8") for p in VALID + PLC_FILES]
-TOKENS = ["IF", "THEN", "END_IF", ";", ":=", "=>", "(", ")", "[", "]", "(*", "*)", "'", '"',
-          "VAR", "END_VAR", "FUNCTION_BLOCK", "END_FUNCTION", "..", ".", ",", "#", "16#",
-          "T#", "K4M0", "D0.F", "U0\\G", "NOT", "**", "\n", "$", "MOV(", "TON", ":", "ARRAY"]
 
 
 def run_all(text: str, target: str = "gxworks2") -> list[ast.Diagnostic]:
