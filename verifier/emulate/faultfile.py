@@ -20,6 +20,7 @@ from typing import Any
 
 from verifier.amr import ConfigError, Fault, RobotConfig, check_fault_addresses, faults_from_list
 from verifier.amr.schema import reject_unknown_keys
+from verifier.textfile import UnreadableText, read_utf8
 from verifier.tomlpos import Place, decode_error_position, place_of_key
 
 FILE_KEYS = ("robot", "faults")
@@ -45,11 +46,9 @@ def load_fault_file(path: str | Path, own_address: int | None = None) -> FaultFi
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as err:
-        raise FaultFileError(f"{path}: cannot read: {err.strerror or err}") from None
-    except UnicodeDecodeError as err:
-        raise FaultFileError(f"{path}: byte {err.start}: not UTF-8 text") from None
+        text = read_utf8(path)
+    except UnreadableText as err:
+        raise FaultFileError(f"{path}: {err}") from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:

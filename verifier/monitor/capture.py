@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from verifier import protocol
+from verifier.textfile import UnreadableText, read_utf8
 
 
 @dataclass(frozen=True)
@@ -120,11 +121,9 @@ def read_capture(path: Path) -> dict[str, list[Chunk]]:
     """A capture file, plain or our JSONL trace (told apart by the first character that is
     not blank or a comment), as chunks per capture name."""
     try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise CaptureError(f"{path}: cannot read: {exc.strerror or exc}") from None
-    except UnicodeDecodeError as exc:
-        raise CaptureError(f"{path}: byte {exc.start}: not UTF-8 text") from None
+        text = read_utf8(path)
+    except UnreadableText as exc:
+        raise CaptureError(f"{path}: {exc}") from None
     first = next((line.lstrip() for line in text.splitlines()
                   if line.strip() and not line.lstrip().startswith("#")), "")
     if first.startswith("{"):
