@@ -57,3 +57,16 @@ def test_unknown_function_holds_everything_after_it():
     frames, rest = split_frames(stop + b"\x01\x03\x00\x00" + stop, "request")
     assert frames == [stop]
     assert rest == b"\x01\x03\x00\x00" + stop
+
+
+def test_length_without_knowing_the_side():
+    """A receive-only tap does not know who sent a frame: the length holds when both sides
+    agree on it (FC01/FC06 requests and replies are 8 bytes) and for exception replies."""
+    from verifier.protocol.stream import frame_length_either_side
+
+    assert frame_length_either_side(bytes([1, 0x06])) == 8
+    assert frame_length_either_side(bytes([1, 0x01])) == 8
+    assert frame_length_either_side(bytes([1, 0x86])) == 5
+    assert frame_length_either_side(bytes([1, 0x83])) is None  # exception of a function not on this line
+    assert frame_length_either_side(bytes([1, 0x03])) is None
+    assert frame_length_either_side(bytes([1])) is None

@@ -46,7 +46,7 @@ from dataclasses import dataclass, field
 from verifier.amr.robot import Robot
 from verifier.link.trace import RX, TX, LineEvent, TraceFrame
 from verifier.protocol.codec import hex_bytes
-from verifier.protocol.timing import BAUD, BITS_PER_CHAR, T1_5_US, T3_5_US
+from verifier.protocol.timing import BAUD, BITS_PER_CHAR, gap_limit_us, silence_us
 
 
 @dataclass(frozen=True)
@@ -82,18 +82,14 @@ class LineConfig:
         """t1.5: the longest silence allowed inside a frame."""
         if self.t1_5_us is not None:
             return self.t1_5_us
-        if self.baud == BAUD and self.bits_per_char == BITS_PER_CHAR:
-            return T1_5_US
-        return 750 if self.baud > 19200 else round(1.5 * self.bits_per_char * 1_000_000 / self.baud)
+        return gap_limit_us(self.baud, self.bits_per_char)
 
     @property
     def frame_gap_us(self) -> int:
         """t3.5: the silence that ends a frame."""
         if self.t3_5_us is not None:
             return self.t3_5_us
-        if self.baud == BAUD and self.bits_per_char == BITS_PER_CHAR:
-            return T3_5_US
-        return 1750 if self.baud > 19200 else round(3.5 * self.bits_per_char * 1_000_000 / self.baud)
+        return silence_us(self.baud, self.bits_per_char)
 
 
 _NEVER = float("inf")

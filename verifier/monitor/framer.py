@@ -22,8 +22,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 from verifier.protocol import timing as line_timing
-from verifier.protocol.catalogue import EXCEPTION_FLAG, FUNCTION_CODES
-from verifier.protocol.codec import EXCEPTION_REPLY_LENGTH, REQUEST_LENGTH
+from verifier.protocol.stream import frame_length_either_side
 
 from .capture import Chunk
 
@@ -49,7 +48,7 @@ class LineTiming:
     @property
     def silence_us(self) -> int:
         """t3.5 (for baud rates above 19200 the standard fixes it at 1.75 ms)."""
-        return 1750 if self.baud > 19200 else round(self.char_us * Fraction(7, 2))
+        return line_timing.silence_us(self.baud, self.bits_per_char)
 
     def frame_us(self, length: int) -> int:
         return round(self.char_us * length)
@@ -61,18 +60,6 @@ class Frame:
     t_end_us: int
     data: bytes
     direction: str | None = None  # known only when the capture said it
-
-
-def known_length(head: bytes) -> int | None:
-    """The frame length the first two bytes imply (None: function code not of this protocol)."""
-    if len(head) < 2:
-        return None
-    function = head[1]
-    if function & EXCEPTION_FLAG and function & ~EXCEPTION_FLAG in FUNCTION_CODES:
-        return EXCEPTION_REPLY_LENGTH
-    if function in FUNCTION_CODES:
-        return REQUEST_LENGTH
-    return None
 
 
 class Framer:
@@ -140,7 +127,7 @@ class Framer:
 
     def _silence_ends_frame(self, t_us: int) -> bool:
         gap = t_us - (self._last_us if self._last_us is not None else t_us)
-        length = known_length(self._buffer)
+        length = frame_length_either_side(self._buffer)
         undecided = length is not None and (len(self._buffer) < length or len(self._buffer) == length + 1)
         if undecided:  # a frame, or the next frame's first byte, still incomplete
             return gap >= self.timing.silence_us + self.timing.tolerance_us
@@ -157,7 +144,7 @@ class Framer:
         out: list[Frame] = []
         exact = self.timing.tolerance_us == 0
         while True:
-            length = known_length(self._buffer)
+            length = frame_length_either_side(self._buffer)
             if length is None or len(self._buffer) < length:
                 if len(self._buffer) >= MAX_FRAME:  # noise with no frame in it: let it go
                     out += self.flush()
@@ -166,7 +153,7 @@ class Framer:
             if len(self._buffer) == length and not exact:
                 out.append(self._take(length))
                 continue
-            if len(rest) < 2 or known_length(rest) is None:
+            if len(rest) < 2 or frame_length_either_side(rest) is None:
                 if len(self._buffer) >= MAX_FRAME:
                     out += self.flush()
                 return out

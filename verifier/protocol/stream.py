@@ -33,6 +33,19 @@ def frame_length(head: bytes, direction: Direction) -> int | None:
     return REQUEST_LENGTH if direction == "request" else REPLY_LENGTHS[function]
 
 
+def frame_length_either_side(head: bytes) -> int | None:
+    """The frame length ``head`` implies when the side that sent it is not known (a
+    receive-only tap): an exception reply of a known function, or a function code whose
+    requests and replies are equally long; None otherwise."""
+    if len(head) < 2:
+        return None
+    function = head[1]
+    if function & EXCEPTION_FLAG:
+        return frame_length(head, "reply") if function & ~EXCEPTION_FLAG in FUNCTION_CODES else None
+    request, reply = frame_length(head, "request"), frame_length(head, "reply")
+    return request if request == reply else None
+
+
 def split_frames(data: bytes, direction: Direction) -> tuple[list[bytes], bytes]:
     """Complete frames at the start of ``data`` and the bytes left over.
 

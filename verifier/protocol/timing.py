@@ -29,6 +29,21 @@ DEFAULT_REPLY_TIMEOUT_US = 500_000
 DEFAULT_ATTEMPTS = 3
 
 
+def silence_us(baud: int = BAUD, bits_per_char: int = BITS_PER_CHAR) -> int:
+    """t3.5, the silence that ends a frame, at any line speed: 3.5 characters, but fixed at
+    1750 µs above 19200 bit/s (Modbus over Serial Line V1.02 §2.5.1.1)."""
+    if baud == BAUD and bits_per_char == BITS_PER_CHAR:
+        return T3_5_US
+    return 1750 if baud > 19200 else round(3.5 * bits_per_char * 1_000_000 / baud)
+
+
+def gap_limit_us(baud: int = BAUD, bits_per_char: int = BITS_PER_CHAR) -> int:
+    """t1.5, the longest silence inside a frame: 1.5 characters, 750 µs above 19200 bit/s."""
+    if baud == BAUD and bits_per_char == BITS_PER_CHAR:
+        return T1_5_US
+    return 750 if baud > 19200 else round(1.5 * bits_per_char * 1_000_000 / baud)
+
+
 def frame_time_us(length: int) -> int:
     """Time to send ``length`` characters back to back, rounded to whole µs."""
     return round(BYTE_TIME_EXACT_US * length)
