@@ -23,7 +23,7 @@ from .expectations import judge
 from .result import LineEvent, ScenarioResult, TraceRecord, UnusableInput
 from .rules import check_all
 from .scenario import BUFFER_MEMORY, DEVICE_NAME, Scenario
-from .traffic import analyse
+from .traffic import analyse, converter_drops
 
 Progress = Callable[[int, int], None]  # (virtual now, virtual end) in µs
 PROGRESS_STEP_US = 1_000_000  # report progress every virtual second
@@ -338,7 +338,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     line_events = line.events if converter is None else sorted(line.events + converter.events, key=lambda e: e.t_us)
     events = [LineEvent(e.t_us, e.kind, e.message) for e in line_events if e.t_us <= end]
     evidence = RunEvidence(scenario.settings, trace, end, events, samples, scenario.options, aborted is not None)
-    traffic = analyse(trace, scenario.settings, scenario.options)
+    traffic = analyse(trace, scenario.settings, scenario.options, converter_drops(events))
     violations = check_all(evidence, traffic)
     outcomes = [judge(expectation, evidence, traffic) for expectation in scenario.expectations]
     return ScenarioResult(

@@ -8,7 +8,7 @@ given up (Modbus over Serial Line V1.02 §2.4.1, "response time-out").
 from __future__ import annotations
 
 import enum
-from bisect import bisect_right
+from bisect import bisect_left, bisect_right
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Sequence
@@ -26,6 +26,7 @@ class ReplyStatus(enum.Enum):
     GARBLED = "garbled"
     LATE = "late"
     NONE = "no reply"
+    LOST = "lost at the converter"  # TCP route: the robot answered, the PLC never got it
 
     @property
     def failed(self) -> bool:
@@ -63,6 +64,7 @@ class Exchange:
     rx: list[TraceFrameLike]  # every robot frame until the next request
     settings: protocol.Settings
     reply_timeout_us: int
+    lost_at_converter: bool = False  # the converter dropped the connection after forwarding it
 
     @cached_property
     def decoded_request(self):
@@ -94,6 +96,9 @@ class Exchange:
         reply = self.reply
         if reply is None:
             return ReplyStatus.NONE, "no reply"
+        if self.lost_at_converter:
+            return ReplyStatus.LOST, ("the robot answered, but the converter had dropped the connection: "
+                                      "the reply never reached the PLC")
         if reply.t_start_us > self.deadline_us:
             late_ms = (reply.t_start_us - self.request.t_end_us) / 1000
             return ReplyStatus.LATE, f"reply started {late_ms:.1f} ms after the request ended"
@@ -164,12 +169,21 @@ def _is_reply_to(frame: TraceFrameLike, exchange: Exchange) -> bool:
     return True
 
 
-def analyse(trace: Sequence[TraceFrameLike], settings: protocol.Settings, options: RuleOptions) -> Traffic:
+def converter_drops(events) -> list[int]:
+    """When a converter dropped the PLC's connection after forwarding a request (TCP route
+    events `converter.dropped`): the time of each."""
+    return [e.t_us for e in events if e.kind == "converter.dropped"]
+
+
+def analyse(trace: Sequence[TraceFrameLike], settings: protocol.Settings, options: RuleOptions,
+            dropped_at: Sequence[int] = ()) -> Traffic:
     """Pair requests and replies the way a slave answers: once per request, in order.
 
     A robot frame goes to the oldest request that has ended, has no reply yet and whose
     time-out has not run out — preferring one it is a valid reply to. When no request is
     waiting, it joins the latest request that ended before it (a late reply, garbage).
+    `dropped_at`: times a converter dropped the connection (`converter_drops`); the first
+    request at or after each is one whose reply the PLC never got (ReplyStatus.LOST).
     """
     frames = sorted(trace, key=lambda f: (f.t_start_us, f.direction != "tx"))
     tx = [f for f in frames if f.direction == "tx"]
@@ -194,4 +208,9 @@ def analyse(trace: Sequence[TraceFrameLike], settings: protocol.Settings, option
         else:
             owner = exchanges[count - 1]
         owner.rx.append(frame)
+    starts = [e.request.t_start_us for e in exchanges]
+    for t in dropped_at:
+        k = bisect_left(starts, t)
+        if k < len(exchanges):
+            exchanges[k].lost_at_converter = True
     return Traffic(exchanges, before, rx, tx)

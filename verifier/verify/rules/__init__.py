@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 from ..evidence import RunEvidence, Violation
-from ..traffic import Traffic, analyse
+from ..traffic import Traffic, analyse, converter_drops
 from . import framing, response, sequence, timing
 
 MANUAL = "UITAMR Modbus 通訊手冊 V2.05"
@@ -101,5 +101,5 @@ RULES_BY_ID = {rule.id: rule for rule in RULES}
 def check_all(evidence: RunEvidence, traffic: Traffic | None = None) -> dict[str, list[Violation]]:
     """Every rule's violations (an empty list for a rule that holds), in rule order."""
     if traffic is None:
-        traffic = analyse(evidence.trace, evidence.settings, evidence.options)
+        traffic = analyse(evidence.trace, evidence.settings, evidence.options, converter_drops(evidence.events))
     return {rule.id: sorted(rule.check(evidence, traffic), key=lambda v: v.t_us) for rule in RULES}

@@ -53,7 +53,6 @@ def check_cycle(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
     violations = []
     last_control = None
     status_read = False
-    lost = _replies_lost_at_the_converter(evidence, traffic)
     for exchange in traffic.exchanges:
         if exchange.is_status:
             status_read = status_read or exchange.answered
@@ -62,7 +61,7 @@ def check_cycle(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
             continue
         retry = (
             last_control is not None
-            and (not last_control.answered or last_control.index in lost)
+            and not last_control.answered
             and bytes(last_control.request.data) == bytes(exchange.request.data)
         )
         if last_control is not None and not status_read and not retry:
@@ -81,19 +80,3 @@ def check_cycle(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
         status_read = False
     return violations
 
-
-def _replies_lost_at_the_converter(evidence: RunEvidence, traffic: Traffic) -> set[int]:
-    """Exchanges (by index) whose request a converter forwarded just before it dropped the
-    connection (TCP route, `converter.dropped`): the robot answered on its line, but the
-    reply never reached the PLC - for the program the exchange failed, and resending the
-    same command is a retry."""
-    drops = [e.t_us for e in evidence.events if e.kind == "converter.dropped"]
-    if not drops:
-        return set()
-    lost, previous = set(), -1
-    for exchange in traffic.exchanges:
-        start = exchange.request.t_start_us
-        if any(previous < t <= start for t in drops):
-            lost.add(exchange.index)
-        previous = start
-    return lost
