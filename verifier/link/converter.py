@@ -177,7 +177,7 @@ class Converter:
             t, connection, data, origin = self._to_line.popleft()
             if connection != self.connection:
                 continue  # sent on a connection that is gone
-            self._collect(line.receive_until(max(t, line.now_us)))
+            self._serial.extend(line.receive_until(max(t, line.now_us)))
             line.send(data, max(t, line.now_us), origin)
             if self._drops and self._drops[0] <= t:
                 while self._drops and self._drops[0] <= t:
@@ -188,12 +188,9 @@ class Converter:
                 self._closed_at[connection] = t + self.config.delay_us
                 self._end_connection()
         if t_us > line.now_us:
-            self._collect(line.receive_until(t_us))
+            self._serial.extend(line.receive_until(t_us))
         self._pack(t_us)
         self.now_us = t_us
-
-    def _collect(self, received: list[tuple[int, int]]) -> None:
-        self._serial.extend(received)
 
     def _pack(self, t_us: int) -> None:
         """Forward robot bytes once the line has been quiet for the packing interval."""

@@ -54,7 +54,6 @@ def infer_platform(sources: tuple[Path, ...]) -> str:
 
 
 _COMMENT = re.compile(r"\(\*.*?\*\)|//[^\n]*", re.DOTALL)
-_ETHERNET_CALL = re.compile(r"\b(?:SP_SOC(?:OPEN|SND|RCV|CLOSE)|ZP_(?:OPEN|BUFSND|BUFRCV|CLOSE))\s*\(", re.IGNORECASE)
 
 
 def uses_tcp_route(sources: tuple[Path, ...], program: str | None = None) -> bool:
@@ -64,9 +63,11 @@ def uses_tcp_route(sources: tuple[Path, ...], program: str | None = None) -> boo
     scenarios). A library folder holding serial and Ethernet port FBs side by side does
     not make a serial program a TCP one."""
     from verifier import st
+    from verifier.sim.instructions import ETHERNET
     from verifier.st.ast import ArrayType, NamedType
     from verifier.st.source import read_source
 
+    ethernet_call = re.compile(r"\b(?:" + "|".join(sorted(ETHERNET)) + r")\s*\(", re.IGNORECASE)
     pous, calls = {}, set()
     for path in sources:
         text, _ = read_source(path)  # an unreadable file is reported where the sources load
@@ -74,7 +75,7 @@ def uses_tcp_route(sources: tuple[Path, ...], program: str | None = None) -> boo
         for pou in st.parse(text, str(path)).pous:
             pous[pou.key] = pou
             own = "\n".join(lines[pou.span.line - 1:pou.span.end_line]) if pou.span.line else text
-            if _ETHERNET_CALL.search(_COMMENT.sub(" ", own)):
+            if ethernet_call.search(_COMMENT.sub(" ", own)):
                 calls.add(pou.key)
     if program is not None:
         todo = [program.upper()]

@@ -60,6 +60,8 @@ SPECS = {s.name: s for s in (
     InstructionSpec("ZP_BUFRCV", ("val", "val", "blk", "dst", "dst"), frozenset({"q"}), False, always=True),
     InstructionSpec("ZP_CLOSE", ("val", "val", "blk", "dst"), frozenset({"q"}), False, always=True),
 )}
+#: the Ethernet instructions (tcp.py): a program that calls one reaches the robot over TCP
+ETHERNET = frozenset(name for name in SPECS if name.startswith(("SP_SOC", "ZP_")))
 # FX5's ADPRW has a completion-bits operand after the data block.
 FX5_ADPRW = InstructionSpec("ADPRW", ("val", "val", "val", "val", "blk", "dst"), frozenset({"fx5"}), False)
 

@@ -112,7 +112,7 @@ class TcpPort:
             self.pending.append((done, 1))
 
     # ---- instructions --------------------------------------------------------------------------
-    def open(self, number, control, done, loc_id, *, receive_pair: bool = False) -> None:
+    def open(self, number, control, done, loc_id) -> None:
         conn = self.connection(number, control, done, loc_id)
         if conn is None:
             return
