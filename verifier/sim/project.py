@@ -76,6 +76,7 @@ class Project:
         self.before_scan: list[Callable[["Project"], None]] = []
         self.after_scan: list[Callable[["Project"], None]] = []
         self.touched: list[InstanceProxy] = []  # instances handed out (shown on test failure)
+        self.idle_scans = None  # a verifier.sim.idle.IdleScans while a run skips idle scans
         _register(self)
 
     # ------------------------------------------------------------------ state
@@ -223,10 +224,13 @@ class Project:
         begin, end = rt.begin_scan, rt.end_scan
         before, after = self.before_scan, self.after_scan
         remaining = scans if scans is not None else -1
+        # idle-scan skipping (verifier.sim.idle) only when running to a time, not a count
+        idle = self.idle_scans if scans is None else None
 
         def loop():
             nonlocal remaining
             while remaining != 0 and (stop_us is None or rt.now_us < stop_us):
+                started = rt.now_us
                 begin()
                 for cb in before:
                     cb(self)
@@ -236,8 +240,23 @@ class Project:
                     cb(self)
                 end()
                 remaining -= 1
+                if idle is not None:
+                    idle.after_scan(started, stop_us)
 
         self._guard(loop)
+
+    def skip_idle_scans(self, names: list[str], *, read_devices: tuple[str, ...] = (),
+                        next_input_us=None):
+        """Let timed runs of the PROGRAMs `names` jump over idle scans (verifier.sim.idle).
+        `read_devices`: devices the caller reads between scans; `next_input_us()`: when the
+        caller next writes an input. Returns the IdleScans (its `reason` says when it
+        cannot skip)."""
+        from .idle import INFINITY, IdleScans
+
+        roots = [self.module.namespace["_G"]] + [self._program_obj(self._pou(n).key) for n in names]
+        self.idle_scans = IdleScans(self, roots, read_devices=read_devices,
+                                    next_input_us=next_input_us or (lambda: INFINITY))
+        return self.idle_scans
 
     def restart(self, off_ms: float = 0) -> None:
         """Power the CPU off for `off_ms` of virtual time and on again (RUN from the
@@ -247,6 +266,7 @@ class Project:
         ASSUMPTION: no latched (battery-backed) device ranges and no VAR_RETAIN labels
         are kept — set them again from Python after the restart if your CPU keeps them."""
         rt = self.rt
+        self.idle_scans, rt.dirty_log = None, None  # the labels start again: a new walk needed
         rt.advance_to(rt.now_us + round(off_ms * 1000))
         for cells in rt.dev.areas.values():
             zero = False if cells and isinstance(cells[0], bool) else 0

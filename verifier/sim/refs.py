@@ -37,7 +37,10 @@ class Ref:
         return self.cells[self._index(k)]
 
     def set(self, k: int, value) -> None:
-        self.cells[self._index(k)] = self.norm(value)
+        i = self._index(k)
+        self.cells[i] = self.norm(value)
+        if self.rt.dirty_log is not None:
+            self.rt.dirty_log.append((self.cells, i))
 
     def get_u16(self, k: int = 0) -> int:
         return int(self.cells[self._index(k)]) & 0xFFFF
@@ -109,8 +112,11 @@ class DwordRef(Ref):
 
     def set(self, k: int, value) -> None:
         v = int(value) & 0xFFFFFFFF
-        self.cells[self._index(2 * k)] = ((v & 0xFFFF) + 0x8000 & 0xFFFF) - 0x8000
-        self.cells[self._index(2 * k + 1)] = ((v >> 16) + 0x8000 & 0xFFFF) - 0x8000
+        lo, hi = self._index(2 * k), self._index(2 * k + 1)
+        self.cells[lo] = ((v & 0xFFFF) + 0x8000 & 0xFFFF) - 0x8000
+        self.cells[hi] = ((v >> 16) + 0x8000 & 0xFFFF) - 0x8000
+        if self.rt.dirty_log is not None:
+            self.rt.dirty_log.extend(((self.cells, lo), (self.cells, hi)))
 
 
 class BitRef(Ref):
@@ -145,5 +151,7 @@ class BitRef(Ref):
         word = self.word_norm(word)
         if isinstance(self.obj, list):
             self.obj[self.attr] = word
+            if self.rt.dirty_log is not None:
+                self.rt.dirty_log.append((self.obj, self.attr))
         else:
             setattr(self.obj, self.attr, word)

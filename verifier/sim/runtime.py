@@ -41,6 +41,9 @@ class Runtime:
         self.diagnostics: list[SimDiagnostic] = []
         self.locations: list[str] = []  # location id -> "file:line:col"
         self.pollers: list = []  # objects with poll(now_us), run before each scan
+        # (cells, index) of every cell an instruction operand wrote, while a run skips idle
+        # scans (verifier.sim.idle); None otherwise
+        self.dirty_log: list | None = None
         self.after_scan: list = []  # objects with after_scan(now_us), run after each scan
         self.ports: dict[str, SerialChannel] = {}  # channel name ("fx3:1") -> byte stream
         self.buffers: dict[int, list[int]] = {}  # module start I/O -> buffer memory words

@@ -301,11 +301,18 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     end = scenario.duration_us
     from verifier.sim.errors import SimulationError
 
+    # the fast path jumps over idle scans (verifier.sim.idle); the plain one runs them all
+    idle = None if plain else plc.project.skip_idle_scans(
+        [plc.name], read_devices=tuple(name for name in names if _DEVICE.match(name)),
+        next_input_us=lambda: schedule[0][0] if schedule else float("inf"))
+
     def apply_inputs() -> None:
         now = plc.now_us
         while schedule and schedule[0][0] <= now:
             for name, value in schedule.pop(0)[1].items():
                 plc.write(name, value)
+            if idle is not None:
+                idle.busy = True
 
     getters = [plc.reader(name) for name in names]
     last: list[Any] = [object()]  # the values at the previous scan: record only changes
@@ -315,6 +322,8 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         if values != last[0]:
             last[0] = values
             samples.record(plc.now_us, {name: _plain(value) for name, value in zip(names, values)})
+            if idle is not None:
+                idle.busy = True
 
     def sample_plainly() -> None:
         samples.record(plc.now_us, {name: _plain(plc.read(name)) for name in names})

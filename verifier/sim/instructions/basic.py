@@ -152,6 +152,8 @@ def zrst(rt, en, d1, d2, loc_id):
         zero = False if isinstance(d1.cells[lo], bool) else 0
         for i in range(lo, hi + 1):
             d1.cells[i] = zero
+        if rt.dirty_log is not None:
+            rt.dirty_log.extend((d1.cells, i) for i in range(lo, hi + 1))
     return bool(en)
 
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..refs import Ref
 from ..serial import LineFormat, SerialChannel
 
 
@@ -165,6 +166,36 @@ class Rs2Port:
         elif self.rx and not self.rx_done and now - self.rx_last_t >= self.timeout_us():
             self._complete(timed_out=True)
             self._set(self._recv_count, len(self.rx))
+
+    # -- idle-scan skipping (verifier.sim.idle) -------------------------------------------
+    def idle_deadline(self, now: int) -> float | None:
+        """The first instant `poll` can change anything, or None when it may at `now`
+        (sending: the remaining count moves on every scan)."""
+        if self.sending_until is not None or (self.rx_done and not self._get(self._recv_done)):
+            return None
+        endpoint = self.channel.endpoint
+        if endpoint is None:
+            deadline = float("inf")
+        elif self.channel.knows_quiet and endpoint.now_us <= now < endpoint.quiet_until_us:
+            deadline = endpoint.quiet_until_us
+        else:
+            return None
+        if self.rx and not self.rx_done:
+            deadline = min(deadline, self.rx_last_t + self.timeout_us())
+        return deadline
+
+    def idle_state(self) -> tuple:
+        """Everything `call` and `poll` change, the scan of the last call relative to now."""
+        refs = tuple((id(r.cells), r.base) if isinstance(r, Ref) else id(r) for r in (self.s_ref, self.d_ref))
+        return (self.last_call_scan - self.rt.scan_count, refs, self.m, self.n, self.sending_until,
+                self.send_started, self.send_len, bytes(self.rx), self.rx_last_t, self.rx_done,
+                self.reported_format, len(self.channel.sent))
+
+    def skipped(self, scan_count: int, scans: int) -> None:
+        """`scans` idle scans after scan `scan_count` - 1 were skipped: one that called RS2
+        called it in each of them."""
+        if self.last_call_scan == scan_count - 1:
+            self.last_call_scan += scans
 
     def _poll_send(self, now: int) -> None:
         if now >= self.sending_until:

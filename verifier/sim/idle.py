@@ -1,0 +1,277 @@
+"""Skipping idle scans: a run that waits (a pace timer, a reply time-out, the next input)
+jumps over the scans that cannot change anything, in one step.
+
+A scan is a pure function of the state before it and of what it reads from outside: the
+virtual clock (timers, clock relays), the I/O models polled at END, and the inputs a
+scenario writes.  So when one scan left every piece of state exactly as it found it, the
+next scans do the same, until the first instant at which something outside can differ:
+
+- a running TON/TOF/TP reaches PT (its Q changes);
+- a clock relay the program (or a watch) reads toggles;
+- an I/O model has something to do (a byte arrives, a receive time-out runs out);
+- the scenario's next input, or the end of the run.
+
+`IdleScans.after_scan` decides this after every scan, cheaply enough to run on each one:
+the expensive comparison (every label of the program tree, the device cells the program
+names, the I/O models' own state) only runs when the I/O models say they are quiet, and
+two quiet scans in a row with equal state make an idle one.  The jump then moves the
+clock scan by scan (the jitter generator is drawn exactly as the skipped scans would
+have drawn it), so the next scan that runs starts at the same instant as in a plain run.
+
+What is left out of the comparison, and why that is sound:
+- a timer's ET, which changes on every scan while the timer runs.  The run is only
+  allowed to skip when no generated code reads ET (checked on the generated source); a
+  watched ET makes the runner's samples change on every scan, which is never idle;
+- the absolute scan number a port remembers (`last_call_scan`): compared relative to the
+  scan count, and moved on with the jump (`skipped`).
+
+Not skippable (the run then goes scan by scan, as before): any I/O model without the
+`idle_deadline`/`idle_state`/`skipped` protocol (today: C24, ADPRW and the Ethernet ports),
+a program that reads a timer's ET, arrays of arrays, and labels of a type the walk does
+not know.  `IdleScans.reason` says which.
+
+The equivalence with a plain scan-by-scan run is tested on every bundled scenario and on
+random ones (tests/test_idle_skip.py): same report bytes.
+"""
+from __future__ import annotations
+
+import operator
+import re
+from typing import Callable
+
+from .refs import Ref
+from .stdfbs import StdFB, TOF, TON, TP
+
+INFINITY = float("inf")
+_CONST_CELL = re.compile(r"\b(_A_[A-Z]+|_U[0-9A-F]+)\[(\d+)\]")
+_ANY_USE = re.compile(r"\b(_A_[A-Z]+|_U[0-9A-F]+)\b(?!\[\d+\])")
+_OPERAND_CONSTRUCTORS = ("_Ref(", "_BitRef(", "_DwordRef(")
+# a read of a timer's ET: `.ET` not followed by an assignment, or the name as an operand
+_ET_READ = re.compile(r"\.ET\b(?!\s*=[^=])|['\"]ET['\"]")
+
+
+class IdleScans:
+    """Decides after each scan whether the run is idle, and jumps when it is."""
+
+    def __init__(self, project, roots: list, *, read_devices: tuple[str, ...] = (),
+                 next_input_us: Callable[[], float] = lambda: INFINITY):
+        self.rt = rt = project.rt
+        self.next_input_us = next_input_us
+        self.busy = False  # set by the caller for a scan it wrote inputs in, or sampled a change
+        self.skipped_scans = 0
+        self.jumps = 0
+        self._previous = None
+        self._shadow: dict[tuple[int, int], object] = {}
+        source = project.module.source
+        self.reason: str | None = None
+        if _ET_READ.search(source):
+            self.reason = "the program reads a timer's ET"
+        self._holders = self._memory_holders(project)
+        self._objects: list[tuple[Callable, object]] = []
+        self._arrays: list[tuple[object, str]] = []
+        self._timers: list[StdFB] = []
+        self._walk(roots)
+        self._cells, self._whole = self._device_footprint(source)
+        self._clocks = self._relevant_clocks(source, read_devices)
+        if self.reason is None:
+            rt.dirty_log = []
+
+    # ---- what the program can change --------------------------------------------------
+    @staticmethod
+    def _memory_holders(project) -> dict[str, list]:
+        rt = project.rt
+        holders = {f"_A_{area}": cells for area, cells in rt.dev.areas.items()}
+        holders.update({f"_U{module:X}": cells for module, cells in rt.buffers.items()})
+        return holders
+
+    def _walk(self, roots: list) -> None:
+        """Every object of the program tree, and which of its slots hold state."""
+        seen: set[int] = set()
+        memory = {id(cells) for cells in self._holders.values()}
+        stack = list(roots)
+        while stack:
+            obj = stack.pop()
+            if id(obj) in seen:
+                continue
+            seen.add(id(obj))
+            slots = [s for cls in type(obj).__mro__ for s in getattr(cls, "__slots__", ()) if s != "_rt"]
+            if isinstance(obj, (TON, TOF, TP)):
+                self._timers.append(obj)
+                if self.reason is None:  # ET is not state when nothing reads it (module docstring)
+                    slots = [s for s in slots if s != "ET"]
+            scalars = []
+            for slot in slots:
+                value = getattr(obj, slot)
+                if isinstance(value, list):
+                    if id(value) in memory:
+                        continue  # device memory handed to an FB: compared as devices
+                    self._arrays.append((obj, slot))
+                    for item in value:
+                        if isinstance(item, list):
+                            self.reason = self.reason or "an array of arrays"
+                        elif hasattr(type(item), "__slots__") and not isinstance(item, (str, Ref)):
+                            stack.append(item)
+                elif isinstance(value, Ref):
+                    continue  # an operand handle, fixed at load
+                elif isinstance(value, (bool, int, float, str, type(None))):
+                    scalars.append(slot)
+                elif hasattr(type(value), "__slots__"):
+                    scalars.append(slot)  # compared by identity; its own state is walked
+                    stack.append(value)
+                else:
+                    self.reason = self.reason or f"a label of a kind the idle check does not know ({type(value).__name__})"
+            if scalars:
+                getter = operator.attrgetter(*scalars)
+                self._objects.append((getter, obj))
+
+    def _device_footprint(self, source: str):
+        """The device and buffer cells the generated code names with a constant index, and
+        the whole areas it reaches any other way (an index expression). Cells written
+        through an instruction operand are logged by the operand (`Runtime.dirty_log`)."""
+        constant: dict[str, set[int]] = {}
+        for holder, index in _CONST_CELL.findall(source):
+            constant.setdefault(holder, set()).add(int(index))
+        cells = []
+        for holder, indexes in constant.items():
+            ordered = sorted(indexes)
+            getter = operator.itemgetter(*ordered) if len(ordered) > 1 else (lambda c, i=ordered[0]: (c[i],))
+            cells.append((self._holders[holder], getter))
+        whole = []
+        for match in _ANY_USE.finditer(source):
+            if source.endswith(_OPERAND_CONSTRUCTORS, 0, match.start()):
+                continue  # an instruction operand: its writes are logged
+            area = self._holders.get(match.group(1))
+            if area is not None and all(area is not w for w in whole):
+                whole.append(area)
+        return cells, whole
+
+    def _relevant_clocks(self, source: str, read_devices: tuple[str, ...]):
+        """The clock relays that can matter: named in the program or read by the caller, or
+        in an area the program reaches through an operand or an index."""
+        rt = self.rt
+        named = {(h[3:], int(i)) for h, i in _CONST_CELL.findall(source) if h.startswith("_A_")}
+        reached = {m.group(1)[3:] for m in _ANY_USE.finditer(source) if m.group(1).startswith("_A_")}
+        for name in read_devices:
+            try:
+                a = rt.dev.address(name)
+            except (KeyError, ValueError):
+                continue
+            named.update((a.area, a.index + k) for k in range(max(1, (a.digits or 0) * 4)))
+        clocks = []
+        for cells, index, half_us in rt._clocks:
+            area = next(name for name, c in rt.dev.areas.items() if c is cells)
+            if (area, index) in named or area in reached:
+                clocks.append(("fixed", half_us, None))
+        for relay, register, unit_us, _ in rt._settable_clocks:
+            if (relay.area, relay.index) in named or relay.area in reached:
+                clocks.append(("settable", unit_us, (rt.dev.areas[register.area], register.index)))
+        return clocks
+
+    # ---- after every scan ---------------------------------------------------------------
+    def after_scan(self, started_us: int, stop_us: int | None) -> None:
+        """Called after each scan (the clock already at the next one); `started_us` is when
+        the scan that just ran started."""
+        if self.reason is not None:
+            return
+        rt = self.rt
+        changed = self._logged_cells_changed()
+        busy, self.busy = self.busy, False
+        if busy or changed or rt.scan_count < 2:
+            self._previous = None
+            return
+        now = rt.now_us
+        deadline = self.next_input_us()
+        for poller in rt.pollers:
+            until = getattr(poller, "idle_deadline", None)
+            until = until(now) if until is not None else None
+            if until is None or until <= now:
+                self._previous = None
+                return
+            deadline = min(deadline, until)
+        state = self._state()
+        if state != self._previous:
+            self._previous = state
+            return
+        deadline = min(deadline, self._timer_deadline_us(), self._clock_deadline_us(started_us))
+        if stop_us is not None:
+            deadline = min(deadline, stop_us)
+        if now < deadline < INFINITY:
+            self._jump(deadline)
+
+    def _logged_cells_changed(self) -> bool:
+        log = self.rt.dirty_log
+        if not log:
+            return False
+        shadow, changed = self._shadow, False
+        missing = object()
+        for cells, index in log:
+            key = (id(cells), index)
+            value = cells[index]
+            if shadow.get(key, missing) != value or type(shadow.get(key)) is not type(value):
+                changed = True
+                shadow[key] = value
+        log.clear()
+        return changed
+
+    def _state(self):
+        rt = self.rt
+        return (
+            [getter(obj) for getter, obj in self._objects],
+            [getattr(obj, slot)[:] for obj, slot in self._arrays],
+            [getter(cells) for cells, getter in self._cells],
+            [cells[:] for cells in self._whole],
+            [poller.idle_state() for poller in rt.pollers],
+            len(rt.diagnostics),
+        )
+
+    def _timer_deadline_us(self) -> float:
+        """The first instant a running timer's Q can change (timers read whole ticks)."""
+        rt = self.rt
+        first_ms = INFINITY
+        for t in self._timers:
+            if t._start is None:
+                continue
+            running = (t.IN and not t.Q) if isinstance(t, TON) else (not t.IN and t.Q) if isinstance(t, TOF) else t.Q
+            if running:
+                first_ms = min(first_ms, t._start + t.PT)
+        if first_ms == INFINITY:
+            return INFINITY
+        resolution = rt.timer_resolution_ms
+        return -(-first_ms // resolution) * resolution * 1000
+
+    def _clock_deadline_us(self, started_us: int) -> float:
+        """The first toggle of a relevant clock relay after the idle scan read it."""
+        first = INFINITY
+        for kind, unit_us, register in self._clocks:
+            if kind == "fixed":
+                half = unit_us
+            else:
+                cells, index = register
+                if cells[index] <= 0:
+                    continue  # out of range: the relay keeps its state (Runtime)
+                half = cells[index] * unit_us
+            first = min(first, (started_us // half + 1) * half)
+        return first
+
+    def _jump(self, deadline: float) -> None:
+        """Move on over every scan that would start before `deadline`, as those scans would."""
+        rt = self.rt
+        count = rt.scan_count
+        now, step, jitter = rt.now_us, rt.scan_us, rt.jitter_us
+        scans = 0
+        if jitter:
+            draw = rt.rng.randint
+            while now < deadline:
+                now += step + draw(-jitter, jitter)
+                scans += 1
+        else:
+            scans = max(0, int(-(-(deadline - now) // step)))
+            now += scans * step
+        if scans == 0:
+            return
+        rt.scan_count = count + scans
+        rt.advance_to(now)
+        for poller in rt.pollers:
+            poller.skipped(count, scans)
+        self.skipped_scans += scans
+        self.jumps += 1
