@@ -6,6 +6,8 @@ Behaviour, buffer addresses and what is an ASSUMPTION: docs/instructions.md ("QJ
 """
 from __future__ import annotations
 
+from ..refs import BitRef, Ref
+
 # buffer memory (word addresses) per channel: receive data count, receive end code,
 # word/byte unit designation
 BUFFER = {
@@ -20,6 +22,22 @@ ABNORMAL = {1: 0x4, 2: 0xB}
 # result codes the simulator writes (ASSUMPTION: the module's own codes are not modelled)
 ERR_CHANNEL = 0x7FF1
 ERR_TOO_LONG = 0x7FF2
+
+
+def operand_key(ref):
+    """A comparable stand-in for an instruction operand in an `idle_state` tuple (verifier.sim.idle):
+    the memory it names, not the handle (a handle built on every call is a new object)."""
+    if isinstance(ref, BitRef):
+        return ("bit", id(ref.obj), ref.attr, ref.bit)
+    if isinstance(ref, Ref):
+        attr = getattr(ref, "attr", None)  # AttrRef: a scalar label
+        return (id(ref.cells), ref.base) if attr is None else ("attr", id(ref.obj), attr)
+    return None if ref is None else ("object", id(ref))
+
+
+def pulse_keys(flags) -> tuple:
+    """`operand_key` of each (operand, bit) of a pulse list."""
+    return tuple((operand_key(ref), bit) for ref, bit in flags)
 
 
 class _Channel:
@@ -133,6 +151,38 @@ class C24Module:
                 d.set(0, True)
                 self.pulses.append((d, 0))
             self._receive(chan, now)
+
+    # -- idle-scan skipping (verifier.sim.idle) -------------------------------------------
+    def idle_deadline(self, now: int) -> float | None:
+        """The first instant `poll` can change anything, or None when it may at `now` (a
+        completion bit to turn ON or OFF)."""
+        if self.pulses or self.pending:
+            return None
+        deadline = float("inf")
+        for chan in self.channels.values():
+            if chan.sending_until is not None:
+                deadline = min(deadline, chan.sending_until)
+            endpoint = chan.port.endpoint
+            if endpoint is not None:
+                # SerialChannel.receive_until: on a quiet line it only moves the line's clock
+                if not (chan.port.knows_quiet and endpoint.now_us <= now < endpoint.quiet_until_us):
+                    return None
+                deadline = min(deadline, endpoint.quiet_until_us)
+            if chan.rx and chan.no_reception_us is not None:
+                # the frame ends once more than the no-reception time has passed (integer µs)
+                deadline = min(deadline, chan.rx_last_t + chan.no_reception_us + 1)
+        return deadline
+
+    def idle_state(self) -> tuple:
+        """Everything the instructions and `poll` change (nothing counts scans)."""
+        channels = tuple(
+            (c.sending_until, None if c.out_done is None else tuple(map(operand_key, c.out_done)),
+             bytes(c.rx), c.rx_last_t, tuple(c.frames), c.no_reception_us, len(c.port.sent))
+            for c in self.channels.values())
+        return channels, pulse_keys(self.pulses), pulse_keys(self.pending)
+
+    def skipped(self, scan_count: int, scans: int) -> None:
+        """Nothing here depends on the scan count."""
 
     def _receive(self, chan: _Channel, now: int) -> None:
         target = 2 * self._word(chan.ch, "recv_count") if self._word(chan.ch, "unit") == 0 \
