@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from verifier.protocol import crc_ok, with_crc
 
+from .c24 import operand_key, pulse_keys
+
 # simulator error codes (ASSUMPTION: the manuals' chapter-12 codes are not modelled)
 ERR_TIMEOUT = 1
 ERR_CRC = 2
@@ -136,6 +138,34 @@ class AdprwMaster:
                 self._send(None)
             else:
                 self._complete(ERR_TIMEOUT)
+
+    # -- idle-scan skipping (verifier.sim.idle) -------------------------------------------
+    def idle_deadline(self, now: int) -> float | None:
+        """The first instant `poll` can change anything, or None when it may at `now` (a
+        completion bit to turn ON or OFF, a line with something under way)."""
+        if self.pulses or self.pending:
+            return None
+        port = self.port
+        endpoint = port.endpoint
+        deadline = float("inf")
+        if endpoint is not None:
+            # SerialChannel.receive_until: on a quiet line it only moves the line's clock
+            if not (port.knows_quiet and endpoint.now_us <= now < endpoint.quiet_until_us):
+                return None
+            deadline = endpoint.quiet_until_us
+        if self.busy:
+            deadline = min(deadline, self.deadline)  # the slave response time-out (or a retry)
+        return deadline
+
+    def idle_state(self) -> tuple:
+        """Everything `call` and `poll` change (nothing counts scans)."""
+        fc, count, data, d2 = self.job if self.job is not None else (None, None, None, None)
+        return (self.busy, self.completed, self.request, self.expect, self.deadline, self.attempts_left,
+                bytes(self.rx), fc, count, operand_key(data), operand_key(d2),
+                pulse_keys(self.pulses), pulse_keys(self.pending), len(self.port.sent))
+
+    def skipped(self, scan_count: int, scans: int) -> None:
+        """Nothing here depends on the scan count."""
 
     def _reply(self) -> None:
         frame = bytes(self.rx)
