@@ -162,6 +162,31 @@ class Converter:
             self._event(t_us, "converter.closed", f"the PLC closes connection {connection}")
             self._end_connection()
 
+    # ---- idle-scan skipping (verifier.sim.idle) -------------------------------------------
+
+    def quiet_until_us(self, connection: int) -> int | float:
+        """Before this time nothing happens for `connection`: for ``now_us <= t <`` it,
+        ``receive_until(t, connection)`` returns no segment, ``peer_closed(t, connection)``
+        returns False, and both only move the clocks (``now_us``, the line's ``now_us``).
+        ``now_us`` (no quiet time at all) when the close is already known."""
+        first = self.line.quiet_until_us  # Line: a call before it only moves the line's clock
+        if self._to_line:
+            first = min(first, self._to_line[0][0])  # a segment reaches the converter
+        if self._serial:  # what _pack left: one group, forwarded pack_us after its last byte
+            first = min(first, self._serial[-1][1] + self.config.pack_us)
+        if connection and connection == self.connection and self._to_plc:
+            first = min(first, self._to_plc[0][0])  # a segment reaches the PLC
+        if connection in self._closed_at:
+            first = min(first, self._closed_at[connection])
+        elif connection and connection != self.connection:
+            return self.now_us  # peer_closed is True already
+        return max(first, self.now_us)
+
+    def idle_state(self) -> tuple:
+        """What the PLC's calls change here (compared between scans; nothing counts them)."""
+        return (self.connection, self._count, len(self._to_line), len(self._serial), len(self._to_plc),
+                len(self._closed_at), len(self._drops), len(self.events))
+
     # ---- the converter's work ------------------------------------------------------------
 
     def advance(self, t_us: int) -> None:

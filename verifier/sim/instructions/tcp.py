@@ -20,6 +20,8 @@ from __future__ import annotations
 
 from collections import deque
 
+from .c24 import operand_key, pulse_keys
+
 # completion status codes the simulator writes (ASSUMPTION: the modules' own codes are
 # not modelled; these sit in a range the modules do not document, like the C24 model's)
 ERR_REFUSED = 0x7FE1  # the converter answered the open with a reset
@@ -245,6 +247,48 @@ class TcpPort:
             elif conn.state == PEER_CLOSED:
                 active = True
         self._active = active
+
+    # ---- idle-scan skipping (verifier.sim.idle) -------------------------------------------
+    def idle_deadline(self, now: int) -> float | None:
+        """The first instant `poll` can change anything, or None when it may at `now` (a
+        completion bit to turn ON or OFF, a segment or a close under way, an endpoint that
+        cannot say when it is quiet)."""
+        if self.pulses or self.pending:
+            return None
+        if not self._active:
+            return float("inf")  # poll returns at once
+        deadline, active = float("inf"), False
+        endpoint = self.endpoint
+        for conn in self.connections.values():
+            if conn.state == OPENING:
+                active = True
+                deadline = min(deadline, conn.open_done_us)
+            elif conn.state == OPEN and endpoint is not None:
+                active = True
+                quiet = getattr(endpoint, "quiet_until_us", None)
+                until = quiet(conn.remote) if quiet is not None else None
+                if until is None or until <= now:
+                    return None
+                deadline = min(deadline, until)
+            elif conn.state == PEER_CLOSED:
+                active = True
+        return deadline if active else None  # not active: poll clears `_active`
+
+    def idle_state(self) -> tuple:
+        """Everything the instructions and `poll` change (nothing counts scans)."""
+        number = lambda c: None if c is None else c.number  # noqa: E731
+        conns = tuple(
+            (c.state, c.remote, c.open_done_us, c.open_ok, c.open_status,
+             None if c.open_refs is None else tuple(map(operand_key, c.open_refs)),
+             tuple(c.received), number(c.receiver), number(c.partner), number(c.pair))
+            for c in self.connections.values())
+        endpoint = self.endpoint
+        peer = endpoint.idle_state() if hasattr(endpoint, "idle_state") else None
+        return (conns, tuple(self._last_en.items()), pulse_keys(self.pulses), pulse_keys(self.pending),
+                self._active, tuple(getattr(self, "direction", {}).items()), peer)
+
+    def skipped(self, scan_count: int, scans: int) -> None:
+        """Nothing here depends on the scan count."""
 
     def opened(self, conn: _Connection) -> None:
         """After an open completed (the E71 opens the paired connection too)."""
