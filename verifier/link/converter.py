@@ -164,7 +164,7 @@ class Converter:
 
     # ---- idle-scan skipping (verifier.sim.idle) -------------------------------------------
 
-    def quiet_until_us(self, connection: int) -> int | float:
+    def quiet_until(self, connection: int) -> int | float:
         """Before this time nothing happens for `connection`: for ``now_us <= t <`` it,
         ``receive_until(t, connection)`` returns no segment, ``peer_closed(t, connection)``
         returns False, and both only move the clocks (``now_us``, the line's ``now_us``).

@@ -265,7 +265,7 @@ class TcpPort:
                 deadline = min(deadline, conn.open_done_us)
             elif conn.state == OPEN and endpoint is not None:
                 active = True
-                quiet = getattr(endpoint, "quiet_until_us", None)
+                quiet = getattr(endpoint, "quiet_until", None)
                 until = quiet(conn.remote) if quiet is not None else None
                 if until is None or until <= now:
                     return None
