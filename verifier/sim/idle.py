@@ -25,10 +25,17 @@ What is left out of the comparison, and why that is sound:
 - the absolute scan number a port remembers (`last_call_scan`): compared relative to the
   scan count, and moved on with the jump (`skipped`).
 
-Not skippable (the run then goes scan by scan, as before): any I/O model without the
-`idle_deadline`/`idle_state`/`skipped` protocol (today: C24, ADPRW and the Ethernet ports),
-a program that reads a timer's ET, arrays of arrays, and labels of a type the walk does
-not know.  `IdleScans.reason` says which.
+Every I/O model takes part through three methods; a model without them keeps the run
+scan by scan (safe by default).  RS2, C24, ADPRW and the Ethernet ports have them:
+- `idle_deadline(now)`: the first instant `poll` can change anything, never later than
+  the truth; None when it may change something at `now` (sending, a completion pulse);
+- `idle_state()`: a comparable tuple of everything its instruction calls and `poll`
+  change (operands as the memory they name, `refs.operand_key`; scan numbers relative);
+- `skipped(scan_count, scans)`: fix what counts scans after a jump.
+
+Not skippable (the run then goes scan by scan, as before): a program that reads a timer's
+ET, arrays of arrays, and labels of a type the walk does not know.  `IdleScans.reason`
+says which.
 
 The equivalence with a plain scan-by-scan run is tested on every bundled scenario and on
 random ones (tests/test_idle_skip.py): same report bytes.

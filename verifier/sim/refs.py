@@ -155,3 +155,19 @@ class BitRef(Ref):
                 self.rt.dirty_log.append((self.obj, self.attr))
         else:
             setattr(self.obj, self.attr, word)
+
+
+def operand_key(ref):
+    """A comparable stand-in for an instruction operand in an `idle_state` tuple (verifier.sim.idle):
+    the memory it names, not the handle (a handle built on every call is a new object)."""
+    if isinstance(ref, BitRef):
+        return ("bit", id(ref.obj), ref.attr, ref.bit)
+    if isinstance(ref, Ref):
+        attr = getattr(ref, "attr", None)  # AttrRef: a scalar label
+        return (id(ref.cells), ref.base) if attr is None else ("attr", id(ref.obj), attr)
+    return None if ref is None else ("object", id(ref))
+
+
+def pulse_keys(flags) -> tuple:
+    """`operand_key` of each (operand, bit) of a pulse list."""
+    return tuple((operand_key(ref), bit) for ref, bit in flags)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from verifier.protocol import crc_ok, with_crc
 
-from .c24 import operand_key, pulse_keys
+from ..refs import operand_key, pulse_keys
 
 # simulator error codes (ASSUMPTION: the manuals' chapter-12 codes are not modelled)
 ERR_TIMEOUT = 1

@@ -6,7 +6,7 @@ Behaviour, buffer addresses and what is an ASSUMPTION: docs/instructions.md ("QJ
 """
 from __future__ import annotations
 
-from ..refs import BitRef, Ref
+from ..refs import operand_key, pulse_keys
 
 # buffer memory (word addresses) per channel: receive data count, receive end code,
 # word/byte unit designation
@@ -22,22 +22,6 @@ ABNORMAL = {1: 0x4, 2: 0xB}
 # result codes the simulator writes (ASSUMPTION: the module's own codes are not modelled)
 ERR_CHANNEL = 0x7FF1
 ERR_TOO_LONG = 0x7FF2
-
-
-def operand_key(ref):
-    """A comparable stand-in for an instruction operand in an `idle_state` tuple (verifier.sim.idle):
-    the memory it names, not the handle (a handle built on every call is a new object)."""
-    if isinstance(ref, BitRef):
-        return ("bit", id(ref.obj), ref.attr, ref.bit)
-    if isinstance(ref, Ref):
-        attr = getattr(ref, "attr", None)  # AttrRef: a scalar label
-        return (id(ref.cells), ref.base) if attr is None else ("attr", id(ref.obj), attr)
-    return None if ref is None else ("object", id(ref))
-
-
-def pulse_keys(flags) -> tuple:
-    """`operand_key` of each (operand, bit) of a pulse list."""
-    return tuple((operand_key(ref), bit) for ref, bit in flags)
 
 
 class _Channel:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..refs import Ref
+from ..refs import operand_key
 from ..serial import LineFormat, SerialChannel
 
 
@@ -186,8 +186,8 @@ class Rs2Port:
 
     def idle_state(self) -> tuple:
         """Everything `call` and `poll` change, the scan of the last call relative to now."""
-        refs = tuple((id(r.cells), r.base) if isinstance(r, Ref) else id(r) for r in (self.s_ref, self.d_ref))
-        return (self.last_call_scan - self.rt.scan_count, refs, self.m, self.n, self.sending_until,
+        return (self.last_call_scan - self.rt.scan_count, operand_key(self.s_ref), operand_key(self.d_ref),
+                self.m, self.n, self.sending_until,
                 self.send_started, self.send_len, bytes(self.rx), self.rx_last_t, self.rx_done,
                 self.reported_format, len(self.channel.sent))
 

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from collections import deque
 
-from .c24 import operand_key, pulse_keys
+from ..refs import operand_key, pulse_keys
 
 # completion status codes the simulator writes (ASSUMPTION: the modules' own codes are
 # not modelled; these sit in a range the modules do not document, like the C24 model's)
