@@ -358,6 +358,11 @@ class ModuleCompiler:
 
     # ------------------------------------------------------------------ generation
     def compile(self) -> CompiledModule:
+        return instantiate(self.generate(), self.rt)
+
+    def generate(self) -> "Generated":
+        """The Python source and code object of the files, and the tables they index."""
+        first_location = len(self.rt.locations)
         self.build_symbols()
         check_storage(self.struct_fields, self.pous, self.globals,
                       {key: sd.name for key, sd in self.structs.items()})
@@ -376,7 +381,6 @@ class ModuleCompiler:
             lines, spans = inliner.expanded(key) if inliner else (body.lines, body.spans)
             self.gen_class(self.pous[key], lines, spans, bc)
         source = "\n".join(em.lines) + "\n"
-        ns = self.namespace()
         try:
             code = compile(source, GENERATED_FILE, "exec")
         except (SyntaxError, RecursionError, MemoryError) as e:
@@ -385,43 +389,10 @@ class ModuleCompiler:
             span = em.spans[lineno - 1] if lineno and 0 < lineno <= len(em.spans) else None
             raise CompileError(span, "expression nested too deeply to simulate; "
                                      "split it into several statements") from None
-        exec(code, ns)
-        for key in pure_functions(self.functions):
-            name = self.functions[key].class_name
-            ns[name] = remembered(ns[name])
-        ns["_G"] = ns["_Globals"]()
-        module = CompiledModule(ns, source, list(em.spans), self.pous, self.struct_fields, self.globals)
-        for info in self.pous.values():
-            if info.kind != "FUNCTION":
-                module.class_symbols[ns[info.class_name]] = info.symbols
-        for key in self.structs:
-            module.class_symbols[ns[f"S_{key}"]] = self.struct_fields[key]
-        module.class_symbols[ns["_Globals"]] = self.globals
-        return module
-
-    def namespace(self) -> dict:
-        rt = self.rt
-        oob = self.oob
-
-        def _oob(index, k):
-            location, label, lo, hi = oob[k]
-            raise SimulationError(
-                f"index {index} is outside {label}[{lo}..{hi}]; the real CPU does not "
-                "check this and would silently read or overwrite neighbouring memory",
-                location, rt.now_us)
-
-        ns = {"__name__": "verifier_sim_generated", "_rt": rt, "_I": InstructionSet(rt),
-              "_Ref": Ref, "_AttrRef": AttrRef, "_BitRef": BitRef,
-              "_DwordRef": DwordRef, "_oob": _oob}
-        ns.update(make_helpers(rt))
-        ns.update(anyint_helpers())
-        for name, cls in STANDARD_FBS.items():
-            ns[f"_STD_{name}"] = cls
-        for area in self.cpu.areas:
-            ns[f"_A_{area}"] = rt.dev.areas[area]
-        for module in self.buffers:
-            ns[f"_U{module:X}"] = rt.buffer(module)
-        return ns
+        return Generated(
+            self.files, self.cpu, self.inline, source, code, list(em.spans), self.pous, self.struct_fields,
+            self.globals, list(self.structs), [self.functions[k].class_name for k in pure_functions(self.functions)],
+            self.rt.locations[first_location:], first_location, list(self.oob), sorted(self.buffers))
 
     def gen_struct(self, key: str, sd: ast.StructDecl) -> None:
         em = self.em
@@ -591,8 +562,91 @@ def default_code(t) -> str:
     raise CompileError(None, f"no default for {t}")
 
 
+@dataclass
+class Generated:
+    """What code generation made of one set of parsed files for one CPU. It holds no
+    run-time state (the location and index tables are plain lists), so `uitamr verify`
+    generates and compiles the library once and runs scenario after scenario on it."""
+    files: list
+    cpu: CpuProfile
+    inline: bool
+    source: str
+    code: object
+    spans: list
+    pous: dict[str, PouInfo]
+    struct_fields: dict[str, dict[str, Symbol]]
+    globals: dict[str, Symbol]
+    struct_keys: list[str]
+    pure_functions: list[str]  # class names of FUNCTIONs whose results can be remembered
+    locations: list[str]  # the runtime's location table from `first_location` on
+    first_location: int
+    oob: list[tuple[str, str, int, int]]
+    buffers: list[int]
+
+
+def namespace(rt, cpu: CpuProfile, oob: list, buffers) -> dict:
+    """The globals the generated code runs in, bound to one runtime."""
+
+    def _oob(index, k):
+        location, label, lo, hi = oob[k]
+        raise SimulationError(
+            f"index {index} is outside {label}[{lo}..{hi}]; the real CPU does not "
+            "check this and would silently read or overwrite neighbouring memory",
+            location, rt.now_us)
+
+    ns = {"__name__": "verifier_sim_generated", "_rt": rt, "_I": InstructionSet(rt),
+          "_Ref": Ref, "_AttrRef": AttrRef, "_BitRef": BitRef,
+          "_DwordRef": DwordRef, "_oob": _oob}
+    ns.update(make_helpers(rt))
+    ns.update(anyint_helpers())
+    for name, cls in STANDARD_FBS.items():
+        ns[f"_STD_{name}"] = cls
+    for area in cpu.areas:
+        ns[f"_A_{area}"] = rt.dev.areas[area]
+    for module in buffers:
+        ns[f"_U{module:X}"] = rt.buffer(module)
+    return ns
+
+
+def instantiate(generated: Generated, rt) -> CompiledModule:
+    """The generated code run into a namespace of `rt`: classes, functions, globals."""
+    if len(rt.locations) != generated.first_location + len(generated.locations):
+        # a runtime other than the one the code was generated with: give it the same table
+        if len(rt.locations) != generated.first_location:
+            raise ValueError("the runtime's location table does not match the generated code")
+        rt.locations.extend(generated.locations)
+    ns = namespace(rt, generated.cpu, generated.oob, generated.buffers)
+    exec(generated.code, ns)
+    for name in generated.pure_functions:
+        ns[name] = remembered(ns[name])
+    ns["_G"] = ns["_Globals"]()
+    module = CompiledModule(ns, generated.source, generated.spans, generated.pous, generated.struct_fields,
+                            generated.globals)
+    for info in generated.pous.values():
+        if info.kind != "FUNCTION":
+            module.class_symbols[ns[info.class_name]] = info.symbols
+    for key in generated.struct_keys:
+        module.class_symbols[ns[f"S_{key}"]] = generated.struct_fields[key]
+    module.class_symbols[ns["_Globals"]] = generated.globals
+    return module
+
+
+#: generated code by parsed files (the parse cache hands back the same list for the same
+#: texts), CPU and inlining; the entry keeps the files alive, so their id is not reused
+_GENERATED: dict[tuple[int, str, bool], Generated] = {}
+_GENERATED_MAX = 8
+
+
 def compile_files(files: list[ast.SourceFile], rt, cpu: CpuProfile, inline: bool = True) -> CompiledModule:
-    return ModuleCompiler(files, rt, cpu, inline).compile()
+    key = (id(files), cpu.name, inline)
+    generated = _GENERATED.get(key)
+    if generated is None or generated.files is not files or rt.locations:
+        generated = ModuleCompiler(files, rt, cpu, inline).generate()
+        if generated.first_location == 0:
+            if len(_GENERATED) >= _GENERATED_MAX:
+                _GENERATED.pop(next(iter(_GENERATED)))
+            _GENERATED[key] = generated
+    return instantiate(generated, rt)
 
 
 __all__ = ["compile_files", "CompiledModule", "CompileError", "concrete", "is_int", "is_real"]

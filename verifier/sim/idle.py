@@ -44,6 +44,8 @@ from __future__ import annotations
 
 import operator
 import re
+from dataclasses import dataclass
+from functools import lru_cache
 from typing import Callable
 
 from .refs import Ref
@@ -55,6 +57,32 @@ _ANY_USE = re.compile(r"\b(_A_[A-Z]+|_U[0-9A-F]+)\b(?!\[\d+\])")
 _OPERAND_CONSTRUCTORS = ("_Ref(", "_BitRef(", "_DwordRef(")
 # a read of a timer's ET: `.ET` not followed by an assignment, or the name as an operand
 _ET_READ = re.compile(r"\.ET\b(?!\s*=[^=])|['\"]ET['\"]")
+
+
+@dataclass(frozen=True)
+class SourceFacts:
+    """What the idle check needs to know of the generated code (worked out once per source)."""
+    reads_et: bool
+    constant: dict[str, tuple[int, ...]]  # memory holder -> the indexes named as constants
+    whole: tuple[str, ...]  # holders reached by an index expression or a helper
+    reached: frozenset[str]  # device areas used other than by a constant index
+
+
+@lru_cache(maxsize=8)
+def _source_facts(source: str) -> SourceFacts:
+    constant: dict[str, set[int]] = {}
+    for holder, index in _CONST_CELL.findall(source):
+        constant.setdefault(holder, set()).add(int(index))
+    whole: list[str] = []
+    reached: set[str] = set()
+    for match in _ANY_USE.finditer(source):
+        holder = match.group(1)
+        if holder.startswith("_A_"):
+            reached.add(holder[3:])
+        if not source.endswith(_OPERAND_CONSTRUCTORS, 0, match.start()) and holder not in whole:
+            whole.append(holder)  # not an instruction operand (whose writes are logged)
+    return SourceFacts(bool(_ET_READ.search(source)), {h: tuple(sorted(i)) for h, i in constant.items()},
+                       tuple(whole), frozenset(reached))
 
 
 class IdleScans:
@@ -69,17 +97,17 @@ class IdleScans:
         self.jumps = 0
         self._previous = None
         self._shadow: dict[tuple[int, int], object] = {}
-        source = project.module.source
+        facts = _source_facts(project.module.source)
         self.reason: str | None = None
-        if _ET_READ.search(source):
+        if facts.reads_et:
             self.reason = "the program reads a timer's ET"
         self._holders = self._memory_holders(project)
         self._objects: list[tuple[Callable, object]] = []
         self._arrays: list[tuple[object, str]] = []
         self._timers: list[StdFB] = []
         self._walk(roots)
-        self._cells, self._whole = self._device_footprint(source)
-        self._clocks = self._relevant_clocks(source, read_devices)
+        self._cells, self._whole = self._device_footprint(facts)
+        self._clocks = self._relevant_clocks(facts, read_devices)
         if self.reason is None:
             rt.dirty_log = []
 
@@ -131,33 +159,24 @@ class IdleScans:
                 getter = operator.attrgetter(*scalars)
                 self._objects.append((getter, obj))
 
-    def _device_footprint(self, source: str):
+    def _device_footprint(self, facts: "SourceFacts"):
         """The device and buffer cells the generated code names with a constant index, and
         the whole areas it reaches any other way (an index expression). Cells written
         through an instruction operand are logged by the operand (`Runtime.dirty_log`)."""
-        constant: dict[str, set[int]] = {}
-        for holder, index in _CONST_CELL.findall(source):
-            constant.setdefault(holder, set()).add(int(index))
         cells = []
-        for holder, indexes in constant.items():
-            ordered = sorted(indexes)
+        for holder, ordered in facts.constant.items():
             getter = operator.itemgetter(*ordered) if len(ordered) > 1 else (lambda c, i=ordered[0]: (c[i],))
             cells.append((self._holders[holder], getter))
-        whole = []
-        for match in _ANY_USE.finditer(source):
-            if source.endswith(_OPERAND_CONSTRUCTORS, 0, match.start()):
-                continue  # an instruction operand: its writes are logged
-            area = self._holders.get(match.group(1))
-            if area is not None and all(area is not w for w in whole):
-                whole.append(area)
+        whole = [self._holders[holder] for holder in facts.whole if holder in self._holders]
         return cells, whole
 
-    def _relevant_clocks(self, source: str, read_devices: tuple[str, ...]):
+    def _relevant_clocks(self, facts: "SourceFacts", read_devices: tuple[str, ...]):
         """The clock relays that can matter: named in the program or read by the caller, or
         in an area the program reaches through an operand or an index."""
         rt = self.rt
-        named = {(h[3:], int(i)) for h, i in _CONST_CELL.findall(source) if h.startswith("_A_")}
-        reached = {m.group(1)[3:] for m in _ANY_USE.finditer(source) if m.group(1).startswith("_A_")}
+        named = {(holder[3:], index) for holder, indexes in facts.constant.items() if holder.startswith("_A_")
+                 for index in indexes}
+        reached = facts.reached
         for name in read_devices:
             try:
                 a = rt.dev.address(name)
