@@ -102,10 +102,11 @@ class IdleScans:
         if facts.reads_et:
             self.reason = "the program reads a timer's ET"
         self._holders = self._memory_holders(project)
-        self._objects: list[tuple[Callable, object]] = []
+        self._objects: list[tuple[object, list[str]]] = []
         self._arrays: list[tuple[object, str]] = []
         self._timers: list[StdFB] = []
         self._walk(roots)
+        self._labels = self._label_reader()
         self._cells, self._whole = self._device_footprint(facts)
         self._clocks = self._relevant_clocks(facts, read_devices)
         if self.reason is None:
@@ -156,8 +157,22 @@ class IdleScans:
                 else:
                     self.reason = self.reason or f"a label of a kind the idle check does not know ({type(value).__name__})"
             if scalars:
-                getter = operator.attrgetter(*scalars)
-                self._objects.append((getter, obj))
+                self._objects.append((obj, scalars))
+
+    def _label_reader(self) -> Callable[[], tuple]:
+        """One generated function reading every label slot and copying every array: the
+        comparison runs twice per idle stretch, so it is kept to plain attribute loads."""
+        env: dict[str, object] = {}
+        parts = []
+        for k, (obj, slots) in enumerate(self._objects):
+            env[f"o{k}"] = obj
+            parts += [f"o{k}.{slot}" for slot in slots]
+        for k, (obj, slot) in enumerate(self._arrays):
+            env[f"a{k}"] = obj
+            parts.append(f"a{k}.{slot}[:]")
+        source = "def labels():\n    return (" + ", ".join(parts) + ("," if len(parts) == 1 else "") + ")\n"
+        exec(compile(source, "<idle-labels>", "exec"), env)
+        return env["labels"]
 
     def _device_footprint(self, facts: "SourceFacts"):
         """The device and buffer cells the generated code names with a constant index, and
@@ -242,8 +257,7 @@ class IdleScans:
     def _state(self):
         rt = self.rt
         return (
-            [getter(obj) for getter, obj in self._objects],
-            [getattr(obj, slot)[:] for obj, slot in self._arrays],
+            self._labels(),
             [getter(cells) for cells, getter in self._cells],
             [cells[:] for cells in self._whole],
             [poller.idle_state() for poller in rt.pollers],
