@@ -166,19 +166,15 @@ def _display_path(path: Path | None) -> str | None:
         return str(path)
 
 
-def _relative(origin: str | None) -> str | None:
-    """An ST location "file:line:col" with the file relative to the working folder when inside it."""
+@lru_cache(maxsize=1024)
+def _relative(origin: str | None, cwd: str) -> str | None:
+    """An ST location "file:line:col" with the file relative to the working folder `cwd`
+    when inside it. Worked out once per location: every frame of a long run names the ST
+    line that sent it, and the frames then share one string."""
     if not origin:
         return origin
     file, _, rest = origin.partition(":")
-    return f"{_shown_file(file, os.getcwd())}:{rest}"
-
-
-@lru_cache(maxsize=1024)
-def _shown_file(file: str, cwd: str) -> str | None:
-    """`_display_path` of one ST file, worked out once per file and working folder (every
-    frame of a long run names the file that sent it)."""
-    return _display_path(Path(file))
+    return f"{_display_path(Path(file))}:{rest}"
 
 
 def _plain(value: Any) -> Any:
@@ -342,7 +338,9 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         converter.advance(max(end, converter.now_us))
     else:
         line.advance(max(end, line.now_us))
-    trace = [TraceRecord(f.t_start_us, f.t_end_us, f.direction, bytes(f.data), _relative(f.origin)) for f in line.trace]
+    cwd = os.getcwd()
+    trace = [TraceRecord(f.t_start_us, f.t_end_us, f.direction, bytes(f.data), _relative(f.origin, cwd))
+             for f in line.trace]
     trace = [f for f in trace if f.t_start_us < end]
     line_events = line.events if converter is None else sorted(line.events + converter.events, key=lambda e: e.t_us)
     events = [LineEvent(e.t_us, e.kind, e.message) for e in line_events if e.t_us <= end]
