@@ -77,6 +77,17 @@ class SerialChannel:
         self.sent.append(SentFrame(t_us, end, data, origin))
         return end
 
+    def quiet_until(self, now: int) -> float | None:
+        """Until when `receive_until` brings nothing (idle-scan skipping, verifier.sim.idle):
+        the line's quiet time, infinity with nothing attached, None when not known quiet at
+        `now`."""
+        endpoint = self.endpoint
+        if endpoint is None:
+            return float("inf")
+        if self.knows_quiet and endpoint.now_us <= now < endpoint.quiet_until_us:
+            return endpoint.quiet_until_us
+        return None
+
     def receive_until(self, t_us: int) -> list[tuple[int, int]]:
         endpoint = self.endpoint
         if endpoint is None:

@@ -145,14 +145,9 @@ class AdprwMaster:
         completion bit to turn ON or OFF, a line with something under way)."""
         if self.pulses or self.pending:
             return None
-        port = self.port
-        endpoint = port.endpoint
-        deadline = float("inf")
-        if endpoint is not None:
-            # SerialChannel.receive_until: on a quiet line it only moves the line's clock
-            if not (port.knows_quiet and endpoint.now_us <= now < endpoint.quiet_until_us):
-                return None
-            deadline = endpoint.quiet_until_us
+        deadline = self.port.quiet_until(now)
+        if deadline is None:
+            return None
         if self.busy:
             deadline = min(deadline, self.deadline)  # the slave response time-out (or a retry)
         return deadline

@@ -146,12 +146,10 @@ class C24Module:
         for chan in self.channels.values():
             if chan.sending_until is not None:
                 deadline = min(deadline, chan.sending_until)
-            endpoint = chan.port.endpoint
-            if endpoint is not None:
-                # SerialChannel.receive_until: on a quiet line it only moves the line's clock
-                if not (chan.port.knows_quiet and endpoint.now_us <= now < endpoint.quiet_until_us):
-                    return None
-                deadline = min(deadline, endpoint.quiet_until_us)
+            quiet = chan.port.quiet_until(now)
+            if quiet is None:
+                return None
+            deadline = min(deadline, quiet)
             if chan.rx and chan.no_reception_us is not None:
                 # the frame ends once more than the no-reception time has passed (integer µs)
                 deadline = min(deadline, chan.rx_last_t + chan.no_reception_us + 1)

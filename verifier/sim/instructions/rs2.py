@@ -173,12 +173,8 @@ class Rs2Port:
         (sending: the remaining count moves on every scan)."""
         if self.sending_until is not None or (self.rx_done and not self._get(self._recv_done)):
             return None
-        endpoint = self.channel.endpoint
-        if endpoint is None:
-            deadline = float("inf")
-        elif self.channel.knows_quiet and endpoint.now_us <= now < endpoint.quiet_until_us:
-            deadline = endpoint.quiet_until_us
-        else:
+        deadline = self.channel.quiet_until(now)
+        if deadline is None:
             return None
         if self.rx and not self.rx_done:
             deadline = min(deadline, self.rx_last_t + self.timeout_us())
