@@ -77,12 +77,36 @@ def test_the_serial_examples_skip_most_scans(idle_runs):
 
 # ---- random scenarios of the robot examples --------------------------------------------
 
+# platform -> (sources, PROGRAM, start input, CPU, behind a TCP converter)
 EXAMPLES = {
     "fx3u": ('["../core/*.st", "../fx3/*.st", "../examples/common/*.st", "../examples/fx3/*.st"]',
-             "UITAMR_ExampleFx3", "X0"),
+             "UITAMR_ExampleFx3", "X0", "fx3u", False),
+    "fx3u-adprw": ('["../core/*.st", "../fx3/*.st", "../examples/common/*.st", "../examples/fx3/*.st"]',
+                   "UITAMR_ExampleAdpFx3", "X0", "fx3u", False),
     "fx5u": ('["../core/*.st", "../fx5/*.st", "../examples/common/*.st", "../examples/fx5/*.st"]',
-             "UITAMR_ExampleFx5", "X0"),
+             "UITAMR_ExampleFx5", "X0", "fx5u", False),
+    "q": ('["../core/*.st", "../q/*.st", "../examples/common/*.st", "../examples/q/*.st"]',
+          "UITAMR_ExampleQ", "X20", "q", False),
+    "fx5u-tcp": ('["../core/*.st", "../fx5/*.st", "../examples/common/*.st", "../examples/fx5/UITAMR_ExampleTcpFx5.st"]',
+                 "UITAMR_ExampleTcpFx5", "X0", "fx5u", True),
+    "q-tcp": ('["../core/*.st", "../q/*.st", "../examples/common/*.st", "../examples/q/UITAMR_ExampleTcpQ.st"]',
+              "UITAMR_ExampleTcpQ", "X20", "q", True),
 }
+
+
+@st.composite
+def converters(draw, seconds: int) -> str:
+    """A [converter] section: its delays, packing, refusals, drops and split replies."""
+    lines = ["[converter]", f'delay = "{draw(st.integers(0, 40))}ms"', f'connect = "{draw(st.integers(0, 80))}ms"',
+             f'packing = "{draw(st.integers(1, 20))}ms"']
+    if draw(st.booleans()):
+        lines.append(f'refuse_until = "{draw(st.integers(1, 4000))}ms"')
+    drops = draw(st.lists(st.integers(1, seconds * 1000 - 1), max_size=2))
+    if drops:
+        lines.append("drops = [" + ", ".join(f'"{ms}ms"' for ms in sorted(drops)) + "]")
+    if draw(st.booleans()):
+        lines += ["split_reply = true", f'split_gap = "{draw(st.integers(1, 60))}ms"']
+    return "\n".join(lines)
 
 FAULTS = st.one_of(
     st.builds(lambda at, d: f'kind = "no_reply"\nat_s = {at}\nduration_s = {d}',
@@ -99,8 +123,8 @@ FAULTS = st.one_of(
 
 @st.composite
 def robot_scenarios(draw):
-    platform = draw(st.sampled_from(sorted(EXAMPLES)))
-    sources, program, start = EXAMPLES[platform]
+    example_name = draw(st.sampled_from(sorted(EXAMPLES)))
+    sources, program, start, platform, tcp = EXAMPLES[example_name]
     scan_ms = draw(st.integers(2, 20))
     jitter_ms = draw(st.integers(0, scan_ms - 1))
     seconds = draw(st.integers(5, 30))
@@ -111,6 +135,8 @@ def robot_scenarios(draw):
         'watch = ["fbEngine.o_wTxCount", "fbCycle.o_wPoint", "fbEngine.o_uErrId"]',
         "[robot]", f"point_duration_s = {draw(st.sampled_from([1.0, 2.5, 6.0]))}",
     ]
+    if tcp:
+        lines.append(draw(converters(seconds)))
     for fault in draw(st.lists(FAULTS, max_size=3)):
         lines += ["[[faults]]", fault]
     for at_ms in draw(st.lists(st.integers(0, seconds * 1000 - 1), max_size=3)):
@@ -120,7 +146,7 @@ def robot_scenarios(draw):
     return "\n".join(lines) + "\n"
 
 
-@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=16, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(text=robot_scenarios())
 @example(text="\n".join([
     'name = "late reply after a pulse"', f"sources = {EXAMPLES['fx3u'][0]}", 'program = "UITAMR_ExampleFx3"',
