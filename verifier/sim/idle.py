@@ -96,7 +96,9 @@ class IdleScans:
         self.skipped_scans = 0
         self.jumps = 0
         self._previous = None
-        self._shadow: dict[tuple[int, int], object] = {}
+        # cells instruction operands have written: compared by value from then on, whoever
+        # writes them later (cells list id -> (cells, indexes, getter of their values))
+        self._operand_cells: dict[int, tuple[list, set[int], Callable]] = {}
         facts = _source_facts(project.module.source)
         self.reason: str | None = None
         if facts.reads_et:
@@ -215,7 +217,7 @@ class IdleScans:
         if self.reason is not None:
             return
         rt = self.rt
-        changed = self._logged_cells_changed()
+        changed = self._new_operand_cells()
         busy, self.busy = self.busy, False
         if busy or changed or rt.scan_count < 2:
             self._previous = None
@@ -239,26 +241,34 @@ class IdleScans:
         if now < deadline < INFINITY:
             self._jump(deadline)
 
-    def _logged_cells_changed(self) -> bool:
+    def _new_operand_cells(self) -> bool:
+        """Take in the cells instruction operands wrote since the last scan; True when one
+        was not compared before (the comparison with the previous scan is then not valid)."""
         log = self.rt.dirty_log
         if not log:
             return False
-        shadow, changed = self._shadow, False
-        missing = object()
+        known, grew = self._operand_cells, False
         for cells, index in log:
-            key = (id(cells), index)
-            value = cells[index]
-            if shadow.get(key, missing) != value or type(shadow.get(key)) is not type(value):
-                changed = True
-                shadow[key] = value
+            entry = known.get(id(cells))
+            if entry is None:
+                entry = known[id(cells)] = (cells, set(), None)
+            if index not in entry[1]:
+                entry[1].add(index)
+                grew = True
         log.clear()
-        return changed
+        if grew:
+            for key, (cells, indexes, _) in known.items():
+                ordered = sorted(indexes)
+                getter = operator.itemgetter(*ordered) if len(ordered) > 1 else (lambda c, i=ordered[0]: (c[i],))
+                known[key] = (cells, indexes, getter)
+        return grew
 
     def _state(self):
         rt = self.rt
         return (
             self._labels(),
             [getter(cells) for cells, getter in self._cells],
+            [getter(cells) for cells, _, getter in self._operand_cells.values()],
             [cells[:] for cells in self._whole],
             [poller.idle_state() for poller in rt.pollers],
             len(rt.diagnostics),
