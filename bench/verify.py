@@ -13,7 +13,9 @@ Prints, measured in one run on this machine:
      resolved once and recorded on change, idle scans jumped over) against the plain
      path (every label by name, every scan run) - the ratio of the two, the number of
      scans jumped over, and whether the results are equal;
-  4. `uitamr verify --matrix --jobs N` for each N: wall time and speed-up against N=1;
+  4. `uitamr verify --matrix --jobs N` for each N: wall time and speed-up against N=1,
+     next to the machine's ceiling: N copies of a CPU-bound Python loop at once against
+     one after the other (median of 5);
   5. peak RSS of a 1 h and a 10 h run of fx3u-healthy (whole processes, os.wait4).
 Wall-clock figures move with the machine's load; ratios measured side by side much less.
 """
@@ -66,6 +68,28 @@ def run_process(*args) -> tuple[float, int]:
         raise SystemExit(f"uitamr {' '.join(map(str, args))} exited {code}: {proc.stderr.read().decode()}")
     proc.stderr.close()
     return wall, usage.ru_maxrss
+
+
+# a pure-Python CPU-bound loop of about a second: what N cores give N processes of it
+_SPIN = "x = 0\nfor i in range(12_000_000):\n    x += i * i % 7\n"
+
+
+def machine_ceiling(n: int, repeat: int = 5) -> tuple[float, float, float]:
+    """How much faster N copies of a CPU-bound Python process finish at once than one
+    after the other, on this machine now: the most `--jobs N` can give (vCPUs may share
+    a physical core, and other tenants share the host). Lowest, median, highest."""
+    ratios = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        subprocess.run([sys.executable, "-c", _SPIN], check=True)
+        alone = time.perf_counter() - start
+        start = time.perf_counter()
+        procs = [subprocess.Popen([sys.executable, "-c", _SPIN]) for _ in range(n)]
+        for proc in procs:
+            proc.wait()
+        ratios.append(n * alone / (time.perf_counter() - start))
+    ratios.sort()
+    return ratios[0], ratios[len(ratios) // 2], ratios[-1]
 
 
 def best_wall(*args, repeat: int = 3) -> float:
@@ -137,6 +161,10 @@ def main() -> None:
         base = times[jobs[0]]
         print("4. uitamr verify --matrix: " + ", ".join(
             f"--jobs {n}: {t:.1f} s (x{base / t:.2f})" for n, t in times.items()))
+        for n in (n for n in jobs if n > 1):
+            low, median, high = machine_ceiling(n)
+            print(f"   the machine's own ceiling for N={n}: {n} CPU-bound Python processes at once against "
+                  f"one after the other: x{median:.2f} (x{low:.2f} to x{high:.2f} in 5 tries)")
 
         if not options.skip_rss:
             one = stretched(healthy, folder, 3600)
