@@ -12,10 +12,11 @@ next scans do the same, until the first instant at which something outside can d
 - the scenario's next input, or the end of the run.
 
 `IdleScans.after_scan` decides this after every scan, cheaply enough to run on each one:
-the expensive comparison (every label of the program tree, the device cells the program
-names, the I/O models' own state) only runs when the I/O models say they are quiet, and
-two quiet scans in a row with equal state make an idle one.  The jump then moves the
-clock scan by scan (the jitter generator is drawn exactly as the skipped scans would
+the expensive comparison (every label of the program tree, the device and buffer cells
+the generated code names, every cell an instruction operand has written, the I/O models'
+own state) only runs when the I/O models say they are quiet, and two quiet scans in a
+row with equal state make an idle one.  The jump moves the clock over the skipped scans
+(with jitter, the generator is drawn once per skipped scan, exactly as those scans would
 have drawn it), so the next scan that runs starts at the same instant as in a plain run.
 
 What is left out of the comparison, and why that is sound:
