@@ -9,6 +9,7 @@ running scan by scan), and a control shows the comparison catches a skip that en
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import asdict
 from pathlib import Path
 
@@ -77,21 +78,17 @@ def test_the_serial_examples_skip_most_scans(idle_runs):
 
 # ---- random scenarios of the robot examples --------------------------------------------
 
-# platform -> (sources, PROGRAM, start input, CPU, behind a TCP converter)
-EXAMPLES = {
-    "fx3u": ('["../core/*.st", "../fx3/*.st", "../examples/common/*.st", "../examples/fx3/*.st"]',
-             "UITAMR_ExampleFx3", "X0", "fx3u", False),
-    "fx3u-adprw": ('["../core/*.st", "../fx3/*.st", "../examples/common/*.st", "../examples/fx3/*.st"]',
-                   "UITAMR_ExampleAdpFx3", "X0", "fx3u", False),
-    "fx5u": ('["../core/*.st", "../fx5/*.st", "../examples/common/*.st", "../examples/fx5/*.st"]',
-             "UITAMR_ExampleFx5", "X0", "fx5u", False),
-    "q": ('["../core/*.st", "../q/*.st", "../examples/common/*.st", "../examples/q/*.st"]',
-          "UITAMR_ExampleQ", "X20", "q", False),
-    "fx5u-tcp": ('["../core/*.st", "../fx5/*.st", "../examples/common/*.st", "../examples/fx5/UITAMR_ExampleTcpFx5.st"]',
-                 "UITAMR_ExampleTcpFx5", "X0", "fx5u", True),
-    "q-tcp": ('["../core/*.st", "../q/*.st", "../examples/common/*.st", "../examples/q/UITAMR_ExampleTcpQ.st"]',
-              "UITAMR_ExampleTcpQ", "X20", "q", True),
-}
+def _example(name: str) -> tuple[str, str, str, str, bool]:
+    """(sources, PROGRAM, start input, CPU, behind a converter) of a bundled healthy scenario:
+    the random scenarios run the examples exactly as the bundled ones load them."""
+    text = (PLC / "scenarios" / f"{name}.toml").read_text(encoding="utf-8")
+    value = lambda key: re.search(rf"^{key} = (.*)$", text, re.M).group(1)  # noqa: E731
+    start = re.search(r"set = \{ (\w+) = true", text).group(1)
+    return value("sources"), json.loads(value("program")), start, json.loads(value("platform")), "-tcp-" in name
+
+
+EXAMPLES = {name: _example(name) for name in ("fx3u-healthy", "fx3u-adprw-healthy", "fx5u-healthy", "q-healthy",
+                                               "fx5u-tcp-healthy", "q-tcp-healthy")}
 
 
 @st.composite
@@ -149,7 +146,7 @@ def robot_scenarios(draw):
 @settings(max_examples=16, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(text=robot_scenarios())
 @example(text="\n".join([
-    'name = "late reply after a pulse"', f"sources = {EXAMPLES['fx3u'][0]}", 'program = "UITAMR_ExampleFx3"',
+    'name = "late reply after a pulse"', f"sources = {EXAMPLES['fx3u-healthy'][0]}", 'program = "UITAMR_ExampleFx3"',
     'platform = "fx3u"', 'duration = "12s"', 'scan = "7ms"', 'scan_jitter = "3ms"', "seed = 5",
     "[[faults]]", 'kind = "late_reply"', "on_request = 3", "delay_ms = 700",
     "[[inputs]]", 'at = "1500ms"', "set = { X0 = true }", 'pulse = "300ms"']) + "\n")
