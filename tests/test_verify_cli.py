@@ -9,6 +9,7 @@ import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import pytest
 from click.testing import CliRunner
 
 from verifier.commands.verify import bundled_scenarios, command
@@ -251,3 +252,15 @@ def test_parallel_run_reports_what_a_serial_run_reports(tmp_path):
         assert result.exit_code in (0, 1), result.output
         return re.sub(r'"wall[^"]*": [0-9.e+-]+', '"wall": 0', out.read_text())
     assert report(2) == report(1)
+
+
+@pytest.mark.parametrize("jobs", ["1", "2"])
+def test_every_scan_reports_what_the_default_reports(tmp_path, jobs):
+    """--every-scan (every scan run, every label read by name) is the reference the default
+    fast path must match: the same JSON report byte for byte, wall times aside."""
+    def report(*extra: str):
+        out = tmp_path / f"r{len(extra)}.json"
+        result = invoke("--platform", "fx3u", "--duration", "8s", "--jobs", jobs, "--json", out, *extra)
+        assert result.exit_code in (0, 1), result.output
+        return re.sub(r'"wall[^"]*": [0-9.e+-]+', '"wall": 0', out.read_text())
+    assert report("--every-scan") == report()

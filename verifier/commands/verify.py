@@ -159,14 +159,10 @@ def _source_files(sources) -> tuple[Path, ...]:
     return unique(found)
 
 
-def _run_one(scenario: Scenario) -> ScenarioResult:
+def _run_batch(batch: list[Scenario], every_scan: bool = False) -> list[ScenarioResult]:
     from verifier.verify.runner import run_scenario
 
-    return run_scenario(scenario)
-
-
-def _run_batch(batch: list[Scenario]) -> list[ScenarioResult]:
-    return [_run_one(scenario) for scenario in batch]
+    return [run_scenario(scenario, plain=every_scan) for scenario in batch]
 
 
 def _batches(scenarios: list[Scenario], jobs: int) -> list[list[int]]:
@@ -236,14 +232,15 @@ class _LazyProgress:
             self.bar.stop()
 
 
-def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress) -> list[ScenarioResult]:
+def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress,
+             every_scan: bool = False) -> list[ScenarioResult]:
     from verifier.verify.runner import run_scenario
 
     if jobs > 1 and len(scenarios) > 1:
         results: list[ScenarioResult | None] = [None] * len(scenarios)
         done = 0
         with ProcessPoolExecutor(max_workers=jobs) as pool:
-            futures = {pool.submit(_run_batch, [scenarios[i] for i in batch]): batch
+            futures = {pool.submit(_run_batch, [scenarios[i] for i in batch], every_scan): batch
                        for batch in _batches(scenarios, jobs)}
             for future in as_completed(futures):
                 for index, result in zip(futures[future], future.result()):
@@ -255,7 +252,8 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress) -> l
     offset = 0
     for position, scenario in enumerate(scenarios):
         label = f"[{position + 1}/{len(scenarios)}] {scenario.name}"
-        results.append(run_scenario(scenario, lambda now, end, o=offset, l=label: progress.update(o + now, l)))
+        results.append(run_scenario(scenario, lambda now, end, o=offset, l=label: progress.update(o + now, l),
+                                    plain=every_scan))
         offset += scenario.duration_us
     return results
 
@@ -277,12 +275,14 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress) -> l
 @click.option("--scan", type=_Duration(), help="PLC scan time, e.g. 10ms (overrides the scenarios'; default 10ms).")
 @click.option("--seed", type=int, help="Seed for everything random in the run (overrides the scenarios').")
 @click.option("--jobs", "-j", type=click.IntRange(min=1), default=1, show_default=True, help="Scenarios run in parallel processes.")
+@click.option("--every-scan", is_flag=True,
+              help="Run every scan and read every watched label by name on each (the reference path; several times slower). The default jumps over idle scans and gives the same report.")
 @report_options
 @click.option("--list-rules", is_flag=True, help="Print the rules (id, title, source) and exit.")
 @click.option("--violations", "first", type=click.IntRange(min=0), default=3, show_default=True,
               help="Times listed per broken rule and scenario on the console (0: counts only).")
 def command(sources, program, platform, channel, response_signal, scenario_files, matrix, duration, scan, seed, jobs,
-            json_path, junit_path, trace_path, html_path, list_rules, first):
+            every_scan, json_path, junit_path, trace_path, html_path, list_rules, first):
     """Run PLC programs against the emulated robot on a virtual RS-485 line and check
     every frame and gap against the robot's manual.
 
@@ -311,7 +311,7 @@ def command(sources, program, platform, channel, response_signal, scenario_files
     stderr = Console(stderr=True)
     progress = _LazyProgress(stderr, sum(s.duration_us for s in scenarios), stderr.is_terminal)
     try:
-        results = _run_all(scenarios, jobs, progress)
+        results = _run_all(scenarios, jobs, progress, every_scan)
     except (ScenarioError, UnusableInput) as exc:
         progress.stop()
         _unusable(str(exc))
