@@ -195,6 +195,8 @@ class Converter:
         self.line.advance(max(t_us, self.line.now_us))
 
     def _work_until(self, t_us: int) -> None:
+        if t_us == self.now_us and not (self._to_line and self._to_line[0][0] <= t_us):
+            return  # worked out to this instant already (the PLC's calls of one scan share it)
         if t_us < self.now_us:
             raise ValueError(f"converter at {t_us} µs: already at {self.now_us} µs (virtual time only moves forward)")
         line = self.line

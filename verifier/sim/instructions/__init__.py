@@ -219,12 +219,17 @@ class InstructionSet:
         return self._socket
 
     def e71(self, un):
-        from .tcp import FixedBufferPort
-
-        un = _module_number(un)
+        """The QJ71E71 of a Un operand; the operand as written is remembered too (four
+        instruction calls a scan would otherwise parse 'U0' each time)."""
         port = self._e71.get(un)
         if port is None:
-            port = self._e71[un] = FixedBufferPort(self.rt, un)
+            from .tcp import FixedBufferPort
+
+            number = _module_number(un)
+            port = self._e71.get(number)
+            if port is None:
+                port = self._e71[number] = FixedBufferPort(self.rt, number)
+            self._e71[un] = port
         return port
 
     def SP_SOCOPEN(self, en, u, s1, s2, d, loc_id):
