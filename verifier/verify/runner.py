@@ -280,8 +280,9 @@ def _input_schedule(scenario: Scenario) -> list[tuple[int, dict[str, Any]]]:
 def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain: bool = False) -> ScenarioResult:
     """Run `scenario` to its end and judge it. UnusableInput for input that cannot run.
 
-    `plain` reads the watched labels by their names on every scan and records them all
-    (the reference the fast path is tested against: same result, byte for byte)."""
+    `plain` runs every scan (no idle scans jumped over, verifier.sim.idle) and reads the
+    watched labels by their names on each, recording them all: the reference the fast
+    path is tested against (same result, byte for byte; `uitamr verify --every-scan`)."""
     wall_start = time.perf_counter()
     robot = Robot(scenario.settings, scenario.robot, list(scenario.faults))
     line = Line(robot)
