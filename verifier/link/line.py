@@ -103,7 +103,7 @@ class _Byte:
     lost: bool = False  # never reaches the other side (collision)
 
 
-@dataclass
+@dataclass(slots=True)
 class _Transmission:
     """One send() call or one robot reply: the unit a collision event names."""
 
@@ -116,7 +116,7 @@ class _Transmission:
     collided_with: list["_Transmission"] = field(default_factory=list)
 
 
-@dataclass
+@dataclass(slots=True)
 class _OpenFrame:
     """The trace frame being built from PLC sends (t3.5 of silence closes it)."""
 

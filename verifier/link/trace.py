@@ -7,7 +7,7 @@ TX = "tx"  # PLC -> robot
 RX = "rx"  # robot -> PLC
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class TraceFrame:
     """One frame on the wire, seen from the PLC: ``tx`` = PLC to robot, ``rx`` = robot to PLC.
 

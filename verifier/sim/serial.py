@@ -15,7 +15,7 @@ from fractions import Fraction
 CHANNELS = ("fx3:1", "fx3:2", "fx5:1", "fx5:2", "q:1", "q:2", "adp:1", "adp:2")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class SentFrame:
     t_start_us: int
     t_end_us: int

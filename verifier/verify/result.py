@@ -20,7 +20,7 @@ class UnusableInput(Exception):
     The message is complete and meant for people; the command exits 2 with it."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class TraceRecord:
     t_start_us: int
     t_end_us: int
