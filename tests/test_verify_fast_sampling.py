@@ -26,3 +26,40 @@ def test_fast_sampling_gives_the_plain_result(path):
     fast = run_scenario(scenario)
     plain = run_scenario(scenario, plain=True)
     assert _comparable(fast) == _comparable(plain)
+
+
+def test_read_together_merges_slots_and_cells_and_calls_the_rest():
+    """Plain labels and device words become attribute loads and list indexing in one
+    generated function; anything else (a computed label, a bit of a word) is called; the
+    tuple follows the values as they change, in the readers' order."""
+    from verifier.sim.values import _slot_reader, read_together
+
+    class Labels:
+        __slots__ = ("o_wCount", "bDone")
+
+    labels = Labels()
+    labels.o_wCount, labels.bDone = 1, False
+    cells = [0, 10, 20]
+
+    def word():
+        return cells[2]
+    word.item = (cells, 2)
+    computed = [7]
+    readers = [_slot_reader(labels, "o_wCount"), word, lambda: computed[0], _slot_reader(labels, "bDone")]
+    read_all = read_together(readers)
+    assert read_all() == (1, 20, 7, False)
+    labels.o_wCount, cells[2], computed[0], labels.bDone = 2, 21, 8, True
+    assert read_all() == (2, 21, 8, True)
+    assert read_together([])() == ()
+
+
+def test_read_together_calls_a_reader_whose_slot_is_a_python_keyword():
+    """A slot named like a Python keyword cannot be an attribute load in generated code."""
+    from verifier.sim.values import _slot_reader, read_together
+
+    class Odd:
+        pass
+
+    odd = Odd()
+    setattr(odd, "pass", 5)
+    assert read_together([_slot_reader(odd, "pass")])() == (5,)

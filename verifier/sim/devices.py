@@ -88,7 +88,11 @@ class DeviceMemory:
         cells = self.areas[a.area]
         if a.bit is None and a.digits is None:
             index = a.index
-            return lambda: cells[index]
+
+            def read():
+                return cells[index]
+            read.item = (cells, index)  # verifier.sim.values.read_together merges it
+            return read
         return lambda: self.read(a)
 
     def __setitem__(self, name: str, value) -> None:

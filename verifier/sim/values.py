@@ -3,6 +3,9 @@ access, array views indexed by the ST bounds, and conversion of Python values in
 values (with the same normalisation the generated code applies)."""
 from __future__ import annotations
 
+import keyword
+from typing import Callable
+
 from . import datatypes
 from .typesys import ArrayT, FbT, StringT, StructT
 
@@ -205,4 +208,35 @@ def reader(root: "InstanceProxy", parts: list[str]):
     if computed or not isinstance(t, (str, StringT)):
         return lambda: getattr(target, last)
     obj = target._obj
-    return lambda: getattr(obj, attr)
+    return _slot_reader(obj, attr)
+
+
+def _slot_reader(obj, attr: str):
+    """`getattr(obj, attr)` as a function that `read_together` can merge with others."""
+    def read():
+        return getattr(obj, attr)
+    read.slot = (obj, attr)
+    return read
+
+
+def read_together(readers: list) -> Callable[[], tuple]:
+    """One function returning the values of all `readers` as a tuple: those that read a
+    slot of an object (`reader` for a plain label) become plain attribute loads of one
+    generated function, and so do those that read one cell of a list (a device word),
+    the rest are called.  Read on every scan, it is kept cheap."""
+    env: dict[str, object] = {}
+    parts = []
+    for k, read in enumerate(readers):
+        slot, item = getattr(read, "slot", None), getattr(read, "item", None)
+        if slot is not None and slot[1].isidentifier() and not keyword.iskeyword(slot[1]):
+            env[f"o{k}"] = slot[0]
+            parts.append(f"o{k}.{slot[1]}")
+        elif item is not None and type(item[1]) is int:
+            env[f"c{k}"] = item[0]
+            parts.append(f"c{k}[{item[1]}]")
+        else:
+            env[f"r{k}"] = read
+            parts.append(f"r{k}()")
+    source = "def read_all():\n    return (" + "".join(p + ", " for p in parts) + ")\n"
+    exec(compile(source, "<watched-labels>", "exec"), env)
+    return env["read_all"]

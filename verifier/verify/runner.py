@@ -17,6 +17,7 @@ from typing import Any, Callable
 from verifier.amr.robot import Robot
 from verifier.link import Line
 from verifier.link.converter import Converter
+from verifier.sim.values import read_together
 
 from .evidence import RunEvidence, Samples
 from .expectations import judge
@@ -83,13 +84,13 @@ class _Plc:
         return self.project.now_us
 
     def run(self, until_us: int, before_scan, after_scan) -> None:
-        """Scan the program until virtual time `until_us`, with a hook on each side of a scan."""
-        hook = lambda project: after_scan()  # noqa: E731 — the simulator passes the project
-        self.project.after_scan.append(hook)
+        """Scan the program until virtual time `until_us`, with a hook on each side of a
+        scan (each called with the project, verifier.sim.project.Project)."""
+        self.project.after_scan.append(after_scan)
         try:
-            self.project.run_programs([self.name], until_us=until_us, on_scan=lambda project: before_scan())
+            self.project.run_programs([self.name], until_us=until_us, on_scan=before_scan)
         finally:
-            self.project.after_scan.remove(hook)
+            self.project.after_scan.remove(after_scan)
 
     def problem(self, name: str) -> str | None:
         """Why `name` is not a single value this program can read, or None."""
@@ -303,26 +304,28 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         [plc.name], read_devices=tuple(name for name in names if _DEVICE.match(name)),
         next_input_us=lambda: schedule[0][0] if schedule else float("inf"))
 
-    def apply_inputs() -> None:
-        now = plc.now_us
+    rt = plc.project.rt
+
+    def apply_inputs(_project=None) -> None:
+        now = rt.now_us
         while schedule and schedule[0][0] <= now:
             for name, value in schedule.pop(0)[1].items():
                 plc.write(name, value)
             if idle is not None:
                 idle.busy = True
 
-    getters = [plc.reader(name) for name in names]
+    read_all = read_together([plc.reader(name) for name in names])
     last: list[Any] = [object()]  # the values at the previous scan: record only changes
 
-    def sample_on_change() -> None:
-        values = [get() for get in getters]
+    def sample_on_change(_project=None) -> None:
+        values = read_all()
         if values != last[0]:
             last[0] = values
-            samples.record(plc.now_us, {name: _plain(value) for name, value in zip(names, values)})
+            samples.record(rt.now_us, {name: _plain(value) for name, value in zip(names, values)})
             if idle is not None:
                 idle.busy = True
 
-    def sample_plainly() -> None:
+    def sample_plainly(_project=None) -> None:
         samples.record(plc.now_us, {name: _plain(plc.read(name)) for name in names})
 
     sample = sample_plainly if plain else sample_on_change  # plain: the reference path
