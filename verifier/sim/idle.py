@@ -86,6 +86,12 @@ def _source_facts(source: str) -> SourceFacts:
                        tuple(whole), frozenset(reached))
 
 
+def _never_idle(now: int) -> None:
+    """The idle deadline of an I/O model that cannot tell: it may change something at
+    every scan."""
+    return None
+
+
 class IdleScans:
     """Decides after each scan whether the run is idle, and jumps when it is."""
 
@@ -97,6 +103,7 @@ class IdleScans:
         self.skipped_scans = 0
         self.jumps = 0
         self._previous = None
+        self._deadlines: list[Callable[[int], float | None]] = []  # each poller's idle_deadline
         # cells instruction operands have written: compared by value from then on, whoever
         # writes them later (cells list id -> (cells, indexes, getter of their values))
         self._operand_cells: dict[int, tuple[list, set[int], Callable]] = {}
@@ -218,20 +225,23 @@ class IdleScans:
         if self.reason is not None:
             return
         rt = self.rt
-        changed = self._new_operand_cells()
+        changed = self._new_operand_cells() if rt.dirty_log else False
         busy, self.busy = self.busy, False
         if busy or changed or rt.scan_count < 2:
             self._previous = None
             return
         now = rt.now_us
         deadline = self.next_input_us()
-        for poller in rt.pollers:
-            until = getattr(poller, "idle_deadline", None)
-            until = until(now) if until is not None else None
+        pollers = rt.pollers
+        if len(pollers) != len(self._deadlines):  # a port is made on its first call
+            self._deadlines = [getattr(p, "idle_deadline", None) or _never_idle for p in pollers]
+        for idle_deadline in self._deadlines:
+            until = idle_deadline(now)
             if until is None or until <= now:
                 self._previous = None
                 return
-            deadline = min(deadline, until)
+            if until < deadline:
+                deadline = until
         state = self._state()
         if state != self._previous:
             self._previous = state
