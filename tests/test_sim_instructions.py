@@ -145,6 +145,23 @@ def test_rs2_sends_low_byte_first_and_clears_m8402_after_the_last_byte():
     assert project.serial_log("fx3:1")[0].t_end_us == 20_000 + 8333
 
 
+def test_the_serial_log_can_be_turned_off_and_the_count_goes_on():
+    """uitamr verify turns the channels' log off (its line records every frame); the
+    count the idle check compares keeps counting, and asking for the log says why not."""
+    ep = FakeEndpoint()
+    project, p = rs2_project(ep)
+    project.keep_serial_log(False)
+    p.uSend = packed([0x01, 0x06, 0x01, 0xA0, 0x00, 0x00, 0x88, 0x14])
+    p.bStart = True
+    project.run_programs(["P"], scans=2)
+    channel = project.rt.channel("fx3:1")
+    assert len(ep.sent) == 1 and channel.sent == [] and channel.sent_count == 1
+    with pytest.raises(RuntimeError, match="serial log is off"):
+        project.serial_log("fx3:1")
+    project.keep_serial_log(True)
+    assert project.serial_log("fx3:1") == []
+
+
 def test_rs2_receives_by_count_then_waits_for_m8403_reset():
     ep = FakeEndpoint()
     project, p = rs2_project(ep)

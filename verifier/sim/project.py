@@ -309,7 +309,18 @@ class Project:
 
     def serial_log(self, channel: str):
         """Frames the PLC sent on a channel: [SentFrame(t_start_us, t_end_us, data, origin)]."""
+        if not self.rt.keep_sent:
+            raise RuntimeError("the serial log is off (keep_serial_log(False)): read the frames from "
+                               "the line the channel is attached to")
         return list(self.rt.channel(channel).sent)
+
+    def keep_serial_log(self, keep: bool) -> None:
+        """Whether the serial channels keep every frame sent for `serial_log` (the default).
+        A caller whose attached line records the traffic itself turns it off: an hour of
+        traffic is thousands of frames kept twice."""
+        self.rt.keep_sent = keep
+        for channel in self.rt.ports.values():
+            channel.keep_sent = keep
 
     def configure_c24(self, un: int = 0, channel: int = 1, *, byte_units: bool | None = None,
                       receive_count: int | None = None, end_code: int | None = None,

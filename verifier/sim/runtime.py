@@ -46,6 +46,7 @@ class Runtime:
         self.dirty_log: list | None = None
         self.after_scan: list = []  # objects with after_scan(now_us), run after each scan
         self.ports: dict[str, SerialChannel] = {}  # channel name ("fx3:1") -> byte stream
+        self.keep_sent = True  # the channels log what they send (Project.keep_serial_log)
         self.buffers: dict[int, list[int]] = {}  # module start I/O -> buffer memory words
         self.origins: dict[str, str] = {}  # channel -> location of the last send-request flag write
         self.tcp_endpoint = None  # the Ethernet port's peer (verifier.link.converter.Converter)
@@ -79,7 +80,7 @@ class Runtime:
     def channel(self, name: str) -> SerialChannel:
         ch = self.ports.get(name)
         if ch is None:
-            ch = self.ports[name] = SerialChannel(name)
+            ch = self.ports[name] = SerialChannel(name, self.keep_sent)
         return ch
 
     # ---- locations -------------------------------------------------------------

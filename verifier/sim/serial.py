@@ -50,12 +50,16 @@ NINE_SIX_8N1 = LineFormat()
 
 
 class SerialChannel:
-    def __init__(self, name: str):
+    def __init__(self, name: str, keep_sent: bool = True):
         self.name = name
         self.endpoint = None
         self.knows_quiet = False
         self.format = NINE_SIX_8N1
+        # every frame sent, for `Project.serial_log`; a run whose line records the traffic
+        # itself (uitamr verify) does not keep a second copy (`keep_sent` False)
+        self.keep_sent = keep_sent
         self.sent: list[SentFrame] = []
+        self.sent_count = 0
 
     def attach(self, endpoint) -> None:
         for attr in ("send", "receive_until"):
@@ -74,7 +78,9 @@ class SerialChannel:
         end = t_us + self.format.duration_us(len(data))
         if self.endpoint is not None and data:
             self.endpoint.send(data, t_us, origin)
-        self.sent.append(SentFrame(t_us, end, data, origin))
+        if self.keep_sent:
+            self.sent.append(SentFrame(t_us, end, data, origin))
+        self.sent_count += 1
         return end
 
     def quiet_until(self, now: int) -> float | None:

@@ -290,6 +290,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     # the TCP route: the PLC talks to a converter, the rules judge the line behind it
     converter = Converter(line, scenario.converter) if scenario.converter is not None else None
     plc = _Plc(scenario, converter or line)
+    plc.project.keep_serial_log(False)  # the line records every frame: the trace below
     scenario = _check_labels(plc, scenario)
     _apply_plc_settings(plc, scenario)
     names = scenario.variables()

@@ -157,7 +157,7 @@ class AdprwMaster:
         fc, count, data, d2 = self.job if self.job is not None else (None, None, None, None)
         return (self.busy, self.completed, self.request, self.expect, self.deadline, self.attempts_left,
                 bytes(self.rx), fc, count, operand_key(data), operand_key(d2),
-                pulse_keys(self.pulses), pulse_keys(self.pending), len(self.port.sent))
+                pulse_keys(self.pulses), pulse_keys(self.pending), self.port.sent_count)
 
     def skipped(self, scan_count: int, scans: int) -> None:
         """Nothing here depends on the scan count."""

@@ -159,7 +159,7 @@ class C24Module:
         """Everything the instructions and `poll` change (nothing counts scans)."""
         channels = tuple(
             (c.sending_until, None if c.out_done is None else tuple(map(operand_key, c.out_done)),
-             bytes(c.rx), c.rx_last_t, tuple(c.frames), c.no_reception_us, len(c.port.sent))
+             bytes(c.rx), c.rx_last_t, tuple(c.frames), c.no_reception_us, c.port.sent_count)
             for c in self.channels.values())
         return channels, pulse_keys(self.pulses), pulse_keys(self.pending)
 

@@ -185,7 +185,7 @@ class Rs2Port:
         return (self.last_call_scan - self.rt.scan_count, operand_key(self.s_ref), operand_key(self.d_ref),
                 self.m, self.n, self.sending_until,
                 self.send_started, self.send_len, bytes(self.rx), self.rx_last_t, self.rx_done,
-                self.reported_format, len(self.channel.sent))
+                self.reported_format, self.channel.sent_count)
 
     def skipped(self, scan_count: int, scans: int) -> None:
         """`scans` idle scans after scan `scan_count` - 1 were skipped: one that called RS2
