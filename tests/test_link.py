@@ -41,6 +41,17 @@ def test_reply_starts_after_the_turnaround_and_arrives_byte_by_byte():
     ]
 
 
+def test_hand_over_trace_gives_the_trace_and_the_line_keeps_no_frames():
+    line = make_line()
+    line.send(STOP_FRAME, 0, origin="Main.st:12:5")
+    line.receive_until(100_000)
+    expected = line.trace
+    assert line.hand_over_trace() == expected and len(expected) == 2
+    assert line.trace == []
+    line.send(STATUS, 200_000)  # the line goes on recording
+    assert [f.data for f in line.trace] == [STATUS]
+
+
 def test_receive_until_hands_each_byte_over_once_and_only_when_it_has_arrived():
     line = make_line()
     line.send(STOP_FRAME, 0)

@@ -63,3 +63,21 @@ def test_read_together_calls_a_reader_whose_slot_is_a_python_keyword():
     odd = Odd()
     setattr(odd, "pass", 5)
     assert read_together([_slot_reader(odd, "pass")])() == (5,)
+
+
+def test_the_trace_shares_the_bytes_of_equal_frames_and_stops_at_the_end():
+    """A long run repeats the same status poll and reply thousands of times: each distinct
+    frame is held once. Frames that start at or after the end of the run are not in it."""
+    from verifier.verify.result import TraceRecord
+    from verifier.verify.runner import _trace_records
+
+    poll, reply = b"\x01\x01\x03\x00\x00\x08\x3c\x4c", b"\x01\x01\x01\x00\x51\x88"
+    frames = [TraceRecord(t, t + 8333, "tx", bytes(bytearray(poll)), "a.st:1:1") for t in (0, 100, 200)]
+    frames += [TraceRecord(300, 306, "rx", bytes(bytearray(reply)))]
+    records = _trace_records(list(frames), 300)
+    assert records == frames[:3]
+    assert len({id(r.data) for r in records}) == 1
+    scenario = load_scenario(SCENARIOS[[p.stem for p in SCENARIOS].index("fx3u-healthy")])
+    trace = run_scenario(scenario).trace
+    assert len({id(r.data) for r in trace}) == len({r.data for r in trace}) < len(trace)
+    assert trace and all(r.t_start_us < scenario.duration_us for r in trace)

@@ -178,6 +178,24 @@ def _relative(origin: str | None, cwd: str) -> str | None:
     return f"{_display_path(Path(file))}:{rest}"
 
 
+def _trace_records(frames: list, end_us: int) -> list[TraceRecord]:
+    """The line's frames that started before `end_us` as trace records, converted in place
+    (one frame at a time is held twice, not the whole trace), with origins relative to the
+    working folder and equal frames sharing one bytes object (a status poll and its reply
+    repeat thousands of times in an hour)."""
+    cwd = os.getcwd()
+    shared: dict[bytes, bytes] = {}
+    kept = len(frames)
+    while kept and frames[kept - 1].t_start_us >= end_us:  # in start order: the late ones are last
+        kept -= 1
+    del frames[kept:]
+    for k, f in enumerate(frames):
+        data = bytes(f.data)
+        frames[k] = TraceRecord(f.t_start_us, f.t_end_us, f.direction, shared.setdefault(data, data),
+                                _relative(f.origin, cwd))
+    return frames
+
+
 def _plain(value: Any) -> Any:
     """A sampled value as bool/int/float (the simulator may hand back typed wrappers)."""
     if isinstance(value, (bool, int, float)):
@@ -343,10 +361,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         converter.advance(max(end, converter.now_us))
     else:
         line.advance(max(end, line.now_us))
-    cwd = os.getcwd()
-    trace = [TraceRecord(f.t_start_us, f.t_end_us, f.direction, bytes(f.data), _relative(f.origin, cwd))
-             for f in line.trace]
-    trace = [f for f in trace if f.t_start_us < end]
+    trace = _trace_records(line.hand_over_trace(), end)
     line_events = line.events if converter is None else sorted(line.events + converter.events, key=lambda e: e.t_us)
     events = [LineEvent(e.t_us, e.kind, e.message) for e in line_events if e.t_us <= end]
     evidence = RunEvidence(scenario.settings, trace, end, events, samples, scenario.options, aborted is not None)
