@@ -190,8 +190,15 @@ def _is_reply_to(frame: TraceFrameLike, exchange: Exchange) -> bool:
     request = exchange.decoded_request
     if request is None:
         return False
+    return _decodes_as_reply(bytes(frame.data), exchange.settings, request)
+
+
+@lru_cache(maxsize=4096)
+def _decodes_as_reply(data: bytes, settings: protocol.Settings, request) -> bool:
+    """Whether `data` decodes as a reply to `request` (worked out once per distinct frame:
+    a status poll and its reply repeat thousands of times in a long run)."""
     try:
-        protocol.decode_reply(frame.data, exchange.settings, request)
+        protocol.decode_reply(data, settings, request)
     except protocol.FrameError:
         return False
     return True

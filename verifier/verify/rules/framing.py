@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from bisect import bisect_right
+from functools import lru_cache
 
 from verifier import protocol
 
@@ -12,23 +13,30 @@ from ..traffic import Traffic, frame_ref
 def check_crc(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
     violations = []
     for frame in traffic.tx:
-        data = bytes(frame.data)
-        if protocol.crc_ok(data):
-            continue
-        ref = frame_ref(frame, evidence.settings)
-        if len(data) < 3:
-            message = f"a {len(data)}-byte frame is too short to carry a CRC"
-        else:
-            expected = protocol.with_crc(data[:-2])[-2:]
-            got = protocol.hex_bytes(data[-2:])
-            message = (
-                f"CRC bytes are {got}, expected {protocol.hex_bytes(expected)} "
-                f"(CRC-16/MODBUS of the first {len(data) - 2} bytes, low byte first)"
-            )
-            if data[-2:] == expected[::-1]:
-                message += " — the two CRC bytes are swapped: send the low byte first"
-        violations.append(Violation("UITAMR-CRC", frame.t_start_us, message, (ref,), frame.origin))
+        message = _crc_problem(bytes(frame.data))
+        if message is not None:
+            ref = frame_ref(frame, evidence.settings)
+            violations.append(Violation("UITAMR-CRC", frame.t_start_us, message, (ref,), frame.origin))
     return violations
+
+
+@lru_cache(maxsize=4096)
+def _crc_problem(data: bytes) -> str | None:
+    """What is wrong with the CRC of request `data`, or None (once per distinct frame: a
+    long run repeats the same few requests thousands of times)."""
+    if protocol.crc_ok(data):
+        return None
+    if len(data) < 3:
+        return f"a {len(data)}-byte frame is too short to carry a CRC"
+    expected = protocol.with_crc(data[:-2])[-2:]
+    got = protocol.hex_bytes(data[-2:])
+    message = (
+        f"CRC bytes are {got}, expected {protocol.hex_bytes(expected)} "
+        f"(CRC-16/MODBUS of the first {len(data) - 2} bytes, low byte first)"
+    )
+    if data[-2:] == expected[::-1]:
+        message += " — the two CRC bytes are swapped: send the low byte first"
+    return message
 
 
 def check_format(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
@@ -37,20 +45,7 @@ def check_format(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
     violations = []
     gaps = _gap_events(evidence.events)
     for frame in traffic.tx:
-        data = bytes(frame.data)
-        if len(data) >= 3 and not protocol.crc_ok(data):
-            data = protocol.with_crc(data[:-2])
-        problem = None
-        try:
-            request = protocol.decode_request(data, settings)
-        except protocol.FrameError as exc:
-            problem = str(exc)
-        else:
-            if request.address != settings.address:
-                problem = (
-                    f"byte 0: addressed to slave {request.address}, the robot is slave "
-                    f"{settings.address}"
-                )
+        problem = _layout_problem(bytes(frame.data), settings)
         gap = _gap_inside(frame, gaps)
         if gap is not None and problem is None:
             problem = (
@@ -68,6 +63,21 @@ def check_format(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
                 )
             )
     return violations
+
+
+@lru_cache(maxsize=4096)
+def _layout_problem(data: bytes, settings: protocol.Settings) -> str | None:
+    """What is wrong with the layout of request `data` (its CRC taken as right), or None;
+    worked out once per distinct frame."""
+    if len(data) >= 3 and not protocol.crc_ok(data):
+        data = protocol.with_crc(data[:-2])
+    try:
+        request = protocol.decode_request(data, settings)
+    except protocol.FrameError as exc:
+        return str(exc)
+    if request.address != settings.address:
+        return f"byte 0: addressed to slave {request.address}, the robot is slave {settings.address}"
+    return None
 
 
 def _gap_events(events) -> tuple[list[int], list]:
