@@ -93,6 +93,23 @@ def test_sources_with_errors_are_reported_with_their_place(tmp_path):
     assert not (tmp_path / "o").exists()
 
 
+def test_an_export_into_the_sources_own_folder_never_writes_over_the_source(tmp_path):
+    """`--out` = the folder of a source whose name is its POU's: the body alone would
+    replace the file (declarations and comments lost). Refused, nothing written."""
+    src = tmp_path / "FB_Count.st"
+    text = "(* counts *)\nFUNCTION_BLOCK FB_Count\nVAR\n    wX : INT;\nEND_VAR\nwX := wX + 1;\nEND_FUNCTION_BLOCK\n"
+    src.write_text(text)
+    result = CliRunner().invoke(command, ["--target", "gxworks2", "--out", str(tmp_path), str(src)])
+    assert result.exit_code == 1
+    assert f"{src}:2:1: error: exporting into {tmp_path} would write FB_Count.st over this source file" in result.output
+    assert src.read_text() == text
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["FB_Count.st"]
+    other = tmp_path / "Counting.st"  # a file named otherwise: its folder is fine
+    src.rename(other)
+    assert run("--target", "gxworks2", "--out", str(tmp_path), str(other)).exit_code == 0
+    assert other.read_text() == text and (tmp_path / "FB_Count.st").exists()
+
+
 def test_missing_source_is_a_usage_error(tmp_path):
     result = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(tmp_path), "nope.st"])
     assert result.exit_code == 2 and "nope.st" in result.output

@@ -10,6 +10,7 @@ returned as a `DroppedValue` note naming file, line and column; a file without a
 global label or structure type is refused (`NothingToExport`)."""
 from __future__ import annotations
 
+import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -179,6 +180,29 @@ def _empty_files(files: list[ast.SourceFile]) -> list[ast.Diagnostic]:
             for f in files if not (f.pous or f.globals or f.types)]
 
 
+def _overwritten_sources(files: list[ast.SourceFile], paths: list[Path], out: Path) -> list[ast.Diagnostic]:
+    """The sources the export would write over (`--out` is their own folder and a POU has
+    the file's name): refused before anything is written, or the declarations are lost."""
+    outputs = [(f, pou, out / f"{pou.name}.{suffix}") for f in files for pou in f.pous for suffix in ("st", "labels.tsv")]
+    outputs += [(f, struct, out / f"{struct.name}.struct.tsv") for f in files for struct in f.types]
+    fixed = [out / GLOBAL_TABLE, out / DROPPED_TABLE, out / "IMPORT_ORDER.txt"]
+    sources = {source.resolve(): (f, source) for f, source in zip(files, paths)}
+    problems = []
+    for written in [(None, None, p) for p in fixed] + outputs:
+        f, what, target = written
+        hit = sources.get(target.resolve())
+        if hit is None and target.exists():
+            hit = next((v for k, v in sources.items() if k.exists() and os.path.samefile(k, target)), None)
+        if hit is None:
+            continue
+        source_file, source = hit
+        line, col = (what.span.line, what.span.col) if what is not None and source_file is f else (1, 1)
+        problems.append(ast.Diagnostic(
+            source_file.filename, line, col, "error",
+            f"exporting into {out} would write {target.name} over this source file: choose another --out folder"))
+    return problems
+
+
 def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, str] | None = None,
                    notes: list[DroppedValue] | None = None) -> list[Path]:
     """Parse and check `paths`, write the export into `out`; returns the files written.
@@ -196,6 +220,9 @@ def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, 
     empty = _empty_files(files)
     if empty:
         raise NothingToExport(empty)
+    clashes = _overwritten_sources(files, paths, out)
+    if clashes:
+        raise ExportError(clashes)
     known = {p.key for f in files for p in f.pous}
     exported: list[ExportedPou] = []
     out.mkdir(parents=True, exist_ok=True)
