@@ -98,3 +98,14 @@ def test_too_deep_initial_value_is_reported_at_its_label():
     found = [d for d in st.check([source]) if d.is_error]
     assert [(d.line, d.col) for d in found] == [(2, 14)]
     assert "initial value nested too deeply" in found[0].message
+
+
+def test_real_constants_outside_the_real_types_are_errors_at_the_constant():
+    """1.0E999 is an infinity in Python and 1.0E39 one once stored in a REAL: the
+    simulator stopped with NameError('inf') instead of the checker saying what is wrong."""
+    text = ("PROGRAM Main\nVAR r : REAL; l : LREAL; b : BOOL; END_VAR\n"
+            "r := 1.0E39;\nb := 1.0E999 > 0.0;\nl := 1.0E39;\nr := 3.0E38;\nEND_PROGRAM\n")
+    assert errors(text) == [
+        "t.st:3:6: error: assignment: 1.0E39 is outside the REAL range (about ±3.4E38); a REAL label cannot hold it",
+        "t.st:4:6: error: 1.0E999 is outside the range of every real type (LREAL reaches about ±1.8E308)",
+    ]

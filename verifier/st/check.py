@@ -9,12 +9,15 @@ is suspicious (warnings). The simulator reuses the annotations and `SymbolTable`
 from __future__ import annotations
 
 import functools
+import math
 import re
 from dataclasses import dataclass, field
 
 from verifier.st import ast, library, structure
 from verifier.st import types as T
 from verifier.st.devices import looks_like_device
+
+REAL_MAX = 3.4028234663852886e38  # the largest 32-bit float
 
 
 # ----------------------------------------------------------------------------- symbol table
@@ -439,6 +442,11 @@ class Checker:
         if problem:
             self.rep.error(node, f"{what}: {problem}")
             return
+        if (T.is_group(source, "real-literal") and source.value is not None and isinstance(target, T.Elementary)
+                and target.name == "REAL" and math.isfinite(source.value) and abs(source.value) > REAL_MAX):
+            shown = node.text if isinstance(node, ast.RealLiteral) else f"{source.value:g}"
+            self.rep.error(node, f"{what}: {shown} is outside the REAL range (about ±3.4E38); "
+                                 "a REAL label cannot hold it")
         if T.is_group(source, "int-literal") and source.value is not None and isinstance(target, T.Elementary):
             if not T.fits(source.value, target):
                 lo, hi = T.INT_RANGE[target.name]
@@ -500,6 +508,9 @@ class Checker:
         if isinstance(e, ast.IntLiteral):
             return T.int_literal(e.value)
         if isinstance(e, ast.RealLiteral):
+            if not math.isfinite(e.value):
+                self.rep.error(e, f"{e.text} is outside the range of every real type (LREAL reaches about "
+                                  "±1.8E308)")
             return T.real_literal(e.value)
         if isinstance(e, ast.BoolLiteral):
             return T.BOOL
