@@ -63,6 +63,32 @@ def test_condition_errors_name_the_column(text, column):
     assert info.value.column == column
 
 
+@pytest.mark.parametrize("text, message", [
+    ("(" * 150 + "TRUE" + ")" * 150, "nested too deeply"),
+    ("NOT " * 1000 + "TRUE", "nested too deeply"),
+    ("- " * 500 + "1 = 1", "nested too deeply"),
+    (" AND ".join(["a"] * 3000), "too long: more than 200 operators"),
+])
+def test_absurdly_deep_conditions_are_errors_not_a_recursion_crash(text, message):
+    with pytest.raises(ConditionError, match=message):
+        parse_condition(text)
+
+
+def test_conditions_at_the_nesting_limit_still_parse():
+    assert parse_condition("(" * 50 + "a" + ")" * 50).holds({"a": True})
+    assert parse_condition(" AND ".join(["a"] * 150)).holds({"a": True})
+
+
+def test_numbers_in_robot_and_fault_settings_are_bounded():
+    from verifier.amr.schema import ConfigError, as_number
+
+    assert as_number(1e9, "x") == 1e9
+    with pytest.raises(ConfigError, match="out of range"):
+        as_number(1e308, "x")
+    with pytest.raises(ConfigError, match="out of range"):
+        as_number(-2e9, "x")
+
+
 # --- scenario files ---------------------------------------------------------------------------
 
 MINIMAL = """

@@ -42,11 +42,17 @@ def reject_unknown_keys(data: Mapping[str, Any], allowed: Iterable[str], path: s
             )
 
 
+# no setting needs more: times are turned into microseconds (x 1e6) and must stay integers
+LARGEST = 1e9
+
+
 def as_number(value: Any, path: str, *, minimum: float | None = None,
               maximum: float | None = None, strictly_positive: bool = False) -> float:
-    """A finite int or float (not a bool) within the given bounds."""
+    """A finite int or float (not a bool) within the given bounds (and within +-1e9)."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise ConfigError(path, f"expected a number, got {_shown(value)}")
+    if abs(value) > LARGEST:
+        raise ConfigError(path, f"{value:g} is out of range (at most {LARGEST:g} either way)")
     if strictly_positive and value <= 0:
         raise ConfigError(path, f"must be greater than 0, got {value}")
     if minimum is not None and value < minimum:

@@ -16,6 +16,7 @@ naming file, line and column; nothing in it is skipped silently.
 from __future__ import annotations
 
 import json
+import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -105,16 +106,32 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
                 raise CaptureError(f"{name}:{number}:1: the record has no {key!r}")
         if record["dir"] not in ("tx", "rx"):
             raise CaptureError(f"{name}:{number}:1: 'dir' is {record['dir']!r}; expected \"tx\" or \"rx\"")
-        try:
-            data = bytes.fromhex(str(record["hex"]))
-            t_start = float(record["t"])
-        except (TypeError, ValueError) as exc:
-            raise CaptureError(f"{name}:{number}:1: {exc}") from None
-        t_end = record.get("t_end")
-        t_us = round((float(t_end) if isinstance(t_end, (int, float)) else t_start) * 1_000_000)
+        where = f"{name}:{number}:1"
+        hex_text = record["hex"]
+        if not isinstance(hex_text, str) or not _HEX_BYTES.fullmatch(hex_text):
+            raise CaptureError(f"{where}: 'hex' is {hex_text!r}; expected bytes in hex, two digits each, "
+                               "e.g. \"01 06 01 A0 00 00 88 14\"")
+        data = bytes.fromhex(hex_text)
+        t_start = _seconds(record["t"], "t", where)
+        t_end = _seconds(record["t_end"], "t_end", where) if record.get("t_end") is not None else t_start
+        if t_end < t_start:
+            raise CaptureError(f"{where}: 't_end' ({t_end:g} s) is before 't' ({t_start:g} s)")
         scenarios.setdefault(str(record.get("scenario", name)), []).append(
-            Chunk(t_us, data, record["dir"], round(t_start * 1_000_000)))
+            Chunk(round(t_end * 1_000_000), data, record["dir"], round(t_start * 1_000_000)))
     return scenarios
+
+
+_HEX_BYTES = re.compile(r"\s*(?:[0-9A-Fa-f]{2}\s*)*")
+_LATEST_S = 1e9  # a time in seconds beyond this is not a capture's (and overflows microseconds)
+
+
+def _seconds(value, key: str, where: str) -> float:
+    """A trace record's time in seconds: a finite number (not true/false), not negative."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
+            or not 0 <= value <= _LATEST_S:
+        raise CaptureError(f"{where}: {key!r} is {json.dumps(value)}; expected a time in seconds "
+                           f"from 0 to {_LATEST_S:g}")
+    return float(value)
 
 
 def read_capture(path: Path) -> dict[str, list[Chunk]]:

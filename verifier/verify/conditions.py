@@ -83,10 +83,21 @@ def _number(token: _Token) -> Value:
 #   ("and"|"or"|"xor", left, right) | ("cmp", op, left, right)
 
 
+MAX_NESTING = 50  # parentheses, NOT and unary minus inside one another
+MAX_DEPTH = 200  # the tree: nesting plus chained AND/OR/XOR (evaluated recursively)
+
+
 class _Parser:
     def __init__(self, text: str):
         self.tokens = _tokenize(text)
         self.index = 0
+        self.nesting = 0
+
+    def nest(self, token: _Token) -> None:
+        self.nesting += 1
+        if self.nesting > MAX_NESTING:
+            raise ConditionError(f"nested too deeply (more than {MAX_NESTING} levels of parentheses, NOT or "
+                                 "minus signs inside one another)", token.column)
 
     @property
     def current(self) -> _Token:
@@ -103,6 +114,9 @@ class _Parser:
         node = self.logic()
         if self.current.kind != "end":
             raise ConditionError(f"unexpected {self.current.text!r}", self.current.column)
+        if _depth(node) > MAX_DEPTH:
+            raise ConditionError(f"too long: more than {MAX_DEPTH} operators one inside the other; "
+                                 "split it into several expectations", 1)
         return node
 
     def logic(self, level: int = 0):
@@ -117,8 +131,10 @@ class _Parser:
 
     def negation(self):
         if self.current.kind == "keyword" and self.current.text == "NOT":
-            self.take()
-            return ("not", self.negation())
+            self.nest(self.take())
+            node = ("not", self.negation())
+            self.nesting -= 1
+            return node
         return self.comparison()
 
     def comparison(self):
@@ -142,15 +158,30 @@ class _Parser:
         if token.kind == "name":
             return ("var", token.text)
         if token.kind == "op" and token.text == "-":
-            return ("neg", self.operand())
+            self.nest(token)
+            node = ("neg", self.operand())
+            self.nesting -= 1
+            return node
         if token.kind == "op" and token.text == "(":
+            self.nest(token)
             node = self.logic()
             closing = self.take()
             if closing.text != ")":
                 raise ConditionError("missing ')'", closing.column)
+            self.nesting -= 1
             return node
         found = "the end of the condition" if token.kind == "end" else repr(token.text)
         raise ConditionError(f"expected a label, a value or '(', found {found}", token.column)
+
+
+def _depth(node) -> int:
+    """How deep the tree goes (worked out without recursion: it may be very deep)."""
+    deepest, stack = 0, [(node, 1)]
+    while stack:
+        item, level = stack.pop()
+        deepest = max(deepest, level)
+        stack += [(child, level + 1) for child in item[1:] if isinstance(child, tuple)]
+    return deepest
 
 
 def _names(node) -> set[str]:

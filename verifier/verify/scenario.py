@@ -16,6 +16,7 @@ from verifier import protocol
 from verifier.amr.config import RobotConfig
 from verifier.amr.faults import Fault, check_fault_addresses
 from verifier.amr.schema import ConfigError
+from verifier.textfile import UnreadableText, read_utf8
 from verifier.tomlpos import Place, decode_error_position, place_of_key
 
 from verifier.link.converter import ConverterConfig
@@ -233,12 +234,15 @@ def power_on_stop_expectation(duration_us: int, address: int = 1, after_us: int 
 
 def load_scenario(path: Path | str) -> Scenario:
     path = Path(path)
+    if not path.exists():
+        raise ScenarioError(path, "", "no such scenario file")
     try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ScenarioError(path, "", "no such scenario file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ScenarioError(path, "", f"cannot read it: {exc}") from None
+        text = read_utf8(path)
+    except UnreadableText as exc:
+        if exc.line is None:
+            raise ScenarioError(path, "", str(exc)) from None
+        raise ScenarioError(path, "", f"not UTF-8 text (byte {exc.byte}): save the file as UTF-8",
+                            Place(exc.line, exc.col)) from None
     return parse_scenario(text, path)
 
 
@@ -378,6 +382,12 @@ class _Reader:
             self.c24(item, f"c24[{i}]", platform)
             for i, item in enumerate(self.array_of_tables(data.get("c24", []), "c24"))
         )
+        seen_c24: dict[tuple[int, int], str] = {}
+        for setting in c24:
+            first = seen_c24.setdefault((setting.unit, setting.channel), setting.key)
+            if first != setting.key:
+                raise self.fail(setting.key, f"U{setting.unit:X} channel {setting.channel} is already set in "
+                                             f"{first}: one [[c24]] table per module channel", at_name=True)
         converter = self.converter(data["converter"], platform) if "converter" in data else None
         if converter is not None and channel is not None:
             raise self.fail("channel", "a scenario with [converter] reaches the robot over TCP: "

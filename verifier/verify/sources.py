@@ -13,8 +13,10 @@ class SourceError(ValueError):
 
 
 def expand(name: str, base: Path) -> list[Path]:
-    """The .st files `name` stands for, relative to `base` unless absolute, sorted."""
-    if any(ch in name for ch in GLOB_CHARACTERS):
+    """The .st files `name` stands for, relative to `base` unless absolute, sorted. A name
+    with glob characters that is also an existing path ("[A]/x.st") is that path."""
+    literal = Path(name) if Path(name).is_absolute() else base / name
+    if any(ch in name for ch in GLOB_CHARACTERS) and not literal.exists():
         pattern = name if Path(name).is_absolute() else str(base / name)
         matches = sorted(Path(p) for p in glob.glob(pattern, recursive=True))
         files: list[Path] = []
@@ -24,7 +26,7 @@ def expand(name: str, base: Path) -> list[Path]:
             where = "" if Path(name).is_absolute() else f" (relative to {base})"
             raise SourceError(f"{name!r} matches no file{where}")
         return files
-    path = Path(name) if Path(name).is_absolute() else base / name
+    path = literal
     if path.is_dir():
         files = _folder(path)
         if not files:
