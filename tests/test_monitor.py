@@ -11,6 +11,7 @@ import json
 import random
 import signal
 import socket
+import os
 import subprocess
 import threading
 import time
@@ -338,3 +339,47 @@ def test_a_port_that_cannot_be_opened_exits_2_with_its_name(tmp_path):
     done = subprocess.run(uitamr("monitor", "--tcp", "127.0.0.1:1"), capture_output=True, text=True,
                           timeout=WAIT_S)
     assert done.returncode == 2 and "127.0.0.1:1" in done.stderr
+
+
+@pytest.mark.parametrize("record, message", [
+    ('{"t": NaN, "dir": "tx", "hex": "01"}', "'t' is NaN; expected a time in seconds from 0 to 1e+09"),
+    ('{"t": 1e400, "dir": "tx", "hex": "01"}', "'t' is Infinity; expected a time in seconds"),
+    ('{"t": true, "dir": "tx", "hex": "01"}', "'t' is true; expected a time in seconds"),
+    ('{"t": "x", "dir": "tx", "hex": "01"}', "'t' is \"x\"; expected a time in seconds"),
+    ('{"t": 0.2, "t_end": 0.1, "dir": "tx", "hex": "01"}', "'t_end' (0.1 s) is before 't' (0.2 s)"),
+    ('{"t": 0.1, "dir": "tx", "hex": "ZZ"}', "'hex' is 'ZZ'; expected bytes in hex"),
+    ('{"t": 0.1, "dir": "tx", "hex": 5}', "'hex' is 5; expected bytes in hex"),
+])
+def test_a_trace_record_with_a_bad_value_names_the_key(tmp_path, record, message):
+    path = tmp_path / "t.jsonl"
+    path.write_text(record + "\n", encoding="utf-8")
+    with pytest.raises(CaptureError) as caught:
+        read_capture(path)
+    assert str(caught.value).startswith(f"{path}:1:1: {message}")
+
+
+def test_replay_refuses_to_write_a_report_over_its_own_capture(tmp_path):
+    path = tmp_path / "t.jsonl"
+    text = '{"t": 0.1, "t_end": 0.108, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}\n'
+    path.write_text(text, encoding="utf-8")
+    done = subprocess.run(uitamr("replay", path, "--trace", path), capture_output=True, text=True, timeout=WAIT_S)
+    assert done.returncode == 2 and "is one of the captures to replay" in done.stderr
+    assert path.read_text(encoding="utf-8") == text
+
+
+def test_a_named_pipe_is_not_read_as_a_capture(tmp_path):
+    fifo = tmp_path / "c.txt"
+    os.mkfifo(fifo)
+    done = subprocess.run(uitamr("replay", fifo), capture_output=True, text=True, timeout=WAIT_S)
+    assert done.returncode == 2 and "not a regular file" in done.stderr
+
+
+@pytest.mark.serial
+def test_a_capture_that_cannot_be_written_is_an_error_not_a_traceback(line, tmp_path):
+    """/proc/version exists in a folder that exists, so it passes the check before the
+    session, and only fails at the write at its end."""
+    monitor = monitor_on(line, tmp_path, "--duration", "1s", "--capture", "/proc/version")
+    out, err = monitor.communicate(timeout=WAIT_S)
+    assert monitor.returncode == 2 and "Traceback" not in err
+    assert "uitamr monitor: cannot write the capture /proc/version" in err
+    assert (tmp_path / "m.json").exists()  # the reports are written first

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import re
+import os
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -264,3 +265,53 @@ def test_every_scan_reports_what_the_default_reports(tmp_path, jobs):
         assert result.exit_code in (0, 1), result.output
         return re.sub(r'"wall[^"]*": [0-9.e+-]+', '"wall": 0', out.read_text())
     assert report("--every-scan") == report()
+
+
+def test_text_in_square_brackets_is_shown_as_written_not_read_as_markup(tmp_path):
+    """The console library reads "[...]" as styling: user text in an error must be escaped,
+    or "[/]" crashes and "uMbx[i]" loses its index (found by a robustness sweep)."""
+    done = _run_cli(*FX3_SOURCES, "--program", "[/]")
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert "no PROGRAM '[/]' in the sources" in done.stderr
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('program = "UITAMR_ExampleFx3"\nduration = "1s"\nwatch = ["uMbx[i]"]\n')
+    done = _run_cli(*FX3_SOURCES, "--scenario", scenario)
+    assert done.returncode == 2 and "'uMbx[i]'" in done.stderr
+
+
+def test_two_reports_to_one_file_are_refused_before_the_run(tmp_path):
+    report = tmp_path / "r.out"
+    done = _run_cli(*FX3_SOURCES, "--json", report, "--html", report)
+    assert done.returncode == 2 and "are the same file" in done.stderr and not report.exists()
+
+
+def test_a_named_pipe_as_scenario_is_refused_not_waited_on(tmp_path):
+    fifo = tmp_path / "s.toml"
+    os.mkfifo(fifo)
+    done = _run_cli("--scenario", fifo)
+    assert done.returncode == 2 and "not a regular file" in done.stderr
+
+
+def test_scenario_files_with_a_byte_order_mark_or_bad_bytes(tmp_path):
+    from verifier.verify.scenario import ScenarioError, load_scenario
+
+    text = (PLC / "scenarios" / "fx3u-healthy.toml").read_text(encoding="utf-8").replace('"../', f'"{PLC}/')
+    with_bom = tmp_path / "bom.toml"
+    with_bom.write_bytes(b"\xef\xbb\xbf" + text.encode("utf-8"))
+    assert load_scenario(with_bom).program == "UITAMR_ExampleFx3"
+    latin1 = tmp_path / "latin1.toml"
+    latin1.write_bytes(b'name = "x"\n# caf\xe9\n')
+    with pytest.raises(ScenarioError) as caught:
+        load_scenario(latin1)
+    assert str(caught.value) == f"{latin1}:2:6: not UTF-8 text (byte 16): save the file as UTF-8"
+
+
+def test_huge_numbers_in_a_scenario_are_refused_at_their_key(tmp_path):
+    """1e308 ms used to reach the simulator as an infinity and stop the run there, blamed
+    on the ST program."""
+    text = (PLC / "scenarios" / "fx3u-healthy.toml").read_text(encoding="utf-8").replace('"../', f'"{PLC}/')
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(text.replace("point_duration_s = 6.0", "point_duration_s = 1e308"), encoding="utf-8")
+    done = _run_cli("--scenario", scenario)
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert "robot.point_duration_s: 1e+308 is out of range" in done.stderr

@@ -2,6 +2,7 @@
 tests of a real PLC (docs/emulator.md)."""
 from __future__ import annotations
 
+import math
 import signal
 import sys
 import threading
@@ -10,10 +11,11 @@ import click
 
 from verifier.amr import ConfigError, Fault, Robot, RobotConfig
 from verifier.amr.config import BEFORE_STOP_POLICIES, PACING_POLICIES
+from verifier.amr.schema import LARGEST
 from verifier.emulate.assembler import DEFAULT_SILENCE_US
 from verifier.emulate.core import Emulator
 from verifier.emulate.faultfile import FaultFileError, load_fault_file
-from verifier.emulate.ports import PortError, serve_serial, serve_tcp
+from verifier.emulate.ports import PortError, serial_url_problem, serve_serial, serve_tcp
 from verifier.commands.protocol_options import protocol_settings
 
 
@@ -50,7 +52,29 @@ def _serial_url(ctx: click.Context, param: click.Parameter, value: str | None) -
             "loop:// sends every byte back to the port itself, so the robot would read its own "
             "replies as new requests (an FC06 reply echoes the request) and never hear a PLC; "
             "give a real port, a pty (socat) or socket://HOST:PORT")
+    problem = serial_url_problem(value) if value is not None else None
+    if problem:
+        raise click.BadParameter(problem)
     return value
+
+
+class _FiniteFloat(click.ParamType):
+    """A number of seconds or milliseconds: finite (click's float takes "nan" and "inf")
+    and within the range every setting keeps (verifier.amr.schema.LARGEST)."""
+
+    name = "number"
+
+    def convert(self, value, param, ctx):
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            self.fail(f"{value!r} is not a number", param, ctx)
+        if not math.isfinite(number) or abs(number) > LARGEST:
+            self.fail(f"{value!r} is not a finite number of at most {LARGEST:g}", param, ctx)
+        return number
+
+
+FINITE = _FiniteFloat()
 
 
 def _exit_after(ctx: click.Context, param: click.Parameter, value: float | None) -> float | None:
@@ -118,8 +142,8 @@ def _flag_faults(no_reply, bad_crc, garbage, wrong_address, exception, late,
 @protocol_settings
 @click.option("--faults", "faults_file", type=click.Path(dir_okay=False), metavar="FILE.toml",
               help="Scripted faults ([[faults]]) and robot settings ([robot]).")
-@click.option("--turnaround-ms", type=float, help="Delay from the end of a request to the reply [5].")
-@click.option("--point-duration-s", type=float, help="How long a point/script run takes [8].")
+@click.option("--turnaround-ms", type=FINITE, help="Delay from the end of a request to the reply [5].")
+@click.option("--point-duration-s", type=FINITE, help="How long a point/script run takes [8].")
 @click.option("--pacing", type=click.Choice(PACING_POLICIES),
               help="Requests 250 ms or less apart: answer (default), ignore, or answer late.")
 @click.option("--before-stop", type=click.Choice(BEFORE_STOP_POLICIES),
@@ -130,12 +154,12 @@ def _flag_faults(no_reply, bad_crc, garbage, wrong_address, exception, late,
 @click.option("--wrong-address-on", multiple=True, metavar="N", help="Answer request N from another address.")
 @click.option("--exception-on", multiple=True, metavar="N[:CODE]", help="Answer request N with exception CODE [4].")
 @click.option("--late-reply-on", multiple=True, metavar="N:MS", help="Answer request N MS milliseconds late.")
-@click.option("--anti-collision-at", multiple=True, type=float, metavar="S", help="Obstacle at S seconds (error 01).")
-@click.option("--off-tape-at", multiple=True, type=float, metavar="S", help="Leave the tape at S seconds (error 02).")
-@click.option("--low-battery-at", multiple=True, type=float, metavar="S", help="Battery warning from S seconds (error 03).")
-@click.option("--frame-gap-ms", type=float, default=DEFAULT_SILENCE_US / 1000, show_default=True,
+@click.option("--anti-collision-at", multiple=True, type=FINITE, metavar="S", help="Obstacle at S seconds (error 01).")
+@click.option("--off-tape-at", multiple=True, type=FINITE, metavar="S", help="Leave the tape at S seconds (error 02).")
+@click.option("--low-battery-at", multiple=True, type=FINITE, metavar="S", help="Battery warning from S seconds (error 03).")
+@click.option("--frame-gap-ms", type=FINITE, default=DEFAULT_SILENCE_US / 1000, show_default=True,
               help="Silence that ends an incomplete frame on the wall clock (USB adapters deliver in chunks).")
-@click.option("--exit-after", type=float, metavar="S", callback=_exit_after,
+@click.option("--exit-after", type=FINITE, metavar="S", callback=_exit_after,
               help="Stop by itself after S seconds (S > 0).")
 @click.option("--quiet", is_flag=True, help="No live log, only the summary line.")
 def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_duration_s, pacing,

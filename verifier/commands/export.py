@@ -36,7 +36,10 @@ def bundled_sources(target: str) -> list[Path]:
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), required=True,
               help="Folder for <POU>.st, <POU>.labels.tsv, GlobalLabels.labels.tsv and IMPORT_ORDER.txt.")
 def command(sources: tuple[str, ...], target: str, out_dir: str) -> None:
-    """Write, per POU, the ST body and a tab-separated label table for GX Works."""
+    """Write, per POU, the ST body and a tab-separated label table for GX Works.
+
+    With no SOURCES: the bundled library (plc/core, the ports and the examples of the
+    target editor's platforms)."""
     from verifier.export import ExportError, NothingToExport, export_sources
 
     if sources:

@@ -16,11 +16,13 @@ from pathlib import Path
 
 import click
 from rich.console import Console
+from rich.markup import escape
 
 from verifier.commands.emulate import STANDARD_BAUD_RATES, _tcp_endpoint
 from verifier.commands.protocol_options import protocol_settings
 from verifier.commands.report_files import ReportError, check_folders, report_options, write_reports
 from verifier.commands.verify import _Duration
+from verifier.emulate.ports import serial_url_problem
 from verifier.monitor.capture import format_plain
 from verifier.monitor.framer import DEFAULT_TOLERANCE_US, LineTiming
 from verifier.monitor.session import CaptureInfo, MonitorSession
@@ -75,6 +77,9 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
     """Listen on the robot's line and check every frame and gap against the manual, live."""
     if (serial_url is None) == (tcp is None):
         raise click.UsageError("give exactly one of --serial PORT or --tcp HOST:PORT")
+    problem = serial_url_problem(serial_url) if serial_url is not None else None
+    if problem:
+        raise click.BadParameter(problem, param_hint="--serial")
     console = Console(highlight=False, soft_wrap=True)
     try:
         check_folders(json_path, junit_path, trace_path, html_path, capture_path)
@@ -100,7 +105,7 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
     previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGINT, signal.SIGTERM)}
     deadline = None if duration is None else time.monotonic() + duration / 1_000_000
     lost: str | None = None
-    console.print(f"[dim]listening on {source.description} ({baud} {line_format}, tolerance "
+    console.print(f"[dim]listening on {escape(source.description)} ({baud} {line_format}, tolerance "
                   f"{timing.tolerance_us / 1000:g} ms); Ctrl-C stops[/]")
     console.file.flush()
     try:
@@ -128,15 +133,19 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
         for sig, handler in previous.items():
             signal.signal(sig, handler)
     if lost:
-        console.print(f"[yellow]stopped: {lost}[/]")
+        console.print(f"[yellow]stopped: {escape(lost)}[/]")
     result = session.result()
     if lost:
         result.notes.append(f"the capture ended early: {lost}")
     _finish([result], console, json_path, junit_path, trace_path, html_path)
     if capture_path:
-        Path(capture_path).write_text(format_plain(session.chunks, f"uitamr monitor capture of {source.description}, "
-                                                                   f"{baud} {line_format}"), encoding="utf-8")
-        console.print(f"[dim]wrote {capture_path}[/]")
+        text = format_plain(session.chunks, f"uitamr monitor capture of {source.description}, {baud} {line_format}")
+        try:
+            Path(capture_path).write_text(text, encoding="utf-8")
+        except OSError as exc:
+            click.echo(f"uitamr monitor: cannot write the capture {capture_path}: {exc.strerror or exc}", err=True)
+            sys.exit(EXIT_UNUSABLE)
+        console.print(f"[dim]wrote {escape(str(capture_path))}[/]")
     sys.exit(EXIT_FINDINGS if result.violation_count else EXIT_CLEAN)
 
 

@@ -35,6 +35,10 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
         check_folders(json_path, junit_path, trace_path, html_path)
     except ReportError as exc:
         raise click.UsageError(str(exc)) from None
+    inputs = {Path(name).resolve(): name for name in captures}
+    for report in (json_path, junit_path, trace_path, html_path):
+        if report and Path(report).resolve() in inputs:
+            raise click.UsageError(f"{report} is one of the captures to replay: write the report to another file")
     results = []
     for name in captures:
         path = Path(name)

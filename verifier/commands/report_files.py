@@ -6,6 +6,7 @@ from pathlib import Path
 
 import click
 from rich.console import Console
+from rich.markup import escape
 
 REPORT_OPTIONS = (
     click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Write the verdict as JSON."),
@@ -28,10 +29,18 @@ class ReportError(Exception):
 
 
 def check_folders(*paths: str | None) -> None:
-    """Refuse before any work when a report's folder does not exist."""
+    """Refuse before any work when a report's folder does not exist, or when two reports
+    are to go to the same file (the second would silently replace the first)."""
+    seen: dict[Path, str] = {}
     for path in paths:
-        if path and not Path(path).resolve().parent.is_dir():
-            raise ReportError(f"cannot write {path}: the folder {Path(path).resolve().parent} does not exist")
+        if not path:
+            continue
+        resolved = Path(path).resolve()
+        if not resolved.parent.is_dir():
+            raise ReportError(f"cannot write {path}: the folder {resolved.parent} does not exist")
+        if resolved in seen:
+            raise ReportError(f"{seen[resolved]} and {path} are the same file: give each report a file of its own")
+        seen[resolved] = path
 
 
 def write_reports(results, console: Console, json_path=None, junit_path=None, trace_path=None,
@@ -46,4 +55,4 @@ def write_reports(results, console: Console, json_path=None, junit_path=None, tr
                 writer.write(results, Path(path))
             except OSError as exc:
                 raise ReportError(f"cannot write {path}: {exc.strerror or exc}") from None
-            console.print(f"[dim]wrote {path}[/]")
+            console.print(f"[dim]wrote {escape(str(path))}[/]")

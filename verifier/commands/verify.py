@@ -12,6 +12,7 @@ from pathlib import Path
 
 import click
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
 from verifier.commands.report_files import ReportError, check_folders, report_options, write_reports
@@ -60,7 +61,7 @@ class _Duration(click.ParamType):
 
 
 def _unusable(message: str) -> None:
-    Console(stderr=True, highlight=False).print(f"[bold red]error:[/] {message}", markup=True, soft_wrap=True)
+    Console(stderr=True, highlight=False).print(f"[bold red]error:[/] {escape(message)}", markup=True, soft_wrap=True)
     sys.exit(EXIT_UNUSABLE)
 
 

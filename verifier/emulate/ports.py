@@ -181,3 +181,17 @@ def serve_tcp(host: str, port: int, emulator: Emulator, stop: threading.Event, s
             sock.close()
         selector.close()
         server.close()
+
+
+def serial_url_problem(url: str) -> str | None:
+    """What is wrong with a pyserial network URL (socket://, rfc2217://) before pyserial
+    says it less clearly: it needs HOST:PORT with a port 1-65535. None for other ports."""
+    scheme, sep, rest = url.partition("://")
+    if not sep or scheme.lower() not in ("socket", "rfc2217"):
+        return None
+    host, colon, port = rest.split("/", 1)[0].split("?", 1)[0].rpartition(":")
+    if not colon or not host:
+        return f"{url} needs a host and a port: {scheme}://HOST:PORT"
+    if not port.isdigit() or not 1 <= int(port) <= 65535:
+        return f"{url}: the port {port!r} is not a number from 1 to 65535"
+    return None
