@@ -276,7 +276,7 @@ def test_robot_config_from_dict_converts_and_checks():
     ({"taught_points": [1, 0]}, "robot.taught_points[1]: must be at least 1, got 0"),
     ({"trackless_speeds_mps": [1, 2, 3]}, "robot.trackless_speeds_mps: expected four speeds"),
     ({"magnetic_speeds_mps": [1, 2, 0, 3]}, "robot.magnetic_speeds_mps[2]: must be greater than 0"),
-    ({"battery_pct": True}, "robot.battery_pct: expected a number, got True"),
+    ({"battery_pct": True}, "robot.battery_pct: expected a number, got true"),
     ([1, 2], "robot: expected a table of keys"),
 ])
 def test_bad_robot_config_names_the_key(data, message):

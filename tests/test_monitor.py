@@ -363,7 +363,7 @@ def test_replay_refuses_to_write_a_report_over_its_own_capture(tmp_path):
     text = '{"t": 0.1, "t_end": 0.108, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}\n'
     path.write_text(text, encoding="utf-8")
     done = subprocess.run(uitamr("replay", path, "--trace", path), capture_output=True, text=True, timeout=WAIT_S)
-    assert done.returncode == 2 and "is one of the captures to replay" in done.stderr
+    assert done.returncode == 2 and "is one of the run's input files" in done.stderr
     assert path.read_text(encoding="utf-8") == text
 
 
@@ -383,3 +383,17 @@ def test_a_capture_that_cannot_be_written_is_an_error_not_a_traceback(line, tmp_
     assert monitor.returncode == 2 and "Traceback" not in err
     assert "uitamr monitor: cannot write the capture /proc/version" in err
     assert (tmp_path / "m.json").exists()  # the reports are written first
+
+
+def test_an_html_report_of_a_capture_spanning_years_stays_small(tmp_path):
+    """A tick every 10 s over a 1e9 s gap was 100 million ticks: the run never ended."""
+    from verifier.verify import report_html
+
+    path = tmp_path / "gap.jsonl"
+    path.write_text('{"t": 0, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}\n'
+                    '{"t": 999999999, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}\n', encoding="utf-8")
+    done = subprocess.run(uitamr("replay", path, "--html", tmp_path / "r.html"), capture_output=True, text=True,
+                          timeout=WAIT_S)
+    assert done.returncode in (0, 1), done.stderr
+    assert (tmp_path / "r.html").stat().st_size < 2_000_000
+    assert report_html.MAJOR_TICKS_AT_MOST == 5000

@@ -147,3 +147,13 @@ def test_undecodable_bytes_are_named_with_line_and_column(tmp_path):
     result = run(path)
     assert result.exit_code == 1
     assert f"{path}:3:12: error: byte 0x80 at offset 42 is neither UTF-8 nor Shift-JIS text" in result.output
+
+
+def test_a_file_named_twice_is_checked_once(tmp_path):
+    """`check a a/Main.st` used to report Main as defined twice, in the same file."""
+    folder = tmp_path / "a"
+    folder.mkdir()
+    (folder / "Main.st").write_text("PROGRAM Main\nVAR x : INT; END_VAR\nx := 1;\nEND_PROGRAM\n", encoding="utf-8")
+    result = run(folder, folder / "Main.st")
+    assert result.exit_code == 0, result.output
+    assert "1 file(s) checked" in result.output

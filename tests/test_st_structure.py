@@ -109,3 +109,23 @@ def test_real_constants_outside_the_real_types_are_errors_at_the_constant():
         "t.st:3:6: error: assignment: 1.0E39 is outside the REAL range (about ±3.4E38); a REAL label cannot hold it",
         "t.st:4:6: error: 1.0E999 is outside the range of every real type (LREAL reaches about ±1.8E308)",
     ]
+
+
+def test_an_if_or_case_with_more_branches_than_the_simulator_runs_is_an_error():
+    """About 3,000 branches make Python's compiler give up; check said nothing and the
+    simulator's error had no place. At the limit, both still load and run."""
+    def program(n_elsif: int, n_case: int) -> str:
+        elsifs = "".join(f"ELSIF i = {k} THEN\n    y := {k};\n" for k in range(1, n_elsif + 1))
+        cases = "".join(f"{k}: y := {k};\n" for k in range(n_case))
+        return ("PROGRAM Main\nVAR i, y : INT; END_VAR\nIF i = 0 THEN\n    y := 0;\n" + elsifs + "END_IF;\n"
+                "CASE i OF\n" + cases + "END_CASE;\nEND_PROGRAM\n")
+
+    found = errors(program(1000, 1001))
+    assert [f.split(": error: ")[1].split(":")[0] for f in found] == [
+        "IF with 1000 ELSIF branches", "CASE with 1001 branches"]
+    assert found[0].startswith("t.st:3:1:")
+    project = verifier.sim.load(sources={"t.st": program(999, 1000)})
+    main = project.program("Main")
+    main.i = 998
+    project.run_programs(["Main"], scans=1)
+    assert main.y == 998

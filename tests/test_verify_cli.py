@@ -315,3 +315,47 @@ def test_huge_numbers_in_a_scenario_are_refused_at_their_key(tmp_path):
     done = _run_cli("--scenario", scenario)
     assert done.returncode == 2 and "Traceback" not in done.stderr
     assert "robot.point_duration_s: 1e+308 is out of range" in done.stderr
+
+
+def test_a_report_over_one_of_the_run_inputs_is_refused(tmp_path):
+    """--json onto the scenario, --html onto an ST source: the input was replaced."""
+    text = (PLC / "scenarios" / "fx3u-healthy.toml").read_text(encoding="utf-8").replace('"../', f'"{PLC}/')
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(text, encoding="utf-8")
+    done = _run_cli("--scenario", scenario, "--json", scenario)
+    assert done.returncode == 2 and "is one of the run's input files" in done.stderr
+    assert scenario.read_text(encoding="utf-8") == text
+    source = tmp_path / "Main.st"
+    source.write_text("PROGRAM Main\nVAR x : INT; END_VAR\nx := 1;\nEND_PROGRAM\n", encoding="utf-8")
+    done = _run_cli(source, "--html", source)
+    assert done.returncode == 2 and "is one of the run's input files" in done.stderr
+
+
+def test_a_pipe_named_as_source_is_called_what_it_is(tmp_path):
+    fifo = tmp_path / "p.st"
+    os.mkfifo(fifo)
+    done = _run_cli(fifo)
+    assert done.returncode == 2 and "is not a regular file" in done.stderr and "no such file" not in done.stderr
+
+
+def test_a_fault_timed_after_the_end_of_the_run_is_an_error(tmp_path):
+    text = (PLC / "scenarios" / "fx3u-no-reply.toml").read_text(encoding="utf-8").replace('"../', f'"{PLC}/')
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(re.sub(r"at_s = [0-9.]+", "at_s = 500", text, count=1), encoding="utf-8")
+    done = _run_cli("--scenario", scenario)
+    assert done.returncode == 2 and "faults[0].at_s: is at or after the end of the run" in done.stderr
+
+
+def test_junit_stays_well_formed_with_control_characters_in_a_name(tmp_path):
+    import xml.dom.minidom
+
+    text = (PLC / "scenarios" / "fx3u-healthy.toml").read_text(encoding="utf-8").replace('"../', f'"{PLC}/')
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(re.sub(r'^name = ".*"$', r'name = "bad\\u0001name\\u001b[31m"', text, count=1, flags=re.M),
+                        encoding="utf-8")
+    report = tmp_path / "r.xml"
+    done = _run_cli("--scenario", scenario, "--junit", report)
+    assert done.returncode == 0, done.stderr
+    case = xml.dom.minidom.parse(str(report)).getElementsByTagName("testcase")[0]
+    assert case.getAttribute("name") == "bad\\x01name\\x1b[31m"
+    assert "\x1b" not in done.stdout and "bad\\x01name" in done.stdout

@@ -145,3 +145,21 @@ def _array_item(text: str, start: int, index: int) -> int | None:
             count, expecting = count + 1, False
         i += 1
     return None
+
+
+def shown(value) -> str:
+    """A TOML value for messages: `true`/`false` and arrays as the file writes them, a
+    date-time as one, a table as "a table"; text quoted as the other messages quote it."""
+    import datetime
+
+    if isinstance(value, bool):
+        text = "true" if value else "false"
+    elif isinstance(value, (datetime.datetime, datetime.date, datetime.time)):
+        text = f"{value.isoformat()} (a date or time)"
+    elif isinstance(value, dict):
+        text = "a table"
+    elif isinstance(value, list):
+        text = "[" + ", ".join(shown(item) for item in value) + "]"
+    else:
+        text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."

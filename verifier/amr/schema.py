@@ -10,6 +10,8 @@ import math
 from collections.abc import Iterable, Mapping
 from typing import Any
 
+from verifier.tomlpos import shown
+
 
 class ConfigError(ValueError):
     """A bad value in a robot configuration or fault list; ``path`` names the key."""
@@ -118,5 +120,4 @@ def as_int_keyed(value: Any, path: str) -> dict[int, Any]:
 
 
 def _shown(value: Any) -> str:
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
+    return shown(value)

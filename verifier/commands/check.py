@@ -24,14 +24,17 @@ EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
 
 
 def expand_sources(sources: tuple[str, ...]) -> list[Path]:
-    """Files named on the command line; directories give their *.st files (recursive)."""
+    """Files named on the command line; directories give their *.st files (recursive). A
+    file named twice (itself and through its folder) is read once, where first named."""
     paths: list[Path] = []
+    seen: set[Path] = set()
     for s in sources:
         p = Path(s)
-        if p.is_dir():
-            paths.extend(sorted(p.rglob("*.st")))
-        else:
-            paths.append(p)
+        for path in sorted(p.rglob("*.st")) if p.is_dir() else [p]:
+            key = path.resolve()
+            if key not in seen:
+                seen.add(key)
+                paths.append(path)
     return paths
 
 

@@ -69,8 +69,10 @@ class _FiniteFloat(click.ParamType):
             number = float(value)
         except (TypeError, ValueError):
             self.fail(f"{value!r} is not a number", param, ctx)
-        if not math.isfinite(number) or abs(number) > LARGEST:
-            self.fail(f"{value!r} is not a finite number of at most {LARGEST:g}", param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{value!r} is not a finite number", param, ctx)
+        if abs(number) > LARGEST:
+            self.fail(f"{value!r} is out of range (at most {LARGEST:g} either way)", param, ctx)
         return number
 
 

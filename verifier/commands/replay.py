@@ -15,7 +15,7 @@ from rich.console import Console
 
 from verifier.commands.monitor import EXIT_CLEAN, EXIT_FINDINGS, EXIT_UNUSABLE, _finish, line_options, line_timing
 from verifier.commands.protocol_options import protocol_settings
-from verifier.commands.report_files import ReportError, check_folders, report_options
+from verifier.commands.report_files import ReportError, check_folders, check_not_inputs, report_options
 from verifier.monitor.capture import CaptureError, read_capture
 from verifier.monitor.framer import DEFAULT_TOLERANCE_US
 from verifier.monitor.session import CaptureInfo, MonitorSession
@@ -35,10 +35,10 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
         check_folders(json_path, junit_path, trace_path, html_path)
     except ReportError as exc:
         raise click.UsageError(str(exc)) from None
-    inputs = {Path(name).resolve(): name for name in captures}
-    for report in (json_path, junit_path, trace_path, html_path):
-        if report and Path(report).resolve() in inputs:
-            raise click.UsageError(f"{report} is one of the captures to replay: write the report to another file")
+    try:
+        check_not_inputs(captures, json_path, junit_path, trace_path, html_path)
+    except ReportError as exc:
+        raise click.UsageError(str(exc)) from None
     results = []
     for name in captures:
         path = Path(name)

@@ -43,6 +43,15 @@ def check_folders(*paths: str | None) -> None:
         seen[resolved] = path
 
 
+def check_not_inputs(inputs, *paths: str | None) -> None:
+    """Refuse a report that would be written over one of the run's own input files (a
+    scenario, an ST source, a capture): the input would be lost."""
+    resolved = {Path(p).resolve() for p in inputs}
+    for path in paths:
+        if path and Path(path).resolve() in resolved:
+            raise ReportError(f"{path} is one of the run's input files: write the report to another file")
+
+
 def write_reports(results, console: Console, json_path=None, junit_path=None, trace_path=None,
                   html_path=None) -> None:
     from verifier.verify import report_html, report_json, report_junit, report_trace

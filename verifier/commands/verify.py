@@ -15,7 +15,8 @@ from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-from verifier.commands.report_files import ReportError, check_folders, report_options, write_reports
+from verifier.commands.report_files import (ReportError, check_folders, check_not_inputs, report_options,
+                                             write_reports)
 from verifier.verify.durations import format_duration, format_seconds, parse_duration_us
 from verifier.verify.result import ScenarioResult, UnusableInput
 from verifier.bundled import plc_dir as bundled_plc_dir
@@ -307,7 +308,9 @@ def command(sources, program, platform, channel, response_signal, scenario_files
         scenarios = _scenarios(sources, program, platform, channel, scenario_files, matrix, duration, scan, seed)
         if response_signal is not None:
             scenarios = [_with_signal(s, response_signal) for s in scenarios]
-    except (ScenarioError, UnusableInput) as exc:
+        inputs = [p for s in scenarios for p in ([s.path] if s.path else []) + list(s.sources)]
+        check_not_inputs(inputs, json_path, junit_path, trace_path, html_path)
+    except (ScenarioError, UnusableInput, ReportError) as exc:
         _unusable(str(exc))
     stderr = Console(stderr=True)
     progress = _LazyProgress(stderr, sum(s.duration_us for s in scenarios), stderr.is_terminal)

@@ -18,6 +18,8 @@ from verifier.st import types as T
 from verifier.st.devices import looks_like_device
 
 REAL_MAX = 3.4028234663852886e38  # the largest 32-bit float
+# branches of one IF or CASE: the simulator's Python compiler gives up near 3,000
+MAX_BRANCHES = 1000
 
 
 # ----------------------------------------------------------------------------- symbol table
@@ -367,12 +369,18 @@ class Checker:
         elif isinstance(s, ast.CallStmt):
             self.call(s.call, statement=True)
         elif isinstance(s, ast.If):
+            if len(s.branches) > MAX_BRANCHES:
+                self.rep.error(s, f"IF with {len(s.branches) - 1} ELSIF branches: the simulator runs at most "
+                                  f"{MAX_BRANCHES - 1} in one statement; split it into several IF statements")
             for b in s.branches:
                 self._bool_cond(b.cond, "IF condition")
                 self.stmts(b.body)
             if s.else_body is not None:
                 self.stmts(s.else_body)
         elif isinstance(s, ast.Case):
+            if len(s.clauses) > MAX_BRANCHES:
+                self.rep.error(s, f"CASE with {len(s.clauses)} branches: the simulator runs at most "
+                                  f"{MAX_BRANCHES} in one statement; split it into several CASE statements")
             st = self.expr(s.selector)
             if not (T.is_group(st, "int", "int-literal", "any16", "any32", "any")):
                 self.rep.error(s.selector, f"CASE needs an integer selector (INT or DINT), not {st}; "

@@ -45,6 +45,10 @@ def _event_class(kind: str) -> str:
     return "info"
 
 
+# a 10 h run has 3,600 ten-second ticks; a capture with a gap of years would have millions
+MAJOR_TICKS_AT_MOST = 5000
+
+
 def scenario_view(index: int, result: ScenarioResult) -> dict:
     frames = list(records(result))
     end_ms = max(
@@ -71,6 +75,8 @@ def scenario_view(index: int, result: ScenarioResult) -> dict:
         for v in result.all_violations()
     ]
     major_ms = 1000 if end_ms <= 300_000 else 10_000
+    while end_ms / major_ms > MAJOR_TICKS_AT_MOST:  # a capture spanning days or years
+        major_ms *= 10
     ticks = [{"t": t, "label": f"{t / 1000:g} s"} for t in range(0, int(end_ms) + 1, major_ms)]
     minor = []
     if end_ms <= MINOR_TICKS_UP_TO_MS:

@@ -5,6 +5,7 @@ failed expectation (type = "expectation"); an <error> when the simulation stoppe
 """
 from __future__ import annotations
 
+import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -86,7 +87,25 @@ def to_element(results: list[ScenarioResult]) -> ET.Element:
     return suites
 
 
+# characters XML 1.0 cannot hold at all, not even escaped (control characters, surrogates)
+_NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
+
+
+def _xml_safe(text: str | None) -> str | None:
+    """`text` with each character XML cannot hold written as \\xNN / \\uNNNN (a scenario
+    name or message with a control character made the file unreadable for CI tools)."""
+    if text is None or not _NOT_XML.search(text):
+        return text
+    return _NOT_XML.sub(lambda m: f"\\x{ord(m.group()):02x}" if ord(m.group()) < 0x100
+                        else f"\\u{ord(m.group()):04x}", text)
+
+
 def write(results: list[ScenarioResult], path: Path) -> None:
-    tree = ET.ElementTree(to_element(results))
+    root = to_element(results)
+    for element in root.iter():
+        element.text, element.tail = _xml_safe(element.text), _xml_safe(element.tail)
+        for name, value in element.attrib.items():
+            element.set(name, _xml_safe(value))
+    tree = ET.ElementTree(root)
     ET.indent(tree)
     tree.write(path, encoding="utf-8", xml_declaration=True)

@@ -17,7 +17,7 @@ from verifier.amr.config import RobotConfig
 from verifier.amr.faults import Fault, check_fault_addresses
 from verifier.amr.schema import ConfigError
 from verifier.textfile import UnreadableText, read_utf8
-from verifier.tomlpos import Place, decode_error_position, place_of_key
+from verifier.tomlpos import Place, decode_error_position, place_of_key, shown
 
 from verifier.link.converter import ConverterConfig
 
@@ -368,6 +368,10 @@ class _Reader:
             check_fault_addresses(faults, settings.address)
         except ConfigError as exc:
             raise self.fail(exc.path, exc.message) from None
+        for i, fault in enumerate(faults):
+            if fault.at_s is not None and fault.at_s * 1_000_000 >= duration:
+                raise self.fail(f"faults[{i}].at_s", f"is at or after the end of the run "
+                                                     f"({format_duration(duration)}): the fault would never happen")
         inputs = tuple(
             self.input_step(item, f"inputs[{i}]", duration)
             for i, item in enumerate(self.array_of_tables(data.get("inputs", []), "inputs"))
@@ -601,5 +605,4 @@ class _Reader:
 
 
 def _shown(value: Any) -> str:
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
+    return shown(value)

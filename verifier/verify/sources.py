@@ -33,6 +33,8 @@ def expand(name: str, base: Path) -> list[Path]:
             raise SourceError(f"the folder {path} holds no .st file")
         return files
     if not path.is_file():
+        if path.exists():
+            raise SourceError(f"{path} is not a regular file (a pipe, socket or device); give .st files")
         raise SourceError(f"no such file or folder: {path}")
     return [path]
 
