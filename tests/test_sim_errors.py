@@ -100,3 +100,38 @@ def test_load_reads_files_as_check_does(tmp_path):
     with pytest.raises(LoadError) as err:
         verifier.load(str(bad))
     assert str(expected) in str(err.value) and "bad.st:2:4" in str(err.value)
+
+
+FB_T = ("FUNCTION_BLOCK FB_T\nVAR_INPUT i_nVal : INT; i_rVal : REAL; i_aArr : ARRAY[0..3] OF INT; END_VAR\n"
+        "END_FUNCTION_BLOCK\nPROGRAM Main\nVAR x : INT; END_VAR\nx := x + 1;\nEND_PROGRAM\n")
+
+
+@pytest.mark.parametrize("how", [
+    {}, {"scans": -1}, {"scans": 1.5}, {"scans": "3"}, {"ms": float("nan")}, {"ms": -5}, {"until_us": 2.5},
+])
+def test_a_run_that_would_never_end_or_makes_no_sense_is_refused(how):
+    """run_programs() with no limit, or scans=-1 / 1.5, looped for ever (a hung test)."""
+    project = verifier.sim.load(sources={"t.st": FB_T})
+    with pytest.raises(ValueError, match="ms=|scans must|ms must|until_us must"):
+        project.run_programs(["Main"], **how)
+    with pytest.raises(ValueError):  # Instance.run takes ms and scans (no until_us)
+        project.instance("FB_T").run(**{k: v for k, v in how.items() if k != "until_us"})
+    project.run_programs(["Main"], scans=2)
+    project.run_programs(["Main"], ms=0)
+    assert project.program("Main").x == 2
+
+
+@pytest.mark.parametrize("label, value, message", [
+    ("i_nVal", None, "FB_T.i_nVal is INT; give a whole number, got None"),
+    ("i_nVal", "12", "FB_T.i_nVal is INT; give a whole number, got '12'"),
+    ("i_rVal", "x", "FB_T.i_rVal is REAL; give a finite number, got 'x'"),
+    ("i_rVal", float("inf"), "FB_T.i_rVal is REAL; give a finite number, got inf"),
+    ("i_aArr", 5, "FB_T.i_aArr is an array of 4; give a list of values, got 5"),
+    ("i_aArr", {1: 2}, "FB_T.i_aArr is an array of 4; give a list of values"),
+    ("i_aArr", ["a"], "FB_T.i_aArr[0] is INT; give a whole number, got 'a'"),
+])
+def test_a_label_set_from_python_with_the_wrong_kind_says_which_and_what(label, value, message):
+    fb = verifier.sim.load(sources={"t.st": FB_T}).instance("FB_T")
+    with pytest.raises(ValueError) as caught:
+        setattr(fb, label, value)
+    assert str(caught.value).startswith(message)

@@ -2,6 +2,7 @@
 scan by scan in virtual time, attach serial endpoints.  See docs/testing-st.md."""
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 from typing import Callable, Iterable
@@ -220,6 +221,11 @@ class Project:
                 self.before_scan.remove(on_scan)
 
     def _run(self, bodies, stop_us, scans) -> None:
+        if scans is not None and (isinstance(scans, bool) or not isinstance(scans, int) or scans < 0):
+            raise ValueError(f"scans must be a whole number of scans, 0 or more; got {scans!r}")
+        if scans is None and stop_us is None:
+            raise ValueError("say how long to run: ms=..., scans=... or until_us=... (with none the "
+                             "run would never end)")
         rt = self.rt
         begin, end = rt.begin_scan, rt.end_scan
         before, after = self.before_scan, self.after_scan
@@ -421,7 +427,11 @@ class Instance(InstanceProxy):
 
 def _stop_time(now: int, ms, until_us):
     if ms is not None:
+        if isinstance(ms, bool) or not isinstance(ms, (int, float)) or not math.isfinite(ms) or ms < 0:
+            raise ValueError(f"ms must be a finite number of milliseconds, 0 or more; got {ms!r}")
         return now + round(ms * 1000)
+    if until_us is not None and (isinstance(until_us, bool) or not isinstance(until_us, int)):
+        raise ValueError(f"until_us must be a whole number of microseconds; got {until_us!r}")
     return until_us
 
 

@@ -4,6 +4,9 @@ values (with the same normalisation the generated code applies)."""
 from __future__ import annotations
 
 import keyword
+import math
+import numbers
+import operator
 from typing import Callable
 
 from . import datatypes
@@ -24,14 +27,22 @@ def to_st(t, value, label: str, make_default=None):
         if isinstance(value, bool):
             raise ValueError(f"{label} is {t}; got a bool")
         if t in ("REAL", "LREAL"):
+            if not isinstance(value, numbers.Real) or not math.isfinite(value):
+                raise ValueError(f"{label} is {t}; give a finite number, got {value!r}")
             return datatypes.NORMALIZERS[t](float(value))
         if isinstance(value, float):
             raise ValueError(f"{label} is {t}; got the float {value!r}")
-        return datatypes.NORMALIZERS[t](int(value))
+        try:
+            whole = operator.index(value)  # int, or an integer type such as numpy's
+        except TypeError:
+            raise ValueError(f"{label} is {t}; give a whole number, got {value!r}") from None
+        return datatypes.NORMALIZERS[t](whole)
     raise ValueError(f"{label} ({t}) cannot be set from {value!r}")
 
 
 def to_st_list(t: ArrayT, values, label: str, default) -> list:
+    if isinstance(values, (str, bytes, dict)) or not hasattr(values, "__iter__"):
+        raise ValueError(f"{label} is an array of {t.size}; give a list of values, got {values!r}")
     values = list(values)
     if len(values) > t.size:
         raise ValueError(f"{label} has {t.size} elements; got {len(values)} values")
