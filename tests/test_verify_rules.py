@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import pytest
 from hypothesis import given, settings as hsettings, strategies as st
 
 from verifier import protocol
@@ -137,6 +138,15 @@ def test_format_flags_a_wrong_quantity_and_an_unknown_query():
     query = protocol.with_crc(bytes.fromhex("010100070016"))
     found = check([tx(0, quantity), tx(300, query)])
     assert len(found["UITAMR-FORMAT"]) == 2
+
+
+@pytest.mark.parametrize("fragment", ["01 06 01", "01 01 00"])
+def test_a_three_byte_fragment_is_too_short_not_an_invented_function_code(fragment):
+    """Taking the last two bytes as a CRC left the address alone and put the made-up CRC's
+    low byte where the function code goes ('unknown function code 0x7E')."""
+    (violation,) = check([tx(0, bytes.fromhex(fragment))])["UITAMR-FORMAT"]
+    assert violation.message.startswith("byte 3: too short for an FC0")
+    assert "0x7E" not in violation.message
 
 
 def test_format_flags_another_slave_address():

@@ -69,7 +69,7 @@ def check_format(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
 def _layout_problem(data: bytes, settings: protocol.Settings) -> str | None:
     """What is wrong with the layout of request `data` (its CRC taken as right), or None;
     worked out once per distinct frame."""
-    if len(data) >= 3 and not protocol.crc_ok(data):
+    if len(data) >= 4 and not protocol.crc_ok(data):  # address, function code and the CRC at least
         data = protocol.with_crc(data[:-2])
     try:
         request = protocol.decode_request(data, settings)
