@@ -309,6 +309,28 @@ def test_tcp_serves_two_clients_on_one_robot(start_emulator):
     assert emulator.stop()[0] == 0
 
 
+def test_tcp_answers_a_client_that_shut_its_sending_side(start_emulator):
+    """A client may send its request and shut its side (SHUT_WR): the reply is still owed
+    and was dropped with the connection ("1 reply not sent")."""
+    emulator, port = tcp_emulator(start_emulator)
+    with socket.create_connection(("127.0.0.1", port), timeout=5) as sock:
+        sock.sendall(STOP_FRAME)
+        sock.shutdown(socket.SHUT_WR)
+        got = b""
+        while chunk := sock.recv(64):
+            got += chunk
+    assert got == STOP_FRAME  # then the emulator closed its side
+    emulator.wait_for(r"client 127\.0\.0\.1:\d+ disconnected")
+    code, summary = emulator.stop()
+    assert code == 0 and "1 replies out" in summary and "not sent" not in summary
+
+
+def test_quiet_still_says_which_port_it_listens_on(start_emulator):
+    emulator = start_emulator("--tcp", "0", "--quiet")
+    assert re.search(r"listening on tcp 127\.0\.0\.1:\d+", "".join(emulator.lines))
+    assert emulator.stop()[0] == 0
+
+
 # ---- the command's own errors ------------------------------------------------------------------
 
 def run_cli(*args: str) -> subprocess.CompletedProcess:

@@ -229,7 +229,10 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
         if endpoint is None:
             serve_serial(serial_url, emulator, stop, silence_us, baud)
         else:
-            serve_tcp(endpoint[0], endpoint[1], emulator, stop, silence_us)
+            # with --quiet the live log is off, but a client needs the port (port 0 = any)
+            shown = (lambda host, port: (click.echo(f"listening on tcp {host}:{port}"), sys.stdout.flush())
+                     ) if quiet else None
+            serve_tcp(endpoint[0], endpoint[1], emulator, stop, silence_us, on_listening=shown)
     except PortError as err:
         click.echo(emulator.summary())
         raise click.ClickException(str(err)) from None

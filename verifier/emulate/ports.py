@@ -29,6 +29,10 @@ from verifier.protocol.codec import hex_bytes
 POLL_S = 0.005  # longest wait between looks at the clock (reply and silence deadlines)
 
 
+# how long replies still owed to a peer that shut its sending side are waited for
+END_GRACE_US = 2_000_000
+
+
 class PortError(RuntimeError):
     """A port that cannot be opened or failed while in use (message for the user)."""
 
@@ -40,6 +44,23 @@ class _Channel:
     assembler: RequestAssembler
     peer: str = ""
     outgoing: list[Outgoing] = field(default_factory=list)
+    ended_us: int | None = None  # when the peer closed its sending side (replies still owed)
+    unread_at_end: bytes = b""  # a request it had not finished when it did
+
+    @property
+    def ended(self) -> bool:
+        return self.ended_us is not None
+
+    def end(self, now_us: int) -> None:
+        """The peer shut its sending side: no more bytes come, so a part of a request is
+        dropped now; the replies already owed are still sent (`finished` says when done)."""
+        self.ended_us = now_us
+        self.unread_at_end = self.assembler.discard()
+
+    def finished(self, now_us: int) -> bool:
+        """Ended, and every reply sent - or the grace for them over (a peer that closed
+        altogether looks the same as one that only shut its sending side)."""
+        return self.ended_us is not None and (not self.outgoing or now_us - self.ended_us >= END_GRACE_US)
 
     def take(self, emulator: Emulator, items) -> None:
         for item in items:
@@ -50,7 +71,7 @@ class _Channel:
 
     def close(self) -> str:
         """Forget what is still in flight; the words for the log, '' when nothing was."""
-        unread = self.assembler.discard()
+        unread = self.unread_at_end + self.assembler.discard()
         lost = []
         if unread:
             lost.append(f"{len(unread)} received byte{'s' if len(unread) != 1 else ''} that were not yet "
@@ -132,7 +153,8 @@ def serve_tcp(host: str, port: int, emulator: Emulator, stop: threading.Event, s
 
     def drop(sock: socket.socket, why: str) -> None:
         channel = clients.pop(sock)
-        selector.unregister(sock)
+        if not channel.ended:  # an ended one is no longer watched for reading
+            selector.unregister(sock)
         sock.close()
         emulator.note(f"client {channel.peer} {why}{channel.close()}")
 
@@ -159,8 +181,12 @@ def serve_tcp(host: str, port: int, emulator: Emulator, stop: threading.Event, s
                 except OSError as err:
                     drop(sock, f"lost: {err}")
                     continue
-                if not data:
-                    drop(sock, "disconnected")
+                if not data:  # the peer shut its side: what it sent is still answered
+                    channel = clients[sock]
+                    channel.end(emulator.now_us())
+                    selector.unregister(sock)
+                    if not channel.outgoing:
+                        drop(sock, "disconnected")
                     continue
                 channel = clients[sock]
                 channel.take(emulator, channel.assembler.feed(data, emulator.now_us()))
@@ -176,6 +202,9 @@ def serve_tcp(host: str, port: int, emulator: Emulator, stop: threading.Event, s
                         drop(sock, f"lost while writing: {err}")
                         break
                     emulator.sent(reply, emulator.now_us(), channel.peer)
+            for sock, channel in list(clients.items()):
+                if channel.finished(emulator.now_us()):
+                    drop(sock, "disconnected")
     finally:
         for sock in list(clients):
             sock.close()
