@@ -135,3 +135,16 @@ def test_a_label_set_from_python_with_the_wrong_kind_says_which_and_what(label, 
     with pytest.raises(ValueError) as caught:
         setattr(fb, label, value)
     assert str(caught.value).startswith(message)
+
+
+def test_api_calls_in_the_wrong_shape_say_the_right_shape():
+    with pytest.raises(TypeError, match=r"load\(\) takes the files as separate arguments"):
+        verifier.sim.load(["a.st"])
+    with pytest.raises(TypeError, match="sources maps file names to ST text"):
+        verifier.sim.load(sources=["x"])
+    project = verifier.sim.load(sources={"t.st": FB_T})
+    with pytest.raises(TypeError, match=r"run_programs takes a list of PROGRAM names: run_programs\(\['Main'\]"):
+        project.run_programs("Main", scans=1)
+    with pytest.raises(KeyError, match="no POU named 'NOPE' and not a device; the POUs are FB_T, Main"):
+        project.get("NOPE.x")
+    assert project.get("D100.5") is False and project.get("Main.x") == 0

@@ -31,7 +31,12 @@ def load(*paths, target: str = "gxworks2", cpu: str | None = None, scan_ms: floa
     ("fx3u", "fx3g", "fx5u", "q").  Raises LoadError listing file:line:col diagnostics."""
     texts: dict[str, str] = {}
     problems = []
+    if sources is not None and not isinstance(sources, dict):
+        raise TypeError(f"sources maps file names to ST text, e.g. {{'main.st': 'PROGRAM ...'}}; got {sources!r:.60}")
     for p in paths:
+        if not isinstance(p, (str, Path)):
+            raise TypeError(f"load() takes the files as separate arguments: load('a.st', 'b.st'), "
+                            f"or load(*files); got {p!r:.60}")
         path = Path(p)
         files = sorted(path.glob("*.st")) if path.is_dir() else [path]
         for f in files:
@@ -193,7 +198,13 @@ class Project:
         elif head.upper() in self.module.pous:
             obj = self.program(head)
         else:
-            return self.devices[path]
+            try:
+                return self.devices[path]  # a device: "D100", or a bit of a word "D100.5"
+            except (KeyError, ValueError):
+                if not rest:
+                    raise
+            raise KeyError(f"{path!r}: no POU named {head!r} and not a device; the POUs are "
+                           f"{', '.join(sorted(self.pou_names()))}") from None
         for part in rest.split(".") if rest else []:
             obj = getattr(obj, part)
         return obj
@@ -207,6 +218,8 @@ class Project:
         """Run PROGRAMs in the given order, one scan after another: for `ms` of virtual
         time, or `scans` scans, or until virtual time `until_us`.  `on_scan(project)` runs
         at the start of every scan, before the programs (set inputs, sample labels)."""
+        if isinstance(names, str):
+            raise TypeError(f"run_programs takes a list of PROGRAM names: run_programs([{names!r}], ...)")
         bodies = [self._program_obj(self._pou(n).key)._body for n in names]
         for n in names:
             if self._pou(n).kind != "PROGRAM":
