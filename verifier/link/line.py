@@ -242,11 +242,8 @@ class Line:
         """`trace`, for a caller done with the line: the line lets go of its frames (an hour
         of traffic is tens of thousands of them, not to be held twice); later frames are
         recorded afresh."""
-        frames = [TraceFrame(f.start, f.end, TX, bytes(f.data), f.origin) for f in self._tx_frames]
-        self._tx_frames = []
-        frames += self._rx_frames
-        self._rx_frames = []
-        frames.sort(key=lambda f: (f.t_start_us, f.direction == RX))
+        frames = self.trace
+        self._tx_frames, self._rx_frames = [], []
         return frames
 
     @property

@@ -69,16 +69,24 @@ def _decoded_request(data: bytes, settings: protocol.Settings):
 
 
 @lru_cache(maxsize=4096)
+def _decoded_reply(data: bytes, settings: protocol.Settings, request):
+    """`data` decoded as a reply to `request`, or the FrameError saying why it is not one."""
+    try:
+        return protocol.decode_reply(data, settings, request)
+    except protocol.FrameError as exc:
+        return exc
+
+
+@lru_cache(maxsize=4096)
 def _reply_verdict(data: bytes, settings: protocol.Settings, request) -> tuple[ReplyStatus, str]:
     """The status of an in-time reply `data` to `request` (the decoded request or None)."""
     if data and data[0] != settings.address:
         return ReplyStatus.WRONG_ADDRESS, f"reply from address {data[0]}, not {settings.address}"
     if not protocol.crc_ok(data):
         return ReplyStatus.BAD_CRC, "reply CRC does not match"
-    try:
-        decoded = protocol.decode_reply(data, settings, request)
-    except protocol.FrameError as exc:
-        return ReplyStatus.GARBLED, str(exc)
+    decoded = _decoded_reply(data, settings, request)
+    if isinstance(decoded, protocol.FrameError):
+        return ReplyStatus.GARBLED, str(decoded)
     if isinstance(decoded, protocol.ExceptionReply):
         return ReplyStatus.EXCEPTION, protocol.describe(decoded, settings)
     return ReplyStatus.OK, "ok"
@@ -190,18 +198,7 @@ def _is_reply_to(frame: TraceFrameLike, exchange: Exchange) -> bool:
     request = exchange.decoded_request
     if request is None:
         return False
-    return _decodes_as_reply(bytes(frame.data), exchange.settings, request)
-
-
-@lru_cache(maxsize=4096)
-def _decodes_as_reply(data: bytes, settings: protocol.Settings, request) -> bool:
-    """Whether `data` decodes as a reply to `request` (worked out once per distinct frame:
-    a status poll and its reply repeat thousands of times in a long run)."""
-    try:
-        protocol.decode_reply(data, settings, request)
-    except protocol.FrameError:
-        return False
-    return True
+    return not isinstance(_decoded_reply(bytes(frame.data), exchange.settings, request), protocol.FrameError)
 
 
 def converter_drops(events) -> list[int]:
