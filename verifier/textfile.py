@@ -1,5 +1,6 @@
-"""Reading the UTF-8 text files the tool takes (captures, fault files, scenarios), with
-one wording for what went wrong: the caller puts it in its own error with the file name."""
+"""Reading the text files the tool takes (captures, fault files, scenarios; ST files go
+through verifier.st.source, which shares the helpers below), with one wording for what
+went wrong: the caller puts it in its own error with the file name."""
 from __future__ import annotations
 
 import stat
@@ -26,7 +27,7 @@ def read_utf8(path: Path) -> str:
         if stat.S_ISDIR(mode):
             raise UnreadableText("cannot read: it is a folder, not a file")
         if not stat.S_ISREG(mode):
-            raise UnreadableText("cannot read: not a regular file (a pipe, socket or device)")
+            raise UnreadableText(f"cannot read: not a regular file ({file_kind(mode)})")
         data = path.read_bytes()
     except OSError as exc:
         raise UnreadableText(f"cannot read: {exc.strerror or exc}") from None
@@ -34,8 +35,27 @@ def read_utf8(path: Path) -> str:
     try:
         return data[start:].decode("utf-8")
     except UnicodeDecodeError as exc:
-        before = data[start:start + exc.start].decode("utf-8")
-        line = before.count("\n") + 1
-        col = len(before) - (before.rfind("\n") + 1) + 1
-        raise UnreadableText(f"line {line}, column {col} (byte {start + exc.start}): not UTF-8 text",
-                             line, col, start + exc.start) from None
+        bad = start + exc.start
+        line, col = place_of_byte(data, bad)
+        raise UnreadableText(f"line {line}, column {col} (byte {bad}): not UTF-8 text", line, col, bad) from None
+
+
+def place_of_byte(data: bytes, offset: int) -> tuple[int, int]:
+    """The line and column (1-based) at which byte `offset` of a file's `data` stands, the
+    text before it read as UTF-8 (a leading byte order mark is not a column)."""
+    start = len(BOM) if data.startswith(BOM) else 0
+    before = data[start:offset].decode("utf-8", errors="replace")
+    return before.count("\n") + 1, len(before) - (before.rfind("\n") + 1) + 1
+
+
+def file_kind(mode: int) -> str:
+    """What a path that is not a regular file is, from its `stat` mode, for messages."""
+    if stat.S_ISCHR(mode):
+        return "a character device"
+    if stat.S_ISBLK(mode):
+        return "a block device"
+    if stat.S_ISFIFO(mode):
+        return "a pipe"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    return "not a file"

@@ -12,6 +12,7 @@ import stat
 from pathlib import Path
 
 from verifier.st.ast import Diagnostic
+from verifier.textfile import file_kind, place_of_byte
 
 ENCODINGS = ("utf-8-sig", "cp932")
 #: Python's cp932 decodes these single bytes to control or private-use characters that
@@ -34,7 +35,7 @@ def read_source(path: str | Path) -> tuple[str, list[Diagnostic]]:
     if stat.S_ISDIR(mode):
         return "", [_error(name, 0, 0, "is a folder; give .st files (or the folder to check/export/load)")]
     if not stat.S_ISREG(mode):
-        return "", [_error(name, 0, 0, f"is not a regular file ({_kind(mode)}); give a .st file")]
+        return "", [_error(name, 0, 0, f"is not a regular file ({file_kind(mode)}); give a .st file")]
     try:
         data = p.read_bytes()
     except OSError as e:
@@ -54,10 +55,7 @@ def decode_source(data: bytes, name: str = "<bytes>") -> tuple[str, list[Diagnos
         text = None
     if text is not None and not _NOT_SHIFT_JIS.intersection(text):
         return text, []
-    start = 3 if data.startswith(b"\xef\xbb\xbf") else 0
-    prefix = data[start:bad].decode("utf-8", errors="replace")
-    line = prefix.count("\n") + 1
-    col = len(prefix) - (prefix.rfind("\n") + 1) + 1
+    line, col = place_of_byte(data, bad)
     return "", [_error(name, line, col,
                        f"byte 0x{data[bad]:02X} at offset {bad} is neither UTF-8 nor Shift-JIS text; "
                        "save the file as UTF-8")]
@@ -65,15 +63,3 @@ def decode_source(data: bytes, name: str = "<bytes>") -> tuple[str, list[Diagnos
 
 def _error(name: str, line: int, col: int, message: str) -> Diagnostic:
     return Diagnostic(name, line, col, "error", message)
-
-
-def _kind(mode: int) -> str:
-    if stat.S_ISCHR(mode):
-        return "a character device"
-    if stat.S_ISBLK(mode):
-        return "a block device"
-    if stat.S_ISFIFO(mode):
-        return "a pipe"
-    if stat.S_ISSOCK(mode):
-        return "a socket"
-    return "not a file"

@@ -5,6 +5,8 @@ from __future__ import annotations
 import glob
 from pathlib import Path
 
+from verifier.textfile import file_kind
+
 GLOB_CHARACTERS = "*?["
 
 
@@ -34,7 +36,7 @@ def expand(name: str, base: Path) -> list[Path]:
         return files
     if not path.is_file():
         if path.exists():
-            raise SourceError(f"{path} is not a regular file (a pipe, socket or device); give .st files")
+            raise SourceError(f"{path} is not a regular file ({file_kind(path.stat().st_mode)}); give .st files")
         raise SourceError(f"no such file or folder: {path}")
     return [path]
 
