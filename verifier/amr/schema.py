@@ -31,7 +31,7 @@ def join(path: str, key: str | int) -> str:
 
 def require_mapping(value: Any, path: str) -> Mapping[str, Any]:
     if not isinstance(value, Mapping):
-        raise ConfigError(path, f"expected a table of keys, got {_shown(value)}")
+        raise ConfigError(path, f"expected a table of keys, got {shown(value)}")
     return value
 
 
@@ -52,7 +52,7 @@ def as_number(value: Any, path: str, *, minimum: float | None = None,
               maximum: float | None = None, strictly_positive: bool = False) -> float:
     """A finite int or float (not a bool) within the given bounds (and within +-1e9)."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ConfigError(path, f"expected a number, got {_shown(value)}")
+        raise ConfigError(path, f"expected a number, got {shown(value)}")
     if abs(value) > LARGEST:
         raise ConfigError(path, f"{value:g} is out of range (at most {LARGEST:g} either way)")
     if strictly_positive and value <= 0:
@@ -68,7 +68,7 @@ def as_int(value: Any, path: str, *, minimum: int | None = None,
            maximum: int | None = None) -> int:
     """An integer (not a bool) within the given bounds."""
     if isinstance(value, bool) or not isinstance(value, int):
-        raise ConfigError(path, f"expected a whole number, got {_shown(value)}")
+        raise ConfigError(path, f"expected a whole number, got {shown(value)}")
     if minimum is not None and value < minimum:
         raise ConfigError(path, f"must be at least {minimum}, got {value}")
     if maximum is not None and value > maximum:
@@ -78,14 +78,14 @@ def as_int(value: Any, path: str, *, minimum: int | None = None,
 
 def as_bool(value: Any, path: str) -> bool:
     if not isinstance(value, bool):
-        raise ConfigError(path, f"expected true or false, got {_shown(value)}")
+        raise ConfigError(path, f"expected true or false, got {shown(value)}")
     return value
 
 
 def as_choice(value: Any, path: str, choices: Iterable[str], what: str = "value") -> str:
     choices = list(choices)
     if not isinstance(value, str) or value not in choices:
-        raise ConfigError(path, f"unknown {what} {_shown(value)}; expected one of {', '.join(choices)}")
+        raise ConfigError(path, f"unknown {what} {shown(value)}; expected one of {', '.join(choices)}")
     return value
 
 
@@ -96,11 +96,11 @@ def as_hex_bytes(value: Any, path: str) -> bytes:
         try:
             data = bytes.fromhex(text)
         except ValueError:
-            raise ConfigError(path, f"expected hex bytes like \"A5 5A FF\", got {_shown(value)}") from None
+            raise ConfigError(path, f"expected hex bytes like \"A5 5A FF\", got {shown(value)}") from None
     elif isinstance(value, list):
         data = bytes(as_int(v, join(path, i), minimum=0, maximum=255) for i, v in enumerate(value))
     else:
-        raise ConfigError(path, f"expected hex bytes like \"A5 5A FF\", got {_shown(value)}")
+        raise ConfigError(path, f"expected hex bytes like \"A5 5A FF\", got {shown(value)}")
     if not data:
         raise ConfigError(path, "needs at least one byte")
     return data
@@ -118,6 +118,3 @@ def as_int_keyed(value: Any, path: str) -> dict[int, Any]:
         result[number] = item
     return result
 
-
-def _shown(value: Any) -> str:
-    return shown(value)

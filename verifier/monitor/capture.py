@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from verifier import protocol
+from verifier.amr.schema import LARGEST  # the largest number of seconds any setting holds
 from verifier.textfile import UnreadableText, read_utf8
 
 
@@ -122,15 +123,14 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
 
 
 _HEX_BYTES = re.compile(r"\s*(?:[0-9A-Fa-f]{2}\s*)*")
-_LATEST_S = 1e9  # a time in seconds beyond this is not a capture's (and overflows microseconds)
 
 
 def _seconds(value, key: str, where: str) -> float:
     """A trace record's time in seconds: a finite number (not true/false), not negative."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
-            or not 0 <= value <= _LATEST_S:
+            or not 0 <= value <= LARGEST:
         raise CaptureError(f"{where}: {key!r} is {json.dumps(value)}; expected a time in seconds "
-                           f"from 0 to {_LATEST_S:g}")
+                           f"from 0 to {LARGEST:g}")
     return float(value)
 
 

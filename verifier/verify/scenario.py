@@ -286,12 +286,12 @@ class _Reader:
 
     def table(self, value: Any, key: str) -> dict:
         if not isinstance(value, dict):
-            raise self.fail(key, f"expected a table, got {_shown(value)}")
+            raise self.fail(key, f"expected a table, got {shown(value)}")
         return value
 
     def array_of_tables(self, value: Any, key: str) -> list[dict]:
         if not isinstance(value, list) or not all(isinstance(item, dict) for item in value):
-            raise self.fail(key, f"expected an array of tables ([[{key}]]), got {_shown(value)}")
+            raise self.fail(key, f"expected an array of tables ([[{key}]]), got {shown(value)}")
         return value
 
     def only(self, data: dict, allowed: tuple[str, ...], key: str) -> None:
@@ -302,7 +302,7 @@ class _Reader:
 
     def string(self, value: Any, key: str) -> str:
         if not isinstance(value, str):
-            raise self.fail(key, f"expected a string, got {_shown(value)}")
+            raise self.fail(key, f"expected a string, got {shown(value)}")
         return value
 
     def duration(self, value: Any, key: str, *, positive: bool = True) -> int:
@@ -356,7 +356,7 @@ class _Reader:
             raise self.fail("scan_jitter", "must be shorter than the scan time")
         seed = data.get("seed", 0)
         if isinstance(seed, bool) or not isinstance(seed, int):
-            raise self.fail("seed", f"expected a whole number, got {_shown(seed)}")
+            raise self.fail("seed", f"expected a whole number, got {shown(seed)}")
         watch = data.get("watch", [])
         if not isinstance(watch, list):
             raise self.fail("watch", "expected a list of label paths")
@@ -425,7 +425,7 @@ class _Reader:
         if "port" in item:
             port = item["port"]
             if isinstance(port, bool) or not isinstance(port, int) or not 1 <= port <= 65535:
-                raise self.fail("converter.port", f"expected a TCP port 1..65535, got {_shown(port)}")
+                raise self.fail("converter.port", f"expected a TCP port 1..65535, got {shown(port)}")
             changes["port"] = port
         for key, attr in (("delay", "delay_us"), ("connect", "connect_us"), ("packing", "pack_us"),
                           ("refuse_until", "refuse_until_us"), ("unreachable", "unreachable_us"),
@@ -441,7 +441,7 @@ class _Reader:
                                      for i, t in enumerate(drops))
         if "split_reply" in item:
             if not isinstance(item["split_reply"], bool):
-                raise self.fail("converter.split_reply", f"expected true or false, got {_shown(item['split_reply'])}")
+                raise self.fail("converter.split_reply", f"expected true or false, got {shown(item['split_reply'])}")
             changes["split_reply"] = item["split_reply"]
         return replace(config, **changes)
 
@@ -459,7 +459,7 @@ class _Reader:
             if isinstance(item, bool) and match:
                 raise self.fail(key, "buffer memory holds words: give a number")
             if not isinstance(item, (bool, int)) or (match and not -0x8000 <= item <= 0xFFFF):
-                raise self.fail(key, f"expected true/false or a whole number (a word: -32768..65535), got {_shown(item)}")
+                raise self.fail(key, f"expected true/false or a whole number (a word: -32768..65535), got {shown(item)}")
             result.append((name, item))
         return tuple(result)
 
@@ -472,14 +472,14 @@ class _Reader:
                 return None
             value = item[name]
             if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
-                raise self.fail(f"{key}.{name}", f"expected a whole number {low}..{high}, got {_shown(value)}")
+                raise self.fail(f"{key}.{name}", f"expected a whole number {low}..{high}, got {shown(value)}")
             return value
         unit = whole("unit", 0, 0xFF)
         channel = whole("channel", 1, 2)
         no_reception = self.duration(item["no_reception"], f"{key}.no_reception") if "no_reception" in item else None
         byte_units = item.get("byte_units")
         if byte_units is not None and not isinstance(byte_units, bool):
-            raise self.fail(f"{key}.byte_units", f"expected true (bytes) or false (words), got {_shown(byte_units)}")
+            raise self.fail(f"{key}.byte_units", f"expected true (bytes) or false (words), got {shown(byte_units)}")
         end_code = item.get("end_code")
         if end_code == "none":
             end_code = 0xFFFF
@@ -546,7 +546,7 @@ class _Reader:
             if isinstance(value, (bool, int, float)):
                 checked[name] = value
             else:
-                raise self.fail(f"{key}.set.{name}", f"expected true/false or a number, got {_shown(value)}")
+                raise self.fail(f"{key}.set.{name}", f"expected true/false or a number, got {shown(value)}")
         pulse = self.duration(item["pulse"], f"{key}.pulse") if "pulse" in item else None
         if pulse is not None and not any(isinstance(v, bool) for v in checked.values()):
             raise self.fail(f"{key}.pulse", "a pulse sets BOOL labels back after a while; this input sets no BOOL")
@@ -574,7 +574,7 @@ class _Reader:
             what = f"sent {words}"
         else:
             if isinstance(value, bool) or not isinstance(value, int) or value not in range(1, 22):
-                raise self.fail(f"{key}.reached_point", f"expected a point number 1-21, got {_shown(value)}")
+                raise self.fail(f"{key}.reached_point", f"expected a point number 1-21, got {shown(value)}")
             fields["point"] = value
             what = f"robot reached point {value}"
         expectation = Expectation(kind=kind, label="", after_us=after, within_us=within, key=key, **fields)
@@ -603,6 +603,3 @@ class _Reader:
             )
         return options, "signal" in response
 
-
-def _shown(value: Any) -> str:
-    return shown(value)
