@@ -41,6 +41,7 @@ def command(sources: tuple[str, ...], target: str, out_dir: str) -> None:
     With no SOURCES: the bundled library (plc/core, the ports and the examples of the
     target editor's platforms)."""
     from verifier.export import ExportError, NothingToExport, export_sources
+    from verifier.export.writer import DROPPED_TABLE, IMPORT_ORDER
 
     if sources:
         missing = [s for s in sources if not Path(s).exists()]
@@ -84,7 +85,7 @@ def command(sources: tuple[str, ...], target: str, out_dir: str) -> None:
         click.echo(str(note), err=True)
     pous = sum(1 for p in written if p.suffix == ".st")
     click.echo(f"{pous} POU(s) exported for {target} into {out_dir} (import order: "
-               f"{Path(out_dir) / 'IMPORT_ORDER.txt'})")
+               f"{Path(out_dir) / IMPORT_ORDER})")
     if notes:
         click.echo(f"{len(notes)} initial value(s) not carried by the {target} label tables: "
-                   f"see {Path(out_dir) / 'DROPPED_INITIAL_VALUES.txt'}")
+                   f"see {Path(out_dir) / DROPPED_TABLE}")

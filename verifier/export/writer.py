@@ -41,6 +41,7 @@ STRUCT_COLUMNS = {
 
 
 DROPPED_TABLE = "DROPPED_INITIAL_VALUES.txt"
+IMPORT_ORDER = "IMPORT_ORDER.txt"
 #: label classes whose initial value the editor's label table can hold. GX Works2's label
 #: editor has no initial-value column at all (only the Constant column of VAR_CONSTANT);
 #: GX Works3 has one for every class the checker lets carry a value (it refuses one on
@@ -180,25 +181,32 @@ def _empty_files(files: list[ast.SourceFile]) -> list[ast.Diagnostic]:
             for f in files if not (f.pous or f.globals or f.types)]
 
 
+def _pou_files(out: Path, pou) -> tuple[Path, Path]:
+    """Where a POU's body and its label table go."""
+    return out / f"{pou.name}.st", out / f"{pou.name}.labels.tsv"
+
+
+def _struct_file(out: Path, struct) -> Path:
+    return out / f"{struct.name}.struct.tsv"
+
+
 def _overwritten_sources(files: list[ast.SourceFile], paths: list[Path], out: Path) -> list[ast.Diagnostic]:
     """The sources the export would write over (`--out` is their own folder and a POU has
     the file's name): refused before anything is written, or the declarations are lost."""
-    outputs = [(f, pou, out / f"{pou.name}.{suffix}") for f in files for pou in f.pous for suffix in ("st", "labels.tsv")]
-    outputs += [(f, struct, out / f"{struct.name}.struct.tsv") for f in files for struct in f.types]
-    fixed = [out / GLOBAL_TABLE, out / DROPPED_TABLE, out / "IMPORT_ORDER.txt"]
-    sources = {source.resolve(): (f, source) for f, source in zip(files, paths)}
+    planned = [(f, pou, target) for f in files for pou in f.pous for target in _pou_files(out, pou)]
+    planned += [(f, struct, _struct_file(out, struct)) for f in files for struct in f.types]
+    planned += [(None, None, out / name) for name in (GLOBAL_TABLE, DROPPED_TABLE, IMPORT_ORDER)]
+    sources = {path.resolve(): f for f, path in zip(files, paths)}
     problems = []
-    for written in [(None, None, p) for p in fixed] + outputs:
-        f, what, target = written
-        hit = sources.get(target.resolve())
-        if hit is None and target.exists():
-            hit = next((v for k, v in sources.items() if k.exists() and os.path.samefile(k, target)), None)
-        if hit is None:
+    for f, node, target in planned:
+        source = sources.get(target.resolve())
+        if source is None and target.exists():  # the same file by another name (a hard link)
+            source = next((v for k, v in sources.items() if k.exists() and os.path.samefile(k, target)), None)
+        if source is None:
             continue
-        source_file, source = hit
-        line, col = (what.span.line, what.span.col) if what is not None and source_file is f else (1, 1)
+        line, col = (node.span.line, node.span.col) if source is f else (1, 1)
         problems.append(ast.Diagnostic(
-            source_file.filename, line, col, "error",
+            source.filename, line, col, "error",
             f"exporting into {out} would write {target.name} over this source file: choose another --out folder"))
     return problems
 
@@ -231,8 +239,7 @@ def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, 
         for pou in f.pous:
             body = body_text(pou, f.text)
             rows = label_rows(pou, f.text, target)
-            body_path = out / f"{pou.name}.st"
-            table_path = out / f"{pou.name}.labels.tsv"
+            body_path, table_path = _pou_files(out, pou)
             body_path.write_text(body, encoding="utf-8")
             table_path.write_text(label_table(rows, target), encoding="utf-8")
             written += [body_path, table_path]
@@ -240,7 +247,7 @@ def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, 
             exported.append(ExportedPou(pou.name, pou.kind, f.filename, result, _uses(pou, body, known)))
     for f in files:
         for struct in f.types:
-            path = out / f"{struct.name}.struct.tsv"
+            path = _struct_file(out, struct)
             path.write_text(struct_table(rows_of(struct.fields, f.text, target), target), encoding="utf-8")
             written.append(path)
             exported.append(ExportedPou(struct.name, "STRUCT", f.filename))
@@ -258,7 +265,7 @@ def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, 
         stale.unlink()                     # from an earlier export into the same folder
     if notes is not None:
         notes.extend(dropped)
-    order = out / "IMPORT_ORDER.txt"
+    order = out / IMPORT_ORDER
     by_name = {p.name: p for p in exported}
     rows = [(name, by_name[name].kind, by_name[name].result) for name in import_order(exported)]
     order.write_text("".join("\t".join(filter(None, row)) + "\n" for row in rows), encoding="utf-8")
