@@ -1,10 +1,12 @@
 """Reading the text files the tool takes (captures, fault files, scenarios; ST files go
 through verifier.st.source, which shares the helpers below), with one wording for what
-went wrong: the caller puts it in its own error with the file name."""
+went wrong: the caller puts it in its own error with the file name. And the one way
+characters a report cannot hold are shown in it (`escape_chars`)."""
 from __future__ import annotations
 
 import stat
 from pathlib import Path
+from typing import Callable
 
 BOM = b"\xef\xbb\xbf"  # a UTF-8 byte order mark, as Windows editors write it: skipped
 
@@ -59,3 +61,12 @@ def file_kind(mode: int) -> str:
     if stat.S_ISSOCK(mode):
         return "a socket"
     return "not a file"
+
+
+def escape_chars(text: str, keep: Callable[[str], bool]) -> str:
+    """`text` with each character `keep` refuses written as \\xNN or \\uNNNN (a control
+    character in a scenario name would restyle a terminal or break an XML report)."""
+    if all(keep(c) for c in text):
+        return text
+    return "".join(c if keep(c) else f"\\x{ord(c):02x}" if ord(c) < 0x100 else f"\\u{ord(c):04x}"
+                   for c in text)

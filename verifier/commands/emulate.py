@@ -206,10 +206,13 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
         raise click.BadParameter("must be greater than 0", param_hint="--frame-gap-ms")
     endpoint = _tcp_endpoint(tcp) if tcp is not None else None
 
+    def log_anyway(line: str) -> None:
+        click.echo(line)
+        sys.stdout.flush()
+
     def log(line: str) -> None:
         if not quiet:
-            click.echo(line)
-            sys.stdout.flush()
+            log_anyway(line)
 
     emulator = Emulator(Robot(settings, config, faults), log)
     for fault in faults:
@@ -230,9 +233,8 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
             serve_serial(serial_url, emulator, stop, silence_us, baud)
         else:
             # with --quiet the live log is off, but a client needs the port (port 0 = any)
-            shown = (lambda host, port: (click.echo(f"listening on tcp {host}:{port}"), sys.stdout.flush())
-                     ) if quiet else None
-            serve_tcp(endpoint[0], endpoint[1], emulator, stop, silence_us, on_listening=shown)
+            serve_tcp(endpoint[0], endpoint[1], emulator, stop, silence_us,
+                      on_listening=(lambda host, port: log_anyway(f"listening on tcp {host}:{port}")) if quiet else None)
     except PortError as err:
         click.echo(emulator.summary())
         raise click.ClickException(str(err)) from None

@@ -6,6 +6,8 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
+from verifier.textfile import escape_chars
+
 from .durations import format_seconds
 from .result import ScenarioResult, overall_verdict
 from .rules import RULES
@@ -36,7 +38,7 @@ def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
         else f"{len(result.expectations)} expectation(s) met"
     )
     console.print(
-        f"{mark} [bold]{escape(_printable(result.name))}[/]{where}: {escape(result.program or 'the PLC')} on {result.platform}, {tx} requests in "
+        f"{mark} [bold]{escape(escape_chars(result.name, str.isprintable))}[/]{where}: {escape(result.program or 'the PLC')} on {result.platform}, {tx} requests in "
         f"{format_seconds(result.ended_us)}, {result.violation_count} violation(s), {expectations}"
     )
     for note in result.notes:
@@ -48,13 +50,6 @@ def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
         _rule_block(found, console, first)
     for outcome in result.failed_expectations:
         console.print(f"    [red]expected[/] {escape(outcome.expectation.label)}: {escape(outcome.detail)}")
-
-
-def _printable(text: str) -> str:
-    """`text` with control characters shown as \\xNN, not sent to the terminal (an escape
-    sequence in a scenario name would restyle the console)."""
-    return "".join(c if c.isprintable() else f"\\x{ord(c):02x}" if ord(c) < 0x100 else f"\\u{ord(c):04x}"
-                   for c in text)
 
 
 def _rule_block(found: list, console: Console, first: int) -> None:

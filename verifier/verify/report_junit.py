@@ -9,6 +9,8 @@ import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+from verifier.textfile import escape_chars
+
 from .durations import format_seconds
 from .result import ScenarioResult
 from .rules import RULES_BY_ID
@@ -92,12 +94,8 @@ _NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
 
 
 def _xml_safe(text: str | None) -> str | None:
-    """`text` with each character XML cannot hold written as \\xNN / \\uNNNN (a scenario
-    name or message with a control character made the file unreadable for CI tools)."""
-    if text is None or not _NOT_XML.search(text):
-        return text
-    return _NOT_XML.sub(lambda m: f"\\x{ord(m.group()):02x}" if ord(m.group()) < 0x100
-                        else f"\\u{ord(m.group()):04x}", text)
+    """`text` without the characters XML cannot hold (shown as \\xNN / \\uNNNN instead)."""
+    return None if text is None else escape_chars(text, lambda c: not _NOT_XML.match(c))
 
 
 def write(results: list[ScenarioResult], path: Path) -> None:
