@@ -33,9 +33,6 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
     console = Console(highlight=False, soft_wrap=True)
     try:
         check_folders(json_path, junit_path, trace_path, html_path)
-    except ReportError as exc:
-        raise click.UsageError(str(exc)) from None
-    try:
         check_not_inputs(captures, json_path, junit_path, trace_path, html_path)
     except ReportError as exc:
         raise click.UsageError(str(exc)) from None
