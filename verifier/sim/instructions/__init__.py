@@ -176,12 +176,11 @@ class InstructionSet:
         return port.call(en, s, m, n, d, loc_id)
 
     def c24(self, un: int):
-        from .c24 import C24Module
-
         mod = self._c24.get(un)
-        if mod is None:
-            mod = C24Module(self.rt, un)
-            self._c24[un] = mod
+        if mod is None:  # imported on first use only (each G.INPUT/G.OUTPUT call comes here)
+            from .c24 import C24Module
+
+            mod = self._c24[un] = C24Module(self.rt, un)
         return mod
 
     def G_OUTPUT(self, en, un, s1, s2, d, loc_id):
@@ -195,12 +194,11 @@ class InstructionSet:
         return self.c24(un).input(s, d1, d2, loc_id)
 
     def adprw_port(self, channel: int = 1):
-        from .adprw import AdprwMaster
-
         port = self._adprw.get(channel)
-        if port is None:
-            port = AdprwMaster(self.rt, channel)
-            self._adprw[channel] = port
+        if port is None:  # imported on first use only (every ADPRW call comes here)
+            from .adprw import AdprwMaster
+
+            port = self._adprw[channel] = AdprwMaster(self.rt, channel)
         return port
 
     def ADPRW(self, en, s, s1, s2, s3, s4d, *rest):
@@ -212,11 +210,12 @@ class InstructionSet:
 
     # -- Ethernet ------------------------------------------------------------------------
     def socket_port(self):
-        from .tcp import SocketPort
+        socket = self._socket
+        if socket is None:  # imported on first use only: this runs four times a scan
+            from .tcp import SocketPort
 
-        if self._socket is None:
-            self._socket = SocketPort(self.rt)
-        return self._socket
+            socket = self._socket = SocketPort(self.rt)
+        return socket
 
     def e71(self, un):
         """The QJ71E71 of a Un operand; the operand as written is remembered too (four
