@@ -18,6 +18,14 @@ def test_catalogue_section_matches_the_declarations():
         "docs/plc-library.md is out of date: run `python -m verifier.export.catalogue --write`")
 
 
+def test_a_summary_that_runs_over_two_header_lines_is_kept_whole():
+    # "UITAMR_PortTcpFx5 : FX5U / FX5UC built-in Ethernet port for" goes on on the next line
+    summaries = re.findall(r"^### .*\n\n(.*)\n", catalogue(), flags=re.MULTILINE)
+    assert "FX5U / FX5UC built-in Ethernet port for UITAMR_Engine (socket communication, TCP client)." in summaries
+    cut = [s for s in summaries if re.search(r"(,| for| and| of| the| a)\.$", s)]
+    assert not cut, f"summaries cut in mid-sentence: {cut}"
+
+
 def test_every_error_code_in_the_st_is_documented():
     codes = set()
     for path in (ROOT / "plc").rglob("*.st"):

@@ -20,11 +20,19 @@ INTERFACE = ("VAR_INPUT", "VAR_OUTPUT", "VAR_IN_OUT")
 
 
 def _title(text: str, name: str) -> str:
-    """The one-line summary of the header comment: `NAME : summary`."""
-    for line in text.splitlines():
+    """The summary of the header comment: `NAME : summary`, with the lines that carry it on
+    (up to a blank line or the header's ---- rule)."""
+    lines = text.splitlines()
+    for k, line in enumerate(lines):
         head, sep, rest = line.strip().partition(":")
         if sep and head.strip() == name:
-            return rest.strip()
+            summary = [rest.strip()]
+            for more in lines[k + 1:]:
+                more = more.strip()
+                if not more or more.startswith(("---", "===", "*)")):
+                    break
+                summary.append(more)
+            return " ".join(summary)
     return ""
 
 
