@@ -116,6 +116,10 @@ CPU_ALIASES = {"fx3": "fx3u", "fx3uc": "fx3u", "fx3gc": "fx3g", "fx5": "fx5u",
                "fx5uc": "fx5u", "qcpu": "q", "qnu": "q", "l": "q"}
 TARGET_DEFAULT_CPU = {"gxworks2": "fx3u", "gxworks3": "fx5u"}
 
+# The timer resolutions the simulator's TON/TOF/TP can count in (ms): the timer devices
+# of the CPUs modelled come in 100 ms, 10 ms and 1 ms kinds (docs/instructions.md §4).
+TIMER_RESOLUTIONS_MS = (1, 10, 100)
+
 
 # Send-request flags of the serial channels: writing TRUE to one of them is where a
 # transmission starts, so the compiler records that ST location as the bytes' origin.
