@@ -23,6 +23,36 @@ def test_unknown_target_and_cpu():
     assert "unknown CPU" in str(err.value)
 
 
+@pytest.mark.parametrize("target, cpu, message", [
+    ("gxworks2", "fx5u", "GX Works2 does not program the FX5U CPU (GX Works3 does): use target='gxworks3' "
+                         "with cpu='fx5u', or a CPU GX Works2 programs: fx3u, fx3g, q"),
+    ("gxworks2:fx5uc", None, "GX Works2 does not program the FX5U CPU (GX Works3 does)"),
+    ("gxworks3", "fx3u", "GX Works3 does not program the FX3U CPU (GX Works2 does): use target='gxworks2' "
+                         "with cpu='fx3u', or a CPU GX Works3 programs: fx5u"),
+    ("gxworks3", "FX3G", "GX Works3 does not program the FX3G CPU (GX Works2 does)"),
+    ("gxworks3:q", None, "GX Works3 does not program the Q CPU (GX Works2 does)"),
+    ("gxworks2:q", "fx3u", "target 'gxworks2:q' and cpu='fx3u' name two CPUs; name the CPU once"),
+    ("gxworks9", "q", "unknown target 'gxworks9'; use one of ['gxworks2', 'gxworks3']"),
+])
+def test_a_cpu_the_editor_does_not_program_is_refused(target, cpu, message):
+    with pytest.raises(LoadError) as err:
+        load_st("PROGRAM P\nEND_PROGRAM\n", target=target, cpu=cpu)
+    assert f"<target>:0:0: error: {message}" in str(err.value)
+
+
+@pytest.mark.parametrize("target, cpu", [("gxworks2", "fx3u"), ("gxworks2", "fx3gc"), ("gxworks2", "qnu"),
+                                         ("gxworks2:q", "q"), ("gxworks2:Q", None), ("gxworks3", "fx5uc")])
+def test_the_cpus_each_editor_programs_load(target, cpu):
+    load_st("PROGRAM P\nEND_PROGRAM\n", target=target, cpu=cpu)
+
+
+def test_target_and_cpu_are_names():
+    with pytest.raises(TypeError, match="target is a name such as 'gxworks2'; got 2"):
+        load_st("PROGRAM P\nEND_PROGRAM\n", target=2)
+    with pytest.raises(TypeError, match="cpu is a name such as 'fx3u'; got 5"):
+        load_st("PROGRAM P\nEND_PROGRAM\n", cpu=5)
+
+
 def test_instruction_of_another_cpu_is_refused_at_its_location():
     src = ("PROGRAM P\nVAR c : ARRAY[0..2] OF WORD; d : ARRAY[0..3] OF WORD; b : ARRAY[0..1] OF BOOL; END_VAR\n"
            "G_OUTPUT(TRUE, 16#0, c, d, b);\nEND_PROGRAM\n")

@@ -57,11 +57,11 @@ class Project:
     def __init__(self, texts: dict[str, str], target: str = "gxworks2", cpu: str | None = None,
                  scan_ms: float = 10, jitter_ms: float = 0, seed: int = 0,
                  stop_on_operation_error: bool | None = None, timer_resolution_ms: int = 1):
-        editor = target.split(":", 1)[0]
         try:
             self.cpu = profile_for(target, cpu)
         except ValueError as e:
             raise LoadError([ast.Diagnostic("<target>", 0, 0, "error", str(e))]) from None
+        editor = target.split(":", 1)[0]
         self.target = editor
         files, warnings = _parsed_and_checked(texts, editor)
         self.warnings = list(warnings)
