@@ -82,6 +82,23 @@ def test_attach_serial_checks_the_channel():
         project.attach_serial("fx3:1", object())
 
 
+def test_serial_log_of_a_channel_the_cpu_lacks_names_the_ones_it_has():
+    project = load_st("PROGRAM P\nEND_PROGRAM\n")
+    assert project.serial_channels() == ["fx3:1", "fx3:2", "adp:1", "adp:2"]
+    assert project.serial_log("fx3:2") == []           # a channel nothing sent on yet
+    with pytest.raises(ValueError) as err:
+        project.serial_log("nope")
+    assert str(err.value) == "unknown serial channel 'nope'; the fx3u CPU has fx3:1, fx3:2, adp:1, adp:2"
+    with pytest.raises(ValueError, match="channel q:1 does not exist on the fx3u CPU; the fx3u CPU has fx3:1"):
+        project.serial_log("q:1")
+    q = load_st("PROGRAM P\nEND_PROGRAM\n", cpu="q")  # no ADPRW on a Q CPU
+    assert q.serial_channels() == ["q:1", "q:2"]
+    with pytest.raises(ValueError, match="channel adp:1 does not exist on the q CPU; the q CPU has q:1, q:2"):
+        q.attach_serial("adp:1", FakeEndpoint())
+    fx5 = load_st("PROGRAM P\nEND_PROGRAM\n", target="gxworks3")
+    assert fx5.serial_channels() == ["fx5:1", "fx5:2", "adp:1", "adp:2"]
+
+
 def test_api_misuse_names_what_exists():
     project = load_st("FUNCTION F : INT\nVAR_INPUT a : INT; END_VAR\nF := a;\nEND_FUNCTION\n"
                       "FUNCTION_BLOCK FB\nEND_FUNCTION_BLOCK\n")

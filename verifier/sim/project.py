@@ -308,15 +308,29 @@ class Project:
         self.rt.advance_to(self.rt.now_us + round(ms * 1000))
 
     # ------------------------------------------------------------------ serial
+    def serial_channels(self) -> list[str]:
+        """The serial channels this CPU has: its own ports ("fx3:1", "fx3:2" / "fx5:1",
+        "fx5:2" / "q:1", "q:2") and, where it has ADPRW, the MODBUS master's ("adp:1")."""
+        from .instructions import lookup
+
+        adprw, _ = lookup("ADPRW", self.cpu.family)
+        families = {self.cpu.family, "adp"} if self.cpu.family in adprw.families else {self.cpu.family}
+        return [c for c in CHANNELS if c.split(":")[0] in families]
+
+    def _serial_channel(self, channel: str):
+        """The channel by name; ValueError naming the channels this CPU has otherwise."""
+        have = self.serial_channels()
+        if channel not in have:
+            problem = (f"channel {channel} does not exist on the {self.cpu.name} CPU" if channel in CHANNELS
+                       else f"unknown serial channel {channel!r}")
+            raise ValueError(f"{problem}; the {self.cpu.name} CPU has {', '.join(have)}")
+        return self.rt.channel(channel)
+
     def attach_serial(self, channel: str, endpoint) -> None:
-        """Connect a serial channel ("fx3:1", "fx3:2", "fx5:1", "q:1", "q:2", "adp:1") to an
-        endpoint with the verifier.link.Line master interface."""
-        if channel not in CHANNELS:
-            raise ValueError(f"unknown serial channel {channel!r}; use one of {', '.join(CHANNELS)}")
-        family = channel.split(":")[0]
-        if family not in (self.cpu.family, "adp"):
-            raise ValueError(f"channel {channel} does not exist on the {self.cpu.name} CPU")
-        self.rt.channel(channel).attach(endpoint)
+        """Connect a serial channel of this CPU (`serial_channels()`: "fx3:1", "fx3:2",
+        "fx5:1", "fx5:2", "q:1", "q:2", "adp:1") to an endpoint with the verifier.link.Line
+        master interface."""
+        self._serial_channel(channel).attach(endpoint)
 
     def attach_tcp(self, endpoint) -> None:
         """Connect the PLC's Ethernet port (FX5U socket / QJ71E71 fixed buffer instructions)
@@ -327,11 +341,13 @@ class Project:
         self.rt.tcp_endpoint = endpoint
 
     def serial_log(self, channel: str):
-        """Frames the PLC sent on a channel: [SentFrame(t_start_us, t_end_us, data, origin)]."""
+        """Frames the PLC sent on a channel of this CPU (`serial_channels()`):
+        [SentFrame(t_start_us, t_end_us, data, origin)]."""
+        port = self._serial_channel(channel)
         if not self.rt.keep_sent:
             raise RuntimeError("the serial log is off (keep_serial_log(False)): read the frames from "
                                "the line the channel is attached to")
-        return list(self.rt.channel(channel).sent)
+        return list(port.sent)
 
     def keep_serial_log(self, keep: bool) -> None:
         """Whether the serial channels keep every frame sent for `serial_log` (the default).
