@@ -99,6 +99,21 @@ def test_serial_log_of_a_channel_the_cpu_lacks_names_the_ones_it_has():
     assert fx5.serial_channels() == ["fx5:1", "fx5:2", "adp:1", "adp:2"]
 
 
+def test_configure_c24_needs_a_q_cpu_and_a_channel_and_unit_the_module_has():
+    with pytest.raises(ValueError) as err:
+        load_st("PROGRAM P\nEND_PROGRAM\n").configure_c24(0, 1, byte_units=True)
+    assert str(err.value) == ("the QJ71C24N is a Q-series module and this project's CPU is fx3u: configure_c24 "
+                              "needs a Q CPU (verifier.load(..., cpu='q'))")
+    q = load_st("PROGRAM P\nEND_PROGRAM\n", cpu="q")
+    with pytest.raises(ValueError, match="the QJ71C24N has channels 1 and 2; got channel=3"):
+        q.configure_c24(0, 3, byte_units=True)
+    with pytest.raises(ValueError, match=r"un is the module's start I/O number without its last digit, "
+                                         r"0..1FFH \(0 for X/Y000, 2 for X/Y020\); got un=-1"):
+        q.configure_c24(-1, 1)
+    q.configure_c24(2, 2, receive_count=8)
+    assert q.c24_buffer(2)[0x144] == 8
+
+
 def test_api_misuse_names_what_exists():
     project = load_st("FUNCTION F : INT\nVAR_INPUT a : INT; END_VAR\nF := a;\nEND_FUNCTION\n"
                       "FUNCTION_BLOCK FB\nEND_FUNCTION_BLOCK\n")

@@ -363,9 +363,18 @@ class Project:
         """QJ71C24N settings normally made in GX Works (switch settings / buffer memory):
         word or byte units, received data count, receive end code (0xFFFF = none) and the
         no-reception monitoring time that ends a message on a silent line."""
-        module = self._instructions().c24(un)
         from .instructions.c24 import BUFFER
 
+        if self.cpu.family != "q":
+            raise ValueError(f"the QJ71C24N is a Q-series module and this project's CPU is {self.cpu.name}: "
+                             f"configure_c24 needs a Q CPU (verifier.load(..., cpu='q'))")
+        if type(channel) is not int or channel not in BUFFER:
+            raise ValueError(f"the QJ71C24N has channels {' and '.join(map(str, BUFFER))}; got channel={channel!r}")
+        last_un = self.cpu.areas["X"].size // 16 - 1  # the start I/O's upper digits: U0 = X/Y000
+        if type(un) is not int or not 0 <= un <= last_un:
+            raise ValueError(f"un is the module's start I/O number without its last digit, 0..{last_un:X}H "
+                             f"(0 for X/Y000, 2 for X/Y020); got un={un!r}")
+        module = self._instructions().c24(un)
         addr = BUFFER[channel]
         buf = module.buffer
         if byte_units is not None:
