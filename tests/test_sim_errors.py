@@ -129,6 +129,41 @@ def test_api_misuse_names_what_exists():
         project.call("F", 1.5)
 
 
+ADD3 = ("FUNCTION Add3 : INT\nVAR_INPUT a : INT; b : INT; c : INT; END_VAR\nAdd3 := a + b + c;\nEND_FUNCTION\n"
+        "PROGRAM P\nVAR x : INT; END_VAR\nx := {call};\nEND_PROGRAM\n")
+
+
+@pytest.mark.parametrize("call, message", [
+    ("Add3(1, 2)", "t.st:7:6: error: Add3 takes 3 argument(s) (a, b, c), 2 given: input c missing; "
+                   "GX Works needs every input of a function"),
+    ("Add3(a := 1)", "t.st:7:6: error: Add3 is called without inputs b, c; GX Works needs every input of a "
+                     "function: add b := ..., c := ..."),
+])
+def test_a_function_call_without_an_input_does_not_load(call, message):
+    with pytest.raises(LoadError) as err:
+        load_st(ADD3.format(call=call))
+    assert message in str(err.value)
+
+
+def test_the_simulator_never_runs_a_function_call_without_an_input(monkeypatch):
+    import verifier.sim.project
+
+    monkeypatch.setattr(verifier.sim.project, "_run_checker", lambda files, target: [])  # the checker would stop it
+    with pytest.raises(LoadError) as err:
+        load_st(ADD3.format(call="Add3(a := 1, c := 3)"))
+    assert "t.st:7:6: error: Add3 is called without input b; GX Works needs every input of a function" \
+        in str(err.value)
+
+
+def test_project_call_without_an_input_says_which_and_the_call():
+    project = load_st(ADD3.format(call="Add3(1, 2, 3)"))
+    with pytest.raises(TypeError) as err:
+        project.call("Add3", 1, c=3)
+    assert str(err.value) == ("Add3 is called without input b; GX Works needs every input of a function: "
+                              "call('Add3', a, b, c)")
+    assert project.call("Add3", 1, 2, c=3) == 6
+
+
 def test_operand_block_past_an_array_through_a_function_local():
     src = ("FUNCTION F : WORD\nVAR_INPUT n : INT; END_VAR\nVAR b : ARRAY[0..1] OF WORD; c : WORD; END_VAR\n"
            "CRC(TRUE, b[0], n, c);\nF := c;\nEND_FUNCTION\n")

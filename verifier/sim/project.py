@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Callable, Iterable
 
 from verifier.st import ast
+from verifier.st.check import called_without
 from verifier.st.source import read_source
 
 from .compiler import GENERATED_FILE, CompiledModule, compile_files, default_code
@@ -140,12 +141,14 @@ class Project:
             if k.upper() not in {p.key for p in params}:
                 raise TypeError(f"{info.pou.name} has no input {k}")
             given[k.upper()] = v
+        missing = [p.name for p in params if p.key not in given]
+        if missing:
+            raise TypeError(f"{called_without(info.pou.name, missing)}: "
+                            f"call({info.pou.name!r}, {', '.join(p.name for p in params)})")
         converted = []
         for p in params:
             label = f"{info.pou.name}.{p.name}"
-            if p.key not in given:
-                converted.append(eval(self.module_default(p.type), self.module.namespace))
-            elif isinstance(p.type, ArrayT):
+            if isinstance(p.type, ArrayT):
                 default = eval(self.module_default(p.type.elem), self.module.namespace)
                 converted.append(to_st_list(p.type, given[p.key], label, default))
             else:
