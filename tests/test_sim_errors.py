@@ -23,6 +23,36 @@ def test_unknown_target_and_cpu():
     assert "unknown CPU" in str(err.value)
 
 
+@pytest.mark.parametrize("target, cpu, message", [
+    ("gxworks2", "fx5u", "GX Works2 does not program the FX5U CPU (GX Works3 does): use target='gxworks3' "
+                         "with cpu='fx5u', or a CPU GX Works2 programs: fx3u, fx3g, q"),
+    ("gxworks2:fx5uc", None, "GX Works2 does not program the FX5U CPU (GX Works3 does)"),
+    ("gxworks3", "fx3u", "GX Works3 does not program the FX3U CPU (GX Works2 does): use target='gxworks2' "
+                         "with cpu='fx3u', or a CPU GX Works3 programs: fx5u"),
+    ("gxworks3", "FX3G", "GX Works3 does not program the FX3G CPU (GX Works2 does)"),
+    ("gxworks3:q", None, "GX Works3 does not program the Q CPU (GX Works2 does)"),
+    ("gxworks2:q", "fx3u", "target 'gxworks2:q' and cpu='fx3u' name two CPUs; name the CPU once"),
+    ("gxworks9", "q", "unknown target 'gxworks9'; use one of ['gxworks2', 'gxworks3']"),
+])
+def test_a_cpu_the_editor_does_not_program_is_refused(target, cpu, message):
+    with pytest.raises(LoadError) as err:
+        load_st("PROGRAM P\nEND_PROGRAM\n", target=target, cpu=cpu)
+    assert f"<target>:0:0: error: {message}" in str(err.value)
+
+
+@pytest.mark.parametrize("target, cpu", [("gxworks2", "fx3u"), ("gxworks2", "fx3gc"), ("gxworks2", "qnu"),
+                                         ("gxworks2:q", "q"), ("gxworks2:Q", None), ("gxworks3", "fx5uc")])
+def test_the_cpus_each_editor_programs_load(target, cpu):
+    load_st("PROGRAM P\nEND_PROGRAM\n", target=target, cpu=cpu)
+
+
+def test_target_and_cpu_are_names():
+    with pytest.raises(TypeError, match="target is a name such as 'gxworks2'; got 2"):
+        load_st("PROGRAM P\nEND_PROGRAM\n", target=2)
+    with pytest.raises(TypeError, match="cpu is a name such as 'fx3u'; got 5"):
+        load_st("PROGRAM P\nEND_PROGRAM\n", cpu=5)
+
+
 def test_instruction_of_another_cpu_is_refused_at_its_location():
     src = ("PROGRAM P\nVAR c : ARRAY[0..2] OF WORD; d : ARRAY[0..3] OF WORD; b : ARRAY[0..1] OF BOOL; END_VAR\n"
            "G_OUTPUT(TRUE, 16#0, c, d, b);\nEND_PROGRAM\n")
@@ -52,6 +82,38 @@ def test_attach_serial_checks_the_channel():
         project.attach_serial("fx3:1", object())
 
 
+def test_serial_log_of_a_channel_the_cpu_lacks_names_the_ones_it_has():
+    project = load_st("PROGRAM P\nEND_PROGRAM\n")
+    assert project.serial_channels() == ["fx3:1", "fx3:2", "adp:1", "adp:2"]
+    assert project.serial_log("fx3:2") == []           # a channel nothing sent on yet
+    with pytest.raises(ValueError) as err:
+        project.serial_log("nope")
+    assert str(err.value) == "unknown serial channel 'nope'; the fx3u CPU has fx3:1, fx3:2, adp:1, adp:2"
+    with pytest.raises(ValueError, match="channel q:1 does not exist on the fx3u CPU; the fx3u CPU has fx3:1"):
+        project.serial_log("q:1")
+    q = load_st("PROGRAM P\nEND_PROGRAM\n", cpu="q")  # no ADPRW on a Q CPU
+    assert q.serial_channels() == ["q:1", "q:2"]
+    with pytest.raises(ValueError, match="channel adp:1 does not exist on the q CPU; the q CPU has q:1, q:2"):
+        q.attach_serial("adp:1", FakeEndpoint())
+    fx5 = load_st("PROGRAM P\nEND_PROGRAM\n", target="gxworks3")
+    assert fx5.serial_channels() == ["fx5:1", "fx5:2", "adp:1", "adp:2"]
+
+
+def test_configure_c24_needs_a_q_cpu_and_a_channel_and_unit_the_module_has():
+    with pytest.raises(ValueError) as err:
+        load_st("PROGRAM P\nEND_PROGRAM\n").configure_c24(0, 1, byte_units=True)
+    assert str(err.value) == ("the QJ71C24N is a Q-series module and this project's CPU is fx3u: configure_c24 "
+                              "needs a Q CPU (verifier.load(..., cpu='q'))")
+    q = load_st("PROGRAM P\nEND_PROGRAM\n", cpu="q")
+    with pytest.raises(ValueError, match="the QJ71C24N has channels 1 and 2; got channel=3"):
+        q.configure_c24(0, 3, byte_units=True)
+    with pytest.raises(ValueError, match=r"un is the module's start I/O number without its last digit, "
+                                         r"0..1FFH \(0 for X/Y000, 2 for X/Y020\); got un=-1"):
+        q.configure_c24(-1, 1)
+    q.configure_c24(2, 2, receive_count=8)
+    assert q.c24_buffer(2)[0x144] == 8
+
+
 def test_api_misuse_names_what_exists():
     project = load_st("FUNCTION F : INT\nVAR_INPUT a : INT; END_VAR\nF := a;\nEND_FUNCTION\n"
                       "FUNCTION_BLOCK FB\nEND_FUNCTION_BLOCK\n")
@@ -65,6 +127,41 @@ def test_api_misuse_names_what_exists():
         project.call("F", 1, 2)
     with pytest.raises(ValueError, match="F.a is INT"):
         project.call("F", 1.5)
+
+
+ADD3 = ("FUNCTION Add3 : INT\nVAR_INPUT a : INT; b : INT; c : INT; END_VAR\nAdd3 := a + b + c;\nEND_FUNCTION\n"
+        "PROGRAM P\nVAR x : INT; END_VAR\nx := {call};\nEND_PROGRAM\n")
+
+
+@pytest.mark.parametrize("call, message", [
+    ("Add3(1, 2)", "t.st:7:6: error: Add3 takes 3 argument(s) (a, b, c), 2 given: input c missing; "
+                   "GX Works needs every input of a function"),
+    ("Add3(a := 1)", "t.st:7:6: error: Add3 is called without inputs b, c; GX Works needs every input of a "
+                     "function: add b := ..., c := ..."),
+])
+def test_a_function_call_without_an_input_does_not_load(call, message):
+    with pytest.raises(LoadError) as err:
+        load_st(ADD3.format(call=call))
+    assert message in str(err.value)
+
+
+def test_the_simulator_never_runs_a_function_call_without_an_input(monkeypatch):
+    import verifier.sim.project
+
+    monkeypatch.setattr(verifier.sim.project, "_run_checker", lambda files, target: [])  # the checker would stop it
+    with pytest.raises(LoadError) as err:
+        load_st(ADD3.format(call="Add3(a := 1, c := 3)"))
+    assert "t.st:7:6: error: Add3 is called without input b; GX Works needs every input of a function" \
+        in str(err.value)
+
+
+def test_project_call_without_an_input_says_which_and_the_call():
+    project = load_st(ADD3.format(call="Add3(1, 2, 3)"))
+    with pytest.raises(TypeError) as err:
+        project.call("Add3", 1, c=3)
+    assert str(err.value) == ("Add3 is called without input b; GX Works needs every input of a function: "
+                              "call('Add3', a, b, c)")
+    assert project.call("Add3", 1, 2, c=3) == 6
 
 
 def test_operand_block_past_an_array_through_a_function_local():

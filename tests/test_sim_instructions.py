@@ -93,7 +93,7 @@ SET(TRUE, w.3);
 RST(TRUE, w.0);
 END_PROGRAM
 """.replace("bit : BOOL; END_VAR", "bit : BOOL; w : WORD := 1; END_VAR")
-    project = load_st(src, target="gxworks3", cpu="fx3u")  # initial values: GX Works3 dialect
+    project = load_st(src, target="gxworks3")  # initial values: GX Works3 dialect (FX5U)
     project.run_programs(["P"], scans=1)
     p = project.program("P")
     assert p.x == 42 and list(p.b) == [2, 3, 4, 0] and p.bit is True
@@ -363,7 +363,7 @@ IF M21 THEN nRise := nRise + 1; END_IF;
 IF M22 THEN nFall := nFall + 1; END_IF;
 END_PROGRAM
 """
-    project = load_st(src, target="gxworks3", cpu="fx3u")  # initial values: GX Works3 dialect
+    project = load_st(src, target="gxworks3")  # initial values: GX Works3 dialect (FX5U)
     dev = project.devices
     dev["D3"] = 0x1234
     for m in ("M10", "M11", "M12", "M13"):

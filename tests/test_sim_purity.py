@@ -45,7 +45,7 @@ END_PROGRAM
 
 
 def test_only_input_only_functions_are_remembered():
-    project = load_st(SOURCES, target="gxworks3", cpu="fx3u")
+    project = load_st(SOURCES)
     functions = {k: v for k, v in project.module.pous.items() if v.kind == "FUNCTION"}
     assert pure_functions(functions) == {"SUM", "TWICE"}
     namespace = project.module.namespace
@@ -53,7 +53,7 @@ def test_only_input_only_functions_are_remembered():
 
 
 def test_remembered_results_follow_the_array_contents_and_the_rest_runs_every_call():
-    project = load_st(SOURCES, target="gxworks3", cpu="fx3u")
+    project = load_st(SOURCES)
     assert project.call("Sum", [1, 2, 3, 4], 4) == 8
     assert project.call("Sum", [1, 2, 3, 5], 4) == 10      # another array: computed again
     assert project.call("Sum", [1, 2, 3, 4], 4) == 8
@@ -71,7 +71,7 @@ def test_remembered_results_follow_the_array_contents_and_the_rest_runs_every_ca
     assert project.devices["M8067"] is False               # no division by zero yet
     # a FUNCTION that divides is never remembered: a division by zero flags every time
     src = "FUNCTION Inv : INT\nVAR_INPUT x : INT; END_VAR\nInv := 100 / x;\nEND_FUNCTION\n"
-    inv = load_st(src, target="gxworks3", cpu="fx3u")
+    inv = load_st(src)
     for _ in range(2):
         inv.devices["M8067"] = False
         inv.call("Inv", 0)

@@ -2,7 +2,10 @@
 ms), edge detectors, counters, bistables."""
 from __future__ import annotations
 
+import pytest
+
 from sim_helpers import load_st
+from verifier.sim import LoadError
 
 TIMERS = """
 FUNCTION_BLOCK FB_T
@@ -133,3 +136,11 @@ def test_bad_scan_options_are_load_errors():
         load_st(TIMERS, scan_ms=10, jitter_ms=10)
     with pytest.raises(LoadError, match="timer resolution"):
         load_st(TIMERS, timer_resolution_ms=0)
+
+
+@pytest.mark.parametrize("resolution", [7, 1000, 10.0, True, "10"])
+def test_a_timer_resolution_no_cpu_timer_has_is_refused_naming_the_ones_it_has(resolution):
+    with pytest.raises(LoadError) as err:
+        load_st(TIMERS, timer_resolution_ms=resolution)
+    assert ("<options>:0:0: error: the timer resolution (timer_resolution_ms) must be 1, 10 or 100 ms, "
+            f"the resolutions the CPU's timers count in; got {resolution!r}") in str(err.value)

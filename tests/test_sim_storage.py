@@ -19,7 +19,7 @@ def no_checker(monkeypatch):
 
 def refused(src: str) -> str:
     with pytest.raises(LoadError) as err:
-        load_st(src, target="gxworks3", cpu="fx3u")
+        load_st(src)
     return str(err.value)
 
 
@@ -70,14 +70,14 @@ def test_in_out_and_external_labels_are_references_not_copies():
            "VAR_EXTERNAL g : ARRAY[0..999999] OF INT; END_VAR\nio[0] := g[0];\nEND_FUNCTION_BLOCK\n"
            "PROGRAM M\nVAR_EXTERNAL g : ARRAY[0..999999] OF INT; END_VAR\nVAR fbA, fbB, fbC, fbD, fbE : B; END_VAR\n"
            "fbA(io := g);\nEND_PROGRAM\n")
-    load_st(src, target="gxworks3", cpu="fx3u").run_programs(["M"], scans=1)
+    load_st(src).run_programs(["M"], scans=1)
 
 
 def test_endless_function_recursion_stops_with_a_located_error():
     src = ("FUNCTION Fact : INT\nVAR_INPUT n : INT; END_VAR\n"
            "IF n <= 1 THEN Fact := 1; ELSE Fact := Fact(n - 1); END_IF;\nEND_FUNCTION\n"
            "PROGRAM M\nVAR x : INT; END_VAR\nx := Fact(30000);\nEND_PROGRAM\n")
-    project = load_st(src, target="gxworks3", cpu="fx3u")
+    project = load_st(src)
     with pytest.raises(SimulationError) as err:
         project.run_programs(["M"], scans=1)
     assert "t.st:3:" in str(err.value) and "recursion" in str(err.value)
@@ -87,7 +87,7 @@ def test_long_flat_expressions_run_and_deep_ones_are_refused_at_the_statement():
     terms = 3000
     src = (f"PROGRAM M\nVAR i : INT := 300; x : INT; b : BOOL; END_VAR\nx := {'+'.join(['i'] * terms)};\n"
            f"b := {' AND '.join(['(i > 0)'] * terms)};\nEND_PROGRAM\n")
-    project = load_st(src, target="gxworks3", cpu="fx3u")
+    project = load_st(src)
     project.run_programs(["M"], scans=1)
     assert project.program("M").x == (300 * terms + 32768) % 65536 - 32768   # wraps as INT
     assert project.program("M").b is True

@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from verifier.st import ast
+from verifier.st.check import called_without
 
 from . import instructions, stdfuncs
 from .cpu import SEND_FLAGS
@@ -126,12 +127,10 @@ class CallCompiler:
                 values[p.key] = vcode
             else:
                 values[p.key] = self.coerce(vcode, vt, p.type, a.span)
-        arglist = []
-        for p in params:
-            if p.key in values:
-                arglist.append(values[p.key])
-            else:
-                arglist.append(self.m.default_code(p.type))
+        missing = [p.name for p in params if p.key not in values]
+        if missing:  # the checker reports it first; never run the call with made-up inputs
+            raise CompileError(c.span, called_without(c.name, missing))
+        arglist = [values[p.key] for p in params]
         return f"{info.class_name}({', '.join(arglist)})", info.return_type
 
     def call_function_stmt(self, c: ast.Call, target: LValue | None):

@@ -114,7 +114,19 @@ PROFILES = {p.name: p for p in (FX3U, FX3G, FX5U, QCPU)}
 # Accepted spellings of a CPU, and the default CPU of each editor target.
 CPU_ALIASES = {"fx3": "fx3u", "fx3uc": "fx3u", "fx3gc": "fx3g", "fx5": "fx5u",
                "fx5uc": "fx5u", "qcpu": "q", "qnu": "q", "l": "q"}
-TARGET_DEFAULT_CPU = {"gxworks2": "fx3u", "gxworks3": "fx5u"}
+# The CPUs each editor programs, its default first. GX Works2 programs the FX3 and Q
+# CPUs, GX Works3 the FX5 (iQ-F), not the other way round: docs/import-gxworks2.md
+# ("FX3U / FX3G / Q"), docs/import-gxworks3.md ("FX5U / FX5UC", series FX5CPU) and
+# docs/verifier.md ("GX Works2 for FX3U and Q, GX Works3 for FX5U"); "GX Works2 has
+# superseded GX Developer for new A/Q/L/FX projects and GX Works3 covers the MELSEC iQ-R
+# and iQ-F platforms" (https://industrialmonitordirect.com/blogs/knowledgebase/gx-developer-reference-typical-plc-controlled-system-architecture).
+TARGET_CPUS = {"gxworks2": ("fx3u", "fx3g", "q"), "gxworks3": ("fx5u",)}
+TARGET_DEFAULT_CPU = {target: cpus[0] for target, cpus in TARGET_CPUS.items()}
+EDITOR_NAMES = {"gxworks2": "GX Works2", "gxworks3": "GX Works3"}
+
+# The timer resolutions the simulator's TON/TOF/TP can count in (ms): the timer devices
+# of the CPUs modelled come in 100 ms, 10 ms and 1 ms kinds (docs/instructions.md §4).
+TIMER_RESOLUTIONS_MS = (1, 10, 100)
 
 
 # Send-request flags of the serial channels: writing TRUE to one of them is where a
@@ -128,14 +140,27 @@ SEND_FLAGS = {
 
 def profile_for(target: str, cpu: str | None = None) -> CpuProfile:
     """CPU profile for an editor target ("gxworks2", "gxworks3") or a "target:cpu" pair
-    ("gxworks2:q")."""
-    if cpu is None and ":" in target:
-        target, cpu = target.split(":", 1)
+    ("gxworks2:q"), refusing a CPU the editor does not program."""
+    for what, value in (("target", target), ("cpu", cpu)):
+        if value is not None and not isinstance(value, str):
+            raise TypeError(f"{what} is a name such as {'gxworks2' if what == 'target' else 'fx3u'!r}; got {value!r:.60}")
+    editor, colon, named = target.partition(":")
+    if editor not in TARGET_CPUS:
+        raise ValueError(f"unknown target {editor!r}; use one of {sorted(TARGET_CPUS)}")
+    if colon and cpu is not None and _cpu_key(named) != _cpu_key(cpu):
+        raise ValueError(f"target {target!r} and cpu={cpu!r} name two CPUs; name the CPU once")
     if cpu is None:
-        if target not in TARGET_DEFAULT_CPU:
-            raise ValueError(f"unknown target {target!r}; use one of {sorted(TARGET_DEFAULT_CPU)}")
-        cpu = TARGET_DEFAULT_CPU[target]
-    key = CPU_ALIASES.get(cpu.lower(), cpu.lower())
+        cpu = named if colon else TARGET_DEFAULT_CPU[editor]
+    key = _cpu_key(cpu)
     if key not in PROFILES:
         raise ValueError(f"unknown CPU {cpu!r}; use one of {sorted(PROFILES)}")
+    if key not in TARGET_CPUS[editor]:
+        other = next(t for t, cpus in TARGET_CPUS.items() if key in cpus)
+        raise ValueError(f"{EDITOR_NAMES[editor]} does not program the {key.upper()} CPU ({EDITOR_NAMES[other]} "
+                         f"does): use target={other!r} with cpu={key!r}, or a CPU {EDITOR_NAMES[editor]} "
+                         f"programs: {', '.join(TARGET_CPUS[editor])}")
     return PROFILES[key]
+
+
+def _cpu_key(cpu: str) -> str:
+    return CPU_ALIASES.get(cpu.lower(), cpu.lower())

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Callable, Iterable
 
 from verifier.st import ast
+from verifier.st.check import called_without
 from verifier.st.source import read_source
 
 from .compiler import GENERATED_FILE, CompiledModule, compile_files, default_code
@@ -57,11 +58,11 @@ class Project:
     def __init__(self, texts: dict[str, str], target: str = "gxworks2", cpu: str | None = None,
                  scan_ms: float = 10, jitter_ms: float = 0, seed: int = 0,
                  stop_on_operation_error: bool | None = None, timer_resolution_ms: int = 1):
-        editor = target.split(":", 1)[0]
         try:
             self.cpu = profile_for(target, cpu)
         except ValueError as e:
             raise LoadError([ast.Diagnostic("<target>", 0, 0, "error", str(e))]) from None
+        editor = target.split(":", 1)[0]
         self.target = editor
         files, warnings = _parsed_and_checked(texts, editor)
         self.warnings = list(warnings)
@@ -140,12 +141,14 @@ class Project:
             if k.upper() not in {p.key for p in params}:
                 raise TypeError(f"{info.pou.name} has no input {k}")
             given[k.upper()] = v
+        missing = [p.name for p in params if p.key not in given]
+        if missing:
+            raise TypeError(f"{called_without(info.pou.name, missing)}: "
+                            f"call({info.pou.name!r}, {', '.join(p.name for p in params)})")
         converted = []
         for p in params:
             label = f"{info.pou.name}.{p.name}"
-            if p.key not in given:
-                converted.append(eval(self.module_default(p.type), self.module.namespace))
-            elif isinstance(p.type, ArrayT):
+            if isinstance(p.type, ArrayT):
                 default = eval(self.module_default(p.type.elem), self.module.namespace)
                 converted.append(to_st_list(p.type, given[p.key], label, default))
             else:
@@ -308,15 +311,29 @@ class Project:
         self.rt.advance_to(self.rt.now_us + round(ms * 1000))
 
     # ------------------------------------------------------------------ serial
+    def serial_channels(self) -> list[str]:
+        """The serial channels this CPU has: its own ports ("fx3:1", "fx3:2" / "fx5:1",
+        "fx5:2" / "q:1", "q:2") and, where it has ADPRW, the MODBUS master's ("adp:1")."""
+        from .instructions import lookup
+
+        adprw, _ = lookup("ADPRW", self.cpu.family)
+        families = {self.cpu.family, "adp"} if self.cpu.family in adprw.families else {self.cpu.family}
+        return [c for c in CHANNELS if c.split(":")[0] in families]
+
+    def _serial_channel(self, channel: str):
+        """The channel by name; ValueError naming the channels this CPU has otherwise."""
+        have = self.serial_channels()
+        if channel not in have:
+            problem = (f"channel {channel} does not exist on the {self.cpu.name} CPU" if channel in CHANNELS
+                       else f"unknown serial channel {channel!r}")
+            raise ValueError(f"{problem}; the {self.cpu.name} CPU has {', '.join(have)}")
+        return self.rt.channel(channel)
+
     def attach_serial(self, channel: str, endpoint) -> None:
-        """Connect a serial channel ("fx3:1", "fx3:2", "fx5:1", "q:1", "q:2", "adp:1") to an
-        endpoint with the verifier.link.Line master interface."""
-        if channel not in CHANNELS:
-            raise ValueError(f"unknown serial channel {channel!r}; use one of {', '.join(CHANNELS)}")
-        family = channel.split(":")[0]
-        if family not in (self.cpu.family, "adp"):
-            raise ValueError(f"channel {channel} does not exist on the {self.cpu.name} CPU")
-        self.rt.channel(channel).attach(endpoint)
+        """Connect a serial channel of this CPU (`serial_channels()`: "fx3:1", "fx3:2",
+        "fx5:1", "fx5:2", "q:1", "q:2", "adp:1") to an endpoint with the verifier.link.Line
+        master interface."""
+        self._serial_channel(channel).attach(endpoint)
 
     def attach_tcp(self, endpoint) -> None:
         """Connect the PLC's Ethernet port (FX5U socket / QJ71E71 fixed buffer instructions)
@@ -327,11 +344,13 @@ class Project:
         self.rt.tcp_endpoint = endpoint
 
     def serial_log(self, channel: str):
-        """Frames the PLC sent on a channel: [SentFrame(t_start_us, t_end_us, data, origin)]."""
+        """Frames the PLC sent on a channel of this CPU (`serial_channels()`):
+        [SentFrame(t_start_us, t_end_us, data, origin)]."""
+        port = self._serial_channel(channel)
         if not self.rt.keep_sent:
             raise RuntimeError("the serial log is off (keep_serial_log(False)): read the frames from "
                                "the line the channel is attached to")
-        return list(self.rt.channel(channel).sent)
+        return list(port.sent)
 
     def keep_serial_log(self, keep: bool) -> None:
         """Whether the serial channels keep every frame sent for `serial_log` (the default).
@@ -347,9 +366,18 @@ class Project:
         """QJ71C24N settings normally made in GX Works (switch settings / buffer memory):
         word or byte units, received data count, receive end code (0xFFFF = none) and the
         no-reception monitoring time that ends a message on a silent line."""
-        module = self._instructions().c24(un)
         from .instructions.c24 import BUFFER
 
+        if self.cpu.family != "q":
+            raise ValueError(f"the QJ71C24N is a Q-series module and this project's CPU is {self.cpu.name}: "
+                             f"configure_c24 needs a Q CPU (verifier.load(..., cpu='q'))")
+        if type(channel) is not int or channel not in BUFFER:
+            raise ValueError(f"the QJ71C24N has channels {' and '.join(map(str, BUFFER))}; got channel={channel!r}")
+        last_un = self.cpu.areas["X"].size // 16 - 1  # the start I/O's upper digits: U0 = X/Y000
+        if type(un) is not int or not 0 <= un <= last_un:
+            raise ValueError(f"un is the module's start I/O number without its last digit, 0..{last_un:X}H "
+                             f"(0 for X/Y000, 2 for X/Y020); got un={un!r}")
+        module = self._instructions().c24(un)
         addr = BUFFER[channel]
         buf = module.buffer
         if byte_units is not None:

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import random
 
-from .cpu import CpuProfile
+from .cpu import TIMER_RESOLUTIONS_MS, CpuProfile
 from .devices import DeviceMemory
 from .errors import SimDiagnostic, SimulationError
 from .serial import SerialChannel
@@ -23,8 +23,10 @@ class Runtime:
                  timer_resolution_ms: int = 1):
         if scan_us <= 0:
             raise ValueError("scan time must be positive")
-        if not isinstance(timer_resolution_ms, int) or timer_resolution_ms <= 0:
-            raise ValueError("the timer resolution is a positive whole number of ms (1, 10, 100)")
+        if type(timer_resolution_ms) is not int or timer_resolution_ms not in TIMER_RESOLUTIONS_MS:
+            *others, last = map(str, TIMER_RESOLUTIONS_MS)
+            raise ValueError(f"the timer resolution (timer_resolution_ms) must be {', '.join(others)} or {last} "
+                             f"ms, the resolutions the CPU's timers count in; got {timer_resolution_ms!r}")
         # timers (TON/TOF/TP) read `now_ms`: virtual time in whole ticks of the resolution
         self.timer_resolution_ms = timer_resolution_ms
         self._tick_us = timer_resolution_ms * 1000

@@ -816,9 +816,13 @@ class Checker:
         named = [a for a in c.args if a.name is not None]
         if positional and named:
             self.rep.error(c, "mix of positional and named arguments; use one style")
-        if positional:
+            self._args_only(c)
+        elif positional:
             if len(positional) != len(params):
-                self.rep.error(c, f"{info.pou.name} takes {len(params)} argument(s), {len(positional)} given")
+                missing = [pn for pn, _ in params[len(positional):]]
+                self.rep.error(c, f"{info.pou.name} takes {len(params)} argument(s) ({', '.join(pn for pn, _ in params)}), "
+                                  f"{len(positional)} given"
+                                  + (f": {_inputs(missing)} missing; {NEEDS_EVERY_INPUT}" if missing else ""))
             for a, (pn, pt) in zip(positional, params):
                 vt = self.expr(a.value)
                 self._assign_compat(a.value, pt, vt, f"argument {pn} of {info.pou.name}")
@@ -830,6 +834,8 @@ class Checker:
                 key = a.key
                 match = next(((pn, pt) for pn, pt in params if pn.upper() == key), None)
                 out = next(((pn, pt) for pn, pt in outputs if pn.upper() == key), None)
+                if key in given:
+                    self.rep.error(a, f"argument '{a.name}' is given twice")
                 given.add(key)
                 if a.output and out is not None:
                     tt = self.lvalue(a.value)
@@ -843,7 +849,8 @@ class Checker:
                     self.rep.error(a, f"{info.pou.name} has no {'output' if a.output else 'input'} '{a.name}'")
             missing = [pn for pn, _ in params if pn.upper() not in given]
             if missing:
-                self.rep.error(c, f"{info.pou.name} needs argument(s) {', '.join(missing)}")
+                self.rep.error(c, called_without(info.pou.name, missing) + ": add "
+                                  + ", ".join(f"{pn} := ..." for pn in missing))
         if statement:
             self.rep.warning(c, f"the result of function {info.pou.name} is discarded")
         return info.return_type or T.ANY
@@ -965,6 +972,22 @@ class Checker:
 
 
 # ----------------------------------------------------------------------------- helpers
+#: Why a FUNCTION call that leaves out an input is an error. IEC 61131-3 lets a formal
+#: call leave inputs at their initial values; that GX Works does not is an ASSUMPTION
+#: (docs/st-dialect.md §8).
+NEEDS_EVERY_INPUT = "GX Works needs every input of a function"
+
+
+def _inputs(names: list[str]) -> str:
+    return f"input{'s' if len(names) > 1 else ''} {', '.join(names)}"
+
+
+def called_without(function: str, names: list[str]) -> str:
+    """The error for a call of FUNCTION `function` that leaves out the inputs `names`
+    (the checker's, and the simulator's when it is handed such a call)."""
+    return f"{function} is called without {_inputs(names)}; {NEEDS_EVERY_INPUT}"
+
+
 def library_missing(name: str, target: str = "gxworks2") -> str:
     return f"type {name} does not exist in {_target_name(target)}: " + T.MISSING_TYPES.get(name, "")
 
