@@ -37,8 +37,8 @@ def bundled_scenarios() -> list[Path]:
 
 
 class _Duration(click.ParamType):
-    """A duration option: a number with a unit, longer than 0 (or 0 itself with
-    `zero_ok`) and at most `maximum_us`."""
+    """A duration option: a number with a unit, longer than 0 (or 0 itself, with or
+    without a unit, with `zero_ok`) and at most `maximum_us`."""
 
     name = "duration"
 
@@ -49,6 +49,8 @@ class _Duration(click.ParamType):
     def convert(self, value, param, ctx):
         if isinstance(value, int):
             return value
+        if self.zero_ok and str(value).strip() in ("0", "0.0"):
+            return 0  # nothing needs no unit: `--tolerance 0` (docs/commissioning.md)
         try:
             us = parse_duration_us(value)
         except ValueError as exc:
