@@ -18,7 +18,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from verifier.commands.report_files import (ReportError, check_folders, check_not_inputs, report_options,
                                              write_reports)
 from verifier.verify.durations import format_duration, format_seconds, parse_duration_us
-from verifier.verify.result import ScenarioResult, UnusableInput
+from verifier.verify.result import KEEP_ALL, Keep, ScenarioResult, UnusableInput
 from verifier.bundled import plc_dir as bundled_plc_dir
 from verifier.verify.scenario import (
     CHANNELS, DEFAULT_DURATION_US, MAX_DURATION_US, PLATFORMS, Scenario, ScenarioError, default_scenario, load_scenario,
@@ -163,10 +163,10 @@ def _source_files(sources) -> tuple[Path, ...]:
     return unique(found)
 
 
-def _run_batch(batch: list[Scenario], every_scan: bool = False) -> list[ScenarioResult]:
+def _run_batch(batch: list[Scenario], every_scan: bool, keep: Keep) -> list[ScenarioResult]:
     from verifier.verify.runner import run_scenario
 
-    return [run_scenario(scenario, plain=every_scan) for scenario in batch]
+    return [run_scenario(scenario, plain=every_scan, keep=keep) for scenario in batch]
 
 
 def _batches(scenarios: list[Scenario], jobs: int) -> list[list[int]]:
@@ -237,14 +237,14 @@ class _LazyProgress:
 
 
 def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress,
-             every_scan: bool = False) -> list[ScenarioResult]:
+             every_scan: bool = False, keep: Keep = KEEP_ALL) -> list[ScenarioResult]:
     from verifier.verify.runner import run_scenario
 
     if jobs > 1 and len(scenarios) > 1:
         results: list[ScenarioResult | None] = [None] * len(scenarios)
         done = 0
         with ProcessPoolExecutor(max_workers=jobs) as pool:
-            futures = {pool.submit(_run_batch, [scenarios[i] for i in batch], every_scan): batch
+            futures = {pool.submit(_run_batch, [scenarios[i] for i in batch], every_scan, keep): batch
                        for batch in _batches(scenarios, jobs)}
             for future in as_completed(futures):
                 for index, result in zip(futures[future], future.result()):
@@ -257,7 +257,7 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress,
     for position, scenario in enumerate(scenarios):
         label = f"[{position + 1}/{len(scenarios)}] {scenario.name}"
         results.append(run_scenario(scenario, lambda now, end, o=offset, l=label: progress.update(o + now, l),
-                                    plain=every_scan))
+                                    plain=every_scan, keep=keep))
         offset += scenario.duration_us
     return results
 
@@ -317,7 +317,9 @@ def command(sources, program, platform, channel, response_signal, scenario_files
     stderr = Console(stderr=True)
     progress = _LazyProgress(stderr, sum(s.duration_us for s in scenarios), stderr.is_terminal)
     try:
-        results = _run_all(scenarios, jobs, progress, every_scan)
+        # a run holds every frame and watched change only for the reports that list them
+        keep = Keep(frames=bool(trace_path or html_path), watched=bool(json_path or html_path))
+        results = _run_all(scenarios, jobs, progress, every_scan, keep)
     except (ScenarioError, UnusableInput) as exc:
         progress.stop()
         _unusable(str(exc))

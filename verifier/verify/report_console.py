@@ -31,7 +31,7 @@ def render(results: list[ScenarioResult], console: Console, *, first: int = FIRS
 def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
     mark = "[green]PASS[/]" if result.passed else "[red]FAIL[/]"
     where = f" ({escape(result.file)})" if result.file else ""
-    tx = sum(1 for frame in result.trace if frame.direction == "tx")
+    tx = result.tx_count
     failed = len(result.failed_expectations)
     expectations = (
         f"{failed} of {len(result.expectations)} expectation(s) failed" if failed

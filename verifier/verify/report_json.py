@@ -68,8 +68,8 @@ def scenario_dict(result: ScenarioResult) -> dict[str, Any]:
         "protocol": asdict(result.settings),
         "faults": result.faults,
         "frames": {
-            "tx": sum(1 for f in result.trace if f.direction == "tx"),
-            "rx": sum(1 for f in result.trace if f.direction == "rx"),
+            "tx": result.tx_count,
+            "rx": result.rx_count,
         },
         "rules": {
             rule.id: {

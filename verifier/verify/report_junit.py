@@ -67,8 +67,7 @@ def to_element(results: list[ScenarioResult]) -> ET.Element:
             failures += 1
             _failure(case, "expectation", f"expected {outcome.expectation.label}: {outcome.detail}", outcome.detail)
         out = ET.SubElement(case, "system-out")
-        tx = sum(1 for frame in result.trace if frame.direction == "tx")
-        rx = len(result.trace) - tx
+        tx, rx = result.tx_count, result.rx_count
         out.text = "\n".join(
             [
                 result.description,

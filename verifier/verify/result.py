@@ -14,6 +14,19 @@ from .evidence import Violation
 from .expectations import ExpectationResult
 
 
+@dataclass(frozen=True)
+class Keep:
+    """What a run keeps beyond its verdict, for the reports that list it: every frame
+    (`--trace`, `--html`) and the watched labels' changes (`--json`, `--html`). A run that
+    keeps neither holds no more than its findings once the rules have judged it."""
+
+    frames: bool = True
+    watched: bool = True
+
+
+KEEP_ALL = Keep()
+
+
 class UnusableInput(Exception):
     """Input the verifier cannot run (bad scenario, ST that does not load, unknown program).
 
@@ -63,6 +76,21 @@ class ScenarioResult:
     ended_us: int = 0
     wall_s: float = 0.0  # real time the run took (for people; nothing judges it)
     notes: list[str] = field(default_factory=list)  # how the run differs from its scenario file
+    frame_counts: tuple[int, int] | None = None  # (requests, replies) when `trace` was not kept
+
+    @property
+    def tx_count(self) -> int:
+        """Frames the PLC sent (counted when the trace was not kept)."""
+        if self.frame_counts is not None:
+            return self.frame_counts[0]
+        return sum(1 for frame in self.trace if frame.direction == "tx")
+
+    @property
+    def rx_count(self) -> int:
+        """Frames the robot sent."""
+        if self.frame_counts is not None:
+            return self.frame_counts[1]
+        return len(self.trace) - self.tx_count
 
     @property
     def violation_count(self) -> int:

@@ -21,7 +21,7 @@ from verifier.sim.values import read_together
 
 from .evidence import RunEvidence, Samples
 from .expectations import judge
-from .result import LineEvent, ScenarioResult, TraceRecord, UnusableInput
+from .result import KEEP_ALL, Keep, LineEvent, ScenarioResult, TraceRecord, UnusableInput
 from .rules import check_all
 from .scenario import BUFFER_MEMORY, DEVICE_NAME, Scenario
 from .traffic import analyse, converter_drops
@@ -296,8 +296,13 @@ def _input_schedule(scenario: Scenario) -> list[tuple[int, dict[str, Any]]]:
     return sorted(steps, key=lambda s: s[0])
 
 
-def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain: bool = False) -> ScenarioResult:
+def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain: bool = False,
+                 keep: Keep = KEEP_ALL) -> ScenarioResult:
     """Run `scenario` to its end and judge it. UnusableInput for input that cannot run.
+
+    `keep` says what the result holds for reports beyond the verdict and the findings:
+    every frame, the watched labels' changes (verifier.verify.result.Keep). The verdict,
+    findings and frame counts do not depend on it.
 
     `plain` runs every scan (no idle scans jumped over, verifier.sim.idle) and reads the
     watched labels by their names on each, recording them all: the reference the fast
@@ -311,7 +316,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     plc.project.keep_serial_log(False)  # the line records every frame: the trace below
     scenario = _check_labels(plc, scenario)
     _apply_plc_settings(plc, scenario)
-    names = scenario.variables()
+    names = scenario.variables(watched=keep.watched)
     samples = Samples(names)
     schedule = _input_schedule(scenario)
     aborted = None
@@ -368,6 +373,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     traffic = analyse(trace, scenario.settings, scenario.options, converter_drops(events))
     violations = check_all(evidence, traffic)
     outcomes = [judge(expectation, evidence, traffic) for expectation in scenario.expectations]
+    tx_count = len(traffic.tx)
     return ScenarioResult(
         name=scenario.name,
         file=_display_path(scenario.path),
@@ -385,17 +391,18 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         reply_timeout_us=scenario.options.reply_timeout_us,
         faults=[fault.describe() for fault in scenario.faults]
         + ([scenario.converter.describe()] if scenario.converter is not None else []),
-        trace=trace,
+        trace=trace if keep.frames else [],
+        frame_counts=None if keep.frames else (tx_count, len(trace) - tx_count),
         events=events,
         violations=violations,
         expectations=outcomes,
         diagnostics=plc.diagnostics(),
-        watched={name: list(samples.changes.get(name, [])) for name in scenario.watch},
+        watched={name: list(samples.changes.get(name, [])) for name in scenario.watch} if keep.watched else {},
         aborted=aborted,
         ended_us=end,
         wall_s=time.perf_counter() - wall_start,
         notes=list(scenario.notes) + (
-            [] if any(f.direction == "tx" for f in trace)
+            [] if tx_count
             else [f"the program sent nothing on {scenario.serial_channel} in the whole run"
                   + (" (nothing reached the robot's line through the converter)" if converter is not None else "")]
         ),

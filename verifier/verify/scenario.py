@@ -155,8 +155,9 @@ class Scenario:
             return TCP_CHANNEL
         return self.channel or PLATFORMS[self.platform][1]
 
-    def variables(self) -> list[str]:
-        """Every PLC label the run must sample: expectations, the response signal, watch."""
+    def variables(self, watched: bool = True) -> list[str]:
+        """Every PLC label the run must sample: expectations, the response signal, watch
+        (left out with `watched=False`, when no report lists the watched labels)."""
         names: list[str] = []
         for expectation in self.expectations:
             if expectation.condition is not None:
@@ -165,7 +166,8 @@ class Scenario:
             names += sorted(self.options.response_signal.names)
         for step in self.inputs:
             names += list(step.values)
-        names += list(self.watch)
+        if watched:
+            names += list(self.watch)
         return list(dict.fromkeys(names))
 
     def label_uses(self) -> list[LabelUse]:

@@ -1,0 +1,84 @@
+"""A run that keeps neither its frames nor its watched labels' changes (what `uitamr
+verify` does when no report lists them: verifier.verify.result.Keep) reaches the same
+verdict, findings, expectations, notes and frame counts as one that keeps everything,
+and every report it can feed reads the same."""
+from __future__ import annotations
+
+import io
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from rich.console import Console
+
+from verifier.verify import report_console, report_junit
+from verifier.verify.report_json import to_dict
+from verifier.verify.result import Keep
+from verifier.verify.runner import run_scenario
+from verifier.verify.scenario import load_scenario
+
+ROOT = Path(__file__).resolve().parent.parent
+SCENARIOS = sorted((ROOT / "plc" / "scenarios").glob("*.toml"))
+NOTHING = Keep(frames=False, watched=False)
+
+
+def _console(result) -> str:
+    out = io.StringIO()
+    report_console.render([result], Console(file=out, width=200, highlight=False, soft_wrap=True), first=3)
+    return out.getvalue()
+
+
+def _junit(result, tmp_path) -> str:
+    path = tmp_path / "r.xml"
+    report_junit.write([result], path)
+    return re.sub(r'time="[^"]*"', 'time=""', path.read_text(encoding="utf-8"))
+
+
+@pytest.mark.parametrize("path", SCENARIOS, ids=lambda p: p.stem)
+def test_keeping_nothing_changes_no_finding(path, tmp_path):
+    scenario = load_scenario(path)
+    full = run_scenario(scenario)
+    lean = run_scenario(scenario, keep=NOTHING)
+    assert lean.trace == [] and lean.watched == {}
+    assert (lean.tx_count, lean.rx_count) == (full.tx_count, full.rx_count)
+    assert full.tx_count == sum(f.direction == "tx" for f in full.trace) and full.tx_count > 0
+    for field in ("violations", "expectations", "notes", "events", "aborted", "ended_us", "diagnostics"):
+        assert getattr(lean, field) == getattr(full, field), field
+    full.wall_s = lean.wall_s = 0.0
+    assert _console(lean) == _console(full)
+    assert _junit(lean, tmp_path) == _junit(full, tmp_path)
+    lean_json, full_json = to_dict([lean]), to_dict([full])
+    for data in (lean_json, full_json):
+        data["scenarios"][0].pop("watched")
+    assert lean_json == full_json
+
+
+def test_watched_changes_are_kept_without_the_frames():
+    scenario = load_scenario(ROOT / "plc" / "scenarios" / "fx3u-healthy.toml")
+    full = run_scenario(scenario)
+    watched_only = run_scenario(scenario, keep=Keep(frames=False, watched=True))
+    assert watched_only.watched == full.watched and full.watched["fbEngine.o_wTxCount"]
+    assert watched_only.trace == []
+
+
+def _verify(*args, cwd):
+    return subprocess.run([sys.executable, "-m", "verifier.cli", "verify", *map(str, args)],
+                          capture_output=True, text=True, timeout=300, cwd=cwd)
+
+
+def test_the_command_keeps_what_its_reports_list(tmp_path):
+    """--json lists the watched labels, --trace every frame: each still gets them when the
+    other is not asked for."""
+    scenario = ROOT / "plc" / "scenarios" / "fx3u-healthy.toml"
+    done = _verify("--scenario", scenario, "--json", tmp_path / "r.json", cwd=ROOT)
+    assert done.returncode == 0, done.stdout + done.stderr
+    data = json.loads((tmp_path / "r.json").read_text(encoding="utf-8"))["scenarios"][0]
+    assert data["watched"]["fbEngine.o_wTxCount"][-1][1] == data["frames"]["tx"]
+    done = _verify("--scenario", scenario, "--trace", tmp_path / "t.jsonl", cwd=ROOT)
+    assert done.returncode == 0, done.stdout + done.stderr
+    lines = (tmp_path / "t.jsonl").read_text(encoding="utf-8").splitlines()
+    assert sum('"dir": "tx"' in line for line in lines) == data["frames"]["tx"]
+    assert len(lines) == data["frames"]["tx"] + data["frames"]["rx"]
