@@ -65,6 +65,24 @@ def describe_window(expectation: Expectation) -> str:
 
 
 def judge(expectation: Expectation, evidence: RunEvidence, traffic: Traffic) -> ExpectationResult:
+    """`expectation` judged over a whole run."""
+    watch = watch_exchanges(expectation, evidence.settings)
+    if watch is not None:
+        for exchange in traffic.exchanges:
+            watch.exchange(exchange)
+    return verdict(expectation, evidence, watch)
+
+
+def watch_exchanges(expectation: Expectation, settings) -> "ExchangeWatch | None":
+    """What judges a `sent` or `reached_point` expectation as the exchanges settle, one at
+    a time and in order (None for the kinds judged on PLC labels)."""
+    kind = {"sent": _Sent, "reached_point": _ReachedPoint}.get(expectation.kind)
+    return None if kind is None else kind(expectation, settings)
+
+
+def verdict(expectation: Expectation, evidence: RunEvidence, watch: "ExchangeWatch | None") -> ExpectationResult:
+    """The result of `expectation` once the run has ended: from `watch` (every exchange of
+    the run given to it) for the kinds about exchanges, from the samples for the others."""
     start, end = expectation.window(evidence.end_us)
     short = expectation.within_us is not None and expectation.after_us + expectation.within_us > evidence.end_us
     if short:
@@ -75,14 +93,14 @@ def judge(expectation: Expectation, evidence: RunEvidence, traffic: Traffic) -> 
             why = (f"the run ended at {format_seconds(evidence.end_us)}, before the window closed at {closes}: "
                    "make the scenario's duration longer")
         return ExpectationResult(expectation, False, why)
+    if watch is not None:
+        return watch.result(start, end)
     judge_kind = {
         "that": _judge_that,
         "always": _judge_always,
         "never": _judge_never,
-        "sent": _judge_sent,
-        "reached_point": _judge_reached_point,
     }[expectation.kind]
-    return judge_kind(expectation, evidence, traffic, start, end)
+    return judge_kind(expectation, evidence, start, end)
 
 
 def _span(start: int, end: int) -> str:
@@ -95,7 +113,7 @@ def _values_at(evidence: RunEvidence, condition: Condition, t_us: int) -> str:
     )
 
 
-def _judge_that(expectation, evidence, traffic, start, end) -> ExpectationResult:
+def _judge_that(expectation, evidence, start, end) -> ExpectationResult:
     seen = evidence.samples.first_time(expectation.condition, start, end)
     if seen is None:
         return ExpectationResult(
@@ -114,7 +132,7 @@ def _first_in_window(condition: Condition, evidence: RunEvidence, start: int, en
     return None
 
 
-def _judge_always(expectation, evidence, traffic, start, end) -> ExpectationResult:
+def _judge_always(expectation, evidence, start, end) -> ExpectationResult:
     condition = expectation.condition
     at = _first_in_window(Condition(f"NOT ({condition.text})", ("not", condition.tree)), evidence, start, end)
     if at is None:
@@ -124,7 +142,7 @@ def _judge_always(expectation, evidence, traffic, start, end) -> ExpectationResu
     )
 
 
-def _judge_never(expectation, evidence, traffic, start, end) -> ExpectationResult:
+def _judge_never(expectation, evidence, start, end) -> ExpectationResult:
     condition = expectation.condition
     at = _first_in_window(condition, evidence, start, end)
     if at is None:
@@ -134,60 +152,121 @@ def _judge_never(expectation, evidence, traffic, start, end) -> ExpectationResul
     )
 
 
-def _judge_sent(expectation, evidence, traffic, start, end) -> ExpectationResult:
-    wanted = protocol.encode(expectation.request, evidence.settings)
-    sent_unanswered = None
-    for exchange in traffic.exchanges:
+class ExchangeWatch:
+    """An expectation about exchanges, given each settled exchange in order.
+
+    Exchanges after the window are left out as they come: the window's end is
+    `after + within` (the run's end when `within` is not given, and every request of the
+    run starts before it); a window the run ended inside fails in `verdict` before this
+    is asked."""
+
+    def __init__(self, expectation: Expectation, settings):
+        self.expectation = expectation
+        self.settings = settings
+        self.first_us = expectation.after_us
+        self.last_us = (float("inf") if expectation.within_us is None
+                        else expectation.after_us + expectation.within_us)
+
+    def exchange(self, exchange) -> None:
         t = exchange.request.t_start_us
-        if t < start or t > end or bytes(exchange.request.data) != wanted:
-            continue
+        if self.first_us <= t <= self.last_us:
+            self.in_window(exchange, t)
+
+    def in_window(self, exchange, t: int) -> None:
+        raise NotImplementedError
+
+    def result(self, start: int, end: int) -> ExpectationResult:
+        raise NotImplementedError
+
+
+class _Sent(ExchangeWatch):
+    """`sent`: the request went out and was answered inside the window."""
+
+    def __init__(self, expectation: Expectation, settings):
+        super().__init__(expectation, settings)
+        self.wanted = protocol.encode(expectation.request, settings)
+        self.answered = None  # the first exchange of the request that was answered
+        self.unanswered = None  # else the first one sent
+
+    def in_window(self, exchange, t: int) -> None:
+        if self.answered is not None or bytes(exchange.request.data) != self.wanted:
+            return
         if exchange.answered:
+            self.answered = exchange
+        elif self.unanswered is None:
+            self.unanswered = exchange
+
+    def result(self, start: int, end: int) -> ExpectationResult:
+        expectation = self.expectation
+        if self.answered is not None:
+            t = self.answered.request.t_start_us
             return ExpectationResult(
-                expectation, True, f"sent and answered at {format_seconds(t)}", t, exchange.refs()
+                expectation, True, f"sent and answered at {format_seconds(t)}", t, self.answered.refs()
             )
-        sent_unanswered = sent_unanswered or exchange
-    meaning = protocol.describe(expectation.request, evidence.settings)
-    if sent_unanswered is not None:
+        meaning = protocol.describe(expectation.request, self.settings)
+        if self.unanswered is not None:
+            t = self.unanswered.request.t_start_us
+            return ExpectationResult(
+                expectation, False,
+                f"{meaning} was sent at {format_seconds(t)} but never answered {_span(start, end)}",
+                t, self.unanswered.refs(),
+            )
         return ExpectationResult(
             expectation, False,
-            f"{meaning} was sent at {format_seconds(sent_unanswered.request.t_start_us)} but never "
-            f"answered {_span(start, end)}",
-            sent_unanswered.request.t_start_us, sent_unanswered.refs(),
+            f"{meaning} ({protocol.hex_bytes(self.wanted)}) was not sent {_span(start, end)}",
         )
-    return ExpectationResult(
-        expectation, False,
-        f"{meaning} ({protocol.hex_bytes(wanted)}) was not sent {_span(start, end)}",
-    )
 
 
-def _judge_reached_point(expectation, evidence, traffic, start, end) -> ExpectationResult:
-    point = expectation.point
-    accepted_at = None
-    running_seen = False
-    progress = f"run-point {point} was not sent and answered {_span(start, end)}"
-    for exchange in traffic.exchanges:
-        t = exchange.request.t_start_us
-        if t < start or t > end or not exchange.answered:
-            continue
-        request = exchange.decoded_request
+class _ReachedPoint(ExchangeWatch):
+    """`reached_point`: run point N accepted, its task seen running, then finished (idle,
+    with no error that stops a task) inside the window."""
+
+    def __init__(self, expectation: Expectation, settings):
+        super().__init__(expectation, settings)
+        self.accepted_at: int | None = None
+        self.running_seen = False
+        self.progress: tuple = ("not sent",)  # how far it got, worded in `result`
+        self.reached = None  # (t, exchange) of the task reported finished
+
+    def in_window(self, exchange, t: int) -> None:
+        if self.reached is not None or not exchange.answered:
+            return
+        point, request = self.expectation.point, exchange.decoded_request
         if isinstance(request, protocol.ControlRequest):
             if request.code == protocol.ControlCode.ROBOT and request.command == point:
-                accepted_at, running_seen = t, False
-                progress = f"run-point {point} accepted at {format_seconds(t)}, but the robot never reported the task running"
-            elif accepted_at is not None:
-                accepted_at = None
-                progress = f"run-point {point} was superseded by {protocol.describe(request, evidence.settings)} at {format_seconds(t)}"
-            continue
-        if accepted_at is None or request.query != protocol.Query.TASK:
-            continue
-        reply = protocol.decode_reply(exchange.reply.data, evidence.settings, request)
+                self.accepted_at, self.running_seen = t, False
+                self.progress = ("accepted", t)
+            elif self.accepted_at is not None:
+                self.accepted_at = None
+                self.progress = ("superseded", protocol.describe(request, self.settings), t)
+            return
+        if self.accepted_at is None or request.query != protocol.Query.TASK:
+            return
+        reply = protocol.decode_reply(exchange.reply.data, self.settings, request)
         if reply.value == 1:
-            running_seen = True
-            progress = f"run-point {point} was running (since {format_seconds(accepted_at)}) but did not finish {_span(start, end)}"
-        elif running_seen and reply.error not in TASK_STOPPING_ERRORS:
+            self.running_seen = True
+            self.progress = ("running", self.accepted_at)
+        elif self.running_seen and reply.error not in TASK_STOPPING_ERRORS:
+            self.reached = (t, exchange)
+        elif self.running_seen:
+            self.progress = ("stopped", int(reply.error), t)
+
+    def result(self, start: int, end: int) -> ExpectationResult:
+        point = self.expectation.point
+        if self.reached is not None:
+            t, exchange = self.reached
             return ExpectationResult(
-                expectation, True, f"point {point} reached: task idle at {format_seconds(t)}", t, exchange.refs()
+                self.expectation, True, f"point {point} reached: task idle at {format_seconds(t)}", t, exchange.refs()
             )
-        elif running_seen:
-            progress = f"the task of run-point {point} ended with error {int(reply.error):02d} at {format_seconds(t)}"
-    return ExpectationResult(expectation, False, progress)
+        kind, *args = self.progress
+        if kind == "accepted":
+            why = f"run-point {point} accepted at {format_seconds(args[0])}, but the robot never reported the task running"
+        elif kind == "superseded":
+            why = f"run-point {point} was superseded by {args[0]} at {format_seconds(args[1])}"
+        elif kind == "running":
+            why = f"run-point {point} was running (since {format_seconds(args[0])}) but did not finish {_span(start, end)}"
+        elif kind == "stopped":
+            why = f"the task of run-point {point} ended with error {args[0]:02d} at {format_seconds(args[1])}"
+        else:
+            why = f"run-point {point} was not sent and answered {_span(start, end)}"
+        return ExpectationResult(self.expectation, False, why)
