@@ -1,10 +1,13 @@
 """A monitoring session: chunks in, classified frames and the verifier's findings out.
 
-The rules are `uitamr verify`'s own (`verifier.verify.rules.check_all` over a
-`RunEvidence`); only the evidence differs: frames timed by the host instead of the
-simulator, no PLC variables. `check` re-judges the whole capture and returns the findings
-it has not returned before, so a live view can print each once; `result` is the final
-judgement, in the shape every report of `uitamr verify` reads.
+The rules are `uitamr verify`'s own (`verifier.verify.rules`, over a `RunEvidence`); only
+the evidence differs: frames timed by the host instead of the simulator, no PLC variables.
+`check` judges the frames the line has settled since the last call (a request whose reply
+or time-out is known; the next frame may still come at any time, so a reply time-out and
+the frames at the line's last instant stay open) and returns the findings they make, so a
+live view prints each once and a long session does not judge its whole past again at
+every call; `result` is the final judgement, in the shape every report of `uitamr
+verify` reads, and the same as judging the whole capture at once (`violations`).
 """
 from __future__ import annotations
 
@@ -13,14 +16,15 @@ from dataclasses import dataclass, field, replace
 from verifier import protocol
 from verifier.verify.evidence import RuleOptions, RunEvidence, Violation
 from verifier.verify.result import ScenarioResult, TraceRecord
-from verifier.verify.rules import check_all
-from verifier.verify.traffic import analyse
+from verifier.verify.rules import Judgement, check_all
+from verifier.verify.traffic import Pairing, analyse
 
 from .capture import Chunk
 from .classify import Classifier
 from .framer import Framer, LineTiming
 
 POWER_ON_RULE = "UITAMR-POWERON-STOP"
+PROVISIONAL_RULE = "UITAMR-RESPONSE-HANDLING"  # the one rule with early word (Judgement.provisional)
 
 
 @dataclass
@@ -47,12 +51,23 @@ class MonitorSession:
         self.chunks: list[Chunk] = []
         self.frames: list[TraceRecord] = []
         self._origin_us: int | None = None  # host time of the first byte: t = 0 in reports
-        self._reported: set[tuple[str, int]] = set()
         self.last_us = 0
+        # the live judgement: frames go to the pairing once no frame still to come can sort
+        # before them (they start before the end of the latest frame), the rules judge what
+        # the pairing has settled
+        self._pairing = Pairing(settings, self.options)
+        self._evidence = RunEvidence(settings, self.frames, 0, (), options=self.options)
+        self._judgement = Judgement(self._evidence, self._pairing.traffic)
+        self.judged_frames = 0  # frames handed to the rules (each once)
+        self._line_end_us: int | None = None  # the end of the latest frame
+        self._in_line_order = True  # every frame started after the one before it ended
+        self._closed = False
+        self._shown: set = set()  # early findings (Judgement.provisional) check has returned
 
     # --- input ---------------------------------------------------------------------------
     def feed(self, chunk: Chunk) -> list[TraceRecord]:
         """Take the next chunk (host times in µs, any origin); the frames it completed."""
+        self._open()
         if self._origin_us is None:
             self._origin_us = (chunk.t_start_us if chunk.t_start_us is not None
                                else chunk.t_us - self.timing.frame_us(len(chunk.data)))
@@ -64,25 +79,39 @@ class MonitorSession:
 
     def poll(self, host_us: int) -> list[TraceRecord]:
         """Frames ended by silence up to host time `host_us`."""
+        self._open()
         if self._origin_us is None:
             return []
         now = host_us - self._origin_us
         self.last_us = max(self.last_us, now)
         return self._take(self.framer.poll(now))
 
+    def _open(self) -> None:
+        if self._closed:
+            raise RuntimeError("the monitoring session has ended: it takes no more bytes")
+
     def close(self) -> list[TraceRecord]:
-        return self._take(self.framer.flush())
+        """The end of the capture: the pending bytes as a frame; nothing more comes."""
+        frames = self._take(self.framer.flush())
+        self._closed = True
+        return frames
 
     def _take(self, frames) -> list[TraceRecord]:
         records = []
         for frame in frames:
             direction = self.classifier.direction(frame)
-            records.append(TraceRecord(frame.t_start_us, frame.t_end_us, direction, frame.data))
+            record = TraceRecord(frame.t_start_us, frame.t_end_us, direction, frame.data)
+            if self._line_end_us is not None and record.t_start_us < self._line_end_us:
+                self._in_line_order = False  # frames of a trace that overlap: judged as a whole at the end
+            self._line_end_us = max(record.t_end_us, self._line_end_us or record.t_end_us)
+            records.append(record)
         self.frames += records
         return records
 
     # --- judgement -----------------------------------------------------------------------
     def violations(self, end_us: int | None = None) -> dict[str, list[Violation]]:
+        """The whole capture judged at once, as if it ended at `end_us` (default: the latest
+        byte or poll)."""
         end = self.last_us if end_us is None else end_us
         evidence = RunEvidence(self.settings, self.frames, end, (), options=self.options)
         found = check_all(evidence, analyse(self.frames, self.settings, self.options))
@@ -91,15 +120,73 @@ class MonitorSession:
         return found
 
     def check(self) -> list[Violation]:
-        """Findings not returned by an earlier call, in time order."""
-        new = []
-        for violations in self.violations().values():
-            for violation in violations:
-                key = (violation.rule, violation.t_us)
-                if key not in self._reported:
-                    self._reported.add(key)
-                    new.append(violation)
-        return sorted(new, key=lambda v: (v.t_us, v.rule))
+        """Findings not returned by an earlier call, in time order: each violation once it is
+        final (no frame still to come can change it; after `close`, all the rest), and early
+        word of replies that are still failing after the bound of UITAMR-RESPONSE-HANDLING
+        (its final finding is then not returned again)."""
+        self._evidence.end_us = self.last_us  # the run lasts at least this long
+        if not self._in_line_order:
+            new = self._judged_whole() if self._closed else []
+        elif self._closed:
+            self._give(len(self.frames))
+            new = self._judgement.finish()
+        else:
+            self._give(self._ready())
+            settled = self._pairing.settled(self._line_end_us)
+            new = self._judgement.advance(settled)
+            # what is still open goes on at least until the first request not settled has
+            # ended (its reply starts after it) or, when all are, until the line's last frame
+            exchanges = self._pairing.traffic.exchanges
+            open_until = exchanges[settled].request.t_end_us if settled < len(exchanges) else self._line_end_us
+            new += self._judgement.provisional(open_until)
+        shown = []
+        for violation in new:
+            if violation.rule == POWER_ON_RULE and not self.from_power_on:
+                continue
+            if violation.rule == PROVISIONAL_RULE:
+                key = (violation.rule, violation.t_us, violation.frames)
+                if key in self._shown:
+                    continue
+                self._shown.add(key)
+            shown.append(violation)
+        return sorted(shown, key=lambda v: (v.t_us, v.rule))
+
+    def _ready(self) -> int:
+        """How many frames (from the first) no frame still to come can sort before: those
+        that started before the latest frame ended."""
+        ready = self.judged_frames
+        while ready < len(self.frames) and self.frames[ready].t_start_us < self._line_end_us:
+            ready += 1
+        return ready
+
+    def _give(self, upto: int) -> None:
+        """Hand frames up to `upto` to the pairing, in `analyse`'s order."""
+        for frame in sorted(self.frames[self.judged_frames:upto], key=lambda f: (f.t_start_us, f.direction != "tx")):
+            if frame.direction == "tx":
+                self._pairing.request(frame)
+            elif frame.direction == "rx":
+                self._pairing.reply(frame)
+        self.judged_frames = max(self.judged_frames, upto)
+
+    def _judged_whole(self) -> list[Violation]:
+        """Frames that overlap (only a trace file's can; bytes from a line never do) make the
+        pairing of earlier frames change with later ones: the whole capture is judged once,
+        at the end (findings an earlier check returned come again)."""
+        if self._judgement.finished:
+            return []
+        self._judgement.finished = True
+        self._judgement.found = self.violations()
+        self.judged_frames = len(self.frames)
+        return [v for found in self._judgement.found.values() for v in found]
+
+    def _final(self) -> dict[str, list[Violation]]:
+        if not self._judgement.finished:
+            self._closed = True
+            self.check()
+        found = self._judgement.violations()
+        if not self.from_power_on:
+            found[POWER_ON_RULE] = []
+        return found
 
     def result(self) -> ScenarioResult:
         end = self.last_us
@@ -125,7 +212,7 @@ class MonitorSession:
             min_period_us=self.options.min_period_us,
             reply_timeout_us=self.options.reply_timeout_us,
             trace=list(self.frames),
-            violations=self.violations(end),
+            violations=self._final(),
             ended_us=end,
             notes=notes,
         )

@@ -10,7 +10,7 @@ from __future__ import annotations
 import enum
 from bisect import bisect_left, bisect_right
 from dataclasses import dataclass, field
-from functools import cached_property, lru_cache
+from functools import lru_cache
 from typing import Sequence
 
 from verifier import protocol
@@ -176,22 +176,16 @@ class Traffic:
     rx_before_first_request: list[TraceFrameLike]
     rx: list[TraceFrameLike]
     tx: list[TraceFrameLike]
+    # robot frames by start time -> the exchanges they joined (Pairing keeps it up to date)
+    owners: dict[int, list[Exchange]] = field(default_factory=dict, repr=False)
 
     def request_of(self, frame: TraceFrameLike):
         """The decoded request a robot frame was paired with (None before the first request,
         or when that request is not valid), so every report describes a reply the same way."""
-        for exchange in self._owners.get(frame.t_start_us, ()):
+        for exchange in sorted(self.owners.get(frame.t_start_us, ()), key=lambda e: e.index):
             if any(f is frame for f in exchange.rx):
                 return exchange.decoded_request
         return None
-
-    @cached_property
-    def _owners(self) -> dict[int, list[Exchange]]:
-        owners: dict[int, list[Exchange]] = {}
-        for exchange in self.exchanges:
-            for frame in exchange.rx:
-                owners.setdefault(frame.t_start_us, []).append(exchange)
-        return owners
 
 
 def _is_reply_to(frame: TraceFrameLike, exchange: Exchange) -> bool:
@@ -207,42 +201,88 @@ def converter_drops(events) -> list[int]:
     return [e.t_us for e in events if e.kind == "converter.dropped"]
 
 
-def analyse(trace: Sequence[TraceFrameLike], settings: protocol.Settings, options: RuleOptions,
-            dropped_at: Sequence[int] = ()) -> Traffic:
-    """Pair requests and replies the way a slave answers: once per request, in order.
+class Pairing:
+    """Requests and robot frames paired as they come, the way a slave answers: once per
+    request, in order.
 
     A robot frame goes to the oldest request that has ended, has no reply yet and whose
     time-out has not run out — preferring one it is a valid reply to. When no request is
     waiting, it joins the latest request that ended before it (a late reply, garbage).
-    `dropped_at`: times a converter dropped the connection (`converter_drops`); the first
-    request at or after each is one whose reply the PLC never got (ReplyStatus.LOST).
+
+    Frames are given in `analyse`'s order (by start; a request before a robot frame that
+    starts at the same time). A live monitor gives them as the line settles them: when
+    requests never overlap (every frame starts after the one before it ended, as on a
+    half-duplex line) each frame's pairing is then final as soon as it is given, and
+    `settled` says how many exchanges no later frame can change.
     """
-    frames = sorted(trace, key=lambda f: (f.t_start_us, f.direction != "tx"))
-    tx = [f for f in frames if f.direction == "tx"]
-    rx = [f for f in frames if f.direction == "rx"]
-    exchanges = [
-        Exchange(index, frame, [], settings, options.reply_timeout_us) for index, frame in enumerate(tx)
-    ]
-    before: list[TraceFrameLike] = []
-    ends = [e.request.t_end_us for e in exchanges]
-    oldest = 0  # exchanges before this one are answered or timed out for good
-    for frame in rx:
+
+    def __init__(self, settings: protocol.Settings, options: RuleOptions):
+        self.settings = settings
+        self.reply_timeout_us = options.reply_timeout_us
+        self.traffic = Traffic([], [], [], [])
+        self._ends: list[int] = []  # when each request ended
+        self._oldest = 0  # exchanges before this one are answered or timed out for good
+        self._settled = 0
+
+    def request(self, frame: TraceFrameLike) -> None:
+        traffic = self.traffic
+        traffic.exchanges.append(Exchange(len(traffic.exchanges), frame, [], self.settings, self.reply_timeout_us))
+        traffic.tx.append(frame)
+        self._ends.append(frame.t_end_us)
+
+    def reply(self, frame: TraceFrameLike) -> None:
+        """A robot frame (every request that starts before it must have been given)."""
+        traffic, exchanges = self.traffic, self.traffic.exchanges
+        traffic.rx.append(frame)
         t = frame.t_start_us
-        count = bisect_right(ends, t)  # requests that ended before this frame began
+        count = bisect_right(self._ends, t)  # requests that ended before this frame began
         if count == 0:
-            before.append(frame)
-            continue
-        while oldest < count and (exchanges[oldest].rx or exchanges[oldest].deadline_us < t):
-            oldest += 1
-        waiting = [e for e in exchanges[oldest:count] if not e.rx and t <= e.deadline_us]
+            traffic.rx_before_first_request.append(frame)
+            return
+        while self._oldest < count and (exchanges[self._oldest].rx or exchanges[self._oldest].deadline_us < t):
+            self._oldest += 1
+        waiting = [e for e in exchanges[self._oldest:count] if not e.rx and t <= e.deadline_us]
         if waiting:
             owner = next((e for e in waiting if _is_reply_to(frame, e)), waiting[0])
         else:
             owner = exchanges[count - 1]
         owner.rx.append(frame)
+        traffic.owners.setdefault(t, []).append(owner)
+
+    def settled(self, frontier_us: int) -> int:
+        """How many exchanges, from the first, are final when no frame still to come starts
+        before `frontier_us`: each has its reply, or its time-out ran out before the frontier
+        and the next request ended (so no late reply can become its first robot frame)."""
+        exchanges, ends = self.traffic.exchanges, self._ends
+        k = self._settled
+        while k < len(exchanges):
+            if not exchanges[k].rx and (frontier_us <= exchanges[k].deadline_us or k + 1 == len(exchanges)
+                                        or ends[k + 1] > frontier_us):
+                break
+            k += 1
+        self._settled = k
+        return k
+
+
+def analyse(trace: Sequence[TraceFrameLike], settings: protocol.Settings, options: RuleOptions,
+            dropped_at: Sequence[int] = ()) -> Traffic:
+    """The whole trace paired (`Pairing`), every request known before the first reply.
+
+    `dropped_at`: times a converter dropped the connection (`converter_drops`); the first
+    request at or after each is one whose reply the PLC never got (ReplyStatus.LOST).
+    """
+    frames = sorted(trace, key=lambda f: (f.t_start_us, f.direction != "tx"))
+    pairing = Pairing(settings, options)
+    for frame in frames:
+        if frame.direction == "tx":
+            pairing.request(frame)
+    for frame in frames:
+        if frame.direction == "rx":
+            pairing.reply(frame)
+    exchanges = pairing.traffic.exchanges
     starts = [e.request.t_start_us for e in exchanges]
     for t in dropped_at:
         k = bisect_left(starts, t)
         if k < len(exchanges):
             exchanges[k].lost_at_converter = True
-    return Traffic(exchanges, before, rx, tx)
+    return pairing.traffic

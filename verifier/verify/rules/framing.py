@@ -3,21 +3,22 @@ from __future__ import annotations
 
 from bisect import bisect_right
 from functools import lru_cache
+from typing import Iterator
 
 from verifier import protocol
 
 from ..evidence import RunEvidence, Violation
 from ..traffic import Traffic, frame_ref
+from .judge import Judge
 
 
-def check_crc(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
-    violations = []
-    for frame in traffic.tx:
+class Crc(Judge):
+    def request(self, index: int) -> Iterator[Violation]:
+        frame = self.traffic.tx[index]
         message = _crc_problem(bytes(frame.data))
         if message is not None:
-            ref = frame_ref(frame, evidence.settings)
-            violations.append(Violation("UITAMR-CRC", frame.t_start_us, message, (ref,), frame.origin))
-    return violations
+            ref = frame_ref(frame, self.evidence.settings)
+            yield Violation("UITAMR-CRC", frame.t_start_us, message, (ref,), frame.origin)
 
 
 @lru_cache(maxsize=4096)
@@ -39,30 +40,25 @@ def _crc_problem(data: bytes) -> str | None:
     return message
 
 
-def check_format(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
+class Format(Judge):
     """Judge the layout of each request; a bad CRC is UITAMR-CRC's business, not this rule's."""
-    settings = evidence.settings
-    violations = []
-    gaps = _gap_events(evidence.events)
-    for frame in traffic.tx:
-        problem = _layout_problem(bytes(frame.data), settings)
-        gap = _gap_inside(frame, gaps)
+
+    def __init__(self, evidence: RunEvidence, traffic: Traffic):
+        super().__init__(evidence, traffic)
+        self.gaps = _gap_events(evidence.events)
+
+    def request(self, index: int) -> Iterator[Violation]:
+        frame = self.traffic.tx[index]
+        problem = _layout_problem(bytes(frame.data), self.evidence.settings)
+        gap = _gap_inside(frame, self.gaps)
         if gap is not None and problem is None:
             problem = (
                 f"{gap.message}; a Modbus RTU frame must be sent as one continuous stream "
                 f"(at most t1.5 = {protocol.T1_5_US / 1000:.2f} ms between bytes)"
             )
         if problem:
-            violations.append(
-                Violation(
-                    "UITAMR-FORMAT",
-                    frame.t_start_us,
-                    problem,
-                    (frame_ref(frame, settings),),
-                    frame.origin,
-                )
-            )
-    return violations
+            yield Violation("UITAMR-FORMAT", frame.t_start_us, problem,
+                            (frame_ref(frame, self.evidence.settings),), frame.origin)
 
 
 @lru_cache(maxsize=4096)

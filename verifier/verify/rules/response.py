@@ -12,10 +12,12 @@ from __future__ import annotations
 from bisect import bisect_right
 from collections import Counter
 from dataclasses import dataclass, field
+from typing import Iterator
 
 from ..durations import format_seconds
 from ..evidence import RunEvidence, Violation
 from ..traffic import Exchange, ReplyStatus, Traffic
+from .judge import Judge
 
 
 @dataclass
@@ -36,36 +38,50 @@ class Episode:
         return ", ".join(f"{kind} ×{count}" for kind, count in counts.items())
 
 
-def episodes(traffic: Traffic) -> list[Episode]:
-    found: list[Episode] = []
-    current: Episode | None = None
-    for exchange in traffic.exchanges:
+class ResponseHandling(Judge):
+    def __init__(self, evidence: RunEvidence, traffic: Traffic):
+        super().__init__(evidence, traffic)
+        options = evidence.options
+        self.spans = []  # when the signal held: [(began, stopped)], computed once for every episode
+        if options.response_signal is not None:
+            self.spans = evidence.samples.intervals(options.response_signal, evidence.end_us)
+        self.stops = [stopped for _, stopped in self.spans]
+        self.current: Episode | None = None  # the episode the latest exchange is in
+        self._told: Episode | None = None  # the episode `provisional` has spoken of
+
+    def exchange(self, index: int) -> Iterator[Violation]:
+        exchange = self.traffic.exchanges[index]
         if exchange.answered:
-            if current is not None:
-                current.end_us = exchange.reply.t_end_us
-                current = None
-            continue
-        if current is None:
-            current = Episode()
-            found.append(current)
-        current.exchanges.append(exchange)
-    return found
+            if self.current is not None:
+                episode, self.current = self.current, None
+                episode.end_us = exchange.reply.t_end_us
+                yield from self._judge(episode, self.evidence.end_us)
+            return
+        if self.current is None:
+            self.current = Episode()
+        self.current.exchanges.append(exchange)
 
+    def finish(self) -> Iterator[Violation]:
+        if self.current is not None:
+            yield from self._judge(self.current, self.evidence.end_us)
 
-def check_response_handling(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
-    options = evidence.options
-    within = options.response_within_us
-    violations = []
-    spans = []  # when the signal held: [(began, stopped)], computed once for every episode
-    if options.response_signal is not None:
-        spans = evidence.samples.intervals(options.response_signal, evidence.end_us)
-    stops = [stopped for _, stopped in spans]
-    for episode in episodes(traffic):
+    def provisional(self, end_us: int) -> Iterator[Violation]:
+        """Replies failing for longer than the bound, still going on: said once per episode."""
+        if self.current is not None and self.current is not self._told:
+            for violation in self._judge(self.current, end_us):
+                self._told = self.current
+                yield violation
+
+    def _judge(self, episode: Episode, run_end_us: int) -> Iterator[Violation]:
+        """The episode's violation, if the run ended at `run_end_us` (at or after the end of a
+        closed episode: an episode is judged when it closes or when the run ends)."""
+        options = self.evidence.options
+        within = options.response_within_us
         start = episode.noticeable_us
         bound = start + within
-        end = evidence.end_us if episode.end_us is None else episode.end_us
-        if end <= bound or evidence.end_us < bound:
-            continue  # recovered in time (or the run ended before the bound: nothing to judge)
+        end = run_end_us if episode.end_us is None else episode.end_us
+        if end <= bound or run_end_us < bound:
+            return  # recovered in time (or the run ended before the bound: nothing to judge)
         first = episode.exchanges[0]
         lasted = "until the end of the run" if episode.end_us is None else f"until {format_seconds(end)}"
         if not options.outputs_visible:
@@ -81,21 +97,18 @@ def check_response_handling(evidence: RunEvidence, traffic: Traffic) -> list[Vio
                 f"[response_handling] signal in the scenario or --response-signal (e.g. \"o_bErr\")"
             )
         else:
-            index = bisect_right(stops, start)  # the first span still running after `start`
-            if index < len(spans) and spans[index][0] <= bound:
-                continue
+            index = bisect_right(self.stops, start)  # the first span still running after `start`
+            if index < len(self.spans) and self.spans[index][0] <= bound:
+                return
             message = (
                 f"the robot's replies failed from {format_seconds(start)} {lasted} "
                 f"({episode.summary()}), but '{options.response_signal}' did not become true "
                 f"within {within / 1_000_000:g} s"
             )
-        violations.append(
-            Violation(
-                "UITAMR-RESPONSE-HANDLING",
-                start,
-                message,
-                first.refs(),
-                first.request.origin,
-            )
+        yield Violation(
+            "UITAMR-RESPONSE-HANDLING",
+            start,
+            message,
+            first.refs(),
+            first.request.origin,
         )
-    return violations

@@ -5,28 +5,35 @@ ignore are the business of UITAMR-CRC and UITAMR-FORMAT.
 """
 from __future__ import annotations
 
+from typing import Iterator
+
 from verifier import protocol
 
 from ..evidence import RunEvidence, Violation
 from ..traffic import Traffic
+from .judge import Judge
 
 STOP_HEX = protocol.hex_bytes(protocol.STOP_FRAME)
 
 
-def check_power_on_stop(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
-    settings = evidence.settings
-    stop_sent = False
-    for exchange in traffic.exchanges:
-        if not exchange.is_control:
-            continue
+class PowerOnStop(Judge):
+    def __init__(self, evidence: RunEvidence, traffic: Traffic):
+        super().__init__(evidence, traffic)
+        self.stop_sent = False
+        self.decided = False  # the stop was answered, or the first violation found: nothing more to judge
+
+    def exchange(self, index: int) -> Iterator[Violation]:
+        exchange = self.traffic.exchanges[index]
+        if self.decided or not exchange.is_control:
+            return
+        settings = self.evidence.settings
         request = exchange.decoded_request
         if protocol.is_stop_command(request, settings):
-            if exchange.answered:
-                return []
-            stop_sent = True
-            continue
+            self.decided = exchange.answered
+            self.stop_sent = True
+            return
         meaning = protocol.describe(request, settings)
-        if stop_sent:
+        if self.stop_sent:
             message = (
                 f"control command {meaning} sent before the robot acknowledged the stop command; "
                 "repeat the stop until it is answered"
@@ -36,47 +43,44 @@ def check_power_on_stop(evidence: RunEvidence, traffic: Traffic) -> list[Violati
                 f"the first control command after power-on is {meaning}; it must be the stop "
                 f"command 01/A0 ({STOP_HEX} at address 1)"
             )
-        return [
-            Violation(
-                "UITAMR-POWERON-STOP",
-                exchange.request.t_start_us,
-                message,
-                exchange.refs(),
-                exchange.request.origin,
-            )
-        ]
-    return []
+        self.decided = True
+        yield Violation(
+            "UITAMR-POWERON-STOP",
+            exchange.request.t_start_us,
+            message,
+            exchange.refs(),
+            exchange.request.origin,
+        )
 
 
-def check_cycle(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
-    settings = evidence.settings
-    violations = []
-    last_control = None
-    status_read = False
-    for exchange in traffic.exchanges:
+class Cycle(Judge):
+    def __init__(self, evidence: RunEvidence, traffic: Traffic):
+        super().__init__(evidence, traffic)
+        self.last_control = None
+        self.status_read = False
+
+    def exchange(self, index: int) -> Iterator[Violation]:
+        exchange = self.traffic.exchanges[index]
         if exchange.is_status:
-            status_read = status_read or exchange.answered
-            continue
+            self.status_read = self.status_read or exchange.answered
+            return
         if not exchange.is_control:
-            continue
+            return
+        settings, last_control = self.evidence.settings, self.last_control
         retry = (
             last_control is not None
             and not last_control.answered
             and bytes(last_control.request.data) == bytes(exchange.request.data)
         )
-        if last_control is not None and not status_read and not retry:
-            violations.append(
-                Violation(
-                    "UITAMR-CYCLE",
-                    exchange.request.t_start_us,
-                    f"control command {protocol.describe(exchange.decoded_request, settings)} "
-                    f"follows {protocol.describe(last_control.decoded_request, settings)} "
-                    f"with no status read answered in between",
-                    last_control.refs() + exchange.refs(),
-                    exchange.request.origin,
-                )
+        if last_control is not None and not self.status_read and not retry:
+            yield Violation(
+                "UITAMR-CYCLE",
+                exchange.request.t_start_us,
+                f"control command {protocol.describe(exchange.decoded_request, settings)} "
+                f"follows {protocol.describe(last_control.decoded_request, settings)} "
+                f"with no status read answered in between",
+                last_control.refs() + exchange.refs(),
+                exchange.request.origin,
             )
-        last_control = exchange
-        status_read = False
-    return violations
-
+        self.last_control = exchange
+        self.status_read = False

@@ -2,48 +2,51 @@
 from __future__ import annotations
 
 from bisect import bisect_right
+from typing import Iterator
 
 from verifier import protocol
 
 from ..evidence import RunEvidence, Violation
 from ..traffic import Traffic, frame_ref
+from .judge import Judge
 
 
 def _ms(t_us: int) -> str:
     return f"{t_us / 1000:.1f} ms"
 
 
-def check_pacing(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
-    minimum = evidence.options.min_period_us
-    tolerance = evidence.options.timing_tolerance_us
-    violations = []
-    for previous, frame in zip(traffic.tx, traffic.tx[1:]):
+class Pacing(Judge):
+    def request(self, index: int) -> Iterator[Violation]:
+        if index == 0:
+            return
+        options, tx = self.evidence.options, self.traffic.tx
+        previous, frame = tx[index - 1], tx[index]
         gap = frame.t_start_us - previous.t_start_us
-        if gap + tolerance <= minimum:
-            violations.append(
-                Violation(
-                    "UITAMR-PACING",
-                    frame.t_start_us,
-                    f"request started {_ms(gap)} after the start of the previous request; "
-                    f"the period must be more than {_ms(minimum)}",
-                    (frame_ref(previous, evidence.settings), frame_ref(frame, evidence.settings)),
-                    frame.origin,
-                )
+        if gap + options.timing_tolerance_us <= options.min_period_us:
+            yield Violation(
+                "UITAMR-PACING",
+                frame.t_start_us,
+                f"request started {_ms(gap)} after the start of the previous request; "
+                f"the period must be more than {_ms(options.min_period_us)}",
+                (frame_ref(previous, self.evidence.settings), frame_ref(frame, self.evidence.settings)),
+                frame.origin,
             )
-    return violations
 
 
-def check_half_duplex(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
-    settings = evidence.settings
-    violations = []
-    rx_starts = [rx.t_start_us for rx in traffic.rx]
-    tolerance = evidence.options.timing_tolerance_us
-    for position, frame in enumerate(traffic.tx):
+class HalfDuplex(Judge):
+    def __init__(self, evidence: RunEvidence, traffic: Traffic):
+        super().__init__(evidence, traffic)
+        self.rx_starts: list[int] = []  # of traffic.rx, as far as it has been read
+
+    def exchange(self, index: int) -> Iterator[Violation]:
+        settings, traffic = self.evidence.settings, self.traffic
+        self.rx_starts += [rx.t_start_us for rx in traffic.rx[len(self.rx_starts):]]
+        frame = traffic.tx[index]
         start = frame.t_start_us
-        judged = start + tolerance  # host timestamps (captures): blame only what is certain
+        judged = start + self.evidence.options.timing_tolerance_us  # host timestamps (captures): blame only what is certain
         blamed = None
-        if position > 0:
-            previous = traffic.exchanges[position - 1]
+        if index > 0:
+            previous = traffic.exchanges[index - 1]
             reply = previous.reply
             if reply is not None and reply.t_start_us <= previous.deadline_us:
                 if judged < reply.t_start_us:
@@ -55,7 +58,7 @@ def check_half_duplex(evidence: RunEvidence, traffic: Traffic) -> list[Violation
                     blamed = (reply, f"only {_ms(start - reply.t_end_us)} after the reply ended; the "
                               f"line needs {_ms(protocol.T3_5_US)} (3.5 characters) of silence")
         if blamed is None:
-            rx = _last_robot_frame_before(traffic.rx, rx_starts, start)
+            rx = _last_robot_frame_before(traffic.rx, self.rx_starts, start)
             if rx is not None and judged < rx.t_end_us:
                 blamed = (rx, "while a frame from the robot was arriving")
             elif rx is not None and judged < rx.t_end_us + protocol.T3_5_US:
@@ -63,17 +66,14 @@ def check_half_duplex(evidence: RunEvidence, traffic: Traffic) -> list[Violation
                           f"ended; the line needs {_ms(protocol.T3_5_US)} of silence")
         if blamed:
             rx, why = blamed
-            violations.append(
-                Violation(
-                    "UITAMR-HALF-DUPLEX",
-                    start,
-                    f"the PLC started transmitting {why}",
-                    tuple(sorted((frame_ref(rx, settings, request=traffic.request_of(rx)),
-                                  frame_ref(frame, settings)), key=lambda ref: ref.t_us)),
-                    frame.origin,
-                )
+            yield Violation(
+                "UITAMR-HALF-DUPLEX",
+                start,
+                f"the PLC started transmitting {why}",
+                tuple(sorted((frame_ref(rx, settings, request=traffic.request_of(rx)),
+                              frame_ref(frame, settings)), key=lambda ref: ref.t_us)),
+                frame.origin,
             )
-    return violations
 
 
 def _last_robot_frame_before(rx: list, starts: list[int], t_us: int):
@@ -82,14 +82,15 @@ def _last_robot_frame_before(rx: list, starts: list[int], t_us: int):
     return rx[index] if index >= 0 else None
 
 
-def check_one_at_a_time(evidence: RunEvidence, traffic: Traffic) -> list[Violation]:
-    settings = evidence.settings
-    violations = []
-    tolerance = evidence.options.timing_tolerance_us
-    for previous, current in zip(traffic.exchanges, traffic.exchanges[1:]):
+class OneAtATime(Judge):
+    def exchange(self, index: int) -> Iterator[Violation]:
+        if index == 0:
+            return
+        options = self.evidence.options
+        previous, current = self.traffic.exchanges[index - 1], self.traffic.exchanges[index]
         start = current.request.t_start_us
-        if start + tolerance >= previous.finished_us:
-            continue
+        if start + options.timing_tolerance_us >= previous.finished_us:
+            return
         reply = previous.reply
         if reply is not None and reply.t_start_us <= previous.deadline_us:
             why = "before the reply to the previous request had been received"
@@ -97,16 +98,13 @@ def check_one_at_a_time(evidence: RunEvidence, traffic: Traffic) -> list[Violati
             waited = start - previous.request.t_end_us
             why = (
                 f"{_ms(waited)} after the previous request with no reply yet; wait for the "
-                f"reply time-out ({_ms(evidence.options.reply_timeout_us)} after the request "
+                f"reply time-out ({_ms(options.reply_timeout_us)} after the request "
                 f"ended) before sending again"
             )
-        violations.append(
-            Violation(
-                "UITAMR-ONE-AT-A-TIME",
-                start,
-                f"a new request started {why}",
-                previous.refs() + (frame_ref(current.request, settings),),
-                current.request.origin,
-            )
+        yield Violation(
+            "UITAMR-ONE-AT-A-TIME",
+            start,
+            f"a new request started {why}",
+            previous.refs() + (frame_ref(current.request, self.evidence.settings),),
+            current.request.origin,
         )
-    return violations
