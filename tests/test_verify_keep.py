@@ -1,7 +1,7 @@
-"""A run that keeps neither its frames nor its watched labels' changes (what `uitamr
-verify` does when no report lists them: verifier.verify.result.Keep) reaches the same
-verdict, findings, expectations, notes and frame counts as one that keeps everything,
-and every report it can feed reads the same."""
+"""A run that keeps neither its frames nor its watched labels' changes and events (what
+`uitamr verify` does when no report lists them: verifier.verify.result.Keep) reaches the
+same verdict, findings, expectations, notes and frame counts as one that keeps
+everything, and every report it can feed reads the same."""
 from __future__ import annotations
 
 import io
@@ -22,7 +22,7 @@ from verifier.verify.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIOS = sorted((ROOT / "plc" / "scenarios").glob("*.toml"))
-NOTHING = Keep(frames=False, watched=False)
+NOTHING = Keep(frames=False, details=False)
 
 
 def _console(result) -> str:
@@ -42,10 +42,10 @@ def test_keeping_nothing_changes_no_finding(path, tmp_path):
     scenario = load_scenario(path)
     full = run_scenario(scenario)
     lean = run_scenario(scenario, keep=NOTHING)
-    assert lean.trace == [] and lean.watched == {}
+    assert lean.trace == [] and lean.watched == {} and lean.events == []
     assert (lean.tx_count, lean.rx_count) == (full.tx_count, full.rx_count)
     assert full.tx_count == sum(f.direction == "tx" for f in full.trace) and full.tx_count > 0
-    for field in ("violations", "expectations", "notes", "events", "aborted", "ended_us", "diagnostics"):
+    for field in ("violations", "expectations", "notes", "aborted", "ended_us", "diagnostics"):
         assert getattr(lean, field) == getattr(full, field), field
     full.wall_s = lean.wall_s = 0.0
     assert _console(lean) == _console(full)
@@ -53,15 +53,17 @@ def test_keeping_nothing_changes_no_finding(path, tmp_path):
     lean_json, full_json = to_dict([lean]), to_dict([full])
     for data in (lean_json, full_json):
         data["scenarios"][0].pop("watched")
+        data["scenarios"][0].pop("line_events")
     assert lean_json == full_json
 
 
-def test_watched_changes_are_kept_without_the_frames():
+def test_watched_changes_and_events_are_kept_without_the_frames():
     scenario = load_scenario(ROOT / "plc" / "scenarios" / "fx3u-healthy.toml")
     full = run_scenario(scenario)
-    watched_only = run_scenario(scenario, keep=Keep(frames=False, watched=True))
-    assert watched_only.watched == full.watched and full.watched["fbEngine.o_wTxCount"]
-    assert watched_only.trace == []
+    details_only = run_scenario(scenario, keep=Keep(frames=False, details=True))
+    assert details_only.watched == full.watched and full.watched["fbEngine.o_wTxCount"]
+    assert details_only.events == full.events and full.events
+    assert details_only.trace == []
 
 
 def _verify(*args, cwd):
@@ -70,13 +72,14 @@ def _verify(*args, cwd):
 
 
 def test_the_command_keeps_what_its_reports_list(tmp_path):
-    """--json lists the watched labels, --trace every frame: each still gets them when the
-    other is not asked for."""
+    """--json lists the watched labels and the events, --trace every frame: each still gets
+    them when the other is not asked for."""
     scenario = ROOT / "plc" / "scenarios" / "fx3u-healthy.toml"
     done = _verify("--scenario", scenario, "--json", tmp_path / "r.json", cwd=ROOT)
     assert done.returncode == 0, done.stdout + done.stderr
     data = json.loads((tmp_path / "r.json").read_text(encoding="utf-8"))["scenarios"][0]
     assert data["watched"]["fbEngine.o_wTxCount"][-1][1] == data["frames"]["tx"]
+    assert any(event["kind"] == "robot.task" for event in data["line_events"])
     done = _verify("--scenario", scenario, "--trace", tmp_path / "t.jsonl", cwd=ROOT)
     assert done.returncode == 0, done.stdout + done.stderr
     lines = (tmp_path / "t.jsonl").read_text(encoding="utf-8").splitlines()

@@ -318,7 +318,7 @@ def command(sources, program, platform, channel, response_signal, scenario_files
     progress = _LazyProgress(stderr, sum(s.duration_us for s in scenarios), stderr.is_terminal)
     try:
         # a run holds every frame and watched change only for the reports that list them
-        keep = Keep(frames=bool(trace_path or html_path), watched=bool(json_path or html_path))
+        keep = Keep(frames=bool(trace_path or html_path), details=bool(json_path or html_path))
         results = _run_all(scenarios, jobs, progress, every_scan, keep)
     except (ScenarioError, UnusableInput) as exc:
         progress.stop()

@@ -149,6 +149,7 @@ class Line:
         # before this time nothing can happen on the line (see the module docstring)
         self.quiet_until_us: int | float = 0
         self._offsets = [0]  # offset_us(k), computed once per k
+        self.settled_until_us = 0  # see take_settled
 
     # ---- the PLC's endpoint ----------------------------------------------------------------
 
@@ -245,6 +246,32 @@ class Line:
         frames = self.trace
         self._tx_frames, self._rx_frames = [], []
         return frames
+
+    def take_settled(self) -> list[TraceFrame]:
+        """The frames at the head of `trace` that nothing still to come on the line can
+        change or precede, handed over (the line lets go of them): each ended t3.5 or more
+        before the line's clock, so a PLC frame can no longer grow, and every frame still
+        to come starts later (a PLC send starts at the clock or after; a reply, t3.5 after
+        a request the robot has not yet heard in full). In `trace` order; `trace` then
+        starts at the first frame not handed over, and no frame still to come starts
+        before `settled_until_us`."""
+        limit = self.now_us - self._t35
+        frames = self.trace
+        count = 0
+        while count < len(frames) and frames[count].t_end_us <= limit:
+            count += 1
+        taken = frames[:count]
+        self.settled_until_us = min(self.now_us, frames[count].t_start_us) if count < len(frames) else self.now_us
+        tx = sum(1 for f in taken if f.direction == TX)
+        del self._tx_frames[:tx]
+        del self._rx_frames[:count - tx]
+        return taken
+
+    @property
+    def line_events(self) -> list[LineEvent]:
+        """The line's own events (collisions, gaps, discarded frames) in time order; the
+        list itself, not a copy."""
+        return self._events
 
     @property
     def events(self) -> list[LineEvent]:

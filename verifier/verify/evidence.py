@@ -70,8 +70,10 @@ class Samples:
         self.names = list(dict.fromkeys(names))
         self.changes: dict[str, list[tuple[int, Any]]] = {name: [] for name in self.names}
         self._times: dict[str, list[int]] = {name: [] for name in self.names}
+        self._spans: dict[Condition, Spans] = {}
 
     def record(self, t_us: int, values: dict[str, Any]) -> None:
+        changed = set()
         for name, value in values.items():
             if name not in self.changes:
                 self.names.append(name)
@@ -80,6 +82,20 @@ class Samples:
             if not history or history[-1][1] != value:
                 history.append((t_us, value))
                 self._times[name].append(t_us)
+                changed.add(name)
+        for spans in self._spans.values():
+            if not changed.isdisjoint(spans.names):
+                spans.moment(t_us, {name: self.value_at(name, t_us) for name in spans.names})
+
+    def spans(self, condition: Condition) -> "Spans":
+        """When `condition` held, as `intervals` says, kept up to date as samples come in
+        (a run judged as it goes asks before its first sample; a finished run, at the end)."""
+        spans = self._spans.get(condition)
+        if spans is None:
+            spans = self._spans[condition] = Spans(condition)
+            for t_us, values in self.states(condition.names):
+                spans.moment(t_us, values)
+        return spans
 
     def value_at(self, name: str, t_us: int) -> Any:
         index = bisect_right(self._times.get(name, []), t_us) - 1
@@ -132,6 +148,33 @@ class Samples:
         if began is not None:
             spans.append((began, end_us))
         return spans
+
+
+class Spans:
+    """The [began, stopped) stretches during which a condition held, built moment by moment
+    (`Samples.states`); a stretch still running has no stop yet."""
+
+    def __init__(self, condition: Condition):
+        self.condition = condition
+        self.names = condition.names
+        self.began: list[int] = []
+        self.stopped: list[int] = []  # one fewer than `began` while a stretch runs
+
+    def moment(self, t_us: int, values: dict[str, Any]) -> None:
+        if any(value is None for value in values.values()):
+            return  # not every name known yet (Samples.states starts when all are)
+        holds = self.condition.holds(values)
+        running = len(self.began) > len(self.stopped)
+        if holds and not running:
+            self.began.append(t_us)
+        elif not holds and running:
+            self.stopped.append(t_us)
+
+    def first_running_after(self, t_us: int) -> int | None:
+        """When the first stretch still running after `t_us` began (it may have begun
+        before), or None."""
+        index = bisect_right(self.stopped, t_us)
+        return self.began[index] if index < len(self.began) else None
 
 
 @dataclass

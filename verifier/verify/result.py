@@ -17,11 +17,12 @@ from .expectations import ExpectationResult
 @dataclass(frozen=True)
 class Keep:
     """What a run keeps beyond its verdict, for the reports that list it: every frame
-    (`--trace`, `--html`) and the watched labels' changes (`--json`, `--html`). A run that
-    keeps neither holds no more than its findings once the rules have judged it."""
+    (`--trace`, `--html`); the watched labels' changes and the line's and robot's events
+    (`--json`, `--html`). A run that keeps no frames is judged as it goes
+    (verifier.verify.stream) and holds little more than its findings however long it runs."""
 
     frames: bool = True
-    watched: bool = True
+    details: bool = True
 
 
 KEEP_ALL = Keep()

@@ -24,6 +24,7 @@ from .expectations import judge
 from .result import KEEP_ALL, Keep, LineEvent, ScenarioResult, TraceRecord, UnusableInput
 from .rules import check_all
 from .scenario import BUFFER_MEMORY, DEVICE_NAME, Scenario
+from .stream import Stream
 from .traffic import analyse, converter_drops
 
 Progress = Callable[[int, int], None]  # (virtual now, virtual end) in µs
@@ -196,6 +197,23 @@ def _trace_records(frames: list, end_us: int) -> list[TraceRecord]:
     return frames
 
 
+class _RuleEvents:
+    """The events the rules read, so far: the line's own and the converter's (a robot's
+    events are for reports only), in time order; a new list only when there are more."""
+
+    def __init__(self, line: Line, converter: Converter | None):
+        self.sources = [line.line_events] + ([converter.events] if converter is not None else [])
+        self.count = 0
+        self.merged: list = []
+
+    def __call__(self) -> list:
+        count = sum(len(events) for events in self.sources)
+        if count != self.count:
+            self.count = count
+            self.merged = sorted((e for events in self.sources for e in events), key=lambda e: e.t_us)
+        return self.merged
+
+
 def _plain(value: Any) -> Any:
     """A sampled value as bool/int/float (the simulator may hand back typed wrappers)."""
     if isinstance(value, (bool, int, float)):
@@ -301,8 +319,9 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     """Run `scenario` to its end and judge it. UnusableInput for input that cannot run.
 
     `keep` says what the result holds for reports beyond the verdict and the findings:
-    every frame, the watched labels' changes (verifier.verify.result.Keep). The verdict,
-    findings and frame counts do not depend on it.
+    every frame, the watched labels' changes and the events (verifier.verify.result.Keep).
+    A run that keeps no frames is judged as it goes (verifier.verify.stream): the verdict,
+    findings and frame counts are the same either way.
 
     `plain` runs every scan (no idle scans jumped over, verifier.sim.idle) and reads the
     watched labels by their names on each, recording them all: the reference the fast
@@ -316,8 +335,13 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     plc.project.keep_serial_log(False)  # the line records every frame: the trace below
     scenario = _check_labels(plc, scenario)
     _apply_plc_settings(plc, scenario)
-    names = scenario.variables(watched=keep.watched)
-    samples = Samples(names)
+    # every label the scenario names is read on each scan (a change marks the scan busy for
+    # the idle check, which then need not compare the whole state); the watched ones are
+    # recorded only when a report lists them
+    names = scenario.variables()
+    recorded = scenario.variables(watched=keep.details)
+    samples = Samples(recorded)
+    picked = [k for k, name in enumerate(names) if name in set(recorded)]
     schedule = _input_schedule(scenario)
     aborted = None
     end = scenario.duration_us
@@ -345,7 +369,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         values = read_all()
         if values != last[0]:
             last[0] = values
-            samples.record(rt.now_us, {name: _plain(value) for name, value in zip(names, values)})
+            samples.record(rt.now_us, {names[k]: _plain(values[k]) for k in picked})
             if idle is not None:
                 idle.busy = True
 
@@ -354,9 +378,17 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
 
     sample = sample_plainly if plain else sample_on_change  # plain: the reference path
 
+    # judged as it goes when no report lists every frame; else as a whole at the end
+    stream = None if plain or keep.frames else Stream(
+        scenario.settings, scenario.options, samples, scenario.expectations, _relative)
+    rule_events = _RuleEvents(line, converter)
     try:
         while plc.now_us < end:
             plc.run(min(end, plc.now_us + PROGRESS_STEP_US), apply_inputs, sample)
+            if stream is not None:
+                stream.take(line.take_settled(), line.settled_until_us, rule_events())
+                if not keep.details:
+                    robot.events.clear()  # read by no rule, listed by no report asked for
             if progress is not None:
                 progress(plc.now_us, end)
     except SimulationError as exc:
@@ -366,14 +398,22 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         converter.advance(max(end, converter.now_us))
     else:
         line.advance(max(end, line.now_us))
-    trace = _trace_records(line.hand_over_trace(), end)
+    if stream is not None:
+        rest = [frame for frame in line.hand_over_trace() if frame.t_start_us < end]
+        violations, outcomes = stream.finish(rest, end, aborted is not None,
+                                             [e for e in rule_events() if e.t_us <= end])
+        trace, tx_count, rx_count = [], stream.tx_count, stream.rx_count
+    else:
+        trace = _trace_records(line.hand_over_trace(), end)
     line_events = line.events if converter is None else sorted(line.events + converter.events, key=lambda e: e.t_us)
     events = [LineEvent(e.t_us, e.kind, e.message) for e in line_events if e.t_us <= end]
-    evidence = RunEvidence(scenario.settings, trace, end, events, samples, scenario.options, aborted is not None)
-    traffic = analyse(trace, scenario.settings, scenario.options, converter_drops(events))
-    violations = check_all(evidence, traffic)
-    outcomes = [judge(expectation, evidence, traffic) for expectation in scenario.expectations]
-    tx_count = len(traffic.tx)
+    if stream is None:
+        evidence = RunEvidence(scenario.settings, trace, end, events, samples, scenario.options, aborted is not None)
+        traffic = analyse(trace, scenario.settings, scenario.options, converter_drops(events))
+        violations = check_all(evidence, traffic)
+        outcomes = [judge(expectation, evidence, traffic) for expectation in scenario.expectations]
+        tx_count = len(traffic.tx)
+        rx_count = len(trace) - tx_count
     return ScenarioResult(
         name=scenario.name,
         file=_display_path(scenario.path),
@@ -392,12 +432,12 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         faults=[fault.describe() for fault in scenario.faults]
         + ([scenario.converter.describe()] if scenario.converter is not None else []),
         trace=trace if keep.frames else [],
-        frame_counts=None if keep.frames else (tx_count, len(trace) - tx_count),
-        events=events,
+        frame_counts=None if keep.frames else (tx_count, rx_count),
+        events=events if keep.details else [],
         violations=violations,
         expectations=outcomes,
         diagnostics=plc.diagnostics(),
-        watched={name: list(samples.changes.get(name, [])) for name in scenario.watch} if keep.watched else {},
+        watched={name: list(samples.changes.get(name, [])) for name in scenario.watch} if keep.details else {},
         aborted=aborted,
         ended_us=end,
         wall_s=time.perf_counter() - wall_start,

@@ -249,6 +249,30 @@ class Pairing:
         owner.rx.append(frame)
         traffic.owners.setdefault(t, []).append(owner)
 
+    def forget(self, count: int) -> int:
+        """Let go of the first `count` exchanges and of the robot frames that started before
+        the last one that began at or before the first request kept (a rule judging that
+        request still looks back to it); returns how many robot frames went. Only for
+        exchanges that are settled, judged and not the latest to have ended before any frame
+        still to come (the one a late robot frame would join): `Stream` says which."""
+        if count <= 0:
+            return 0
+        traffic = self.traffic
+        first_kept = traffic.exchanges[count].request.t_start_us
+        starts = [frame.t_start_us for frame in traffic.rx]
+        gone = max(0, bisect_right(starts, first_kept) - 1)
+        for frame in traffic.rx[:gone]:
+            traffic.owners.pop(frame.t_start_us, None)
+        del traffic.rx[:gone]
+        del traffic.exchanges[:count], traffic.tx[:count], self._ends[:count]
+        self._oldest = max(0, self._oldest - count)
+        self._settled = max(0, self._settled - count)
+        return gone
+
+    def ended_before(self, t_us: int) -> int:
+        """How many requests ended at or before `t_us` (requests never overlap each other)."""
+        return bisect_right(self._ends, t_us)
+
     def settled(self, frontier_us: int) -> int:
         """How many exchanges, from the first, are final when no frame still to come starts
         before `frontier_us`: each has its reply, or its time-out ran out before the frontier

@@ -133,6 +133,14 @@ class Judgement:
         self.requests, self.exchanges = len(self.traffic.tx), max(self.exchanges, settled)
         return new
 
+    def forget(self, requests: int, robot_frames: int) -> None:
+        """The traffic let go of its first `requests` exchanges and `robot_frames` robot
+        frames (`Pairing.forget`), all of them judged."""
+        self.requests -= requests
+        self.exchanges -= requests
+        for _, judge in self._judges:
+            judge.forget(requests, robot_frames)
+
     def provisional(self, end_us: int) -> list[Violation]:
         """What the rules would still find if the run ended at `end_us` and nothing came."""
         return [v for _, judge in self._judges for v in judge.provisional(end_us)]

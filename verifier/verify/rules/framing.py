@@ -45,9 +45,13 @@ class Format(Judge):
 
     def __init__(self, evidence: RunEvidence, traffic: Traffic):
         super().__init__(evidence, traffic)
+        self._events = evidence.events
         self.gaps = _gap_events(evidence.events)
 
     def request(self, index: int) -> Iterator[Violation]:
+        if self.evidence.events is not self._events:  # a run judged as it goes: events so far
+            self._events = self.evidence.events
+            self.gaps = _gap_events(self._events)
         frame = self.traffic.tx[index]
         problem = _layout_problem(bytes(frame.data), self.evidence.settings)
         gap = _gap_inside(frame, self.gaps)

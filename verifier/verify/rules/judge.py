@@ -30,6 +30,11 @@ class Judge:
         judged."""
         return ()
 
+    def forget(self, requests: int, robot_frames: int) -> None:
+        """The traffic let go of its first `requests` requests (and exchanges) and
+        `robot_frames` robot frames: indexes from now on count from what is left. Only a
+        judge that keeps positions in the traffic's lists has anything to do."""
+
     def finish(self) -> Iterable[Violation]:
         """The run ended at evidence.end_us, every exchange judged."""
         return ()

@@ -9,7 +9,6 @@ time-out when nothing came).
 """
 from __future__ import annotations
 
-from bisect import bisect_right
 from collections import Counter
 from dataclasses import dataclass, field
 from typing import Iterator
@@ -22,30 +21,34 @@ from .judge import Judge
 
 @dataclass
 class Episode:
-    exchanges: list[Exchange] = field(default_factory=list)
+    """Failed exchanges in a row: the first, and how many of each kind of failure (a robot
+    that stops answering for hours makes one episode of thousands of exchanges)."""
+
+    first: Exchange
+    counts: Counter = field(default_factory=Counter)
     end_us: int | None = None  # None: still failing when the run ended
+
+    def add(self, exchange: Exchange) -> None:
+        self.counts[exchange.reply_status[0].value] += 1
 
     @property
     def noticeable_us(self) -> int:
-        first = self.exchanges[0]
+        first = self.first
         status = first.reply_status[0]
         if status in (ReplyStatus.NONE, ReplyStatus.LATE):
             return first.deadline_us
         return first.reply.t_end_us
 
     def summary(self) -> str:
-        counts = Counter(exchange.reply_status[0].value for exchange in self.exchanges)
-        return ", ".join(f"{kind} ×{count}" for kind, count in counts.items())
+        return ", ".join(f"{kind} ×{count}" for kind, count in self.counts.items())
 
 
 class ResponseHandling(Judge):
     def __init__(self, evidence: RunEvidence, traffic: Traffic):
         super().__init__(evidence, traffic)
         options = evidence.options
-        self.spans = []  # when the signal held: [(began, stopped)], computed once for every episode
-        if options.response_signal is not None:
-            self.spans = evidence.samples.intervals(options.response_signal, evidence.end_us)
-        self.stops = [stopped for _, stopped in self.spans]
+        # when the signal held (kept up to date while a run is judged as it goes)
+        self.signal = None if options.response_signal is None else evidence.samples.spans(options.response_signal)
         self.current: Episode | None = None  # the episode the latest exchange is in
         self._told: Episode | None = None  # the episode `provisional` has spoken of
 
@@ -58,8 +61,8 @@ class ResponseHandling(Judge):
                 yield from self._judge(episode, self.evidence.end_us)
             return
         if self.current is None:
-            self.current = Episode()
-        self.current.exchanges.append(exchange)
+            self.current = Episode(exchange)
+        self.current.add(exchange)
 
     def finish(self) -> Iterator[Violation]:
         if self.current is not None:
@@ -82,7 +85,7 @@ class ResponseHandling(Judge):
         end = run_end_us if episode.end_us is None else episode.end_us
         if end <= bound or run_end_us < bound:
             return  # recovered in time (or the run ended before the bound: nothing to judge)
-        first = episode.exchanges[0]
+        first = episode.first
         lasted = "until the end of the run" if episode.end_us is None else f"until {format_seconds(end)}"
         if not options.outputs_visible:
             message = (
@@ -97,8 +100,8 @@ class ResponseHandling(Judge):
                 f"[response_handling] signal in the scenario or --response-signal (e.g. \"o_bErr\")"
             )
         else:
-            index = bisect_right(self.stops, start)  # the first span still running after `start`
-            if index < len(self.spans) and self.spans[index][0] <= bound:
+            began = self.signal.first_running_after(start)
+            if began is not None and began <= bound:
                 return
             message = (
                 f"the robot's replies failed from {format_seconds(start)} {lasted} "

@@ -38,6 +38,9 @@ class HalfDuplex(Judge):
         super().__init__(evidence, traffic)
         self.rx_starts: list[int] = []  # of traffic.rx, as far as it has been read
 
+    def forget(self, requests: int, robot_frames: int) -> None:
+        del self.rx_starts[:robot_frames]
+
     def exchange(self, index: int) -> Iterator[Violation]:
         settings, traffic = self.evidence.settings, self.traffic
         self.rx_starts += [rx.t_start_us for rx in traffic.rx[len(self.rx_starts):]]

@@ -1,0 +1,89 @@
+"""A run judged as it goes (verifier.verify.stream: what `uitamr verify` does when no
+report lists every frame) finds exactly what the same run judged as a whole finds: the
+same violations in the same order, the same expectation results, notes, events and
+frame counts - on every bundled scenario and on random ones with faults, converters,
+inputs and every kind of expectation. The exchanges it lets go of along the way are let
+go of early and often here (COMPACT_AT patched small), so that path is exercised too."""
+from __future__ import annotations
+
+from dataclasses import asdict
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from test_idle_skip import robot_scenarios
+from verifier.verify import stream as stream_module
+from verifier.verify.result import KEEP_ALL, Keep
+from verifier.verify.runner import run_scenario
+from verifier.verify.scenario import load_scenario, parse_scenario
+
+ROOT = Path(__file__).resolve().parent.parent
+SCENARIOS = sorted((ROOT / "plc" / "scenarios").glob("*.toml"))
+STREAMED = Keep(frames=False, details=True)
+
+
+def _findings(result) -> dict:
+    data = asdict(result)
+    for key in ("trace", "frame_counts", "wall_s"):
+        data.pop(key)
+    data["counts"] = (result.tx_count, result.rx_count)
+    return data
+
+
+def _same(scenario, monkeypatch, compact_at: int) -> tuple:
+    monkeypatch.setattr(stream_module, "COMPACT_AT", compact_at)
+    whole = run_scenario(scenario, keep=KEEP_ALL)
+    streamed = run_scenario(scenario, keep=STREAMED)
+    assert streamed.trace == []
+    assert _findings(streamed) == _findings(whole)
+    return whole, streamed
+
+
+@pytest.mark.parametrize("path", SCENARIOS, ids=lambda p: p.stem)
+def test_bundled_scenarios_streamed_find_the_same(path, monkeypatch):
+    whole, _ = _same(load_scenario(path), monkeypatch, compact_at=2)
+    assert whole.tx_count > 0
+
+
+def test_a_long_run_lets_go_of_what_it_judged(monkeypatch):
+    """10 minutes of fx3u-healthy: the traffic the stream still holds at the end is a few
+    exchanges, not the run's two thousand."""
+    made = []
+    original = stream_module.Stream.finish
+
+    def spy(self, *args, **kwargs):
+        made.append(len(self.pairing.traffic.exchanges))
+        return original(self, *args, **kwargs)
+
+    monkeypatch.setattr(stream_module.Stream, "finish", spy)
+    text = (ROOT / "plc" / "scenarios" / "fx3u-healthy.toml").read_text(encoding="utf-8")
+    text = text.replace('duration = "60s"', 'duration = "600s"')
+    assert 'duration = "600s"' in text
+    scenario = parse_scenario(text, ROOT / "plc" / "scenarios" / "long.toml")
+    whole, _ = _same(scenario, monkeypatch, compact_at=stream_module.COMPACT_AT)
+    assert whole.tx_count > 1900
+    assert made and made[-1] < stream_module.COMPACT_AT + 20
+
+
+EXPECTATIONS = st.lists(st.sampled_from([
+    '[[expect]]\nsent = "stop"',
+    '[[expect]]\nsent = "run-point 2"\nafter = "3s"\nwithin = "20s"',
+    '[[expect]]\nreached_point = 1',
+    '[[expect]]\nreached_point = 2\nwithin = "25s"',
+    '[[expect]]\nthat = "fbEngine.o_wTxCount > 5"\nwithin = "4s"',
+    '[[expect]]\nalways = "fbEngine.o_wRetryCount < 3"',
+    '[[expect]]\nnever = "fbEngine.o_wCommErrCount > 0"\nafter = "2s"',
+    '[response_handling]\nsignal = "fbEngine.o_bErr"\nwithin = "1s"',
+]), max_size=4, unique=True)
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(text=robot_scenarios(), extra=EXPECTATIONS, compact_at=st.sampled_from([1, 2, 5]))
+def test_random_scenarios_streamed_find_the_same(text, extra, compact_at, monkeypatch):
+    head, sep, tail = text.partition("[robot]")
+    response = [e for e in extra if e.startswith("[response_handling]")]
+    text = head + "\n".join(response) + "\n" + sep + tail + "\n".join(e for e in extra if e not in response) + "\n"
+    scenario = parse_scenario(text, ROOT / "plc" / "scenarios" / "random.toml")
+    _same(scenario, monkeypatch, compact_at)
