@@ -117,17 +117,12 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
                 except SourceError as exc:
                     lost = str(exc)
                     break
-                frames = session.feed(chunk) if chunk is not None else session.poll(now_us())
-                for frame in frames:
-                    view.frame(frame)
+                view.frames(session.feed(chunk) if chunk is not None else session.poll(now_us()))
                 if time.monotonic() >= next_check:
-                    for violation in session.check():
-                        view.finding(violation)
+                    view.findings(session.check())
                     next_check = time.monotonic() + CHECK_EVERY_S
-            for frame in session.close():
-                view.frame(frame)
-            for violation in session.check():
-                view.finding(violation)
+            view.frames(session.close())
+            view.findings(session.check())
     finally:
         source.close()
         for sig, handler in previous.items():
