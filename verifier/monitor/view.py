@@ -55,8 +55,6 @@ class MonitorView:
 
     def frames(self, frames: list[TraceRecord]) -> None:
         """New frames, printed in one go (a burst hands over hundreds at a time)."""
-        if not frames:
-            return
         lines = []
         for frame in frames:
             self.counts[frame.direction] += 1
@@ -68,22 +66,23 @@ class MonitorView:
             if not self.quiet:
                 request = self._request if frame.direction == "rx" else None
                 lines.append(escape(frame_line(frame, self.settings, request)))
-        if lines:
-            self.console.print("\n".join(lines), highlight=False)
-        self._refresh()
+        self._show(lines, counted=bool(frames))
 
     def findings(self, violations: list[Violation]) -> None:
         """New findings, each a red line and its frames, printed in one go."""
-        if not violations:
-            return
         lines = []
         for violation in violations:
             self.rules[violation.rule] += 1
             first, *rest = finding_lines(violation)
-            lines.append(f"[bold red]{escape(first)}[/]")
-            lines += [escape(line) for line in rest]
-        self.console.print("\n".join(lines), highlight=False)
-        self._refresh()
+            lines += [f"[bold red]{escape(first)}[/]", *(escape(line) for line in rest)]
+        self._show(lines, counted=bool(violations))
+
+    def _show(self, lines: list[str], counted: bool) -> None:
+        """Print `lines` (markup) at once; refresh the panel when its counts changed."""
+        if lines:
+            self.console.print("\n".join(lines), highlight=False)
+        if counted:
+            self._refresh()
 
     def _refresh(self) -> None:
         if self._live is not None:
