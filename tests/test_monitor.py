@@ -332,6 +332,68 @@ def test_monitor_on_a_tcp_stream(tmp_path):
     assert findings(tmp_path / "m.json") == Counter(BAD_MASTER_FINDINGS)
 
 
+# --------------------------------------------------------------------- no traffic: nothing verified
+def test_a_tcp_stream_that_carries_nothing_is_no_traffic_not_a_pass(tmp_path):
+    """A converter port that streams no bytes (wrong port, its serial side miswired or at
+    another baud): the monitor verified nothing, so it does not pass - exit 3, and every
+    report says so."""
+    server = socket.create_server(("127.0.0.1", 0))
+    port = server.getsockname()[1]
+    thread = threading.Thread(target=lambda: server.accept()[0].recv(1), daemon=True)  # connects, sends nothing
+    thread.start()
+    done = subprocess.run(uitamr("monitor", "--tcp", f"127.0.0.1:{port}", "--duration", "1s",
+                                 "--json", tmp_path / "m.json", "--junit", tmp_path / "m.xml",
+                                 "--html", tmp_path / "m.html", "--trace", tmp_path / "m.jsonl"),
+                          capture_output=True, text=True, timeout=WAIT_S)
+    server.close()
+    assert done.returncode == 3, done.stdout + done.stderr
+    (verdict,) = [line for line in done.stdout.splitlines() if line.startswith("NO TRAFFIC:")]
+    assert verdict.startswith(f"NO TRAFFIC: no bytes were seen on tcp 127.0.0.1:{port} in 1.0 s: check that the "
+                              "converter streams the line to this port"), done.stdout
+    assert "9600 8N1" in verdict and "PASS" not in done.stdout and "Traceback" not in done.stderr
+    report = json.loads((tmp_path / "m.json").read_text())
+    assert report["verdict"] == "no-traffic" and report["scenarios"][0]["verdict"] == "no-traffic"
+    assert report["scenarios"][0]["no_traffic"] == verdict.removeprefix("NO TRAFFIC: ")
+    assert report["summary"]["passed"] == 0 and report["summary"]["no_traffic"] == 1
+    assert report["scenarios"][0]["ended"] == pytest.approx(1.0, abs=0.5)
+    junit = (tmp_path / "m.xml").read_text()
+    assert 'errors="1"' in junit and 'type="no-traffic"' in junit and "no bytes were seen" in junit
+    html = (tmp_path / "m.html").read_text()
+    assert '<span class="badge no-traffic" id="verdict">NO TRAFFIC</span>' in html and "<b>No traffic:</b>" in html
+    assert (tmp_path / "m.jsonl").read_text() == ""
+
+
+@pytest.mark.serial
+def test_a_silent_serial_line_names_the_port_and_the_line_settings(tmp_path):
+    bus = LineBus(tmp_path)
+    try:
+        done = subprocess.run(uitamr("monitor", "--serial", bus.tap, "--duration", "1s", "--baud", "19200",
+                                     "--framing", "8E1", "--json", tmp_path / "m.json"),
+                              capture_output=True, text=True, timeout=WAIT_S)
+    finally:
+        bus.close()
+    assert done.returncode == 3, done.stdout + done.stderr
+    assert (f"NO TRAFFIC: no bytes were seen on {bus.tap} in 1.0 s: check the wiring (A, B, GND), the port "
+            "name and 19200 8E1") in done.stdout
+    assert json.loads((tmp_path / "m.json").read_text())["verdict"] == "no-traffic"
+
+
+def test_replay_of_a_capture_with_no_bytes_is_no_traffic_and_findings_come_first(tmp_path):
+    empty = tmp_path / "site.txt"
+    empty.write_text("# uitamr monitor capture of /dev/ttyUSB0, 9600 8N1\n", encoding="utf-8")
+    done = subprocess.run(uitamr("replay", empty, "--json", tmp_path / "r.json"), capture_output=True, text=True,
+                          timeout=WAIT_S)
+    assert done.returncode == 3, done.stdout + done.stderr
+    assert f"NO TRAFFIC: {empty} holds no bytes, so nothing was verified" in done.stdout
+    assert json.loads((tmp_path / "r.json").read_text())["verdict"] == "no-traffic"
+    done = subprocess.run(uitamr("replay", empty, CAPTURES / "bad-master.txt", "--json", tmp_path / "r.json"),
+                          capture_output=True, text=True, timeout=WAIT_S)
+    assert done.returncode == 1, done.stdout + done.stderr  # a rule broken outranks a capture with nothing
+    assert "FAIL: 1 of 2 scenario(s) failed, 1 saw no traffic" in done.stdout
+    report = json.loads((tmp_path / "r.json").read_text())
+    assert report["verdict"] == "fail" and [s["verdict"] for s in report["scenarios"]] == ["no-traffic", "fail"]
+
+
 def test_a_port_that_cannot_be_opened_exits_2_with_its_name(tmp_path):
     done = subprocess.run(uitamr("monitor", "--serial", tmp_path / "nope"), capture_output=True, text=True,
                           timeout=WAIT_S)

@@ -54,3 +54,10 @@ def test_the_example_view_is_what_the_monitor_prints_for_the_bad_master():
         lines += finding_lines(violation)
     block = DOC.split("```\n     0.000 s  PLC → robot", 1)[1].split("```", 1)[0]
     assert ("     0.000 s  PLC → robot" + block).rstrip("\n").splitlines() == lines
+
+
+def test_the_no_traffic_verdict_is_what_the_monitor_says():
+    session = MonitorSession(CaptureInfo("doc", "/dev/ttyUSB0"))
+    session.close()
+    result = session.result(listened_us=600_000_000)
+    assert f"```\nNO TRAFFIC: {result.no_traffic}\n```" in DOC

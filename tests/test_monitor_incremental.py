@@ -194,7 +194,7 @@ def test_a_burst_over_tcp_is_judged_live_as_it_is_on_replay(tmp_path):
 
     thread = threading.Thread(target=stream, daemon=True)
     thread.start()
-    done = subprocess.run(uitamr("monitor", "--tcp", f"127.0.0.1:{server.getsockname()[1]}", "--duration", "3s",
+    done = subprocess.run(uitamr("monitor", "--tcp", f"127.0.0.1:{server.getsockname()[1]}", "--duration", "5s",
                                  "--quiet", "--json", tmp_path / "m.json", "--capture", tmp_path / "c.txt"),
                           capture_output=True, text=True, timeout=60)
     thread.join(timeout=5)

@@ -130,6 +130,27 @@ def test_console_summary_shows_verdict_counts_and_first_violations():
     assert text.rstrip().endswith("FAIL: 1 of 2 scenario(s) failed")
 
 
+def test_a_capture_with_no_traffic_neither_passes_nor_fails():
+    """A monitored line or a capture with no bytes verified nothing: its verdict is
+    "no-traffic" (any failure elsewhere still makes the whole run fail)."""
+    from dataclasses import replace
+
+    from verifier.verify.result import NO_TRAFFIC, overall_verdict
+
+    silent = replace(_result("silent", [], 0), no_traffic="no bytes were seen on COM5 in 20.0 s: check the wiring")
+    assert silent.verdict == NO_TRAFFIC == "no-traffic" and not silent.passed
+    assert overall_verdict([silent]) == overall_verdict([good_result(), silent]) == NO_TRAFFIC
+    assert overall_verdict([silent, bad_result()]) == "fail" and overall_verdict([good_result()]) == "pass"
+    out = io.StringIO()
+    report_console.render([good_result(), silent], Console(file=out, width=200, color_system=None))
+    text = out.getvalue()
+    assert "NO TRAFFIC silent" in text and "violations per rule" in text
+    assert text.rstrip().endswith("NO TRAFFIC: no bytes were seen on COM5 in 20.0 s: check the wiring")
+    data = report_json.to_dict([good_result(), silent])
+    assert data["verdict"] == "no-traffic" and data["summary"]["no_traffic"] == 1
+    assert [s["no_traffic"] for s in data["scenarios"]] == [None, silent.no_traffic]
+
+
 def test_console_lists_as_many_times_per_rule_as_asked():
     out = io.StringIO()
     report_console.render([bad_result()], Console(file=out, width=200, color_system=None), first=1)

@@ -4,7 +4,8 @@ Listens (never transmits), splits the bytes into RTU frames, tells requests from
 decodes them and applies the eight rules of `uitamr verify` while the line runs; Ctrl-C
 or `--duration` stops it and writes the same reports as `verify` (and `--capture FILE`,
 the plain capture `uitamr replay` reads). Exit status: 0 no finding, 1 findings, 2 the
-port or an option is unusable. docs/commissioning.md.
+port or an option is unusable, 3 no traffic: not a byte was seen, so nothing was verified.
+docs/commissioning.md.
 """
 from __future__ import annotations
 
@@ -30,8 +31,8 @@ from verifier.monitor.sources import SerialSource, SourceError, TcpSource, now_u
 from verifier.monitor.view import MonitorView
 from verifier.verify.evidence import RuleOptions
 
-EXIT_CLEAN, EXIT_FINDINGS, EXIT_UNUSABLE = 0, 1, 2
-#: how often the rules re-judge the capture while it runs
+EXIT_CLEAN, EXIT_FINDINGS, EXIT_UNUSABLE, EXIT_NO_TRAFFIC = 0, 1, 2, 3
+#: how often the rules judge what the line has settled since the last time
 CHECK_EVERY_S = 0.5
 
 
@@ -98,12 +99,13 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
     except SourceError as exc:
         click.echo(f"uitamr monitor: {exc}", err=True)
         sys.exit(EXIT_UNUSABLE)
-    info = CaptureInfo(f"monitor {source.description}", source.description, channel)
+    info = CaptureInfo(f"monitor {source.description}", source.description, channel, line=f"{baud} {line_format}")
     session = MonitorSession(info, settings, RuleOptions(reply_timeout_us=reply_timeout), timing,
                              from_power_on=not joined)
     stop = threading.Event()
     previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGINT, signal.SIGTERM)}
-    deadline = None if duration is None else time.monotonic() + duration / 1_000_000
+    started = time.monotonic()
+    deadline = None if duration is None else started + duration / 1_000_000
     lost: str | None = None
     console.print(f"[dim]listening on {escape(source.description)} ({baud} {line_format}, tolerance "
                   f"{timing.tolerance_us / 1000:g} ms); Ctrl-C stops[/]")
@@ -117,24 +119,19 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
                 except SourceError as exc:
                     lost = str(exc)
                     break
-                frames = session.feed(chunk) if chunk is not None else session.poll(now_us())
-                for frame in frames:
-                    view.frame(frame)
+                view.frames(session.feed(chunk) if chunk is not None else session.poll(now_us()))
                 if time.monotonic() >= next_check:
-                    for violation in session.check():
-                        view.finding(violation)
+                    view.findings(session.check())
                     next_check = time.monotonic() + CHECK_EVERY_S
-            for frame in session.close():
-                view.frame(frame)
-            for violation in session.check():
-                view.finding(violation)
+            view.frames(session.close())
+            view.findings(session.check())
     finally:
         source.close()
         for sig, handler in previous.items():
             signal.signal(sig, handler)
     if lost:
         console.print(f"[yellow]stopped: {escape(lost)}[/]")
-    result = session.result()
+    result = session.result(listened_us=round((time.monotonic() - started) * 1_000_000))
     if lost:
         result.notes.append(f"the capture ended early: {lost}")
     _finish([result], console, json_path, junit_path, trace_path, html_path)
@@ -146,7 +143,16 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
             click.echo(f"uitamr monitor: cannot write the capture {capture_path}: {exc.strerror or exc}", err=True)
             sys.exit(EXIT_UNUSABLE)
         console.print(f"[dim]wrote {escape(str(capture_path))}[/]")
-    sys.exit(EXIT_FINDINGS if result.violation_count else EXIT_CLEAN)
+    sys.exit(exit_status([result]))
+
+
+def exit_status(results) -> int:
+    """Findings first (1); else a capture that saw nothing (3): it verified nothing; else 0."""
+    if any(result.violation_count for result in results):
+        return EXIT_FINDINGS
+    if any(result.no_traffic for result in results):
+        return EXIT_NO_TRAFFIC
+    return EXIT_CLEAN
 
 
 def _finish(results, console: Console, json_path, junit_path, trace_path, html_path) -> None:

@@ -3,7 +3,8 @@
 Reads our JSONL trace (`uitamr verify --trace`, `uitamr monitor --trace`) or a plain
 capture (timestamped hex lines, docs/commissioning.md), runs it through the monitor's
 framing and the eight rules, and writes the same reports. Exit status: 0 no finding,
-1 findings, 2 a capture that cannot be read (named with file, line and column).
+1 findings, 2 a capture that cannot be read (named with file, line and column), 3 a
+capture that holds no bytes (nothing was verified).
 """
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ from pathlib import Path
 import click
 from rich.console import Console
 
-from verifier.commands.monitor import EXIT_CLEAN, EXIT_FINDINGS, EXIT_UNUSABLE, _finish, line_options, line_timing
+from verifier.commands.monitor import EXIT_UNUSABLE, _finish, exit_status, line_options, line_timing
 from verifier.commands.protocol_options import protocol_settings
 from verifier.commands.report_files import ReportError, check_folders, check_not_inputs, report_options
 from verifier.monitor.capture import CaptureError, read_capture
@@ -47,7 +48,8 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
         is_trace = any(chunk.direction is not None for chunks in loaded.values() for chunk in chunks)
         timing = line_timing(baud, line_format, tolerance, 0 if is_trace else DEFAULT_TOLERANCE_US)
         for capture_name, chunks in loaded.items():
-            info = CaptureInfo(capture_name if len(loaded) > 1 else path.name, str(path), "capture")
+            info = CaptureInfo(capture_name if len(loaded) > 1 else path.name, str(path), "capture",
+                               line=f"{baud} {line_format}")
             session = MonitorSession(info, settings, RuleOptions(reply_timeout_us=reply_timeout), timing,
                                      from_power_on=not joined)
             for chunk in chunks:
@@ -55,4 +57,4 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
             session.close()
             results.append(session.result())
     _finish(results, console, json_path, junit_path, trace_path, html_path)
-    sys.exit(EXIT_FINDINGS if any(r.violation_count for r in results) else EXIT_CLEAN)
+    sys.exit(exit_status(results))

@@ -5,6 +5,6 @@ Data flow, pure in the middle and I/O at the edges:
     sources (serial port / TCP stream / capture file)  ->  Chunk(t_us, bytes)
     framer   (t3.5 silence + the protocol's frame lengths + CRC)  ->  frames
     classify (request or reply: content, then the master/slave turn)  ->  TraceRecord
-    session  (the same RunEvidence + check_all as `uitamr verify`)  ->  ScenarioResult
+    session  (the rules of `uitamr verify`, judging what the line settled)  ->  ScenarioResult
     reports  (the JSON, JUnit, JSONL trace and HTML writers of `uitamr verify`)
 """

@@ -34,6 +34,7 @@ class CaptureInfo:
     name: str
     source: str  # "/dev/ttyUSB0", "tcp 192.168.0.50:4001", "capture.txt"
     channel: str = "rs485"  # rs485 / tcp / capture
+    line: str = "9600 8N1"  # the line's speed and framing, as the monitor was told them
     notes: list[str] = field(default_factory=list)
 
 
@@ -188,15 +189,19 @@ class MonitorSession:
             found[POWER_ON_RULE] = []
         return found
 
-    def result(self) -> ScenarioResult:
+    def result(self, listened_us: int | None = None) -> ScenarioResult:
+        """The final judgement; `listened_us`: how long a live session listened (for a line
+        on which nothing was seen)."""
         end = self.last_us
         notes = list(self.info.notes)
         notes.append(f"frames timed by the host; timing rules allow {self.timing.tolerance_us / 1000:g} ms "
                      "for the adapter's latency (--tolerance)")
         if not self.from_power_on:
             notes.append(f"the capture began after power-on: {POWER_ON_RULE} is not judged")
+        no_traffic = None
         if not self.frames:
-            notes.append("no bytes were seen on the line")
+            no_traffic = self._silence(listened_us)
+            end = listened_us or 0
         return ScenarioResult(
             name=self.info.name,
             file=self.info.source,
@@ -215,4 +220,18 @@ class MonitorSession:
             violations=self._final(),
             ended_us=end,
             notes=notes,
+            no_traffic=no_traffic,
         )
+
+    def _silence(self, listened_us: int | None) -> str:
+        """What a session that saw no bytes says: nothing was verified, and what to check
+        (on site it is almost always the wiring, the port or the line's settings)."""
+        source, line = self.info.source, self.info.line
+        if self.info.channel == "capture":
+            return (f"{source} holds no bytes, so nothing was verified: capture the line again once "
+                    f"the monitor shows frames (check the wiring, the port name and {line})")
+        during = "" if listened_us is None else f" in {listened_us / 1_000_000:.1f} s"
+        if self.info.channel == "tcp":
+            return (f"no bytes were seen on {source}{during}: check that the converter streams the line "
+                    f"to this port, its wiring to the line and its serial settings ({line})")
+        return f"no bytes were seen on {source}{during}: check the wiring (A, B, GND), the port name and {line}"

@@ -53,25 +53,36 @@ class MonitorView:
         if self._live is not None:
             self._live.__exit__(*exc)
 
-    def frame(self, frame: TraceRecord) -> None:
-        self.counts[frame.direction] += 1
-        if frame.direction == "tx":
-            try:
-                self._request = protocol.decode_request(frame.data, self.settings)
-            except protocol.FrameError:
-                self._request = None
-        if not self.quiet:
-            self.console.print(escape(frame_line(frame, self.settings, self._request if frame.direction == "rx" else None)),
-                               highlight=False)
-        self._refresh()
+    def frames(self, frames: list[TraceRecord]) -> None:
+        """New frames, printed in one go (a burst hands over hundreds at a time)."""
+        lines = []
+        for frame in frames:
+            self.counts[frame.direction] += 1
+            if frame.direction == "tx":
+                try:
+                    self._request = protocol.decode_request(frame.data, self.settings)
+                except protocol.FrameError:
+                    self._request = None
+            if not self.quiet:
+                request = self._request if frame.direction == "rx" else None
+                lines.append(escape(frame_line(frame, self.settings, request)))
+        self._show(lines, counted=bool(frames))
 
-    def finding(self, violation: Violation) -> None:
-        self.rules[violation.rule] += 1
-        first, *rest = finding_lines(violation)
-        self.console.print(f"[bold red]{escape(first)}[/]", highlight=False)
-        for line in rest:
-            self.console.print(escape(line), highlight=False)
-        self._refresh()
+    def findings(self, violations: list[Violation]) -> None:
+        """New findings, each a red line and its frames, printed in one go."""
+        lines = []
+        for violation in violations:
+            self.rules[violation.rule] += 1
+            first, *rest = finding_lines(violation)
+            lines += [f"[bold red]{escape(first)}[/]", *(escape(line) for line in rest)]
+        self._show(lines, counted=bool(violations))
+
+    def _show(self, lines: list[str], counted: bool) -> None:
+        """Print `lines` (markup) at once; refresh the panel when its counts changed."""
+        if lines:
+            self.console.print("\n".join(lines), highlight=False)
+        if counted:
+            self._refresh()
 
     def _refresh(self) -> None:
         if self._live is not None:

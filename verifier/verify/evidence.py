@@ -42,7 +42,7 @@ class RuleOptions:
     outputs_visible: bool = True
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class FrameRef:
     """A frame as a report shows it."""
 
@@ -54,7 +54,7 @@ class FrameRef:
     origin: str | None = None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Violation:
     rule: str
     t_us: int

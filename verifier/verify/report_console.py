@@ -9,7 +9,7 @@ from rich.table import Table
 from verifier.textfile import escape_chars
 
 from .durations import format_seconds
-from .result import ScenarioResult, overall_verdict
+from .result import NO_TRAFFIC, ScenarioResult, overall_verdict
 from .rules import RULES
 
 FIRST_VIOLATIONS = 3  # times listed per broken rule and scenario
@@ -18,18 +18,23 @@ FIRST_VIOLATIONS = 3  # times listed per broken rule and scenario
 def render(results: list[ScenarioResult], console: Console, *, first: int = FIRST_VIOLATIONS) -> None:
     for result in results:
         _scenario(result, console, first)
-    if len(results) > 1 or any(not r.passed for r in results):
-        console.print(_rule_table(results))
     verdict = overall_verdict(results)
-    failed = sum(not r.passed for r in results)
+    if len(results) > 1 or verdict == "fail":
+        console.print(_rule_table(results))
+    silent = [r.no_traffic for r in results if r.no_traffic is not None]
     if verdict == "pass":
         console.print(f"[bold green]PASS[/]: {len(results)} scenario(s) compliant, every expectation met")
+    elif verdict == NO_TRAFFIC:
+        more = f" (and {len(silent) - 1} more capture(s) with no bytes)" if len(silent) > 1 else ""
+        console.print(f"[bold yellow]NO TRAFFIC[/]: {escape(silent[0])}{more}")
     else:
-        console.print(f"[bold red]FAIL[/]: {failed} of {len(results)} scenario(s) failed")
+        failed = sum(r.verdict == "fail" for r in results)
+        also = f", {len(silent)} saw no traffic" if silent else ""
+        console.print(f"[bold red]FAIL[/]: {failed} of {len(results)} scenario(s) failed{also}")
 
 
 def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
-    mark = "[green]PASS[/]" if result.passed else "[red]FAIL[/]"
+    mark = {"pass": "[green]PASS[/]", "fail": "[red]FAIL[/]", NO_TRAFFIC: "[yellow]NO TRAFFIC[/]"}[result.verdict]
     where = f" ({escape(result.file)})" if result.file else ""
     tx = result.tx_count
     failed = len(result.failed_expectations)

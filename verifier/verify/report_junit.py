@@ -1,7 +1,8 @@
 """`--junit FILE`: JUnit XML as GitHub, GitLab and Jenkins read it.
 
 One <testcase> per scenario; one <failure> per broken rule (type = the rule id) and per
-failed expectation (type = "expectation"); an <error> when the simulation stopped.
+failed expectation (type = "expectation"); an <error> when the simulation stopped, or when
+a monitored line or a capture had no bytes (type = "no-traffic").
 """
 from __future__ import annotations
 
@@ -55,6 +56,10 @@ def to_element(results: list[ScenarioResult]) -> ET.Element:
             errors += 1
             element = ET.SubElement(case, "error", message="simulation stopped", type="simulation")
             element.text = result.aborted
+        if result.no_traffic:
+            errors += 1  # nothing was verified: not a pass, and not a rule the PLC broke
+            element = ET.SubElement(case, "error", message=f"no traffic: {result.no_traffic}", type="no-traffic")
+            element.text = result.no_traffic
         for rule_id, found in result.violations.items():
             if found:
                 failures += 1

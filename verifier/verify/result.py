@@ -27,6 +27,9 @@ class Keep:
 
 KEEP_ALL = Keep()
 
+#: the verdict of a capture that saw no bytes (`uitamr monitor`, `uitamr replay`)
+NO_TRAFFIC = "no-traffic"
+
 
 class UnusableInput(Exception):
     """Input the verifier cannot run (bad scenario, ST that does not load, unknown program).
@@ -78,6 +81,9 @@ class ScenarioResult:
     wall_s: float = 0.0  # real time the run took (for people; nothing judges it)
     notes: list[str] = field(default_factory=list)  # how the run differs from its scenario file
     frame_counts: tuple[int, int] | None = None  # (requests, replies) when `trace` was not kept
+    # a capture that saw no bytes (`uitamr monitor`, `uitamr replay`): nothing was verified;
+    # what was silent and what to check
+    no_traffic: str | None = None
 
     @property
     def tx_count(self) -> int:
@@ -103,10 +109,14 @@ class ScenarioResult:
 
     @property
     def passed(self) -> bool:
-        return self.aborted is None and self.violation_count == 0 and not self.failed_expectations
+        return (self.no_traffic is None and self.aborted is None and self.violation_count == 0
+                and not self.failed_expectations)
 
     @property
     def verdict(self) -> str:
+        """"pass", "fail", or NO_TRAFFIC: a capture with nothing on it neither passes nor fails."""
+        if self.no_traffic is not None:
+            return NO_TRAFFIC
         return "pass" if self.passed else "fail"
 
     def all_violations(self) -> list[Violation]:
@@ -114,4 +124,9 @@ class ScenarioResult:
 
 
 def overall_verdict(results: list[ScenarioResult]) -> str:
-    return "pass" if results and all(result.passed for result in results) else "fail"
+    """"fail" when any result failed (or there are none), else NO_TRAFFIC when any capture
+    saw nothing, else "pass"."""
+    verdicts = {result.verdict for result in results}
+    if not results or "fail" in verdicts:
+        return "fail"
+    return NO_TRAFFIC if NO_TRAFFIC in verdicts else "pass"

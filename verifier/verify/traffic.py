@@ -47,14 +47,22 @@ def describe_bytes(data: bytes, settings: protocol.Settings, direction: str, *, 
 
 
 def frame_ref(frame: TraceFrameLike, settings: protocol.Settings, *, request=None) -> FrameRef:
+    hex_text, meaning = _shown(bytes(frame.data), settings, frame.direction, request)
     return FrameRef(
         t_us=frame.t_start_us,
         t_end_us=frame.t_end_us,
         direction=frame.direction,
-        hex=protocol.hex_bytes(frame.data),
-        meaning=describe_bytes(frame.data, settings, frame.direction, request=request),
+        hex=hex_text,
+        meaning=meaning,
         origin=frame.origin,
     )
+
+
+@lru_cache(maxsize=4096)
+def _shown(data: bytes, settings: protocol.Settings, direction: str, request) -> tuple[str, str]:
+    """A frame's bytes in hex and its meaning, worked out once per distinct frame and
+    shared by every violation that shows it (a burst's thousands of findings, too)."""
+    return protocol.hex_bytes(data), describe_bytes(data, settings, direction, request=request)
 
 
 # A long run repeats the same few frames thousands of times (a status poll and its
