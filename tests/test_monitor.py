@@ -329,6 +329,7 @@ def test_monitor_on_a_tcp_stream(tmp_path):
     server.close()
     assert done.returncode == 1, done.stdout + done.stderr
     assert "the server closed the connection" in done.stdout  # ended by the stream, reports still written
+    assert f"reading, connected to tcp 127.0.0.1:{port}" in done.stdout  # a client, not a listener
     assert findings(tmp_path / "m.json") == Counter(BAD_MASTER_FINDINGS)
 
 

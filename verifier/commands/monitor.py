@@ -107,7 +107,9 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
     started = time.monotonic()
     deadline = None if duration is None else started + duration / 1_000_000
     lost: str | None = None
-    console.print(f"[dim]listening on {escape(source.description)} ({baud} {line_format}, tolerance "
+    # a serial port is listened on; a TCP stream is read from a server it connected to
+    doing = "reading, connected to" if channel == "tcp" else "listening on"
+    console.print(f"[dim]{doing} {escape(source.description)} ({baud} {line_format}, tolerance "
                   f"{timing.tolerance_us / 1000:g} ms); Ctrl-C stops[/]")
     console.file.flush()
     try:
