@@ -73,7 +73,7 @@ class Samples:
         self._spans: dict[Condition, Spans] = {}
 
     def record(self, t_us: int, values: dict[str, Any]) -> None:
-        changed = set()
+        changed = []
         for name, value in values.items():
             if name not in self.changes:
                 self.names.append(name)
@@ -82,9 +82,9 @@ class Samples:
             if not history or history[-1][1] != value:
                 history.append((t_us, value))
                 self._times[name].append(t_us)
-                changed.add(name)
+                changed.append(name)
         for spans in self._spans.values():
-            if not changed.isdisjoint(spans.names):
+            if not spans.names.isdisjoint(changed):
                 spans.moment(t_us, {name: self.value_at(name, t_us) for name in spans.names})
 
     def spans(self, condition: Condition) -> "Spans":

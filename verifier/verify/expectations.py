@@ -225,7 +225,8 @@ class _ReachedPoint(ExchangeWatch):
         super().__init__(expectation, settings)
         self.accepted_at: int | None = None
         self.running_seen = False
-        self.progress: tuple = ("not sent",)  # how far it got, worded in `result`
+        # how far it got, worded once the window is known: (start, end) -> text
+        self.progress = lambda start, end: f"run-point {self.expectation.point} was not sent and answered {_span(start, end)}"
         self.reached = None  # (t, exchange) of the task reported finished
 
     def in_window(self, exchange, t: int) -> None:
@@ -235,21 +236,28 @@ class _ReachedPoint(ExchangeWatch):
         if isinstance(request, protocol.ControlRequest):
             if request.code == protocol.ControlCode.ROBOT and request.command == point:
                 self.accepted_at, self.running_seen = t, False
-                self.progress = ("accepted", t)
+                self.progress = lambda start, end: (
+                    f"run-point {point} accepted at {format_seconds(t)}, but the robot never reported the task running")
             elif self.accepted_at is not None:
                 self.accepted_at = None
-                self.progress = ("superseded", protocol.describe(request, self.settings), t)
+                other = protocol.describe(request, self.settings)
+                self.progress = lambda start, end: (
+                    f"run-point {point} was superseded by {other} at {format_seconds(t)}")
             return
         if self.accepted_at is None or request.query != protocol.Query.TASK:
             return
         reply = protocol.decode_reply(exchange.reply.data, self.settings, request)
         if reply.value == 1:
             self.running_seen = True
-            self.progress = ("running", self.accepted_at)
+            since = self.accepted_at
+            self.progress = lambda start, end: (
+                f"run-point {point} was running (since {format_seconds(since)}) but did not finish {_span(start, end)}")
         elif self.running_seen and reply.error not in TASK_STOPPING_ERRORS:
             self.reached = (t, exchange)
         elif self.running_seen:
-            self.progress = ("stopped", int(reply.error), t)
+            error = int(reply.error)
+            self.progress = lambda start, end: (
+                f"the task of run-point {point} ended with error {error:02d} at {format_seconds(t)}")
 
     def result(self, start: int, end: int) -> ExpectationResult:
         point = self.expectation.point
@@ -258,15 +266,4 @@ class _ReachedPoint(ExchangeWatch):
             return ExpectationResult(
                 self.expectation, True, f"point {point} reached: task idle at {format_seconds(t)}", t, exchange.refs()
             )
-        kind, *args = self.progress
-        if kind == "accepted":
-            why = f"run-point {point} accepted at {format_seconds(args[0])}, but the robot never reported the task running"
-        elif kind == "superseded":
-            why = f"run-point {point} was superseded by {args[0]} at {format_seconds(args[1])}"
-        elif kind == "running":
-            why = f"run-point {point} was running (since {format_seconds(args[0])}) but did not finish {_span(start, end)}"
-        elif kind == "stopped":
-            why = f"the task of run-point {point} ended with error {args[0]:02d} at {format_seconds(args[1])}"
-        else:
-            why = f"run-point {point} was not sent and answered {_span(start, end)}"
-        return ExpectationResult(self.expectation, False, why)
+        return ExpectationResult(self.expectation, False, self.progress(start, end))

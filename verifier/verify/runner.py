@@ -29,6 +29,7 @@ from .traffic import analyse, converter_drops
 
 Progress = Callable[[int, int], None]  # (virtual now, virtual end) in µs
 PROGRESS_STEP_US = 1_000_000  # report progress every virtual second
+STREAM_EVERY_US = 10_000_000  # how often a run judged as it goes takes the settled frames
 
 _DEVICE = DEVICE_NAME
 
@@ -314,6 +315,14 @@ def _input_schedule(scenario: Scenario) -> list[tuple[int, dict[str, Any]]]:
     return sorted(steps, key=lambda s: s[0])
 
 
+def _judge_whole(scenario: Scenario, trace: list[TraceRecord], end_us: int, events: list[LineEvent],
+                 samples: Samples, stopped_early: bool):
+    """Every rule's violations and every expectation's result, the run judged as a whole."""
+    evidence = RunEvidence(scenario.settings, trace, end_us, events, samples, scenario.options, stopped_early)
+    traffic = analyse(trace, scenario.settings, scenario.options, converter_drops(events))
+    return check_all(evidence, traffic), [judge(expectation, evidence, traffic) for expectation in scenario.expectations]
+
+
 def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain: bool = False,
                  keep: Keep = KEEP_ALL) -> ScenarioResult:
     """Run `scenario` to its end and judge it. UnusableInput for input that cannot run.
@@ -341,7 +350,8 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     names = scenario.variables()
     recorded = scenario.variables(watched=keep.details)
     samples = Samples(recorded)
-    picked = [k for k, name in enumerate(names) if name in set(recorded)]
+    recorded_names = frozenset(recorded)
+    picked = [k for k, name in enumerate(names) if name in recorded_names]
     schedule = _input_schedule(scenario)
     aborted = None
     end = scenario.duration_us
@@ -382,10 +392,12 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     stream = None if plain or keep.frames else Stream(
         scenario.settings, scenario.options, samples, scenario.expectations, _relative)
     rule_events = _RuleEvents(line, converter)
+    taken_us = 0
     try:
         while plc.now_us < end:
             plc.run(min(end, plc.now_us + PROGRESS_STEP_US), apply_inputs, sample)
-            if stream is not None:
+            if stream is not None and plc.now_us - taken_us >= STREAM_EVERY_US:
+                taken_us = plc.now_us
                 stream.take(line.take_settled(), line.settled_until_us, rule_events())
                 if not keep.details:
                     robot.events.clear()  # read by no rule, listed by no report asked for
@@ -408,11 +420,8 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     line_events = line.events if converter is None else sorted(line.events + converter.events, key=lambda e: e.t_us)
     events = [LineEvent(e.t_us, e.kind, e.message) for e in line_events if e.t_us <= end]
     if stream is None:
-        evidence = RunEvidence(scenario.settings, trace, end, events, samples, scenario.options, aborted is not None)
-        traffic = analyse(trace, scenario.settings, scenario.options, converter_drops(events))
-        violations = check_all(evidence, traffic)
-        outcomes = [judge(expectation, evidence, traffic) for expectation in scenario.expectations]
-        tx_count = len(traffic.tx)
+        violations, outcomes = _judge_whole(scenario, trace, end, events, samples, aborted is not None)
+        tx_count = sum(1 for frame in trace if frame.direction == "tx")
         rx_count = len(trace) - tx_count
     return ScenarioResult(
         name=scenario.name,

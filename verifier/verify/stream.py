@@ -26,6 +26,7 @@ from .traffic import Pairing
 # (an episode of failed replies is judged when it closes, before the end)
 _OPEN_END_US = 2**62
 COMPACT_AT = 1024  # exchanges judged and let go of in one step (slicing lists costs their length)
+SHARED_FRAMES = 4096  # distinct frames whose bytes equal frames share (garbage makes many)
 
 
 class Stream:
@@ -84,6 +85,8 @@ class Stream:
             self._drops = [e.t_us for e in events if e.kind == "converter.dropped"]
 
     def _give(self, frames: list) -> None:
+        if len(self._shared) > SHARED_FRAMES:
+            self._shared.clear()
         pairing, shared, cwd, origin = self.pairing, self._shared, self._cwd, self._origin
         for frame in frames:
             data = bytes(frame.data)
