@@ -15,6 +15,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from test_idle_skip import robot_scenarios
+from test_verify_pipeline import FX3_EXAMPLE, VARIANTS, library_copy
 from verifier.verify import runner as runner_module
 from verifier.verify import stream as stream_module
 from verifier.verify.result import KEEP_ALL, Keep
@@ -92,3 +93,15 @@ def test_random_scenarios_streamed_find_the_same(text, extra, compact_at, every_
     text = head + "\n".join(response) + "\n" + sep + tail + "\n".join(e for e in extra if e not in response) + "\n"
     scenario = parse_scenario(text, ROOT / "plc" / "scenarios" / "random.toml")
     _same(scenario, monkeypatch, compact_at, every_s * 1_000_000)
+
+
+@pytest.mark.parametrize("variant", sorted(VARIANTS))
+def test_broken_libraries_streamed_break_the_same_rules(tmp_path, monkeypatch, variant):
+    """Programs that break each rule (tests/test_verify_pipeline.py's broken copies of the
+    library), run for 40 s: the violations judged as the run goes are the whole run's."""
+    edits, options, _ = VARIANTS[variant]
+    copy = library_copy(tmp_path, edits)
+    text = FX3_EXAMPLE.format(duration="40s", robot=options.get("robot", ""), faults=options.get("faults", ""),
+                              point_within="10s")
+    whole, _ = _same(parse_scenario(text, copy / "scenario.toml"), monkeypatch, compact_at=2)
+    assert whole.violation_count > 0
