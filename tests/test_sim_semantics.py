@@ -296,6 +296,17 @@ def test_function_with_in_out_and_outputs():
     assert (value, outputs["r"], outputs["acc"]) == (3, 2, 1)
 
 
+def test_positional_arguments_follow_the_declaration_order_in_out_first():
+    """A VAR_IN_OUT declared before the VAR_INPUT takes the first positional argument, in
+    the checker (types) as in the simulator (values)."""
+    src = ("FUNCTION Fill : INT\nVAR_IN_OUT io_wBuf : ARRAY[0..3] OF INT; END_VAR\n"
+           "VAR_INPUT i_wValue : INT; END_VAR\nio_wBuf[0] := i_wValue; Fill := i_wValue;\nEND_FUNCTION\n"
+           "PROGRAM P\nVAR a : ARRAY[0..3] OF INT; w : INT; END_VAR\nw := Fill(a, 7);\nEND_PROGRAM\n")
+    project = load_st(src)
+    project.run_programs(["P"], scans=1)
+    assert list(project.program("P").a) == [7, 0, 0, 0] and project.program("P").w == 7
+
+
 def test_function_array_input_is_copied():
     src = ("FUNCTION F : INT\nVAR_INPUT a : ARRAY[0..2] OF INT; END_VAR\na[0] := 99; F := a[0];\nEND_FUNCTION\n"
            "PROGRAM P\nVAR a : ARRAY[0..2] OF INT; r : INT; END_VAR\nr := F(a);\nEND_PROGRAM\n")

@@ -164,6 +164,7 @@ class Checker:
         if pou.return_type is not None:
             info.return_type = self.resolve_type(pou.return_type)
         inputs, outputs, in_outs, publics = [], [], [], []
+        passed_in = []  # VAR_INPUT and VAR_IN_OUT in declaration order: a call's positional order
         for block in pou.var_blocks:
             self._check_block_kind(block, top_level=False, pou=pou)
             for v in block.variables:
@@ -182,10 +183,12 @@ class Checker:
                 info.labels[v.key] = (v, t)
                 if v.section == "VAR_INPUT":
                     inputs.append((v.name, t))
+                    passed_in.append((v.name, t))
                 elif v.section == "VAR_OUTPUT":
                     outputs.append((v.name, t))
                 elif v.section == "VAR_IN_OUT":
                     in_outs.append((v.name, t))
+                    passed_in.append((v.name, t))
                 elif v.section == "VAR_PUBLIC":
                     publics.append((v.name, t))
                 if pou.kind == "FUNCTION" and isinstance(t, T.FbType):
@@ -199,7 +202,8 @@ class Checker:
             info.fb_type = None
             info.extra_inputs = inputs  # type: ignore[attr-defined]
         if pou.kind == "FUNCTION":
-            info.fn_inputs = inputs + in_outs  # type: ignore[attr-defined]
+            info.fn_inputs = passed_in  # type: ignore[attr-defined]
+            info.fn_in_outs = {name.upper() for name, _ in in_outs}  # type: ignore[attr-defined]
             info.fn_outputs = outputs  # type: ignore[attr-defined]
 
     def _check_block_kind(self, block: ast.VarBlock, top_level: bool, pou: ast.Pou | None = None) -> None:
@@ -469,7 +473,7 @@ class Checker:
     # ------------------------------------------------------------- expressions
     def lvalue(self, e: ast.Expr) -> T.Type | None:
         """Type of an assignment target, reporting what cannot be written."""
-        if isinstance(e, (ast.IntLiteral, ast.RealLiteral, ast.BoolLiteral, ast.TimeLiteral, ast.StringLiteral)):
+        if isinstance(e, _LITERALS):
             self.expr(e)
             self.rep.error(e, f"cannot assign to the constant {_lit_text(e)}")
             return None
@@ -824,8 +828,7 @@ class Checker:
                                   f"{len(positional)} given"
                                   + (f": {_inputs(missing)} missing; {NEEDS_EVERY_INPUT}" if missing else ""))
             for a, (pn, pt) in zip(positional, params):
-                vt = self.expr(a.value)
-                self._assign_compat(a.value, pt, vt, f"argument {pn} of {info.pou.name}")
+                self._function_argument(a, pn, pt, info)
             for a in positional[len(params):]:
                 self.expr(a.value)
         else:
@@ -842,8 +845,7 @@ class Checker:
                     if tt is not None:
                         self._assign_compat(a.value, tt, out[1], f"output {out[0]}")
                 elif match is not None and not a.output:
-                    vt = self.expr(a.value)
-                    self._assign_compat(a.value, match[1], vt, f"argument {match[0]} of {info.pou.name}")
+                    self._function_argument(a, match[0], match[1], info)
                 else:
                     self.expr(a.value)
                     self.rep.error(a, f"{info.pou.name} has no {'output' if a.output else 'input'} '{a.name}'")
@@ -854,6 +856,20 @@ class Checker:
         if statement:
             self.rep.warning(c, f"the result of function {info.pou.name} is discarded")
         return info.return_type or T.ANY
+
+    def _function_argument(self, a, name: str, param_type: T.Type, info: PouInfo) -> None:
+        """One input of a user FUNCTION; a VAR_IN_OUT takes a label (the function writes it)."""
+        if name.upper() in getattr(info, "fn_in_outs", ()):
+            if isinstance(a.value, _NOT_LABELS):
+                self.expr(a.value)
+                what = "a constant" if _is_literal(a.value) else "an expression"
+                self.rep.error(a.value, f"VAR_IN_OUT '{name}' of {info.pou.name} needs a label or device to work on, "
+                                        f"not {what}")
+                return
+            vt = self.lvalue(a.value)
+        else:
+            vt = self.expr(a.value)
+        self._assign_compat(a.value, param_type, vt, f"argument {name} of {info.pou.name}")
 
     def _signature_call(self, c: ast.Call, sig: T.Signature, statement: bool, kind: str) -> T.Type:
         c.resolved = T.CallTarget(kind, sig.name, signature=sig)
@@ -1021,8 +1037,12 @@ def _const_int(e) -> int | None:
     return None
 
 
+_LITERALS = (ast.IntLiteral, ast.RealLiteral, ast.BoolLiteral, ast.TimeLiteral, ast.StringLiteral)
+_NOT_LABELS = _LITERALS + (ast.BinaryOp, ast.UnaryOp, ast.Call)  # what a VAR_IN_OUT cannot be given
+
+
 def _is_literal(e) -> bool:
-    return isinstance(e, (ast.IntLiteral, ast.RealLiteral, ast.BoolLiteral, ast.TimeLiteral, ast.StringLiteral))
+    return isinstance(e, _LITERALS)
 
 
 def _is_zero(init) -> bool:
