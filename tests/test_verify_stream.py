@@ -7,6 +7,7 @@ go of early and often here (COMPACT_AT patched small, the frames taken every vir
 second), so that path is exercised too."""
 from __future__ import annotations
 
+import shutil
 from dataclasses import asdict
 from pathlib import Path
 
@@ -105,3 +106,23 @@ def test_broken_libraries_streamed_break_the_same_rules(tmp_path, monkeypatch, v
                               point_within="10s")
     whole, _ = _same(parse_scenario(text, copy / "scenario.toml"), monkeypatch, compact_at=2)
     assert whole.violation_count > 0
+
+
+def test_a_run_the_program_stops_midway_streamed_ends_the_same(tmp_path, monkeypatch):
+    """The Q example with an index that runs out of its array after 12 s of traffic: the
+    Q CPU stops (an operation error), and the run judged as it goes ends where the whole
+    run ends, with the same findings and expectations (one cut short by the stop)."""
+    copy = tmp_path / "plc"
+    shutil.copytree(ROOT / "plc", copy, ignore=shutil.ignore_patterns("ladder"))
+    example = copy / "examples" / "q" / "UITAMR_ExampleQ.st"
+    text = example.read_text(encoding="utf-8")
+    text = text.replace("    bEngineOn : BOOL;", "    bEngineOn : BOOL;\n    iScan : INT;\n    wCrash : ARRAY[0..3] OF WORD;", 1)
+    text = text.replace("bEngineOn := NOT SM402;", "bEngineOn := NOT SM402;\niScan := iScan + 1;\n"
+                        "IF iScan > 1200 THEN\n    wCrash[iScan - 1197] := 1;\nEND_IF;", 1)
+    example.write_text(text, encoding="utf-8")
+    scenario_text = (copy / "scenarios" / "q-healthy.toml").read_text(encoding="utf-8")
+    scenario = parse_scenario(scenario_text, copy / "scenarios" / "q-crash.toml")
+    whole, streamed = _same(scenario, monkeypatch, compact_at=2)
+    assert whole.aborted and "UITAMR_ExampleQ.st" in whole.aborted
+    assert 10_000_000 < whole.ended_us < scenario.duration_us and whole.tx_count > 30
+    assert whole.failed_expectations
