@@ -126,3 +126,28 @@ def test_a_run_the_program_stops_midway_streamed_ends_the_same(tmp_path, monkeyp
     assert whole.aborted and "UITAMR_ExampleQ.st" in whole.aborted
     assert 10_000_000 < whole.ended_us < scenario.duration_us and whole.tx_count > 30
     assert whole.failed_expectations
+
+
+def test_events_no_report_lists_are_let_go_of(monkeypatch):
+    """A converter that splits every reply makes an event per reply: a run that keeps no
+    details reads the drops among them and lets the rest go, so ten minutes hold a few,
+    not thousands (each hand-over used to sort and scan them all again)."""
+    from verifier.link import converter as converter_module
+
+    made = []
+
+    class Recorded(converter_module.Converter):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            made.append(self)
+
+    monkeypatch.setattr(runner_module, "Converter", Recorded)
+    text = (ROOT / "plc" / "scenarios" / "fx5u-tcp-split.toml").read_text(encoding="utf-8")
+    text = text.replace('duration = "60s"', 'duration = "600s"')
+    assert 'duration = "600s"' in text
+    scenario = parse_scenario(text, ROOT / "plc" / "scenarios" / "long-split.toml")
+    lean = run_scenario(scenario, keep=Keep(frames=False, details=False))
+    assert made[-1].event_count > 1000 and len(made[-1].events) < 100
+    whole = run_scenario(scenario)
+    assert (lean.violations, lean.expectations, lean.notes) == (whole.violations, whole.expectations, whole.notes)
+    assert (lean.tx_count, lean.rx_count) == (whole.tx_count, whole.rx_count) and whole.tx_count > 1900

@@ -84,6 +84,7 @@ class Converter:
         self.line = line
         self.config = config if config is not None else ConverterConfig()
         self.events: list[LineEvent] = []
+        self.event_count = 0  # events made so far (a run judged as it goes may drop old ones)
         self.connection = 0  # current accepted connection (0: none)
         self._count = 0
         self._closed_at: dict[int, int] = {}  # connection the converter dropped -> when the PLC learns it
@@ -185,7 +186,7 @@ class Converter:
     def idle_state(self) -> tuple:
         """What the PLC's calls change here (compared between scans; nothing counts them)."""
         return (self.connection, self._count, len(self._to_line), len(self._serial), len(self._to_plc),
-                len(self._closed_at), len(self._drops), len(self.events))
+                len(self._closed_at), len(self._drops), self.event_count)
 
     # ---- the converter's work ------------------------------------------------------------
 
@@ -259,3 +260,4 @@ class Converter:
 
     def _event(self, t_us: int, kind: str, message: str, frames: tuple[bytes, ...] = ()) -> None:
         self.events.append(LineEvent(t_us, kind, message, frames))
+        self.event_count += 1

@@ -150,6 +150,9 @@ class Line:
         self.quiet_until_us: int | float = 0
         self._offsets = [0]  # offset_us(k), computed once per k
         self.settled_until_us = 0  # see take_settled
+        # the "gap" events (a pause inside a PLC frame) as they happen, which is in time
+        # order: what the format rule reads of the events while a run is judged as it goes
+        self.gaps: list[LineEvent] = []
 
     # ---- the PLC's endpoint ----------------------------------------------------------------
 
@@ -266,12 +269,6 @@ class Line:
         del self._tx_frames[:tx]
         del self._rx_frames[:count - tx]
         return taken
-
-    @property
-    def line_events(self) -> list[LineEvent]:
-        """The line's own events (collisions, gaps, discarded frames) in time order; the
-        list itself, not a copy."""
-        return self._events
 
     @property
     def events(self) -> list[LineEvent]:
@@ -400,7 +397,10 @@ class Line:
             self._tx_frames.append(_OpenFrame(send.start, send.end, bytearray(send.data), send.origin))
 
     def _event(self, t_us: int, kind: str, message: str, frames: tuple[bytes, ...] = ()) -> None:
-        bisect.insort(self._events, LineEvent(t_us, kind, message, frames), key=lambda e: e.t_us)
+        event = LineEvent(t_us, kind, message, frames)
+        bisect.insort(self._events, event, key=lambda e: e.t_us)
+        if kind == "gap":
+            self.gaps.append(event)
 
     def _check_time(self, t_us: int, what: str) -> None:
         if not isinstance(t_us, int):

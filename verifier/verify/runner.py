@@ -198,21 +198,29 @@ def _trace_records(frames: list, end_us: int) -> list[TraceRecord]:
     return frames
 
 
-class _RuleEvents:
-    """The events the rules read, so far: the line's own and the converter's (a robot's
-    events are for reports only), in time order; a new list only when there are more."""
+class _NewRuleEvents:
+    """The events the rules read that happened since the last call: the line's "gap"
+    events and the converter's drops (a robot's events, and the converter's others, are
+    for reports only). With `drop_the_rest`, the converter's events are let go of once
+    read (no report lists them)."""
 
-    def __init__(self, line: Line, converter: Converter | None):
-        self.sources = [line.line_events] + ([converter.events] if converter is not None else [])
-        self.count = 0
-        self.merged: list = []
+    def __init__(self, line: Line, converter: Converter | None, drop_the_rest: bool):
+        self.line, self.converter, self.drop_the_rest = line, converter, drop_the_rest
+        self.gaps_read = 0
+        self.converter_read = 0
 
-    def __call__(self) -> list:
-        count = sum(len(events) for events in self.sources)
-        if count != self.count:
-            self.count = count
-            self.merged = sorted((e for events in self.sources for e in events), key=lambda e: e.t_us)
-        return self.merged
+    def __call__(self, end_us: float = float("inf")) -> list:
+        gaps = self.line.gaps
+        new = [e for e in gaps[self.gaps_read:] if e.t_us <= end_us]
+        self.gaps_read = len(gaps)
+        if self.converter is not None:
+            events = self.converter.events
+            new += [e for e in events[self.converter_read:] if e.kind == "converter.dropped" and e.t_us <= end_us]
+            self.converter_read = len(events)
+            if self.drop_the_rest:
+                events.clear()
+                self.converter_read = 0
+        return new
 
 
 def _plain(value: Any) -> Any:
@@ -391,7 +399,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     # judged as it goes when no report lists every frame; else as a whole at the end
     stream = None if plain or keep.frames else Stream(
         scenario.settings, scenario.options, samples, scenario.expectations, _relative)
-    rule_events = _RuleEvents(line, converter)
+    rule_events = _NewRuleEvents(line, converter, drop_the_rest=not keep.details)
     taken_us = 0
     try:
         while plc.now_us < end:
@@ -412,8 +420,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         line.advance(max(end, line.now_us))
     if stream is not None:
         rest = [frame for frame in line.hand_over_trace() if frame.t_start_us < end]
-        violations, outcomes = stream.finish(rest, end, aborted is not None,
-                                             [e for e in rule_events() if e.t_us <= end])
+        violations, outcomes = stream.finish(rest, end, aborted is not None, rule_events(end))
         trace, tx_count, rx_count = [], stream.tx_count, stream.rx_count
     else:
         trace = _trace_records(line.hand_over_trace(), end)

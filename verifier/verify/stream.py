@@ -1,6 +1,6 @@
 """Judging a run as it goes, for a run that keeps no frames (`Keep(frames=False)`).
 
-Every virtual second the runner hands over the frames the line has settled
+Every ten virtual seconds the runner hands over the frames the line has settled
 (`Line.take_settled`): they are paired (`Pairing`), the rules judge each request and each
 settled exchange once (`Judgement`), the expectations about exchanges take them in order
 (`watch_exchanges`), and the exchanges and robot frames that nothing reads again are let
@@ -48,9 +48,9 @@ class Stream:
         self.rx_count = 0
 
     def take(self, frames: list, frontier_us: int, events: Sequence[Any]) -> None:
-        """The line's settled frames (in trace order) and the events the rules read so far
-        (the line's and the converter's, in time order); no frame still to come starts
-        before `frontier_us`."""
+        """The line's settled frames (in trace order) and the events the rules read that
+        happened since the last call (the line's "gap" events and the converter's drops,
+        each kind in time order); no frame still to come starts before `frontier_us`."""
         self._events(events)
         self._give(frames)
         pairing, judgement = self.pairing, self.judgement
@@ -67,8 +67,9 @@ class Stream:
 
     def finish(self, frames: list, end_us: int, stopped_early: bool,
                events: Sequence[Any]) -> tuple[dict[str, list[Violation]], list[ExpectationResult]]:
-        """The rest of the run's frames (each starting before `end_us`); every rule's
-        violations and every expectation's result, as `check_all` and `judge` give them."""
+        """The rest of the run's frames (each starting before `end_us`) and events (as
+        `take`); every rule's violations and every expectation's result, as `check_all`
+        and `judge` give them."""
         self._events(events)
         self._give(frames)
         self.evidence.end_us = end_us
@@ -80,9 +81,8 @@ class Stream:
         return self.judgement.violations(), outcomes
 
     def _events(self, events: Sequence[Any]) -> None:
-        if len(events) != len(self.evidence.events):
-            self.evidence.events = list(events)  # a new list: the format rule reads its gaps again
-            self._drops = [e.t_us for e in events if e.kind == "converter.dropped"]
+        self.evidence.events.extend(events)  # the format rule reads the gaps as they are added
+        self._drops += [e.t_us for e in events if e.kind == "converter.dropped"]
 
     def _give(self, frames: list) -> None:
         if len(self._shared) > SHARED_FRAMES:

@@ -45,13 +45,18 @@ class Format(Judge):
 
     def __init__(self, evidence: RunEvidence, traffic: Traffic):
         super().__init__(evidence, traffic)
-        self._events = evidence.events
-        self.gaps = _gap_events(evidence.events)
+        self.gaps: tuple[list[int], list] = ([], [])  # the "gap" events read so far, and their times
+        self._read = 0  # events read (a run judged as it goes appends them as they happen)
 
     def request(self, index: int) -> Iterator[Violation]:
-        if self.evidence.events is not self._events:  # a run judged as it goes: events so far
-            self._events = self.evidence.events
-            self.gaps = _gap_events(self._events)
+        events = self.evidence.events
+        if len(events) > self._read:
+            times, found = self.gaps
+            for event in events[self._read:]:
+                if getattr(event, "kind", "") == "gap":  # they come in time order
+                    times.append(event.t_us)
+                    found.append(event)
+            self._read = len(events)
         frame = self.traffic.tx[index]
         problem = _layout_problem(bytes(frame.data), self.evidence.settings)
         gap = _gap_inside(frame, self.gaps)
@@ -78,12 +83,6 @@ def _layout_problem(data: bytes, settings: protocol.Settings) -> str | None:
     if request.address != settings.address:
         return f"byte 0: addressed to slave {request.address}, the robot is slave {settings.address}"
     return None
-
-
-def _gap_events(events) -> tuple[list[int], list]:
-    """The line's "gap" events (a pause inside a PLC frame) and their times, in time order."""
-    found = sorted((e for e in events if getattr(e, "kind", "") == "gap"), key=lambda e: e.t_us)
-    return [e.t_us for e in found], found
 
 
 def _gap_inside(frame, gaps: tuple[list[int], list]):
