@@ -10,6 +10,8 @@ the emulated robot, the rules and the expectations.
 from __future__ import annotations
 
 import shutil
+import subprocess
+import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -20,6 +22,7 @@ from verifier.amr.config import RobotConfig
 from verifier.amr.faults import Fault
 from verifier.verify.conditions import parse_condition
 from verifier.verify.evidence import RuleOptions
+from verifier.verify.result import KEEP_ALL, Keep
 from verifier.verify.runner import run_scenario
 from verifier.verify.scenario import InputStep, Scenario, parse_scenario
 
@@ -321,3 +324,73 @@ def test_the_complete_example_in_the_scenario_docs_runs_and_passes():
     assert {e.kind for e in scenario.expectations} == {"sent", "that", "reached_point", "never"}
     result = run_scenario(scenario)
     assert result.passed, ([v.message for v in result.all_violations()], [e.detail for e in result.failed_expectations])
+
+
+LATE_ECHO_PROGRAM = """PROGRAM P
+VAR
+    n : INT;
+    k : INT;
+    wLen : INT;
+    uSend : ARRAY[0..3] OF WORD;
+    uRecv : ARRAY[0..3] OF WORD;
+    bInit : BOOL;
+END_VAR
+IF NOT bInit THEN
+    D8400 := 16#1C81;
+    D8409 := 5;
+    bInit := TRUE;
+ELSE
+    n := n + 1;
+    IF n >= 30 AND NOT M8402 AND k < 4 THEN
+        n := 0;
+        k := k + 1;
+        wLen := 8;
+        IF k = 1 THEN       (* stop: 01 06 01 A0 00 00 88 14 *)
+            uSend[0] := 16#0601; uSend[1] := 16#A001; uSend[2] := 16#0000; uSend[3] := 16#1488;
+        ELSIF k = 2 THEN    (* run-point 1: 01 06 01 01 00 00 D9 F6 *)
+            uSend[0] := 16#0601; uSend[1] := 16#0101; uSend[2] := 16#0000; uSend[3] := 16#F6D9;
+        ELSIF k = 3 THEN    (* read task: 01 01 00 00 00 16 BD C4 *)
+            uSend[0] := 16#0101; uSend[1] := 16#0000; uSend[2] := 16#1600; uSend[3] := 16#C4BD;
+        ELSE                (* stop with its CRC bytes swapped: 01 06 01 A0 00 00 14 88 *)
+            uSend[0] := 16#0601; uSend[1] := 16#A001; uSend[2] := 16#0000; uSend[3] := 16#8814;
+        END_IF;
+        M8402 := TRUE;
+    END_IF;
+    M8403 := FALSE;
+    M8409 := FALSE;
+END_IF;
+RS2(bInit, uSend[0], wLen, 8, 1, uRecv[0]);
+END_PROGRAM
+"""
+
+
+@pytest.mark.parametrize("keep", [KEEP_ALL, Keep(frames=False, details=False)], ids=["whole", "streamed"])
+def test_a_late_reply_paired_with_a_request_the_robot_ignores_is_no_crash(tmp_path, keep):
+    """Stop, run point 1, read the task (its reply 700 ms late), then a stop with its CRC
+    bytes swapped: the late reply lands after the bad request and counts as its answer,
+    an exchange with no request the robot would read. reached_point used to stop with
+    AttributeError on it; it is not a step towards the point."""
+    (tmp_path / "P.st").write_text(LATE_ECHO_PROGRAM, encoding="utf-8")
+    text = ('name = "late echo"\nsources = ["P.st"]\nprogram = "P"\nplatform = "fx3u"\nduration = "3s"\n'
+            '[[faults]]\nkind = "late_reply"\non_request = 3\ndelay_ms = 700\n[[expect]]\nreached_point = 1\n')
+    result = run_scenario(parse_scenario(text, tmp_path / "s.toml"), keep=keep)
+    assert result.tx_count == 4
+    outcome = result.expectations[0]
+    assert not outcome.passed and "never reported the task running" in outcome.detail
+
+
+def test_a_location_on_line_100_is_printed_as_it_is(tmp_path):
+    """':100:' is an emoji code to rich: the console printed 'P.st💯9' for a frame sent
+    from line 100 (the JSON had it right)."""
+    lines = LATE_ECHO_PROGRAM.splitlines()
+    sending = next(k for k, line in enumerate(lines) if "M8402 := TRUE" in line)  # starts each send
+    padded = ["(* padding *)"] * (99 - sending) + lines
+    assert "M8402 := TRUE" in padded[99]
+    (tmp_path / "P.st").write_text("\n".join(padded).replace("n >= 30", "n >= 5") + "\n", encoding="utf-8")
+    (tmp_path / "s.toml").write_text('name = "fast"\nsources = ["P.st"]\nprogram = "P"\nplatform = "fx3u"\n'
+                                     'duration = "2s"\n', encoding="utf-8")
+    done = subprocess.run([sys.executable, "-m", "verifier.cli", "verify", "--scenario", str(tmp_path / "s.toml")],
+                          capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert "UITAMR-PACING" in done.stdout and "P.st:100:9" in done.stdout, done.stdout
+    assert "\N{HUNDRED POINTS SYMBOL}" not in done.stdout

@@ -21,7 +21,7 @@ from rich.markup import escape
 
 from verifier.commands.emulate import STANDARD_BAUD_RATES, _tcp_endpoint
 from verifier.commands.protocol_options import protocol_settings
-from verifier.commands.report_files import ReportError, check_folders, report_options, write_reports
+from verifier.commands.report_files import ReportError, check_folders, report_options, text_console, write_reports
 from verifier.commands.verify import _Duration
 from verifier.emulate.ports import serial_url_problem
 from verifier.monitor.capture import format_plain
@@ -81,7 +81,7 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
     problem = serial_url_problem(serial_url) if serial_url is not None else None
     if problem:
         raise click.BadParameter(problem, param_hint="--serial")
-    console = Console(highlight=False, soft_wrap=True)
+    console = text_console()
     try:
         check_folders(json_path, junit_path, trace_path, html_path, capture_path)
     except ReportError as exc:

@@ -12,11 +12,10 @@ import sys
 from pathlib import Path
 
 import click
-from rich.console import Console
 
 from verifier.commands.monitor import EXIT_UNUSABLE, _finish, exit_status, line_options, line_timing
 from verifier.commands.protocol_options import protocol_settings
-from verifier.commands.report_files import ReportError, check_folders, check_not_inputs, report_options
+from verifier.commands.report_files import ReportError, check_folders, check_not_inputs, report_options, text_console
 from verifier.monitor.capture import CaptureError, read_capture
 from verifier.monitor.framer import DEFAULT_TOLERANCE_US
 from verifier.monitor.session import CaptureInfo, MonitorSession
@@ -31,7 +30,7 @@ from verifier.verify.evidence import RuleOptions
 def command(captures, baud, line_format, tolerance, joined, reply_timeout, settings,
             json_path, junit_path, trace_path, html_path):
     """Re-check a saved trace or capture with the rules of `uitamr verify`."""
-    console = Console(highlight=False, soft_wrap=True)
+    console = text_console()
     try:
         check_folders(json_path, junit_path, trace_path, html_path)
         check_not_inputs(captures, json_path, junit_path, trace_path, html_path)

@@ -8,6 +8,12 @@ import click
 from rich.console import Console
 from rich.markup import escape
 
+def text_console(**options) -> Console:
+    """The console the judging commands print on: no syntax highlighting, long lines kept
+    whole, and no emoji codes (a location such as 'Main.st:100:9' holds one, ':100:')."""
+    return Console(highlight=False, soft_wrap=True, emoji=False, **options)
+
+
 REPORT_OPTIONS = (
     click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Write the verdict as JSON."),
     click.option("--junit", "junit_path", type=click.Path(dir_okay=False),

@@ -16,7 +16,7 @@ from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
 from verifier.commands.report_files import (ReportError, check_folders, check_not_inputs, report_options,
-                                             write_reports)
+                                             text_console, write_reports)
 from verifier.verify.durations import format_duration, format_seconds, parse_duration_us
 from verifier.verify.result import KEEP_ALL, Keep, ScenarioResult, UnusableInput
 from verifier.bundled import plc_dir as bundled_plc_dir
@@ -64,7 +64,7 @@ class _Duration(click.ParamType):
 
 
 def _unusable(message: str) -> None:
-    Console(stderr=True, highlight=False).print(f"[bold red]error:[/] {escape(message)}", markup=True, soft_wrap=True)
+    text_console(stderr=True).print(f"[bold red]error:[/] {escape(message)}", markup=True)
     sys.exit(EXIT_UNUSABLE)
 
 
@@ -295,7 +295,7 @@ def command(sources, program, platform, channel, response_signal, scenario_files
     """
     from verifier.verify import report_console
 
-    console = Console(highlight=False, soft_wrap=True)
+    console = text_console()
     if list_rules:
         from verifier.verify.rules import RULES
 
@@ -314,7 +314,7 @@ def command(sources, program, platform, channel, response_signal, scenario_files
         check_not_inputs(inputs, json_path, junit_path, trace_path, html_path)
     except (ScenarioError, UnusableInput, ReportError) as exc:
         _unusable(str(exc))
-    stderr = Console(stderr=True)
+    stderr = text_console(stderr=True)
     progress = _LazyProgress(stderr, sum(s.duration_us for s in scenarios), stderr.is_terminal)
     try:
         # a run holds every frame and watched change only for the reports that list them

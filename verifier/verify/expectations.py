@@ -233,6 +233,8 @@ class _ReachedPoint(ExchangeWatch):
         if self.reached is not None or not exchange.answered:
             return
         point, request = self.expectation.point, exchange.decoded_request
+        if request is None:
+            return  # a request the robot would ignore (what answered it was a late reply)
         if isinstance(request, protocol.ControlRequest):
             if request.code == protocol.ControlCode.ROBOT and request.command == point:
                 self.accepted_at, self.running_seen = t, False
