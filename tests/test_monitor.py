@@ -393,6 +393,9 @@ def test_replay_of_a_capture_with_no_bytes_is_no_traffic_and_findings_come_first
     assert "FAIL: 1 of 2 scenario(s) failed, 1 saw no traffic" in done.stdout
     report = json.loads((tmp_path / "r.json").read_text())
     assert report["verdict"] == "fail" and [s["verdict"] for s in report["scenarios"]] == ["no-traffic", "fail"]
+    # counted as the console counts them: passed + failed + no_traffic = scenarios
+    assert {key: report["summary"][key] for key in ("scenarios", "passed", "failed", "no_traffic")} == {
+        "scenarios": 2, "passed": 0, "failed": 1, "no_traffic": 1}
 
 
 def test_a_port_that_cannot_be_opened_exits_2_with_its_name(tmp_path):

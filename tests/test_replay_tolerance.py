@@ -17,6 +17,8 @@ SIDED = "0.001097 tx 01 06 01 01 00 00 D9 F6\n0.006417 rx 01 06 01 01 00 00 D9 F
     (SIDED, (), "0"),
     (SIDED, ("--tolerance", "20ms"), "20"),
     (CHUNKS, ("--tolerance", "0"), "0"),
+    (CHUNKS, ("--tolerance", "0.00"), "0"),
+    (CHUNKS, ("--tolerance", "-0"), "0"),
 ])
 def test_default_tolerance_follows_the_kind_of_capture(tmp_path, text, extra, allowed):
     capture = tmp_path / "c.txt"

@@ -41,9 +41,17 @@ def test_a_cpu_the_editor_does_not_program_is_refused(target, cpu, message):
 
 
 @pytest.mark.parametrize("target, cpu", [("gxworks2", "fx3u"), ("gxworks2", "fx3gc"), ("gxworks2", "qnu"),
-                                         ("gxworks2:q", "q"), ("gxworks2:Q", None), ("gxworks3", "fx5uc")])
+                                         ("gxworks2:q", "q"), ("gxworks2:Q", None), ("gxworks3", "fx5uc"),
+                                         ("GXWorks2", None), ("GXWORKS3:FX5U", None)])
 def test_the_cpus_each_editor_programs_load(target, cpu):
     load_st("PROGRAM P\nEND_PROGRAM\n", target=target, cpu=cpu)
+
+
+def test_a_target_in_capitals_applies_its_editors_rules():
+    """'GXWorks2' is GX Works2 for the dialect too, not only for the CPU: its label tables
+    have no initial values."""
+    with pytest.raises(LoadError, match="GX Works2 label tables have no initial value column"):
+        load_st("PROGRAM P\nVAR w : INT := 5; END_VAR\nw := w + 1;\nEND_PROGRAM\n", target="GXWorks2")
 
 
 def test_target_and_cpu_are_names():

@@ -49,7 +49,7 @@ class _Duration(click.ParamType):
     def convert(self, value, param, ctx):
         if isinstance(value, int):
             return value
-        if self.zero_ok and str(value).strip() in ("0", "0.0"):
+        if self.zero_ok and _is_zero(value):
             return 0  # nothing needs no unit: `--tolerance 0` (docs/commissioning.md)
         try:
             us = parse_duration_us(value)
@@ -61,6 +61,14 @@ class _Duration(click.ParamType):
             self.fail(f"{value!r} is longer than the limit of {format_duration(self.maximum_us)} of virtual time; "
                       "split a longer soak test into several runs (--seed differs per run)", param, ctx)
         return us
+
+
+def _is_zero(value) -> bool:
+    """'0', '0.00', '-0', '00': a bare number that is zero."""
+    try:
+        return float(str(value).strip()) == 0
+    except ValueError:
+        return False
 
 
 def _unusable(message: str) -> None:

@@ -145,6 +145,7 @@ def profile_for(target: str, cpu: str | None = None) -> CpuProfile:
         if value is not None and not isinstance(value, str):
             raise TypeError(f"{what} is a name such as {'gxworks2' if what == 'target' else 'fx3u'!r}; got {value!r:.60}")
     editor, colon, named = target.partition(":")
+    editor = editor.lower()  # 'GXWorks2' as 'gxworks2:Q' already was
     if editor not in TARGET_CPUS:
         raise ValueError(f"unknown target {editor!r}; use one of {sorted(TARGET_CPUS)}")
     if colon and cpu is not None and _cpu_key(named) != _cpu_key(cpu):

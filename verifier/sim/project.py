@@ -62,7 +62,7 @@ class Project:
             self.cpu = profile_for(target, cpu)
         except ValueError as e:
             raise LoadError([ast.Diagnostic("<target>", 0, 0, "error", str(e))]) from None
-        editor = target.split(":", 1)[0]
+        editor = target.split(":", 1)[0].lower()  # as profile_for reads it
         self.target = editor
         files, warnings = _parsed_and_checked(texts, editor)
         self.warnings = list(warnings)

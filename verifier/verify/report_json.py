@@ -100,7 +100,7 @@ def to_dict(results: list[ScenarioResult]) -> dict[str, Any]:
         "summary": {
             "scenarios": len(results),
             "passed": sum(r.passed for r in results),
-            "failed": sum(not r.passed for r in results),
+            "failed": sum(r.verdict == "fail" for r in results),  # passed + failed + no_traffic = scenarios
             "no_traffic": sum(r.no_traffic is not None for r in results),
             "violations": {
                 rule.id: sum(len(r.violations.get(rule.id, [])) for r in results) for rule in RULES
