@@ -24,7 +24,7 @@ from verifier.verify.conditions import parse_condition
 from verifier.verify.evidence import RuleOptions
 from verifier.verify.result import KEEP_ALL, Keep
 from verifier.verify.runner import run_scenario
-from verifier.verify.scenario import InputStep, Scenario, parse_scenario
+from verifier.verify.scenario import Scenario, parse_scenario
 
 REPO = Path(__file__).resolve().parents[1]
 PLC = REPO / "plc"
