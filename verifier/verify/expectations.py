@@ -15,6 +15,7 @@ The window is [after, after + within] (`after` defaults to 0, `within` to the en
 """
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
 from verifier import protocol
@@ -152,7 +153,7 @@ def _judge_never(expectation, evidence, start, end) -> ExpectationResult:
     )
 
 
-class ExchangeWatch:
+class ExchangeWatch(ABC):
     """An expectation about exchanges, given each settled exchange in order.
 
     Exchanges after the window are left out as they come: the window's end is
@@ -172,11 +173,13 @@ class ExchangeWatch:
         if self.first_us <= t <= self.last_us:
             self.in_window(exchange, t)
 
+    @abstractmethod
     def in_window(self, exchange, t: int) -> None:
-        raise NotImplementedError
+        """Take `exchange`, whose request started at `t`, inside the window."""
 
+    @abstractmethod
     def result(self, start: int, end: int) -> ExpectationResult:
-        raise NotImplementedError
+        """The verdict once every exchange of the run was given; the window is [start, end]."""
 
 
 class _Sent(ExchangeWatch):
