@@ -231,10 +231,12 @@ class Pairing:
         self._ends: list[int] = []  # when each request ended
         self._oldest = 0  # exchanges before this one are answered or timed out for good
         self._settled = 0
+        self._given = 0  # requests given, those let go of (`forget`) included
 
     def request(self, frame: TraceFrameLike) -> None:
         traffic = self.traffic
-        traffic.exchanges.append(Exchange(len(traffic.exchanges), frame, [], self.settings, self.reply_timeout_us))
+        traffic.exchanges.append(Exchange(self._given, frame, [], self.settings, self.reply_timeout_us))
+        self._given += 1
         traffic.tx.append(frame)
         self._ends.append(frame.t_end_us)
 
