@@ -477,7 +477,7 @@ class Checker:
             self.expr(e)
             self.rep.error(e, f"cannot assign to the constant {_lit_text(e)}")
             return None
-        if isinstance(e, (ast.BinaryOp, ast.UnaryOp, ast.Call)):
+        if isinstance(e, _EXPRESSIONS):
             self.expr(e)
             self.rep.error(e, "cannot assign to an expression; the left of ':=' must be a label or device")
             return None
@@ -1038,7 +1038,8 @@ def _const_int(e) -> int | None:
 
 
 _LITERALS = (ast.IntLiteral, ast.RealLiteral, ast.BoolLiteral, ast.TimeLiteral, ast.StringLiteral)
-_NOT_LABELS = _LITERALS + (ast.BinaryOp, ast.UnaryOp, ast.Call)  # what a VAR_IN_OUT cannot be given
+_EXPRESSIONS = (ast.BinaryOp, ast.UnaryOp, ast.Call)
+_NOT_LABELS = _LITERALS + _EXPRESSIONS  # what cannot be written to, so not given to a VAR_IN_OUT
 
 
 def _is_literal(e) -> bool:
