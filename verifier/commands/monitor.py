@@ -30,6 +30,7 @@ from verifier.monitor.session import CaptureInfo, MonitorSession
 from verifier.monitor.sources import SerialSource, SourceError, TcpSource, now_us
 from verifier.monitor.view import MonitorView
 from verifier.verify.evidence import RuleOptions
+from verifier.verify.result import NO_TRAFFIC, overall_verdict
 
 EXIT_CLEAN, EXIT_FINDINGS, EXIT_UNUSABLE, EXIT_NO_TRAFFIC = 0, 1, 2, 3
 #: how often the rules judge what the line has settled since the last time
@@ -149,12 +150,9 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
 
 
 def exit_status(results) -> int:
-    """Findings first (1); else a capture that saw nothing (3): it verified nothing; else 0."""
-    if any(result.violation_count for result in results):
-        return EXIT_FINDINGS
-    if any(result.no_traffic for result in results):
-        return EXIT_NO_TRAFFIC
-    return EXIT_CLEAN
+    """The exit status of the overall verdict: findings first (1); else a capture that saw
+    nothing (3): it verified nothing; else 0."""
+    return {"fail": EXIT_FINDINGS, NO_TRAFFIC: EXIT_NO_TRAFFIC, "pass": EXIT_CLEAN}[overall_verdict(results)]
 
 
 def _finish(results, console: Console, json_path, junit_path, trace_path, html_path) -> None:
