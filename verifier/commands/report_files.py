@@ -52,6 +52,8 @@ def check_folders(*paths: str | None) -> None:
 def check_not_inputs(inputs, *paths: str | None) -> None:
     """Refuse a report that would be written over one of the run's own input files (a
     scenario, an ST source, a capture): the input would be lost."""
+    if not any(paths):
+        return
     resolved = {Path(p).resolve() for p in inputs}
     for path in paths:
         if path and Path(path).resolve() in resolved:

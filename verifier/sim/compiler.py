@@ -26,6 +26,7 @@ from .refs import AttrRef, BitRef, DwordRef, Ref
 from .stdfbs import STANDARD_FBS, FB_PARAM_TYPES
 from .stdfuncs import make_helpers
 from .purity import pure_functions, remembered
+from .reach import needed_pous
 from .storage import check_storage
 from .typesys import (ArrayT, CompileError, FbT, PouInfo, StringT, StructT, Symbol, anyint_helpers,
                       concrete, is_int, is_real, norm_code)
@@ -51,9 +52,11 @@ class CompiledModule:
 
 
 class ModuleCompiler:
-    def __init__(self, files: list[ast.SourceFile], rt, cpu: CpuProfile, inline: bool = True):
+    def __init__(self, files: list[ast.SourceFile], rt, cpu: CpuProfile, inline: bool = True,
+                 programs: frozenset[str] | None = None):
         self.files = files
         self.inline = inline
+        self.programs = programs  # generate only what these PROGRAMs need (None: every POU)
         self.rt = rt
         self.cpu = cpu
         self.structs: dict[str, ast.StructDecl] = {}
@@ -366,6 +369,10 @@ class ModuleCompiler:
         self.build_symbols()
         check_storage(self.struct_fields, self.pous, self.globals,
                       {key: sd.name for key, sd in self.structs.items()})
+        if self.programs is not None:
+            needed = needed_pous(self.pous, self.struct_fields, self.globals, self.programs)
+            self.pous = {key: info for key, info in self.pous.items() if key in needed}
+            self.functions = {key: info for key, info in self.functions.items() if key in needed}
         em = self.em
         for key, sd in self.structs.items():
             self.gen_struct(key, sd)
@@ -632,16 +639,20 @@ def instantiate(generated: Generated, rt) -> CompiledModule:
 
 
 #: generated code by parsed files (the parse cache hands back the same list for the same
-#: texts), CPU and inlining; the entry keeps the files alive, so their id is not reused
-_GENERATED: dict[tuple[int, str, bool], Generated] = {}
+#: texts), CPU, inlining and programs; the entry keeps the files alive, so their id is not
+#: reused
+_GENERATED: dict[tuple[int, str, bool, frozenset[str] | None], Generated] = {}
 _GENERATED_MAX = 8
 
 
-def compile_files(files: list[ast.SourceFile], rt, cpu: CpuProfile, inline: bool = True) -> CompiledModule:
-    key = (id(files), cpu.name, inline)
+def compile_files(files: list[ast.SourceFile], rt, cpu: CpuProfile, inline: bool = True, *,
+                  programs: frozenset[str] | None = None) -> CompiledModule:
+    """The files compiled for a runtime: every POU, or (`programs`, upper-case PROGRAM
+    names) only what those PROGRAMs need (`reach.needed_pous`)."""
+    key = (id(files), cpu.name, inline, programs)
     generated = _GENERATED.get(key)
     if generated is None or generated.files is not files or rt.locations:
-        generated = ModuleCompiler(files, rt, cpu, inline).generate()
+        generated = ModuleCompiler(files, rt, cpu, inline, programs).generate()
         if generated.first_location == 0:
             if len(_GENERATED) >= _GENERATED_MAX:
                 _GENERATED.pop(next(iter(_GENERATED)))

@@ -23,13 +23,17 @@ from .values import InstanceProxy, to_st, to_st_list, wrap
 
 def load(*paths, target: str = "gxworks2", cpu: str | None = None, scan_ms: float = 10,
          jitter_ms: float = 0, seed: int = 0, stop_on_operation_error: bool | None = None,
-         sources: dict[str, str] | None = None, timer_resolution_ms: int = 1) -> "Project":
+         sources: dict[str, str] | None = None, timer_resolution_ms: int = 1,
+         programs: Iterable[str] | None = None) -> "Project":
     """Parse, check and compile ST files into a simulated CPU.
 
     `paths` are .st files (or directories, whose *.st files are loaded); `sources` maps
     file names to ST text for sources that are not on disk.  `target` is the editor
     ("gxworks2", "gxworks3", or "gxworks2:q" to pick the CPU); `cpu` picks the CPU profile
-    ("fx3u", "fx3g", "fx5u", "q").  Raises LoadError listing file:line:col diagnostics."""
+    ("fx3u", "fx3g", "fx5u", "q").  `programs` (PROGRAM names) makes the simulator compile
+    only those programs and what they use, which loads a large library faster; every file
+    is parsed and checked all the same. Names that are not all PROGRAMs of the files are
+    ignored (everything is compiled). Raises LoadError listing file:line:col diagnostics."""
     texts: dict[str, str] = {}
     problems = []
     if sources is not None and not isinstance(sources, dict):
@@ -49,7 +53,8 @@ def load(*paths, target: str = "gxworks2", cpu: str | None = None, scan_ms: floa
     if problems:
         raise LoadError(problems)
     return Project(texts, target=target, cpu=cpu, scan_ms=scan_ms, jitter_ms=jitter_ms, seed=seed,
-                   stop_on_operation_error=stop_on_operation_error, timer_resolution_ms=timer_resolution_ms)
+                   stop_on_operation_error=stop_on_operation_error, timer_resolution_ms=timer_resolution_ms,
+                   programs=programs)
 
 
 class Project:
@@ -57,7 +62,8 @@ class Project:
 
     def __init__(self, texts: dict[str, str], target: str = "gxworks2", cpu: str | None = None,
                  scan_ms: float = 10, jitter_ms: float = 0, seed: int = 0,
-                 stop_on_operation_error: bool | None = None, timer_resolution_ms: int = 1):
+                 stop_on_operation_error: bool | None = None, timer_resolution_ms: int = 1,
+                 programs: Iterable[str] | None = None):
         try:
             self.cpu = profile_for(target, cpu)
         except ValueError as e:
@@ -74,7 +80,8 @@ class Project:
         except ValueError as e:
             raise LoadError([ast.Diagnostic("<options>", 0, 0, "error", str(e))]) from None
         try:
-            self.module: CompiledModule = compile_files(files, self.rt, self.cpu)
+            self.programs = _only_programs(files, programs)
+            self.module: CompiledModule = compile_files(files, self.rt, self.cpu, programs=self.programs)
         except CompileError as e:
             span = e.span
             raise LoadError([ast.Diagnostic(getattr(span, "file", "<st>"), getattr(span, "line", 0),
@@ -119,6 +126,9 @@ class Project:
     def _pou(self, name: str):
         info = self.module.pous.get(name.upper())
         if info is None:
+            if self.programs is not None and any(pou.key == name.upper() for f in self.files for pou in f.pous):
+                raise KeyError(f"{name!r} is not compiled: the project was loaded with programs="
+                               f"{sorted(self.programs)}, which compiles only what those programs use")
             raise KeyError(f"no POU named {name!r}; loaded: {', '.join(self.pou_names())}")
         return info
 
@@ -504,6 +514,19 @@ def _parsed_and_checked(texts: dict[str, str], editor: str) -> tuple[list, list]
         _CHECKED.pop(next(iter(_CHECKED)))
     _CHECKED[key] = (files, warnings)
     return files, warnings
+
+
+def _only_programs(files, programs: Iterable[str] | None) -> frozenset[str] | None:
+    """`programs` as compile_files takes them: upper-case, and None (compile everything)
+    unless each names a PROGRAM of the files, so that asking for a missing one still
+    finds every POU loaded and the caller's "no such PROGRAM" can list them."""
+    if programs is None:
+        return None
+    if isinstance(programs, str):
+        raise TypeError(f"programs is a list of PROGRAM names, e.g. [{programs!r}]")
+    wanted = frozenset(name.upper() for name in programs)
+    defined = {pou.key for f in files for pou in f.pous if pou.kind == "PROGRAM"}
+    return wanted if wanted and wanted <= defined else None
 
 
 def _run_checker(files, target):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import glob
+from functools import lru_cache
 from pathlib import Path
 
 from verifier.textfile import file_kind
@@ -47,4 +48,11 @@ def _folder(path: Path) -> list[Path]:
 
 def unique(paths: list[Path]) -> tuple[Path, ...]:
     """Resolved, each once, in first-seen order."""
-    return tuple(dict.fromkeys(p.resolve() for p in paths))
+    return tuple(dict.fromkeys(_resolved(p) for p in paths))
+
+
+@lru_cache(maxsize=4096)
+def _resolved(path: Path) -> Path:
+    """`path.resolve()`, remembered: the bundled scenarios name the same 30-odd files
+    again and again, and resolving one walks every folder above it."""
+    return path.resolve()
