@@ -1,6 +1,6 @@
 """`uitamr verify` as users run it: whole processes, long scenarios, side by side.
 
-    python bench/verify.py [--hours 1] [--stretch 5] [--jobs 1,2] [--skip-rss]
+    python bench/verify.py [--hours 1] [--stretch 5] [--jobs 1,2] [--skip-rss] [--parts 1,2,3,4,5]
 
 Prints, measured in one run on this machine:
   1. fx3u-healthy at 60 s and stretched to --hours: the wall time of each whole
@@ -14,8 +14,8 @@ Prints, measured in one run on this machine:
      resolved once and recorded on change, idle scans jumped over) against the plain
      path (every label by name, every scan run) - the ratio of the two, the number of
      scans jumped over, and whether the results are equal;
-  4. `uitamr verify --matrix --jobs N` for each N: wall time and speed-up against N=1,
-     next to the machine's ceiling: N copies of a CPU-bound Python loop at once against
+  4. `uitamr verify --matrix --jobs N` for each N, three rounds of one after the other:
+     the median speed-up against N=1, next to the machine's ceiling: N copies of a CPU-bound Python loop at once against
      one after the other (median of 5);
   5. peak RSS of a 1 h and a 10 h run of fx3u-healthy (whole processes, os.wait4).
 Wall-clock figures move with the machine's load; ratios measured side by side much less.
@@ -119,76 +119,99 @@ def main() -> None:
     parser.add_argument("--stretch", type=float, default=5.0)
     parser.add_argument("--jobs", default=f"1,{os.cpu_count() or 1}")
     parser.add_argument("--skip-rss", action="store_true")
+    parser.add_argument("--parts", default="1,2,3,4,5", help="which of the figures above to measure, e.g. 4")
     options = parser.parse_args()
+    parts = {int(p) for p in options.parts.split(",")}
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         healthy = SCENARIOS / "fx3u-healthy.toml"
         short, long = stretched(healthy, folder, 60), stretched(healthy, folder, options.hours * 3600)
-        s, l, x, bound = x_real_time(short, long)
-        print(f"1. uitamr verify fx3u-healthy: 60 s in {s:.2f} s wall, {options.hours:g} h in {l:.2f} s wall "
-              f"-> {'at least ' if bound else ''}{x:,.0f}x real time "
-              f"(the {options.hours:g} h costs {l - s:.2f} s more than 60 s)")
-        every = best_wall("verify", "--scenario", long, "--every-scan", repeat=1)
-        print(f"   the same {options.hours:g} h with --every-scan (every scan run, every label read by name): "
-              f"{every:.2f} s wall -> the default is {every / l:.1f}x faster as a whole process")
+        if 1 in parts:
+            part_1(short, long, options.hours)
+        if 2 in parts:
+            part_2(folder, options.stretch)
+        if 3 in parts:
+            part_3(healthy, folder)
+        if 4 in parts:
+            part_4([int(j) for j in options.jobs.split(",")])
+        if 5 in parts and not options.skip_rss:
+            part_5(healthy, folder)
 
-        print(f"2. every bundled scenario at its duration and stretched to max({options.stretch:g}x, 600 s) "
-              "(whole processes, best of 3):")
-        worst = None
-        for source in sorted(SCENARIOS.glob("*.toml")):
-            base = duration_of(source)
-            a = stretched(source, folder, base)
-            b = stretched(source, folder, max(base * options.stretch, 600))
-            _, _, x, bound = x_real_time(a, b, repeat=3)
-            worst = x if worst is None else min(worst, x)
-            print(f"   {source.stem:32} {'>=' if bound else '  '}{x:10,.0f}x"
-                  + (f"  (the longer run costs less than {NOISE_S} s more: within the start-up noise)"
-                     if bound else ""))
-        print(f"   lowest: {worst:,.0f}x")
 
-        scenario = load_scenario(stretched(healthy, folder, 600))
-        skippers = []
-        original = Project.skip_idle_scans
+def part_1(short: Path, long: Path, hours: float) -> None:
+    s, l, x, bound = x_real_time(short, long)
+    print(f"1. uitamr verify fx3u-healthy: 60 s in {s:.2f} s wall, {hours:g} h in {l:.2f} s wall "
+          f"-> {'at least ' if bound else ''}{x:,.0f}x real time "
+          f"(the {hours:g} h costs {l - s:.2f} s more than 60 s)")
+    every = best_wall("verify", "--scenario", long, "--every-scan", repeat=1)
+    print(f"   the same {hours:g} h with --every-scan (every scan run, every label read by name): "
+          f"{every:.2f} s wall -> the default is {every / l:.1f}x faster as a whole process")
 
-        def recording(self, *args, **kwargs):
-            skippers.append(original(self, *args, **kwargs))
-            return skippers[-1]
 
-        Project.skip_idle_scans = recording
-        fast_start = time.perf_counter()
-        fast = run_scenario(scenario)
-        fast_wall = time.perf_counter() - fast_start
-        Project.skip_idle_scans = original
-        plain_start = time.perf_counter()
-        plain = run_scenario(scenario, plain=True)
-        plain_wall = time.perf_counter() - plain_start
-        fast.wall_s = plain.wall_s = 0.0
-        same = fast == plain
-        idle = skippers[-1]
-        print(f"3. 600 s of fx3u-healthy in one process: fast path {fast_wall:.2f} s (accessors, record on "
-              f"change, {idle.skipped_scans:,} of {idle.rt.scan_count:,} scans idle and jumped over), plain "
-              f"path {plain_wall:.2f} s (every label by name, every scan run) -> {plain_wall / fast_wall:.1f}x; "
-              f"same result: {same}")
+def part_2(folder: Path, stretch: float) -> None:
+    print(f"2. every bundled scenario at its duration and stretched to max({stretch:g}x, 600 s) "
+          "(whole processes, best of 3):")
+    worst = None
+    for source in sorted(SCENARIOS.glob("*.toml")):
+        base = duration_of(source)
+        a = stretched(source, folder, base)
+        b = stretched(source, folder, max(base * stretch, 600))
+        _, _, x, bound = x_real_time(a, b, repeat=3)
+        worst = x if worst is None else min(worst, x)
+        print(f"   {source.stem:32} {'>=' if bound else '  '}{x:10,.0f}x"
+              + (f"  (the longer run costs less than {NOISE_S} s more: within the start-up noise)"
+                 if bound else ""))
+    print(f"   lowest: {worst:,.0f}x")
 
-        jobs = [int(j) for j in options.jobs.split(",")]
-        times = {}
-        for n in jobs:
-            times[n] = best_wall("verify", "--matrix", "--jobs", n, repeat=1)
-        base = times[jobs[0]]
-        print("4. uitamr verify --matrix: " + ", ".join(
-            f"--jobs {n}: {t:.1f} s (x{base / t:.2f})" for n, t in times.items()))
-        for n in (n for n in jobs if n > 1):
-            low, median, high = machine_ceiling(n)
-            print(f"   the machine's own ceiling for N={n}: {n} CPU-bound Python processes at once against "
-                  f"one after the other: x{median:.2f} (x{low:.2f} to x{high:.2f} in 5 tries)")
 
-        if not options.skip_rss:
-            one = stretched(healthy, folder, 3600)
-            ten = stretched(healthy, folder, 36000)
-            _, rss_one = run_process("verify", "--scenario", one)
-            _, rss_ten = run_process("verify", "--scenario", ten)
-            print(f"5. peak RSS: 1 h {rss_one / 1024:.0f} MiB, 10 h {rss_ten / 1024:.0f} MiB "
-                  f"(ratio {rss_ten / rss_one:.2f})")
+def part_3(healthy: Path, folder: Path) -> None:
+    scenario = load_scenario(stretched(healthy, folder, 600))
+    skippers = []
+    original = Project.skip_idle_scans
+
+    def recording(self, *args, **kwargs):
+        skippers.append(original(self, *args, **kwargs))
+        return skippers[-1]
+
+    Project.skip_idle_scans = recording
+    fast_start = time.perf_counter()
+    fast = run_scenario(scenario)
+    fast_wall = time.perf_counter() - fast_start
+    Project.skip_idle_scans = original
+    plain_start = time.perf_counter()
+    plain = run_scenario(scenario, plain=True)
+    plain_wall = time.perf_counter() - plain_start
+    fast.wall_s = plain.wall_s = 0.0
+    same = fast == plain
+    idle = skippers[-1]
+    print(f"3. 600 s of fx3u-healthy in one process: fast path {fast_wall:.2f} s (accessors, record on "
+          f"change, {idle.skipped_scans:,} of {idle.rt.scan_count:,} scans idle and jumped over), plain "
+          f"path {plain_wall:.2f} s (every label by name, every scan run) -> {plain_wall / fast_wall:.1f}x; "
+          f"same result: {same}")
+
+
+def part_4(jobs: list[int]) -> None:
+    rounds: list[dict[int, float]] = []
+    for _ in range(3):  # the job counts one after the other, three times: side by side
+        rounds.append({n: run_process("verify", "--matrix", "--jobs", n)[0] for n in jobs})
+    print("4. uitamr verify --matrix, three rounds of " + ", ".join(f"--jobs {n}" for n in jobs) + ":")
+    for n in jobs[1:]:
+        speedups = sorted(r[jobs[0]] / r[n] for r in rounds)
+        print(f"   --jobs {n} against --jobs {jobs[0]}: x{speedups[1]:.2f} (median; rounds "
+              + ", ".join(f"{r[jobs[0]]:.2f} s / {r[n]:.2f} s" for r in rounds) + ")")
+    for n in (n for n in jobs if n > 1):
+        low, median, high = machine_ceiling(n)
+        print(f"   the machine's own ceiling for N={n}: {n} CPU-bound Python processes at once against "
+              f"one after the other: x{median:.2f} (x{low:.2f} to x{high:.2f} in 5 tries)")
+
+
+def part_5(healthy: Path, folder: Path) -> None:
+    one = stretched(healthy, folder, 3600)
+    ten = stretched(healthy, folder, 36000)
+    _, rss_one = run_process("verify", "--scenario", one)
+    _, rss_ten = run_process("verify", "--scenario", ten)
+    print(f"5. peak RSS: 1 h {rss_one / 1024:.0f} MiB, 10 h {rss_ten / 1024:.0f} MiB "
+          f"(ratio {rss_ten / rss_one:.2f})")
 
 
 if __name__ == "__main__":
