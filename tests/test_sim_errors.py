@@ -92,11 +92,11 @@ def test_attach_serial_checks_the_channel():
 
 def test_serial_log_of_a_channel_the_cpu_lacks_names_the_ones_it_has():
     project = load_st("PROGRAM P\nEND_PROGRAM\n")
-    assert project.serial_channels() == ["fx3:1", "fx3:2", "adp:1", "adp:2"]
+    assert project.serial_channels() == ["fx3:1", "fx3:2", "adp:1"]
     assert project.serial_log("fx3:2") == []           # a channel nothing sent on yet
     with pytest.raises(ValueError) as err:
         project.serial_log("nope")
-    assert str(err.value) == "unknown serial channel 'nope'; the fx3u CPU has fx3:1, fx3:2, adp:1, adp:2"
+    assert str(err.value) == "unknown serial channel 'nope'; the fx3u CPU has fx3:1, fx3:2, adp:1"
     with pytest.raises(ValueError, match="channel q:1 does not exist on the fx3u CPU; the fx3u CPU has fx3:1"):
         project.serial_log("q:1")
     q = load_st("PROGRAM P\nEND_PROGRAM\n", cpu="q")  # no ADPRW on a Q CPU
@@ -104,7 +104,16 @@ def test_serial_log_of_a_channel_the_cpu_lacks_names_the_ones_it_has():
     with pytest.raises(ValueError, match="channel adp:1 does not exist on the q CPU; the q CPU has q:1, q:2"):
         q.attach_serial("adp:1", FakeEndpoint())
     fx5 = load_st("PROGRAM P\nEND_PROGRAM\n", target="gxworks3")
-    assert fx5.serial_channels() == ["fx5:1", "fx5:2", "adp:1", "adp:2"]
+    assert fx5.serial_channels() == ["fx5:1", "fx5:2", "adp:1"]
+
+
+def test_a_second_modbus_master_channel_is_refused_not_left_silent():
+    """ADPRW drives adp:1 only: a robot attached to adp:2 would never hear a frame."""
+    project = load_st("PROGRAM P\nEND_PROGRAM\n")
+    with pytest.raises(ValueError) as err:
+        project.attach_serial("adp:2", FakeEndpoint())
+    assert str(err.value) == ("channel adp:2 is not simulated: the simulated ADPRW is the MODBUS master on adp:1 "
+                              "only (docs/instructions.md, ADPRW); the fx3u CPU has fx3:1, fx3:2, adp:1")
 
 
 def test_configure_c24_needs_a_q_cpu_and_a_channel_and_unit_the_module_has():

@@ -16,7 +16,7 @@ from .cpu import profile_for
 from .errors import LoadError, SimulationError
 from .instructions import InstructionSet
 from .runtime import Runtime
-from .serial import CHANNELS
+from .serial import CHANNELS, NOT_SIMULATED
 from .typesys import ArrayT, CompileError, StringT, StructT
 from .values import InstanceProxy, to_st, to_st_list, wrap
 
@@ -334,8 +334,12 @@ class Project:
         """The channel by name; ValueError naming the channels this CPU has otherwise."""
         have = self.serial_channels()
         if channel not in have:
-            problem = (f"channel {channel} does not exist on the {self.cpu.name} CPU" if channel in CHANNELS
-                       else f"unknown serial channel {channel!r}")
+            if channel in CHANNELS:
+                problem = f"channel {channel} does not exist on the {self.cpu.name} CPU"
+            elif channel in NOT_SIMULATED:
+                problem = f"channel {channel} is not simulated: {NOT_SIMULATED[channel]}"
+            else:
+                problem = f"unknown serial channel {channel!r}"
             raise ValueError(f"{problem}; the {self.cpu.name} CPU has {', '.join(have)}")
         return self.rt.channel(channel)
 
