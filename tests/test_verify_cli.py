@@ -359,3 +359,23 @@ def test_junit_stays_well_formed_with_control_characters_in_a_name(tmp_path):
     case = xml.dom.minidom.parse(str(report)).getElementsByTagName("testcase")[0]
     assert case.getAttribute("name") == "bad\\x01name\\x1b[31m"
     assert "\x1b" not in done.stdout and "bad\\x01name" in done.stdout
+
+
+def test_the_fx5_second_port_can_carry_the_robot(tmp_path):
+    """The FX5 port FB drives channel 2 (FX5-485-BD) as well as the built-in port: a
+    program set to it passes with --channel fx5:2, and the same program fails on fx5:1."""
+    from test_verify_pipeline import library_copy
+
+    plc = library_copy(tmp_path, {"examples/fx5/UITAMR_ExampleFx5.st": [
+        ("SERIAL_CHANNEL : INT := 1;", "SERIAL_CHANNEL : INT := 2;")]})
+    scenario = PLC / "scenarios" / "fx5u-healthy.toml"
+    text = scenario.read_text(encoding="utf-8").replace('"../', f'"{plc.as_posix()}/')
+    copy = tmp_path / "fx5u-ch2.toml"
+    copy.write_text(text, encoding="utf-8")
+    report = tmp_path / "r.json"
+    passed = invoke("--scenario", copy, "--channel", "fx5:2", "--json", report)
+    assert passed.exit_code == 0, passed.output
+    (result,) = json.loads(report.read_text())["scenarios"]
+    assert result["channel"] == "fx5:2" and result["frames"]["tx"] > 10
+    failed = invoke("--scenario", copy, "--channel", "fx5:1")
+    assert failed.exit_code == 1 and "the program sent nothing on fx5:1 in the whole run" in failed.output

@@ -33,7 +33,7 @@ PLATFORMS = {
     "fx5u": ("gxworks3", "fx5:1"),
     "q": ("gxworks2", "q:1"),
 }
-CHANNELS = ("fx3:1", "fx3:2", "fx5:1", "q:1", "q:2", "adp:1")
+CHANNELS = ("fx3:1", "fx3:2", "fx5:1", "fx5:2", "q:1", "q:2", "adp:1")
 DEFAULT_DURATION_US = 60_000_000
 #: The longest run accepted (virtual time). A day of 10 ms scans takes the simulator about
 #: an hour; anything longer is almost always a typo ("1000h") and would look like a hang.
