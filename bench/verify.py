@@ -17,7 +17,8 @@ Prints, measured in one run on this machine:
   4. `uitamr verify --matrix --jobs N` for each N, three rounds of one after the other:
      the median speed-up against N=1, next to the machine's ceiling: N copies of a CPU-bound Python loop at once against
      one after the other (median of 5);
-  5. peak RSS of a 1 h and a 10 h run of fx3u-healthy (whole processes, os.wait4).
+  5. peak RSS of a 1 h and a 10 h run of fx3u-healthy (whole processes, os.wait4), without
+     reports and with --trace.
 Wall-clock figures move with the machine's load; ratios measured side by side much less.
 """
 from __future__ import annotations
@@ -212,6 +213,11 @@ def part_5(healthy: Path, folder: Path) -> None:
     _, rss_ten = run_process("verify", "--scenario", ten)
     print(f"5. peak RSS: 1 h {rss_one / 1024:.0f} MiB, 10 h {rss_ten / 1024:.0f} MiB "
           f"(ratio {rss_ten / rss_one:.2f})")
+    trace = folder / "trace.jsonl"
+    _, rss_one = run_process("verify", "--scenario", one, "--trace", trace)
+    _, rss_ten = run_process("verify", "--scenario", ten, "--trace", trace)
+    print(f"   with --trace (every frame listed): 1 h {rss_one / 1024:.0f} MiB, 10 h {rss_ten / 1024:.0f} MiB "
+          f"(ratio {rss_ten / rss_one:.2f}; the trace file: {trace.stat().st_size / 2**20:.0f} MiB)")
 
 
 if __name__ == "__main__":

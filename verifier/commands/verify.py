@@ -254,20 +254,40 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress,
         with ProcessPoolExecutor(max_workers=jobs) as pool:
             futures = {pool.submit(_run_batch, [scenarios[i] for i in batch], every_scan, keep): batch
                        for batch in _batches(scenarios, jobs)}
-            for future in as_completed(futures):
-                for index, result in zip(futures[future], future.result()):
-                    results[index] = result
-                    done += scenarios[index].duration_us
-                progress.update(done, f"{sum(r is not None for r in results)}/{len(scenarios)} scenarios")
+            try:
+                for future in as_completed(futures):
+                    for index, result in zip(futures[future], future.result()):
+                        results[index] = result
+                        done += scenarios[index].duration_us
+                    progress.update(done, f"{sum(r is not None for r in results)}/{len(scenarios)} scenarios")
+            except BaseException:
+                for future in futures:  # the batches that still finish leave their trace files too
+                    future.cancel()
+                    if not future.cancelled() and future.exception() is None:
+                        _discard_trace_files(future.result())
+                _discard_trace_files([r for r in results if r is not None])
+                raise
         return [r for r in results if r is not None]
     results = []
     offset = 0
-    for position, scenario in enumerate(scenarios):
-        label = f"[{position + 1}/{len(scenarios)}] {scenario.name}"
-        results.append(run_scenario(scenario, lambda now, end, o=offset, l=label: progress.update(o + now, l),
-                                    plain=every_scan, keep=keep))
-        offset += scenario.duration_us
+    try:
+        for position, scenario in enumerate(scenarios):
+            label = f"[{position + 1}/{len(scenarios)}] {scenario.name}"
+            results.append(run_scenario(scenario, lambda now, end, o=offset, l=label: progress.update(o + now, l),
+                                        plain=every_scan, keep=keep))
+            offset += scenario.duration_us
+    except BaseException:
+        _discard_trace_files(results)
+        raise
     return results
+
+
+def _discard_trace_files(results: list[ScenarioResult]) -> None:
+    """Remove the trace lines runs wrote as they went (Keep.frames_to_file), once the
+    trace is written or will not be."""
+    for result in results:
+        if result.trace_file is not None:
+            Path(result.trace_file).unlink(missing_ok=True)
 
 
 @click.command(context_settings={"help_option_names": ["-h", "--help"]})
@@ -326,15 +346,20 @@ def command(sources, program, platform, channel, response_signal, scenario_files
     progress = _LazyProgress(stderr, sum(s.duration_us for s in scenarios), stderr.is_terminal)
     try:
         # a run holds every frame and watched change only for the reports that list them
-        keep = Keep(frames=bool(trace_path or html_path), details=bool(json_path or html_path))
+        # the trace alone does not make a run hold its frames: they go to a file beside it
+        spool_folder = str(Path(trace_path).resolve().parent) if trace_path and not html_path else None
+        keep = Keep(frames=bool(trace_path or html_path), details=bool(json_path or html_path),
+                    frames_to_file=spool_folder)
         results = _run_all(scenarios, jobs, progress, every_scan, keep)
     except (ScenarioError, UnusableInput) as exc:
         progress.stop()
         _unusable(str(exc))
     progress.stop()
-    report_console.render(results, console, first=first)
     try:
+        report_console.render(results, console, first=first)
         write_reports(results, console, json_path, junit_path, trace_path, html_path)
     except ReportError as exc:
         _unusable(str(exc))
+    finally:
+        _discard_trace_files(results)
     sys.exit(EXIT_PASS if all(r.passed for r in results) else EXIT_FAIL)

@@ -19,10 +19,15 @@ class Keep:
     """What a run keeps beyond its verdict, for the reports that list it: every frame
     (`--trace`, `--html`); the watched labels' changes and the line's and robot's events
     (`--json`, `--html`). A run that keeps no frames is judged as it goes
-    (verifier.verify.stream) and holds little more than its findings however long it runs."""
+    (verifier.verify.stream) and holds little more than its findings however long it runs;
+    so is one whose frames only `--trace` lists (`frames_to_file`)."""
 
     frames: bool = True
     details: bool = True
+    # only the trace lists the frames: they go to a file in this folder (the trace's) as
+    # the run goes (`ScenarioResult.trace_file`) instead of being held, and the run is
+    # judged as it goes
+    frames_to_file: str | None = None
 
 
 KEEP_ALL = Keep()
@@ -81,6 +86,10 @@ class ScenarioResult:
     wall_s: float = 0.0  # real time the run took (for people; nothing judges it)
     notes: list[str] = field(default_factory=list)  # how the run differs from its scenario file
     frame_counts: tuple[int, int] | None = None  # (requests, replies) when `trace` was not kept
+    # the frames as trace lines written while the run went (Keep.frames_to_file): a file
+    # of report_trace.spool_line lines, which report_trace.write completes and whoever
+    # made the result removes
+    trace_file: str | None = None
     # a capture that saw no bytes (`uitamr monitor`, `uitamr replay`): nothing was verified;
     # what was silent and what to check
     no_traffic: str | None = None

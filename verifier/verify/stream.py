@@ -12,12 +12,13 @@ the same findings and verdicts on every bundled scenario and on random ones).
 from __future__ import annotations
 
 import os
-from typing import Any, Sequence
+from typing import Any, Sequence, TextIO
 
 from verifier import protocol
 
 from .evidence import RuleOptions, RunEvidence, Samples, Violation
 from .expectations import Expectation, ExpectationResult, verdict, watch_exchanges
+from .report_trace import spool_lines
 from .result import TraceRecord
 from .rules import Judgement
 from .traffic import Pairing
@@ -31,7 +32,11 @@ SHARED_FRAMES = 4096  # distinct frames whose bytes equal frames share (garbage 
 
 class Stream:
     def __init__(self, settings: protocol.Settings, options: RuleOptions, samples: Samples,
-                 expectations: Sequence[Expectation], relative_origin):
+                 expectations: Sequence[Expectation], relative_origin, spool: TextIO | None = None,
+                 name: str = ""):
+        self.settings = settings
+        self.spool = spool  # the frames' trace lines go here as they are given (`--trace`)
+        self.name = name  # the scenario's, for the trace lines
         self.pairing = Pairing(settings, options)
         self.evidence = RunEvidence(settings, (), _OPEN_END_US, [], samples, options)
         self.judgement = Judgement(self.evidence, self.pairing.traffic)
@@ -88,10 +93,12 @@ class Stream:
         if len(self._shared) > SHARED_FRAMES:
             self._shared.clear()
         pairing, shared, cwd, origin = self.pairing, self._shared, self._cwd, self._origin
+        records = []
         for frame in frames:
             data = bytes(frame.data)
             record = TraceRecord(frame.t_start_us, frame.t_end_us, frame.direction, shared.setdefault(data, data),
                                  frame.origin and origin(frame.origin, cwd))
+            records.append(record)
             if record.direction == "tx":
                 self.tx_count += 1
                 pairing.request(record)
@@ -99,6 +106,9 @@ class Stream:
             else:
                 self.rx_count += 1
                 pairing.reply(record)
+        if self.spool is not None and records:
+            # a robot frame's pairing is final once given: nothing later changes its request
+            self.spool.writelines(spool_lines(self.name, records, self.settings, pairing.traffic.request_of))
 
     def _mark_lost(self, start_us: int) -> None:
         """The first request at or after a converter drop is one whose reply the PLC never

@@ -1,0 +1,101 @@
+"""`uitamr verify --trace` without `--html` does not hold the run's frames: the run is
+judged as it goes and writes each frame's trace line to a file beside the trace as the
+line settles it (verifier/verify/report_trace.py), and the trace is completed from that
+file at the end. The trace file is the same, byte for byte, as the one written from a run
+that held every frame: on every bundled scenario, on the library broken to break each
+rule, and on random scenarios; and no spool file is left behind, whatever happens."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from click.testing import CliRunner
+
+from test_idle_skip import robot_scenarios
+from test_verify_pipeline import FX3_EXAMPLE, VARIANTS, library_copy
+from verifier.commands.verify import command
+from verifier.verify import report_trace
+from verifier.verify import runner as runner_module
+from verifier.verify import stream as stream_module
+from verifier.verify.result import KEEP_ALL, Keep
+from verifier.verify.runner import run_scenario
+from verifier.verify.scenario import load_scenario, parse_scenario
+
+ROOT = Path(__file__).resolve().parent.parent
+SCENARIOS = sorted((ROOT / "plc" / "scenarios").glob("*.toml"))
+
+
+def _traces(scenario, folder: Path, monkeypatch, every_us: int = 0, compact_at: int = 2) -> tuple[bytes, bytes]:
+    """The trace of the run holding its frames and of the run spooling them."""
+    monkeypatch.setattr(stream_module, "COMPACT_AT", compact_at)
+    monkeypatch.setattr(runner_module, "STREAM_EVERY_US", every_us)  # 0: every virtual second
+    held = run_scenario(scenario, keep=KEEP_ALL)
+    spooled = run_scenario(scenario, keep=Keep(frames=True, details=False, frames_to_file=str(folder)))
+    assert spooled.trace == [] and held.trace_file is None
+    assert Path(spooled.trace_file).parent == folder
+    assert (spooled.tx_count, spooled.rx_count) == (held.tx_count, held.rx_count)
+    assert spooled.violations == held.violations and spooled.expectations == held.expectations
+    report_trace.write([held], folder / "held.jsonl")
+    report_trace.write([spooled], folder / "spooled.jsonl")
+    Path(spooled.trace_file).unlink()
+    return (folder / "held.jsonl").read_bytes(), (folder / "spooled.jsonl").read_bytes()
+
+
+@pytest.mark.parametrize("path", SCENARIOS, ids=lambda p: p.stem)
+def test_bundled_scenarios_give_the_same_trace(path, tmp_path, monkeypatch):
+    held, spooled = _traces(load_scenario(path), tmp_path, monkeypatch)
+    assert spooled == held and held.count(b"\n") > 10
+
+
+@pytest.mark.parametrize("variant", sorted(VARIANTS))
+def test_broken_libraries_give_the_same_trace_and_blame(tmp_path, monkeypatch, variant):
+    """The frames each broken rule blames are marked in the spooled trace as in the held one."""
+    edits, options, _ = VARIANTS[variant]
+    copy = library_copy(tmp_path, edits)
+    text = FX3_EXAMPLE.format(duration="30s", robot=options.get("robot", ""), faults=options.get("faults", ""),
+                              point_within="10s")
+    folder = tmp_path / "out"
+    folder.mkdir()
+    held, spooled = _traces(parse_scenario(text, copy / "scenario.toml"), folder, monkeypatch)
+    assert spooled == held and b'"rules": ["UITAMR-' in held
+
+
+@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(text=robot_scenarios(), every_s=st.sampled_from([0, 1, 3]), compact_at=st.sampled_from([1, 2, 1024]))
+def test_random_scenarios_give_the_same_trace(text, every_s, compact_at, tmp_path_factory, monkeypatch):
+    folder = tmp_path_factory.mktemp("spool")
+    scenario = parse_scenario(text, ROOT / "plc" / "scenarios" / "random.toml")
+    held, spooled = _traces(scenario, folder, monkeypatch, every_s * 1_000_000, compact_at)
+    assert spooled == held
+
+
+def _invoke(*args):
+    return CliRunner().invoke(command, [str(a) for a in args], catch_exceptions=False)
+
+
+@pytest.mark.parametrize("jobs", ["1", "2"])
+def test_the_command_leaves_no_spool_file(tmp_path, jobs):
+    scenarios = [ROOT / "plc" / "scenarios" / f"{name}.toml" for name in ("fx3u-healthy", "q-bad-crc")]
+    args = [arg for path in scenarios for arg in ("--scenario", path)]
+    result = _invoke(*args, "--jobs", jobs, "--trace", tmp_path / "t.jsonl", "--duration", "5s")
+    assert result.exit_code == 1, result.output  # q-bad-crc fails: the report is still written
+    lines = (tmp_path / "t.jsonl").read_text(encoding="utf-8").splitlines()
+    assert {'"scenario": "FX3U' in line or '"scenario": "Q' in line for line in lines} == {True}
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.jsonl"]
+
+
+def test_a_run_that_cannot_go_on_leaves_no_spool_file(tmp_path):
+    """The second scenario names a label its program lacks: the command exits 2, and the
+    trace lines the first run wrote are removed with it."""
+    bad = tmp_path / "bad.toml"
+    text = (ROOT / "plc" / "scenarios" / "fx3u-healthy.toml").read_text(encoding="utf-8")
+    bad.write_text(text.replace('"../', f'"{(ROOT / "plc").as_posix()}/').replace(
+        'watch = ["fbEngine.o_wTxCount", "fbCycle.o_wPoint"]', 'watch = ["fbEngine.o_wNoSuchLabel"]'), encoding="utf-8")
+    out = tmp_path / "out"
+    out.mkdir()
+    result = _invoke("--scenario", ROOT / "plc" / "scenarios" / "q-healthy.toml", "--scenario", bad,
+                     "--trace", out / "t.jsonl", "--duration", "3s")
+    assert result.exit_code == 2 and "o_wNoSuchLabel" in result.output
+    assert list(out.iterdir()) == []
