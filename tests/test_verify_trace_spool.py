@@ -99,3 +99,29 @@ def test_a_run_that_cannot_go_on_leaves_no_spool_file(tmp_path):
                      "--trace", out / "t.jsonl", "--duration", "3s")
     assert result.exit_code == 2 and "o_wNoSuchLabel" in result.output
     assert list(out.iterdir()) == []
+
+
+def test_a_folder_the_trace_cannot_go_to_is_said_before_the_run(tmp_path, monkeypatch):
+    def refused(*args, **kwargs):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(runner_module.tempfile, "mkstemp", refused)
+    result = _invoke("--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml", "--trace", tmp_path / "t.jsonl")
+    assert result.exit_code == 2
+    assert f"cannot write the trace in {tmp_path}: Permission denied" in result.output
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_disk_that_fills_up_during_the_run_is_said_and_the_spool_removed(tmp_path, monkeypatch):
+    original = stream_module.Stream._give
+
+    def full(self, frames):
+        if self.spool is not None and self.tx_count > 20:
+            raise OSError(28, "No space left on device")
+        return original(self, frames)
+
+    monkeypatch.setattr(stream_module.Stream, "_give", full)
+    result = _invoke("--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml", "--trace", tmp_path / "t.jsonl")
+    assert result.exit_code == 2
+    assert f"cannot write the trace in {tmp_path}: No space left on device" in result.output
+    assert list(tmp_path.iterdir()) == []

@@ -470,19 +470,39 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
                       + (" (nothing reached the robot's line through the converter)" if converter is not None else "")]
             ),
         )
-    except BaseException:
+    except BaseException as exc:
         if spool is not None:
-            spool.close()
-            os.remove(spool.name)
+            _discard(spool)
+            if isinstance(exc, OSError):  # the simulation itself reads and writes no file
+                raise _cannot_spool(keep.frames_to_file, exc) from None
         raise
     if spool is not None:
-        spool.close()
+        try:
+            spool.close()
+        except OSError as exc:  # a full disk shows when the last lines are flushed
+            _discard(spool)
+            raise _cannot_spool(keep.frames_to_file, exc) from None
         result.trace_file = spool.name
     return result
 
 
 def _open_spool(folder: str):
     """A file in `folder` for the trace lines of a run as it goes (report_trace.spool_lines)."""
-    handle, path = tempfile.mkstemp(prefix=".uitamr-trace-", suffix=".part", dir=folder)
+    try:
+        handle, path = tempfile.mkstemp(prefix=".uitamr-trace-", suffix=".part", dir=folder)
+    except OSError as exc:
+        raise _cannot_spool(folder, exc) from None
     os.close(handle)
     return open(path, "w", encoding="utf-8")  # its `name` is the path
+
+
+def _cannot_spool(folder: str, exc: OSError) -> UnusableInput:
+    return UnusableInput(f"cannot write the trace in {folder}: {exc.strerror or exc}")
+
+
+def _discard(spool) -> None:
+    try:
+        spool.close()
+    except OSError:
+        pass
+    Path(spool.name).unlink(missing_ok=True)
