@@ -63,6 +63,8 @@ def test_plain_capture_reads_chunks_and_frames_with_directions():
     ("0.1 01 6\n", "c.txt:1:8: '6' is not a byte in hex"),
     ("0.2 01\n0.1 02\n", "c.txt:2:1: time 0.1 s is earlier than the line before"),
     ("0.1   # nothing\n", "c.txt:1:4: the line has a time but no bytes"),
+    ("0.1 01\n 1" + "0" * 400 + " 02\n", "c.txt:2:2: time 1000"),  # was an OverflowError traceback
+    ("1000000001 01\n", "c.txt:1:1: time 1000000001 s is beyond 1e+09 s; expected a time in seconds"),
 ])
 def test_a_bad_capture_is_named_with_file_line_and_column(text, where):
     with pytest.raises(CaptureError) as caught:

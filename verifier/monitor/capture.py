@@ -58,7 +58,11 @@ def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
             col = len(line) - len(line.lstrip()) + 1
             raise CaptureError(f"{name}:{number}:{col}: expected a time in seconds (e.g. 0.250) "
                                "at the start of the line")
-        t_us = round(float(time_match.group(1)) * 1_000_000)
+        seconds = float(time_match.group(1))
+        if seconds > LARGEST:  # the same bound as a trace record's time; 1e400 would not even be a number
+            raise CaptureError(f"{name}:{number}:{time_match.start(1) + 1}: time {time_match.group(1)} s is "
+                               f"beyond {LARGEST:g} s; expected a time in seconds from 0 to {LARGEST:g}")
+        t_us = round(seconds * 1_000_000)
         if last_t is not None and t_us < last_t:
             raise CaptureError(f"{name}:{number}:{time_match.start(1) + 1}: time {time_match.group(1)} s is "
                                f"earlier than the line before ({last_t / 1_000_000:.6f} s); a capture "
