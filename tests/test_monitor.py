@@ -417,6 +417,7 @@ def test_a_port_that_cannot_be_opened_exits_2_with_its_name(tmp_path):
     ('{"t": 0.2, "t_end": 0.1, "dir": "tx", "hex": "01"}', "'t_end' (0.1 s) is before 't' (0.2 s)"),
     ('{"t": 0.1, "dir": "tx", "hex": "ZZ"}', "'hex' is 'ZZ'; expected bytes in hex"),
     ('{"t": 0.1, "dir": "tx", "hex": 5}', "'hex' is 5; expected bytes in hex"),
+    ('{"t": 0.1, "dir": "tx", "hex": " "}', "'hex' is ' '; expected bytes in hex"),  # was judged as a 0-byte frame
 ])
 def test_a_trace_record_with_a_bad_value_names_the_key(tmp_path, record, message):
     path = tmp_path / "t.jsonl"
@@ -424,6 +425,21 @@ def test_a_trace_record_with_a_bad_value_names_the_key(tmp_path, record, message
     with pytest.raises(CaptureError) as caught:
         read_capture(path)
     assert str(caught.value).startswith(f"{path}:1:1: {message}")
+
+
+def test_a_trace_out_of_time_order_is_an_error_not_a_reply_before_its_request(tmp_path):
+    """A hand-edited or merged trace whose records go back in time was replayed as it
+    stood: the reply came out 0.5 s before power-on and the run passed."""
+    path = tmp_path / "t.jsonl"
+    path.write_text('{"t": 1.0, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}\n'
+                    '{"t": 0.5, "dir": "rx", "hex": "01 06 01 A0 00 00 88 14"}\n', encoding="utf-8")
+    done = subprocess.run(uitamr("replay", path), capture_output=True, text=True, timeout=WAIT_S)
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert f"{path}:2:1: 't' (0.5 s) is earlier than the record before of scenario '{path}' (1 s)" in done.stderr
+    # each scenario of a trace has its own time line
+    path.write_text('{"scenario": "a", "t": 1.0, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}\n'
+                    '{"scenario": "b", "t": 0.5, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}\n', encoding="utf-8")
+    assert set(read_capture(path)) == {"a", "b"}
 
 
 def test_replay_refuses_to_write_a_report_over_its_own_capture(tmp_path):
