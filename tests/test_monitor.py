@@ -469,6 +469,23 @@ def test_a_capture_that_cannot_be_written_is_an_error_not_a_traceback(line, tmp_
     assert (tmp_path / "m.json").exists()  # the reports are written first
 
 
+@pytest.mark.serial
+def test_the_capture_is_written_even_when_a_report_cannot_be(line, tmp_path):
+    """The line's bytes cannot be had again; a report can, from the capture (`uitamr
+    replay`). A --json in a folder that exists but cannot be written used to end the
+    command before the capture was written: the capture was lost."""
+    monitor = start("monitor", "--serial", line.tap, "--duration", "2s", "--json", "/proc/m.json",
+                    "--capture", tmp_path / "c.txt")
+    wait_for_line(monitor, "listening")
+    master = Master(line.plc)
+    master.send(STOP)
+    master.close()
+    out, err = monitor.communicate(timeout=WAIT_S)
+    assert monitor.returncode == 2 and "Traceback" not in err
+    assert "cannot write /proc/m.json" in err
+    assert parse_plain((tmp_path / "c.txt").read_text(encoding="utf-8"))  # the capture holds the stop
+
+
 def test_an_html_report_of_a_capture_spanning_years_stays_small(tmp_path):
     """A tick every 10 s over a 1e9 s gap was 100 million ticks: the run never ended."""
     from verifier.verify import report_html
