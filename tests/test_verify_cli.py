@@ -245,6 +245,28 @@ def test_parallel_batches_group_sources_and_cover_every_scenario():
         assert sizes == sorted(sizes, reverse=True)
 
 
+def test_jobs_beyond_the_batches_start_no_idle_workers(tmp_path, monkeypatch):
+    """The process pool forks all its workers at once: --jobs 5000 for two scenarios
+    forked 5000 processes and the run never ended. It gets a worker per batch at most."""
+    import concurrent.futures
+    from verifier.commands import verify
+
+    asked = []
+
+    class Pool(concurrent.futures.ThreadPoolExecutor):  # records the size, runs in threads
+        def __init__(self, max_workers):
+            asked.append(max_workers)
+            super().__init__(max_workers=min(max_workers, 4))
+
+    monkeypatch.setattr(verify, "ProcessPoolExecutor", Pool)
+    sources = [str(p) for p in FX3_SOURCES]
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(f'sources = {json.dumps(sources)}\nprogram = "UITAMR_ExampleFx3"\nduration = "1s"\n')
+    result = invoke("--scenario", scenario, "--scenario", scenario, "--jobs", "5000")
+    assert result.exit_code in (0, 1), result.output
+    assert asked and asked[0] <= 2
+
+
 def test_parallel_run_reports_what_a_serial_run_reports(tmp_path):
     """The JSON report of --jobs 2 is the one of --jobs 1, in the same order (wall times aside)."""
     def report(jobs: int):

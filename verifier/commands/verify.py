@@ -251,9 +251,12 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress,
     if jobs > 1 and len(scenarios) > 1:
         results: list[ScenarioResult | None] = [None] * len(scenarios)
         done = 0
-        with ProcessPoolExecutor(max_workers=jobs) as pool:
+        batches = _batches(scenarios, jobs)
+        # a worker per batch at most: the pool forks all its workers at once, and --jobs 5000
+        # forked 5000 processes for two scenarios (the run never ended)
+        with ProcessPoolExecutor(max_workers=min(jobs, len(batches))) as pool:
             futures = {pool.submit(_run_batch, [scenarios[i] for i in batch], every_scan, keep): batch
-                       for batch in _batches(scenarios, jobs)}
+                       for batch in batches}
             for future in as_completed(futures):
                 for index, result in zip(futures[future], future.result()):
                     results[index] = result
