@@ -110,6 +110,22 @@ def test_an_export_into_the_sources_own_folder_never_writes_over_the_source(tmp_
     assert other.read_text() == text and (tmp_path / "FB_Count.st").exists()
 
 
+@pytest.mark.parametrize("name", ["GlobalLabels", "GLOBALLABELS"])
+def test_a_pou_named_like_the_global_label_table_is_refused(tmp_path, name):
+    """A PROGRAM GlobalLabels had its label table written over by the global label table
+    (or the other way round): its labels were lost without a word, exit 0. On Windows,
+    where GX Works runs, GLOBALLABELS.labels.tsv is the same file."""
+    src = tmp_path / "src"
+    src.mkdir()
+    (src / "Prog.st").write_text(f"PROGRAM {name}\nVAR\n    wX : INT;\nEND_VAR\nwX := gY;\nEND_PROGRAM\n")
+    (src / "Globals.st").write_text("VAR_GLOBAL\n    gY : INT;\nEND_VAR\n")
+    result = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(tmp_path / "o"), str(src)])
+    assert result.exit_code == 1
+    assert (f"{src / 'Prog.st'}:1:1: error: a POU named {name} would have its label table written to "
+            "GlobalLabels.labels.tsv") in result.output
+    assert not (tmp_path / "o").exists()
+
+
 def test_missing_source_is_a_usage_error(tmp_path):
     result = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(tmp_path), "nope.st"])
     assert result.exit_code == 2 and "nope.st" in result.output
