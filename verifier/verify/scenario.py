@@ -394,7 +394,7 @@ class _Reader:
             if first != setting.key:
                 raise self.fail(setting.key, f"U{setting.unit:X} channel {setting.channel} is already set in "
                                              f"{first}: one [[c24]] table per module channel", at_name=True)
-        converter = self.converter(data["converter"], platform) if "converter" in data else None
+        converter = self.converter(data["converter"], platform, duration) if "converter" in data else None
         if converter is not None and channel is not None:
             raise self.fail("channel", "a scenario with [converter] reaches the robot over TCP: "
                                        "it has no serial channel; remove 'channel'")
@@ -410,7 +410,7 @@ class _Reader:
             key_lines={key: self.line_of(key) for key in keys}, initial=initial, c24=c24, converter=converter,
         )
 
-    def converter(self, value: Any, platform: str) -> ConverterConfig:
+    def converter(self, value: Any, platform: str, duration: int) -> ConverterConfig:
         item = self.table(value, "converter")
         self.only(item, CONVERTER_KEYS, "converter")
         if platform not in TCP_PLATFORMS:
@@ -441,6 +441,10 @@ class _Reader:
                 raise self.fail("converter.drops", "expected a list of times, e.g. [\"20s\", \"40s\"]")
             changes["drops"] = tuple(self.duration(t, f"converter.drops[{i}]", positive=False)
                                      for i, t in enumerate(drops))
+            for i, drop in enumerate(changes["drops"]):
+                if drop >= duration:  # as for a fault's at_s: a drop that never happens tests nothing
+                    raise self.fail(f"converter.drops[{i}]", f"is at or after the end of the run "
+                                                             f"({format_duration(duration)}): the drop would never happen")
         if "split_reply" in item:
             if not isinstance(item["split_reply"], bool):
                 raise self.fail("converter.split_reply", f"expected true or false, got {shown(item['split_reply'])}")
