@@ -245,6 +245,26 @@ def test_parallel_batches_group_sources_and_cover_every_scenario():
         assert sizes == sorted(sizes, reverse=True)
 
 
+def test_a_duration_that_ends_the_run_before_a_fault_says_the_fault_was_not_tested(tmp_path):
+    """--duration shorter than a scenario's fault times: the faults never struck, and with
+    --matrix (the scenario's own expectations left out) the run passed with a note that
+    claimed 'robot, faults, timing and every rule applied'. The run now says which were not."""
+    sources = [str(p) for p in FX3_SOURCES]
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(f'sources = {json.dumps(sources)}\nprogram = "UITAMR_ExampleFx3"\nduration = "10s"\n'
+                        '[[faults]]\nkind = "no_reply"\nat_s = 1.0\nduration_s = 0.5\n'
+                        '[[faults]]\nkind = "anti_collision"\nat_s = 6.0\n')
+    report = tmp_path / "r.json"
+    result = invoke("--scenario", scenario, "--duration", "3s", "--json", report)
+    assert result.exit_code in (0, 1), result.output
+    note = "--duration 3s ends the run before 1 of its scripted fault(s), not tested: anti_collision at 6 s"
+    assert note in result.output
+    (run,) = json.loads(report.read_text())["scenarios"]
+    assert note in run["notes"]
+    result = invoke("--scenario", scenario, "--duration", "7s")  # every fault strikes: no such note
+    assert "not tested" not in result.output
+
+
 def test_jobs_beyond_the_batches_start_no_idle_workers(tmp_path, monkeypatch):
     """The process pool forks all its workers at once: --jobs 5000 for two scenarios
     forked 5000 processes and the run never ended. It gets a worker per batch at most."""
