@@ -409,6 +409,12 @@ def test_a_port_that_cannot_be_opened_exits_2_with_its_name(tmp_path):
     assert done.returncode == 2 and "127.0.0.1:1" in done.stderr
 
 
+def test_an_empty_port_name_is_named_as_empty():
+    done = subprocess.run(uitamr("monitor", "--serial", "", "--duration", "1s"), capture_output=True, text=True,
+                          timeout=WAIT_S)
+    assert done.returncode == 2 and "the port name is empty" in done.stderr and "Traceback" not in done.stderr
+
+
 @pytest.mark.parametrize("record, message", [
     ('{"t": NaN, "dir": "tx", "hex": "01"}', "'t' is NaN; expected a time in seconds from 0 to 1e+09"),
     ('{"t": 1e400, "dir": "tx", "hex": "01"}', "'t' is Infinity; expected a time in seconds"),
