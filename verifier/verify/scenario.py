@@ -335,6 +335,8 @@ class _Reader:
     def read(self, data: dict) -> Scenario:
         self.only(data, TOP_KEYS, "")
         name = self.string(data.get("name", self.path.stem if self.path else "scenario"), "name")
+        if not name.strip():  # every report names the run by it: a JUnit test case with no name
+            raise self.fail("name", "is empty: give the scenario a name, or leave 'name' out to use the file name")
         description = self.string(data.get("description", ""), "description")
         sources = tuple(self.sources(data["sources"])) if "sources" in data else ()
         program = self.string(data["program"], "program") if "program" in data else None
