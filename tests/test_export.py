@@ -84,6 +84,23 @@ def test_label_table_uses_the_editors_words(tmp_path):
     assert body.startswith("(* ====") and "VAR_INPUT" not in body and "END_VAR" not in body
 
 
+def test_a_comment_over_two_lines_after_a_declaration_is_kept(tmp_path):
+    """A trailing comment closed on the next line was dropped from the label table, the
+    bundled engine's IDLE_POLLS_TO_END among them. Joined into one line, as the editors'
+    label comments are."""
+    src = tmp_path / "src" / "FB_Two.st"
+    src.parent.mkdir()
+    src.write_text("FUNCTION_BLOCK FB_Two\nVAR\n    wX : INT;  (* counts the\n                  retries *)\n"
+                   "    wY : INT;  (* one line *) wZ : INT;\nEND_VAR\nwX := wY + wZ;\nEND_FUNCTION_BLOCK\n")
+    assert run("--target", "gxworks2", "--out", str(tmp_path / "o"), str(src)).exit_code == 0
+    table = (tmp_path / "o" / "FB_Two.labels.tsv").read_text()
+    assert "VAR\twX\tWord[Signed]\t\tcounts the retries\n" in table
+    assert "VAR\twY\tWord[Signed]\t\tone line\n" in table
+    run("--target", "gxworks3", "--out", str(tmp_path / "3"))
+    assert ("IDLE_POLLS_TO_END\tWord [Signed]\tVAR_CONSTANT\t\t1\t'idle' answers in a row that end a task; "
+            "2 if the robot is slow to report a started task\n") in (tmp_path / "3" / "UITAMR_Engine.labels.tsv").read_text()
+
+
 def test_sources_with_errors_are_reported_with_their_place(tmp_path):
     bad = tmp_path / "FB_Bad.st"
     bad.write_text("FUNCTION_BLOCK FB_Bad\nVAR\n    wX : INT;\nEND_VAR\nwX := ;\n")
