@@ -138,6 +138,17 @@ def test_labels_of_the_wrong_type_are_refused(tmp_path, program, body, words):
     assert f"{scenario}:{line}:{col}: " in result.output and words in result.output
 
 
+def test_an_input_to_a_constant_is_refused_not_a_traceback(tmp_path):
+    """The trial write was put back in a `finally` that wrote to the constant again: an
+    AttributeError traceback instead of the error at the input's line."""
+    source = tmp_path / "Main.st"
+    source.write_text("PROGRAM Main\nVAR CONSTANT\n    MAX_W : INT := 3;\nEND_VAR\nVAR\n    w : INT;\nEND_VAR\n"
+                      "w := MAX_W;\nEND_PROGRAM\n", encoding="utf-8")
+    result, scenario = _run_scenario(tmp_path, source, '[[inputs]]\nat = "0s"\nset = { MAX_W = 5 }\n')
+    assert result.exit_code == 2, result.output
+    assert f"{scenario}:5:7: inputs[0].set: Main.MAX_W is a constant" in result.output
+
+
 def test_values_that_fit_are_accepted(tmp_path, program):
     body = ('watch = ["w", "u", "D100", "r"]\n[[inputs]]\nat = "0s"\n'
             'set = { w = -32768, u = 65535, D100 = 0xFFFF, r = 0.1, X0 = true, b = true }\n'

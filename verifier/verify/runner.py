@@ -271,9 +271,10 @@ def _input_problem(plc: _Plc, name: str, value: Any) -> str | None:
         return f"{name} is a number: set it to a number, not {str(value).lower()}"
     try:
         plc.write(name, value)
-        after = _plain(plc.read(name))
     except (ValueError, TypeError, AttributeError) as exc:
-        return str(exc)
+        return str(exc)  # nothing was written: nothing to put back (a constant refuses that too)
+    try:
+        after = _plain(plc.read(name))
     finally:
         plc.write(name, before)
     if isinstance(value, float) and isinstance(after, float):
