@@ -250,7 +250,8 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
         if missing is not None:
             raise UnusableInput(f"{scenario.where(use.key, use.line)}: {missing}")
         for name in use.names:
-            kinds[name] = "bool" if isinstance(_plain(plc.read(name)), bool) else "number"
+            value = _plain(plc.read(name))
+            kinds[name] = "bool" if isinstance(value, bool) else "STRING" if isinstance(value, str) else "number"
         problem = use.condition.type_error(kinds) if use.condition is not None else None
         for name, value in (use.values or {}).items():
             problem = problem or _input_problem(plc, name, value)
@@ -265,6 +266,8 @@ def _input_problem(plc: _Plc, name: str, value: Any) -> str | None:
     """Why `value` cannot be written to `name`, or None. Tried on the real label before
     the first scan (and put back): the simulator's own conversion is the judge of range."""
     before = _plain(plc.read(name))
+    if isinstance(before, str):  # a scenario's values are true/false and numbers: it cannot say one
+        return f"{name} is a STRING: an input sets BOOL and number labels only; set a BOOL the program reads instead"
     if isinstance(before, bool) != isinstance(value, bool):
         if isinstance(before, bool):
             return f"{name} is a BOOL (a bit): set it to true or false, not {value!r}"
