@@ -457,6 +457,16 @@ def test_replay_refuses_to_write_a_report_over_its_own_capture(tmp_path):
     assert path.read_text(encoding="utf-8") == text
 
 
+def test_a_capture_named_with_control_characters_does_not_restyle_the_terminal(tmp_path):
+    """The run's name was shown escaped, but its file path beside it was printed raw: a
+    file name holding ESC [31m turned the console red, a newline split the verdict line."""
+    path = tmp_path / "site\x1b[31m\nred.txt"
+    path.write_text("0.1 01 06 01 A0 00 00 88 14\n", encoding="utf-8")
+    done = subprocess.run(uitamr("replay", path), capture_output=True, text=True, timeout=WAIT_S)
+    assert done.returncode == 0, done.stderr
+    assert "\x1b" not in done.stdout and "site\\x1b[31m\\x0ared.txt" in done.stdout
+
+
 def test_a_named_pipe_is_not_read_as_a_capture(tmp_path):
     fifo = tmp_path / "c.txt"
     os.mkfifo(fifo)
