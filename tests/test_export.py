@@ -143,6 +143,24 @@ def test_a_pou_named_like_the_global_label_table_is_refused(tmp_path, name):
     assert not (tmp_path / "o").exists()
 
 
+def test_exporting_a_folder_into_a_folder_inside_it_runs_twice(tmp_path):
+    """`--out src/gx2 src`: the second run read the first run's bodies (no declarations)
+    as sources and failed with 'a statement outside a POU' at src/gx2/Main.st."""
+    src = tmp_path / "src"
+    src.mkdir()
+    (src / "Main.st").write_text("PROGRAM Main\nVAR\n    wX : INT;\nEND_VAR\nwX := wX + 1;\nEND_PROGRAM\n")
+    args = ["--target", "gxworks2", "--out", str(src / "gx2"), str(src)]
+    first = CliRunner().invoke(command, args)
+    assert first.exit_code == 0, first.output
+    second = CliRunner().invoke(command, args)
+    assert second.exit_code == 0, second.output
+    assert f"1 file(s) in the --out folder {src / 'gx2'} left out of the sources (an earlier export)" in second.output
+    assert (src / "gx2" / "Main.st").read_text() == "wX := wX + 1;\n"
+    # the output folder named as the source is read: it is what was asked for
+    third = CliRunner().invoke(command, ["--target", "gxworks2", "--out", str(tmp_path / "o"), str(src / "gx2")])
+    assert third.exit_code == 1 and "outside a POU" in third.output
+
+
 def test_missing_source_is_a_usage_error(tmp_path):
     result = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(tmp_path), "nope.st"])
     assert result.exit_code == 2 and "nope.st" in result.output
