@@ -309,6 +309,19 @@ def test_every_scan_reports_what_the_default_reports(tmp_path, jobs):
     assert report("--every-scan") == report()
 
 
+def test_a_function_block_or_no_program_at_all_is_named_as_such():
+    """`--program UITAMR_Engine` (the FB under test) said 'no PROGRAM ... they define:
+    none', and sources with no PROGRAM said 'say which PROGRAM to run (--program ...)',
+    which no --program could satisfy."""
+    core = sorted((PLC / "core").glob("*.st")) + sorted((PLC / "fx3").glob("*.st"))
+    result = invoke(*core, "--program", "UITAMR_Engine", "--duration", "1s")
+    assert result.exit_code == 2
+    assert "UITAMR_Engine is a FUNCTION_BLOCK, not a PROGRAM: name the PROGRAM that calls it" in result.output
+    result = invoke(*core, "--duration", "1s")
+    assert result.exit_code == 2
+    assert "the sources define no PROGRAM, only function blocks and functions" in result.output
+
+
 def test_text_in_square_brackets_is_shown_as_written_not_read_as_markup(tmp_path):
     """The console library reads "[...]" as styling: user text in an error must be escaped,
     or "[/]" crashes and "uMbx[i]" loses its index (found by a robustness sweep)."""

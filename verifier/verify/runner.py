@@ -72,6 +72,14 @@ class _Plc:
     def _program_name(self, scenario: Scenario) -> str:
         programs = self.project.pou_names("PROGRAM")
         listing = ", ".join(programs) or "none"
+        wanted = (scenario.program or "").upper()
+        other = next((pou for f in self.project.files for pou in f.pous if pou.key == wanted), None)
+        if other is not None and other.kind != "PROGRAM":  # the FB under test named instead of its caller
+            raise UnusableInput(f"{_where(scenario)}: {other.name} is a {other.kind}, not a PROGRAM: name the PROGRAM "
+                                f"that calls it (the sources define: {listing})")
+        if not programs:
+            raise UnusableInput(f"{_where(scenario)}: the sources define no PROGRAM, only function blocks and "
+                                "functions: give also the .st file of the PROGRAM to run")
         if scenario.program is None:
             if len(programs) == 1:
                 return programs[0]
