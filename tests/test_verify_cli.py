@@ -309,6 +309,17 @@ def test_every_scan_reports_what_the_default_reports(tmp_path, jobs):
     assert report("--every-scan") == report()
 
 
+def test_a_report_in_a_folder_that_is_a_file_says_so(tmp_path):
+    """`--json src.st/r.json` said 'the folder .../src.st does not exist' of a file that does."""
+    from verifier.commands.report_files import ReportError, check_folders
+
+    (tmp_path / "src.st").write_text("")
+    with pytest.raises(ReportError, match=r"src.st is a file, not a folder$"):
+        check_folders(str(tmp_path / "src.st" / "r.json"))
+    with pytest.raises(ReportError, match=r"nope does not exist$"):
+        check_folders(str(tmp_path / "nope" / "r.json"))
+
+
 def test_a_function_block_or_no_program_at_all_is_named_as_such():
     """`--program UITAMR_Engine` (the FB under test) said 'no PROGRAM ... they define:
     none', and sources with no PROGRAM said 'say which PROGRAM to run (--program ...)',
