@@ -118,6 +118,15 @@ def test_a_scenario_given_as_source_is_pointed_to_scenario_option():
     assert f"{scenario} is a scenario, not ST source: give it as --scenario {scenario}" in done.stderr
 
 
+def test_st_source_given_as_a_scenario_is_pointed_to_the_arguments():
+    """`--scenario Main.st` said 'Main.st:1:9: not valid TOML: Expected '=' after a key',
+    which does not say the file went to the wrong option."""
+    source = FX3_SOURCES[-1]
+    result = invoke("--scenario", source)
+    assert result.exit_code == 2
+    assert f"{source} is ST source, not a scenario: give it without --scenario" in result.output
+
+
 def test_the_bundled_scenarios_cover_every_fault_kind():
     from verifier.amr.faults import FAULT_KINDS
     from verifier.verify.scenario import load_scenario

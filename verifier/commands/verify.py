@@ -170,6 +170,9 @@ def _scenario_files(names) -> list[Path]:
             if not found:
                 raise UnusableInput(f"the folder {path} holds no scenario (.toml) file")
             files += found
+        elif path.suffix.lower() == ".st":  # as a .toml among the SOURCES is sent to --scenario
+            raise UnusableInput(f"{name} is ST source, not a scenario: give it without --scenario "
+                                f"(uitamr verify {name} ...)")
         else:
             files.append(path)
     return files
