@@ -412,6 +412,8 @@ def test_fault_file_is_applied(tmp_path, start_emulator):
     (("--tcp", "0", "--turnaround-ms", "1e300"), "--turnaround-ms': '1e300' is out of range", 2),
     (("--serial", "socket://127.0.0.1"), "socket://127.0.0.1 needs a host and a port: socket://HOST:PORT", 2),
     (("--serial", "socket://127.0.0.1:http"), "the port 'http' is not a number from 1 to 65535", 2),
+    # `--serial "$PORT"` with PORT unset: was exit 1, "cannot open serial port : ... ''"
+    (("--serial", ""), "the port name is empty: give the serial port", 2),
 ])
 def test_cli_mistakes_get_a_clear_message(args, message, code):
     result = run_cli(*args)

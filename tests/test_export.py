@@ -84,6 +84,23 @@ def test_label_table_uses_the_editors_words(tmp_path):
     assert body.startswith("(* ====") and "VAR_INPUT" not in body and "END_VAR" not in body
 
 
+def test_a_comment_over_two_lines_after_a_declaration_is_kept(tmp_path):
+    """A trailing comment closed on the next line was dropped from the label table, the
+    bundled engine's IDLE_POLLS_TO_END among them. Joined into one line, as the editors'
+    label comments are."""
+    src = tmp_path / "src" / "FB_Two.st"
+    src.parent.mkdir()
+    src.write_text("FUNCTION_BLOCK FB_Two\nVAR\n    wX : INT;  (* counts the\n                  retries *)\n"
+                   "    wY : INT;  (* one line *) wZ : INT;\nEND_VAR\nwX := wY + wZ;\nEND_FUNCTION_BLOCK\n")
+    assert run("--target", "gxworks2", "--out", str(tmp_path / "o"), str(src)).exit_code == 0
+    table = (tmp_path / "o" / "FB_Two.labels.tsv").read_text()
+    assert "VAR\twX\tWord[Signed]\t\tcounts the retries\n" in table
+    assert "VAR\twY\tWord[Signed]\t\tone line\n" in table
+    run("--target", "gxworks3", "--out", str(tmp_path / "3"))
+    assert ("IDLE_POLLS_TO_END\tWord [Signed]\tVAR_CONSTANT\t\t1\t'idle' answers in a row that end a task; "
+            "2 if the robot is slow to report a started task\n") in (tmp_path / "3" / "UITAMR_Engine.labels.tsv").read_text()
+
+
 def test_sources_with_errors_are_reported_with_their_place(tmp_path):
     bad = tmp_path / "FB_Bad.st"
     bad.write_text("FUNCTION_BLOCK FB_Bad\nVAR\n    wX : INT;\nEND_VAR\nwX := ;\n")
@@ -108,6 +125,40 @@ def test_an_export_into_the_sources_own_folder_never_writes_over_the_source(tmp_
     src.rename(other)
     assert run("--target", "gxworks2", "--out", str(tmp_path), str(other)).exit_code == 0
     assert other.read_text() == text and (tmp_path / "FB_Count.st").exists()
+
+
+@pytest.mark.parametrize("name", ["GlobalLabels", "GLOBALLABELS"])
+def test_a_pou_named_like_the_global_label_table_is_refused(tmp_path, name):
+    """A PROGRAM GlobalLabels had its label table written over by the global label table
+    (or the other way round): its labels were lost without a word, exit 0. On Windows,
+    where GX Works runs, GLOBALLABELS.labels.tsv is the same file."""
+    src = tmp_path / "src"
+    src.mkdir()
+    (src / "Prog.st").write_text(f"PROGRAM {name}\nVAR\n    wX : INT;\nEND_VAR\nwX := gY;\nEND_PROGRAM\n")
+    (src / "Globals.st").write_text("VAR_GLOBAL\n    gY : INT;\nEND_VAR\n")
+    result = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(tmp_path / "o"), str(src)])
+    assert result.exit_code == 1
+    assert (f"{src / 'Prog.st'}:1:1: error: a POU named {name} would have its label table written to "
+            "GlobalLabels.labels.tsv") in result.output
+    assert not (tmp_path / "o").exists()
+
+
+def test_exporting_a_folder_into_a_folder_inside_it_runs_twice(tmp_path):
+    """`--out src/gx2 src`: the second run read the first run's bodies (no declarations)
+    as sources and failed with 'a statement outside a POU' at src/gx2/Main.st."""
+    src = tmp_path / "src"
+    src.mkdir()
+    (src / "Main.st").write_text("PROGRAM Main\nVAR\n    wX : INT;\nEND_VAR\nwX := wX + 1;\nEND_PROGRAM\n")
+    args = ["--target", "gxworks2", "--out", str(src / "gx2"), str(src)]
+    first = CliRunner().invoke(command, args)
+    assert first.exit_code == 0, first.output
+    second = CliRunner().invoke(command, args)
+    assert second.exit_code == 0, second.output
+    assert f"1 file(s) in the --out folder {src / 'gx2'} left out of the sources (an earlier export)" in second.output
+    assert (src / "gx2" / "Main.st").read_text() == "wX := wX + 1;\n"
+    # the output folder named as the source is read: it is what was asked for
+    third = CliRunner().invoke(command, ["--target", "gxworks2", "--out", str(tmp_path / "o"), str(src / "gx2")])
+    assert third.exit_code == 1 and "outside a POU" in third.output
 
 
 def test_missing_source_is_a_usage_error(tmp_path):

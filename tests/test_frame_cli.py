@@ -229,3 +229,11 @@ def test_mbpoll_command_line():
     result = run("read", "battery", "--address", "3", "--mbpoll", "/dev/ttyUSB0")
     assert result.output.splitlines()[1] == (
         "mbpoll -m rtu -b 9600 -d 8 -s 1 -P none -a 3 -0 -1 -t 0 -r 3 -c 22 /dev/ttyUSB0")
+
+
+@pytest.mark.parametrize("device", ["", "  "])
+def test_mbpoll_with_an_empty_device_is_an_error_not_a_silent_nothing(device):
+    """`--mbpoll "$PORT"` with PORT unset printed the frame without the mbpoll line and exited 0."""
+    result = run("stop", "--mbpoll", device)
+    assert result.exit_code == 2
+    assert "--mbpoll" in result.output and "the device is empty" in result.output

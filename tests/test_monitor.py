@@ -63,6 +63,8 @@ def test_plain_capture_reads_chunks_and_frames_with_directions():
     ("0.1 01 6\n", "c.txt:1:8: '6' is not a byte in hex"),
     ("0.2 01\n0.1 02\n", "c.txt:2:1: time 0.1 s is earlier than the line before"),
     ("0.1   # nothing\n", "c.txt:1:4: the line has a time but no bytes"),
+    ("0.1 01\n 1" + "0" * 400 + " 02\n", "c.txt:2:2: time 1000"),  # was an OverflowError traceback
+    ("1000000001 01\n", "c.txt:1:1: time 1000000001 s is beyond 1e+09 s; expected a time in seconds"),
 ])
 def test_a_bad_capture_is_named_with_file_line_and_column(text, where):
     with pytest.raises(CaptureError) as caught:
@@ -407,6 +409,12 @@ def test_a_port_that_cannot_be_opened_exits_2_with_its_name(tmp_path):
     assert done.returncode == 2 and "127.0.0.1:1" in done.stderr
 
 
+def test_an_empty_port_name_is_named_as_empty():
+    done = subprocess.run(uitamr("monitor", "--serial", "", "--duration", "1s"), capture_output=True, text=True,
+                          timeout=WAIT_S)
+    assert done.returncode == 2 and "the port name is empty" in done.stderr and "Traceback" not in done.stderr
+
+
 @pytest.mark.parametrize("record, message", [
     ('{"t": NaN, "dir": "tx", "hex": "01"}', "'t' is NaN; expected a time in seconds from 0 to 1e+09"),
     ('{"t": 1e400, "dir": "tx", "hex": "01"}', "'t' is Infinity; expected a time in seconds"),
@@ -415,6 +423,7 @@ def test_a_port_that_cannot_be_opened_exits_2_with_its_name(tmp_path):
     ('{"t": 0.2, "t_end": 0.1, "dir": "tx", "hex": "01"}', "'t_end' (0.1 s) is before 't' (0.2 s)"),
     ('{"t": 0.1, "dir": "tx", "hex": "ZZ"}', "'hex' is 'ZZ'; expected bytes in hex"),
     ('{"t": 0.1, "dir": "tx", "hex": 5}', "'hex' is 5; expected bytes in hex"),
+    ('{"t": 0.1, "dir": "tx", "hex": " "}', "'hex' is ' '; expected bytes in hex"),  # was judged as a 0-byte frame
 ])
 def test_a_trace_record_with_a_bad_value_names_the_key(tmp_path, record, message):
     path = tmp_path / "t.jsonl"
@@ -424,6 +433,21 @@ def test_a_trace_record_with_a_bad_value_names_the_key(tmp_path, record, message
     assert str(caught.value).startswith(f"{path}:1:1: {message}")
 
 
+def test_a_trace_out_of_time_order_is_an_error_not_a_reply_before_its_request(tmp_path):
+    """A hand-edited or merged trace whose records go back in time was replayed as it
+    stood: the reply came out 0.5 s before power-on and the run passed."""
+    path = tmp_path / "t.jsonl"
+    path.write_text('{"t": 1.0, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}\n'
+                    '{"t": 0.5, "dir": "rx", "hex": "01 06 01 A0 00 00 88 14"}\n', encoding="utf-8")
+    done = subprocess.run(uitamr("replay", path), capture_output=True, text=True, timeout=WAIT_S)
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert f"{path}:2:1: 't' (0.5 s) is earlier than the record before of scenario '{path}' (1 s)" in done.stderr
+    # each scenario of a trace has its own time line
+    path.write_text('{"scenario": "a", "t": 1.0, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}\n'
+                    '{"scenario": "b", "t": 0.5, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}\n', encoding="utf-8")
+    assert set(read_capture(path)) == {"a", "b"}
+
+
 def test_replay_refuses_to_write_a_report_over_its_own_capture(tmp_path):
     path = tmp_path / "t.jsonl"
     text = '{"t": 0.1, "t_end": 0.108, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}\n'
@@ -431,6 +455,16 @@ def test_replay_refuses_to_write_a_report_over_its_own_capture(tmp_path):
     done = subprocess.run(uitamr("replay", path, "--trace", path), capture_output=True, text=True, timeout=WAIT_S)
     assert done.returncode == 2 and "is one of the run's input files" in done.stderr
     assert path.read_text(encoding="utf-8") == text
+
+
+def test_a_capture_named_with_control_characters_does_not_restyle_the_terminal(tmp_path):
+    """The run's name was shown escaped, but its file path beside it was printed raw: a
+    file name holding ESC [31m turned the console red, a newline split the verdict line."""
+    path = tmp_path / "site\x1b[31m\nred.txt"
+    path.write_text("0.1 01 06 01 A0 00 00 88 14\n", encoding="utf-8")
+    done = subprocess.run(uitamr("replay", path), capture_output=True, text=True, timeout=WAIT_S)
+    assert done.returncode == 0, done.stderr
+    assert "\x1b" not in done.stdout and "site\\x1b[31m\\x0ared.txt" in done.stdout
 
 
 def test_a_named_pipe_is_not_read_as_a_capture(tmp_path):
@@ -449,6 +483,23 @@ def test_a_capture_that_cannot_be_written_is_an_error_not_a_traceback(line, tmp_
     assert monitor.returncode == 2 and "Traceback" not in err
     assert "uitamr monitor: cannot write the capture /proc/version" in err
     assert (tmp_path / "m.json").exists()  # the reports are written first
+
+
+@pytest.mark.serial
+def test_the_capture_is_written_even_when_a_report_cannot_be(line, tmp_path):
+    """The line's bytes cannot be had again; a report can, from the capture (`uitamr
+    replay`). A --json in a folder that exists but cannot be written used to end the
+    command before the capture was written: the capture was lost."""
+    monitor = start("monitor", "--serial", line.tap, "--duration", "2s", "--json", "/proc/m.json",
+                    "--capture", tmp_path / "c.txt")
+    wait_for_line(monitor, "listening")
+    master = Master(line.plc)
+    master.send(STOP)
+    master.close()
+    out, err = monitor.communicate(timeout=WAIT_S)
+    assert monitor.returncode == 2 and "Traceback" not in err
+    assert "cannot write /proc/m.json" in err
+    assert parse_plain((tmp_path / "c.txt").read_text(encoding="utf-8"))  # the capture holds the stop
 
 
 def test_an_html_report_of_a_capture_spanning_years_stays_small(tmp_path):

@@ -55,6 +55,23 @@ def test_directory_argument_checks_every_st_file_below_it():
     assert result.exit_code == 0, result.output  # multi_file_a/b resolve each other
 
 
+def test_a_folder_is_read_as_verify_reads_it(tmp_path):
+    """A folder named like a file (`old.st/`) below the folder given was taken for a source
+    (exit 2, 'is a folder'), and `MAIN.ST` was not seen on a case-sensitive disk, where
+    `uitamr verify` read both folders right. check and export now read a folder as verify does."""
+    src = tmp_path / "src"
+    (src / "old.st").mkdir(parents=True)
+    (src / "old.st" / "Inner.st").write_text(GOOD.read_text(encoding="utf-8").replace("PROGRAM ", "PROGRAM Inner_", 1),
+                                             encoding="utf-8")
+    (src / "MAIN.ST").write_text(GOOD.read_text(encoding="utf-8"), encoding="utf-8")
+    result = run(src)
+    assert result.exit_code == 0, result.output
+    assert "2 file(s) checked" in result.output
+    from verifier.verify.sources import expand
+    from verifier.commands.check import expand_sources
+    assert expand_sources((str(src),)) == expand(str(src), tmp_path)
+
+
 def test_json_format():
     result = run("--format", "json", BAD, WARN)
     assert result.exit_code == 1

@@ -247,6 +247,9 @@ BASE = 'platform = "fx5u"\n'
     (BASE + '[converter]\nport = 70000\n', "s.toml:3:8: converter.port: expected a TCP port 1..65535"),
     (BASE + '[converter]\ndrops = "20s"\n', "s.toml:3:9: converter.drops: expected a list of times"),
     (BASE + '[converter]\ndrops = ["20s", "x"]\n', "s.toml:3:17: converter.drops[1]"),
+    # a drop after the run was silently never done, while a fault's at_s there is an error
+    (BASE + 'duration = "30s"\n[converter]\ndrops = ["20s", "30s"]\n',
+     "s.toml:4:17: converter.drops[1]: is at or after the end of the run (30s): the drop would never happen"),
     (BASE + '[converter]\nsplit = true\n', "s.toml:3:1: converter.split: unknown key"),
     (BASE + 'channel = "fx5:1"\n[converter]\n', "s.toml:2:11: channel: a scenario with [converter]"),
 ])

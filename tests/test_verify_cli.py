@@ -118,6 +118,15 @@ def test_a_scenario_given_as_source_is_pointed_to_scenario_option():
     assert f"{scenario} is a scenario, not ST source: give it as --scenario {scenario}" in done.stderr
 
 
+def test_st_source_given_as_a_scenario_is_pointed_to_the_arguments():
+    """`--scenario Main.st` said 'Main.st:1:9: not valid TOML: Expected '=' after a key',
+    which does not say the file went to the wrong option."""
+    source = FX3_SOURCES[-1]
+    result = invoke("--scenario", source)
+    assert result.exit_code == 2
+    assert f"{source} is ST source, not a scenario: give it without --scenario" in result.output
+
+
 def test_the_bundled_scenarios_cover_every_fault_kind():
     from verifier.amr.faults import FAULT_KINDS
     from verifier.verify.scenario import load_scenario
@@ -245,6 +254,48 @@ def test_parallel_batches_group_sources_and_cover_every_scenario():
         assert sizes == sorted(sizes, reverse=True)
 
 
+def test_a_duration_that_ends_the_run_before_a_fault_says_the_fault_was_not_tested(tmp_path):
+    """--duration shorter than a scenario's fault times: the faults never struck, and with
+    --matrix (the scenario's own expectations left out) the run passed with a note that
+    claimed 'robot, faults, timing and every rule applied'. The run now says which were not."""
+    sources = [str(p) for p in FX3_SOURCES]
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(f'sources = {json.dumps(sources)}\nprogram = "UITAMR_ExampleFx3"\nduration = "10s"\n'
+                        '[[faults]]\nkind = "no_reply"\nat_s = 1.0\nduration_s = 0.5\n'
+                        '[[faults]]\nkind = "anti_collision"\nat_s = 6.0\n')
+    report = tmp_path / "r.json"
+    result = invoke("--scenario", scenario, "--duration", "3s", "--json", report)
+    assert result.exit_code in (0, 1), result.output
+    note = "--duration 3s ends the run before 1 of its scripted fault(s), not tested: anti_collision at 6 s"
+    assert note in result.output
+    (run,) = json.loads(report.read_text())["scenarios"]
+    assert note in run["notes"]
+    result = invoke("--scenario", scenario, "--duration", "7s")  # every fault strikes: no such note
+    assert "not tested" not in result.output
+
+
+def test_jobs_beyond_the_batches_start_no_idle_workers(tmp_path, monkeypatch):
+    """The process pool forks all its workers at once: --jobs 5000 for two scenarios
+    forked 5000 processes and the run never ended. It gets a worker per batch at most."""
+    import concurrent.futures
+    from verifier.commands import verify
+
+    asked = []
+
+    class Pool(concurrent.futures.ThreadPoolExecutor):  # records the size, runs in threads
+        def __init__(self, max_workers):
+            asked.append(max_workers)
+            super().__init__(max_workers=min(max_workers, 4))
+
+    monkeypatch.setattr(verify, "ProcessPoolExecutor", Pool)
+    sources = [str(p) for p in FX3_SOURCES]
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(f'sources = {json.dumps(sources)}\nprogram = "UITAMR_ExampleFx3"\nduration = "1s"\n')
+    result = invoke("--scenario", scenario, "--scenario", scenario, "--jobs", "5000")
+    assert result.exit_code in (0, 1), result.output
+    assert asked and asked[0] <= 2
+
+
 def test_parallel_run_reports_what_a_serial_run_reports(tmp_path):
     """The JSON report of --jobs 2 is the one of --jobs 1, in the same order (wall times aside)."""
     def report(jobs: int):
@@ -265,6 +316,30 @@ def test_every_scan_reports_what_the_default_reports(tmp_path, jobs):
         assert result.exit_code in (0, 1), result.output
         return re.sub(r'"wall[^"]*": [0-9.e+-]+', '"wall": 0', out.read_text())
     assert report("--every-scan") == report()
+
+
+def test_a_report_in_a_folder_that_is_a_file_says_so(tmp_path):
+    """`--json src.st/r.json` said 'the folder .../src.st does not exist' of a file that does."""
+    from verifier.commands.report_files import ReportError, check_folders
+
+    (tmp_path / "src.st").write_text("")
+    with pytest.raises(ReportError, match=r"src.st is a file, not a folder$"):
+        check_folders(str(tmp_path / "src.st" / "r.json"))
+    with pytest.raises(ReportError, match=r"nope does not exist$"):
+        check_folders(str(tmp_path / "nope" / "r.json"))
+
+
+def test_a_function_block_or_no_program_at_all_is_named_as_such():
+    """`--program UITAMR_Engine` (the FB under test) said 'no PROGRAM ... they define:
+    none', and sources with no PROGRAM said 'say which PROGRAM to run (--program ...)',
+    which no --program could satisfy."""
+    core = sorted((PLC / "core").glob("*.st")) + sorted((PLC / "fx3").glob("*.st"))
+    result = invoke(*core, "--program", "UITAMR_Engine", "--duration", "1s")
+    assert result.exit_code == 2
+    assert "UITAMR_Engine is a FUNCTION_BLOCK, not a PROGRAM: name the PROGRAM that calls it" in result.output
+    result = invoke(*core, "--duration", "1s")
+    assert result.exit_code == 2
+    assert "the sources define no PROGRAM, only function blocks and functions" in result.output
 
 
 def test_text_in_square_brackets_is_shown_as_written_not_read_as_markup(tmp_path):

@@ -138,6 +138,43 @@ def test_labels_of_the_wrong_type_are_refused(tmp_path, program, body, words):
     assert f"{scenario}:{line}:{col}: " in result.output and words in result.output
 
 
+def test_an_input_to_a_constant_is_refused_not_a_traceback(tmp_path):
+    """The trial write was put back in a `finally` that wrote to the constant again: an
+    AttributeError traceback instead of the error at the input's line."""
+    source = tmp_path / "Main.st"
+    source.write_text("PROGRAM Main\nVAR CONSTANT\n    MAX_W : INT := 3;\nEND_VAR\nVAR\n    w : INT;\nEND_VAR\n"
+                      "w := MAX_W;\nEND_PROGRAM\n", encoding="utf-8")
+    result, scenario = _run_scenario(tmp_path, source, '[[inputs]]\nat = "0s"\nset = { MAX_W = 5 }\n')
+    assert result.exit_code == 2, result.output
+    assert f"{scenario}:5:7: inputs[0].set: Main.MAX_W is a constant" in result.output
+
+
+@pytest.mark.parametrize("value", ["true", "5"])
+def test_an_input_to_a_string_says_it_is_a_string(tmp_path, value):
+    """`s = true` said 's is a number: set it to a number', and `s = 5` 'MAIN.s is a STRING;
+    got 5': a STRING cannot be set from a scenario at all, and neither said so."""
+    source = tmp_path / "Main.st"
+    source.write_text("PROGRAM Main\nVAR\n    s : STRING[10];\n    w : INT;\nEND_VAR\nw := LEN(s);\nEND_PROGRAM\n",
+                      encoding="utf-8")
+    result, scenario = _run_scenario(tmp_path, source, f'[[inputs]]\nat = "0s"\nset = {{ s = {value} }}\n')
+    assert result.exit_code == 2, result.output
+    assert f"{scenario}:5:7: inputs[0].set: s is a STRING: an input sets BOOL and number labels only" in result.output
+
+
+@pytest.mark.parametrize("body", ['[[expect]]\nthat = "s < 5"\n', '[[expect]]\nnever = "s"\n',
+                                  '[response_handling]\nsignal = "w > 0 AND s = 1"\n'])
+def test_a_condition_on_a_string_says_it_is_a_string(tmp_path, body):
+    """`s < 5` on a STRING passed the type check as a number and stopped the run with a
+    TypeError traceback; `never = "s"` said 's is a number'."""
+    source = tmp_path / "Main.st"
+    source.write_text("PROGRAM Main\nVAR\n    s : STRING[10];\n    w : INT;\nEND_VAR\nw := LEN(s);\nEND_PROGRAM\n",
+                      encoding="utf-8")
+    result, scenario = _run_scenario(tmp_path, source, body)
+    assert result.exit_code == 2, result.output
+    assert f"{scenario}:4:" in result.output
+    assert "s is a STRING: a condition reads BOOL and number labels only" in result.output
+
+
 def test_values_that_fit_are_accepted(tmp_path, program):
     body = ('watch = ["w", "u", "D100", "r"]\n[[inputs]]\nat = "0s"\n'
             'set = { w = -32768, u = 65535, D100 = 0xFFFF, r = 0.1, X0 = true, b = true }\n'

@@ -215,6 +215,7 @@ def test_the_nth_table_of_an_array_is_found():
     ('watch = ["9lives"]', "watch[0]", "label path"),
     ('sources = ["nope/*.st"]', "sources[0]", "matches no file"),
     ('bogus = 1', "bogus", "unknown key"),
+    ('name = " "', "name", "is empty"),  # was a run named '' in every report (a JUnit test case with no name)
 ])
 def test_every_mistake_names_its_key(text, key, words):
     source = 'program = "Main"\n' + text + "\n"

@@ -24,13 +24,16 @@ EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
 
 
 def expand_sources(sources: tuple[str, ...]) -> list[Path]:
-    """Files named on the command line; directories give their *.st files (recursive). A
-    file named twice (itself and through its folder) is read once, where first named."""
+    """Files named on the command line; directories give their .st files (recursive, as
+    `uitamr verify` reads them). A file named twice (itself and through its folder) is read
+    once, where first named."""
+    from verifier.verify.sources import st_files_in
+
     paths: list[Path] = []
     seen: set[Path] = set()
     for s in sources:
         p = Path(s)
-        for path in sorted(p.rglob("*.st")) if p.is_dir() else [p]:
+        for path in st_files_in(p) if p.is_dir() else [p]:
             key = path.resolve()
             if key not in seen:
                 seen.add(key)

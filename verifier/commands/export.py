@@ -6,6 +6,8 @@ examples of that editor's platforms). Exit status: 0 written, 1 the sources have
 (listed as file:line:col), 2 usage errors (no such file, a file with no POU in it).
 An initial value the target's label table cannot carry is never dropped silently: one
 note line per value (file:line:col) and DROPPED_INITIAL_VALUES.txt in the output folder.
+An --out folder inside a source folder is left out of the sources (an earlier export there
+is bodies without declarations), with a note.
 """
 from __future__ import annotations
 
@@ -49,6 +51,16 @@ def command(sources: tuple[str, ...], target: str, out_dir: str) -> None:
             click.echo(f"uitamr export: no such file or folder: {', '.join(missing)}", err=True)
             sys.exit(EXIT_USAGE)
         paths = expand_sources(sources)
+        # a folder that holds --out: the files of an earlier export there are not sources (bodies
+        # without declarations: the second run of the same command failed on them)
+        out = Path(out_dir).resolve()
+        folders = [Path(s).resolve() for s in sources if Path(s).is_dir()]
+        earlier = [p for p in paths if p.resolve().is_relative_to(out)] \
+            if any(out != f and out.is_relative_to(f) for f in folders) else []
+        if earlier:
+            click.echo(f"uitamr export: {len(earlier)} file(s) in the --out folder {out_dir} left out of the "
+                       "sources (an earlier export)", err=True)
+            paths = [p for p in paths if p not in earlier]
     else:
         paths = bundled_sources(target)
     if not paths:

@@ -80,6 +80,14 @@ def _kind(frame) -> str:
     return "frame"
 
 
+def _device(ctx, param, value: str | None) -> str | None:
+    """--mbpoll's DEVICE: a blank one (`--mbpoll "$PORT"` with PORT unset) printed no mbpoll
+    line at all and exited 0."""
+    if value is not None and not value.strip():
+        raise click.BadParameter("the device is empty: give the serial port mbpoll sends on, e.g. /dev/ttyUSB0")
+    return value
+
+
 @click.command(
     "frame",
     epilog=_EPILOG,
@@ -95,7 +103,7 @@ def _kind(frame) -> str:
               help="With --decode: read the bytes as a request or a reply. With a COMMAND too, "
                    "--as request checks that the bytes are that command's request.")
 @click.option("--explain", "explain_fields", is_flag=True, help="Also show every field of the frame.")
-@click.option("--mbpoll", "mbpoll_device", metavar="DEVICE",
+@click.option("--mbpoll", "mbpoll_device", metavar="DEVICE", callback=_device,
               help="Also print the mbpoll command line that sends this request on DEVICE "
                    "(for commissioning from a laptop on the RS-485 bus).")
 @click.option("--words", "as_words", is_flag=True,
@@ -119,10 +127,10 @@ def command(words, settings, decode_hex, direction, explain_fields,
         if request is None:
             raise click.UsageError("give a COMMAND (e.g. `uitamr frame stop`) or --decode HEX")
         _print_request(request, settings, explain_fields, as_words)
-        if mbpoll_device:
+        if mbpoll_device is not None:
             click.echo(shlex.join(mbpoll_command(request, settings, mbpoll_device)))
         return
-    if mbpoll_device or as_words:
+    if mbpoll_device is not None or as_words:
         raise click.UsageError("--mbpoll and --words print a COMMAND's request; they do not go with --decode")
     try:
         data = parse_hex(decode_hex)

@@ -137,16 +137,22 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
     result = session.result(listened_us=round((time.monotonic() - started) * 1_000_000))
     if lost:
         result.notes.append(f"the capture ended early: {lost}")
-    _finish([result], console, json_path, junit_path, trace_path, html_path)
-    if capture_path:
-        text = format_plain(session.chunks, f"uitamr monitor capture of {source.description}, {baud} {line_format}")
-        try:
-            Path(capture_path).write_text(text, encoding="utf-8")
-        except OSError as exc:
-            click.echo(f"uitamr monitor: cannot write the capture {capture_path}: {exc.strerror or exc}", err=True)
-            sys.exit(EXIT_UNUSABLE)
-        console.print(f"[dim]wrote {escape(str(capture_path))}[/]")
-    sys.exit(exit_status([result]))
+    capture_written = True
+    try:
+        _finish([result], console, json_path, junit_path, trace_path, html_path)
+    finally:
+        # the capture is the line's only record (the reports can be made again from it by
+        # `uitamr replay`): it is written even when a report cannot be
+        if capture_path:
+            text = format_plain(session.chunks, f"uitamr monitor capture of {source.description}, {baud} {line_format}")
+            try:
+                Path(capture_path).write_text(text, encoding="utf-8")
+            except OSError as exc:
+                click.echo(f"uitamr monitor: cannot write the capture {capture_path}: {exc.strerror or exc}", err=True)
+                capture_written = False
+            else:
+                console.print(f"[dim]wrote {escape(str(capture_path))}[/]")
+    sys.exit(exit_status([result]) if capture_written else EXIT_UNUSABLE)
 
 
 def exit_status(results) -> int:

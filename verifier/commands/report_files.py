@@ -43,7 +43,8 @@ def check_folders(*paths: str | None) -> None:
             continue
         resolved = Path(path).resolve()
         if not resolved.parent.is_dir():
-            raise ReportError(f"cannot write {path}: the folder {resolved.parent} does not exist")
+            what = "is a file, not a folder" if resolved.parent.exists() else "does not exist"
+            raise ReportError(f"cannot write {path}: the folder {resolved.parent} {what}")
         if resolved in seen:
             raise ReportError(f"{seen[resolved]} and {path} are the same file: give each report a file of its own")
         seen[resolved] = path

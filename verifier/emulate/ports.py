@@ -214,7 +214,10 @@ def serve_tcp(host: str, port: int, emulator: Emulator, stop: threading.Event, s
 
 def serial_url_problem(url: str) -> str | None:
     """What is wrong with a pyserial network URL (socket://, rfc2217://) before pyserial
-    says it less clearly: it needs HOST:PORT with a port 1-65535. None for other ports."""
+    says it less clearly: it needs HOST:PORT with a port 1-65535. None for other ports.
+    An empty name (`--serial "$PORT"` with PORT unset) is named as such, not as no file ''."""
+    if not url.strip():
+        return "the port name is empty: give the serial port, e.g. /dev/ttyUSB0 or COM3"
     scheme, sep, rest = url.partition("://")
     if not sep or scheme.lower() not in ("socket", "rfc2217"):
         return None

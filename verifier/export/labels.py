@@ -36,9 +36,16 @@ def trailing_comment(lines: list[str], decl: ast.VarDecl) -> str:
         return ""
     text = lines[line - 1][decl.span.end_col - 1:] if decl.span.end_line else lines[line - 1]
     m = _COMMENT.search(text)
-    if not m:
+    if m:
+        return " ".join((m.group(1) or m.group(2) or "").split())
+    start = text.find("(*")
+    if start < 0:
         return ""
-    return " ".join((m.group(1) or m.group(2) or "").split())
+    # a comment begun after the declaration and closed on a later line: a label comment is
+    # one line in the editors, so its lines are joined (it was dropped)
+    following = "\n".join([text[start + 2:]] + lines[line:])
+    end = following.find("*)")
+    return " ".join(following[:end].split()) if end >= 0 else ""
 
 
 def initial_text(source_text: str, lines: list[str], decl: ast.VarDecl) -> str:

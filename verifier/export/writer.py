@@ -211,6 +211,17 @@ def _overwritten_sources(files: list[ast.SourceFile], paths: list[Path], out: Pa
     return problems
 
 
+def _pous_named_like_the_export_files(files: list[ast.SourceFile], out: Path) -> list[ast.Diagnostic]:
+    """POUs whose label table would be the global label table (a POU named GlobalLabels):
+    one of the two would be written over the other, and the import guides tell to import
+    that file as the global labels."""
+    return [ast.Diagnostic(f.filename, pou.span.line, pou.span.col, "error",
+                           f"a POU named {pou.name} would have its label table written to {GLOBAL_TABLE}, "
+                           "the export's global label table: rename the POU")
+            for f in files for pou in f.pous for table in _pou_files(out, pou)[1:]
+            if table.name.lower() == GLOBAL_TABLE.lower()]
+
+
 def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, str] | None = None,
                    notes: list[DroppedValue] | None = None) -> list[Path]:
     """Parse and check `paths`, write the export into `out`; returns the files written.
@@ -228,7 +239,7 @@ def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, 
     empty = _empty_files(files)
     if empty:
         raise NothingToExport(empty)
-    clashes = _overwritten_sources(files, paths, out)
+    clashes = _overwritten_sources(files, paths, out) + _pous_named_like_the_export_files(files, out)
     if clashes:
         raise ExportError(clashes)
     known = {p.key for f in files for p in f.pous}

@@ -58,7 +58,11 @@ def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
             col = len(line) - len(line.lstrip()) + 1
             raise CaptureError(f"{name}:{number}:{col}: expected a time in seconds (e.g. 0.250) "
                                "at the start of the line")
-        t_us = round(float(time_match.group(1)) * 1_000_000)
+        seconds = float(time_match.group(1))
+        if seconds > LARGEST:  # the same bound as a trace record's time; 1e400 would not even be a number
+            raise CaptureError(f"{name}:{number}:{time_match.start(1) + 1}: time {time_match.group(1)} s is "
+                               f"beyond {LARGEST:g} s; expected a time in seconds from 0 to {LARGEST:g}")
+        t_us = round(seconds * 1_000_000)
         if last_t is not None and t_us < last_t:
             raise CaptureError(f"{name}:{number}:{time_match.start(1) + 1}: time {time_match.group(1)} s is "
                                f"earlier than the line before ({last_t / 1_000_000:.6f} s); a capture "
@@ -109,7 +113,7 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
             raise CaptureError(f"{name}:{number}:1: 'dir' is {record['dir']!r}; expected \"tx\" or \"rx\"")
         where = f"{name}:{number}:1"
         hex_text = record["hex"]
-        if not isinstance(hex_text, str) or not _HEX_BYTES.fullmatch(hex_text):
+        if not isinstance(hex_text, str) or not hex_text.strip() or not _HEX_BYTES.fullmatch(hex_text):
             raise CaptureError(f"{where}: 'hex' is {hex_text!r}; expected bytes in hex, two digits each, "
                                "e.g. \"01 06 01 A0 00 00 88 14\"")
         data = bytes.fromhex(hex_text)
@@ -117,8 +121,13 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
         t_end = _seconds(record["t_end"], "t_end", where) if record.get("t_end") is not None else t_start
         if t_end < t_start:
             raise CaptureError(f"{where}: 't_end' ({t_end:g} s) is before 't' ({t_start:g} s)")
-        scenarios.setdefault(str(record.get("scenario", name)), []).append(
-            Chunk(round(t_end * 1_000_000), data, record["dir"], round(t_start * 1_000_000)))
+        scenario = str(record.get("scenario", name))
+        chunks = scenarios.setdefault(scenario, [])
+        if chunks and round(t_start * 1_000_000) < chunks[-1].t_start_us:
+            raise CaptureError(f"{where}: 't' ({t_start:g} s) is earlier than the record before of scenario "
+                               f"{scenario!r} ({chunks[-1].t_start_us / 1_000_000:g} s); a trace is in time "
+                               "order, and two runs in one trace need names of their own")
+        chunks.append(Chunk(round(t_end * 1_000_000), data, record["dir"], round(t_start * 1_000_000)))
     return scenarios
 
 

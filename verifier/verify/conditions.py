@@ -238,7 +238,10 @@ def _kind(node, kinds: Mapping[str, str]) -> str:
     if tag == "lit":
         return "bool" if isinstance(node[1], bool) else "number"
     if tag == "var":
-        return kinds[node[1]]
+        kind = kinds[node[1]]
+        if kind not in ("bool", "number"):  # a STRING: compared with a number it stopped the run
+            raise _TypeProblem(f"{node[1]} is a {kind}: a condition reads BOOL and number labels only")
+        return kind
     if tag == "not":
         if _kind(node[1], kinds) != "bool":
             raise _TypeProblem(f"NOT needs a BOOL, but {_shown(node[1])} is a number")
@@ -283,8 +286,8 @@ class Condition:
         return bool(_evaluate(self.tree, values))
 
     def type_error(self, kinds: Mapping[str, str]) -> str | None:
-        """Why the condition does not type-check, given each label's kind ("bool" or
-        "number"), or None. A condition must be BOOL; AND/OR/XOR/NOT join BOOLs; a
+        """Why the condition does not type-check, given each label's kind ("bool",
+        "number", or the name of a type a condition cannot read, e.g. "STRING"), or None. A condition must be BOOL; AND/OR/XOR/NOT join BOOLs; a
         comparison compares two numbers, or two BOOLs with = and <>."""
         try:
             kind = _kind(self.tree, kinds)

@@ -35,7 +35,7 @@ def render(results: list[ScenarioResult], console: Console, *, first: int = FIRS
 
 def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
     mark = {"pass": "[green]PASS[/]", "fail": "[red]FAIL[/]", NO_TRAFFIC: "[yellow]NO TRAFFIC[/]"}[result.verdict]
-    where = f" ({escape(result.file)})" if result.file else ""
+    where = f" ({escape(escape_chars(result.file, str.isprintable))})" if result.file else ""
     tx = result.tx_count
     failed = len(result.failed_expectations)
     expectations = (

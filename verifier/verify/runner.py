@@ -73,6 +73,14 @@ class _Plc:
     def _program_name(self, scenario: Scenario) -> str:
         programs = self.project.pou_names("PROGRAM")
         listing = ", ".join(programs) or "none"
+        wanted = (scenario.program or "").upper()
+        other = next((pou for f in self.project.files for pou in f.pous if pou.key == wanted), None)
+        if other is not None and other.kind != "PROGRAM":  # the FB under test named instead of its caller
+            raise UnusableInput(f"{_where(scenario)}: {other.name} is a {other.kind}, not a PROGRAM: name the PROGRAM "
+                                f"that calls it (the sources define: {listing})")
+        if not programs:
+            raise UnusableInput(f"{_where(scenario)}: the sources define no PROGRAM, only function blocks and "
+                                "functions: give also the .st file of the PROGRAM to run")
         if scenario.program is None:
             if len(programs) == 1:
                 return programs[0]
@@ -251,7 +259,8 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
         if missing is not None:
             raise UnusableInput(f"{scenario.where(use.key, use.line)}: {missing}")
         for name in use.names:
-            kinds[name] = "bool" if isinstance(_plain(plc.read(name)), bool) else "number"
+            value = _plain(plc.read(name))
+            kinds[name] = "bool" if isinstance(value, bool) else "STRING" if isinstance(value, str) else "number"
         problem = use.condition.type_error(kinds) if use.condition is not None else None
         for name, value in (use.values or {}).items():
             problem = problem or _input_problem(plc, name, value)
@@ -266,15 +275,18 @@ def _input_problem(plc: _Plc, name: str, value: Any) -> str | None:
     """Why `value` cannot be written to `name`, or None. Tried on the real label before
     the first scan (and put back): the simulator's own conversion is the judge of range."""
     before = _plain(plc.read(name))
+    if isinstance(before, str):  # a scenario's values are true/false and numbers: it cannot say one
+        return f"{name} is a STRING: an input sets BOOL and number labels only; set a BOOL the program reads instead"
     if isinstance(before, bool) != isinstance(value, bool):
         if isinstance(before, bool):
             return f"{name} is a BOOL (a bit): set it to true or false, not {value!r}"
         return f"{name} is a number: set it to a number, not {str(value).lower()}"
     try:
         plc.write(name, value)
-        after = _plain(plc.read(name))
     except (ValueError, TypeError, AttributeError) as exc:
-        return str(exc)
+        return str(exc)  # nothing was written: nothing to put back (a constant refuses that too)
+    try:
+        after = _plain(plc.read(name))
     finally:
         plc.write(name, before)
     if isinstance(value, float) and isinstance(after, float):

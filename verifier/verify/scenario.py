@@ -335,6 +335,8 @@ class _Reader:
     def read(self, data: dict) -> Scenario:
         self.only(data, TOP_KEYS, "")
         name = self.string(data.get("name", self.path.stem if self.path else "scenario"), "name")
+        if not name.strip():  # every report names the run by it: a JUnit test case with no name
+            raise self.fail("name", "is empty: give the scenario a name, or leave 'name' out to use the file name")
         description = self.string(data.get("description", ""), "description")
         sources = tuple(self.sources(data["sources"])) if "sources" in data else ()
         program = self.string(data["program"], "program") if "program" in data else None
@@ -394,7 +396,7 @@ class _Reader:
             if first != setting.key:
                 raise self.fail(setting.key, f"U{setting.unit:X} channel {setting.channel} is already set in "
                                              f"{first}: one [[c24]] table per module channel", at_name=True)
-        converter = self.converter(data["converter"], platform) if "converter" in data else None
+        converter = self.converter(data["converter"], platform, duration) if "converter" in data else None
         if converter is not None and channel is not None:
             raise self.fail("channel", "a scenario with [converter] reaches the robot over TCP: "
                                        "it has no serial channel; remove 'channel'")
@@ -410,7 +412,7 @@ class _Reader:
             key_lines={key: self.line_of(key) for key in keys}, initial=initial, c24=c24, converter=converter,
         )
 
-    def converter(self, value: Any, platform: str) -> ConverterConfig:
+    def converter(self, value: Any, platform: str, duration: int) -> ConverterConfig:
         item = self.table(value, "converter")
         self.only(item, CONVERTER_KEYS, "converter")
         if platform not in TCP_PLATFORMS:
@@ -441,6 +443,10 @@ class _Reader:
                 raise self.fail("converter.drops", "expected a list of times, e.g. [\"20s\", \"40s\"]")
             changes["drops"] = tuple(self.duration(t, f"converter.drops[{i}]", positive=False)
                                      for i, t in enumerate(drops))
+            for i, drop in enumerate(changes["drops"]):
+                if drop >= duration:  # as for a fault's at_s: a drop that never happens tests nothing
+                    raise self.fail(f"converter.drops[{i}]", f"is at or after the end of the run "
+                                                             f"({format_duration(duration)}): the drop would never happen")
         if "split_reply" in item:
             if not isinstance(item["split_reply"], bool):
                 raise self.fail("converter.split_reply", f"expected true or false, got {shown(item['split_reply'])}")

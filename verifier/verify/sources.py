@@ -24,14 +24,14 @@ def expand(name: str, base: Path) -> list[Path]:
         matches = sorted(Path(p) for p in glob.glob(pattern, recursive=True))
         files: list[Path] = []
         for match in matches:
-            files += _folder(match) if match.is_dir() else [match]
+            files += st_files_in(match) if match.is_dir() else [match]
         if not files:
             where = "" if Path(name).is_absolute() else f" (relative to {base})"
             raise SourceError(f"{name!r} matches no file{where}")
         return files
     path = literal
     if path.is_dir():
-        files = _folder(path)
+        files = st_files_in(path)
         if not files:
             raise SourceError(f"the folder {path} holds no .st file")
         return files
@@ -42,7 +42,9 @@ def expand(name: str, base: Path) -> list[Path]:
     return [path]
 
 
-def _folder(path: Path) -> list[Path]:
+def st_files_in(path: Path) -> list[Path]:
+    """The .st files below the folder `path`, recursively: `.ST` too (as Windows tools may
+    name them), and never a folder whose name ends in .st."""
     return sorted(p for p in path.rglob("*") if p.suffix.lower() == ".st" and p.is_file())
 
 
