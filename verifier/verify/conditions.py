@@ -287,8 +287,9 @@ class Condition:
 
     def type_error(self, kinds: Mapping[str, str]) -> str | None:
         """Why the condition does not type-check, given each label's kind ("bool",
-        "number", or the name of a type a condition cannot read, e.g. "STRING"), or None. A condition must be BOOL; AND/OR/XOR/NOT join BOOLs; a
-        comparison compares two numbers, or two BOOLs with = and <>."""
+        "number", or the name of a type a condition cannot read, e.g. "STRING"), or None.
+        A condition must be BOOL; AND/OR/XOR/NOT join BOOLs; a comparison compares two
+        numbers, or two BOOLs with = and <>."""
         try:
             kind = _kind(self.tree, kinds)
         except _TypeProblem as problem:
