@@ -454,3 +454,18 @@ def test_the_fx5_second_port_can_carry_the_robot(tmp_path):
     assert result["channel"] == "fx5:2" and result["frames"]["tx"] > 10
     failed = invoke("--scenario", copy, "--channel", "fx5:1")
     assert failed.exit_code == 1 and "the program sent nothing on fx5:1 in the whole run" in failed.output
+
+
+def test_a_reader_that_goes_away_loses_no_report(tmp_path):
+    """`uitamr verify --json r.json | head -1`: once the pipe's reader is gone, the rest of
+    the console text is dropped, the reports are still written and the exit status is the
+    verdict's (before, the console library exited 1 at once and r.json was never written)."""
+    report = tmp_path / "r.json"
+    proc = subprocess.Popen([sys.executable, "-m", "verifier.cli", "verify", "--scenario",
+                             str(PLC / "scenarios" / "q-bad-crc.toml"), "--duration", "5s", "--json", str(report)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()  # no reader: the first line printed meets a broken pipe
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == 1, stderr.decode()  # q-bad-crc's verdict, not the pipe's
+    assert b"Traceback" not in stderr and b"BrokenPipe" not in stderr
+    assert json.loads(report.read_text(encoding="utf-8"))["verdict"] == "fail"

@@ -2,16 +2,31 @@
 of options, one writer loop, so a capture from site gives the same files as a CI run."""
 from __future__ import annotations
 
+import os
+import sys
 from pathlib import Path
 
 import click
 from rich.console import Console
 from rich.markup import escape
 
+class _ReportConsole(Console):
+    """A console whose reader may go away (`uitamr verify --json r.json | head -1`): the
+    rest of the text is dropped, and the command goes on to write its report files and
+    exit with its verdict (rich's own console exits at once, and the reports were lost)."""
+
+    def on_broken_pipe(self) -> None:
+        self.quiet = True
+        stream = sys.stderr if self.stderr else sys.stdout
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, stream.fileno())  # the interpreter's last flush finds nothing to fail on
+        os.close(devnull)
+
+
 def text_console(**options) -> Console:
     """The console the judging commands print on: no syntax highlighting, long lines kept
     whole, and no emoji codes (a location such as 'Main.st:100:9' holds one, ':100:')."""
-    return Console(highlight=False, soft_wrap=True, emoji=False, **options)
+    return _ReportConsole(highlight=False, soft_wrap=True, emoji=False, **options)
 
 
 REPORT_OPTIONS = (
