@@ -469,3 +469,17 @@ def test_a_reader_that_goes_away_loses_no_report(tmp_path):
     assert proc.returncode == 1, stderr.decode()  # q-bad-crc's verdict, not the pipe's
     assert b"Traceback" not in stderr and b"BrokenPipe" not in stderr
     assert json.loads(report.read_text(encoding="utf-8"))["verdict"] == "fail"
+
+
+def test_a_channel_without_a_platform_picks_the_cpu_it_belongs_to(tmp_path):
+    """ST that loads on every CPU and `--channel q:1`: the run is on a Q CPU, not on the
+    default FX3U that has no such port; a --platform that contradicts it is still refused."""
+    source = tmp_path / "Main.st"
+    source.write_text("PROGRAM Main\nVAR\n    n : INT;\nEND_VAR\nn := n + 1;\nEND_PROGRAM\n", encoding="utf-8")
+    report = tmp_path / "r.json"
+    ran = invoke(source, "--channel", "q:1", "--duration", "2s", "--json", report)
+    assert ran.exit_code == 1 and "Main on q," in ran.output  # it sends nothing: the stop is missing
+    (scenario,) = json.loads(report.read_text())["scenarios"]
+    assert (scenario["platform"], scenario["channel"]) == ("q", "q:1")
+    refused = invoke(source, "--channel", "q:1", "--platform", "fx3u", "--duration", "2s")
+    assert refused.exit_code == 2 and "channel q:1 does not exist on the fx3u CPU" in refused.output

@@ -76,6 +76,10 @@ def _unusable(message: str) -> None:
     sys.exit(EXIT_UNUSABLE)
 
 
+#: the platform a serial channel belongs to (adp:1 is on FX3 and FX5 CPUs alike)
+_CHANNEL_PLATFORMS = {"fx3": "fx3u", "fx5": "fx5u", "q": "q"}
+
+
 def _scenarios(sources, program, platform, channel, scenario_files, matrix, duration, scan, seed) -> list[Scenario]:
     from verifier.verify.matrix import for_user_sources, without_repeats
     from verifier.verify.platform import infer_platform, platforms_that_load, uses_tcp_route
@@ -94,6 +98,9 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
                  "duration_us": duration, "scan_us": scan, "seed": seed}
     if resolved:
         own = [replace(s, sources=resolved) for s in own]
+    if platform is None and channel is not None and resolved and not own:
+        platform = _CHANNEL_PLATFORMS.get(channel.split(":")[0])  # --channel q:1: a Q CPU's port
+        overrides["platform"] = platform
     if resolved and matrix:
         # the user's program under the robot/fault set of every bundled scenario of its platform
         platform = platform or infer_platform(resolved)
