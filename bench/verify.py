@@ -15,7 +15,8 @@ Prints, measured in one run on this machine:
      path (every label by name, every scan run) - the ratio of the two, the number of
      scans jumped over, and whether the results are equal;
   4. `uitamr verify --matrix --jobs N` for each N, three rounds of one after the other:
-     the median speed-up against N=1, next to the machine's ceiling: N copies of a CPU-bound Python loop at once against
+     the median speed-up against N=1, for the bundled matrix as it is and with every
+     scenario run for 300 s, next to the machine's ceiling: N copies of a CPU-bound Python loop at once against
      one after the other (median of 5);
   5. peak RSS of a 1 h and a 10 h run of fx3u-healthy (whole processes, os.wait4), without
      reports and with --trace.
@@ -192,14 +193,17 @@ def part_3(healthy: Path, folder: Path) -> None:
 
 
 def part_4(jobs: list[int]) -> None:
-    rounds: list[dict[int, float]] = []
-    for _ in range(3):  # the job counts one after the other, three times: side by side
-        rounds.append({n: run_process("verify", "--matrix", "--jobs", n)[0] for n in jobs})
     print("4. uitamr verify --matrix, three rounds of " + ", ".join(f"--jobs {n}" for n in jobs) + ":")
-    for n in jobs[1:]:
-        speedups = sorted(r[jobs[0]] / r[n] for r in rounds)
-        print(f"   --jobs {n} against --jobs {jobs[0]}: x{speedups[1]:.2f} (median; rounds "
-              + ", ".join(f"{r[jobs[0]]:.2f} s / {r[n]:.2f} s" for r in rounds) + ")")
+    # the bundled matrix as it is (about 3 s of work: start-up weighs), and with every
+    # scenario run for 300 s, as a fault sweep of a soak test runs it
+    for extra in ((), ("--duration", "300s")):
+        rounds: list[dict[int, float]] = []
+        for _ in range(3):  # the job counts one after the other, three times: side by side
+            rounds.append({n: run_process("verify", "--matrix", *extra, "--jobs", n)[0] for n in jobs})
+        for n in jobs[1:]:
+            speedups = sorted(r[jobs[0]] / r[n] for r in rounds)
+            print(f"   {' '.join(extra) or 'as bundled'}: --jobs {n} against --jobs {jobs[0]}: x{speedups[1]:.2f} "
+                  "(median; rounds " + ", ".join(f"{r[jobs[0]]:.2f} s / {r[n]:.2f} s" for r in rounds) + ")")
     for n in (n for n in jobs if n > 1):
         low, median, high = machine_ceiling(n)
         print(f"   the machine's own ceiling for N={n}: {n} CPU-bound Python processes at once against "
