@@ -102,6 +102,20 @@ def test_junit_has_one_testcase_per_scenario_and_a_failure_per_broken_rule(tmp_p
     assert cases[1].get("file") == "plc/scenarios/broken.toml"
 
 
+def test_junit_keeps_runs_that_share_a_name_apart(tmp_path):
+    """A copied scenario file that kept its name: a CI server would file the two runs as
+    one test, so each such case is named with its file (or a number without one)."""
+    from dataclasses import replace
+
+    copy = replace(good_result(), file="plc/scenarios/healthy-copy.toml")
+    unfiled = replace(good_result(), file=None)
+    path = tmp_path / "r.xml"
+    report_junit.write([good_result(), bad_result(), copy, unfiled], path)
+    names = [c.get("name") for c in ET.parse(path).getroot().findall("./testsuite/testcase")]
+    assert names == ["healthy [plc/scenarios/healthy.toml]", "broken", "healthy [plc/scenarios/healthy-copy.toml]",
+                     "healthy [3]"]
+
+
 def test_trace_is_one_frame_per_line_with_time_direction_hex_and_meaning(tmp_path):
     path = tmp_path / "t.jsonl"
     report_trace.write([bad_result()], path)

@@ -38,16 +38,33 @@ def _rule_failure_text(rule_id: str, result: ScenarioResult) -> str:
     return "\n".join(lines)
 
 
+def _case_names(results: list[ScenarioResult]) -> list[str]:
+    """Each result's test case name: its own, or, for runs that share a name (a copied
+    scenario file that kept it), the name with its file, so that a CI server does not
+    file two runs as one test (else a number)."""
+    count: dict[str, int] = {}
+    for result in results:
+        count[result.name] = count.get(result.name, 0) + 1
+    names, seen = [], {}
+    for result in results:
+        if count[result.name] == 1:
+            names.append(result.name)
+            continue
+        seen[result.name] = seen.get(result.name, 0) + 1
+        names.append(f"{result.name} [{result.file or seen[result.name]}]")
+    return names
+
+
 def to_element(results: list[ScenarioResult]) -> ET.Element:
     suites = ET.Element("testsuites", name="uitamr verify")
     suite = ET.SubElement(suites, "testsuite", name="uitamr verify")
     failures = errors = 0
-    for result in results:
+    for result, name in zip(results, _case_names(results)):
         case = ET.SubElement(
             suite,
             "testcase",
             classname="uitamr.verify." + (result.platform or "plc"),
-            name=result.name,
+            name=name,
             time=f"{result.wall_s:.3f}",
         )
         if result.file:
