@@ -169,3 +169,11 @@ def test_bundled_scenarios_give_the_same_results(name, monkeypatch):
         data.pop("wall_s")
     assert first == second
     assert only.tx_count > 0
+
+
+def test_a_path_through_a_pou_left_out_is_named_as_left_out():
+    """`get` names the program as not compiled, as `program` does, not as a POU that does not exist."""
+    project = _load(programs=["Main"])
+    with pytest.raises(KeyError, match="'Other' is not compiled: the project was loaded with programs="):
+        project.get("Other.fbUnused.o_nOut")
+    assert project.get("Main.nSum") == 0 and _load().get("Other.fbUnused.o_nOut") == 0

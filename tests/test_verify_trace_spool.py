@@ -6,6 +6,7 @@ that held every frame: on every bundled scenario, on the library broken to break
 rule, and on random scenarios; and no spool file is left behind, whatever happens."""
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -125,3 +126,19 @@ def test_a_disk_that_fills_up_during_the_run_is_said_and_the_spool_removed(tmp_p
     assert result.exit_code == 2
     assert f"cannot write the trace in {tmp_path}: No space left on device" in result.output
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_worker_batch_that_cannot_go_on_leaves_no_spool_file(tmp_path):
+    """With --jobs, a batch whose second scenario is unusable loses the first one's result
+    in the worker: its trace lines are removed there, not left beside the trace."""
+    from verifier.commands.verify import _run_batch
+    from verifier.verify.result import UnusableInput
+
+    good = load_scenario(ROOT / "plc" / "scenarios" / "fx3u-healthy.toml")
+    bad = replace(good, name="bad", watch=("fbEngine.o_wNoSuchLabel",))
+    out = tmp_path / "out"
+    out.mkdir()
+    keep = Keep(frames=True, details=False, frames_to_file=str(out))
+    with pytest.raises(UnusableInput, match="o_wNoSuchLabel"):
+        _run_batch([replace(good, duration_us=3_000_000), bad], False, keep)
+    assert list(out.iterdir()) == []

@@ -201,7 +201,14 @@ def _source_files(sources) -> tuple[Path, ...]:
 def _run_batch(batch: list[Scenario], every_scan: bool, keep: Keep) -> list[ScenarioResult]:
     from verifier.verify.runner import run_scenario
 
-    return [run_scenario(scenario, plain=every_scan, keep=keep) for scenario in batch]
+    results = []
+    try:
+        for scenario in batch:
+            results.append(run_scenario(scenario, plain=every_scan, keep=keep))
+    except BaseException:
+        _discard_trace_files(results)  # the batch's results never reach the parent, which removes the rest
+        raise
+    return results
 
 
 def _batches(scenarios: list[Scenario], jobs: int) -> list[list[int]]:

@@ -126,11 +126,15 @@ class Project:
     def _pou(self, name: str):
         info = self.module.pous.get(name.upper())
         if info is None:
-            if self.programs is not None and any(pou.key == name.upper() for f in self.files for pou in f.pous):
+            if self._left_out(name):
                 raise KeyError(f"{name!r} is not compiled: the project was loaded with programs="
                                f"{sorted(self.programs)}, which compiles only what those programs use")
             raise KeyError(f"no POU named {name!r}; loaded: {', '.join(self.pou_names())}")
         return info
+
+    def _left_out(self, name: str) -> bool:
+        """Whether `name` is a POU of the files that programs= left out of the compile."""
+        return self.programs is not None and any(pou.key == name.upper() for f in self.files for pou in f.pous)
 
     def call(self, name: str, *args, **kwargs):
         """Call a FUNCTION with positional arguments in declaration order (Python lists for
@@ -208,7 +212,7 @@ class Project:
         head, _, rest = path.partition(".")
         if head.upper() == "GLOBAL":
             obj = self.globals
-        elif head.upper() in self.module.pous:
+        elif head.upper() in self.module.pous or self._left_out(head):  # left out: _pou says so
             obj = self.program(head)
         else:
             try:
