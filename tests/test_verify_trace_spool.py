@@ -6,7 +6,6 @@ that held every frame: on every bundled scenario, on the library broken to break
 rule, and on random scenarios; and no spool file is left behind, whatever happens."""
 from __future__ import annotations
 
-from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -106,10 +105,21 @@ def test_a_folder_the_trace_cannot_go_to_is_said_before_the_run(tmp_path, monkey
     def refused(*args, **kwargs):
         raise PermissionError(13, "Permission denied")
 
-    monkeypatch.setattr(runner_module.tempfile, "mkstemp", refused)
+    from verifier.commands import verify as verify_command
+
+    monkeypatch.setattr(verify_command.tempfile, "mkdtemp", refused)
     result = _invoke("--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml", "--trace", tmp_path / "t.jsonl")
     assert result.exit_code == 2
-    assert f"cannot write the trace in {tmp_path}: Permission denied" in result.output
+    assert result.output == f"error: cannot write the trace in {tmp_path}: Permission denied\n"
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_spool_file_that_cannot_be_made_names_its_folder(tmp_path, monkeypatch):
+    monkeypatch.setattr(runner_module.tempfile, "mkstemp", lambda *a, **k: (_ for _ in ()).throw(
+        PermissionError(13, "Permission denied")))
+    result = _invoke("--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml", "--trace", tmp_path / "t.jsonl")
+    assert result.exit_code == 2
+    assert f"cannot write the trace in {tmp_path}/.uitamr-trace-" in result.output and "Permission denied" in result.output
     assert list(tmp_path.iterdir()) == []
 
 
@@ -124,21 +134,77 @@ def test_a_disk_that_fills_up_during_the_run_is_said_and_the_spool_removed(tmp_p
     monkeypatch.setattr(stream_module.Stream, "_give", full)
     result = _invoke("--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml", "--trace", tmp_path / "t.jsonl")
     assert result.exit_code == 2
-    assert f"cannot write the trace in {tmp_path}: No space left on device" in result.output
+    assert f"cannot write the trace in {tmp_path}/.uitamr-trace-" in result.output
+    assert "No space left on device" in result.output
     assert list(tmp_path.iterdir()) == []
 
 
 def test_a_worker_batch_that_cannot_go_on_leaves_no_spool_file(tmp_path):
     """With --jobs, a batch whose second scenario is unusable loses the first one's result
-    in the worker: its trace lines are removed there, not left beside the trace."""
-    from verifier.commands.verify import _run_batch
-    from verifier.verify.result import UnusableInput
-
-    good = load_scenario(ROOT / "plc" / "scenarios" / "fx3u-healthy.toml")
-    bad = replace(good, name="bad", watch=("fbEngine.o_wNoSuchLabel",))
+    in the worker: its trace lines go with the command's spool folder all the same."""
+    text = (ROOT / "plc" / "scenarios" / "fx3u-healthy.toml").read_text(encoding="utf-8")
+    text = text.replace('"../', f'"{(ROOT / "plc").as_posix()}/')
+    good, bad = tmp_path / "good.toml", tmp_path / "bad.toml"
+    good.write_text(text.replace('duration = "60s"', 'duration = "3s"'), encoding="utf-8")
+    bad.write_text(text.replace('watch = ["fbEngine.o_wTxCount", "fbCycle.o_wPoint"]',
+                                'watch = ["fbEngine.o_wNoSuchLabel"]'), encoding="utf-8")
     out = tmp_path / "out"
     out.mkdir()
-    keep = Keep(frames=True, details=False, frames_to_file=str(out))
-    with pytest.raises(UnusableInput, match="o_wNoSuchLabel"):
-        _run_batch([replace(good, duration_us=3_000_000), bad], False, keep)
+    result = _invoke("--scenario", good, "--scenario", bad, "--scenario", ROOT / "plc" / "scenarios" / "q-healthy.toml",
+                     "--jobs", "2", "--trace", out / "t.jsonl")
+    assert result.exit_code == 2 and "o_wNoSuchLabel" in result.output
     assert list(out.iterdir()) == []
+
+
+def _spawn_matrix(out: Path):
+    """`uitamr verify --matrix --jobs 2 --trace` long enough to be stopped midway, in a
+    process group of its own (as a CI job runs it)."""
+    import subprocess
+    import sys
+
+    return subprocess.Popen([sys.executable, "-m", "verifier.cli", "verify", "--matrix", "--duration", "600s",
+                             "--jobs", "2", "--trace", str(out / "t.jsonl")],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
+
+
+def _wait_for_spool(out: Path, proc) -> None:
+    import time
+
+    for _ in range(300):
+        if any(out.glob(".uitamr-trace-*/*.part")):
+            return
+        assert proc.poll() is None, proc.stderr.read().decode()
+        time.sleep(0.05)
+    raise AssertionError("no spool file appeared")
+
+
+def test_a_ci_time_out_stops_the_run_and_leaves_nothing(tmp_path):
+    """SIGTERM to the job's process group (a CI time-out): the command ends through its
+    clean-up, exit 143, and the spool folder with the workers' files is gone."""
+    import os
+    import signal
+
+    proc = _spawn_matrix(tmp_path)
+    _wait_for_spool(tmp_path, proc)
+    os.killpg(proc.pid, signal.SIGTERM)
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == 143, stderr.decode()
+    assert b"Traceback" not in stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_worker_killed_midway_is_said_and_leaves_nothing(tmp_path):
+    """A worker process killed (the OOM killer): exit 2 with a message, no traceback, and
+    no spool file left, although the worker could not remove its own."""
+    import os
+    import signal
+
+    proc = _spawn_matrix(tmp_path)
+    _wait_for_spool(tmp_path, proc)
+    children = Path(f"/proc/{proc.pid}/task/{proc.pid}/children").read_text().split()
+    assert children, "the pool has no worker process"
+    os.kill(int(children[0]), signal.SIGKILL)
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == 2, stderr.decode()
+    assert b"a worker process of --jobs 2 stopped without a word" in stderr and b"Traceback" not in stderr
+    assert list(tmp_path.iterdir()) == []

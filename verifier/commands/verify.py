@@ -4,9 +4,14 @@ Exit codes: 0 compliant, 1 violations or failed expectations, 2 unusable input.
 """
 from __future__ import annotations
 
+import shutil
+import signal
 import sys
+import tempfile
 import time
+from contextlib import contextmanager
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import replace
 from pathlib import Path
 
@@ -201,14 +206,7 @@ def _source_files(sources) -> tuple[Path, ...]:
 def _run_batch(batch: list[Scenario], every_scan: bool, keep: Keep) -> list[ScenarioResult]:
     from verifier.verify.runner import run_scenario
 
-    results = []
-    try:
-        for scenario in batch:
-            results.append(run_scenario(scenario, plain=every_scan, keep=keep))
-    except BaseException:
-        _discard_trace_files(results)  # the batch's results never reach the parent, which removes the rest
-        raise
-    return results
+    return [run_scenario(scenario, plain=every_scan, keep=keep) for scenario in batch]
 
 
 def _batches(scenarios: list[Scenario], jobs: int) -> list[list[int]]:
@@ -297,34 +295,49 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress,
                         results[index] = result
                         done += scenarios[index].duration_us
                     progress.update(done, f"{sum(r is not None for r in results)}/{len(scenarios)} scenarios")
+            except BrokenProcessPool:
+                raise UnusableInput(f"a worker process of --jobs {jobs} stopped without a word (killed, or out of "
+                                    "memory?): run again, or with fewer jobs") from None
             except BaseException:
-                for future in futures:  # the batches that still finish leave their trace files too
-                    future.cancel()
-                    if not future.cancelled() and future.exception() is None:
-                        _discard_trace_files(future.result())
-                _discard_trace_files([r for r in results if r is not None])
+                for future in futures:
+                    future.cancel()  # the batches not started yet: the command is ending
                 raise
         return [r for r in results if r is not None]
     results = []
     offset = 0
-    try:
-        for position, scenario in enumerate(scenarios):
-            label = f"[{position + 1}/{len(scenarios)}] {scenario.name}"
-            results.append(run_scenario(scenario, lambda now, end, o=offset, l=label: progress.update(o + now, l),
-                                        plain=every_scan, keep=keep))
-            offset += scenario.duration_us
-    except BaseException:
-        _discard_trace_files(results)
-        raise
+    for position, scenario in enumerate(scenarios):
+        label = f"[{position + 1}/{len(scenarios)}] {scenario.name}"
+        results.append(run_scenario(scenario, lambda now, end, o=offset, l=label: progress.update(o + now, l),
+                                    plain=every_scan, keep=keep))
+        offset += scenario.duration_us
     return results
 
 
-def _discard_trace_files(results: list[ScenarioResult]) -> None:
-    """Remove the trace lines runs wrote as they went (Keep.frames_to_file), once the
-    trace is written or will not be."""
-    for result in results:
-        if result.trace_file is not None:
-            Path(result.trace_file).unlink(missing_ok=True)
+def _spool_folder(trace_path: str) -> str:
+    """A hidden folder beside the trace for the runs' trace lines (Keep.frames_to_file)."""
+    folder = Path(trace_path).resolve().parent
+    try:
+        return tempfile.mkdtemp(prefix=".uitamr-trace-", dir=folder)
+    except OSError as exc:
+        _unusable(f"cannot write the trace in {folder}: {exc.strerror or exc}")
+
+
+@contextmanager
+def _terminate_as_exit():
+    """SIGTERM (what a CI job's time-out sends) ends the command as Ctrl-C does, through
+    its clean-up, instead of at once: the spool folder is removed, the workers stop."""
+    def terminated(signum, frame):
+        raise SystemExit(128 + signal.SIGTERM)
+
+    try:
+        previous = signal.signal(signal.SIGTERM, terminated)
+    except ValueError:  # not the main thread (an embedding application): leave it be
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 @click.command(context_settings={"help_option_names": ["-h", "--help"]})
@@ -381,22 +394,26 @@ def command(sources, program, platform, channel, response_signal, scenario_files
         _unusable(str(exc))
     stderr = text_console(stderr=True)
     progress = _LazyProgress(stderr, sum(s.duration_us for s in scenarios), stderr.is_terminal)
+    # the trace alone does not make a run hold its frames: they go to files in a hidden
+    # folder beside it, removed at the end whatever happens to the runs and their workers
+    spool_folder = _spool_folder(trace_path) if trace_path and not html_path else None
     try:
-        # a run holds every frame and watched change only for the reports that list them
-        # the trace alone does not make a run hold its frames: they go to a file beside it
-        spool_folder = str(Path(trace_path).resolve().parent) if trace_path and not html_path else None
-        keep = Keep(frames=bool(trace_path or html_path), details=bool(json_path or html_path),
-                    frames_to_file=spool_folder)
-        results = _run_all(scenarios, jobs, progress, every_scan, keep)
-    except (ScenarioError, UnusableInput) as exc:
-        progress.stop()
-        _unusable(str(exc))
-    progress.stop()
-    try:
-        report_console.render(results, console, first=first)
-        write_reports(results, console, json_path, junit_path, trace_path, html_path)
-    except ReportError as exc:
-        _unusable(str(exc))
+        with _terminate_as_exit():
+            try:
+                # a run holds every frame and watched change only for the reports that list them
+                keep = Keep(frames=bool(trace_path or html_path), details=bool(json_path or html_path),
+                            frames_to_file=spool_folder)
+                results = _run_all(scenarios, jobs, progress, every_scan, keep)
+            except (ScenarioError, UnusableInput) as exc:
+                progress.stop()
+                _unusable(str(exc))
+            progress.stop()
+            try:
+                report_console.render(results, console, first=first)
+                write_reports(results, console, json_path, junit_path, trace_path, html_path)
+            except ReportError as exc:
+                _unusable(str(exc))
     finally:
-        _discard_trace_files(results)
+        if spool_folder is not None:
+            shutil.rmtree(spool_folder, ignore_errors=True)
     sys.exit(EXIT_PASS if all(r.passed for r in results) else EXIT_FAIL)
