@@ -115,7 +115,7 @@ def test_a_folder_the_trace_cannot_go_to_is_said_before_the_run(tmp_path, monkey
 
 
 def test_a_spool_file_that_cannot_be_made_names_its_folder(tmp_path, monkeypatch):
-    monkeypatch.setattr(runner_module.tempfile, "mkstemp", lambda *a, **k: (_ for _ in ()).throw(
+    monkeypatch.setattr(stream_module.tempfile, "mkstemp", lambda *a, **k: (_ for _ in ()).throw(
         PermissionError(13, "Permission denied")))
     result = _invoke("--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml", "--trace", tmp_path / "t.jsonl")
     assert result.exit_code == 2

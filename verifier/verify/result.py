@@ -24,9 +24,10 @@ class Keep:
 
     frames: bool = True
     details: bool = True
-    # only the trace lists the frames: they go to a file in this folder (the trace's) as
-    # the run goes (`ScenarioResult.trace_file`) instead of being held, and the run is
-    # judged as it goes
+    # only the trace lists the frames: they go to a file in this folder as the run goes
+    # (`ScenarioResult.trace_file`) instead of being held, and the run is judged as it
+    # goes. The folder is the caller's to remove (`uitamr verify` makes a hidden one
+    # beside the trace), with whatever a run that failed midway left in it
     frames_to_file: str | None = None
 
 
@@ -87,8 +88,7 @@ class ScenarioResult:
     notes: list[str] = field(default_factory=list)  # how the run differs from its scenario file
     frame_counts: tuple[int, int] | None = None  # (requests, replies) when `trace` was not kept
     # the frames as trace lines written while the run went (Keep.frames_to_file): a file
-    # of report_trace.spool_line lines, which report_trace.write completes and whoever
-    # made the result removes
+    # of report_trace.spool_lines lines, which report_trace.write completes
     trace_file: str | None = None
     # a capture that saw no bytes (`uitamr monitor`, `uitamr replay`): nothing was verified;
     # what was silent and what to check

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import os
 import re
-import tempfile
 import time
 from functools import lru_cache
 from pathlib import Path
@@ -412,109 +411,72 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     sample = sample_plainly if plain else sample_on_change  # plain: the reference path
 
     # judged as it goes when no report holds every frame (the trace alone takes them from
-    # a file written as the run goes); else as a whole at the end
+    # files written as the run goes); else as a whole at the end
     streamed = not plain and (not keep.frames or keep.frames_to_file is not None)
-    spool = _open_spool(keep.frames_to_file) if streamed and keep.frames else None
     stream = Stream(scenario.settings, scenario.options, samples, scenario.expectations, _relative,
-                    spool, scenario.name) if streamed else None
+                    keep.frames_to_file if keep.frames else None, scenario.name) if streamed else None
+    rule_events = _NewRuleEvents(line, converter, drop_the_rest=not keep.details)
+    taken_us = 0
     try:
-        rule_events = _NewRuleEvents(line, converter, drop_the_rest=not keep.details)
-        taken_us = 0
-        try:
-            while plc.now_us < end:
-                plc.run(min(end, plc.now_us + PROGRESS_STEP_US), apply_inputs, sample)
-                if stream is not None and plc.now_us - taken_us >= STREAM_EVERY_US:
-                    taken_us = plc.now_us
-                    stream.take(line.take_settled(), line.settled_until_us, rule_events())
-                    if not keep.details:
-                        robot.events.clear()  # read by no rule, listed by no report asked for
-                if progress is not None:
-                    progress(plc.now_us, end)
-        except SimulationError as exc:
-            aborted = str(exc)
-            end = min(end, plc.now_us)
-        if converter is not None:
-            converter.advance(max(end, converter.now_us))
-        else:
-            line.advance(max(end, line.now_us))
-        if stream is not None:
-            rest = [frame for frame in line.hand_over_trace() if frame.t_start_us < end]
-            violations, outcomes = stream.finish(rest, end, aborted is not None, rule_events(end))
-            trace, tx_count, rx_count = [], stream.tx_count, stream.rx_count
-        else:
-            trace = _trace_records(line.hand_over_trace(), end)
-        line_events = line.events if converter is None else sorted(line.events + converter.events, key=lambda e: e.t_us)
-        events = [LineEvent(e.t_us, e.kind, e.message) for e in line_events if e.t_us <= end]
-        if stream is None:
-            violations, outcomes = _judge_whole(scenario, trace, end, events, samples, aborted is not None)
-            tx_count = sum(1 for frame in trace if frame.direction == "tx")
-            rx_count = len(trace) - tx_count
-        result = ScenarioResult(
-            name=scenario.name,
-            file=_display_path(scenario.path),
-            description=scenario.description,
-            program=plc.name,
-            platform=scenario.platform,
-            channel=scenario.serial_channel,
-            sources=[str(p) for p in scenario.sources],
-            duration_us=scenario.duration_us,
-            scan_us=scenario.scan_us,
-            scan_jitter_us=scenario.scan_jitter_us,
-            seed=scenario.seed,
-            settings=scenario.settings,
-            min_period_us=scenario.options.min_period_us,
-            reply_timeout_us=scenario.options.reply_timeout_us,
-            faults=[fault.describe() for fault in scenario.faults]
-            + ([scenario.converter.describe()] if scenario.converter is not None else []),
-            trace=trace if keep.frames else [],
-            frame_counts=None if keep.frames and stream is None else (tx_count, rx_count),
-            events=events if keep.details else [],
-            violations=violations,
-            expectations=outcomes,
-            diagnostics=plc.diagnostics(),
-            watched={name: list(samples.changes.get(name, [])) for name in scenario.watch} if keep.details else {},
-            aborted=aborted,
-            ended_us=end,
-            wall_s=time.perf_counter() - wall_start,
-            notes=list(scenario.notes) + (
-                [] if tx_count
-                else [f"the program sent nothing on {scenario.serial_channel} in the whole run"
-                      + (" (nothing reached the robot's line through the converter)" if converter is not None else "")]
-            ),
-        )
-    except BaseException as exc:
-        if spool is not None:
-            _discard(spool)
-            if isinstance(exc, OSError):  # the simulation itself reads and writes no file
-                raise _cannot_spool(keep.frames_to_file, exc) from None
-        raise
-    if spool is not None:
-        try:
-            spool.close()
-        except OSError as exc:  # a full disk shows when the last lines are flushed
-            _discard(spool)
-            raise _cannot_spool(keep.frames_to_file, exc) from None
-        result.trace_file = spool.name
-    return result
-
-
-def _open_spool(folder: str):
-    """A file in `folder` for the trace lines of a run as it goes (report_trace.spool_lines)."""
-    try:
-        handle, path = tempfile.mkstemp(prefix=".uitamr-trace-", suffix=".part", dir=folder)
-    except OSError as exc:
-        raise _cannot_spool(folder, exc) from None
-    os.close(handle)
-    return open(path, "w", encoding="utf-8")  # its `name` is the path
-
-
-def _cannot_spool(folder: str, exc: OSError) -> UnusableInput:
-    return UnusableInput(f"cannot write the trace in {folder}: {exc.strerror or exc}")
-
-
-def _discard(spool) -> None:
-    try:
-        spool.close()
-    except OSError:
-        pass
-    Path(spool.name).unlink(missing_ok=True)
+        while plc.now_us < end:
+            plc.run(min(end, plc.now_us + PROGRESS_STEP_US), apply_inputs, sample)
+            if stream is not None and plc.now_us - taken_us >= STREAM_EVERY_US:
+                taken_us = plc.now_us
+                stream.take(line.take_settled(), line.settled_until_us, rule_events())
+                if not keep.details:
+                    robot.events.clear()  # read by no rule, listed by no report asked for
+            if progress is not None:
+                progress(plc.now_us, end)
+    except SimulationError as exc:
+        aborted = str(exc)
+        end = min(end, plc.now_us)
+    if converter is not None:
+        converter.advance(max(end, converter.now_us))
+    else:
+        line.advance(max(end, line.now_us))
+    if stream is not None:
+        rest = [frame for frame in line.hand_over_trace() if frame.t_start_us < end]
+        violations, outcomes = stream.finish(rest, end, aborted is not None, rule_events(end))
+        trace, tx_count, rx_count = [], stream.tx_count, stream.rx_count
+    else:
+        trace = _trace_records(line.hand_over_trace(), end)
+    line_events = line.events if converter is None else sorted(line.events + converter.events, key=lambda e: e.t_us)
+    events = [LineEvent(e.t_us, e.kind, e.message) for e in line_events if e.t_us <= end]
+    if stream is None:
+        violations, outcomes = _judge_whole(scenario, trace, end, events, samples, aborted is not None)
+        tx_count = sum(1 for frame in trace if frame.direction == "tx")
+        rx_count = len(trace) - tx_count
+    return ScenarioResult(
+        name=scenario.name,
+        file=_display_path(scenario.path),
+        description=scenario.description,
+        program=plc.name,
+        platform=scenario.platform,
+        channel=scenario.serial_channel,
+        sources=[str(p) for p in scenario.sources],
+        duration_us=scenario.duration_us,
+        scan_us=scenario.scan_us,
+        scan_jitter_us=scenario.scan_jitter_us,
+        seed=scenario.seed,
+        settings=scenario.settings,
+        min_period_us=scenario.options.min_period_us,
+        reply_timeout_us=scenario.options.reply_timeout_us,
+        faults=[fault.describe() for fault in scenario.faults]
+        + ([scenario.converter.describe()] if scenario.converter is not None else []),
+        trace=trace if keep.frames else [],
+        frame_counts=None if keep.frames and stream is None else (tx_count, rx_count),
+        trace_file=stream.trace_file if stream is not None else None,
+        events=events if keep.details else [],
+        violations=violations,
+        expectations=outcomes,
+        diagnostics=plc.diagnostics(),
+        watched={name: list(samples.changes.get(name, [])) for name in scenario.watch} if keep.details else {},
+        aborted=aborted,
+        ended_us=end,
+        wall_s=time.perf_counter() - wall_start,
+        notes=list(scenario.notes) + (
+            [] if tx_count
+            else [f"the program sent nothing on {scenario.serial_channel} in the whole run"
+                  + (" (nothing reached the robot's line through the converter)" if converter is not None else "")]
+        ),
+    )

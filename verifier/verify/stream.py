@@ -8,10 +8,14 @@ go of. What stays is bounded: the last few exchanges, the findings, the frame co
 the samples of the labels the expectations and the response signal read. At the end
 `finish` judges the rest exactly as a whole run is judged (tests/test_verify_stream.py:
 the same findings and verdicts on every bundled scenario and on random ones).
+A run whose frames only `--trace` lists writes them as trace lines to a file while it goes
+(`spool_folder`; report_trace completes the lines once the run is judged).
 """
 from __future__ import annotations
 
 import os
+import tempfile
+from contextlib import contextmanager
 from typing import Any, Sequence, TextIO
 
 from verifier import protocol
@@ -19,7 +23,7 @@ from verifier import protocol
 from .evidence import RuleOptions, RunEvidence, Samples, Violation
 from .expectations import Expectation, ExpectationResult, verdict, watch_exchanges
 from .report_trace import spool_lines
-from .result import TraceRecord
+from .result import TraceRecord, UnusableInput
 from .rules import Judgement
 from .traffic import Pairing
 
@@ -32,11 +36,20 @@ SHARED_FRAMES = 4096  # distinct frames whose bytes equal frames share (garbage 
 
 class Stream:
     def __init__(self, settings: protocol.Settings, options: RuleOptions, samples: Samples,
-                 expectations: Sequence[Expectation], relative_origin, spool: TextIO | None = None,
+                 expectations: Sequence[Expectation], relative_origin, spool_folder: str | None = None,
                  name: str = ""):
+        """`spool_folder` (Keep.frames_to_file): the frames' trace lines go to a file there
+        as they are given (`trace_file`, complete after `finish`); the folder's owner
+        removes it. `name`: the scenario's, for the trace lines."""
         self.settings = settings
-        self.spool = spool  # the frames' trace lines go here as they are given (`--trace`)
-        self.name = name  # the scenario's, for the trace lines
+        self.name = name
+        self._spool_folder = spool_folder
+        self.spool: TextIO | None = None
+        self.trace_file: str | None = None
+        if spool_folder is not None:
+            with self._writing():
+                handle, self.trace_file = tempfile.mkstemp(prefix=".uitamr-trace-", suffix=".part", dir=spool_folder)
+                self.spool = os.fdopen(handle, "w", encoding="utf-8")
         self.pairing = Pairing(settings, options)
         self.evidence = RunEvidence(settings, (), _OPEN_END_US, [], samples, options)
         self.judgement = Judgement(self.evidence, self.pairing.traffic)
@@ -57,7 +70,8 @@ class Stream:
         happened since the last call (the line's "gap" events and the converter's drops,
         each kind in time order); no frame still to come starts before `frontier_us`."""
         self._events(events)
-        self._give(frames)
+        with self._writing():
+            self._give(frames)
         pairing, judgement = self.pairing, self.judgement
         settled = pairing.settled(frontier_us)
         judgement.advance(settled)
@@ -76,7 +90,10 @@ class Stream:
         `take`); every rule's violations and every expectation's result, as `check_all`
         and `judge` give them."""
         self._events(events)
-        self._give(frames)
+        with self._writing():
+            self._give(frames)
+            if self.spool is not None:
+                self.spool.close()  # a full disk shows when the last lines are flushed
         self.evidence.end_us = end_us
         self.evidence.stopped_early = stopped_early
         self.judgement.finish()
@@ -84,6 +101,15 @@ class Stream:
         outcomes = [verdict(expectation, self.evidence, watch)
                     for expectation, watch in zip(self.expectations, self.watches)]
         return self.judgement.violations(), outcomes
+
+    @contextmanager
+    def _writing(self):
+        """The spool is the one file a stream writes: what the disk refuses is unusable input
+        (exit 2) that names the folder, not a traceback."""
+        try:
+            yield
+        except OSError as exc:
+            raise UnusableInput(f"cannot write the trace in {self._spool_folder}: {exc.strerror or exc}") from None
 
     def _events(self, events: Sequence[Any]) -> None:
         self.evidence.events.extend(events)  # the format rule reads the gaps as they are added
