@@ -70,8 +70,7 @@ def _body_calls(info, functions) -> set[str] | None:
                 return None
             stack.extend(a.value for a in node.args)
             continue
-        # the syntax only: fields left out of comparison (span, the checker's notes) are not
-        stack.extend(getattr(node, f.name) for f in dataclasses.fields(node) if f.compare)
+        stack.extend(ast.syntax_fields(node))
     return called
 
 

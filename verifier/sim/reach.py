@@ -61,6 +61,5 @@ def _called(pou: ast.Pou, pous: dict) -> list[str]:
             continue
         if isinstance(node, ast.Call) and node.key in pous and pous[node.key].kind == "FUNCTION":
             called.append(node.key)
-        # the syntax only: fields left out of comparison (span, the checker's notes) are not
-        stack.extend(getattr(node, f.name) for f in dataclasses.fields(node) if f.compare)
+        stack.extend(ast.syntax_fields(node))
     return called

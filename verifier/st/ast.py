@@ -13,7 +13,7 @@ Python). Only additive changes: new nodes, new optional fields at the end.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 
 # ----------------------------------------------------------------------------- places
@@ -33,6 +33,13 @@ class Span:
 
 
 NO_SPAN = Span("<none>", 0, 0, 0, 0)
+
+
+def syntax_fields(node) -> list:
+    """The values of a node's syntax fields (nodes, lists of nodes, plain values): those
+    that take part in comparison, so not its span nor what the check filled in. Walkers
+    of the tree (the simulator's purity and reach analyses) descend through these."""
+    return [getattr(node, f.name) for f in fields(node) if f.compare]
 
 
 @dataclass(slots=True)
