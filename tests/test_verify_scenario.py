@@ -356,3 +356,13 @@ def _combine(children):
 def test_conditions_evaluate_like_their_meaning(expression):
     text, expected = expression
     assert parse_condition(text).holds(_VALUES) == expected
+
+
+def test_the_scenario_channels_are_the_simulators():
+    """A scenario (and --channel) offers every serial channel the simulator drives and no
+    other: the two lists are kept apart so that reading a scenario does not import the
+    simulator, and fx5:2 was once missing from this one."""
+    from verifier.sim.serial import CHANNELS as SIMULATED
+    from verifier.verify.scenario import CHANNELS
+
+    assert sorted(CHANNELS) == sorted(SIMULATED)

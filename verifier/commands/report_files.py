@@ -10,6 +10,7 @@ import click
 from rich.console import Console
 from rich.markup import escape
 
+
 class _ReportConsole(Console):
     """A console whose reader may go away (`uitamr verify --json r.json | head -1`): the
     rest of the text is dropped, and the command goes on to write its report files and

@@ -81,8 +81,9 @@ def _unusable(message: str) -> None:
     sys.exit(EXIT_UNUSABLE)
 
 
-#: the platform a serial channel belongs to (adp:1 is on FX3 and FX5 CPUs alike)
-_CHANNEL_PLATFORMS = {"fx3": "fx3u", "fx5": "fx5u", "q": "q"}
+#: the platform a serial channel belongs to, by the family of its default port (fx3:, fx5:,
+#: q:); adp:1 is on FX3 and FX5 CPUs alike, so it names none
+_CHANNEL_PLATFORMS = {channel.split(":")[0]: platform for platform, (_, channel) in PLATFORMS.items()}
 
 
 def _scenarios(sources, program, platform, channel, scenario_files, matrix, duration, scan, seed) -> list[Scenario]:

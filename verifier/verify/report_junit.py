@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
+from collections import Counter
 from pathlib import Path
 
 from verifier.textfile import escape_chars
@@ -42,16 +43,13 @@ def _case_names(results: list[ScenarioResult]) -> list[str]:
     """Each result's test case name: its own, or, for runs that share a name (a copied
     scenario file that kept it), the name with its file, so that a CI server does not
     file two runs as one test (else a number)."""
-    count: dict[str, int] = {}
+    count = Counter(result.name for result in results)
+    seen: Counter = Counter()
+    names = []
     for result in results:
-        count[result.name] = count.get(result.name, 0) + 1
-    names, seen = [], {}
-    for result in results:
-        if count[result.name] == 1:
-            names.append(result.name)
-            continue
-        seen[result.name] = seen.get(result.name, 0) + 1
-        names.append(f"{result.name} [{result.file or seen[result.name]}]")
+        seen[result.name] += 1
+        shared = count[result.name] > 1
+        names.append(f"{result.name} [{result.file or seen[result.name]}]" if shared else result.name)
     return names
 
 
