@@ -50,6 +50,19 @@ def place_of_byte(data: bytes, offset: int) -> tuple[int, int]:
     return before.count("\n") + 1, len(before) - (before.rfind("\n") + 1) + 1
 
 
+def text_lines(text: str) -> list[str]:
+    """The lines of `text` as this tool numbers them everywhere (lark, tomllib and
+    `place_of_byte` count line feeds): split at "\n" only, a "\r" before it dropped.
+    `str.splitlines` also breaks at form feeds, NEL and the Unicode line separators, which
+    can stand inside comments and strings; the source line printed under a message, or
+    the line of a key, would then be the wrong one. Like `splitlines`, a final line feed
+    does not start one more (empty) line."""
+    lines = [line[:-1] if line.endswith("\r") else line for line in text.split("\n")]
+    if text == "" or text.endswith("\n"):
+        lines.pop()
+    return lines
+
+
 def file_kind(mode: int) -> str:
     """What a path that is not a regular file is, from its `stat` mode, for messages."""
     if stat.S_ISCHR(mode):

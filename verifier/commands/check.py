@@ -19,6 +19,7 @@ import click
 from verifier.commands.check_formats import Finding, to_github, to_json, to_sarif
 from verifier.st import TARGETS
 from verifier.st.ast import Diagnostic, SourceFile
+from verifier.textfile import text_lines
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
 
@@ -140,7 +141,7 @@ def command(sources: tuple[str, ...], target: str, fmt: str) -> None:
 
         click.echo(to_sarif(findings, __version__))
     else:
-        texts = {f.filename: f.text.splitlines() for f in files}
+        texts = {f.filename: text_lines(f.text) for f in files}
         for p in paths:
             if p.suffix.lower() == ".toml" and str(p) not in texts:
                 texts[str(p)] = _lines_of(p)
@@ -152,6 +153,6 @@ def command(sources: tuple[str, ...], target: str, fmt: str) -> None:
 
 def _lines_of(path: Path) -> list[str] | None:
     try:
-        return path.read_text(encoding="utf-8").splitlines()
+        return text_lines(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError):
         return None

@@ -20,7 +20,7 @@ from typing import Any
 
 from verifier.amr import ConfigError, Fault, RobotConfig, check_fault_addresses, faults_from_list
 from verifier.amr.schema import reject_unknown_keys
-from verifier.textfile import UnreadableText, read_utf8
+from verifier.textfile import UnreadableText, read_utf8, text_lines
 from verifier.tomlpos import Place, decode_error_position, place_of_key
 
 FILE_KEYS = ("robot", "faults")
@@ -64,7 +64,7 @@ def load_fault_file(path: str | Path, own_address: int | None = None) -> FaultFi
         if own_address is not None:
             check_fault_addresses(faults, own_address)
     except ConfigError as err:
-        place = place_of_key(text.splitlines(), err.path)
+        place = place_of_key(text_lines(text), err.path)
         raise FaultFileError(f"{_where(path, place)}: {err}") from None
     return FaultFile(robot, faults)
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 
 from verifier.st import ast
+from verifier.textfile import text_lines
 
 _END_POU = re.compile(r"^\s*END_(FUNCTION_BLOCK|FUNCTION|PROGRAM)\b.*$", re.IGNORECASE)
 _START_POU = re.compile(r"^\s*(FUNCTION_BLOCK|FUNCTION|PROGRAM)\b", re.IGNORECASE)
@@ -23,7 +24,7 @@ def header_comment(lines: list[str], pou: ast.Pou) -> list[str]:
 
 def body_text(pou: ast.Pou, source_text: str) -> str:
     """Header comment + statements of `pou`, ready to paste into the ST editor."""
-    lines = source_text.splitlines()
+    lines = text_lines(source_text)
     if pou.var_blocks:
         after = max((b.span.end_line, b.span.end_col) for b in pou.var_blocks)
         begin_line, begin_col = after

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from verifier import st
 from verifier.export.labels import label_rows
+from verifier.textfile import text_lines
 
 ROOT = Path(__file__).resolve().parents[2]
 DOC = ROOT / "docs" / "plc-library.md"
@@ -22,7 +23,7 @@ INTERFACE = ("VAR_INPUT", "VAR_OUTPUT", "VAR_IN_OUT")
 def _title(text: str, name: str) -> str:
     """The summary of the header comment: `NAME : summary`, with the lines that carry it on
     (up to a blank line or the header's ---- rule)."""
-    lines = text.splitlines()
+    lines = text_lines(text)
     for k, line in enumerate(lines):
         head, sep, rest = line.strip().partition(":")
         if sep and head.strip() == name:

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 from verifier.st import ast
 from verifier.export.types import type_name
+from verifier.textfile import text_lines
 
 _COMMENT = re.compile(r"\(\*(.*?)\*\)|//(.*)$")
 
@@ -65,7 +66,7 @@ def label_rows(pou: ast.Pou, source_text: str, target: str) -> list[LabelRow]:
 
 
 def rows_of(decls: list[ast.VarDecl], source_text: str, target: str) -> list[LabelRow]:
-    lines = source_text.splitlines()
+    lines = text_lines(source_text)
     rows = []
     for decl in decls:
         value = initial_text(source_text, lines, decl)

@@ -14,6 +14,7 @@ from __future__ import annotations
 import sys
 from dataclasses import dataclass
 from pathlib import Path
+from verifier.textfile import text_lines
 
 HEADER = ("Step Number", "Line Statement", "Instruction", "I/O(Device)", "Blank", "PI Statement", "Note")
 PLC_TYPE = "FX3U/FX3UC"
@@ -42,7 +43,7 @@ class Instruction:
 def parse_il(text: str, name: str = "<il>") -> list[Instruction]:
     program: list[Instruction] = []
     pending = ""
-    for number, raw in enumerate(text.splitlines(), 1):
+    for number, raw in enumerate(text_lines(text), 1):
         line = raw.strip()
         if not line:
             continue

@@ -20,6 +20,7 @@ from verifier.st import ast
 from verifier.export.body import body_text
 from verifier.export.labels import LabelRow, initial_text, label_class, label_rows, rows_of
 from verifier.export.types import type_name
+from verifier.textfile import text_lines
 
 COLUMNS = {
     "gxworks2": ("Class", "Label Name", "Data Type", "Constant", "Comment"),
@@ -160,7 +161,7 @@ def dropped_initial_values(files: list[ast.SourceFile], target: str) -> list[Dro
     carries = CARRIES_INITIAL[target]
     dropped = []
     for f in files:
-        lines = f.text.splitlines()
+        lines = text_lines(f.text)
         scopes = [(pou.name, pou.variables) for pou in f.pous]
         scopes += [("global", block.variables) for block in f.globals]
         scopes += [(struct.name, struct.fields) for struct in f.types]

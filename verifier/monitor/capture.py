@@ -23,7 +23,7 @@ from pathlib import Path
 
 from verifier import protocol
 from verifier.amr.schema import LARGEST  # the largest number of seconds any setting holds
-from verifier.textfile import UnreadableText, read_utf8
+from verifier.textfile import UnreadableText, read_utf8, text_lines
 
 
 @dataclass(frozen=True)
@@ -49,7 +49,7 @@ _HEX_PAIR = re.compile(r"[0-9A-Fa-f]{2}")
 def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
     chunks: list[Chunk] = []
     last_t: int | None = None
-    for number, raw in enumerate(text.splitlines(), start=1):
+    for number, raw in enumerate(text_lines(text), start=1):
         line = raw.split("#", 1)[0].rstrip()
         if not line.strip():
             continue
@@ -97,7 +97,7 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
     """Our JSONL trace (`uitamr verify --trace`, `uitamr monitor --trace`): frames with
     their direction, grouped by scenario, in file order."""
     scenarios: dict[str, list[Chunk]] = {}
-    for number, raw in enumerate(text.splitlines(), start=1):
+    for number, raw in enumerate(text_lines(text), start=1):
         if not raw.strip():
             continue
         try:
@@ -150,7 +150,7 @@ def read_capture(path: Path) -> dict[str, list[Chunk]]:
         text = read_utf8(path)
     except UnreadableText as exc:
         raise CaptureError(f"{path}: {exc}") from None
-    first = next((line.lstrip() for line in text.splitlines()
+    first = next((line.lstrip() for line in text_lines(text)
                   if line.strip() and not line.lstrip().startswith("#")), "")
     if first.startswith("{"):
         return parse_trace(text, str(path))

@@ -10,6 +10,7 @@ from typing import Callable, Iterable
 from verifier.st import ast
 from verifier.st.check import called_without
 from verifier.st.source import read_source
+from verifier.textfile import text_lines
 
 from .compiler import GENERATED_FILE, CompiledModule, compile_files, default_code
 from .cpu import profile_for
@@ -439,7 +440,7 @@ class Project:
         file, line, _ = location.rsplit(":", 2)
         for f in self.files:
             if f.filename == file:
-                lines = f.text.splitlines()
+                lines = text_lines(f.text)
                 n = int(line)
                 return lines[n - 1] if 1 <= n <= len(lines) else None
         return None

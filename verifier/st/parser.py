@@ -16,6 +16,7 @@ from lark.exceptions import LarkError, UnexpectedCharacters, UnexpectedEOF, Unex
 from verifier.st import ast
 from verifier.st.devices import H_CONST_RE, K_CONST_RE, parse_device
 from verifier.st.errors import describe_syntax_error
+from verifier.textfile import text_lines
 
 GRAMMAR_PATH = Path(__file__).with_name("st.lark")
 
@@ -39,7 +40,7 @@ class _ParseContext:
 
     def word_at(self, line: int, col: int) -> str:
         """The keyword or name that starts at line:col of the text being parsed."""
-        lines = self.text.splitlines()
+        lines = text_lines(self.text)
         if not 1 <= line <= len(lines):
             return ""
         return re.match(r"[A-Za-z_0-9]*", lines[line - 1][col - 1:]).group().upper()
@@ -500,14 +501,22 @@ def get_parser() -> Lark:
     return _parser
 
 
+def _lone_cr_as_line_feed(text: str) -> str:
+    """`text` with each carriage return not followed by a line feed made a line feed: the
+    lexers count lines at line feeds only (the returned text is the file's `.text`)."""
+    return re.sub(r"\r(?!\n)", "\n", text) if "\r" in text else text
+
+
 def parse(text: str, filename: str = "<string>", target: str = "gxworks2") -> ast.SourceFile:
     """Parse ST `text`; never raises for bad input (errors are in `.diagnostics`).
 
     Text that reads without a diagnostic goes through the fast path
     (`verifier.st.fastparse`: same tokens, same tree, same spans); anything else is read
-    by `parse_reference`, the lark parser over the grammar, which words the diagnostics."""
+    by `parse_reference`, the lark parser over the grammar, which words the diagnostics.
+    A lone carriage return (a classic Mac OS line end) ends a line, as in every editor."""
     from verifier.st import fastparse
 
+    text = _lone_cr_as_line_feed(text)
     parser = get_parser()
     try:
         return fastparse.parse_fast(text, filename, target, parser)
@@ -517,6 +526,7 @@ def parse(text: str, filename: str = "<string>", target: str = "gxworks2") -> as
 
 def parse_reference(text: str, filename: str = "<string>", target: str = "gxworks2") -> ast.SourceFile:
     """`parse` with lark's LALR parser only (the reference the fast path must equal)."""
+    text = _lone_cr_as_line_feed(text)
     parser = get_parser()
     _ctx.reset(filename, target, text)
     try:

@@ -66,13 +66,15 @@ def uses_tcp_route(sources: tuple[Path, ...], program: str | None = None) -> boo
     from verifier.sim.instructions import ETHERNET
     from verifier.st.ast import ArrayType, NamedType
     from verifier.st.source import read_source
+    from verifier.textfile import text_lines
 
     ethernet_call = re.compile(r"\b(?:" + "|".join(sorted(ETHERNET)) + r")\s*\(", re.IGNORECASE)
     pous, calls = {}, set()
     for path in sources:
         text, _ = read_source(path)  # an unreadable file is reported where the sources load
-        lines = text.splitlines()
-        for pou in st.parse(text, str(path)).pous:
+        parsed = st.parse(text, str(path))
+        lines = text_lines(parsed.text)
+        for pou in parsed.pous:
             pous[pou.key] = pou
             own = "\n".join(lines[pou.span.line - 1:pou.span.end_line]) if pou.span.line else text
             if ethernet_call.search(_COMMENT.sub(" ", own)):

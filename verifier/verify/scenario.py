@@ -16,7 +16,7 @@ from verifier import protocol
 from verifier.amr.config import RobotConfig
 from verifier.amr.faults import Fault, check_fault_addresses
 from verifier.amr.schema import ConfigError
-from verifier.textfile import UnreadableText, read_utf8
+from verifier.textfile import UnreadableText, read_utf8, text_lines
 from verifier.tomlpos import Place, decode_error_position, place_of_key, shown
 
 from verifier.link.converter import ConverterConfig
@@ -261,7 +261,7 @@ class _Reader:
     """Turns the parsed TOML into a Scenario; every error names its key and line."""
 
     def __init__(self, text: str, path: Path | None):
-        self.lines = text.splitlines()
+        self.lines = text_lines(text)
         self.path = path
         self.base = path.parent if path is not None else Path.cwd()
 
