@@ -504,7 +504,9 @@ def get_parser() -> Lark:
 def _lone_cr_as_line_feed(text: str) -> str:
     """`text` with each carriage return not followed by a line feed made a line feed: the
     lexers count lines at line feeds only (the returned text is the file's `.text`)."""
-    return re.sub(r"\r(?!\n)", "\n", text) if "\r" in text else text
+    if text.count("\r") == text.count("\r\n"):  # none, or only CRLF (GX Works, Windows)
+        return text
+    return re.sub(r"\r(?!\n)", "\n", text)
 
 
 def parse(text: str, filename: str = "<string>", target: str = "gxworks2") -> ast.SourceFile:
