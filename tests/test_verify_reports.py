@@ -116,6 +116,13 @@ def test_junit_keeps_runs_that_share_a_name_apart(tmp_path):
                      "healthy [3]"]
 
 
+def test_the_same_file_run_twice_gets_a_number_after_its_file(tmp_path):
+    path = tmp_path / "r.xml"
+    report_junit.write([good_result(), bad_result(), good_result()], path)
+    names = [c.get("name") for c in ET.parse(path).getroot().findall("./testsuite/testcase")]
+    assert names == ["healthy [plc/scenarios/healthy.toml #1]", "broken", "healthy [plc/scenarios/healthy.toml #2]"]
+
+
 def test_trace_is_one_frame_per_line_with_time_direction_hex_and_meaning(tmp_path):
     path = tmp_path / "t.jsonl"
     report_trace.write([bad_result()], path)

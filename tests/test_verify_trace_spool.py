@@ -208,3 +208,34 @@ def test_a_worker_killed_midway_is_said_and_leaves_nothing(tmp_path):
     assert proc.returncode == 2, stderr.decode()
     assert b"a worker process of --jobs 2 stopped without a word" in stderr and b"Traceback" not in stderr
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("spool", [False, True], ids=["held", "spooled"])
+def test_runs_that_share_a_name_are_apart_in_the_trace_and_replay_reads_them(tmp_path, spool):
+    """A copied scenario file that kept its name, and one file given twice: the trace names
+    them as the JUnit report does, and `uitamr replay` reads three runs, each whole."""
+    from verifier.cli import main
+
+    text = (ROOT / "plc/scenarios/fx3u-healthy.toml").read_text(encoding="utf-8")
+    text = text.replace('"../', f'"{(ROOT / "plc").as_posix()}/').replace('duration = "60s"', 'duration = "3s"')
+    text = text[:text.index("[[expect]]")]  # the points are reached later than 3 s
+    first, copy = tmp_path / "a.toml", tmp_path / "b.toml"
+    first.write_text(text, encoding="utf-8")
+    copy.write_text(text, encoding="utf-8")
+    trace = tmp_path / "t.jsonl"
+    extra = [] if spool else ["--html", str(tmp_path / "r.html")]  # --html keeps the frames
+    result = CliRunner().invoke(main, ["verify", "--scenario", str(first), "--scenario", str(copy),
+                                       "--scenario", str(first), "--trace", str(trace), *extra])
+    assert result.exit_code == 0, result.output
+    import json
+
+    name = load_scenario(first).name
+    runs = {}
+    for line in trace.read_text(encoding="utf-8").splitlines():
+        record = json.loads(line)
+        runs.setdefault(record["scenario"], []).append(record["t"])
+    assert list(runs) == [f"{name} [{first} #1]", f"{name} [{copy}]", f"{name} [{first} #2]"]
+    assert runs[f"{name} [{first} #1]"] == runs[f"{name} [{copy}]"] == runs[f"{name} [{first} #2]"]
+    replayed = CliRunner().invoke(main, ["replay", str(trace)])
+    assert replayed.exit_code == 0, replayed.output
+    assert "PASS: 3 scenario(s) compliant" in replayed.output

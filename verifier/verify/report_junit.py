@@ -8,13 +8,12 @@ from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
-from collections import Counter
 from pathlib import Path
 
 from verifier.textfile import escape_chars
 
 from .durations import format_seconds
-from .result import ScenarioResult
+from .result import ScenarioResult, run_names
 from .rules import RULES_BY_ID
 
 MAX_LISTED = 50  # violations written out per rule and scenario
@@ -39,25 +38,11 @@ def _rule_failure_text(rule_id: str, result: ScenarioResult) -> str:
     return "\n".join(lines)
 
 
-def _case_names(results: list[ScenarioResult]) -> list[str]:
-    """Each result's test case name: its own, or, for runs that share a name (a copied
-    scenario file that kept it), the name with its file, so that a CI server does not
-    file two runs as one test (else a number)."""
-    count = Counter(result.name for result in results)
-    seen: Counter = Counter()
-    names = []
-    for result in results:
-        seen[result.name] += 1
-        shared = count[result.name] > 1
-        names.append(f"{result.name} [{result.file or seen[result.name]}]" if shared else result.name)
-    return names
-
-
 def to_element(results: list[ScenarioResult]) -> ET.Element:
     suites = ET.Element("testsuites", name="uitamr verify")
     suite = ET.SubElement(suites, "testsuite", name="uitamr verify")
     failures = errors = 0
-    for result, name in zip(results, _case_names(results)):
+    for result, name in zip(results, run_names(results)):
         case = ET.SubElement(
             suite,
             "testcase",

@@ -18,7 +18,7 @@ from typing import Iterator
 from verifier import protocol
 
 from .evidence import RuleOptions
-from .result import ScenarioResult
+from .result import ScenarioResult, run_names
 from .traffic import analyse, describe_bytes
 
 
@@ -47,12 +47,14 @@ def _blamed(result: ScenarioResult) -> dict[tuple[int, str], set[str]]:
     return blamed
 
 
-def records(result: ScenarioResult) -> Iterator[dict]:
+def records(result: ScenarioResult, name: str | None = None) -> Iterator[dict]:
+    """The trace lines of a run that kept its frames; `name` (default: the run's) goes in
+    each line's `scenario`."""
     blamed = _blamed(result)
     traffic = analyse(result.trace, result.settings, RuleOptions(reply_timeout_us=result.reply_timeout_us))
     for frame in sorted(result.trace, key=_line_order):
         request = traffic.request_of(frame) if frame.direction == "rx" else None
-        record = _frame_fields(result.name, frame, result.settings, request)
+        record = _frame_fields(name or result.name, frame, result.settings, request)
         record["rules"] = sorted(blamed.get((frame.t_start_us, frame.direction), ()))
         yield record
 
@@ -67,20 +69,33 @@ def spool_lines(name: str, frames, settings: protocol.Settings, request_of) -> I
         yield f"{frame.t_start_us} {frame.direction} {head[:-1]}\n"
 
 
-def _spooled(result: ScenarioResult) -> Iterator[str]:
+def _spooled(result: ScenarioResult, name: str) -> Iterator[str]:
+    """The run's spool lines completed; `name` in place of the run's own (`scenario` is the
+    first field, written as `_frame_fields` writes it)."""
     blamed = _blamed(result)
+    spooled_name = _scenario_field(result.name)
+    renamed = _scenario_field(name)
     with open(result.trace_file, encoding="utf-8") as spool:
         for line in spool:
             t_us, direction, head = line.rstrip("\n").split(" ", 2)
+            if renamed != spooled_name:
+                head = renamed + head[len(spooled_name):]
             rules = sorted(blamed.get((int(t_us), direction), ()))
             yield f'{head}, "rules": {json.dumps(rules)}}}\n'
 
 
+def _scenario_field(name: str) -> str:
+    """How a trace line starts: its `scenario` field."""
+    return json.dumps({"scenario": name}, ensure_ascii=False)[:-1]
+
+
 def write(results: list[ScenarioResult], path: Path) -> None:
+    """The trace of `results`, run after run; runs that share a name are told apart as the
+    JUnit report tells them (`run_names`), so that `uitamr replay` reads them as two."""
     with open(path, "w", encoding="utf-8") as out:
-        for result in results:
+        for result, name in zip(results, run_names(results)):
             if result.trace_file is not None:
-                out.writelines(_spooled(result))
+                out.writelines(_spooled(result, name))
                 continue
-            for record in records(result):
+            for record in records(result, name):
                 out.write(json.dumps(record, ensure_ascii=False) + "\n")

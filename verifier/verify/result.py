@@ -5,6 +5,7 @@ report reads the same thing.
 """
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -130,6 +131,31 @@ class ScenarioResult:
 
     def all_violations(self) -> list[Violation]:
         return sorted((v for found in self.violations.values() for v in found), key=lambda v: (v.t_us, v.rule))
+
+
+def run_names(results: list[ScenarioResult]) -> list[str]:
+    """Each run's name where reports tell runs apart by name (JUnit test cases, `--trace`
+    records, which `uitamr replay` groups by it): its own; for runs that share one (a copied
+    scenario file that kept it), the name with its file (a number without one); the same
+    file run twice gets a number after its file too."""
+    count = Counter(result.name for result in results)
+    seen: Counter = Counter()
+    labels: list[str | None] = []
+    for result in results:
+        seen[result.name] += 1
+        labels.append((result.file or str(seen[result.name])) if count[result.name] > 1 else None)
+    clash = Counter(zip((result.name for result in results), labels))
+    again: Counter = Counter()
+    names = []
+    for result, label in zip(results, labels):
+        if label is None:
+            names.append(result.name)
+            continue
+        if clash[result.name, label] > 1:
+            again[result.name, label] += 1
+            label = f"{label} #{again[result.name, label]}"
+        names.append(f"{result.name} [{label}]")
+    return names
 
 
 def overall_verdict(results: list[ScenarioResult]) -> str:
