@@ -17,11 +17,11 @@ from verifier import protocol
 from verifier.verify.evidence import RuleOptions, RunEvidence, Violation
 from verifier.verify.result import ScenarioResult, TraceRecord
 from verifier.verify.rules import Judgement, check_all
-from verifier.verify.traffic import Pairing, analyse
+from verifier.verify.traffic import Exchange, Pairing, analyse
 
 from .capture import Chunk
 from .classify import Classifier
-from .framer import Framer, LineTiming
+from .framer import MAX_FRAME, Framer, LineTiming
 
 POWER_ON_RULE = "UITAMR-POWERON-STOP"
 PROVISIONAL_RULE = "UITAMR-RESPONSE-HANDLING"  # the one rule with early word (Judgement.provisional)
@@ -124,7 +124,8 @@ class MonitorSession:
         """Findings not returned by an earlier call, in time order: each violation once it is
         final (no frame still to come can change it; after `close`, all the rest), and early
         word of replies that are still failing after the bound of UITAMR-RESPONSE-HANDLING
-        (its final finding is then not returned again)."""
+        (its final finding is then not returned again), also when the line has gone silent
+        after a request whose reply is overdue."""
         self._evidence.end_us = self.last_us  # the run lasts at least this long
         if not self._in_line_order:
             new = self._judged_whole() if self._closed else []
@@ -139,18 +140,40 @@ class MonitorSession:
             # ended (its reply starts after it) or, when all are, until the line's last frame
             exchanges = self._pairing.traffic.exchanges
             open_until = exchanges[settled].request.t_end_us if settled < len(exchanges) else self._line_end_us
-            new += self._judgement.provisional(open_until)
+            silence = self._silent_since(settled)
+            if silence is None:
+                new += self._judgement.provisional(open_until)
+            else:  # the latest request failed, and the failure lasts while the line is silent
+                overdue, silent_since = silence
+                new += self._judgement.provisional(silent_since, overdue)
         shown = []
         for violation in new:
             if violation.rule == POWER_ON_RULE and not self.from_power_on:
                 continue
             if violation.rule == PROVISIONAL_RULE:
-                key = (violation.rule, violation.t_us, violation.frames)
+                # the episode's first request and when it showed: early word of an overdue
+                # reply names the request alone; a late reply may join it in the final words
+                key = (violation.rule, violation.t_us, violation.frames[:1])
                 if key in self._shown:
                     continue
                 self._shown.add(key)
             shown.append(violation)
         return sorted(shown, key=lambda v: (v.t_us, v.rule))
+
+    def _silent_since(self, settled: int) -> tuple[Exchange, int] | None:
+        """The latest request and since when the line is known silent, when the line has
+        gone silent after it and its reply can no longer come in time: it is the one
+        exchange not settled, it has no reply, every frame seen is with the pairing, none
+        is pending in the framer, and a frame still to come (bytes a later read returns)
+        starts after its deadline: no earlier than the latest frame's end, nor than one
+        longest frame (and the host's tolerance) before now."""
+        exchanges = self._pairing.traffic.exchanges
+        if settled != len(exchanges) - 1 or exchanges[-1].rx:
+            return None
+        if self.judged_frames < len(self.frames) or self.framer.pending:
+            return None
+        silent = max(self._line_end_us, self.last_us - self.timing.frame_us(MAX_FRAME) - self.timing.tolerance_us)
+        return (exchanges[-1], silent) if silent > exchanges[-1].deadline_us else None
 
     def _ready(self) -> int:
         """How many frames (from the first) no frame still to come can sort before: those

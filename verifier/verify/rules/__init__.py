@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..evidence import RunEvidence, Violation
-from ..traffic import Traffic, analyse, converter_drops
+from ..traffic import Exchange, Traffic, analyse, converter_drops
 from . import framing, response, sequence, timing
 from .judge import Judge
 
@@ -141,9 +141,10 @@ class Judgement:
         for _, judge in self._judges:
             judge.forget(requests, robot_frames)
 
-    def provisional(self, end_us: int) -> list[Violation]:
-        """What the rules would still find if the run ended at `end_us` and nothing came."""
-        return [v for _, judge in self._judges for v in judge.provisional(end_us)]
+    def provisional(self, end_us: int, overdue: Exchange | None = None) -> list[Violation]:
+        """What the rules would still find if the run ended at `end_us` and nothing came;
+        `overdue` (Judge.provisional): the first exchange not settled, its reply overdue."""
+        return [v for _, judge in self._judges for v in judge.provisional(end_us, overdue)]
 
     def finish(self) -> list[Violation]:
         """The run has ended (at evidence.end_us): judge the rest; the violations found."""

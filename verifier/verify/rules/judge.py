@@ -12,7 +12,7 @@ from __future__ import annotations
 from typing import Iterable
 
 from ..evidence import RunEvidence, Violation
-from ..traffic import Traffic
+from ..traffic import Exchange, Traffic
 
 
 class Judge:
@@ -39,7 +39,9 @@ class Judge:
         """The run ended at evidence.end_us, every exchange judged."""
         return ()
 
-    def provisional(self, end_us: int) -> Iterable[Violation]:
+    def provisional(self, end_us: int, overdue: Exchange | None = None) -> Iterable[Violation]:
         """Early word, for a live view, of a violation still going on that `finish` would
-        report if the run ended at `end_us` (replies failing for too long); said once."""
+        report if the run ended at `end_us` (replies failing for too long); said once.
+        `overdue`: the first exchange not settled, when its reply can no longer come in
+        time (its pairing is not final, but it failed: late or not at all)."""
         return ()

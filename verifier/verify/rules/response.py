@@ -34,6 +34,8 @@ class Episode:
     @property
     def noticeable_us(self) -> int:
         first = self.first
+        if first.reply is None:
+            return first.deadline_us  # no reply (yet): the time-out is when it shows
         status = first.reply_status[0]
         if status in (ReplyStatus.NONE, ReplyStatus.LATE):
             return first.deadline_us
@@ -50,7 +52,7 @@ class ResponseHandling(Judge):
         # when the signal held (kept up to date while a run is judged as it goes)
         self.signal = None if options.response_signal is None else evidence.samples.spans(options.response_signal)
         self.current: Episode | None = None  # the episode the latest exchange is in
-        self._told: Episode | None = None  # the episode `provisional` has spoken of
+        self._told: int | None = None  # the first exchange of the episode `provisional` spoke of
 
     def exchange(self, index: int) -> Iterator[Violation]:
         exchange = self.traffic.exchanges[index]
@@ -68,11 +70,17 @@ class ResponseHandling(Judge):
         if self.current is not None:
             yield from self._judge(self.current, self.evidence.end_us)
 
-    def provisional(self, end_us: int) -> Iterator[Violation]:
-        """Replies failing for longer than the bound, still going on: said once per episode."""
-        if self.current is not None and self.current is not self._told:
-            for violation in self._judge(self.current, end_us):
-                self._told = self.current
+    def provisional(self, end_us: int, overdue: Exchange | None = None) -> Iterator[Violation]:
+        """Replies failing for longer than the bound, still going on: said once per episode.
+        An overdue exchange (Judge.provisional) begins an episode when none is under way;
+        it is not counted by kind, since a late reply may still join it."""
+        episode = self.current
+        if episode is None and overdue is not None:
+            episode = Episode(overdue)
+            episode.counts["no reply so far"] += 1
+        if episode is not None and episode.first.index != self._told:
+            for violation in self._judge(episode, end_us):
+                self._told = episode.first.index
                 yield violation
 
     def _judge(self, episode: Episode, run_end_us: int) -> Iterator[Violation]:
