@@ -186,10 +186,7 @@ class MonitorSession:
     def _give(self, upto: int) -> None:
         """Hand frames up to `upto` to the pairing, in `analyse`'s order."""
         for frame in sorted(self.frames[self.judged_frames:upto], key=lambda f: (f.t_start_us, f.direction != "tx")):
-            if frame.direction == "tx":
-                self._pairing.request(frame)
-            elif frame.direction == "rx":
-                self._pairing.reply(frame)
+            self._pairing.give(frame)
         self.judged_frames = max(self.judged_frames, upto)
 
     def _judged_whole(self) -> list[Violation]:

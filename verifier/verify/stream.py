@@ -125,13 +125,12 @@ class Stream:
             record = TraceRecord(frame.t_start_us, frame.t_end_us, frame.direction, shared.setdefault(data, data),
                                  frame.origin and origin(frame.origin, cwd))
             records.append(record)
+            pairing.give(record)
             if record.direction == "tx":
                 self.tx_count += 1
-                pairing.request(record)
                 self._mark_lost(record.t_start_us)
             else:
                 self.rx_count += 1
-                pairing.reply(record)
         if self.spool is not None and records:
             # a robot frame's pairing is final once given: nothing later changes its request
             self.spool.writelines(spool_lines(self.name, records, self.settings, pairing.traffic.request_of))

@@ -259,6 +259,14 @@ class Pairing:
         owner.rx.append(frame)
         traffic.owners.setdefault(t, []).append(owner)
 
+    def give(self, frame: TraceFrameLike) -> None:
+        """The next frame in `analyse`'s order: a request ("tx") or a robot frame ("rx");
+        a frame whose direction is not known is not paired."""
+        if frame.direction == "tx":
+            self.request(frame)
+        elif frame.direction == "rx":
+            self.reply(frame)
+
     def forget(self, count: int) -> int:
         """Let go of the first `count` exchanges and of the robot frames that started before
         the last one that began at or before the first request kept (a rule judging that
