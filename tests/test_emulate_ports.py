@@ -235,6 +235,24 @@ def test_serial_survives_noise_truncated_frames_and_floods(pty_pair, start_emula
     assert code == 0
 
 
+def log_time(line: str) -> float:
+    return float(line.split()[0])
+
+
+def test_serial_reply_waits_for_t3_5_at_the_port_speed(pty_pair, start_emulator):
+    """--turnaround-ms 0 at 1200 bit/s: the reply still waits t3.5 (29.2 ms) after the
+    request, as a slave must; it went out at once. Judged on the emulator's own log."""
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end, "--baud", "1200", "--turnaround-ms", "0")
+    with serial.Serial(master_end, 1200, timeout=WAIT_S) as port:
+        port.write(STOP_FRAME)
+        assert port.read(8) == STOP_FRAME
+    request = emulator.wait_for(r"<- 01 06 01 A0").string
+    reply = emulator.wait_for(r"-> 01 06 01 A0").string
+    assert log_time(reply) - log_time(request) >= 0.029  # t3.5 = 29.167 ms, log in whole ms
+    assert emulator.stop()[0] == 0
+
+
 # ---- TCP: pymodbus client and raw sockets -----------------------------------------------------
 
 def tcp_emulator(start_emulator, *args: str) -> tuple[EmulatorProcess, int]:

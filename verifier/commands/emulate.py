@@ -15,7 +15,7 @@ from verifier.amr.schema import LARGEST
 from verifier.emulate.assembler import DEFAULT_SILENCE_US
 from verifier.emulate.core import Emulator
 from verifier.emulate.faultfile import FaultFileError, load_fault_file
-from verifier.emulate.ports import PortError, serial_url_problem, serve_serial, serve_tcp
+from verifier.emulate.ports import PortError, serial_url_problem, serve_serial, serve_tcp, t3_5_at
 from verifier.commands.protocol_options import protocol_settings
 
 
@@ -214,7 +214,8 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
         if not quiet:
             log_anyway(line)
 
-    emulator = Emulator(Robot(settings, config, faults), log)
+    # no reply before t3.5 at the line's speed (TCP: the robot's 9600 line behind the converter)
+    emulator = Emulator(Robot(settings, config, faults), log, t3_5_us=t3_5_at(baud))
     for fault in faults:
         emulator.note(f"scripted fault: {fault.describe()}")
     stop = threading.Event()

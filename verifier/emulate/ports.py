@@ -88,11 +88,16 @@ class _Channel:
         return ready
 
 
+def t3_5_at(baudrate: int) -> int:
+    """t3.5, the silence that ends a frame, on a line at ``baudrate`` (µs)."""
+    return LineConfig(baud=baudrate).frame_gap_us
+
+
 def serial_assembler(baudrate: int, silence_us: int) -> RequestAssembler:
     """The assembler for a serial port at ``baudrate``. Modbus ends a frame after 3.5
     character times: 3.65 ms at 9600 bit/s, but 117 ms at 300 bit/s, where one byte alone
     takes longer than the default wall-clock gap - so the gap is never shorter than t3.5."""
-    t3_5_us = LineConfig(baud=baudrate).frame_gap_us
+    t3_5_us = t3_5_at(baudrate)
     return RequestAssembler(max(silence_us, t3_5_us), t3_5_us=t3_5_us)
 
 
