@@ -427,6 +427,9 @@ def test_fault_file_is_applied(tmp_path, start_emulator):
     (("--tcp", "0", "--exit-after", "0"), "--exit-after': must be a number of seconds greater than 0", 2),
     (("--tcp", "0", "--exit-after", "inf"), "--exit-after': 'inf' is not a finite number", 2),
     (("--tcp", "0", "--frame-gap-ms", "nan"), "--frame-gap-ms': 'nan' is not a finite number", 2),
+    # rounded to 0 µs: the first TCP client crashed the command with a traceback
+    (("--tcp", "0", "--frame-gap-ms", "0.0001"), "--frame-gap-ms: must be at least 0.001 (1 µs), got 0.0001", 2),
+    (("--tcp", "0", "--frame-gap-ms", "0"), "--frame-gap-ms: must be at least 0.001", 2),
     (("--tcp", "0", "--turnaround-ms", "1e300"), "--turnaround-ms': '1e300' is out of range", 2),
     (("--serial", "socket://127.0.0.1"), "socket://127.0.0.1 needs a host and a port: socket://HOST:PORT", 2),
     (("--serial", "socket://127.0.0.1:http"), "the port 'http' is not a number from 1 to 65535", 2),

@@ -77,6 +77,7 @@ class _FiniteFloat(click.ParamType):
 
 
 FINITE = _FiniteFloat()
+MIN_FRAME_GAP_MS = 0.001
 
 
 def _exit_after(ctx: click.Context, param: click.Parameter, value: float | None) -> float | None:
@@ -202,8 +203,9 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
     config = RobotConfig.from_dict(robot_table)
     faults += _flag_faults(no_reply_on, bad_crc_on, garbage_on, wrong_address_on, exception_on,
                            late_reply_on, anti_collision_at, off_tape_at, low_battery_at)
-    if frame_gap_ms <= 0:
-        raise click.BadParameter("must be greater than 0", param_hint="--frame-gap-ms")
+    if frame_gap_ms < MIN_FRAME_GAP_MS:  # the assemblers count whole µs: less rounds to none
+        raise click.BadParameter(f"must be at least {MIN_FRAME_GAP_MS:g} (1 µs), got {frame_gap_ms:g}; "
+                                 f"the default is {DEFAULT_SILENCE_US / 1000:g}", param_hint="--frame-gap-ms")
     endpoint = _tcp_endpoint(tcp) if tcp is not None else None
 
     def log_anyway(line: str) -> None:
