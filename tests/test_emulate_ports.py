@@ -412,6 +412,12 @@ def test_fault_file_is_applied(tmp_path, start_emulator):
     (("--tcp", "here"), "expected HOST:PORT or PORT", 2),
     (("--tcp", "0", "--late-reply-on", "3"), "expected N:MS", 2),
     (("--tcp", "0", "--no-reply-on", "0"), "request numbers start at 1", 2),
+    # N:VALUE where only N is taken: the :VALUE was silently dropped
+    (("--tcp", "0", "--wrong-address-on", "3:7"),
+     "--wrong-address-on: expected a request number N, got '3:7'; its other settings go in a fault file "
+     '([[faults]] kind = "wrong_address", on_request = 3, ...)', 2),
+    (("--tcp", "0", "--garbage-on", "2:FF"), "--garbage-on: expected a request number N, got '2:FF'", 2),
+    (("--tcp", "0", "--no-reply-on", "2:"), "--no-reply-on: expected a request number N, got '2:'", 2),
     (("--tcp", "0", "--address", "300"), "'--address': 300 is not in the range 1<=x<=247", 2),
     (("--tcp", "0", "--anti-collision-at", "-1"), "--anti-collision-at: must be at least 0.0", 2),
     (("--tcp", "0", "--turnaround-ms", "-3"), "--turnaround-ms: must be at least 0.0", 2),

@@ -98,6 +98,16 @@ def _request_number(value: str, option: str) -> tuple[int, str]:
     return n, rest
 
 
+def _only_request_number(value: str, option: str, kind: str) -> int:
+    """N alone: these options take no :VALUE (3:7 would silently lose the 7)."""
+    n, rest = _request_number(value, option)
+    if rest or ":" in value:
+        raise click.BadParameter(
+            f"expected a request number N, got {value!r}; its other settings go in a fault "
+            f"file ([[faults]] kind = \"{kind}\", on_request = {n}, ...)", param_hint=option)
+    return n
+
+
 def _fault(option: str, table: dict) -> Fault:
     try:
         return Fault.from_dict(table, option)
@@ -111,7 +121,8 @@ def _flag_faults(no_reply, bad_crc, garbage, wrong_address, exception, late,
     for option, kind, values in (("--no-reply-on", "no_reply", no_reply), ("--bad-crc-on", "bad_crc", bad_crc),
                                  ("--garbage-on", "garbage", garbage),
                                  ("--wrong-address-on", "wrong_address", wrong_address)):
-        faults += [_fault(option, {"kind": kind, "on_request": _request_number(v, option)[0]}) for v in values]
+        faults += [_fault(option, {"kind": kind, "on_request": _only_request_number(v, option, kind)})
+                   for v in values]
     for value in exception:
         n, code = _request_number(value, "--exception-on")
         try:
