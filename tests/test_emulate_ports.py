@@ -395,7 +395,31 @@ def test_the_log_says_what_a_closing_tcp_client_left_behind(start_emulator):
         pass
     emulator.wait_for(r"disconnected$")  # nothing left behind: nothing more said
     code, summary = emulator.stop()
-    assert code == 0 and "1 frames in, 0 replies out" in summary
+    # the reply owed to the client that left is counted (the summary used to lose it)
+    assert code == 0 and "1 frames in, 0 replies out, 0 unanswered, 1 reply not sent," in summary
+
+
+def test_replies_still_owed_when_the_emulator_stops_are_logged_and_counted(pty_pair, start_emulator):
+    """SIGTERM while a (late) reply waits: it was dropped without a word, and the summary's
+    frames in (1) did not add up to replies out + unanswered (0 + 0)."""
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end, "--late-reply-on", "1:60000")
+    with serial.Serial(master_end, 9600, timeout=WAIT_S) as port:
+        port.write(STOP_FRAME)
+        port.flush()
+        emulator.wait_for(r"\*\* fault: request 1: late_reply")
+        code, summary = emulator.stop()
+    assert code == 0
+    assert "1 frames in, 0 replies out, 0 unanswered, 1 reply not sent, 1 fault events" in summary
+    emulator.wait_for(rf"-- serial {re.escape(robot_end)} closed; 1 reply not sent$")
+
+    emulator, port = tcp_emulator(start_emulator, "--turnaround-ms", "60000")
+    with socket.create_connection(("127.0.0.1", port), timeout=5) as sock:
+        sock.sendall(STATUS_TASK)
+        emulator.wait_for(r"<- 01 01 00 00 00 16 BD C4")
+        code, summary = emulator.stop()
+    assert code == 0 and "1 frames in, 0 replies out, 0 unanswered, 1 reply not sent," in summary
+    emulator.wait_for(r"-- client 127\.0\.0\.1:\d+ closed: the emulator stops; 1 reply not sent$")
 
 
 def test_fault_file_is_applied(tmp_path, start_emulator):

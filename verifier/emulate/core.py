@@ -84,6 +84,10 @@ class Emulator:
             meaning = f"invalid reply: {err}"
         self.line(t_us, "->", f"{hex_bytes(reply.data)}  {meaning}{where}")
 
+    def not_sent(self, count: int) -> None:
+        """``count`` replies were due to a peer that went away, or when the emulator stopped."""
+        self.stats["not sent"] += count
+
     def tick(self) -> None:
         """Let robot time pass (tasks finish, timed faults fire) and log what happened."""
         self.robot.advance(max(self.now_us(), self.robot.now_us))
@@ -106,9 +110,13 @@ class Emulator:
         self._events_seen = len(events)
 
     def summary(self) -> str:
+        """One line; frames in = replies out + unanswered + replies not sent (that part only
+        when some were not: a client gone, or the stop, before they fell due)."""
         s = self.stats
+        unsent = s["not sent"]
+        not_sent = f", {unsent} repl{'ies' if unsent != 1 else 'y'} not sent" if unsent else ""
         return (f"uitamr emulate: stopped after {self.now_us() / 1e6:.1f} s: "
                 f"{s['frames in']} frames in, {s['replies out']} replies out, "
-                f"{s['no reply']} unanswered, {s['faults']} fault events, "
+                f"{s['no reply']} unanswered{not_sent}, {s['faults']} fault events, "
                 f"{s['dropped bytes']} flood bytes dropped; robot {self.robot.mode}, "
                 f"error {int(self.robot.error):02d}")

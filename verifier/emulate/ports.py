@@ -69,8 +69,10 @@ class _Channel:
                 self.outgoing.append(reply)
         self.outgoing.sort(key=lambda o: o.due_us)
 
-    def close(self) -> str:
-        """Forget what is still in flight; the words for the log, '' when nothing was."""
+    def close(self, emulator: Emulator) -> str:
+        """Forget what is still in flight (counting replies not sent); the words for the
+        log, '' when nothing was."""
+        emulator.not_sent(len(self.outgoing))
         unread = self.unread_at_end + self.assembler.discard()
         lost = []
         if unread:
@@ -135,6 +137,8 @@ def serve_serial(url: str, emulator: Emulator, stop: threading.Event, silence_us
                 emulator.sent(reply, emulator.now_us())
     finally:
         port.close()
+        if left_behind := channel.close(emulator):
+            emulator.note(f"serial {url} closed{left_behind}")
 
 
 def serve_tcp(host: str, port: int, emulator: Emulator, stop: threading.Event, silence_us: int,
@@ -161,7 +165,7 @@ def serve_tcp(host: str, port: int, emulator: Emulator, stop: threading.Event, s
         if not channel.ended:  # an ended one is no longer watched for reading
             selector.unregister(sock)
         sock.close()
-        emulator.note(f"client {channel.peer} {why}{channel.close()}")
+        emulator.note(f"client {channel.peer} {why}{channel.close(emulator)}")
 
     try:
         while not stop.is_set():
@@ -212,7 +216,7 @@ def serve_tcp(host: str, port: int, emulator: Emulator, stop: threading.Event, s
                     drop(sock, "disconnected")
     finally:
         for sock in list(clients):
-            sock.close()
+            drop(sock, "closed: the emulator stops")
         selector.close()
         server.close()
 
