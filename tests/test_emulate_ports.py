@@ -434,6 +434,9 @@ def test_fault_file_is_applied(tmp_path, start_emulator):
     ((), "give exactly one of --serial PORT or --tcp HOST:PORT", 2),
     (("--tcp", "0", "--serial", "/dev/ttyUSB0"), "give exactly one of", 2),
     (("--tcp", "here"), "expected HOST:PORT or PORT", 2),
+    # was read as host ':' port 1, and failed (status 1) with "Name or service not known"
+    (("--tcp", "::1"), "--tcp: an IPv6 address goes in brackets, e.g. [::1]:4001, got '::1'", 2),
+    (("--tcp", "fe80::1:4001"), "an IPv6 address goes in brackets", 2),
     (("--tcp", "0", "--late-reply-on", "3"), "expected N:MS", 2),
     (("--tcp", "0", "--no-reply-on", "0"), "request numbers start at 1", 2),
     # N:VALUE where only N is taken: the :VALUE was silently dropped

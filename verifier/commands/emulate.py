@@ -23,6 +23,9 @@ def _tcp_endpoint(value: str) -> tuple[str, int]:
     host, sep, port = value.rpartition(":")
     if not sep:
         host, port = "127.0.0.1", value
+    if ":" in host and not (host.startswith("[") and host.endswith("]")):
+        raise click.BadParameter(f"an IPv6 address goes in brackets, e.g. [::1]:4001, got {value!r}",
+                                 param_hint="--tcp")
     host = host.strip("[]") or "127.0.0.1"
     try:
         number = int(port)
