@@ -430,6 +430,22 @@ def test_fault_file_is_applied(tmp_path, start_emulator):
         assert exchange(sock, STOP_FRAME, 5) == with_crc(bytes((1, 0x86, 6)))
 
 
+def test_the_scripted_fault_line_says_count_duration_and_filter_together(tmp_path, start_emulator):
+    """count = 2 with duration_s and requests = "status": the log said only "for 600 s",
+    as if every request for 600 s were hit; two status requests are."""
+    path = tmp_path / "faults.toml"
+    path.write_text('[[faults]]\nkind = "no_reply"\non_request = 1\ncount = 2\nduration_s = 600\n'
+                    'requests = "status"\n')
+    emulator, port = tcp_emulator(start_emulator, "--faults", str(path))
+    emulator.wait_for(r"-- scripted fault: no_reply on request 1 ×2 within 600 s, status requests only$")
+    with socket.create_connection(("127.0.0.1", port), timeout=5) as sock:
+        sock.sendall(STATUS_TASK)
+        assert exchange(sock, STOP_FRAME, 8) == STOP_FRAME  # FC06: not a status request
+        sock.sendall(STATUS_TASK)
+        emulator.wait_for(r"request 3: no_reply")
+        assert exchange(sock, STATUS_TASK, 8) == with_crc(bytes.fromhex("010103000000"))  # the third: answered
+
+
 @pytest.mark.parametrize("args, message, code", [
     ((), "give exactly one of --serial PORT or --tcp HOST:PORT", 2),
     (("--tcp", "0", "--serial", "/dev/ttyUSB0"), "give exactly one of", 2),
