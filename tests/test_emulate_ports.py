@@ -182,6 +182,18 @@ def test_mbpoll_writes_stop_and_reads_every_status(pty_pair, start_emulator):
     assert re.search(r"5 frames in, 5 replies out", summary)
 
 
+def test_a_second_emulator_on_the_same_port_is_refused(pty_pair, start_emulator):
+    """Two emulators on one port took turns at the requests; the second now refuses."""
+    robot_end, master_end = pty_pair
+    first = start_emulator("--serial", robot_end)
+    second = run_cli("--serial", robot_end, "--exit-after", "5")
+    assert second.returncode == 1
+    assert f"cannot open serial port {robot_end}: another program has it locked" in second.stderr
+    assert "Traceback" not in second.stderr
+    assert read_status(master_end, Query.TASK) == (0, 0)  # the first still answers
+    assert first.stop()[0] == 0
+
+
 def test_mbpoll_sees_a_task_run_and_an_anti_collision_stop(pty_pair, start_emulator):
     robot_end, master_end = pty_pair
     emulator = start_emulator("--serial", robot_end, "--point-duration-s", "600")

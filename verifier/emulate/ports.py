@@ -14,6 +14,7 @@ and plain sockets, and pymodbus serves as an independent client in the tests.
 """
 from __future__ import annotations
 
+import errno
 import selectors
 import socket
 import threading
@@ -107,10 +108,15 @@ def serve_serial(url: str, emulator: Emulator, stop: threading.Event, silence_us
                  baudrate: int = 9600) -> None:
     """Run until ``stop`` is set: read requests from ``url``, write replies when due."""
     try:
+        # exclusive: a second emulator (or another locking program) on the same port would
+        # take every other request, and each would answer what it read
         port = serial.serial_for_url(url, baudrate=baudrate, bytesize=serial.EIGHTBITS,
                                      parity=serial.PARITY_NONE, stopbits=serial.STOPBITS_ONE,
-                                     timeout=POLL_S)
+                                     timeout=POLL_S, exclusive=True)
     except (serial.SerialException, ValueError, OSError) as err:
+        if getattr(err, "errno", None) in (errno.EAGAIN, errno.EWOULDBLOCK):
+            raise PortError(f"cannot open serial port {url}: another program has it locked (another "
+                            "uitamr emulate?); stop that one first") from None
         raise PortError(f"cannot open serial port {url}: {err}") from None
     channel = _Channel(serial_assembler(baudrate, silence_us))
     gap_us = channel.assembler.silence_us
