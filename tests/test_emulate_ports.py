@@ -182,6 +182,18 @@ def test_mbpoll_writes_stop_and_reads_every_status(pty_pair, start_emulator):
     assert re.search(r"5 frames in, 5 replies out", summary)
 
 
+def test_a_second_emulator_on_the_same_port_is_refused(pty_pair, start_emulator):
+    """Two emulators on one port took turns at the requests; the second now refuses."""
+    robot_end, master_end = pty_pair
+    first = start_emulator("--serial", robot_end)
+    second = run_cli("--serial", robot_end, "--exit-after", "5")
+    assert second.returncode == 1
+    assert f"cannot open serial port {robot_end}: another program has it locked" in second.stderr
+    assert "Traceback" not in second.stderr
+    assert read_status(master_end, Query.TASK) == (0, 0)  # the first still answers
+    assert first.stop()[0] == 0
+
+
 def test_mbpoll_sees_a_task_run_and_an_anti_collision_stop(pty_pair, start_emulator):
     robot_end, master_end = pty_pair
     emulator = start_emulator("--serial", robot_end, "--point-duration-s", "600")
@@ -233,6 +245,24 @@ def test_serial_survives_noise_truncated_frames_and_floods(pty_pair, start_emula
     assert read_status(master_end, Query.TASK) == (0, 0)
     code, _ = emulator.stop(signal.SIGINT)
     assert code == 0
+
+
+def log_time(line: str) -> float:
+    return float(line.split()[0])
+
+
+def test_serial_reply_waits_for_t3_5_at_the_port_speed(pty_pair, start_emulator):
+    """--turnaround-ms 0 at 1200 bit/s: the reply still waits t3.5 (29.2 ms) after the
+    request, as a slave must; it went out at once. Judged on the emulator's own log."""
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end, "--baud", "1200", "--turnaround-ms", "0")
+    with serial.Serial(master_end, 1200, timeout=WAIT_S) as port:
+        port.write(STOP_FRAME)
+        assert port.read(8) == STOP_FRAME
+    request = emulator.wait_for(r"<- 01 06 01 A0").string
+    reply = emulator.wait_for(r"-> 01 06 01 A0").string
+    assert log_time(reply) - log_time(request) >= 0.029  # t3.5 = 29.167 ms, log in whole ms
+    assert emulator.stop()[0] == 0
 
 
 # ---- TCP: pymodbus client and raw sockets -----------------------------------------------------
@@ -377,7 +407,31 @@ def test_the_log_says_what_a_closing_tcp_client_left_behind(start_emulator):
         pass
     emulator.wait_for(r"disconnected$")  # nothing left behind: nothing more said
     code, summary = emulator.stop()
-    assert code == 0 and "1 frames in, 0 replies out" in summary
+    # the reply owed to the client that left is counted (the summary used to lose it)
+    assert code == 0 and "1 frames in, 0 replies out, 0 unanswered, 1 reply not sent," in summary
+
+
+def test_replies_still_owed_when_the_emulator_stops_are_logged_and_counted(pty_pair, start_emulator):
+    """SIGTERM while a (late) reply waits: it was dropped without a word, and the summary's
+    frames in (1) did not add up to replies out + unanswered (0 + 0)."""
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end, "--late-reply-on", "1:60000")
+    with serial.Serial(master_end, 9600, timeout=WAIT_S) as port:
+        port.write(STOP_FRAME)
+        port.flush()
+        emulator.wait_for(r"\*\* fault: request 1: late_reply")
+        code, summary = emulator.stop()
+    assert code == 0
+    assert "1 frames in, 0 replies out, 0 unanswered, 1 reply not sent, 1 fault events" in summary
+    emulator.wait_for(rf"-- serial {re.escape(robot_end)} closed; 1 reply not sent$")
+
+    emulator, port = tcp_emulator(start_emulator, "--turnaround-ms", "60000")
+    with socket.create_connection(("127.0.0.1", port), timeout=5) as sock:
+        sock.sendall(STATUS_TASK)
+        emulator.wait_for(r"<- 01 01 00 00 00 16 BD C4")
+        code, summary = emulator.stop()
+    assert code == 0 and "1 frames in, 0 replies out, 0 unanswered, 1 reply not sent," in summary
+    emulator.wait_for(r"-- client 127\.0\.0\.1:\d+ closed: the emulator stops; 1 reply not sent$")
 
 
 def test_fault_file_is_applied(tmp_path, start_emulator):
@@ -388,12 +442,37 @@ def test_fault_file_is_applied(tmp_path, start_emulator):
         assert exchange(sock, STOP_FRAME, 5) == with_crc(bytes((1, 0x86, 6)))
 
 
+def test_the_scripted_fault_line_says_count_duration_and_filter_together(tmp_path, start_emulator):
+    """count = 2 with duration_s and requests = "status": the log said only "for 600 s",
+    as if every request for 600 s were hit; two status requests are."""
+    path = tmp_path / "faults.toml"
+    path.write_text('[[faults]]\nkind = "no_reply"\non_request = 1\ncount = 2\nduration_s = 600\n'
+                    'requests = "status"\n')
+    emulator, port = tcp_emulator(start_emulator, "--faults", str(path))
+    emulator.wait_for(r"-- scripted fault: no_reply on request 1 ×2 within 600 s, status requests only$")
+    with socket.create_connection(("127.0.0.1", port), timeout=5) as sock:
+        sock.sendall(STATUS_TASK)
+        assert exchange(sock, STOP_FRAME, 8) == STOP_FRAME  # FC06: not a status request
+        sock.sendall(STATUS_TASK)
+        emulator.wait_for(r"request 3: no_reply")
+        assert exchange(sock, STATUS_TASK, 8) == with_crc(bytes.fromhex("010103000000"))  # the third: answered
+
+
 @pytest.mark.parametrize("args, message, code", [
     ((), "give exactly one of --serial PORT or --tcp HOST:PORT", 2),
     (("--tcp", "0", "--serial", "/dev/ttyUSB0"), "give exactly one of", 2),
     (("--tcp", "here"), "expected HOST:PORT or PORT", 2),
+    # was read as host ':' port 1, and failed (status 1) with "Name or service not known"
+    (("--tcp", "::1"), "--tcp: an IPv6 address goes in brackets, e.g. [::1]:4001, got '::1'", 2),
+    (("--tcp", "fe80::1:4001"), "an IPv6 address goes in brackets", 2),
     (("--tcp", "0", "--late-reply-on", "3"), "expected N:MS", 2),
     (("--tcp", "0", "--no-reply-on", "0"), "request numbers start at 1", 2),
+    # N:VALUE where only N is taken: the :VALUE was silently dropped
+    (("--tcp", "0", "--wrong-address-on", "3:7"),
+     "--wrong-address-on: expected a request number N, got '3:7'; its other settings go in a fault file "
+     '([[faults]] kind = "wrong_address", on_request = 3, ...)', 2),
+    (("--tcp", "0", "--garbage-on", "2:FF"), "--garbage-on: expected a request number N, got '2:FF'", 2),
+    (("--tcp", "0", "--no-reply-on", "2:"), "--no-reply-on: expected a request number N, got '2:'", 2),
     (("--tcp", "0", "--address", "300"), "'--address': 300 is not in the range 1<=x<=247", 2),
     (("--tcp", "0", "--anti-collision-at", "-1"), "--anti-collision-at: must be at least 0.0", 2),
     (("--tcp", "0", "--turnaround-ms", "-3"), "--turnaround-ms: must be at least 0.0", 2),
@@ -409,6 +488,9 @@ def test_fault_file_is_applied(tmp_path, start_emulator):
     (("--tcp", "0", "--exit-after", "0"), "--exit-after': must be a number of seconds greater than 0", 2),
     (("--tcp", "0", "--exit-after", "inf"), "--exit-after': 'inf' is not a finite number", 2),
     (("--tcp", "0", "--frame-gap-ms", "nan"), "--frame-gap-ms': 'nan' is not a finite number", 2),
+    # rounded to 0 µs: the first TCP client crashed the command with a traceback
+    (("--tcp", "0", "--frame-gap-ms", "0.0001"), "--frame-gap-ms: must be at least 0.001 (1 µs), got 0.0001", 2),
+    (("--tcp", "0", "--frame-gap-ms", "0"), "--frame-gap-ms: must be at least 0.001", 2),
     (("--tcp", "0", "--turnaround-ms", "1e300"), "--turnaround-ms': '1e300' is out of range", 2),
     (("--serial", "socket://127.0.0.1"), "socket://127.0.0.1 needs a host and a port: socket://HOST:PORT", 2),
     (("--serial", "socket://127.0.0.1:http"), "the port 'http' is not a number from 1 to 65535", 2),

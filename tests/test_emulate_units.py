@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 from hypothesis import given, settings as hsettings, strategies as st
 
-from verifier.amr import Robot
+from verifier.amr import Robot, RobotConfig
 from verifier.emulate import (
     Dropped,
     Emulator,
@@ -15,7 +15,7 @@ from verifier.emulate import (
     load_fault_file,
 )
 from verifier.emulate.ports import serial_assembler
-from verifier.protocol import STOP_FRAME, Query, StatusRequest, encode, with_crc
+from verifier.protocol import STOP_FRAME, T3_5_US, Query, StatusRequest, encode, with_crc
 
 STATUS = encode(StatusRequest(1, Query.TASK))
 
@@ -182,6 +182,19 @@ def test_core_schedules_the_reply_after_the_turnaround_and_logs_both_ways():
     assert lines[1].startswith("     2.000 s  ** command: stop")
     assert lines[2] == "     2.005 s  -> 01 06 01 A0 00 00 88 14  echo: stop (01/A0)"
     assert "1 frames in, 1 replies out" in emulator.summary()
+
+
+@pytest.mark.parametrize("turnaround_ms, t3_5_us, delay_us", [
+    (0, T3_5_US, T3_5_US),  # 9600 bit/s: was sent 0 µs after the request
+    (2, T3_5_US, T3_5_US),
+    (5, 29_167, 29_167),  # 1200 bit/s: was 5 ms, inside the request's own t3.5
+    (40, 29_167, 40_000),  # a longer turnaround stands
+])
+def test_core_never_schedules_a_reply_before_t3_5_has_ended_the_request(turnaround_ms, t3_5_us, delay_us):
+    emulator = Emulator(Robot(config=RobotConfig(turnaround_ms=turnaround_ms)), [].append, FakeClock(),
+                        t3_5_us=t3_5_us)
+    reply = emulator.handle(ReceivedFrame(STOP_FRAME, 0, 1_000_000, "length"))
+    assert reply.due_us == 1_000_000 + delay_us
 
 
 def test_core_describes_a_status_reply_with_its_query():

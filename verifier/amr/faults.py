@@ -152,10 +152,14 @@ class Fault:
     def describe(self) -> str:
         when = f"at {self.at_s:g} s" if self.at_s is not None else f"on request {self.on_request}"
         extent = ""
-        if self.duration_s is not None:
+        if self.duration_s is not None and self.count is not None:  # both limit it
+            extent = f" ×{self.count} within {self.duration_s:g} s"
+        elif self.duration_s is not None:
             extent = f" for {self.duration_s:g} s"
         elif self.count is not None:
             extent = f" ×{self.count}"
+        if self.requests != "any":
+            extent += f", {self.requests} requests only"
         detail = {
             "late_reply": f" (+{self.delay_ms:g} ms)",
             "exception": f" (code {self.code:02X})",

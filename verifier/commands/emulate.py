@@ -15,7 +15,7 @@ from verifier.amr.schema import LARGEST
 from verifier.emulate.assembler import DEFAULT_SILENCE_US
 from verifier.emulate.core import Emulator
 from verifier.emulate.faultfile import FaultFileError, load_fault_file
-from verifier.emulate.ports import PortError, serial_url_problem, serve_serial, serve_tcp
+from verifier.emulate.ports import PortError, serial_url_problem, serve_serial, serve_tcp, t3_5_at
 from verifier.commands.protocol_options import protocol_settings
 
 
@@ -23,6 +23,9 @@ def _tcp_endpoint(value: str) -> tuple[str, int]:
     host, sep, port = value.rpartition(":")
     if not sep:
         host, port = "127.0.0.1", value
+    if ":" in host and not (host.startswith("[") and host.endswith("]")):
+        raise click.BadParameter(f"an IPv6 address goes in brackets, e.g. [::1]:4001, got {value!r}",
+                                 param_hint="--tcp")
     host = host.strip("[]") or "127.0.0.1"
     try:
         number = int(port)
@@ -77,6 +80,7 @@ class _FiniteFloat(click.ParamType):
 
 
 FINITE = _FiniteFloat()
+MIN_FRAME_GAP_MS = 0.001
 
 
 def _exit_after(ctx: click.Context, param: click.Parameter, value: float | None) -> float | None:
@@ -97,6 +101,16 @@ def _request_number(value: str, option: str) -> tuple[int, str]:
     return n, rest
 
 
+def _only_request_number(value: str, option: str, kind: str) -> int:
+    """N alone: these options take no :VALUE (3:7 would silently lose the 7)."""
+    n, rest = _request_number(value, option)
+    if rest or ":" in value:
+        raise click.BadParameter(
+            f"expected a request number N, got {value!r}; its other settings go in a fault "
+            f"file ([[faults]] kind = \"{kind}\", on_request = {n}, ...)", param_hint=option)
+    return n
+
+
 def _fault(option: str, table: dict) -> Fault:
     try:
         return Fault.from_dict(table, option)
@@ -110,7 +124,8 @@ def _flag_faults(no_reply, bad_crc, garbage, wrong_address, exception, late,
     for option, kind, values in (("--no-reply-on", "no_reply", no_reply), ("--bad-crc-on", "bad_crc", bad_crc),
                                  ("--garbage-on", "garbage", garbage),
                                  ("--wrong-address-on", "wrong_address", wrong_address)):
-        faults += [_fault(option, {"kind": kind, "on_request": _request_number(v, option)[0]}) for v in values]
+        faults += [_fault(option, {"kind": kind, "on_request": _only_request_number(v, option, kind)})
+                   for v in values]
     for value in exception:
         n, code = _request_number(value, "--exception-on")
         try:
@@ -202,8 +217,9 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
     config = RobotConfig.from_dict(robot_table)
     faults += _flag_faults(no_reply_on, bad_crc_on, garbage_on, wrong_address_on, exception_on,
                            late_reply_on, anti_collision_at, off_tape_at, low_battery_at)
-    if frame_gap_ms <= 0:
-        raise click.BadParameter("must be greater than 0", param_hint="--frame-gap-ms")
+    if frame_gap_ms < MIN_FRAME_GAP_MS:  # the assemblers count whole µs: less rounds to none
+        raise click.BadParameter(f"must be at least {MIN_FRAME_GAP_MS:g} (1 µs), got {frame_gap_ms:g}; "
+                                 f"the default is {DEFAULT_SILENCE_US / 1000:g}", param_hint="--frame-gap-ms")
     endpoint = _tcp_endpoint(tcp) if tcp is not None else None
 
     def log_anyway(line: str) -> None:
@@ -214,7 +230,8 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
         if not quiet:
             log_anyway(line)
 
-    emulator = Emulator(Robot(settings, config, faults), log)
+    # no reply before t3.5 at the line's speed (TCP: the robot's 9600 line behind the converter)
+    emulator = Emulator(Robot(settings, config, faults), log, t3_5_us=t3_5_at(baud))
     for fault in faults:
         emulator.note(f"scripted fault: {fault.describe()}")
     stop = threading.Event()

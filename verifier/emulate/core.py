@@ -15,6 +15,7 @@ from verifier.emulate.assembler import Dropped, ReceivedFrame
 from verifier.protocol.codec import decode_reply, decode_request, hex_bytes
 from verifier.protocol.describe import describe
 from verifier.protocol.frames import FrameError, Request
+from verifier.protocol.timing import T3_5_US
 
 
 @dataclass(frozen=True)
@@ -27,11 +28,18 @@ class Outgoing:
 
 
 class Emulator:
-    """Hands received frames to the robot and logs every frame and robot event."""
+    """Hands received frames to the robot and logs every frame and robot event.
+
+    ``t3_5_us`` is the line's frame gap (3.5 characters at its speed): no reply starts
+    sooner after its request, whatever the turnaround, because a slave cannot know the
+    request has ended before that silence (Modbus over Serial Line V1.02 §2.5.1.1) - the
+    same floor the verifier's line (``verifier.link.line``) puts under the turnaround.
+    """
 
     def __init__(self, robot: Robot, log: Callable[[str], None],
-                 clock_ns: Callable[[], int] = time.monotonic_ns) -> None:
+                 clock_ns: Callable[[], int] = time.monotonic_ns, t3_5_us: int = T3_5_US) -> None:
         self.robot = robot
+        self.t3_5_us = t3_5_us
         self._log = log
         self._clock_ns = clock_ns
         self._t0_ns = clock_ns()
@@ -64,7 +72,7 @@ class Emulator:
             request = decode_request(item.data, settings)
         except FrameError:
             request = None
-        return Outgoing(t + reply.delay_us, reply.data, request)
+        return Outgoing(t + max(reply.delay_us, self.t3_5_us), reply.data, request)
 
     def sent(self, reply: Outgoing, t_us: int, peer: str = "") -> None:
         self.stats["replies out"] += 1
@@ -75,6 +83,10 @@ class Emulator:
         except FrameError as err:
             meaning = f"invalid reply: {err}"
         self.line(t_us, "->", f"{hex_bytes(reply.data)}  {meaning}{where}")
+
+    def not_sent(self, count: int) -> None:
+        """``count`` replies were due to a peer that went away, or when the emulator stopped."""
+        self.stats["not sent"] += count
 
     def tick(self) -> None:
         """Let robot time pass (tasks finish, timed faults fire) and log what happened."""
@@ -98,9 +110,13 @@ class Emulator:
         self._events_seen = len(events)
 
     def summary(self) -> str:
+        """One line; frames in = replies out + unanswered + replies not sent (that part only
+        when some were not: a client gone, or the stop, before they fell due)."""
         s = self.stats
+        unsent = s["not sent"]
+        not_sent = f", {unsent} repl{'ies' if unsent != 1 else 'y'} not sent" if unsent else ""
         return (f"uitamr emulate: stopped after {self.now_us() / 1e6:.1f} s: "
                 f"{s['frames in']} frames in, {s['replies out']} replies out, "
-                f"{s['no reply']} unanswered, {s['faults']} fault events, "
+                f"{s['no reply']} unanswered{not_sent}, {s['faults']} fault events, "
                 f"{s['dropped bytes']} flood bytes dropped; robot {self.robot.mode}, "
                 f"error {int(self.robot.error):02d}")

@@ -14,6 +14,7 @@ and plain sockets, and pymodbus serves as an independent client in the tests.
 """
 from __future__ import annotations
 
+import errno
 import selectors
 import socket
 import threading
@@ -69,8 +70,10 @@ class _Channel:
                 self.outgoing.append(reply)
         self.outgoing.sort(key=lambda o: o.due_us)
 
-    def close(self) -> str:
-        """Forget what is still in flight; the words for the log, '' when nothing was."""
+    def close(self, emulator: Emulator) -> str:
+        """Forget what is still in flight (counting replies not sent); the words for the
+        log, '' when nothing was."""
+        emulator.not_sent(len(self.outgoing))
         unread = self.unread_at_end + self.assembler.discard()
         lost = []
         if unread:
@@ -88,11 +91,16 @@ class _Channel:
         return ready
 
 
+def t3_5_at(baudrate: int) -> int:
+    """t3.5, the silence that ends a frame, on a line at ``baudrate`` (µs)."""
+    return LineConfig(baud=baudrate).frame_gap_us
+
+
 def serial_assembler(baudrate: int, silence_us: int) -> RequestAssembler:
     """The assembler for a serial port at ``baudrate``. Modbus ends a frame after 3.5
     character times: 3.65 ms at 9600 bit/s, but 117 ms at 300 bit/s, where one byte alone
     takes longer than the default wall-clock gap - so the gap is never shorter than t3.5."""
-    t3_5_us = LineConfig(baud=baudrate).frame_gap_us
+    t3_5_us = t3_5_at(baudrate)
     return RequestAssembler(max(silence_us, t3_5_us), t3_5_us=t3_5_us)
 
 
@@ -100,10 +108,15 @@ def serve_serial(url: str, emulator: Emulator, stop: threading.Event, silence_us
                  baudrate: int = 9600) -> None:
     """Run until ``stop`` is set: read requests from ``url``, write replies when due."""
     try:
+        # exclusive: a second emulator (or another locking program) on the same port would
+        # take every other request, and each would answer what it read
         port = serial.serial_for_url(url, baudrate=baudrate, bytesize=serial.EIGHTBITS,
                                      parity=serial.PARITY_NONE, stopbits=serial.STOPBITS_ONE,
-                                     timeout=POLL_S)
+                                     timeout=POLL_S, exclusive=True)
     except (serial.SerialException, ValueError, OSError) as err:
+        if getattr(err, "errno", None) in (errno.EAGAIN, errno.EWOULDBLOCK):
+            raise PortError(f"cannot open serial port {url}: another program has it locked (another "
+                            "uitamr emulate?); stop that one first") from None
         raise PortError(f"cannot open serial port {url}: {err}") from None
     channel = _Channel(serial_assembler(baudrate, silence_us))
     gap_us = channel.assembler.silence_us
@@ -130,6 +143,8 @@ def serve_serial(url: str, emulator: Emulator, stop: threading.Event, silence_us
                 emulator.sent(reply, emulator.now_us())
     finally:
         port.close()
+        if left_behind := channel.close(emulator):
+            emulator.note(f"serial {url} closed{left_behind}")
 
 
 def serve_tcp(host: str, port: int, emulator: Emulator, stop: threading.Event, silence_us: int,
@@ -156,7 +171,7 @@ def serve_tcp(host: str, port: int, emulator: Emulator, stop: threading.Event, s
         if not channel.ended:  # an ended one is no longer watched for reading
             selector.unregister(sock)
         sock.close()
-        emulator.note(f"client {channel.peer} {why}{channel.close()}")
+        emulator.note(f"client {channel.peer} {why}{channel.close(emulator)}")
 
     try:
         while not stop.is_set():
@@ -207,7 +222,7 @@ def serve_tcp(host: str, port: int, emulator: Emulator, stop: threading.Event, s
                     drop(sock, "disconnected")
     finally:
         for sock in list(clients):
-            sock.close()
+            drop(sock, "closed: the emulator stops")
         selector.close()
         server.close()
 
