@@ -228,6 +228,54 @@ def test_html_report_renders_in_chromium_with_a_timing_diagram_and_violation_mar
     assert [a.get("href") for a in index.iter("a")] == ["#s0", "#s1"]
 
 
+def long_result() -> ScenarioResult:
+    """Over 4,000 frames (about 10 minutes of status polls), one request too early at 615 s."""
+    trace = _frames(0, STOP, protocol.ControlReply.echo(STOP))
+    for i in range(1, 2101):
+        t = 300_000 * i - (100_000 if i == 2050 else 0)
+        trace += _frames(t, READ, protocol.StatusReply(1, 0, 0))
+    return _result("long", trace, 631_000_000)
+
+
+def test_html_of_a_long_run_draws_what_a_page_can_hold_and_says_so(tmp_path):
+    """A soak test's page opens at once: the diagram and the table hold the frames around
+    each violation and the run's first ones, the overview strip marks the whole run, and
+    the page says what it left out and where every frame is."""
+    result = long_result()
+    assert len(result.trace) == 4202
+    page = tmp_path / "report.html"
+    report_html.write([result], page)
+    html = page.read_text()
+    assert "the diagram and the frame table show 4000 of its 4202 frames" in html
+    assert "4000 of the 4202 frames" in html and "--trace lists them" in html
+    with tempfile.TemporaryDirectory() as profile:
+        dom = subprocess.run(
+            [_chromium(), *_chromium_flags(profile), "--dump-dom", page.as_uri()],
+            capture_output=True, text=True, timeout=120,
+        ).stdout
+    root = _parse_dom(dom)
+    frames = [r for r in root.iter("rect") if "frame" in (r.get("class") or "").split()]
+    assert len(frames) == report_html.FRAMES_AT_MOST
+    blamed = [float(r.get("data-t0")) for r in frames if "blamed" in r.get("class")]
+    assert blamed == [614_700.0, 614_900.0]  # the request before and the early one
+    assert max(float(r.get("data-t0")) for r in frames) == 615_600.0  # 4 frames after it
+    rows = [tr for tr in root.iter("tr") if "left-out" in (tr.get("class") or "")]
+    left_out = [int(re.search(r"… (\d+) frame", "".join(tr.itertext())).group(1)) for tr in rows]
+    assert sum(left_out) == 202 and len(rows) == 2  # between the first frames and the violation, and after
+    overview = [line for line in root.iter("line") if (line.get("class") or "").startswith("ov")]
+    assert 1000 < len(overview) < 4202 and max(float(line.get("x1")) for line in overview) > 990
+    assert root.find(".//*[@id='verdict']").text == "FAIL"
+
+
+def test_html_lists_at_most_so_many_violations_and_points_to_the_json(tmp_path, monkeypatch):
+    monkeypatch.setattr(report_html, "VIOLATIONS_AT_MOST", 3)
+    page = tmp_path / "report.html"
+    report_html.write([bad_result()], page)
+    html = page.read_text()
+    assert "Violations (10)" in html and "The first 3 are marked and listed" in html
+    assert html.count('class="violation-row"') == 3 and html.count('<g class="violation"') == 3
+
+
 def test_html_diagram_zooms_in_the_browser(tmp_path):
     page = tmp_path / "report.html"
     report_html.write([bad_result()], page)

@@ -15,12 +15,19 @@ import jinja2
 from verifier import __version__
 
 from .durations import format_seconds
-from .report_trace import records
+from .report_trace import blamed_frames, in_line_order, records
 from .result import ScenarioResult, overall_verdict
 from .rules import RULES
 
 DEFAULT_PX_PER_MS = 0.5
 MINOR_TICKS_UP_TO_MS = 120_000
+#: a page a browser opens at once, however long the run (an hour of fx3u-healthy is 23,000
+#: frames): the diagram and the frame table draw at most this many frames - those around
+#: each violation's frames, then the run's first ones; `--trace` has every frame
+FRAMES_AT_MOST = 4000
+CONTEXT_FRAMES = 4  # frames drawn on each side of a frame that is evidence of a violation
+VIOLATIONS_AT_MOST = 1000  # violations marked and listed (every one is in --json)
+EVENTS_AT_MOST = 2000  # line and robot events drawn (the scenario's faults first)
 
 
 def _environment() -> jinja2.Environment:
@@ -36,6 +43,11 @@ def _ms(t_us: int) -> float:
     return round(t_us / 1000, 3)
 
 
+def _seconds(t_us: int) -> float:
+    """A frame's time as its trace line has it (`t`, `t_end`): the page computes from that."""
+    return t_us / 1_000_000
+
+
 def _event_class(kind: str) -> str:
     """Faults the scenario injected, trouble on the line, or the robot's ordinary doings."""
     if kind == "robot.fault":
@@ -49,31 +61,82 @@ def _event_class(kind: str) -> str:
 MAJOR_TICKS_AT_MOST = 5000
 
 
+def shown_frames(line: list, blamed: dict) -> list[int]:
+    """The positions (in trace order) of the frames the page draws: all of them, or for a
+    longer run FRAMES_AT_MOST: those within CONTEXT_FRAMES of a blamed frame, in time order,
+    then the first frames of the run."""
+    if len(line) <= FRAMES_AT_MOST:
+        return list(range(len(line)))
+    shown: set[int] = set()
+    for k, frame in enumerate(line):
+        if (frame.t_start_us, frame.direction) in blamed:
+            shown.update(range(max(0, k - CONTEXT_FRAMES), min(len(line), k + CONTEXT_FRAMES + 1)))
+            if len(shown) >= FRAMES_AT_MOST:
+                break
+    k = 0
+    while len(shown) < FRAMES_AT_MOST:
+        shown.add(k)
+        k += 1
+    return sorted(shown)[:FRAMES_AT_MOST]
+
+
+def _overview(line: list, end_ms: float, long: bool) -> list[dict]:
+    """The overview strip's marks (x in 0..1000): one per position and direction; for a long
+    run the positions are half units (a strip is about 1000 px wide), so the page draws at
+    most 4002 marks, not a mark per frame."""
+    def x(frame) -> float:
+        at = round(round(_seconds(frame.t_start_us) * 1000, 3) / end_ms * 1000, 2)
+        return round(at * 2) / 2 if long else at
+
+    marks = {(x(frame), frame.direction) for frame in line}
+    return [{"x": x, "dir": direction} for x, direction in sorted(marks, key=lambda m: (m[0], m[1] != "tx"))]
+
+
+def _skipped_before(shown: list[int]) -> list[int]:
+    """For each shown frame, how many frames the table leaves out just before it."""
+    gaps, previous = [], -1
+    for k in shown:
+        gaps.append(k - previous - 1)
+        previous = k
+    return gaps
+
+
 def scenario_view(index: int, result: ScenarioResult) -> dict:
-    frames = list(records(result))
+    line = in_line_order(result)
+    shown = shown_frames(line, blamed_frames(result))
+    frames = list(records(result, only=shown))
     end_ms = max(
-        [_ms(result.ended_us)] + [f["t_end"] * 1000 for f in frames]
+        [_ms(result.ended_us)] + [_seconds(frame.t_end_us) * 1000 for frame in line]
     ) or 1.0
-    requests = [f for f in frames if f["dir"] == "tx"]
+    requests = [k for k, frame in enumerate(line) if frame.direction == "tx"]
+    drawn = set(shown)
     windows = []
     period_ms = result.min_period_us / 1000
-    for position, request in enumerate(requests):
-        t0 = request["t"] * 1000
-        following = requests[position + 1]["t"] * 1000 if position + 1 < len(requests) else None
+    for position, k in enumerate(requests):
+        if k not in drawn:
+            continue
+        t0 = _seconds(line[k].t_start_us) * 1000
+        following = _seconds(line[requests[position + 1]].t_start_us) * 1000 if position + 1 < len(requests) else None
         windows.append({
             "t0": round(t0, 3),
             "t1": round(t0 + period_ms, 3),
             "broken": following is not None and following - t0 <= period_ms,
         })
-    for frame in frames:
+    for frame, skipped in zip(frames, _skipped_before(shown)):
         frame["t0"] = round(frame["t"] * 1000, 3)
         frame["t1"] = round(frame["t_end"] * 1000, 3)
         frame["time"] = f"{frame['t']:.6f} s"
+        frame["skipped"] = skipped
+    violations = result.all_violations()
     markers = [
         {"t": _ms(v.t_us), "rule": v.rule, "message": v.message, "time": format_seconds(v.t_us),
          "origin": v.origin, "frames": v.frames}
-        for v in result.all_violations()
+        for v in violations[:VIOLATIONS_AT_MOST]
     ]
+    events = result.events
+    if len(events) > EVENTS_AT_MOST:  # the faults first, then the others, in the run's order
+        kept = {id(e) for e in sorted(events, key=lambda e: _event_class(e.kind) != "fault")[:EVENTS_AT_MOST]}
+        events = [e for e in events if id(e) in kept]
     major_ms = 1000 if end_ms <= 300_000 else 10_000
     while end_ms / major_ms > MAJOR_TICKS_AT_MOST:  # a capture spanning days or years
         major_ms *= 10
@@ -85,13 +148,18 @@ def scenario_view(index: int, result: ScenarioResult) -> dict:
         "id": f"s{index}",
         "result": result,
         "frames": frames,
+        "overview": _overview(line, end_ms, long=len(line) > FRAMES_AT_MOST),
+        "frames_left_out": len(line) - len(frames),
+        "frames_after_last": len(line) - 1 - shown[-1] if shown else 0,
         "windows": windows,
         "markers": markers,
+        "violations": len(violations),
         "events": [
             {"t": _ms(e.t_us), "message": e.message, "kind": e.kind, "class": _event_class(e.kind),
              "time": format_seconds(e.t_us)}
-            for e in result.events
+            for e in events
         ],
+        "events_left_out": len(result.events) - len(events),
         "ticks": ticks,
         "minor_ticks": minor,
         "end_ms": round(end_ms, 3),
@@ -102,7 +170,7 @@ def scenario_view(index: int, result: ScenarioResult) -> dict:
             for rule in RULES
         ],
         "tx": len(requests),
-        "rx": len(frames) - len(requests),
+        "rx": len(line) - len(requests),
         "ended": format_seconds(result.ended_us),
     }
 

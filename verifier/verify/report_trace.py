@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Iterator
+from typing import Iterable, Iterator
 
 from verifier import protocol
 
@@ -39,7 +39,8 @@ def _frame_fields(name: str, frame, settings: protocol.Settings, request) -> dic
     }
 
 
-def _blamed(result: ScenarioResult) -> dict[tuple[int, str], set[str]]:
+def blamed_frames(result: ScenarioResult) -> dict[tuple[int, str], set[str]]:
+    """(start µs, direction) of each frame that is evidence of a violation -> those rules."""
     blamed: dict[tuple[int, str], set[str]] = {}
     for violation in result.all_violations():
         for frame in violation.frames:
@@ -47,12 +48,20 @@ def _blamed(result: ScenarioResult) -> dict[tuple[int, str], set[str]]:
     return blamed
 
 
-def records(result: ScenarioResult, name: str | None = None) -> Iterator[dict]:
+def in_line_order(result: ScenarioResult) -> list:
+    """The frames of a run that kept them, in trace order."""
+    return sorted(result.trace, key=_line_order)
+
+
+def records(result: ScenarioResult, name: str | None = None, only: Iterable[int] | None = None) -> Iterator[dict]:
     """The trace lines of a run that kept its frames; `name` (default: the run's) goes in
-    each line's `scenario`."""
-    blamed = _blamed(result)
+    each line's `scenario`; `only`: the positions (in trace order) of the frames wanted."""
+    blamed = blamed_frames(result)
     traffic = analyse(result.trace, result.settings, RuleOptions(reply_timeout_us=result.reply_timeout_us))
-    for frame in sorted(result.trace, key=_line_order):
+    frames = in_line_order(result)
+    if only is not None:
+        frames = [frames[k] for k in only]
+    for frame in frames:
         request = traffic.request_of(frame) if frame.direction == "rx" else None
         record = _frame_fields(name or result.name, frame, result.settings, request)
         record["rules"] = sorted(blamed.get((frame.t_start_us, frame.direction), ()))
@@ -72,7 +81,7 @@ def spool_lines(name: str, frames, settings: protocol.Settings, request_of) -> I
 def _spooled(result: ScenarioResult, name: str) -> Iterator[str]:
     """The run's spool lines completed; `name` in place of the run's own (`scenario` is the
     first field, written as `_frame_fields` writes it)."""
-    blamed = _blamed(result)
+    blamed = blamed_frames(result)
     spooled_name = _scenario_field(result.name)
     renamed = _scenario_field(name)
     with open(result.trace_file, encoding="utf-8") as spool:
