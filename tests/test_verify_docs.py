@@ -49,3 +49,18 @@ def test_sent_by_is_the_statement_that_starts_the_transmission():
     """FX3U: the origin is the `M8402 := TRUE` statement (the send request), not the RS2 call."""
     assert "`M8402 := TRUE`" in VERIFIER_MD
     assert "the RS2 / G_OUTPUT /\nADPRW call" not in VERIFIER_MD
+
+
+def test_the_checked_tree_api_of_st_dialect_section_10_is_reachable_as_written():
+    """st-dialect.md §10 names the import that works: `verifier.st.check` on the package is
+    the function check(), so `verifier.st.check.check_project` is no path to it."""
+    text = (DOCS / "st-dialect.md").read_text(encoding="utf-8")
+    section = text.split("## 10. ", 1)[1]
+    statement = re.search(r"`(from verifier\.st\.check import check_project)`", section).group(1)
+    names: dict = {}
+    exec(statement, names)
+    from verifier import st
+    source = st.parse("FUNCTION F : INT\nVAR_INPUT a : INT; END_VAR\nF := a + 1;\nEND_FUNCTION\n", "f.st")
+    diagnostics, table = names["check_project"]([source], "gxworks2")
+    assert diagnostics == [] and "A" in table.pous["F"].labels
+    assert "verifier.st.check.check_project" not in text
