@@ -64,3 +64,68 @@ def test_the_checked_tree_api_of_st_dialect_section_10_is_reachable_as_written()
     diagnostics, table = names["check_project"]([source], "gxworks2")
     assert diagnostics == [] and "A" in table.pous["F"].labels
     assert "verifier.st.check.check_project" not in text
+
+
+def _error_blocks() -> list[list[str]]:
+    section = SCENARIOS_MD.split("## Errors in a scenario file", 1)[1]
+    return [[line for line in block.splitlines() if line.strip()] for block in section.split("```")[1::2]]
+
+
+EXAMPLE_SOURCES = ('sources = ["{plc}/core/*.st", "{plc}/fx3/*.st", "{plc}/examples/common/*.st", '
+                   '"{plc}/examples/fx3/UITAMR_ExampleFx3.st"]\n')
+
+
+def test_the_documented_scenario_file_errors_are_what_verify_prints(tmp_path, monkeypatch):
+    """scenarios.md, "Errors in a scenario file": the three file errors, position and all,
+    come out of `uitamr verify` as printed there, with exit status 2."""
+    from click.testing import CliRunner
+
+    from verifier.cli import main
+
+    plc = (DOCS.parent / "plc").as_posix()
+    files = {
+        "x.toml": EXAMPLE_SOURCES.format(plc=plc) + '[[expect]]\nsent = "stop"\nwithin = "5"\n',
+        "y.toml": EXAMPLE_SOURCES.format(plc=plc) + '[[faults]]\nkind = "no-replies"\nat_s = 1.0\n',
+        "z.toml": 'name = "z"\nsources x\n',
+    }
+    monkeypatch.chdir(tmp_path)
+    for name, text in files.items():
+        (tmp_path / name).write_text(text, encoding="utf-8")
+    documented = _error_blocks()[0]
+    assert len(documented) == len(files)
+    for line, name in zip(documented, files):
+        result = CliRunner().invoke(main, ["verify", "--scenario", name])
+        assert result.exit_code == 2, result.output
+        assert result.output.strip() == line
+
+
+def test_the_documented_label_errors_are_what_verify_prints(tmp_path):
+    """The label errors of scenarios.md name what `uitamr verify` names (file positions
+    differ with the file; the messages after them must not)."""
+    from verifier.verify.runner import run_scenario
+    from verifier.verify.result import UnusableInput
+    from verifier.verify.scenario import parse_scenario
+
+    plc = DOCS.parent / "plc"
+    program = tmp_path / "MAIN.st"
+    program.write_text("PROGRAM MAIN\nVAR\n    fbEngine : UITAMR_Engine;\n    wBuf : ARRAY[0..39] OF WORD;\n"
+                       "END_VAR\nwBuf[0] := 16#1;\nEND_PROGRAM\n", encoding="utf-8")
+    head = f'sources = ["{program.as_posix()}", "{(plc / "core").as_posix()}"]\nprogram = "MAIN"\nduration = "1s"\n'
+    bodies = [
+        '[[expect]]\nthat = "fbEngine.o_bNope"\n',
+        'watch = ["fbEngine.o_wTxCount", "wBuf[40]"]\n',
+        '[[inputs]]\nat = "0s"\nset = { X0 = 5 }\n',
+        '[[inputs]]\nat = "0s"\nset = { X0 = true }\n[[inputs]]\nat = "0s"\nset = { D100 = 99999 }\n',
+        '[[expect]]\nthat = "TRUE"\n[[expect]]\nthat = "TRUE"\n[[expect]]\nthat = "fbEngine.o_wTask"\n',
+    ]
+    documented = _error_blocks()[1]
+    assert len(documented) == len(bodies)
+    for line, body in zip(documented, bodies):
+        expected = re.sub(r"^error: s\.toml:\d+:\d+: ", "", line)
+        scenario = parse_scenario(head + body, tmp_path / "s.toml")
+        try:
+            run_scenario(scenario)
+        except UnusableInput as err:
+            assert str(err).endswith(expected), (str(err), expected)
+        else:
+            raise AssertionError(f"no error for {body!r}")
