@@ -129,3 +129,35 @@ def test_the_documented_label_errors_are_what_verify_prints(tmp_path):
             assert str(err).endswith(expected), (str(err), expected)
         else:
             raise AssertionError(f"no error for {body!r}")
+
+
+def _example_as_main(tmp_path, folder: str, example: str, port_folder: str) -> Path:
+    plc = DOCS.parent / "plc"
+    sources = tmp_path / example
+    sources.mkdir()
+    for path in [*(plc / "core").glob("*.st"), *(plc / port_folder).glob("*.st"),
+                 *(plc / "examples" / "common").glob("*.st")]:
+        (sources / path.name).write_text(path.read_text(encoding="utf-8"), encoding="utf-8")
+    text = (plc / "examples" / folder / f"{example}.st").read_text(encoding="utf-8")
+    (sources / "MAIN.st").write_text(text.replace(example, "MAIN"), encoding="utf-8")
+    return sources
+
+
+def test_matrix_picks_the_bundled_scenarios_of_the_programs_route_as_verifier_md_says(tmp_path):
+    """verifier.md: --matrix with SOURCES runs the scenarios of the program's platform *and
+    route*: a serial FX5U program never meets a [converter] scenario, a TCP one only those."""
+    from click.testing import CliRunner
+
+    from verifier.cli import main
+
+    assert "**and of its route**" in VERIFIER_MD
+    bundled = DOCS.parent / "plc" / "scenarios"
+    tcp_names = {p.stem for p in bundled.glob("fx5u-tcp-*.toml")}
+    serial_names = {p.stem for p in bundled.glob("fx5u-*.toml")} - tcp_names
+    for example, expected in (("UITAMR_ExampleFx5", serial_names), ("UITAMR_ExampleTcpFx5", tcp_names)):
+        sources = _example_as_main(tmp_path, "fx5", example, "fx5")
+        result = CliRunner().invoke(main, ["verify", str(sources), "--program", "MAIN", "--matrix",
+                                           "--duration", "6s"])
+        ran = set(re.findall(r"plc/scenarios/(fx5u-[\w-]+)\.toml\)", result.output))
+        stands_for = len(re.findall(r"also stands for", result.output))
+        assert ran and ran <= expected and len(ran) + stands_for == len(expected), (example, result.output)
