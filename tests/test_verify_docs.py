@@ -151,6 +151,8 @@ def test_matrix_picks_the_bundled_scenarios_of_the_programs_route_as_verifier_md
     from verifier.cli import main
 
     assert "**and of its route**" in VERIFIER_MD
+    helps = " ".join(CliRunner().invoke(main, ["verify", "--help"]).output.split())
+    assert "those of the program's platform and route" in helps
     bundled = DOCS.parent / "plc" / "scenarios"
     tcp_names = {p.stem for p in bundled.glob("fx5u-tcp-*.toml")}
     serial_names = {p.stem for p in bundled.glob("fx5u-*.toml")} - tcp_names
