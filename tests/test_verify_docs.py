@@ -163,3 +163,17 @@ def test_matrix_picks_the_bundled_scenarios_of_the_programs_route_as_verifier_md
         ran = set(re.findall(r"plc/scenarios/(fx5u-[\w-]+)\.toml\)", result.output))
         stands_for = len(re.findall(r"also stands for", result.output))
         assert ran and ran <= expected and len(ran) + stands_for == len(expected), (example, result.output)
+
+
+def test_the_missing_function_input_messages_of_st_dialect_are_the_checkers():
+    """st-dialect.md §8 quotes what `Add3(1, 2)` and `Add3(a := 1, b := 2)` get."""
+    from verifier import st
+
+    text = " ".join((DOCS / "st-dialect.md").read_text(encoding="utf-8").split())
+    source = st.parse("FUNCTION Add3 : INT\nVAR_INPUT a : INT; b : INT; c : INT; END_VAR\nAdd3 := a + b + c;\n"
+                      "END_FUNCTION\nPROGRAM P\nVAR\n    iX : INT;\nEND_VAR\niX := Add3(1, 2);\n"
+                      "iX := Add3(a := 1, b := 2);\nEND_PROGRAM\n", "a.st")
+    messages = [d.message for d in st.check([source]) if d.severity == "error"]
+    assert len(messages) == 2
+    for message in messages:
+        assert f"`{message.replace('...', '')}" in text.replace("...", ""), message
