@@ -269,6 +269,19 @@ def test_gxworks3_carries_initial_values_in_every_table(tmp_path):
     assert (out / "IMPORT_ORDER.txt").read_text().splitlines()[0] == "S_Pos\tSTRUCT"
 
 
+def test_the_help_names_every_kind_of_file_the_export_writes(tmp_path):
+    """--out's help named the label tables and IMPORT_ORDER.txt but not <Type>.struct.tsv,
+    which import-gxworks2.md and import-gxworks3.md describe and the export writes."""
+    out = tmp_path / "out"
+    run("--target", "gxworks3", "--out", str(out), *map(str, _sources(tmp_path)))
+    helps = " ".join(run("--help").output.split())
+    for written in sorted(out.iterdir()):
+        kind = re.sub(r"^(?!GlobalLabels|IMPORT_ORDER)[A-Za-z_]+\.(st|labels\.tsv|struct\.tsv)$",
+                      lambda m: "<Type>." + m.group(1) if m.group(1) == "struct.tsv" else "<POU>." + m.group(1),
+                      written.name)
+        assert kind in helps, written.name
+
+
 @pytest.mark.parametrize("text", ["", "(* only a comment *)\n", "\n\n"])
 def test_a_file_without_a_pou_is_a_usage_error_naming_it(tmp_path, text):
     """QA finding 20: it used to print '0 POU(s) exported' and exit 0."""

@@ -61,3 +61,37 @@ def test_the_no_traffic_verdict_is_what_the_monitor_says():
     session.close()
     result = session.result(listened_us=600_000_000)
     assert f"```\nNO TRAFFIC: {result.no_traffic}\n```" in DOC
+
+
+def test_a_monitor_trace_replays_to_the_monitors_findings(tmp_path):
+    """commissioning.md §6 replays `monitor --trace` files. Their times are the host's, so
+    the replay must allow the tolerance the monitor allowed: a PLC pacing at 240 ms passes
+    the monitor (240 + 20 > 250) and its plain capture, and used to fail the replay of the
+    monitor's own trace (tolerance 0: UITAMR-PACING twice)."""
+    import json
+
+    from verifier.monitor.capture import Chunk
+    from verifier.verify import report_trace
+
+    stop = protocol.encode(protocol.command_from_words(["stop"]), protocol.DEFAULT_SETTINGS)
+    read = protocol.encode(protocol.command_from_words(["read", "task"]), protocol.DEFAULT_SETTINGS)
+    idle = bytes.fromhex("01 01 03 00 00 00 3C 4E")
+    chunks = [Chunk(8_400, stop), Chunk(23_400, stop), Chunk(248_400, read), Chunk(263_400, idle),
+              Chunk(488_400, read), Chunk(503_400, idle)]
+    session = MonitorSession(CaptureInfo("site", "/dev/ttyUSB0"))
+    for chunk in chunks:
+        session.feed(chunk)
+    session.close()
+    live = session.result()
+    assert live.passed, [v.message for v in live.all_violations()]
+    trace = tmp_path / "site.jsonl"
+    report_trace.write([live], trace)
+    report = tmp_path / "replay.json"
+    done = subprocess.run(uitamr("replay", str(trace), "--json", str(report)), capture_output=True, text=True,
+                          timeout=60)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert json.loads(report.read_text())["summary"]["violations"]["UITAMR-PACING"] == 0
+    exact = subprocess.run(uitamr("replay", str(trace), "--tolerance", "0"), capture_output=True, text=True,
+                           timeout=60)
+    assert exact.returncode == 1 and "UITAMR-PACING ×2" in exact.stdout
+    assert all(json.loads(line)["tolerance"] == DEFAULT_TOLERANCE_US / 1e6 for line in trace.read_text().splitlines())

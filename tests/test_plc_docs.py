@@ -41,3 +41,24 @@ def test_every_pou_file_is_named_after_its_pou():
     for path in (ROOT / "plc").rglob("*.st"):
         source = st.parse(path.read_text(), str(path))
         assert [p.name for p in source.pous] == [path.stem], path
+
+
+def test_the_power_on_stop_goes_out_when_import_gxworks2_says():
+    """docs/import-gxworks2.md §7: the stop goes out once the line was quiet for GUARD_TIME
+    (the engine's ST), at 0.23 s in the bundled FX3U scenario, not in the second scan."""
+    from dataclasses import replace
+
+    from verifier.verify.runner import run_scenario
+    from verifier.verify.scenario import load_scenario
+
+    doc = " ".join((ROOT / "docs" / "import-gxworks2.md").read_text(encoding="utf-8").split())
+    claim = re.search(r"The engine sends the stop command once the line has been quiet for "
+                      r"`GUARD_TIME` \((\d+) ms\) after RUN — at ([\d.]+) s with a 10 ms scan", doc)
+    assert claim, "import-gxworks2.md §7 no longer says when the stop goes out"
+    engine = (ROOT / "plc" / "core" / "UITAMR_Engine.st").read_text(encoding="utf-8")
+    assert f"GUARD_TIME : TIME := T#{claim.group(1)}ms;" in engine
+    scenario = load_scenario(ROOT / "plc" / "scenarios" / "fx3u-healthy.toml")
+    result = run_scenario(replace(scenario, duration_us=1_000_000, expectations=()))
+    first = result.trace[0]
+    assert (first.direction, first.data.hex(" ").upper()) == ("tx", "01 06 01 A0 00 00 88 14")
+    assert first.t_start_us == round(float(claim.group(2)) * 1e6)

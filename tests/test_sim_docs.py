@@ -42,3 +42,27 @@ def test_pytest_example_passes(pytester):
     pytester.makepyfile(test_doc_example=blocks("python")[2])
     result = pytester.runpytest("-p", "no:cacheprovider")
     result.assert_outcomes(passed=2)
+
+
+def test_restart_puts_the_instances_the_test_holds_back_to_their_initial_values():
+    """testing-st.md, Time: `project.restart()` powers the CPU off and on, labels back to
+    their initial values. The FB instance and the PROGRAM a test got before the restart
+    used to keep their old values (and the held PROGRAM ran apart from the CPU's)."""
+    import verifier
+
+    delay = blocks("iecst")[0]
+    main = "PROGRAM MAIN\nVAR\n    n : INT;\nEND_VAR\nn := n + 1;\nEND_PROGRAM\n"
+    project = verifier.load(sources={"FB_Delay.st": delay, "MAIN.st": main})
+    fb = project.instance("FB_Delay")
+    program = project.program("MAIN")
+    fb.i_bExecute = True
+    fb.run(ms=3000).scan()
+    project.run_programs(["MAIN"], scans=5)
+    assert fb.o_bDone and program.n == 5
+    project.restart(off_ms=100)
+    assert (fb.i_bExecute, fb.o_bDone, fb.fbTimer.ET, program.n) == (False, False, 0, 0)
+    project.run_programs(["MAIN"], scans=2)
+    assert program.n == project.get("MAIN.n") == 2 and project.program("MAIN") is program
+    fb.i_bExecute = True
+    fb.scan()
+    assert not fb.o_bDone and fb.fbTimer.ET == 0  # a new timer: it starts counting now

@@ -49,3 +49,131 @@ def test_sent_by_is_the_statement_that_starts_the_transmission():
     """FX3U: the origin is the `M8402 := TRUE` statement (the send request), not the RS2 call."""
     assert "`M8402 := TRUE`" in VERIFIER_MD
     assert "the RS2 / G_OUTPUT /\nADPRW call" not in VERIFIER_MD
+
+
+def test_the_checked_tree_api_of_st_dialect_section_10_is_reachable_as_written():
+    """st-dialect.md §10 names the import that works: `verifier.st.check` on the package is
+    the function check(), so `verifier.st.check.check_project` is no path to it."""
+    text = (DOCS / "st-dialect.md").read_text(encoding="utf-8")
+    section = text.split("## 10. ", 1)[1]
+    statement = re.search(r"`(from verifier\.st\.check import check_project)`", section).group(1)
+    names: dict = {}
+    exec(statement, names)
+    from verifier import st
+    source = st.parse("FUNCTION F : INT\nVAR_INPUT a : INT; END_VAR\nF := a + 1;\nEND_FUNCTION\n", "f.st")
+    diagnostics, table = names["check_project"]([source], "gxworks2")
+    assert diagnostics == [] and "A" in table.pous["F"].labels
+    assert "verifier.st.check.check_project" not in text
+
+
+def _error_blocks() -> list[list[str]]:
+    section = SCENARIOS_MD.split("## Errors in a scenario file", 1)[1]
+    return [[line for line in block.splitlines() if line.strip()] for block in section.split("```")[1::2]]
+
+
+EXAMPLE_SOURCES = ('sources = ["{plc}/core/*.st", "{plc}/fx3/*.st", "{plc}/examples/common/*.st", '
+                   '"{plc}/examples/fx3/UITAMR_ExampleFx3.st"]\n')
+
+
+def test_the_documented_scenario_file_errors_are_what_verify_prints(tmp_path, monkeypatch):
+    """scenarios.md, "Errors in a scenario file": the three file errors, position and all,
+    come out of `uitamr verify` as printed there, with exit status 2."""
+    from click.testing import CliRunner
+
+    from verifier.cli import main
+
+    plc = (DOCS.parent / "plc").as_posix()
+    files = {
+        "x.toml": EXAMPLE_SOURCES.format(plc=plc) + '[[expect]]\nsent = "stop"\nwithin = "5"\n',
+        "y.toml": EXAMPLE_SOURCES.format(plc=plc) + '[[faults]]\nkind = "no-replies"\nat_s = 1.0\n',
+        "z.toml": 'name = "z"\nsources x\n',
+    }
+    monkeypatch.chdir(tmp_path)
+    for name, text in files.items():
+        (tmp_path / name).write_text(text, encoding="utf-8")
+    documented = _error_blocks()[0]
+    assert len(documented) == len(files)
+    for line, name in zip(documented, files):
+        result = CliRunner().invoke(main, ["verify", "--scenario", name])
+        assert result.exit_code == 2, result.output
+        assert result.output.strip() == line
+
+
+def test_the_documented_label_errors_are_what_verify_prints(tmp_path):
+    """The label errors of scenarios.md name what `uitamr verify` names (file positions
+    differ with the file; the messages after them must not)."""
+    from verifier.verify.runner import run_scenario
+    from verifier.verify.result import UnusableInput
+    from verifier.verify.scenario import parse_scenario
+
+    plc = DOCS.parent / "plc"
+    program = tmp_path / "MAIN.st"
+    program.write_text("PROGRAM MAIN\nVAR\n    fbEngine : UITAMR_Engine;\n    wBuf : ARRAY[0..39] OF WORD;\n"
+                       "END_VAR\nwBuf[0] := 16#1;\nEND_PROGRAM\n", encoding="utf-8")
+    head = f'sources = ["{program.as_posix()}", "{(plc / "core").as_posix()}"]\nprogram = "MAIN"\nduration = "1s"\n'
+    bodies = [
+        '[[expect]]\nthat = "fbEngine.o_bNope"\n',
+        'watch = ["fbEngine.o_wTxCount", "wBuf[40]"]\n',
+        '[[inputs]]\nat = "0s"\nset = { X0 = 5 }\n',
+        '[[inputs]]\nat = "0s"\nset = { X0 = true }\n[[inputs]]\nat = "0s"\nset = { D100 = 99999 }\n',
+        '[[expect]]\nthat = "TRUE"\n[[expect]]\nthat = "TRUE"\n[[expect]]\nthat = "fbEngine.o_wTask"\n',
+    ]
+    documented = _error_blocks()[1]
+    assert len(documented) == len(bodies)
+    for line, body in zip(documented, bodies):
+        expected = re.sub(r"^error: s\.toml:\d+:\d+: ", "", line)
+        scenario = parse_scenario(head + body, tmp_path / "s.toml")
+        try:
+            run_scenario(scenario)
+        except UnusableInput as err:
+            assert str(err).endswith(expected), (str(err), expected)
+        else:
+            raise AssertionError(f"no error for {body!r}")
+
+
+def _example_as_main(tmp_path, folder: str, example: str, port_folder: str) -> Path:
+    plc = DOCS.parent / "plc"
+    sources = tmp_path / example
+    sources.mkdir()
+    for path in [*(plc / "core").glob("*.st"), *(plc / port_folder).glob("*.st"),
+                 *(plc / "examples" / "common").glob("*.st")]:
+        (sources / path.name).write_text(path.read_text(encoding="utf-8"), encoding="utf-8")
+    text = (plc / "examples" / folder / f"{example}.st").read_text(encoding="utf-8")
+    (sources / "MAIN.st").write_text(text.replace(example, "MAIN"), encoding="utf-8")
+    return sources
+
+
+def test_matrix_picks_the_bundled_scenarios_of_the_programs_route_as_verifier_md_says(tmp_path):
+    """verifier.md: --matrix with SOURCES runs the scenarios of the program's platform *and
+    route*: a serial FX5U program never meets a [converter] scenario, a TCP one only those."""
+    from click.testing import CliRunner
+
+    from verifier.cli import main
+
+    assert "**and of its route**" in VERIFIER_MD
+    helps = " ".join(CliRunner().invoke(main, ["verify", "--help"]).output.split())
+    assert "those of the program's platform and route" in helps
+    bundled = DOCS.parent / "plc" / "scenarios"
+    tcp_names = {p.stem for p in bundled.glob("fx5u-tcp-*.toml")}
+    serial_names = {p.stem for p in bundled.glob("fx5u-*.toml")} - tcp_names
+    for example, expected in (("UITAMR_ExampleFx5", serial_names), ("UITAMR_ExampleTcpFx5", tcp_names)):
+        sources = _example_as_main(tmp_path, "fx5", example, "fx5")
+        result = CliRunner().invoke(main, ["verify", str(sources), "--program", "MAIN", "--matrix",
+                                           "--duration", "6s"])
+        ran = set(re.findall(r"plc/scenarios/(fx5u-[\w-]+)\.toml\)", result.output))
+        stands_for = len(re.findall(r"also stands for", result.output))
+        assert ran and ran <= expected and len(ran) + stands_for == len(expected), (example, result.output)
+
+
+def test_the_missing_function_input_messages_of_st_dialect_are_the_checkers():
+    """st-dialect.md §8 quotes what `Add3(1, 2)` and `Add3(a := 1, b := 2)` get."""
+    from verifier import st
+
+    text = " ".join((DOCS / "st-dialect.md").read_text(encoding="utf-8").split())
+    source = st.parse("FUNCTION Add3 : INT\nVAR_INPUT a : INT; b : INT; c : INT; END_VAR\nAdd3 := a + b + c;\n"
+                      "END_FUNCTION\nPROGRAM P\nVAR\n    iX : INT;\nEND_VAR\niX := Add3(1, 2);\n"
+                      "iX := Add3(a := 1, b := 2);\nEND_PROGRAM\n", "a.st")
+    messages = [d.message for d in st.check([source]) if d.severity == "error"]
+    assert len(messages) == 2
+    for message in messages:
+        assert f"`{message.replace('...', '')}" in text.replace("...", ""), message

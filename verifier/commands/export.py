@@ -36,7 +36,7 @@ def bundled_sources(target: str) -> list[Path]:
 @click.option("--target", type=click.Choice(["gxworks2", "gxworks3"]), required=True,
               help="The engineering tool that will import the files.")
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), required=True,
-              help="Folder for <POU>.st, <POU>.labels.tsv, GlobalLabels.labels.tsv and IMPORT_ORDER.txt.")
+              help="Folder for <POU>.st, <POU>.labels.tsv, GlobalLabels.labels.tsv, <Type>.struct.tsv and IMPORT_ORDER.txt.")
 def command(sources: tuple[str, ...], target: str, out_dir: str) -> None:
     """Write, per POU, the ST body and a tab-separated label table for GX Works.
 

@@ -47,7 +47,8 @@ def line_options(command):
         click.option("--tolerance", type=_Duration(zero_ok=True),
                      help="How far host timestamps may be off (USB adapter latency): timing rules "
                           f"blame only what is beyond it. Default {DEFAULT_TOLERANCE_US // 1000}ms "
-                          "(replay of a capture whose frames say their side - a JSONL trace, tx/rx lines: 0)."),
+                          "(replay of a capture whose frames say their side - a verify trace, tx/rx lines: 0; "
+                          "of a monitor trace: the tolerance it was recorded with)."),
         click.option("--joined", is_flag=True,
                      help="The capture began after the PLC's power-on: do not judge UITAMR-POWERON-STOP."),
         click.option("--reply-timeout", type=_Duration(), default="500ms", show_default=True,

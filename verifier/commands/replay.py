@@ -45,7 +45,12 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
             click.echo(f"uitamr replay: {exc}", err=True)
             sys.exit(EXIT_UNUSABLE)
         is_trace = any(chunk.direction is not None for chunks in loaded.values() for chunk in chunks)
-        timing = line_timing(baud, line_format, tolerance, 0 if is_trace else DEFAULT_TOLERANCE_US)
+        # a monitor's trace says the tolerance its host times were judged with; other frames
+        # that say their side (a verify trace, tx/rx lines) are exactly timed
+        recorded = [chunk.tolerance_us for chunks in loaded.values() for chunk in chunks
+                    if chunk.tolerance_us is not None]
+        default = DEFAULT_TOLERANCE_US if not is_trace else max(recorded, default=0)
+        timing = line_timing(baud, line_format, tolerance, default)
         for capture_name, chunks in loaded.items():
             info = CaptureInfo(capture_name if len(loaded) > 1 else path.name, str(path), "capture",
                                line=f"{baud} {line_format}")

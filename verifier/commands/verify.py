@@ -353,7 +353,7 @@ def _terminate_as_exit():
 @click.option("--response-signal", "response_signal", metavar="CONDITION",
               help="The program's output that shows failed replies were noticed (UITAMR-RESPONSE-HANDLING), e.g. fbRobot.o_bErr; replaces the scenarios' (default: o_bErr when the program has it).")
 @click.option("--matrix", is_flag=True,
-              help="Run every bundled scenario. With SOURCES: those of the program's platform, with their robot, faults and rules but not their example-specific inputs and expectations (see docs/verifier.md).")
+              help="Run every bundled scenario. With SOURCES: those of the program's platform and route (serial, or TCP through a converter), with their robot, faults and rules but not their example-specific inputs and expectations (see docs/verifier.md).")
 @click.option("--duration", type=_Duration(MAX_DURATION_US), help="Virtual run time, e.g. 60s (overrides the scenarios'; default 60s).")
 @click.option("--scan", type=_Duration(), help="PLC scan time, e.g. 10ms (overrides the scenarios'; default 10ms).")
 @click.option("--seed", type=int, help="Seed for everything random in the run (overrides the scenarios').")

@@ -36,6 +36,7 @@ class Chunk:
     data: bytes
     direction: str | None = None
     t_start_us: int | None = None  # a frame whose start is known exactly (our traces)
+    tolerance_us: int | None = None  # a trace of host times (monitor --trace): their tolerance
 
 
 class CaptureError(Exception):
@@ -127,7 +128,9 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
             raise CaptureError(f"{where}: 't' ({t_start:g} s) is earlier than the record before of scenario "
                                f"{scenario!r} ({chunks[-1].t_start_us / 1_000_000:g} s); a trace is in time "
                                "order, and two runs in one trace need names of their own")
-        chunks.append(Chunk(round(t_end * 1_000_000), data, record["dir"], round(t_start * 1_000_000)))
+        tolerance = _seconds(record["tolerance"], "tolerance", where) if record.get("tolerance") is not None else None
+        chunks.append(Chunk(round(t_end * 1_000_000), data, record["dir"], round(t_start * 1_000_000),
+                            None if tolerance is None else round(tolerance * 1_000_000)))
     return scenarios
 
 

@@ -241,6 +241,7 @@ class MonitorSession:
             ended_us=end,
             notes=notes,
             no_traffic=no_traffic,
+            timing_tolerance_us=self.timing.tolerance_us,
         )
 
     def _silence(self, listened_us: int | None) -> str:

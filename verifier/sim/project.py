@@ -317,9 +317,14 @@ class Project:
         ns = self.module.namespace
         ns["_I"] = InstructionSet(rt)
         ns["_G"] = ns["_Globals"]()
-        programs = set(map(id, self._programs.values()))
-        self.touched = [t for t in self.touched if id(t._obj) not in programs]
+        programs = {id(obj): key for key, obj in self._programs.items()}
         self._programs.clear()
+        for inst in self.touched:
+            # the instances handed out stay usable: each now holds fresh memory (a held
+            # PROGRAM the CPU's new one, an FB a new instance at its initial values)
+            key = programs.get(id(inst._obj))
+            fresh = self._program_obj(key) if key is not None else type(inst._obj)()
+            object.__setattr__(inst, "_obj", fresh)
 
     def advance(self, ms: float) -> None:
         """Let virtual time pass without scanning (the CPU in STOP)."""

@@ -2,7 +2,9 @@
 
 Fields: `t`, `t_end` (seconds of virtual time), `dir` ("tx" PLC→robot, "rx" robot→PLC),
 `hex` (space-separated bytes), `meaning` (decoded), `origin` (the ST location that sent a
-tx frame, when known), `scenario`, and `rules` (ids of the rules this frame is evidence for).
+tx frame, when known), `scenario`, and `rules` (ids of the rules this frame is evidence for);
+a trace of host times (`uitamr monitor`, `uitamr replay`) also has `tolerance` (seconds), which
+a replay of it allows again.
 
 A run of `uitamr verify --trace` without `--html` does not hold its frames: it writes each
 one as a spool line while it goes (`spool_line`: everything but `rules`, which only the
@@ -64,6 +66,8 @@ def records(result: ScenarioResult, name: str | None = None, only: Iterable[int]
     for frame in frames:
         request = traffic.request_of(frame) if frame.direction == "rx" else None
         record = _frame_fields(name or result.name, frame, result.settings, request)
+        if result.timing_tolerance_us:  # host times (monitor): a replay allows what the monitor did
+            record["tolerance"] = result.timing_tolerance_us / 1_000_000
         record["rules"] = sorted(blamed.get((frame.t_start_us, frame.direction), ()))
         yield record
 

@@ -94,6 +94,9 @@ class ScenarioResult:
     # a capture that saw no bytes (`uitamr monitor`, `uitamr replay`): nothing was verified;
     # what was silent and what to check
     no_traffic: str | None = None
+    # frames timed by the host (`uitamr monitor`, `uitamr replay`): how far their times may
+    # be off; the trace records it so that a replay of the trace judges with it too
+    timing_tolerance_us: int = 0
 
     @property
     def tx_count(self) -> int:
