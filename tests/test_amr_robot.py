@@ -440,3 +440,34 @@ def test_time_cannot_go_back():
     robot.advance(1000)
     with pytest.raises(ValueError, match="cannot go back"):
         robot.advance(999)
+
+
+def test_every_robot_setting_is_in_the_emulator_docs_with_its_default():
+    """docs/emulator.md's `[robot]` table is where integrators look up a key: every field
+    of RobotConfig is a row, and its default column says what the code does."""
+    import re
+    from collections.abc import Mapping
+    from dataclasses import fields
+    from pathlib import Path
+
+    page = (Path(__file__).resolve().parents[1] / "docs" / "emulator.md").read_text(encoding="utf-8")
+    rows = {}
+    for keys, default in re.findall(r"^\| ((?:`\w+`(?:, )?)+) \| ([^|]+) \|", page, re.M):
+        names = re.findall(r"`(\w+)`", keys)
+        values = [v.strip() for v in re.split(r",\s(?![^\[]*\])", default)] if len(names) > 1 else [default.strip()]
+        rows.update(zip(names, values))
+    config = RobotConfig()
+    for f in fields(RobotConfig):
+        assert f.name in rows, f"docs/emulator.md has no row for [robot] {f.name}"
+        shown = rows[f.name].strip("`")
+        value = getattr(config, f.name)
+        if f.name == "taught_points":
+            assert value is None and shown == "all of 1–21"
+        elif isinstance(value, str):
+            assert shown == f'"{value}"', f.name
+        elif isinstance(value, tuple):
+            assert shown == str(list(value)), f.name
+        elif isinstance(value, Mapping):
+            assert shown == "{}" and not value, f.name
+        else:
+            assert float(shown) == value, f.name
