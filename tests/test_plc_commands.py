@@ -22,6 +22,7 @@ VAR
     uMbx : ARRAY[0..15] OF WORD;
     uPort : ARRAY[0..39] OF WORD;
     bCallEngine : BOOL;
+    bCmdOff : BOOL;
     bRun : BOOL;
     wPoint : INT;
 END_VAR
@@ -29,7 +30,7 @@ fbPort(i_bEN := TRUE, i_wChannel := 1, i_bRs232 := FALSE, io_uPort := uPort);
 IF bCallEngine THEN
     fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := FALSE, io_uMbx := uMbx, io_uPort := uPort);
 END_IF;
-fbRun(i_bEN := TRUE, i_bExecute := bRun, i_wPoint := wPoint, io_uMbx := uMbx);
+fbRun(i_bEN := NOT bCmdOff, i_bExecute := bRun, i_wPoint := wPoint, io_uMbx := uMbx);
 END_PROGRAM
 """
 
@@ -77,3 +78,31 @@ def test_a_request_the_engine_never_takes_ends_with_0303_and_is_withdrawn():
     h.wPoint, h.bRun = 3, True
     run(project, 5000, until=lambda x: x.fbRun.o_bOK)
     assert h.fbRun.o_bOK and encode(ControlRequest(1, 1, 3), SETTINGS) in sent(line)
+
+
+def test_an_edge_when_en_returns_is_served_after_the_discarded_command():
+    """i_bEN off while the engine serves a command discards its result. When i_bEN came
+    back with a rising edge of i_bExecute in the same scan, the FB still showed o_bBusy for
+    the discarded command, ignored the edge, then dropped o_bBusy with neither o_bOK nor
+    o_bErr: the new command was lost while i_bExecute stayed TRUE."""
+    project, h, line = rig()
+    run(project, 1500, until=lambda x: x.fbEngine.o_bInitDone)
+    h.wPoint, h.bRun = 2, True
+    run(project, 400)                                 # sent; the engine polls the task
+    assert encode(ControlRequest(1, 1, 2), SETTINGS) in sent(line)
+    h.bCmdOff, h.bRun = True, False
+    run(project, 100)
+    h.bCmdOff, h.wPoint, h.bRun = False, 3, True      # EN back and a new edge, same scan
+    states = []
+
+    def record(x):
+        states.append((x.fbRun.o_bBusy, x.fbRun.o_bOK, x.fbRun.o_bErr))
+        return x.fbRun.o_bOK or x.fbRun.o_bErr
+    run(project, 8000, until=record)
+    assert h.fbRun.o_bOK and not h.fbRun.o_bErr
+    busy = [s[0] for s in states]
+    assert all(busy[:-1]) and not busy[-1]            # busy from the edge until it ends ok
+    frames = sent(line)
+    assert frames.index(encode(ControlRequest(1, 1, 3), SETTINGS)) > frames.index(
+        encode(ControlRequest(1, 1, 2), SETTINGS))
+    assert h.uMbx[0] == 0 and h.uMbx[8] == 0
