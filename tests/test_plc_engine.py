@@ -503,3 +503,28 @@ def test_en_off_while_the_engine_serves_the_command_discards_the_result_and_free
     h.wPoint, h.bRun = 8, True
     port.run(6000, until=lambda x: x.fbRun.o_bOK)
     assert h.fbRun.o_bOK and encode(ControlRequest(1, 1, 8), SETTINGS) in port.kinds()
+
+
+# ---------------------------------------------------------------------------- parameters at type limits
+@pytest.mark.parametrize("metres", [7000.0, -7000.0, 1.0e30, -3.0e38])
+def test_a_collision_range_beyond_int_is_0301_without_an_operation_error(metres):
+    """REAL_TO_INT of i_eRange / 0.2 beyond INT is an operation error, which stops a Q CPU;
+    the FB evaluates its range on every scan, so a bad HMI value alone used to stop it."""
+    project = verifier.load(CORE, sources={"T_Engine.st": HARNESS}, target="gxworks2:q")
+    h = project.program("T_Engine")
+    port = FakePort(h, project)
+    h.bEnable = True
+    port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)
+    count = len(port.requests)
+    h.eRange = metres                                 # no Execute yet: the value alone
+    port.run(100)
+    h.bRange = True
+    port.run(100)
+    assert h.fbRange.o_bErr and h.fbRange.o_uErrId == 0x0301
+    assert all(d[1] == 1 for d in port.kinds()[count:])   # no control frame
+    assert project.diagnostics == []
+    h.bRange, h.eRange = False, 0.4
+    port.run(50)
+    h.bRange = True
+    port.run(2000, until=lambda x: x.fbRange.o_bOK)
+    assert h.fbRange.o_bOK and encode(ControlRequest(1, 4, 2), SETTINGS) in port.kinds()

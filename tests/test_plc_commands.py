@@ -1,0 +1,108 @@
+"""Command FBs as an integrator wires them: the library on an FX3U (RS2 channel 1) against
+the emulated robot, with the engine's call under the test's control."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import verifier
+from verifier.amr import Robot
+from verifier.amr.config import RobotConfig
+from verifier.link import Line
+from verifier.protocol import ControlRequest, Settings, encode
+
+PLC = Path(__file__).resolve().parents[1] / "plc"
+SETTINGS = Settings()
+
+HARNESS = """
+PROGRAM T_Commands
+VAR
+    fbPort : UITAMR_PortFx3;
+    fbEngine : UITAMR_Engine;
+    fbRun : UITAMR_RunPoint;
+    uMbx : ARRAY[0..15] OF WORD;
+    uPort : ARRAY[0..39] OF WORD;
+    bCallEngine : BOOL;
+    bCmdOff : BOOL;
+    bRun : BOOL;
+    wPoint : INT;
+END_VAR
+fbPort(i_bEN := TRUE, i_wChannel := 1, i_bRs232 := FALSE, io_uPort := uPort);
+IF bCallEngine THEN
+    fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := FALSE, io_uMbx := uMbx, io_uPort := uPort);
+END_IF;
+fbRun(i_bEN := NOT bCmdOff, i_bExecute := bRun, i_wPoint := wPoint, io_uMbx := uMbx);
+END_PROGRAM
+"""
+
+
+def rig():
+    project = verifier.load(PLC / "core", PLC / "fx3", sources={"T_Commands.st": HARNESS})
+    line = Line(Robot(config=RobotConfig(point_duration_s=1.0)))
+    project.attach_serial("fx3:1", line)
+    h = project.program("T_Commands")
+    h.bCallEngine = True
+    return project, h, line
+
+
+def run(project, ms, until=None):
+    stop = project.now_us + ms * 1000
+    while project.now_us < stop:
+        project.run_programs(["T_Commands"], scans=1)
+        if until is not None and until(project.program("T_Commands")):
+            return
+
+
+def sent(line):
+    return [f.data for f in line.trace if f.direction == "tx"]
+
+
+def test_a_request_the_engine_never_takes_ends_with_0303_and_is_withdrawn():
+    """docs/plc-library.md: 16#0303 'command not taken by the engine within 30 s - is the
+    engine called every scan?'. With the mailbox free the request was posted at once and,
+    with no engine to take it, the FB stayed busy for ever."""
+    project, h, line = rig()
+    run(project, 1500, until=lambda x: x.fbEngine.o_bInitDone)
+    assert h.fbEngine.o_bInitDone
+    h.bCallEngine = False                             # e.g. the engine's call is skipped
+    h.wPoint, h.bRun = 2, True
+    run(project, 29_000)
+    assert h.fbRun.o_bBusy and not h.fbRun.o_bErr
+    run(project, 1_100, until=lambda x: x.fbRun.o_bErr)
+    assert h.fbRun.o_bErr and h.fbRun.o_uErrId == 0x0303 and not h.fbRun.o_bBusy
+    assert h.uMbx[0] == 0                             # the request is withdrawn
+    h.bCallEngine = True                              # the engine is back: nothing stale is sent
+    run(project, 2000)
+    assert encode(ControlRequest(1, 1, 2), SETTINGS) not in sent(line)
+    h.bRun = False
+    run(project, 50)
+    h.wPoint, h.bRun = 3, True
+    run(project, 5000, until=lambda x: x.fbRun.o_bOK)
+    assert h.fbRun.o_bOK and encode(ControlRequest(1, 1, 3), SETTINGS) in sent(line)
+
+
+def test_an_edge_when_en_returns_is_served_after_the_discarded_command():
+    """i_bEN off while the engine serves a command discards its result. When i_bEN came
+    back with a rising edge of i_bExecute in the same scan, the FB still showed o_bBusy for
+    the discarded command, ignored the edge, then dropped o_bBusy with neither o_bOK nor
+    o_bErr: the new command was lost while i_bExecute stayed TRUE."""
+    project, h, line = rig()
+    run(project, 1500, until=lambda x: x.fbEngine.o_bInitDone)
+    h.wPoint, h.bRun = 2, True
+    run(project, 400)                                 # sent; the engine polls the task
+    assert encode(ControlRequest(1, 1, 2), SETTINGS) in sent(line)
+    h.bCmdOff, h.bRun = True, False
+    run(project, 100)
+    h.bCmdOff, h.wPoint, h.bRun = False, 3, True      # EN back and a new edge, same scan
+    states = []
+
+    def record(x):
+        states.append((x.fbRun.o_bBusy, x.fbRun.o_bOK, x.fbRun.o_bErr))
+        return x.fbRun.o_bOK or x.fbRun.o_bErr
+    run(project, 8000, until=record)
+    assert h.fbRun.o_bOK and not h.fbRun.o_bErr
+    busy = [s[0] for s in states]
+    assert all(busy[:-1]) and not busy[-1]            # busy from the edge until it ends ok
+    frames = sent(line)
+    assert frames.index(encode(ControlRequest(1, 1, 3), SETTINGS)) > frames.index(
+        encode(ControlRequest(1, 1, 2), SETTINGS))
+    assert h.uMbx[0] == 0 and h.uMbx[8] == 0
