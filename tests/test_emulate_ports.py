@@ -465,6 +465,8 @@ def test_the_scripted_fault_line_says_count_duration_and_filter_together(tmp_pat
     # was read as host ':' port 1, and failed (status 1) with "Name or service not known"
     (("--tcp", "::1"), "--tcp: an IPv6 address goes in brackets, e.g. [::1]:4001, got '::1'", 2),
     (("--tcp", "fe80::1:4001"), "an IPv6 address goes in brackets", 2),
+    # in brackets already: was told to put it in brackets; the port is what it lacks
+    (("--tcp", "[::1]"), "--tcp: the port is missing after the address, e.g. [::1]:4001, got '[::1]'", 2),
     (("--tcp", "0", "--late-reply-on", "3"), "expected N:MS", 2),
     (("--tcp", "0", "--no-reply-on", "0"), "request numbers start at 1", 2),
     # N:VALUE where only N is taken: the :VALUE was silently dropped

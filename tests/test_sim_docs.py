@@ -66,3 +66,23 @@ def test_restart_puts_the_instances_the_test_holds_back_to_their_initial_values(
     fb.i_bExecute = True
     fb.scan()
     assert not fb.o_bDone and fb.fbTimer.ET == 0  # a new timer: it starts counting now
+
+
+def test_restart_puts_a_held_globals_view_back_and_keeps_it_the_cpus():
+    """`g = project.globals` taken before `project.restart()`: after it, `g` shows the
+    initial values and what a test writes through it is what the programs read (it used to
+    keep the old values and write to memory no program read any more)."""
+    import verifier
+
+    text = ("VAR_GLOBAL g_nStep : INT; END_VAR\n"
+            "PROGRAM MAIN\nVAR\n    n : INT;\nEND_VAR\nn := n + g_nStep;\nEND_PROGRAM\n")
+    project = verifier.load(sources={"MAIN.st": text})
+    g = project.globals
+    g.g_nStep = 2
+    project.run_programs(["MAIN"], scans=3)
+    assert project.get("MAIN.n") == 6
+    project.restart()
+    assert g.g_nStep == 0 == project.get("GLOBAL.g_nStep")
+    g.g_nStep = 5
+    project.run_programs(["MAIN"], scans=2)
+    assert project.get("MAIN.n") == 10 and project.get("GLOBAL.g_nStep") == 5

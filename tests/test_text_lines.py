@@ -120,3 +120,21 @@ def test_export_of_a_classic_mac_file_keeps_its_lines(tmp_path):
     for exported in ("FB_A.st", "FB_A.labels.tsv"):
         assert (tmp_path / "out-cr" / exported).read_text() == (tmp_path / "out-lf" / exported).read_text()
     assert "o_bY := i_bX;" in (tmp_path / "out-cr" / "FB_A.st").read_text()
+
+
+@pytest.mark.parametrize("end", ["\r", "\r\n", "\n"], ids=["CR", "CRLF", "LF"])
+def test_a_capture_with_any_line_end_is_replayed_line_by_line(tmp_path, end):
+    """`str.splitlines` read a classic Mac OS capture (lone CRs) line by line; numbering at
+    line feeds alone made its first line, a comment, swallow the file: replay said NO
+    TRAFFIC. A plain capture and a JSONL trace are read alike with any line end."""
+    plain = tmp_path / "plain.txt"
+    plain.write_bytes(end.join(["# bench capture", "0.000000 tx 01 06 01 A0 00 00 88 14",
+                                "0.015000 rx 01 06 01 A0 00 00 88 14", ""]).encode())
+    trace = tmp_path / "trace.jsonl"
+    records = ['{"scenario": "s", "t": 0.0, "t_end": 0.001146, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}',
+               '{"scenario": "s", "t": 0.015, "t_end": 0.016146, "dir": "rx", "hex": "01 06 01 A0 00 00 88 14"}']
+    trace.write_bytes((end.join(records) + end).encode())
+    for capture in (plain, trace):
+        result = CliRunner().invoke(main, ["replay", str(capture)])
+        assert "1 requests" in result.output, result.output
+        assert result.exit_code == 0, result.output

@@ -4,6 +4,7 @@ went wrong: the caller puts it in its own error with the file name. And the one 
 characters a report cannot hold are shown in it (`escape_chars`)."""
 from __future__ import annotations
 
+import re
 import stat
 from pathlib import Path
 from typing import Callable
@@ -48,6 +49,16 @@ def place_of_byte(data: bytes, offset: int) -> tuple[int, int]:
     start = len(BOM) if data.startswith(BOM) else 0
     before = data[start:offset].decode("utf-8", errors="replace")
     return before.count("\n") + 1, len(before) - (before.rfind("\n") + 1) + 1
+
+
+def lone_cr_as_line_feed(text: str) -> str:
+    """`text` with each carriage return not followed by a line feed made a line feed: a
+    file saved with classic Mac OS line ends (a lone CR) is then read line by line, where
+    lark, tomllib-style positions and `text_lines` count lines at line feeds only. CRLF
+    text comes back as it is."""
+    if text.count("\r") == text.count("\r\n"):  # none, or only CRLF (GX Works, Windows)
+        return text
+    return re.sub(r"\r(?!\n)", "\n", text)
 
 
 def text_lines(text: str) -> list[str]:

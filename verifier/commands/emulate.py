@@ -20,6 +20,9 @@ from verifier.commands.protocol_options import protocol_settings
 
 
 def _tcp_endpoint(value: str) -> tuple[str, int]:
+    if value.startswith("[") and value.endswith("]"):  # "[::1]" would read as host "[:" port "1]"
+        raise click.BadParameter(f"the port is missing after the address, e.g. {value}:4001, got {value!r}",
+                                 param_hint="--tcp")
     host, sep, port = value.rpartition(":")
     if not sep:
         host, port = "127.0.0.1", value

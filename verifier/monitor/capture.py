@@ -23,7 +23,7 @@ from pathlib import Path
 
 from verifier import protocol
 from verifier.amr.schema import LARGEST  # the largest number of seconds any setting holds
-from verifier.textfile import UnreadableText, read_utf8, text_lines
+from verifier.textfile import UnreadableText, lone_cr_as_line_feed, read_utf8, text_lines
 
 
 @dataclass(frozen=True)
@@ -48,6 +48,8 @@ _HEX_PAIR = re.compile(r"[0-9A-Fa-f]{2}")
 
 
 def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
+    """A plain capture's chunks; a line ends at a line feed, a CRLF or a lone CR."""
+    text = lone_cr_as_line_feed(text)
     chunks: list[Chunk] = []
     last_t: int | None = None
     for number, raw in enumerate(text_lines(text), start=1):
@@ -96,7 +98,9 @@ def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
 
 def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
     """Our JSONL trace (`uitamr verify --trace`, `uitamr monitor --trace`): frames with
-    their direction, grouped by scenario, in file order."""
+    their direction, grouped by scenario, in file order (a record ends at a line feed, a
+    CRLF or a lone CR: JSON strings hold no raw CR)."""
+    text = lone_cr_as_line_feed(text)
     scenarios: dict[str, list[Chunk]] = {}
     for number, raw in enumerate(text_lines(text), start=1):
         if not raw.strip():
@@ -150,7 +154,7 @@ def read_capture(path: Path) -> dict[str, list[Chunk]]:
     """A capture file, plain or our JSONL trace (told apart by the first character that is
     not blank or a comment), as chunks per capture name."""
     try:
-        text = read_utf8(path)
+        text = lone_cr_as_line_feed(read_utf8(path))  # a classic Mac OS file too
     except UnreadableText as exc:
         raise CaptureError(f"{path}: {exc}") from None
     first = next((line.lstrip() for line in text_lines(text)

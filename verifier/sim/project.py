@@ -316,7 +316,8 @@ class Project:
         rt.scan_count = 0
         ns = self.module.namespace
         ns["_I"] = InstructionSet(rt)
-        ns["_G"] = ns["_Globals"]()
+        # in place: a `project.globals` view taken before the restart stays the CPU's
+        ns["_G"].__init__()
         programs = {id(obj): key for key, obj in self._programs.items()}
         self._programs.clear()
         for inst in self.touched:

@@ -16,7 +16,7 @@ from lark.exceptions import LarkError, UnexpectedCharacters, UnexpectedEOF, Unex
 from verifier.st import ast
 from verifier.st.devices import H_CONST_RE, K_CONST_RE, parse_device
 from verifier.st.errors import describe_syntax_error
-from verifier.textfile import text_lines
+from verifier.textfile import lone_cr_as_line_feed, text_lines
 
 GRAMMAR_PATH = Path(__file__).with_name("st.lark")
 
@@ -501,14 +501,6 @@ def get_parser() -> Lark:
     return _parser
 
 
-def _lone_cr_as_line_feed(text: str) -> str:
-    """`text` with each carriage return not followed by a line feed made a line feed: the
-    lexers count lines at line feeds only (the returned text is the file's `.text`)."""
-    if text.count("\r") == text.count("\r\n"):  # none, or only CRLF (GX Works, Windows)
-        return text
-    return re.sub(r"\r(?!\n)", "\n", text)
-
-
 def parse(text: str, filename: str = "<string>", target: str = "gxworks2") -> ast.SourceFile:
     """Parse ST `text`; never raises for bad input (errors are in `.diagnostics`).
 
@@ -518,7 +510,7 @@ def parse(text: str, filename: str = "<string>", target: str = "gxworks2") -> as
     A lone carriage return (a classic Mac OS line end) ends a line, as in every editor."""
     from verifier.st import fastparse
 
-    text = _lone_cr_as_line_feed(text)
+    text = lone_cr_as_line_feed(text)  # the lexers count lines at line feeds only
     parser = get_parser()
     try:
         return fastparse.parse_fast(text, filename, target, parser)
@@ -528,7 +520,7 @@ def parse(text: str, filename: str = "<string>", target: str = "gxworks2") -> as
 
 def parse_reference(text: str, filename: str = "<string>", target: str = "gxworks2") -> ast.SourceFile:
     """`parse` with lark's LALR parser only (the reference the fast path must equal)."""
-    text = _lone_cr_as_line_feed(text)
+    text = lone_cr_as_line_feed(text)  # the lexers count lines at line feeds only
     parser = get_parser()
     _ctx.reset(filename, target, text)
     try:
