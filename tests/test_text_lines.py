@@ -138,3 +138,18 @@ def test_a_capture_with_any_line_end_is_replayed_line_by_line(tmp_path, end):
         result = CliRunner().invoke(main, ["replay", str(capture)])
         assert "1 requests" in result.output, result.output
         assert result.exit_code == 0, result.output
+
+
+def test_a_toml_file_with_lone_cr_line_ends_is_told_to_be_saved_with_lf_or_crlf(tmp_path):
+    """TOML allows LF and CRLF only; tomllib's own message ("Expected newline...") did not
+    say why a file from a classic Mac editor is refused."""
+    scenario = tmp_path / "s.toml"
+    scenario.write_bytes(b'name = "x"\rsources = ["p.st"]\r')
+    out = check(scenario).output
+    assert "line ends are lone carriage returns (classic Mac OS), which TOML does not allow: " \
+           "save it with LF or CRLF line ends" in out
+    faults = tmp_path / "f.toml"
+    faults.write_bytes(b"[robot]\rturnaround_ms = 5\r")
+    done = subprocess.run([sys.executable, "-m", "verifier.cli", "emulate", "--tcp", "0", "--faults", faults],
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2 and "save it with LF or CRLF line ends" in done.stderr

@@ -276,6 +276,16 @@ def test_html_lists_at_most_so_many_violations_and_points_to_the_json(tmp_path, 
     assert html.count('class="violation-row"') == 3 and html.count('<g class="violation"') == 3
 
 
+def test_html_of_a_run_with_many_events_says_only_what_it_left_out(monkeypatch):
+    from dataclasses import replace
+
+    monkeypatch.setattr(report_html, "EVENTS_AT_MOST", 10)
+    result = replace(good_result(), events=[LineEvent(1000 * i, "robot.task", "done") for i in range(30)])
+    note = re.search(r"<b>A long run:</b>.*?</p>", report_html.render([result])).group(0)
+    assert "the diagram shows 10 of its 30 events (the faults first)" in note
+    assert "frames (" not in note  # every frame is drawn: nothing said of them
+
+
 def test_html_diagram_zooms_in_the_browser(tmp_path):
     page = tmp_path / "report.html"
     report_html.write([bad_result()], page)

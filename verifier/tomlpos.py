@@ -11,6 +11,9 @@ import re
 import tomllib
 from dataclasses import dataclass
 
+from verifier.textfile import lone_cr_as_line_feed
+
+
 @dataclass(frozen=True)
 class Place:
     """A line and column (both 1-based) in a TOML file; prints as `line:col`."""
@@ -68,11 +71,15 @@ def line_of_key(lines: list[str], key: str) -> int | None:
     return start + 1
 
 
-def decode_error_position(error: tomllib.TOMLDecodeError) -> tuple[str, Place | None]:
+def decode_error_position(error: tomllib.TOMLDecodeError, source: str = "") -> tuple[str, Place | None]:
     """A TOML syntax error as (message, place): tomllib writes the place as
     "(at line L, column C)" at the end of its message; callers put it after the file
-    name like every other error."""
+    name like every other error. `source` (the file's text) lets the message name a cause
+    tomllib cannot: line ends that are lone carriage returns, which TOML does not allow."""
     text = str(error)
+    if lone_cr_as_line_feed(source) != source:
+        text += ("; the file's line ends are lone carriage returns (classic Mac OS), which TOML "
+                 "does not allow: save it with LF or CRLF line ends")
     match = _DECODE_POSITION.search(text)
     if match is None:
         return text, None

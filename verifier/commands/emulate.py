@@ -256,7 +256,8 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
             serve_tcp(endpoint[0], endpoint[1], emulator, stop, silence_us,
                       on_listening=(lambda host, port: log_anyway(f"listening on tcp {host}:{port}")) if quiet else None)
     except PortError as err:
-        click.echo(emulator.summary())
+        if err.in_use:
+            click.echo(emulator.summary())  # what it did before the port failed
         raise click.ClickException(str(err)) from None
     finally:
         if timer is not None:

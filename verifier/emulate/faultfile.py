@@ -52,7 +52,7 @@ def load_fault_file(path: str | Path, own_address: int | None = None) -> FaultFi
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
-        message, line = decode_error_position(err)
+        message, line = decode_error_position(err, text)
         raise FaultFileError(f"{_where(path, line)}: not valid TOML: {message}") from None
     try:
         reject_unknown_keys(data, FILE_KEYS, "")

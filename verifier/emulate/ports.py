@@ -35,7 +35,12 @@ END_GRACE_US = 2_000_000
 
 
 class PortError(RuntimeError):
-    """A port that cannot be opened or failed while in use (message for the user)."""
+    """A port that cannot be opened or failed while in use (message for the user);
+    `in_use`: it failed after the emulator had begun to serve on it."""
+
+    def __init__(self, message: str, in_use: bool = False):
+        super().__init__(message)
+        self.in_use = in_use
 
 
 @dataclass
@@ -130,7 +135,7 @@ def serve_serial(url: str, emulator: Emulator, stop: threading.Event, silence_us
                 if data and port.in_waiting:
                     data += port.read(port.in_waiting)
             except (serial.SerialException, OSError) as err:
-                raise PortError(f"serial port {url} failed: {err}") from None
+                raise PortError(f"serial port {url} failed: {err}", in_use=True) from None
             now = emulator.now_us()
             channel.take(emulator, channel.assembler.feed(data, now) if data else channel.assembler.poll(now))
             emulator.tick()
@@ -139,7 +144,7 @@ def serve_serial(url: str, emulator: Emulator, stop: threading.Event, silence_us
                     port.write(reply.data)
                     port.flush()
                 except (serial.SerialException, OSError) as err:
-                    raise PortError(f"serial port {url} failed while writing: {err}") from None
+                    raise PortError(f"serial port {url} failed while writing: {err}", in_use=True) from None
                 emulator.sent(reply, emulator.now_us())
     finally:
         port.close()
@@ -155,9 +160,11 @@ def serve_tcp(host: str, port: int, emulator: Emulator, stop: threading.Event, s
         family = socket.AF_INET6 if ":" in host else socket.AF_INET
         server = socket.create_server((host, port), family=family)
     except OSError as err:
-        raise PortError(f"cannot listen on {host}:{port}: {err}") from None
+        raise PortError(f"cannot listen on {f'[{host}]' if ':' in host else host}:{port}: {err}") from None
     server.setblocking(False)
     bound_host, bound_port = server.getsockname()[:2]
+    if ":" in bound_host:
+        bound_host = f"[{bound_host}]"  # as --tcp takes it back: [::1]:4001
     selector = selectors.DefaultSelector()
     selector.register(server, selectors.EVENT_READ, None)
     clients: dict[socket.socket, _Channel] = {}

@@ -252,7 +252,7 @@ def parse_scenario(text: str, path: Path | None = None) -> Scenario:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        message, place = decode_error_position(exc)
+        message, place = decode_error_position(exc, text)
         raise ScenarioError(path, "", f"not valid TOML: {message}", place) from None
     return _Reader(text, path).read(data)
 

@@ -72,8 +72,9 @@ class ResponseHandling(Judge):
 
     def provisional(self, end_us: int, overdue: Exchange | None = None) -> Iterator[Violation]:
         """Replies failing for longer than the bound, still going on: said once per episode.
-        An overdue exchange (Judge.provisional) begins an episode when none is under way;
-        it is not counted by kind, since a late reply may still join it."""
+        An overdue exchange (Judge.provisional) begins an episode when none is under way,
+        counted as "no reply so far": a late reply may still join it (the final words then
+        say "late")."""
         episode = self.current
         if episode is None and overdue is not None:
             episode = Episode(overdue)
