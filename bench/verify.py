@@ -19,7 +19,7 @@ Prints, measured in one run on this machine:
      scenario run for 300 s, next to the machine's ceiling: N copies of a CPU-bound Python loop at once against
      one after the other (median of 5);
   5. peak RSS of a 1 h and a 10 h run of fx3u-healthy (whole processes, os.wait4), without
-     reports and with --trace.
+     reports, with --trace and with --html.
 Wall-clock figures move with the machine's load; ratios measured side by side much less.
 """
 from __future__ import annotations
@@ -37,6 +37,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from verifier.sim.project import Project  # noqa: E402
+from verifier.verify import report_html  # noqa: E402
 from verifier.verify.runner import run_scenario  # noqa: E402
 from verifier.verify.scenario import load_scenario  # noqa: E402
 
@@ -222,6 +223,14 @@ def part_5(healthy: Path, folder: Path) -> None:
     _, rss_ten = run_process("verify", "--scenario", ten, "--trace", trace)
     print(f"   with --trace (every frame listed): 1 h {rss_one / 1024:.0f} MiB, 10 h {rss_ten / 1024:.0f} MiB "
           f"(ratio {rss_ten / rss_one:.2f}; the trace file: {trace.stat().st_size / 2**20:.0f} MiB)")
+    page = folder / "report.html"
+    _, rss_one = run_process("verify", "--scenario", one, "--html", page)
+    size_one = page.stat().st_size
+    _, rss_ten = run_process("verify", "--scenario", ten, "--html", page)
+    print(f"   with --html (the run keeps every frame; the page holds at most "
+          f"{report_html.FRAMES_AT_MOST:,}): 1 h {rss_one / 1024:.0f} MiB, 10 h {rss_ten / 1024:.0f} MiB "
+          f"(ratio {rss_ten / rss_one:.2f}, not flat; the page: {size_one / 2**20:.1f} / "
+          f"{page.stat().st_size / 2**20:.1f} MiB)")
 
 
 if __name__ == "__main__":
