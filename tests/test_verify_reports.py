@@ -201,12 +201,7 @@ def test_html_report_renders_in_chromium_with_a_timing_diagram_and_violation_mar
     report_html.write([good_result(), bad_result()], page)
     html = page.read_text()
     assert not re.search(r"(src|href)=\"?(https?:)?//|<link|@import|url\(", html)  # self-contained
-    with tempfile.TemporaryDirectory() as profile:
-        dom = subprocess.run(
-            [_chromium(), *_chromium_flags(profile), "--dump-dom", page.as_uri()],
-            capture_output=True, text=True, timeout=120,
-        ).stdout
-    root = _parse_dom(dom)
+    root = _rendered(page.as_uri())
     sections = [s for s in root.iter("section") if "scenario" in (s.get("class") or "")]
     assert [s.get("data-verdict") for s in sections] == ["pass", "fail"]
     good, bad = sections
@@ -248,12 +243,7 @@ def test_html_of_a_long_run_draws_what_a_page_can_hold_and_says_so(tmp_path):
     html = page.read_text()
     assert "the diagram and the frame table show 4000 of its 4202 frames" in html
     assert "4000 of the 4202 frames" in html and "--trace lists them" in html
-    with tempfile.TemporaryDirectory() as profile:
-        dom = subprocess.run(
-            [_chromium(), *_chromium_flags(profile), "--dump-dom", page.as_uri()],
-            capture_output=True, text=True, timeout=120,
-        ).stdout
-    root = _parse_dom(dom)
+    root = _rendered(page.as_uri())
     frames = [r for r in root.iter("rect") if "frame" in (r.get("class") or "").split()]
     assert len(frames) == report_html.FRAMES_AT_MOST
     blamed = [float(r.get("data-t0")) for r in frames if "blamed" in r.get("class")]
@@ -289,12 +279,7 @@ def test_html_of_a_run_with_many_events_says_only_what_it_left_out(monkeypatch):
 def test_html_diagram_zooms_in_the_browser(tmp_path):
     page = tmp_path / "report.html"
     report_html.write([bad_result()], page)
-    with tempfile.TemporaryDirectory() as profile:
-        dom = subprocess.run(
-            [_chromium(), *_chromium_flags(profile), "--dump-dom", page.as_uri() + "#zoom=8"],
-            capture_output=True, text=True, timeout=120,
-        ).stdout
-    root = _parse_dom(dom)
+    root = _rendered(page.as_uri() + "#zoom=8")
     svg = root.find(".//svg[@id='s0-svg']")
     assert svg.get("width") == str(round(2_500 * 8 + 40))  # 2.5 s of virtual time at 8 px/ms
     assert "zoomed" in svg.get("class")  # frame labels are shown from 8 px/ms on
@@ -311,6 +296,14 @@ def test_html_screenshot_is_taken(tmp_path):
         subprocess.run([_chromium(), *_chromium_flags(profile), f"--screenshot={shot}", page.as_uri()],
                        capture_output=True, timeout=120)
     assert shot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and shot.stat().st_size > 10_000
+
+
+def _rendered(uri: str) -> ET.Element:
+    """The page at `uri` as Chromium laid it out, its script run (--dump-dom)."""
+    with tempfile.TemporaryDirectory() as profile:
+        dom = subprocess.run([_chromium(), *_chromium_flags(profile), "--dump-dom", uri],
+                             capture_output=True, text=True, timeout=120).stdout
+    return _parse_dom(dom)
 
 
 def _count(root: ET.Element, tag: str, cls: str) -> int:
