@@ -257,6 +257,22 @@ def test_html_of_a_long_run_draws_what_a_page_can_hold_and_says_so(tmp_path):
     assert root.find(".//*[@id='verdict']").text == "FAIL"
 
 
+def test_a_page_of_many_runs_shares_its_frames_between_them(monkeypatch):
+    """A --matrix of soak tests would draw FRAMES_AT_MOST frames for each run: the page
+    shares PAGE_FRAMES_AT_MOST between them instead (each keeps a floor); a page with
+    fewer frames in all is drawn whole."""
+    results = [good_result(), long_result(), long_result()]
+    assert report_html.frames_each(results[:1]) == report_html.FRAMES_AT_MOST
+    monkeypatch.setattr(report_html, "PAGE_FRAMES_AT_MOST", 3000)
+    monkeypatch.setattr(report_html, "FRAMES_EACH_AT_LEAST", 200)
+    assert report_html.frames_each(results) == 1000
+    html = report_html.render(results)
+    assert html.count('class="frame ') == 40 + 1000 + 1000  # the short run whole, the long ones 1000 each
+    assert html.count("show 1000 of its 4202 frames") == 2
+    monkeypatch.setattr(report_html, "PAGE_FRAMES_AT_MOST", 300)
+    assert report_html.frames_each(results) == 200
+
+
 def test_html_lists_at_most_so_many_violations_and_points_to_the_json(tmp_path, monkeypatch):
     monkeypatch.setattr(report_html, "VIOLATIONS_AT_MOST", 3)
     page = tmp_path / "report.html"

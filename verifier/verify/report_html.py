@@ -25,6 +25,10 @@ MINOR_TICKS_UP_TO_MS = 120_000
 #: frames): the diagram and the frame table draw at most this many frames - those around
 #: each violation's frames, then the run's first ones; `--trace` has every frame
 FRAMES_AT_MOST = 4000
+#: a page of many runs (--matrix of soak tests) shares this many frames between them, each
+#: run keeping at least FRAMES_EACH_AT_LEAST; a page under it draws every run as above
+PAGE_FRAMES_AT_MOST = 20_000
+FRAMES_EACH_AT_LEAST = 500
 CONTEXT_FRAMES = 4  # frames drawn on each side of a frame that is evidence of a violation
 VIOLATIONS_AT_MOST = 1000  # violations marked and listed (every one is in --json)
 EVENTS_AT_MOST = 2000  # line and robot events drawn (the scenario's faults first)
@@ -61,23 +65,31 @@ def _event_class(kind: str) -> str:
 MAJOR_TICKS_AT_MOST = 5000
 
 
-def shown_frames(line: list, blamed: dict) -> list[int]:
+def frames_each(results: list[ScenarioResult]) -> int:
+    """How many frames each run of the page may draw: FRAMES_AT_MOST, or a share of
+    PAGE_FRAMES_AT_MOST when the runs have more frames than that between them."""
+    if sum(len(result.trace) for result in results) <= PAGE_FRAMES_AT_MOST:
+        return FRAMES_AT_MOST
+    return min(FRAMES_AT_MOST, max(FRAMES_EACH_AT_LEAST, PAGE_FRAMES_AT_MOST // len(results)))
+
+
+def shown_frames(line: list, blamed: dict, at_most: int = FRAMES_AT_MOST) -> list[int]:
     """The positions (in trace order) of the frames the page draws: all of them, or for a
-    longer run FRAMES_AT_MOST: those within CONTEXT_FRAMES of a blamed frame, in time order,
+    longer run `at_most`: those within CONTEXT_FRAMES of a blamed frame, in time order,
     then the first frames of the run."""
-    if len(line) <= FRAMES_AT_MOST:
+    if len(line) <= at_most:
         return list(range(len(line)))
     shown: set[int] = set()
     for k, frame in enumerate(line):
         if (frame.t_start_us, frame.direction) in blamed:
             shown.update(range(max(0, k - CONTEXT_FRAMES), min(len(line), k + CONTEXT_FRAMES + 1)))
-            if len(shown) >= FRAMES_AT_MOST:
+            if len(shown) >= at_most:
                 break
     k = 0
-    while len(shown) < FRAMES_AT_MOST:
+    while len(shown) < at_most:
         shown.add(k)
         k += 1
-    return sorted(shown)[:FRAMES_AT_MOST]
+    return sorted(shown)[:at_most]
 
 
 def _overview(line: list, end_ms: float, long: bool) -> list[dict]:
@@ -101,9 +113,9 @@ def _skipped_before(shown: list[int]) -> list[int]:
     return gaps
 
 
-def scenario_view(index: int, result: ScenarioResult) -> dict:
+def scenario_view(index: int, result: ScenarioResult, frames_at_most: int = FRAMES_AT_MOST) -> dict:
     line = in_line_order(result)
-    shown = shown_frames(line, blamed_frames(result))
+    shown = shown_frames(line, blamed_frames(result), frames_at_most)
     frames = list(records(result, only=shown))
     end_ms = max(
         [_ms(result.ended_us)] + [_seconds(frame.t_end_us) * 1000 for frame in line]
@@ -148,7 +160,7 @@ def scenario_view(index: int, result: ScenarioResult) -> dict:
         "id": f"s{index}",
         "result": result,
         "frames": frames,
-        "overview": _overview(line, end_ms, long=len(line) > FRAMES_AT_MOST),
+        "overview": _overview(line, end_ms, long=len(line) > frames_at_most),
         "frames_left_out": len(line) - len(frames),
         "frames_after_last": len(line) - 1 - shown[-1] if shown else 0,
         "windows": windows,
@@ -177,10 +189,11 @@ def scenario_view(index: int, result: ScenarioResult) -> dict:
 
 def render(results: list[ScenarioResult]) -> str:
     template = _environment().get_template("report.html.j2")
+    each = frames_each(results)
     return template.render(
         verdict=overall_verdict(results),
         version=__version__,
-        scenarios=[scenario_view(i, r) for i, r in enumerate(results)],
+        scenarios=[scenario_view(i, r, each) for i, r in enumerate(results)],
         px_per_ms=DEFAULT_PX_PER_MS,
         failed=sum(not r.passed for r in results),
         total=len(results),
