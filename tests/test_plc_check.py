@@ -71,3 +71,30 @@ def test_the_library_keeps_to_the_statements_its_docs_name():
             found += [f"{path.relative_to(PLC)}: {pou.name}: {type(n).__name__}"
                       for n in _statements(pou.body) if isinstance(n, left_out)]
     assert not found, found
+
+
+def test_a_program_without_the_library_files_is_told_which_files_to_add(tmp_path):
+    # an integrator's own program, checked or exported without the library's files: the
+    # error names the library file that declares the FB or FUNCTION, not "declare it"
+    main = tmp_path / "Station.st"
+    main.write_text(
+        "PROGRAM Station\n"
+        "VAR\n"
+        "    fbEngine : UITAMR_Engine;\n"
+        "    uBytes : ARRAY[0..15] OF WORD;\n"
+        "    uCrc : WORD;\n"
+        "    fbOwn : FB_NotInTheLibrary;\n"
+        "END_VAR\n"
+        "uCrc := UITAMR_CRC16(uBytes, 6);\n"
+        "END_PROGRAM\n", encoding="utf-8")
+    result = CliRunner().invoke(check_command, ["--target", "gxworks2", str(main)])
+    assert result.exit_code == 1, result.output
+    lines = [line for line in result.output.splitlines() if ": error: " in line]
+    engine = PLC / "core" / "UITAMR_Engine.st"
+    crc = PLC / "core" / "UITAMR_CRC16.st"
+    assert lines[0] == (f"{main}:3:16: error: unknown type 'UITAMR_Engine'; the UITAMR library "
+                        f"declares it: add {engine} (or its folder) to the sources")
+    assert lines[1] == (f"{main}:6:13: error: unknown type 'FB_NotInTheLibrary'; declare the "
+                        "structure or function block, or use a GX Works type")
+    assert lines[2] == (f"{main}:8:9: error: unknown function or instruction 'UITAMR_CRC16'; the "
+                        f"UITAMR library declares it: add {crc} (or its folder) to the sources")

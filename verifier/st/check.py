@@ -13,6 +13,7 @@ import math
 import re
 from dataclasses import dataclass, field
 
+from verifier.bundled import library_file
 from verifier.st import ast, library, structure
 from verifier.st import types as T
 from verifier.st.devices import looks_like_device
@@ -287,7 +288,8 @@ class Checker:
         if key in T.MISSING_TYPES:
             self.rep.error(ref, library_missing(key, self.target))
             return T.ANY
-        self.rep.error(ref, f"unknown type '{ref.name}'; declare the structure or function block, or use a GX Works type")
+        self.rep.error(ref, f"unknown type '{ref.name}'; "
+                       + (_in_library(ref.name) or "declare the structure or function block, or use a GX Works type"))
         return T.ANY
 
     def check_initializer(self, init, t: T.Type, decl: ast.VarDecl) -> None:
@@ -752,7 +754,8 @@ class Checker:
             self.rep.error(c.callee, f"instruction {name} is not available for {_target_name(self.target)}")
             self._args_only(c)
             return T.ANY
-        self.rep.error(c.callee, f"unknown function or instruction '{c.name}'")
+        hint = _in_library(c.name)
+        self.rep.error(c.callee, f"unknown function or instruction '{c.name}'" + (f"; {hint}" if hint else ""))
         self._args_only(c)
         return T.ANY
 
@@ -1006,6 +1009,12 @@ def called_without(function: str, names: list[str]) -> str:
 
 def library_missing(name: str, target: str = "gxworks2") -> str:
     return f"type {name} does not exist in {_target_name(target)}: " + T.MISSING_TYPES.get(name, "")
+
+
+def _in_library(name: str) -> str | None:
+    """What to do when an undeclared name is a POU of the bundled UITAMR library."""
+    path = library_file(name)
+    return f"the UITAMR library declares it: add {path} (or its folder) to the sources" if path else None
 
 
 def _target_name(target: str) -> str:
