@@ -23,6 +23,21 @@ def test_quick_start_runs(tmp_path, monkeypatch):
     exec(compile(blocks("python")[0], str(DOC), "exec"), {})
 
 
+
+def test_quick_start_runs_outside_the_toolkit_with_the_library_named_by_plc_dir(tmp_path, monkeypatch):
+    # testing-st.md: in your own project, name the library where it is (no plc/ beside it)
+    st_block = blocks("iecst")[0]
+    name = re.search(r"FUNCTION_BLOCK (\w+)", st_block).group(1)
+    (tmp_path / f"{name}.st").write_text(st_block, encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    doc_path = '"plc/core/UITAMR_CRC16.st"'
+    documented = 'verifier.bundled.plc_dir() / "core" / "UITAMR_CRC16.st"'
+    assert documented in DOC.read_text(encoding="utf-8")
+    code = blocks("python")[0]
+    assert doc_path in code
+    exec(compile("import verifier.bundled\n" + code.replace(doc_path, documented), str(DOC), "exec"), {})
+
+
 def test_serial_example_runs(tmp_path, monkeypatch):
     monkeypatch.chdir(ROOT)
     code = blocks("python")[1].replace("ms=60_000", "ms=3_000")
