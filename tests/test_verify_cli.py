@@ -226,6 +226,31 @@ def test_a_plain_run_tells_the_platform_from_the_sources(tmp_path):
     assert (scenario["platform"], scenario["channel"], scenario["program"]) == ("q", "q:1", "UITAMR_ExampleQ")
 
 
+
+def test_a_scenario_on_the_wrong_platform_says_which_platform_to_set(tmp_path):
+    """An FX5U program in a scenario that forgot `platform` (so fx3u): the error names the
+    scenario's platform, not only the library file whose SM device the FX3U lacks."""
+    fx5 = [PLC / "core", PLC / "fx5", PLC / "examples" / "common", PLC / "examples" / "fx5" / "UITAMR_ExampleFx5.st"]
+    text = f'name = "mine"\nsources = {json.dumps([str(p) for p in fx5])}\nduration = "2s"\n'
+    unset = tmp_path / "unset.toml"
+    unset.write_text(text, encoding="utf-8")
+    result = invoke("--scenario", unset)
+    assert result.exit_code == 2
+    assert str(PLC / "fx5" / "UITAMR_Port") in result.output  # the load errors stay
+    assert (f"{unset}: platform: the sources load on fx5u, not on fx3u (the default): set "
+            'platform = "fx5u" in the scenario, or give --platform fx5u') in result.output
+    wrong = tmp_path / "wrong.toml"
+    wrong.write_text(text + 'platform = "q"\n', encoding="utf-8")
+    result = invoke("--scenario", wrong)
+    assert result.exit_code == 2
+    assert (f"{wrong}:4:12: platform: the sources load on fx5u, not on q: set "
+            'platform = "fx5u" in the scenario, or give --platform fx5u') in result.output
+    broken = tmp_path / "Broken.st"  # an ST error loads nowhere: no platform to suggest
+    broken.write_text("PROGRAM Broken\nVAR\n    w : INT;\nEND_VAR\nw := w + ;\nEND_PROGRAM\n", encoding="utf-8")
+    result = invoke("--scenario", unset, broken)
+    assert result.exit_code == 2 and "Broken.st:5:" in result.output and "platform:" not in result.output
+
+
 def test_platform_without_sources_picks_the_bundled_scenarios_of_that_platform(tmp_path):
     from verifier.verify.scenario import load_scenario
 

@@ -58,7 +58,7 @@ class _Plc:
                 programs=None if scenario.program is None else [scenario.program],
             )
         except LoadError as exc:
-            raise UnusableInput(str(exc)) from None
+            raise UnusableInput(str(exc) + _platform_hint(scenario)) from None
         try:
             if isinstance(line, Converter):
                 self.project.attach_tcp(line)
@@ -163,6 +163,21 @@ class _Plc:
 
 def _path_parts(name: str) -> list[str]:
     return re.findall(r"[A-Za-z_][A-Za-z0-9_]*|\[\d+\]", name)
+
+
+def _platform_hint(scenario: Scenario) -> str:
+    """When the sources do not load on the scenario's platform but do on another (an FX5U
+    program in a scenario without `platform`, which means fx3u): a line saying which to set."""
+    from .platform import platforms_that_load
+
+    fits, _ = platforms_that_load(scenario.sources)
+    if not fits or scenario.platform in fits:
+        return ""
+    line = scenario.key_lines.get("platform")
+    defaulted = "platform" not in scenario.key_lines and scenario.platform == "fx3u"
+    now = f"{scenario.platform} (the default)" if defaulted else scenario.platform
+    return (f"\n{scenario.where('platform', line)}: the sources load on {', '.join(fits)}, not on {now}: "
+            f'set platform = "{fits[0]}" in the scenario, or give --platform {fits[0]}')
 
 
 def _where(scenario: Scenario) -> str:

@@ -404,6 +404,7 @@ class _Reader:
         keys += [f"{e.key}.{e.kind}" for e in expectations if e.condition is not None]
         keys += [f"{step.key}.set" for step in inputs] + [f"watch[{i}]" for i in range(len(watch))]
         keys += ["response_handling.signal"] if signal_given else []
+        keys += ["platform"] if "platform" in data else []
         return Scenario(
             name=name, path=self.path, description=description, sources=sources, program=program,
             platform=platform, channel=channel, duration_us=duration, scan_us=scan, scan_jitter_us=jitter, seed=seed,
