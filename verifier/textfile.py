@@ -56,9 +56,13 @@ def lone_cr_as_line_feed(text: str) -> str:
     file saved with classic Mac OS line ends (a lone CR) is then read line by line, where
     lark, tomllib-style positions and `text_lines` count lines at line feeds only. CRLF
     text comes back as it is."""
-    if text.count("\r") == text.count("\r\n"):  # none, or only CRLF (GX Works, Windows)
-        return text
-    return re.sub(r"\r(?!\n)", "\n", text)
+    return re.sub(r"\r(?!\n)", "\n", text) if has_lone_cr(text) else text
+
+
+def has_lone_cr(text: str) -> bool:
+    """Whether `text` has a carriage return not followed by a line feed (CRLF, what GX
+    Works and Windows editors write, is not one)."""
+    return text.count("\r") != text.count("\r\n")
 
 
 def text_lines(text: str) -> list[str]:

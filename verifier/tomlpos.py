@@ -11,7 +11,7 @@ import re
 import tomllib
 from dataclasses import dataclass
 
-from verifier.textfile import lone_cr_as_line_feed
+from verifier.textfile import has_lone_cr
 
 
 @dataclass(frozen=True)
@@ -77,7 +77,7 @@ def decode_error_position(error: tomllib.TOMLDecodeError, source: str = "") -> t
     name like every other error. `source` (the file's text) lets the message name a cause
     tomllib cannot: line ends that are lone carriage returns, which TOML does not allow."""
     text = str(error)
-    if lone_cr_as_line_feed(source) != source:
+    if has_lone_cr(source):
         text += ("; the file's line ends are lone carriage returns (classic Mac OS), which TOML "
                  "does not allow: save it with LF or CRLF line ends")
     match = _DECODE_POSITION.search(text)

@@ -48,8 +48,8 @@ _HEX_PAIR = re.compile(r"[0-9A-Fa-f]{2}")
 
 
 def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
-    """A plain capture's chunks; a line ends at a line feed, a CRLF or a lone CR."""
-    text = lone_cr_as_line_feed(text)
+    """A plain capture's chunks (lines end at a line feed or a CRLF; `read_capture` reads a
+    file with lone CRs too)."""
     chunks: list[Chunk] = []
     last_t: int | None = None
     for number, raw in enumerate(text_lines(text), start=1):
@@ -98,9 +98,8 @@ def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
 
 def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
     """Our JSONL trace (`uitamr verify --trace`, `uitamr monitor --trace`): frames with
-    their direction, grouped by scenario, in file order (a record ends at a line feed, a
-    CRLF or a lone CR: JSON strings hold no raw CR)."""
-    text = lone_cr_as_line_feed(text)
+    their direction, grouped by scenario, in file order (a record ends at a line feed or a
+    CRLF; `read_capture` reads a file with lone CRs too)."""
     scenarios: dict[str, list[Chunk]] = {}
     for number, raw in enumerate(text_lines(text), start=1):
         if not raw.strip():
@@ -154,7 +153,8 @@ def read_capture(path: Path) -> dict[str, list[Chunk]]:
     """A capture file, plain or our JSONL trace (told apart by the first character that is
     not blank or a comment), as chunks per capture name."""
     try:
-        text = lone_cr_as_line_feed(read_utf8(path))  # a classic Mac OS file too
+        # a classic Mac OS file too (a JSON trace's strings hold no raw CR)
+        text = lone_cr_as_line_feed(read_utf8(path))
     except UnreadableText as exc:
         raise CaptureError(f"{path}: {exc}") from None
     first = next((line.lstrip() for line in text_lines(text)
