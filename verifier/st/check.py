@@ -139,6 +139,13 @@ class Checker:
             fields = []
             for v in s.fields:
                 self._check_name(v, v.name, "member")
+                instance = self._fb_type_name(v.type)
+                if instance is not None:  # ASSUMPTION (docs/st-dialect.md): structures hold data only
+                    self.rep.error(v.type, f"structure member '{v.name}' is an instance of the function block "
+                                           f"{instance}: a structure holds data only; declare the instance "
+                                           "as a label of the POU that calls it")
+                    fields.append((v.name, T.ANY))
+                    continue
                 ft = self.resolve_type(v.type)
                 fields.append((v.name, ft))
                 if v.init is not None and self.target == "gxworks2" and not _is_zero(v.init):
@@ -291,6 +298,17 @@ class Checker:
         self.rep.error(ref, f"unknown type '{ref.name}'; "
                        + (_in_library(ref.name) or "declare the structure or function block, or use a GX Works type"))
         return T.ANY
+
+    def _fb_type_name(self, ref: ast.TypeRef) -> str | None:
+        """The function block a declared type (or its array's element type) names, if any."""
+        while isinstance(ref, ast.ArrayType):
+            ref = ref.element
+        if not isinstance(ref, ast.NamedType):
+            return None
+        if ref.key in library.STANDARD_FBS and ref.key not in self.table.structs:
+            return ref.key
+        info = self.table.pous.get(ref.key)
+        return info.pou.name if info is not None and info.pou.kind == "FUNCTION_BLOCK" else None
 
     def check_initializer(self, init, t: T.Type, decl: ast.VarDecl) -> None:
         if isinstance(init, ast.ArrayInit):
