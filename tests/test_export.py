@@ -292,3 +292,150 @@ def test_a_file_without_a_pou_is_a_usage_error_naming_it(tmp_path, text):
     assert result.exit_code == 2, result.output
     assert f"{empty}:1:1: error: no POU" in result.output
     assert not out.exists() or not any(out.iterdir())
+
+
+# ---- --program: only what a program needs ---------------------------------------------------
+
+def _bundled_programs():
+    """(sources, program, target) of every bundled scenario, each set once."""
+    import tomllib
+
+    seen = {}
+    for path in sorted((ROOT / "plc" / "scenarios").glob("*.toml")):
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        sources = tuple(sorted(str(p) for pattern in data["sources"] for p in path.parent.glob(pattern)))
+        platform = data.get("platform", "fx3u")
+        seen[(sources, data["program"])] = (platform, "gxworks3" if platform == "fx5u" else "gxworks2")
+    return [(sources, program, *rest) for (sources, program), rest in seen.items()]
+
+
+@pytest.mark.parametrize("sources, program, platform, target", _bundled_programs(),
+                         ids=lambda v: v if isinstance(v, str) else "")
+def test_export_of_a_program_writes_what_the_simulator_runs_of_it(tmp_path, sources, program, platform, target):
+    """--program exports the POUs `uitamr verify` compiles for that program (verifier.sim.reach,
+    worked out on resolved types): the two walks agree on every bundled program."""
+    import verifier
+
+    result = run("--target", target, "--out", str(tmp_path), "--program", program, *sources)
+    assert result.exit_code == 0, result.output
+    exported = {line.split("\t")[0].upper() for line in (tmp_path / "IMPORT_ORDER.txt").read_text().splitlines()}
+    project = verifier.load(*sources, target=target, cpu=platform, programs=[program])
+    compiled = set(re.findall(r"^(?:class|def) (?:FB|FN|PRG)_(\w+)", project.module.source, re.M))
+    assert exported == compiled
+    every = {p.name.upper() for s in sources for p in st.parse(Path(s).read_text(), s, target).pous}
+    assert exported < every  # a real choice: the folders hold POUs this program does not use
+    written = {p.name for p in tmp_path.iterdir()}
+    assert written == {f"{name}{ext}" for name in (line.split("\t")[0] for line in
+                       (tmp_path / "IMPORT_ORDER.txt").read_text().splitlines()) for ext in (".st", ".labels.tsv")} \
+        | {"IMPORT_ORDER.txt"} | ({"GlobalLabels.labels.tsv"} if "GlobalLabels.labels.tsv" in written else set())
+
+
+NEEDS = """
+TYPE Pair :
+STRUCT
+    wValue : WORD;
+END_STRUCT
+END_TYPE
+
+TYPE Outer :
+STRUCT
+    stPair : Pair;
+END_STRUCT
+END_TYPE
+
+TYPE Unused :
+STRUCT
+    wA : WORD;
+END_STRUCT
+END_TYPE
+
+FUNCTION Twice : INT
+VAR_INPUT
+    iX : INT;
+END_VAR
+Twice := iX * 2;
+END_FUNCTION
+
+FUNCTION Never : INT
+VAR_INPUT
+    iX : INT;
+END_VAR
+Never := iX;
+END_FUNCTION
+
+FUNCTION_BLOCK Inner
+VAR_OUTPUT
+    o_wOut : INT;
+END_VAR
+o_wOut := Twice(iX := 3);
+END_FUNCTION_BLOCK
+
+FUNCTION_BLOCK Spare
+VAR
+    wN : INT;
+END_VAR
+wN := Never(iX := 1);
+END_FUNCTION_BLOCK
+
+PROGRAM Main
+VAR
+    aInner : ARRAY[0..1] OF Inner;
+    aOuter : ARRAY[0..1] OF Outer;
+END_VAR
+aInner[0]();
+aOuter[1].stPair.wValue := 1;
+END_PROGRAM
+
+PROGRAM Other
+VAR
+    fbSpare : Spare;
+END_VAR
+fbSpare();
+END_PROGRAM
+"""
+
+
+def test_export_of_a_program_follows_arrays_structures_and_functions(tmp_path):
+    source = tmp_path / "lib.st"
+    source.write_text(NEEDS)
+    out = tmp_path / "out"
+    result = run("--target", "gxworks3", "--out", str(out), "--program", "main", str(source))
+    assert result.exit_code == 0, result.output
+    order = [line.split("\t")[0] for line in (out / "IMPORT_ORDER.txt").read_text().splitlines()]
+    assert order == ["Pair", "Outer", "Twice", "Inner", "Main"]  # a structure after the ones its members use
+    assert sorted(p.name for p in out.iterdir()) == sorted(
+        ["IMPORT_ORDER.txt", "Outer.struct.tsv", "Pair.struct.tsv", "Twice.st", "Twice.labels.tsv", "Inner.st",
+         "Inner.labels.tsv", "Main.st", "Main.labels.tsv"])
+    both = run("--target", "gxworks3", "--out", str(tmp_path / "both"), "--program", "Main", "--program", "Other",
+               str(source))
+    assert both.exit_code == 0, both.output
+    assert both.output.startswith("6 POU(s) exported")  # Twice, Inner, Main; Never, Spare, Other
+
+
+def test_export_of_an_unknown_program_names_the_programs_and_writes_nothing(tmp_path):
+    source = tmp_path / "lib.st"
+    source.write_text(NEEDS)
+    out = tmp_path / "out"
+    result = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(out), "--program", "Mian", str(source)])
+    assert result.exit_code == 2
+    assert "no POU Mian in the sources (their PROGRAMs: Main, Other)" in result.output
+    assert not out.exists()
+
+
+def test_export_of_a_program_still_checks_every_file(tmp_path):
+    (tmp_path / "lib.st").write_text(NEEDS)
+    (tmp_path / "broken.st").write_text("FUNCTION_BLOCK Broken\nVAR\n    x : INT;\nEND_VAR\nx := TRUE;\nEND_FUNCTION_BLOCK\n")
+    result = run("--target", "gxworks3", "--out", str(tmp_path / "out"), "--program", "Main", str(tmp_path))
+    assert result.exit_code == 1
+    assert "broken.st:5:6: error" in result.output
+
+
+@pytest.mark.parametrize("page, target, example", [("import-gxworks2.md", "gxworks2", "UITAMR_ExampleFx3"),
+                                                   ("import-gxworks3.md", "gxworks3", "UITAMR_ExampleFx5")])
+def test_the_import_pages_list_what_export_writes_for_the_example(tmp_path, page, target, example):
+    text = " ".join((ROOT / "docs" / page).read_text(encoding="utf-8").split())
+    listed = re.search(rf"example \(`{example}`\) these are (.*?) and the example", text).group(1)
+    result = run("--target", target, "--out", str(tmp_path), "--program", example)
+    assert result.exit_code == 0, result.output
+    written = [line.split("\t")[0] for line in (tmp_path / "IMPORT_ORDER.txt").read_text().splitlines()]
+    assert re.findall(r"`(\w+)`", listed) + [example] == written

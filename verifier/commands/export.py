@@ -37,12 +37,17 @@ def bundled_sources(target: str) -> list[Path]:
               help="The engineering tool that will import the files.")
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), required=True,
               help="Folder for <POU>.st, <POU>.labels.tsv, GlobalLabels.labels.tsv, <Type>.struct.tsv and IMPORT_ORDER.txt.")
-def command(sources: tuple[str, ...], target: str, out_dir: str) -> None:
+@click.option("--program", "programs", multiple=True, metavar="NAME",
+              help="Write only this POU (usually your PROGRAM) and every function block, function and "
+                   "structure it needs, with the global labels; repeat for more. Every source is still "
+                   "checked. Default: every POU of the sources.")
+def command(sources: tuple[str, ...], target: str, out_dir: str, programs: tuple[str, ...]) -> None:
     """Write, per POU, the ST body and a tab-separated label table for GX Works.
 
     With no SOURCES: the bundled library (plc/core, the ports and the examples of the
     target editor's platforms)."""
     from verifier.export import ExportError, NothingToExport, export_sources
+    from verifier.export.needed import UnknownProgram
     from verifier.export.writer import DROPPED_TABLE, IMPORT_ORDER
 
     if sources:
@@ -79,7 +84,7 @@ def command(sources: tuple[str, ...], target: str, out_dir: str) -> None:
         sys.exit(EXIT_ERRORS)
     notes: list = []
     try:
-        written = export_sources(paths, target, Path(out_dir), texts, notes=notes)
+        written = export_sources(paths, target, Path(out_dir), texts, notes=notes, programs=list(programs))
     except NothingToExport as e:
         for d in e.diagnostics:
             click.echo(str(d), err=True)
@@ -90,6 +95,9 @@ def command(sources: tuple[str, ...], target: str, out_dir: str) -> None:
             click.echo(str(d), err=True)
         click.echo(f"uitamr export: nothing written, {len(e.diagnostics)} error(s)", err=True)
         sys.exit(EXIT_ERRORS)
+    except UnknownProgram as e:
+        click.echo(f"uitamr export: nothing written: --program: {e}", err=True)
+        sys.exit(EXIT_USAGE)
     except OSError as e:
         click.echo(f"uitamr export: cannot write {out_dir}: {e.strerror or e}", err=True)
         sys.exit(EXIT_USAGE)

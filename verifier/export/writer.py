@@ -18,6 +18,7 @@ from pathlib import Path
 from verifier import st
 from verifier.st import ast
 from verifier.export.body import body_text
+from verifier.export.needed import needed, only, type_names
 from verifier.export.labels import LabelRow, initial_text, label_class, label_rows, rows_of
 from verifier.export.types import type_name
 from verifier.textfile import text_lines
@@ -191,13 +192,15 @@ def _struct_file(out: Path, struct) -> Path:
     return out / f"{struct.name}.struct.tsv"
 
 
-def _overwritten_sources(files: list[ast.SourceFile], paths: list[Path], out: Path) -> list[ast.Diagnostic]:
-    """The sources the export would write over (`--out` is their own folder and a POU has
-    the file's name): refused before anything is written, or the declarations are lost."""
+def _overwritten_sources(files: list[ast.SourceFile], paths: dict[Path, ast.SourceFile],
+                         out: Path) -> list[ast.Diagnostic]:
+    """The sources (`paths`: every source file read, by path) the export of `files` would
+    write over (`--out` is their own folder and a POU has the file's name): refused before
+    anything is written, or the declarations are lost."""
     planned = [(f, pou, target) for f in files for pou in f.pous for target in _pou_files(out, pou)]
     planned += [(f, struct, _struct_file(out, struct)) for f in files for struct in f.types]
     planned += [(None, None, out / name) for name in (GLOBAL_TABLE, DROPPED_TABLE, IMPORT_ORDER)]
-    sources = {path.resolve(): f for f, path in zip(files, paths)}
+    sources = {path.resolve(): f for path, f in paths.items()}
     problems = []
     for f, node, target in planned:
         source = sources.get(target.resolve())
@@ -205,7 +208,7 @@ def _overwritten_sources(files: list[ast.SourceFile], paths: list[Path], out: Pa
             source = next((v for k, v in sources.items() if k.exists() and os.path.samefile(k, target)), None)
         if source is None:
             continue
-        line, col = (node.span.line, node.span.col) if source is f else (1, 1)
+        line, col = (node.span.line, node.span.col) if f is not None and source.filename == f.filename else (1, 1)
         problems.append(ast.Diagnostic(
             source.filename, line, col, "error",
             f"exporting into {out} would write {target.name} over this source file: choose another --out folder"))
@@ -224,11 +227,14 @@ def _pous_named_like_the_export_files(files: list[ast.SourceFile], out: Path) ->
 
 
 def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, str] | None = None,
-                   notes: list[DroppedValue] | None = None) -> list[Path]:
+                   notes: list[DroppedValue] | None = None, programs: list[str] | None = None) -> list[Path]:
     """Parse and check `paths`, write the export into `out`; returns the files written.
     Raises ExportError (with file:line:col diagnostics) when a source has errors, and
     NothingToExport when a file has nothing in it to export. Initial values the target
-    cannot carry are appended to `notes` (and written to DROPPED_INITIAL_VALUES.txt)."""
+    cannot carry are appended to `notes` (and written to DROPPED_INITIAL_VALUES.txt).
+    With `programs` (POU names), only those POUs and what they need are written
+    (`needed.needed`; UnknownProgram for a name the sources do not define); every file
+    is still checked."""
     if target not in COLUMNS:
         raise ValueError(f"unknown target {target!r}; expected gxworks2 or gxworks3")
     texts = texts or {}
@@ -240,10 +246,15 @@ def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, 
     empty = _empty_files(files)
     if empty:
         raise NothingToExport(empty)
-    clashes = _overwritten_sources(files, paths, out) + _pous_named_like_the_export_files(files, out)
+    sources = dict(zip(paths, files))
+    if programs:
+        keys = needed(files, programs)
+        files = [part for part in (only(f, keys) for f in files) if part.pous or part.types or part.globals]
+    clashes = _overwritten_sources(files, sources, out) + _pous_named_like_the_export_files(files, out)
     if clashes:
         raise ExportError(clashes)
     known = {p.key for f in files for p in f.pous}
+    structs = {t.key for f in files for t in f.types}
     exported: list[ExportedPou] = []
     out.mkdir(parents=True, exist_ok=True)
     written: list[Path] = []
@@ -262,7 +273,8 @@ def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, 
             path = _struct_file(out, struct)
             path.write_text(struct_table(rows_of(struct.fields, f.text, target), target), encoding="utf-8")
             written.append(path)
-            exported.append(ExportedPou(struct.name, "STRUCT", f.filename))
+            members = {k for v in struct.fields for k in type_names(v.type) if k in structs}
+            exported.append(ExportedPou(struct.name, "STRUCT", f.filename, uses=members - {struct.key}))
     global_rows = [row for f in files for block in f.globals for row in rows_of(block.variables, f.text, target)]
     if global_rows:
         path = out / GLOBAL_TABLE

@@ -31,7 +31,7 @@ def needed_pous(pous: dict, struct_fields: dict, globals_: dict, programs) -> se
         info = pous[key]
         for sym in info.symbols.values():
             stack += _fb_types(sym.type, struct_fields, set())
-        stack += _called(info.pou, pous)
+        stack += called_functions(info.pou, pous)
     return needed
 
 
@@ -48,7 +48,7 @@ def _fb_types(t, struct_fields: dict, seen: set) -> list[str]:
     return []
 
 
-def _called(pou: ast.Pou, pous: dict) -> list[str]:
+def called_functions(pou: ast.Pou, pous: dict) -> list[str]:
     """The user FUNCTIONs called anywhere in `pou` (its body and its initial values)."""
     called: list[str] = []
     stack: list = [pou.var_blocks, pou.body]
