@@ -212,6 +212,17 @@ def test_import_verifier_stays_cheap():
     assert out.stdout.split() == ["False", "False"]
 
 
+def test_the_cpu_profiles_do_not_import_the_compiler():
+    # uitamr check lists the CPU profiles as its --platform choices on every run
+    import subprocess
+    import sys
+
+    code = ("import sys, verifier.sim.cpu, verifier.sim; print('verifier.sim.project' in sys.modules); "
+            "verifier.sim.load; print('verifier.sim.project' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["False", "True"]
+
+
 def test_load_reads_files_as_check_does(tmp_path):
     """QA 24: one ST reader (verifier.st.read_source) for check, export and load."""
     from verifier.st.source import read_source
