@@ -138,7 +138,9 @@ def render(diag: Diagnostic, lines: list[str] | None) -> str:
 @click.option("--platform", type=click.Choice(sorted(PROFILES)), default=None,
               help="Also check every device (name, range, index register) and instruction against "
                    "this CPU, as `uitamr verify --platform` loads it (fx3g: the FX3G CPU profile, "
-                   "which verify has no scenarios for). Default: no CPU check.")
+                   "which verify has no scenarios for); errors under rule UITAMR-ST-CPU. Implies the "
+                   "dialect; a --target whose editor does not program the CPU is refused. Default: "
+                   "no CPU check.")
 @click.option("--format", "fmt", type=click.Choice(["text", "json", "github", "sarif"]), default="text",
               show_default=True,
               help="text: file:line:col: error: message (editors); json; github: GitHub Actions "
