@@ -40,6 +40,15 @@ def test_check_command_accepts_the_library():
     assert "0 error(s), 0 warning(s)" in result.output
 
 
+@pytest.mark.parametrize("platform", sorted(SETS))
+def test_platform_set_has_only_devices_and_instructions_of_its_cpu(platform):
+    # every .st file (test_every_st_file_belongs_to_a_checked_set), not only those a bundled
+    # scenario names: uitamr check --platform, which implies the editor
+    result = CliRunner().invoke(check_command, ["--platform", platform, *map(str, files(SETS[platform][1]))])
+    assert result.exit_code == 0, result.output
+    assert f"checked for {SETS[platform][0]} on the {platform} CPU: 0 error(s), 0 warning(s)" in result.output
+
+
 def test_every_st_file_belongs_to_a_checked_set():
     checked = {p for _, parts in SETS.values() for p in files(parts)}
     assert set(PLC.rglob("*.st")) <= checked

@@ -70,6 +70,18 @@ def test_instruction_of_another_cpu_is_refused_at_its_location():
     load_st(src, cpu="q")  # fine on a Q CPU
 
 
+@pytest.mark.parametrize("cpu, fits", [("fx3u", False), ("fx3g", False), ("q", True)])
+def test_an_index_register_the_cpu_lacks_is_refused_at_load_not_at_run_time(cpu, fits):
+    # FX3U/FX3G have Z0..Z7, the Q Z0..Z19: D0Z8 used to load on an FX3U and fail in the scan
+    src = "PROGRAM P\nVAR x : INT; END_VAR\nx := D10Z8;\nEND_PROGRAM\n"
+    if fits:
+        load_st(src, cpu=cpu).run_programs(["P"], scans=1)
+        return
+    with pytest.raises(LoadError) as err:
+        load_st(src, cpu=cpu)
+    assert f"t.st:3:6: error: device D10Z8: index register Z8 does not exist on the {cpu} (Z0..Z7)" in str(err.value)
+
+
 def test_rs2_on_a_channel_the_cpu_lacks():
     src = ("PROGRAM P\nVAR s, r : ARRAY[0..3] OF WORD; END_VAR\n"
            "RS2(TRUE, s[0], 4, 4, 3, r[0]);\nEND_PROGRAM\n")
@@ -198,6 +210,17 @@ def test_import_verifier_stays_cheap():
     code = "import verifier, sys; print('verifier.sim' in sys.modules, 'lark' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["False", "False"]
+
+
+def test_the_cpu_profiles_do_not_import_the_compiler():
+    # uitamr check lists the CPU profiles as its --platform choices on every run
+    import subprocess
+    import sys
+
+    code = ("import sys, verifier.sim.cpu, verifier.sim; print('verifier.sim.project' in sys.modules); "
+            "verifier.sim.load; print('verifier.sim.project' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["False", "True"]
 
 
 def test_load_reads_files_as_check_does(tmp_path):

@@ -8,6 +8,11 @@ problem matchers read it). `--format json`, `github` (GitHub Actions annotations
 Exit status: 1 if any error, 0 otherwise (warnings allowed), 2 for usage errors
 (missing file, not a regular file, bad option). Every file is read and checked even when
 another one is broken; POUs may use POUs from the other files given.
+
+`--platform fx3u|fx3g|fx5u|q` also checks every device and instruction against that CPU,
+with the simulator's own rules (verifier.sim.cpucheck): what `uitamr verify` on that
+platform would refuse (SM400 on an FX3U, D9000, Z8, CRC on a Q ...) is reported here, each
+at its file:line:col under the rule UITAMR-ST-CPU. Without it nothing is asked of the CPU.
 """
 from __future__ import annotations
 
@@ -16,7 +21,8 @@ from pathlib import Path
 
 import click
 
-from verifier.commands.check_formats import Finding, to_github, to_json, to_sarif
+from verifier.commands.check_formats import PLATFORM_RULES, RULES, Finding, to_github, to_json, to_sarif
+from verifier.sim.cpu import EDITOR_NAMES, PROFILES, TARGET_CPUS
 from verifier.st import TARGETS
 from verifier.st.ast import Diagnostic, SourceFile
 from verifier.textfile import text_lines
@@ -55,9 +61,11 @@ def _not_a_source(path: Path) -> str | None:
     return problems[0].message if problems else None
 
 
-def check_findings(paths: list[Path], target: str) -> tuple[list[SourceFile], list[Finding]]:
+def check_findings(paths: list[Path], target: str,
+                   platform: str | None = None) -> tuple[list[SourceFile], list[Finding]]:
     """Every finding about `paths` (ST files and scenario .toml files), in file order, each
-    under the rule it comes from (see check_formats)."""
+    under the rule it comes from (see check_formats). With `platform` (a CPU profile name),
+    also the devices and instructions that CPU does not have."""
     from verifier.st import check, parse, read_source
 
     files: list[SourceFile] = []
@@ -73,9 +81,27 @@ def check_findings(paths: list[Path], target: str) -> tuple[list[SourceFile], li
     findings += [Finding(d, "UITAMR-ST-SYNTAX") for f in files for d in f.diagnostics]
     findings += [Finding(d, "UITAMR-ST-CHECK" if d.is_error else "UITAMR-ST-WARNING")
                  for d in check(files, target)]
+    if platform is not None:
+        from verifier.sim.cpucheck import cpu_diagnostics
+
+        findings += [Finding(d, "UITAMR-ST-CPU") for d in cpu_diagnostics(files, PROFILES[platform])]
     order = {str(p): i for i, p in enumerate(paths)}
     findings.sort(key=lambda f: (order.get(f.diagnostic.file, len(order)), f.diagnostic.line, f.diagnostic.col))
     return files, findings
+
+
+def platform_target(platform: str, target: str | None) -> str:
+    """The dialect to check `platform`'s sources in: `target` when given and its editor
+    programs that CPU, else the editor that does (TARGET_CPUS, as `verifier.load` reads
+    it). A contradictory pair is a usage error (SystemExit 2)."""
+    editor = next(t for t, cpus in TARGET_CPUS.items() if platform in cpus)
+    if target is not None and target != editor:
+        click.echo(f"uitamr check: --platform {platform} and --target {target} disagree: the {platform.upper()} "
+                   f"is programmed in {EDITOR_NAMES[editor]} (--target {editor}), not {EDITOR_NAMES[target]}; "
+                   f"drop --target (--platform {platform} implies {editor}) or name a CPU {EDITOR_NAMES[target]} "
+                   f"programs: --platform {'|'.join(TARGET_CPUS[target])}", err=True)
+        sys.exit(EXIT_USAGE)
+    return editor
 
 
 def check_scenario(path: Path) -> list[Diagnostic]:
@@ -106,15 +132,24 @@ def render(diag: Diagnostic, lines: list[str] | None) -> str:
 
 @click.command(name="check")
 @click.argument("sources", nargs=-1, required=True, type=click.Path())
-@click.option("--target", type=click.Choice(TARGETS), default="gxworks2", show_default=True,
-              help="Which engineering tool's dialect to accept.")
+@click.option("--target", type=click.Choice(TARGETS), default=None,
+              help="Which engineering tool's dialect to accept. Default: the editor of --platform's "
+                   "CPU (gxworks3 for fx5u, gxworks2 for the others), else gxworks2.")
+@click.option("--platform", type=click.Choice(sorted(PROFILES)), default=None,
+              help="Also check every device (name, range, index register) and instruction against "
+                   "this CPU, as `uitamr verify --platform` loads it (fx3g: the FX3G CPU profile, "
+                   "which verify has no scenarios for); errors under rule UITAMR-ST-CPU. Implies the "
+                   "dialect; a --target whose editor does not program the CPU is refused. Default: "
+                   "no CPU check.")
 @click.option("--format", "fmt", type=click.Choice(["text", "json", "github", "sarif"]), default="text",
               show_default=True,
               help="text: file:line:col: error: message (editors); json; github: GitHub Actions "
                    "annotations; sarif: SARIF 2.1.0 for code scanning (docs/ci.md).")
-def command(sources: tuple[str, ...], target: str, fmt: str) -> None:
+def command(sources: tuple[str, ...], target: str | None, platform: str | None, fmt: str) -> None:
     """Parse and type-check GX Works structured text (files or directories of .st), and
-    scenario files (.toml) as `uitamr verify` reads them."""
+    scenario files (.toml) as `uitamr verify` reads them. With --platform, also check the
+    devices and instructions against that CPU."""
+    target = platform_target(platform, target) if platform else target or "gxworks2"
     paths = expand_sources(sources)
     unusable = [(p, _not_a_source(p)) for p in paths]
     unusable = [(p, why) for p, why in unusable if why]
@@ -125,21 +160,22 @@ def command(sources: tuple[str, ...], target: str, fmt: str) -> None:
     if not paths:
         click.echo("uitamr check: no .st files found in the given directories", err=True)
         sys.exit(EXIT_USAGE)
-    files, findings = check_findings(paths, target)
+    files, findings = check_findings(paths, target, platform)
     diagnostics = [f.diagnostic for f in findings]
     errors = sum(d.is_error for d in diagnostics)
     warnings = len(diagnostics) - errors
     if fmt == "json":
-        click.echo(to_json(findings, target, [str(p) for p in paths]))
+        click.echo(to_json(findings, target, [str(p) for p in paths], platform))
     elif fmt == "github":
         annotations = to_github(findings)
         if annotations:
             click.echo(annotations)
-        click.echo(f"{len(paths)} file(s) checked for {target}: {errors} error(s), {warnings} warning(s)")
+        click.echo(f"{len(paths)} file(s) checked for {_checked_for(target, platform)}: {errors} error(s), "
+                   f"{warnings} warning(s)")
     elif fmt == "sarif":
         from verifier import __version__
 
-        click.echo(to_sarif(findings, __version__))
+        click.echo(to_sarif(findings, __version__, {**RULES, **PLATFORM_RULES} if platform else RULES))
     else:
         texts = {f.filename: text_lines(f.text) for f in files}
         for p in paths:
@@ -147,7 +183,8 @@ def command(sources: tuple[str, ...], target: str, fmt: str) -> None:
                 texts[str(p)] = _lines_of(p)
         for d in diagnostics:
             click.echo(render(d, texts.get(d.file)))
-        click.echo(f"{len(paths)} file(s) checked for {target}: {errors} error(s), {warnings} warning(s)")
+        click.echo(f"{len(paths)} file(s) checked for {_checked_for(target, platform)}: {errors} error(s), "
+                   f"{warnings} warning(s)")
     sys.exit(EXIT_ERRORS if errors else EXIT_OK)
 
 
@@ -156,3 +193,7 @@ def _lines_of(path: Path) -> list[str] | None:
         return text_lines(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError):
         return None
+
+
+def _checked_for(target: str, platform: str | None) -> str:
+    return f"{target} on the {platform} CPU" if platform else target

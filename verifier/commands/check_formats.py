@@ -11,6 +11,7 @@ SARIF viewer) can group them:
 | `UITAMR-ST-CHECK` | the checker's errors: types, labels, GX Works rules |
 | `UITAMR-ST-WARNING` | the checker's warnings (unused labels, ...) |
 | `UITAMR-SCENARIO` | a scenario file (`.toml`) that `uitamr verify` would refuse |
+| `UITAMR-ST-CPU` | with `--platform` only: a device or instruction that CPU does not have |
 """
 from __future__ import annotations
 
@@ -30,6 +31,11 @@ RULES = {
     "UITAMR-ST-CHECK": "ST check: types, labels and GX Works rules",
     "UITAMR-ST-WARNING": "ST check warning",
     "UITAMR-SCENARIO": "Scenario file: a key or value uitamr verify refuses",
+}
+#: the rules of `uitamr check --platform` (listed only when it is given, so the output
+#: without it stays what it was)
+PLATFORM_RULES = {
+    "UITAMR-ST-CPU": "CPU: a device or instruction the --platform CPU does not have (as uitamr verify loads it)",
 }
 
 
@@ -54,10 +60,11 @@ def relative(file: str) -> str:
     return Path(shown).as_posix()
 
 
-def to_json(findings: list[Finding], target: str, files: list[str]) -> str:
+def to_json(findings: list[Finding], target: str, files: list[str], platform: str | None = None) -> str:
     errors = sum(f.diagnostic.is_error for f in findings)
     return json.dumps({
         "target": target,
+        **({"platform": platform} if platform else {}),
         "files": files,
         "errors": errors,
         "warnings": len(findings) - errors,
@@ -98,9 +105,10 @@ def to_github(findings: list[Finding]) -> str:
     return "\n".join(out)
 
 
-def to_sarif(findings: list[Finding], version: str) -> str:
-    """SARIF 2.1.0, one run, for GitHub code scanning (upload-sarif) and SARIF viewers."""
-    used = sorted({f.rule for f in findings} | set(RULES))
+def to_sarif(findings: list[Finding], version: str, rules: dict[str, str] = RULES) -> str:
+    """SARIF 2.1.0, one run, for GitHub code scanning (upload-sarif) and SARIF viewers;
+    `rules` are those the run lists (RULES, and PLATFORM_RULES with --platform)."""
+    used = sorted({f.rule for f in findings} | set(rules))
     index = {rule: i for i, rule in enumerate(used)}
     results = []
     for f in findings:
@@ -127,7 +135,7 @@ def to_sarif(findings: list[Finding], version: str) -> str:
                 "name": TOOL_NAME,
                 "version": version,
                 "rules": [{"id": rule, "name": rule.title().replace("-", ""),
-                           "shortDescription": {"text": RULES.get(rule, rule)}} for rule in used],
+                           "shortDescription": {"text": rules.get(rule, rule)}} for rule in used],
             }},
             "columnKind": "unicodeCodePoints",
             "originalUriBaseIds": {"%SRCROOT%": {"uri": Path.cwd().resolve().as_uri() + "/"}},

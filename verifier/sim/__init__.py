@@ -10,6 +10,16 @@ a virtual clock (`runtime`) with MELSEC device memory (`devices`), standard FBs
 serial output is a timed byte stream (`serial`).  docs/testing-st.md is the user guide.
 """
 from .errors import LoadError, SimDiagnostic, SimulationError
-from .project import Instance, Project, load
 
 __all__ = ["load", "Project", "Instance", "LoadError", "SimulationError", "SimDiagnostic"]
+
+
+def __getattr__(name: str):
+    # load, Project and Instance come from the compiler's side of the package, imported on
+    # first use: what only needs the CPU profiles (verifier.sim.cpu: `uitamr check`'s
+    # --platform choices) does not pay for the compiler.
+    if name in ("load", "Project", "Instance"):
+        from . import project
+
+        return getattr(project, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

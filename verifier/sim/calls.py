@@ -181,11 +181,10 @@ class CallCompiler:
         return None
 
     def call_instruction(self, c: ast.Call, as_stmt: bool):
-        found = instructions.lookup(c.key, self.family)
-        spec, pulse = found
-        if self.family not in spec.families:
-            raise CompileError(c.span, f"{c.name} does not exist on the {self.m.cpu.name} "
-                                       f"(it is a {'/'.join(sorted(spec.families))} instruction)")
+        spec, pulse = instructions.lookup(c.key, self.family)
+        missing = instructions.not_on_cpu(c.name, self.m.cpu)
+        if missing:
+            raise CompileError(c.span, missing)
         want = 1 + len(spec.operands)
         if len(c.args) != want or any(a.name is not None for a in c.args):
             raise CompileError(c.span, f"{c.name} is called with {want} positional operands "

@@ -16,6 +16,7 @@ from verifier.st import ast
 from . import datatypes
 from .calls import CallCompiler
 from .cpu import SEND_FLAGS
+from .devices import DeviceError, locate
 from .typesys import (ANYINT, ANYREAL, ArrayT, CompileError, FbT, PouInfo, StringT, StructT,
                       Symbol, concrete, is_int, is_real, is_string, norm_code, unify)
 
@@ -325,55 +326,35 @@ class BodyCompiler(CallCompiler):
             g = self.m.buffer_global(int(d.module, 16))
             idx = d.number
             return LValue("INT", f"{g}[{idx}]", f"{g}[{idx}] = {{v}}", label=label)
-        area = cpu.areas.get(d.kind)
-        if area is None:
-            raise CompileError(d.span, f"device {label}: the {cpu.name} CPU profile has no "
-                                       f"{d.kind} devices the simulator can run")
         try:
-            index = int(d.address, area.radix)
-        except ValueError:
-            raise CompileError(d.span, f"device {label}: {d.kind} numbers are base {area.radix} "
-                                       f"on the {cpu.name}") from None
-        if index >= area.size:
-            raise CompileError(d.span, f"device {label} does not exist on the {cpu.name}")
+            area, index = locate(d, cpu)
+        except DeviceError as e:
+            raise CompileError(d.span, str(e)) from None
         cells = f"_A_{d.kind}"
         self.m.use_area(d.kind)
-        prep = []
         idx_code = str(index)
         if d.index is not None:
-            if "Z" not in cpu.areas:
-                raise CompileError(d.span, f"{cpu.name} has no index registers")
             self.m.use_area("Z")
             t = self.new_tmp()
             k = self.m.oob_id(d.span, label, 0, area.size - 1)
-            prep.append(f"{t} = {index} + _A_Z[{d.index}]")
-            prep.append(f"if not 0 <= {t} < {area.size}: _oob({t}, {k})")
-            idx_code = t
-        place = f"{cells}[{idx_code}]"
-        if prep and (d.digits is not None or d.bit is not None):
-            raise CompileError(d.span, f"{label}: index modification of a bit/digit access is not simulated")
-        if prep:
+            prep = [f"{t} = {index} + _A_Z[{d.index}]", f"if not 0 <= {t} < {area.size}: _oob({t}, {k})"]
             # a read needs the checked index inside one expression
-            read = (f"({cells}[{idx_code}] if 0 <= ({idx_code} := {index} + _A_Z[{d.index}]) < {area.size} "
-                    f"else _oob({idx_code}, {self.m.oob_id(d.span, label, 0, area.size - 1)}))")
+            read = (f"({cells}[{t}] if 0 <= ({t} := {index} + _A_Z[{d.index}]) < {area.size} "
+                    f"else _oob({t}, {self.m.oob_id(d.span, label, 0, area.size - 1)}))")
             kind = "BOOL" if area.kind == "bit" else "INT"
-            return LValue(kind, read, f"{place} = {{v}}", prep, label)
+            return LValue(kind, read, f"{cells}[{t}] = {{v}}", prep, label)
+        place = f"{cells}[{idx_code}]"
         if d.digits is not None:
-            if area.kind != "bit":
-                raise CompileError(d.span, f"digit specification needs a bit device: {label}")
-            if index + d.digits * 4 > area.size:
-                raise CompileError(d.span, f"{label} runs past the end of {d.kind}")
             t = "INT" if d.digits <= 4 else "DINT"
             return LValue(t, f"_digits_get({cells}, {idx_code}, {d.digits})",
-                          f"_digits_set({cells}, {idx_code}, {d.digits}, {{v}})", prep, label)
+                          f"_digits_set({cells}, {idx_code}, {d.digits}, {{v}})", [], label)
         if d.bit is not None:
-            if area.kind != "word":
-                raise CompileError(d.span, f"{label}: only word devices have addressable bits")
             mask = 1 << d.bit
             read = f"(({place}) >> {d.bit} & 1 == 1)"
             write = (f"{place} = (((({place}) | {mask}) if ({{v}}) else (({place}) & ~{mask})) "
                      f"+ 32768 & 65535) - 32768")
-            return LValue("BOOL", read, write, prep, label)
+            return LValue("BOOL", read, write, [], label)
+        prep = []
         flag_channel = SEND_FLAGS.get(self.family, {}).get(f"{d.kind}{index}")
         if area.kind == "bit":
             write = f"{place} = {{v}}"

@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from .cpu import CpuProfile
+from .cpu import Area, CpuProfile
 from .datatypes import wrap16, wrap32
 
 _DEVICE_RE = re.compile(r"^(?:K([1-8]))?([A-Z]{1,2})([0-9A-F]+)(?:\.([0-9A-F]))?$")
@@ -58,6 +58,45 @@ def parse_device(name: str, cpu: CpuProfile) -> DeviceAddress:
             raise DeviceError(f"{name!r}: runs past the end of {area_name}")
         return DeviceAddress(area_name, index, "bit", digits=int(digits))
     return DeviceAddress(area_name, index, area.kind)
+
+
+def locate(d, cpu: CpuProfile) -> tuple[Area, int]:
+    """(area, number) of a device written in ST (`verifier.st.ast.Device`, not buffer
+    memory) on `cpu`, or DeviceError saying why the simulator cannot run it there: an area
+    the CPU profile lacks, a number in the wrong radix or past the end, an index register
+    the CPU lacks, a digit or bit access of the wrong kind of device.
+
+    The one check of written devices against a CPU profile: the simulator's compiler and
+    `uitamr check --platform` both ask it, so they cannot disagree."""
+    label = d.text or d.key
+    area = cpu.areas.get(d.kind)
+    if area is None:
+        raise DeviceError(f"device {label}: the {cpu.name} CPU profile has no "
+                          f"{d.kind} devices the simulator can run")
+    try:
+        index = int(d.address, area.radix)
+    except ValueError:
+        raise DeviceError(f"device {label}: {d.kind} numbers are base {area.radix} "
+                          f"on the {cpu.name}") from None
+    if index >= area.size:
+        raise DeviceError(f"device {label} does not exist on the {cpu.name}")
+    if d.index is not None:
+        z = cpu.areas.get("Z")
+        if z is None:
+            raise DeviceError(f"{cpu.name} has no index registers")
+        if d.index >= z.size:
+            raise DeviceError(f"device {label}: index register Z{d.index} does not exist on the "
+                              f"{cpu.name} (Z0..Z{z.size - 1})")
+        if d.digits is not None or d.bit is not None:
+            raise DeviceError(f"{label}: index modification of a bit/digit access is not simulated")
+    if d.digits is not None:
+        if area.kind != "bit":
+            raise DeviceError(f"digit specification needs a bit device: {label}")
+        if index + d.digits * 4 > area.size:
+            raise DeviceError(f"{label} runs past the end of {d.kind}")
+    if d.bit is not None and area.kind != "word":
+        raise DeviceError(f"{label}: only word devices have addressable bits")
+    return area, index
 
 
 def _fmt(n: int, radix: int) -> str:

@@ -80,6 +80,17 @@ def lookup(name: str, family: str) -> tuple[InstructionSpec, bool] | None:
     return None
 
 
+def not_on_cpu(name: str, cpu) -> str | None:
+    """Why the instruction called `name` (as written) does not run on the CPU profile
+    `cpu`, or None: when it does, and for names that are no instruction the simulator
+    knows. The simulator's compiler and `uitamr check --platform` both ask this."""
+    found = lookup(name, cpu.family)
+    if found is None or cpu.family in found[0].families:
+        return None
+    return (f"{name} does not exist on the {cpu.name} "
+            f"(it is a {'/'.join(sorted(found[0].families))} instruction)")
+
+
 class InstructionSet:
     """The instruction implementations bound to one runtime (generated code calls
     `_I.RS2(en, ..., loc_id)`)."""

@@ -1,0 +1,198 @@
+"""`uitamr check --platform`: devices and instructions against a CPU, with the simulator's rules."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from st_helpers import ROOT
+from verifier.cli import main
+from verifier.commands.check_formats import RULES
+
+SCENARIOS = sorted((ROOT / "plc" / "scenarios").glob("*.toml"))
+
+BAD = """PROGRAM Bad
+VAR
+  x : INT;
+END_VAR
+x := D8403;
+SM400 := TRUE;
+END_PROGRAM
+"""
+
+
+def run(*args):
+    return CliRunner().invoke(main, ["check", *map(str, args)])
+
+
+def write(tmp_path: Path, text: str, name: str = "p.st") -> Path:
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def program(body: str, decls: str = "x : INT; b : BOOL;") -> str:
+    return f"PROGRAM P\nVAR\n  {decls}\nEND_VAR\n{body}\nEND_PROGRAM\n"
+
+
+def errors(output: str) -> list[str]:
+    return [line for line in output.splitlines() if ": error: " in line]
+
+
+def test_sm400_on_an_fx3u_is_an_error_at_its_place(tmp_path):
+    bad = write(tmp_path, BAD)
+    assert run(bad).exit_code == 0  # without --platform nothing is asked of the CPU
+    done = run("--platform", "fx3u", bad)
+    assert done.exit_code == 1
+    lines = done.output.splitlines()
+    assert lines[0] == (f"{bad}:6:1: error: device SM400: the fx3u CPU profile has no SM devices "
+                        "the simulator can run")
+    assert lines[1:3] == ["    SM400 := TRUE;", "    ^^^^^"]
+    assert lines[-1] == "1 file(s) checked for gxworks2 on the fx3u CPU: 1 error(s), 0 warning(s)"
+    assert run("--platform", "q", bad).exit_code == 0  # SM400 and D8403 are Q devices
+    assert errors(run("--platform", "fx5u", bad).output) == [  # the FX5U has SM400 but D0..D7999
+        f"{bad}:5:6: error: device D8403 does not exist on the fx5u"]
+
+
+@pytest.mark.parametrize("platform, body, col, message", [
+    ("fx3u", "x := D9000;", 6, "device D9000 does not exist on the fx3u"),
+    ("fx3u", "b := X18;", 6, "device X18: X numbers are base 8 on the fx3u"),
+    ("fx3g", "b := X200;", 6, "device X200 does not exist on the fx3g"),  # X0..X177 on the FX3G
+    ("fx3u", "x := D0Z8;", 6, "device D0Z8: index register Z8 does not exist on the fx3u (Z0..Z7)"),
+    ("fx5u", "x := D8000;", 6, "device D8000 does not exist on the fx5u"),
+    ("q", "b := M8402;", 6, "device M8402 does not exist on the q"),
+    ("q", "x := K4M8190;", 6, "K4M8190 runs past the end of M"),
+])
+def test_device_out_of_range_or_unknown_to_the_cpu(tmp_path, platform, body, col, message):
+    path = write(tmp_path, program(body))
+    done = run("--platform", platform, path)
+    assert done.exit_code == 1, done.output
+    assert errors(done.output) == [f"{path}:5:{col}: error: {message}"]
+
+
+def test_the_cpus_own_devices_pass(tmp_path):
+    body = "x := D8511;\nb := X377;\nx := D0Z7;\nb := M8000;\nx := K4M8496;"
+    assert run("--platform", "fx3u", write(tmp_path, program(body))).exit_code == 0
+
+
+@pytest.mark.parametrize("platform, call, message", [
+    ("q", "CRC(TRUE, w[0], 4, x);", "CRC does not exist on the q (it is a fx3/fx5 instruction)"),
+    ("q", "ADPRW(TRUE, 1, 3, 0, 1, w[0]);", "ADPRW does not exist on the q (it is a fx3 instruction)"),
+    ("fx3u", "G_OUTPUT(TRUE, 16#0, w, w, bb);", "G_OUTPUT does not exist on the fx3u (it is a q instruction)"),
+])
+def test_an_instruction_the_cpu_does_not_have(tmp_path, platform, call, message):
+    path = write(tmp_path, program(call, "x : INT; w : ARRAY[0..3] OF WORD; bb : ARRAY[0..1] OF BOOL;"))
+    assert run(path).exit_code == 0  # GX Works2 has the instruction, for some CPU
+    done = run("--platform", platform, path)
+    assert done.exit_code == 1, done.output
+    assert errors(done.output) == [f"{path}:5:1: error: {message}"]
+
+
+def test_devices_assigned_to_global_labels_are_checked(tmp_path):
+    path = write(tmp_path, "VAR_GLOBAL\n  bRun AT SM400 : BOOL;\nEND_VAR\n", "globals.st")
+    done = run("--platform", "fx3u", path)
+    assert done.exit_code == 1
+    assert done.output.startswith(f"{path}:2:11: error: device SM400: the fx3u CPU profile has no SM devices")
+
+
+def _bundled_sets() -> list[tuple[str, tuple[Path, ...]]]:
+    from verifier.verify.scenario import load_scenario
+
+    sets = {(s.platform, s.sources) for s in map(load_scenario, SCENARIOS)}
+    return sorted(sets)
+
+
+@pytest.mark.parametrize("platform, sources", _bundled_sets(),
+                         ids=lambda v: v if isinstance(v, str) else f"{len(v)}-files")
+def test_every_bundled_library_set_checks_clean_on_its_platform(platform, sources):
+    done = run("--platform", platform, *sources)
+    assert done.exit_code == 0, done.output
+    assert done.output.endswith(f"on the {platform} CPU: 0 error(s), 0 warning(s)\n")
+
+
+def test_the_bundled_sets_cover_every_platform_verify_runs():
+    from verifier.verify.scenario import PLATFORMS
+
+    assert {platform for platform, _ in _bundled_sets()} == set(PLATFORMS)
+
+
+@pytest.mark.parametrize("own, other", [("fx3u", "q"), ("q", "fx3u"), ("q", "fx3g")])
+def test_check_reports_what_the_simulator_refuses_to_load(own, other):
+    # the loader stops at its first device/instruction error; check finds it, and the rest
+    import verifier
+    from verifier.sim import LoadError
+
+    sources = next(s for p, s in _bundled_sets() if p == own)
+    with pytest.raises(LoadError) as err:
+        verifier.load(*sources, target="gxworks2", cpu=other)
+    first = err.value.diagnostics[0]
+    done = run("--platform", other, *sources)
+    assert done.exit_code == 1
+    assert str(first) in done.output.splitlines()
+    assert int(done.output.splitlines()[-1].split(": ")[1].split()[0]) > 1
+
+
+def test_every_format_carries_the_cpu_errors_with_their_positions(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    write(tmp_path, BAD, "bad.st")
+    data = json.loads(run("--platform", "fx3u", "--format", "json", "bad.st").output)
+    assert (data["target"], data["platform"], data["errors"]) == ("gxworks2", "fx3u", 1)
+    assert data["diagnostics"] == [{
+        "file": "bad.st", "line": 6, "col": 1, "end_line": 6, "end_col": 6, "severity": "error",
+        "message": "device SM400: the fx3u CPU profile has no SM devices the simulator can run",
+        "rule": "UITAMR-ST-CPU"}]
+
+    github = run("--platform", "fx3u", "--format", "github", "bad.st")
+    assert github.exit_code == 1
+    assert github.output.splitlines() == [
+        "::error file=bad.st,line=6,col=1,endLine=6,endColumn=6,title=uitamr check UITAMR-ST-CPU::"
+        "device SM400: the fx3u CPU profile has no SM devices the simulator can run",
+        "1 file(s) checked for gxworks2 on the fx3u CPU: 1 error(s), 0 warning(s)"]
+
+    sarif = json.loads(run("--platform", "fx3u", "--format", "sarif", "bad.st").output)
+    sarif_run = sarif["runs"][0]
+    rules = [r["id"] for r in sarif_run["tool"]["driver"]["rules"]]
+    assert set(rules) == set(RULES) | {"UITAMR-ST-CPU"}
+    (result,) = sarif_run["results"]
+    assert result["ruleId"] == "UITAMR-ST-CPU" and rules[result["ruleIndex"]] == "UITAMR-ST-CPU"
+    assert result["level"] == "error"
+    assert result["locations"][0]["physicalLocation"] == {
+        "artifactLocation": {"uri": "bad.st", "uriBaseId": "%SRCROOT%"},
+        "region": {"startLine": 6, "startColumn": 1, "endLine": 6, "endColumn": 6}}
+
+
+def test_without_platform_the_formats_name_no_platform(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    write(tmp_path, BAD, "bad.st")
+    assert "platform" not in json.loads(run("--format", "json", "bad.st").output)
+    sarif = json.loads(run("--format", "sarif", "bad.st").output)
+    assert {r["id"] for r in sarif["runs"][0]["tool"]["driver"]["rules"]} == set(RULES)
+
+
+def test_platform_implies_its_editors_dialect():
+    fx5 = ROOT / "plc" / "fx5" / "UITAMR_PortTcpFx5.st"  # SP_SOCOPEN: GX Works3 only
+    assert run(fx5).exit_code == 1
+    done = run("--platform", "fx5u", fx5)
+    assert done.output.splitlines()[-1].startswith("1 file(s) checked for gxworks3 on the fx5u CPU:")
+    assert run("--platform", "fx5u", "--target", "gxworks3", fx5).output == done.output
+
+
+@pytest.mark.parametrize("platform, target", [("fx3u", "gxworks3"), ("q", "gxworks3"), ("fx5u", "gxworks2")])
+def test_a_contradictory_target_and_platform_is_a_usage_error(tmp_path, platform, target):
+    done = run("--platform", platform, "--target", target, write(tmp_path, BAD))
+    assert done.exit_code == 2
+    assert done.exception is None or isinstance(done.exception, SystemExit)
+    assert "Traceback" not in done.output
+    (line,) = done.output.splitlines()
+    assert line.startswith(f"uitamr check: --platform {platform} and --target {target} disagree: ")
+    assert "drop --target" in line
+
+
+def test_platform_choices_are_the_cpu_profiles(tmp_path):
+    from verifier.sim.cpu import PROFILES
+
+    done = run("--platform", "fx2n", write(tmp_path, BAD))
+    assert done.exit_code == 2
+    assert all(name in done.output for name in PROFILES)

@@ -1,0 +1,52 @@
+"""The devices and instructions of checked ST against one CPU profile (`uitamr check
+--platform`), without compiling anything.
+
+The rules are the simulator's own: `devices.locate` (device areas, numbering, ranges,
+index registers, digit and bit access) and `instructions.not_on_cpu` (which CPU family an
+instruction exists on) are what its compiler asks too. So `check --platform fx3u` reports
+the device and instruction errors `uitamr verify` and `verifier.load(..., cpu="fx3u")`
+would stop at, every one of them rather than the first, and no table of its own.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+from verifier.st import ast
+
+from .cpu import CpuProfile
+from .devices import DeviceError, locate
+from .instructions import not_on_cpu
+
+
+def cpu_diagnostics(files: list[ast.SourceFile], cpu: CpuProfile) -> list[ast.Diagnostic]:
+    """An error for every device (in bodies, initial values and `AT` assignments) and every
+    instruction call of `files` that `cpu` does not have, in file order. Instruction calls
+    are recognised by the check's resolution (`ast.Call.resolved`): run
+    `verifier.st.check` on the files first."""
+    found: list[ast.Diagnostic] = []
+    for f in files:
+        stack: list = [f.globals, f.types, f.pous]
+        mine: list[ast.Diagnostic] = []
+        while stack:
+            node = stack.pop()
+            if isinstance(node, (list, tuple)):
+                stack.extend(node)
+                continue
+            if not dataclasses.is_dataclass(node):
+                continue
+            if isinstance(node, ast.Device) and node.module is None:
+                try:
+                    locate(node, cpu)
+                except DeviceError as e:
+                    mine.append(_at(node.span, str(e)))
+            elif isinstance(node, ast.Call) and getattr(node.resolved, "kind", None) == "instruction":
+                why = not_on_cpu(node.name, cpu)
+                if why:
+                    mine.append(_at(node.callee.span, why))
+            stack.extend(ast.syntax_fields(node))
+        found += sorted(mine, key=lambda d: (d.line, d.col))
+    return found
+
+
+def _at(span: ast.Span, message: str) -> ast.Diagnostic:
+    return ast.Diagnostic(span.file, span.line, span.col, "error", message, span.end_line, span.end_col)
