@@ -51,8 +51,9 @@ VAR
     eRange : REAL;
     bRunB : BOOL;
     wPointB : INT;
+    wAddress : INT;
 END_VAR
-fbEngine(i_bEN := bEnable, i_wAddress := 1, i_bMonitor := bMonitor, io_uMbx := uMbx, io_uPort := uPort);
+fbEngine(i_bEN := bEnable, i_wAddress := wAddress, i_bMonitor := bMonitor, io_uMbx := uMbx, io_uPort := uPort);
 fbRun(i_bEN := NOT bCmdOff, i_bExecute := bRun, i_wPoint := wPoint, io_uMbx := uMbx);
 fbStop(i_bEN := NOT bCmdOff, i_bExecute := bStop, io_uMbx := uMbx);
 fbSpeed(i_bEN := NOT bCmdOff, i_bExecute := bSpeed, i_bMagnetic := FALSE, i_wStage := wStage, io_uMbx := uMbx);
@@ -144,6 +145,7 @@ def rig():
     project = verifier.load(CORE, sources={"T_Engine.st": HARNESS})
     h = project.program("T_Engine")
     port = FakePort(h, project)
+    h.wAddress = 1
     h.bEnable = True
     return h, port
 
@@ -528,3 +530,96 @@ def test_a_collision_range_beyond_int_is_0301_without_an_operation_error(metres)
     h.bRange = True
     port.run(2000, until=lambda x: x.fbRange.o_bOK)
     assert h.fbRange.o_bOK and encode(ControlRequest(1, 4, 2), SETTINGS) in port.kinds()
+
+
+# ---------------------------------------------------------------------------- the robot address
+ERR_ADDRESS = 0x0315
+
+
+def rising_edges(samples):
+    return sum(1 for a, b in zip([False] + samples, samples) if b and not a)
+
+
+@pytest.mark.parametrize("address", [300, -5, 248, -32768])
+def test_an_address_out_of_range_is_one_error_and_nothing_is_sent(rig, address):
+    """Before: the engine tried the power-on stop every INIT_RETRY_TIME, the frame builder
+    refused it each time (16#0301, detail 1 = the control code) and every command ended with
+    16#0107 'stop not acknowledged'. Now: one 16#0315 naming the address, held."""
+    h, port = rig
+    h.wAddress = address
+    errs, ids = [], set()
+    for _ in range(500):                                   # 5 s: two INIT_RETRY_TIMEs
+        port.run(10)
+        errs.append(h.fbEngine.o_bErr)
+        ids.add((h.fbEngine.o_uErrId, h.fbEngine.o_uErrDetail))
+    assert port.requests == []
+    assert rising_edges(errs) == 1 and all(errs[1:])
+    assert ids == {(ERR_ADDRESS, address & 0xFFFF)}
+    assert not (h.fbEngine.o_bOK or h.fbEngine.o_bReady or h.fbEngine.o_bBusy or h.fbEngine.o_bInitDone)
+    assert h.fbEngine.o_bENO
+    h.wPoint, h.bRun, h.bStop, h.wQuery, h.bRead = 3, True, True, 0, True
+    port.run(30)                                           # each command ends at once, with the same error
+    for fb in (h.fbRun, h.fbStop, h.fbRead):                # the wrappers show no detail
+        assert fb.o_bErr and not fb.o_bBusy and fb.o_uErrId == ERR_ADDRESS
+    h.bMonitor = True
+    port.run(2000)
+    assert port.requests == []
+    assert h.uMbx[0] == 0 and h.uMbx[8] == 0               # the mailbox is free again
+
+
+def test_fixing_the_address_recovers_with_the_stop_first(rig):
+    h, port = rig
+    h.wAddress = 300
+    port.run(3000)
+    h.wAddress = 1
+    port.run(20)
+    assert not h.fbEngine.o_bErr and h.fbEngine.o_uErrId == 0   # cleared as by a rising edge
+    port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)
+    assert h.fbEngine.o_bInitDone
+    assert port.kinds()[0] == STOP                          # the first frame is the stop
+    h.wPoint, h.bRun = 3, True
+    port.run(5000, until=lambda x: x.fbRun.o_bOK)
+    assert h.fbRun.o_bOK and encode(ControlRequest(1, 1, 3), SETTINGS) in port.kinds()
+    assert not h.fbEngine.o_bErr
+
+
+def test_an_address_going_out_of_range_ends_the_running_command_and_needs_the_stop_again(rig):
+    h, port = rig
+    port.running_polls = 50
+    start_point(h, port)
+    port.run(1000)                                          # the point runs, its task is polled
+    h.wAddress = 0x1000
+    port.run(600)                                           # a reply still due is discarded
+    count = len(port.requests)
+    assert h.fbRun.o_bErr and h.fbRun.o_uErrId == ERR_ADDRESS
+    assert (h.fbEngine.o_uErrId, h.fbEngine.o_uErrDetail) == (ERR_ADDRESS, 0x1000)
+    assert not h.fbEngine.o_bInitDone
+    port.run(3000)
+    assert len(port.requests) == count                      # nothing more on the line
+    h.wAddress = 0                                          # 0: the default address 1
+    port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)
+    assert port.kinds()[count] == STOP
+
+
+def test_reenabling_with_the_address_still_out_of_range_raises_it_again_and_sends_nothing(rig):
+    h, port = rig
+    h.wAddress = 300
+    port.run(200)
+    h.bEnable = False
+    h.wPoint, h.bRun = 3, True
+    port.run(50)
+    assert h.fbRun.o_bErr and h.fbRun.o_uErrId == 0x0302    # disabled wins: the engine does not run
+    h.bEnable, h.bRun = True, False
+    port.run(1000)
+    assert h.fbEngine.o_bErr and h.fbEngine.o_uErrId == ERR_ADDRESS
+    assert port.requests == []
+
+
+@pytest.mark.parametrize("address", [1, 247])
+def test_the_limits_of_the_address_range_are_sent(rig, address):
+    h, port = rig
+    port.silent = True
+    h.wAddress = address
+    port.run(400)
+    assert port.kinds() and port.kinds()[0][0] == address
+    assert h.fbEngine.o_uErrId != ERR_ADDRESS

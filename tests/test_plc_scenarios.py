@@ -37,3 +37,55 @@ def test_examples_hold_the_rules_at_any_scan_time(name, scan_us):
     scenario = load_scenario(SCENARIOS[0].parent / f"{name}.toml")
     result = run_scenario(replace(scenario, scan_us=scan_us))
     assert result.passed, [v.message for v in result.all_violations()[:5]] + [str(e) for e in result.failed_expectations]
+
+
+ADDRESS_EXAMPLES = {  # platform: (folder of its port FBs, example, its start button)
+    "fx3u": ("fx3", "fx3/UITAMR_ExampleFx3", "X0"),
+    "fx5u": ("fx5", "fx5/UITAMR_ExampleFx5", "X0"),
+    "q": ("q", "q/UITAMR_ExampleQ", "X20"),
+}
+
+
+@pytest.mark.parametrize("platform", sorted(ADDRESS_EXAMPLES))
+def test_an_example_with_its_address_out_of_range_sends_nothing_and_reports_0315_once(tmp_path, platform):
+    """The platform example with ROBOT_ADDRESS 300, run by `uitamr verify`: the engine (the
+    same on every platform) reports 16#0315 with the address as detail from the start and
+    holds it, the line stays silent, and the cycle started on its button ends with 16#0315
+    (it used to end with 16#0107 while the engine retried the stop, refused, every 2 s)."""
+    plc = Path(__file__).resolve().parents[1] / "plc"
+    ports, example, button = ADDRESS_EXAMPLES[platform]
+    source = (plc / "examples" / f"{example}.st").read_text(encoding="utf-8")
+    assert "ROBOT_ADDRESS : INT := 1;" in source
+    name = example.split("/")[1]
+    (tmp_path / f"{name}.st").write_text(source.replace("ROBOT_ADDRESS : INT := 1;", "ROBOT_ADDRESS : INT := 300;"),
+                                         encoding="utf-8")
+    sources = [f"{plc.as_posix()}/core/*.st", f"{plc.as_posix()}/{ports}/*.st",
+               f"{plc.as_posix()}/examples/common/*.st", f"{name}.st"]
+    (tmp_path / "s.toml").write_text(f"""
+sources = {sources!r}
+program = "{name}"
+platform = "{platform}"
+duration = "8s"
+
+[[inputs]]
+at = "2s"
+set = {{ {button} = true }}
+pulse = "500ms"
+
+[[expect]]
+always = "fbEngine.o_bErr AND fbEngine.o_uErrId = 16#0315 AND fbEngine.o_uErrDetail = 300"
+after = "0.1s"
+
+[[expect]]
+never = "fbEngine.o_wTxCount <> 0 OR fbEngine.o_bInitDone OR fbEngine.o_bBusy"
+
+[[expect]]
+that = "fbCycle.o_bErr AND fbCycle.o_uErrId = 16#0315"
+after = "2s"
+within = "0.5s"
+""".replace("'", '"'), encoding="utf-8")
+    result = run_scenario(load_scenario(tmp_path / "s.toml"))
+    assert result.aborted is None, result.aborted
+    assert result.tx_count == 0
+    assert not result.failed_expectations, [str(e.message if hasattr(e, "message") else e)
+                                            for e in result.failed_expectations]
