@@ -52,9 +52,15 @@ class Master:
         self.t0 = time.monotonic()
 
     def at(self, t_s: float) -> None:
-        delay = self.t0 + t_s - time.monotonic()
-        if delay > 0:
-            time.sleep(delay)
+        """Wait until `t_s` after the start. A master that is late (a loaded host) moves
+        the rest of its schedule by as much, so the gaps it was given never shrink: a late
+        request followed by one on time would break the pacing the test sets out to keep."""
+        target = self.t0 + t_s
+        now = time.monotonic()
+        if now < target:
+            time.sleep(target - now)
+            now = time.monotonic()
+        self.t0 += now - target if now > target else 0.0
 
     def send(self, data: bytes, reply_length: int | None = 8, timeout_s: float = 0.2) -> bytes:
         os.write(self.fd, data)
