@@ -12,11 +12,14 @@ import re
 from pathlib import Path
 
 import pytest
+from click.testing import CliRunner
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from test_idle_skip import robot_scenarios
 from test_verify_pipeline import FX3_EXAMPLE, VARIANTS, library_copy
+from verifier.commands import verify as verify_command
+from verifier.commands.verify import command
 from verifier.verify import report_html
 from verifier.verify import runner as runner_module
 from verifier.verify import stream as stream_module
@@ -146,3 +149,65 @@ def test_a_long_run_holds_no_frame_and_the_page_only_those_it_draws(tmp_path, mo
     assert len(read) == len(view["frames"]) == 1000
     assert view["frames_left_out"] == result.tx_count + result.rx_count - 1000
     assert (view["tx"], view["rx"]) == (result.tx_count, result.rx_count)
+
+
+def _invoke(*args):
+    return CliRunner().invoke(command, [str(a) for a in args], catch_exceptions=False)
+
+
+@pytest.mark.parametrize("jobs", ["1", "2"])
+def test_the_command_runs_html_without_holding_frames_and_leaves_no_spool_file(tmp_path, monkeypatch, jobs):
+    """What the reports are written from: no run holds its frames; and the hidden folder
+    beside the page is gone."""
+    written = []
+    write_reports = verify_command.write_reports
+
+    def spy(results, *args, **kwargs):
+        written.extend(results)
+        return write_reports(results, *args, **kwargs)
+
+    monkeypatch.setattr(verify_command, "write_reports", spy)
+    scenarios = [ROOT / "plc" / "scenarios" / f"{name}.toml" for name in ("fx3u-healthy", "q-bad-crc")]
+    args = [arg for path in scenarios for arg in ("--scenario", path)]
+    result = _invoke(*args, "--jobs", jobs, "--html", tmp_path / "r.html", "--duration", "5s")
+    assert result.exit_code == 1, result.output  # q-bad-crc fails: the report is still written
+    assert len(written) == 2 and all(r.trace == [] and r.tx_count > 0 for r in written)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.html"]
+    page = (tmp_path / "r.html").read_text(encoding="utf-8")
+    assert page.count('class="frame ') == sum(r.tx_count + r.rx_count for r in written)
+
+
+def test_the_page_is_the_same_with_every_scan(tmp_path):
+    """--every-scan (the reference path) still holds every frame and judges the run as a
+    whole: its page and the default one's are the same file."""
+    scenario = ROOT / "plc" / "scenarios" / "fx3u-bad-crc.toml"
+    assert _invoke("--scenario", scenario, "--html", tmp_path / "a.html").exit_code == 0
+    assert _invoke("--scenario", scenario, "--html", tmp_path / "b.html", "--every-scan").exit_code == 0
+    assert (tmp_path / "a.html").read_bytes() == (tmp_path / "b.html").read_bytes()
+
+
+def test_a_folder_the_page_cannot_use_is_said_before_the_run(tmp_path, monkeypatch):
+    def refused(*args, **kwargs):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(verify_command.tempfile, "mkdtemp", refused)
+    result = _invoke("--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml", "--html", tmp_path / "r.html")
+    assert result.exit_code == 2
+    assert result.output == f"error: cannot write the HTML report in {tmp_path}: Permission denied\n"
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_disk_that_fills_up_during_an_html_run_is_said_and_the_spool_removed(tmp_path, monkeypatch):
+    original = stream_module.Stream._give
+
+    def full(self, frames):
+        if self.spool is not None and self.tx_count > 20:
+            raise OSError(28, "No space left on device")
+        return original(self, frames)
+
+    monkeypatch.setattr(stream_module.Stream, "_give", full)
+    result = _invoke("--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml", "--html", tmp_path / "r.html")
+    assert result.exit_code == 2 and "Traceback" not in result.output
+    assert f"cannot write the run's frames in {tmp_path}/.uitamr-trace-" in result.output
+    assert "No space left on device" in result.output
+    assert list(tmp_path.iterdir()) == []

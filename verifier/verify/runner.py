@@ -425,8 +425,8 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
 
     sample = sample_plainly if plain else sample_on_change  # plain: the reference path
 
-    # judged as it goes when no report holds every frame (the trace alone takes them from
-    # files written as the run goes); else as a whole at the end
+    # judged as it goes unless the run is the reference path (plain): the trace and the
+    # page take the frames from files written as the run goes; else as a whole at the end
     streamed = not plain and (not keep.frames or keep.frames_to_file is not None)
     stream = Stream(scenario.settings, scenario.options, samples, scenario.expectations, _relative,
                     keep.frames_to_file if keep.frames else None, scenario.name) if streamed else None
