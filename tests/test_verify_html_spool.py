@@ -158,7 +158,7 @@ def _invoke(*args):
 @pytest.mark.parametrize("jobs", ["1", "2"])
 def test_the_command_runs_html_without_holding_frames_and_leaves_no_spool_file(tmp_path, monkeypatch, jobs):
     """What the reports are written from: no run holds its frames; and the hidden folder
-    beside the page is gone."""
+    beside the page is gone. The page draws every frame of these short runs."""
     written = []
     write_reports = verify_command.write_reports
 
@@ -172,6 +172,8 @@ def test_the_command_runs_html_without_holding_frames_and_leaves_no_spool_file(t
     result = _invoke(*args, "--jobs", jobs, "--html", tmp_path / "r.html", "--duration", "5s")
     assert result.exit_code == 1, result.output  # q-bad-crc fails: the report is still written
     assert len(written) == 2 and all(r.trace == [] and r.tx_count > 0 for r in written)
+    # nor the watched labels' changes, which only --json lists (the page draws the events)
+    assert all(r.watched == {} for r in written) and any(r.events for r in written)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.html"]
     page = (tmp_path / "r.html").read_text(encoding="utf-8")
     assert page.count('class="frame ') == sum(r.tx_count + r.rx_count for r in written)

@@ -406,7 +406,7 @@ def command(sources, program, platform, channel, response_signal, scenario_files
             try:
                 # a run holds every frame and watched change only for the reports that list them
                 keep = Keep(frames=bool(trace_path or html_path), details=bool(json_path or html_path),
-                            frames_to_file=spool_folder)
+                            watched=bool(json_path), frames_to_file=spool_folder)
                 results = _run_all(scenarios, jobs, progress, every_scan, keep)
             except (ScenarioError, UnusableInput) as exc:
                 progress.stop()

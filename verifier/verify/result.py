@@ -26,6 +26,9 @@ class Keep:
 
     frames: bool = True
     details: bool = True
+    # with `details`, the watched labels' changes too (only `--json` lists them; the page
+    # draws the events alone, and an o_wTxCount watched changes on every request)
+    watched: bool = True
     # the frames go to a file in this folder as the run goes (`ScenarioResult.trace_file`)
     # instead of being held, and the run is judged as it goes; the trace and the page read
     # them from there. The folder is the caller's to remove (`uitamr verify` makes a hidden

@@ -385,7 +385,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     # the idle check, which then need not compare the whole state); the watched ones are
     # recorded only when a report lists them
     names = scenario.variables()
-    recorded = scenario.variables(watched=keep.details)
+    recorded = scenario.variables(watched=keep.details and keep.watched)
     samples = Samples(recorded)
     recorded_names = frozenset(recorded)
     picked = [k for k, name in enumerate(names) if name in recorded_names]
@@ -485,7 +485,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         violations=violations,
         expectations=outcomes,
         diagnostics=plc.diagnostics(),
-        watched={name: list(samples.changes.get(name, [])) for name in scenario.watch} if keep.details else {},
+        watched={name: list(samples.changes.get(name, [])) for name in scenario.watch} if keep.details and keep.watched else {},
         aborted=aborted,
         ended_us=end,
         wall_s=time.perf_counter() - wall_start,
