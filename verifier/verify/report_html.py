@@ -9,6 +9,7 @@ The geometry is computed here at the default zoom; the page's script only rescal
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Iterator
 
 import jinja2
 
@@ -204,10 +205,11 @@ def scenario_view(index: int, result: ScenarioResult, frames_at_most: int = FRAM
     }
 
 
-def render(results: list[ScenarioResult]) -> str:
+def _pieces(results: list[ScenarioResult]) -> Iterator[str]:
+    """The page, piece by piece as the template gives it."""
     template = _environment().get_template("report.html.j2")
     each = frames_each(results)
-    return template.render(
+    return template.generate(
         verdict=overall_verdict(results),
         version=__version__,
         scenarios=[scenario_view(i, r, each) for i, r in enumerate(results)],
@@ -217,5 +219,12 @@ def render(results: list[ScenarioResult]) -> str:
     )
 
 
+def render(results: list[ScenarioResult]) -> str:
+    return "".join(_pieces(results))
+
+
 def write(results: list[ScenarioResult], path: Path) -> None:
-    Path(path).write_text(render(results), encoding="utf-8")
+    # written as the template goes: the page of a --matrix of soak tests is tens of MB, and
+    # the whole text at once (with its pieces) was the largest thing the command held
+    with open(path, "w", encoding="utf-8") as out:
+        out.writelines(_pieces(results))
