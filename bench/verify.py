@@ -19,7 +19,7 @@ Prints, measured in one run on this machine:
      scenario run for 300 s, next to the machine's ceiling: N copies of a CPU-bound Python loop at once against
      one after the other (median of 5);
   5. peak RSS of a 1 h and a 10 h run of fx3u-healthy (whole processes, os.wait4), without
-     reports, with --trace and with --html.
+     reports, with --trace and with --html; and of the bundled matrix at 1 h with --html.
 Wall-clock figures move with the machine's load; ratios measured side by side much less.
 """
 from __future__ import annotations
@@ -227,10 +227,13 @@ def part_5(healthy: Path, folder: Path) -> None:
     _, rss_one = run_process("verify", "--scenario", one, "--html", page)
     size_one = page.stat().st_size
     _, rss_ten = run_process("verify", "--scenario", ten, "--html", page)
-    print(f"   with --html (the run keeps every frame; the page holds at most "
-          f"{report_html.FRAMES_AT_MOST:,}): 1 h {rss_one / 1024:.0f} MiB, 10 h {rss_ten / 1024:.0f} MiB "
-          f"(ratio {rss_ten / rss_one:.2f}, not flat; the page: {size_one / 2**20:.1f} / "
+    print(f"   with --html (the page draws at most {report_html.FRAMES_AT_MOST:,} frames a run, read "
+          f"from a file the run writes them to): 1 h {rss_one / 1024:.0f} MiB, 10 h {rss_ten / 1024:.0f} MiB "
+          f"(ratio {rss_ten / rss_one:.2f}; the page: {size_one / 2**20:.1f} / "
           f"{page.stat().st_size / 2**20:.1f} MiB)")
+    _, rss = run_process("verify", "--matrix", "--duration", "1h", "--jobs", "2", "--html", page)
+    print(f"   --matrix --duration 1h --jobs 2 --html ({len(list(SCENARIOS.glob('*.toml')))} runs): "
+          f"{rss / 1024:.0f} MiB (the largest process; the page: {page.stat().st_size / 2**20:.1f} MiB)")
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-"""`uitamr verify --trace` without `--html` does not hold the run's frames: the run is
+"""`uitamr verify --trace` (with `--html` or not) does not hold the run's frames: the run is
 judged as it goes and writes each frame's trace line to a file beside the trace as the
 line settles it (verifier/verify/report_trace.py), and the trace is completed from that
 file at the end. The trace file is the same, byte for byte, as the one written from a run
@@ -119,7 +119,7 @@ def test_a_spool_file_that_cannot_be_made_names_its_folder(tmp_path, monkeypatch
         PermissionError(13, "Permission denied")))
     result = _invoke("--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml", "--trace", tmp_path / "t.jsonl")
     assert result.exit_code == 2
-    assert f"cannot write the trace in {tmp_path}/.uitamr-trace-" in result.output and "Permission denied" in result.output
+    assert f"cannot write the run's frames in {tmp_path}/.uitamr-trace-" in result.output and "Permission denied" in result.output
     assert list(tmp_path.iterdir()) == []
 
 
@@ -134,7 +134,7 @@ def test_a_disk_that_fills_up_during_the_run_is_said_and_the_spool_removed(tmp_p
     monkeypatch.setattr(stream_module.Stream, "_give", full)
     result = _invoke("--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml", "--trace", tmp_path / "t.jsonl")
     assert result.exit_code == 2
-    assert f"cannot write the trace in {tmp_path}/.uitamr-trace-" in result.output
+    assert f"cannot write the run's frames in {tmp_path}/.uitamr-trace-" in result.output
     assert "No space left on device" in result.output
     assert list(tmp_path.iterdir()) == []
 
@@ -210,8 +210,8 @@ def test_a_worker_killed_midway_is_said_and_leaves_nothing(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
-@pytest.mark.parametrize("spool", [False, True], ids=["held", "spooled"])
-def test_runs_that_share_a_name_are_apart_in_the_trace_and_replay_reads_them(tmp_path, spool):
+@pytest.mark.parametrize("extra", [["--every-scan"], [], ["--html"]], ids=["held", "spooled", "spooled-with-html"])
+def test_runs_that_share_a_name_are_apart_in_the_trace_and_replay_reads_them(tmp_path, extra):
     """A copied scenario file that kept its name, and one file given twice: the trace names
     them as the JUnit report does, and `uitamr replay` reads three runs, each whole."""
     from verifier.cli import main
@@ -223,7 +223,8 @@ def test_runs_that_share_a_name_are_apart_in_the_trace_and_replay_reads_them(tmp
     first.write_text(text, encoding="utf-8")
     copy.write_text(text, encoding="utf-8")
     trace = tmp_path / "t.jsonl"
-    extra = [] if spool else ["--html", str(tmp_path / "r.html")]  # --html keeps the frames
+    # --every-scan (the reference path) holds every frame; --html spools them as the trace does
+    extra = [arg for given in extra for arg in ([given, str(tmp_path / "r.html")] if given == "--html" else [given])]
     result = CliRunner().invoke(main, ["verify", "--scenario", str(first), "--scenario", str(copy),
                                        "--scenario", str(first), "--trace", str(trace), *extra])
     assert result.exit_code == 0, result.output

@@ -314,13 +314,14 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress,
     return results
 
 
-def _spool_folder(trace_path: str) -> str:
-    """A hidden folder beside the trace for the runs' trace lines (Keep.frames_to_file)."""
-    folder = Path(trace_path).resolve().parent
+def _spool_folder(report_path: str, report: str) -> str:
+    """A hidden folder beside the report (the trace, or else the page) for the runs' trace
+    lines (Keep.frames_to_file)."""
+    folder = Path(report_path).resolve().parent
     try:
         return tempfile.mkdtemp(prefix=".uitamr-trace-", dir=folder)
     except OSError as exc:
-        _unusable(f"cannot write the trace in {folder}: {exc.strerror or exc}")
+        _unusable(f"cannot write the {report} in {folder}: {exc.strerror or exc}")
 
 
 @contextmanager
@@ -395,15 +396,17 @@ def command(sources, program, platform, channel, response_signal, scenario_files
         _unusable(str(exc))
     stderr = text_console(stderr=True)
     progress = _LazyProgress(stderr, sum(s.duration_us for s in scenarios), stderr.is_terminal)
-    # the trace alone does not make a run hold its frames: they go to files in a hidden
-    # folder beside it, removed at the end whatever happens to the runs and their workers
-    spool_folder = _spool_folder(trace_path) if trace_path and not html_path else None
+    # the reports that list frames do not make a run hold them: they go to files in a hidden
+    # folder beside the trace (or the page), removed at the end whatever happens to the runs
+    # and their workers
+    spool_folder = _spool_folder(trace_path or html_path, "trace" if trace_path else "HTML report") \
+        if trace_path or html_path else None
     try:
         with _terminate_as_exit():
             try:
                 # a run holds every frame and watched change only for the reports that list them
                 keep = Keep(frames=bool(trace_path or html_path), details=bool(json_path or html_path),
-                            frames_to_file=spool_folder)
+                            watched=bool(json_path), frames_to_file=spool_folder)
                 results = _run_all(scenarios, jobs, progress, every_scan, keep)
             except (ScenarioError, UnusableInput) as exc:
                 progress.stop()

@@ -9,13 +9,14 @@ The geometry is computed here at the default zoom; the page's script only rescal
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Iterator
 
 import jinja2
 
 from verifier import __version__
 
 from .durations import format_seconds
-from .report_trace import blamed_frames, in_line_order, records
+from .report_trace import LineTimes, blamed_frames, frame_count, records
 from .result import ScenarioResult, overall_verdict
 from .rules import RULES
 
@@ -68,21 +69,23 @@ MAJOR_TICKS_AT_MOST = 5000
 def frames_each(results: list[ScenarioResult]) -> int:
     """How many frames each run of the page may draw: FRAMES_AT_MOST, or a share of
     PAGE_FRAMES_AT_MOST when the runs have more frames than that between them."""
-    if sum(len(result.trace) for result in results) <= PAGE_FRAMES_AT_MOST:
+    if sum(frame_count(result) for result in results) <= PAGE_FRAMES_AT_MOST:
         return FRAMES_AT_MOST
     return min(FRAMES_AT_MOST, max(FRAMES_EACH_AT_LEAST, PAGE_FRAMES_AT_MOST // len(results)))
 
 
-def shown_frames(line: list, blamed: dict, at_most: int = FRAMES_AT_MOST) -> list[int]:
+def shown_frames(line: LineTimes, blamed: dict, at_most: int = FRAMES_AT_MOST) -> list[int]:
     """The positions (in trace order) of the frames the page draws: all of them, or for a
     longer run `at_most`: those within CONTEXT_FRAMES of a blamed frame, in time order,
-    then the first frames of the run."""
-    if len(line) <= at_most:
-        return list(range(len(line)))
+    then the first frames of the run. `line`: each frame's (start µs, end µs, direction),
+    in trace order, and how many there are (`len`); read once, in order."""
+    count = len(line)
+    if count <= at_most:
+        return list(range(count))
     shown: set[int] = set()
-    for k, frame in enumerate(line):
-        if (frame.t_start_us, frame.direction) in blamed:
-            shown.update(range(max(0, k - CONTEXT_FRAMES), min(len(line), k + CONTEXT_FRAMES + 1)))
+    for k, (t_us, _, direction) in enumerate(line):
+        if (t_us, direction) in blamed:
+            shown.update(range(max(0, k - CONTEXT_FRAMES), min(count, k + CONTEXT_FRAMES + 1)))
             if len(shown) >= at_most:
                 break
     k = 0
@@ -92,16 +95,40 @@ def shown_frames(line: list, blamed: dict, at_most: int = FRAMES_AT_MOST) -> lis
     return sorted(shown)[:at_most]
 
 
-def _overview(line: list, end_ms: float, long: bool) -> list[dict]:
+def _overview(line: LineTimes, end_ms: float, long: bool) -> list[dict]:
     """The overview strip's marks (x in 0..1000): one per position and direction; for a long
     run the positions are half units (a strip is about 1000 px wide), so the page draws at
     most 4002 marks, not a mark per frame."""
-    def x(frame) -> float:
-        at = round(round(_seconds(frame.t_start_us) * 1000, 3) / end_ms * 1000, 2)
+    def x(t_us: int) -> float:
+        at = round(round(_seconds(t_us) * 1000, 3) / end_ms * 1000, 2)
         return round(at * 2) / 2 if long else at
 
-    marks = {(x(frame), frame.direction) for frame in line}
+    marks = {(x(t_us), direction) for t_us, _, direction in line}
     return [{"x": x, "dir": direction} for x, direction in sorted(marks, key=lambda m: (m[0], m[1] != "tx"))]
+
+
+def _windows(line: LineTimes, drawn: set[int], period_ms: float) -> tuple[list[dict], int]:
+    """The pacing window of each drawn request (broken when the next request, drawn or not,
+    started inside it), and how many requests the run sent."""
+    windows: list[dict] = []
+    requests = 0
+    waiting = None  # the start (ms) of the last request, when drawn: its window waits for the next one
+
+    def window(t0: float, following: float | None) -> dict:
+        return {"t0": round(t0, 3), "t1": round(t0 + period_ms, 3),
+                "broken": following is not None and following - t0 <= period_ms}
+
+    for k, (t_us, _, direction) in enumerate(line):
+        if direction != "tx":
+            continue
+        requests += 1
+        t0 = _seconds(t_us) * 1000
+        if waiting is not None:
+            windows.append(window(waiting, t0))
+        waiting = t0 if k in drawn else None
+    if waiting is not None:
+        windows.append(window(waiting, None))
+    return windows, requests
 
 
 def _skipped_before(shown: list[int]) -> list[int]:
@@ -114,26 +141,17 @@ def _skipped_before(shown: list[int]) -> list[int]:
 
 
 def scenario_view(index: int, result: ScenarioResult, frames_at_most: int = FRAMES_AT_MOST) -> dict:
-    line = in_line_order(result)
+    """What the page shows of one run. A run whose frames went to a spool file as it went
+    (`ScenarioResult.trace_file`) is read from it pass by pass: only the frames drawn are
+    held at once, and the page is the same as from the frames held."""
+    line = LineTimes(result)
     shown = shown_frames(line, blamed_frames(result), frames_at_most)
     frames = list(records(result, only=shown))
-    end_ms = max(
-        [_ms(result.ended_us)] + [_seconds(frame.t_end_us) * 1000 for frame in line]
-    ) or 1.0
-    requests = [k for k, frame in enumerate(line) if frame.direction == "tx"]
-    drawn = set(shown)
-    windows = []
+    last_end_us = max((t_end_us for _, t_end_us, _ in line), default=None)
+    # the largest of the frames' ends in ms is the end of the last-ending frame in ms
+    end_ms = max([_ms(result.ended_us)] + ([] if last_end_us is None else [_seconds(last_end_us) * 1000])) or 1.0
     period_ms = result.min_period_us / 1000
-    for position, k in enumerate(requests):
-        if k not in drawn:
-            continue
-        t0 = _seconds(line[k].t_start_us) * 1000
-        following = _seconds(line[requests[position + 1]].t_start_us) * 1000 if position + 1 < len(requests) else None
-        windows.append({
-            "t0": round(t0, 3),
-            "t1": round(t0 + period_ms, 3),
-            "broken": following is not None and following - t0 <= period_ms,
-        })
+    windows, requests = _windows(line, set(shown), period_ms)
     for frame, skipped in zip(frames, _skipped_before(shown)):
         frame["t0"] = round(frame["t"] * 1000, 3)
         frame["t1"] = round(frame["t_end"] * 1000, 3)
@@ -181,16 +199,17 @@ def scenario_view(index: int, result: ScenarioResult, frames_at_most: int = FRAM
              "count": len(result.violations.get(rule.id, []))}
             for rule in RULES
         ],
-        "tx": len(requests),
-        "rx": len(line) - len(requests),
+        "tx": requests,
+        "rx": len(line) - requests,
         "ended": format_seconds(result.ended_us),
     }
 
 
-def render(results: list[ScenarioResult]) -> str:
+def _pieces(results: list[ScenarioResult]) -> Iterator[str]:
+    """The page, piece by piece as the template gives it."""
     template = _environment().get_template("report.html.j2")
     each = frames_each(results)
-    return template.render(
+    return template.generate(
         verdict=overall_verdict(results),
         version=__version__,
         scenarios=[scenario_view(i, r, each) for i, r in enumerate(results)],
@@ -200,5 +219,12 @@ def render(results: list[ScenarioResult]) -> str:
     )
 
 
+def render(results: list[ScenarioResult]) -> str:
+    return "".join(_pieces(results))
+
+
 def write(results: list[ScenarioResult], path: Path) -> None:
-    Path(path).write_text(render(results), encoding="utf-8")
+    # written as the template goes: the page of a --matrix of soak tests is tens of MB, and
+    # the whole text at once (with its pieces) was the largest thing the command held
+    with open(path, "w", encoding="utf-8") as out:
+        out.writelines(_pieces(results))

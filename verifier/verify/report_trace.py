@@ -6,16 +6,17 @@ tx frame, when known), `scenario`, and `rules` (ids of the rules this frame is e
 a trace of host times (`uitamr monitor`, `uitamr replay`) also has `tolerance` (seconds), which
 a replay of it allows again.
 
-A run of `uitamr verify --trace` without `--html` does not hold its frames: it writes each
-one as a spool line while it goes (`spool_line`: everything but `rules`, which only the
-judgement at the end knows) and `write` completes the lines. Both ways give the same bytes
-(tests/test_verify_trace_spool.py).
+A run of `uitamr verify --trace` or `--html` does not hold its frames: it writes each
+one as a spool line while it goes (`spool_lines`: everything but `rules`, which only the
+judgement at the end knows) and `write` completes the lines; the HTML page reads the
+frames it draws from the same lines (`LineTimes`, `records`). Both ways give the same
+bytes (tests/test_verify_trace_spool.py, tests/test_verify_html_spool.py).
 """
 from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Iterable, Iterator
+from typing import Collection, Iterator
 
 from verifier import protocol
 
@@ -55,9 +56,38 @@ def in_line_order(result: ScenarioResult) -> list:
     return sorted(result.trace, key=_line_order)
 
 
-def records(result: ScenarioResult, name: str | None = None, only: Iterable[int] | None = None) -> Iterator[dict]:
-    """The trace lines of a run that kept its frames; `name` (default: the run's) goes in
-    each line's `scenario`; `only`: the positions (in trace order) of the frames wanted."""
+def frame_count(result: ScenarioResult) -> int:
+    """How many frames a run that kept them has, held or spooled."""
+    return len(result.trace) if result.trace_file is None else result.tx_count + result.rx_count
+
+
+class LineTimes:
+    """(start µs, end µs, direction) of each frame of a run that kept its frames, in trace
+    order, read afresh on each pass: from the frames it holds, or from its spool file
+    (a long run's frames are never all in memory at once). `len` is the number of frames."""
+
+    def __init__(self, result: ScenarioResult):
+        self._result = result
+        self._held = in_line_order(result) if result.trace_file is None else None
+        self._count = frame_count(result)
+
+    def __len__(self) -> int:
+        return self._count
+
+    def __iter__(self) -> Iterator[tuple[int, int, str]]:
+        if self._held is not None:
+            return ((frame.t_start_us, frame.t_end_us, frame.direction) for frame in self._held)
+        return ((t_us, t_end_us, direction) for t_us, t_end_us, direction, _ in _spool(self._result.trace_file))
+
+
+def records(result: ScenarioResult, name: str | None = None, only: Collection[int] | None = None) -> Iterator[dict]:
+    """The trace lines of a run that kept its frames (held or spooled); `name` (default:
+    the run's) goes in each line's `scenario`; `only`: the positions (in trace order) of
+    the frames wanted."""
+    if result.trace_file is not None:
+        for line in _spooled(result, name or result.name, only):
+            yield json.loads(line)
+        return
     blamed = blamed_frames(result)
     traffic = analyse(result.trace, result.settings, RuleOptions(reply_timeout_us=result.reply_timeout_us))
     frames = in_line_order(result)
@@ -79,22 +109,35 @@ def spool_lines(name: str, frames, settings: protocol.Settings, request_of) -> I
     for frame in sorted(frames, key=_line_order):
         request = request_of(frame) if frame.direction == "rx" else None
         head = json.dumps(_frame_fields(name, frame, settings, request), ensure_ascii=False)
-        yield f"{frame.t_start_us} {frame.direction} {head[:-1]}\n"
+        yield f"{frame.t_start_us} {frame.t_end_us} {frame.direction} {head[:-1]}\n"
 
 
-def _spooled(result: ScenarioResult, name: str) -> Iterator[str]:
+def _spool(path: str) -> Iterator[tuple[int, int, str, str]]:
+    """A spool file's lines: start and end (µs), direction, and the trace line's head."""
+    with open(path, encoding="utf-8") as spool:
+        for line in spool:
+            t_us, t_end_us, direction, head = line.rstrip("\n").split(" ", 3)
+            yield int(t_us), int(t_end_us), direction, head
+
+
+def _spooled(result: ScenarioResult, name: str, only: Collection[int] | None = None) -> Iterator[str]:
     """The run's spool lines completed; `name` in place of the run's own (`scenario` is the
-    first field, written as `_frame_fields` writes it)."""
+    first field, written as `_frame_fields` writes it); `only`: the positions wanted."""
     blamed = blamed_frames(result)
     spooled_name = _scenario_field(result.name)
     renamed = _scenario_field(name)
-    with open(result.trace_file, encoding="utf-8") as spool:
-        for line in spool:
-            t_us, direction, head = line.rstrip("\n").split(" ", 2)
-            if renamed != spooled_name:
-                head = renamed + head[len(spooled_name):]
-            rules = sorted(blamed.get((int(t_us), direction), ()))
-            yield f'{head}, "rules": {json.dumps(rules)}}}\n'
+    wanted = None if only is None else set(only)
+    last = max(wanted, default=-1) if wanted is not None else None
+    for k, (t_us, _, direction, head) in enumerate(_spool(result.trace_file)):
+        if wanted is not None:
+            if k > last:
+                break
+            if k not in wanted:
+                continue
+        if renamed != spooled_name:
+            head = renamed + head[len(spooled_name):]
+        rules = sorted(blamed.get((t_us, direction), ()))
+        yield f'{head}, "rules": {json.dumps(rules)}}}\n'
 
 
 def _scenario_field(name: str) -> str:

@@ -21,14 +21,18 @@ class Keep:
     (`--trace`, `--html`); the watched labels' changes and the line's and robot's events
     (`--json`, `--html`). A run that keeps no frames is judged as it goes
     (verifier.verify.stream) and holds little more than its findings however long it runs;
-    so is one whose frames only `--trace` lists (`frames_to_file`)."""
+    so is one whose frames go to a file (`frames_to_file`, what `uitamr verify` does for
+    `--trace` and `--html`)."""
 
     frames: bool = True
     details: bool = True
-    # only the trace lists the frames: they go to a file in this folder as the run goes
-    # (`ScenarioResult.trace_file`) instead of being held, and the run is judged as it
-    # goes. The folder is the caller's to remove (`uitamr verify` makes a hidden one
-    # beside the trace), with whatever a run that failed midway left in it
+    # with `details`, the watched labels' changes too (only `--json` lists them; the page
+    # draws the events alone, and an o_wTxCount watched changes on every request)
+    watched: bool = True
+    # the frames go to a file in this folder as the run goes (`ScenarioResult.trace_file`)
+    # instead of being held, and the run is judged as it goes; the trace and the page read
+    # them from there. The folder is the caller's to remove (`uitamr verify` makes a hidden
+    # one beside the trace or the page), with whatever a run that failed midway left in it
     frames_to_file: str | None = None
 
 
@@ -89,7 +93,8 @@ class ScenarioResult:
     notes: list[str] = field(default_factory=list)  # how the run differs from its scenario file
     frame_counts: tuple[int, int] | None = None  # (requests, replies) when `trace` was not kept
     # the frames as trace lines written while the run went (Keep.frames_to_file): a file
-    # of report_trace.spool_lines lines, which report_trace.write completes
+    # of report_trace.spool_lines lines, which report_trace.write completes and the HTML
+    # page reads the frames it draws from
     trace_file: str | None = None
     # a capture that saw no bytes (`uitamr monitor`, `uitamr replay`): nothing was verified;
     # what was silent and what to check

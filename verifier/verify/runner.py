@@ -385,7 +385,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     # the idle check, which then need not compare the whole state); the watched ones are
     # recorded only when a report lists them
     names = scenario.variables()
-    recorded = scenario.variables(watched=keep.details)
+    recorded = scenario.variables(watched=keep.details and keep.watched)
     samples = Samples(recorded)
     recorded_names = frozenset(recorded)
     picked = [k for k, name in enumerate(names) if name in recorded_names]
@@ -425,8 +425,8 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
 
     sample = sample_plainly if plain else sample_on_change  # plain: the reference path
 
-    # judged as it goes when no report holds every frame (the trace alone takes them from
-    # files written as the run goes); else as a whole at the end
+    # judged as it goes unless the run is the reference path (plain): the trace and the
+    # page take the frames from files written as the run goes; else as a whole at the end
     streamed = not plain and (not keep.frames or keep.frames_to_file is not None)
     stream = Stream(scenario.settings, scenario.options, samples, scenario.expectations, _relative,
                     keep.frames_to_file if keep.frames else None, scenario.name) if streamed else None
@@ -485,7 +485,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         violations=violations,
         expectations=outcomes,
         diagnostics=plc.diagnostics(),
-        watched={name: list(samples.changes.get(name, [])) for name in scenario.watch} if keep.details else {},
+        watched={name: list(samples.changes.get(name, [])) for name in scenario.watch} if keep.details and keep.watched else {},
         aborted=aborted,
         ended_us=end,
         wall_s=time.perf_counter() - wall_start,

@@ -8,8 +8,9 @@ go of. What stays is bounded: the last few exchanges, the findings, the frame co
 the samples of the labels the expectations and the response signal read. At the end
 `finish` judges the rest exactly as a whole run is judged (tests/test_verify_stream.py:
 the same findings and verdicts on every bundled scenario and on random ones).
-A run whose frames only `--trace` lists writes them as trace lines to a file while it goes
-(`spool_folder`; report_trace completes the lines once the run is judged).
+A run whose frames `--trace` or `--html` lists writes them as trace lines to a file while it
+goes (`spool_folder`; report_trace completes the lines once the run is judged, and the page
+reads the frames it draws from them).
 """
 from __future__ import annotations
 
@@ -109,7 +110,7 @@ class Stream:
         try:
             yield
         except OSError as exc:
-            raise UnusableInput(f"cannot write the trace in {self._spool_folder}: {exc.strerror or exc}") from None
+            raise UnusableInput(f"cannot write the run's frames in {self._spool_folder}: {exc.strerror or exc}") from None
 
     def _events(self, events: Sequence[Any]) -> None:
         self.evidence.events.extend(events)  # the format rule reads the gaps as they are added
