@@ -202,6 +202,7 @@ def test_the_nth_table_of_an_array_is_found():
     ('[robot]\nturnaround_ms = -1', "robot.turnaround_ms", "at least"),
     ('[[faults]]\nkind = "meteor"\nat_s = 1', "faults[0].kind", "unknown fault"),
     ('[[faults]]\nkind = "no_reply"', "faults[0]", "trigger"),
+    ('[[faults]]\nkind = ["no_reply"]\nat_s = 1', "faults[0].kind", "expected a string"),
     ('[[inputs]]\nat = "1s"', "inputs[0]", "needs 'at'"),
     ('[[inputs]]\nat = "1s"\nset = { x = "on" }', "inputs[0].set.x", "true/false or a number"),
     ('[[inputs]]\nat = "1s"\nset = { x = 3 }\npulse = "1s"', "inputs[0].pulse", "no BOOL"),
