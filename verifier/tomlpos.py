@@ -40,8 +40,8 @@ def line_of_key(lines: list[str], key: str) -> int | None:
     if rest and rest[0].startswith("["):
         index = int(rest[0][1:-1])
         rest = rest[1:]
-    header = re.compile(r"^\s*\[\[\s*" + re.escape(table) + r"\s*\]\]")
-    plain_header = re.compile(r"^\s*\[\s*" + re.escape(table) + r"\s*\]")
+    header = re.compile(r"^\s*\[\[\s*" + _name(table) + r"\s*\]\]")
+    plain_header = re.compile(r"^\s*\[\s*" + _name(table) + r"\s*\]")
     start: int | None = None  # the line of the table's header, when the key is in a table
     seen = -1
     for number, line in enumerate(lines):
@@ -61,14 +61,21 @@ def line_of_key(lines: list[str], key: str) -> int | None:
         if start is None and number > 0 and re.match(r"^\s*\[", line):
             break  # a top-level key comes before every table
         if start is not None and number > start and re.match(r"^\s*\[", line) \
-                and not re.match(r"^\s*\[\[?\s*" + re.escape(table) + r"\.", line):
+                and not re.match(r"^\s*\[\[?\s*" + _name(table) + r"\.", line):
             break  # past its table (and the table's sub-tables): point at the table's header
-        if re.match(r"^\s*\"?" + re.escape(target) + r"\"?\s*=", line):
+        if re.match(r"^\s*" + _name(target) + r"\s*=", line):
             return number + 1
     if start is None:
         # no header: the table may be written inline (faults = [{ kind = "x" }]); its line
         return line_of_key(lines, table) if rest or index else None
     return start + 1
+
+
+def _name(key: str) -> str:
+    """A pattern for `key` as a TOML file may write it: bare, "basic" or 'literal' (as the
+    docs write buffer memory: 'U0\\G164' = 8)."""
+    name = re.escape(key)
+    return f"(?:{name}|\"{name}\"|'{name}')"
 
 
 def decode_error_position(error: tomllib.TOMLDecodeError, source: str = "") -> tuple[str, Place | None]:
@@ -101,7 +108,7 @@ def place_of_key(lines: list[str], key: str, at_name: bool = False) -> Place | N
         index = int(parts[-1][1:-1])
         parts = parts[:-1]
     name = parts[-1] if parts else ""
-    match = re.search(r"(?:^|[{,])\s*(\"?" + re.escape(name) + r"\"?)\s*=\s*", text) if name else None
+    match = re.search(r"(?:^|[{,])\s*(" + _name(name) + r")\s*=\s*", text) if name else None
     if match is None:
         return Place(line, len(text) - len(text.lstrip()) + 1)
     if at_name:
