@@ -236,8 +236,11 @@ def power_on_stop_expectation(duration_us: int, address: int = 1, after_us: int 
 
 def load_scenario(path: Path | str) -> Scenario:
     path = Path(path)
-    if not path.exists():
-        raise ScenarioError(path, "", "no such scenario file")
+    try:
+        if not path.exists():
+            raise ScenarioError(path, "", "no such scenario file")
+    except OSError as exc:  # a name too long for the file system, a folder that cannot be read ...
+        raise ScenarioError(path, "", f"cannot read: {exc.strerror or exc}") from None
     try:
         text = read_utf8(path)
     except UnreadableText as exc:

@@ -18,6 +18,13 @@ class SourceError(ValueError):
 def expand(name: str, base: Path) -> list[Path]:
     """The .st files `name` stands for, relative to `base` unless absolute, sorted. A name
     with glob characters that is also an existing path ("[A]/x.st") is that path."""
+    try:
+        return _expand(name, base)
+    except OSError as exc:  # a name too long for the file system, a folder that cannot be read ...
+        raise SourceError(f"{exc.filename or name}: {exc.strerror or exc}") from None
+
+
+def _expand(name: str, base: Path) -> list[Path]:
     literal = Path(name) if Path(name).is_absolute() else base / name
     if any(ch in name for ch in GLOB_CHARACTERS) and not literal.exists():
         pattern = name if Path(name).is_absolute() else str(base / name)

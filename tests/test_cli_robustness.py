@@ -1,0 +1,47 @@
+"""Whatever a hurried integrator or a corrupted file hands a command, it answers with an
+error that names what to fix and an exit status (2: unusable input), never a traceback."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from verifier.cli import main
+from verifier.verify.scenario import ScenarioError, load_scenario
+
+#: longer than any file name a Linux or Windows file system takes (255 bytes)
+LONG = "a" * 300
+
+
+def invoke(*args):
+    return CliRunner().invoke(main, [str(a) for a in args], catch_exceptions=False)
+
+
+@pytest.mark.parametrize("args", [
+    ["check", LONG],
+    ["check", LONG + ".toml"],
+    ["verify", LONG],
+    ["verify", "--scenario", LONG + ".toml"],
+    ["verify", "--duration", "1s", "--json", f"{LONG}/x.json"],
+    ["export", "--target", "gxworks2", "--out", "{tmp}", LONG],
+])
+def test_a_file_name_too_long_is_an_error_not_a_traceback(args, tmp_path):
+    # os.stat raised OSError (ENAMETOOLONG) from Path.is_dir()/exists() before any check
+    result = invoke(*[a.replace("{tmp}", str(tmp_path)) for a in args])
+    assert result.exit_code == 2, result.output
+    assert "File name too long" in result.output and LONG in result.output
+
+
+def test_a_source_name_too_long_in_a_scenario_names_its_key_and_line(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text(f'program = "Main"\nsources = ["{LONG}.st"]\n', encoding="utf-8")
+    with pytest.raises(ScenarioError) as caught:
+        load_scenario(path)
+    assert (caught.value.key, caught.value.line, caught.value.col) == ("sources[0]", 2, 12)
+    assert "File name too long" in caught.value.message
+
+
+def test_a_scenario_file_name_too_long_is_a_scenario_error(tmp_path):
+    with pytest.raises(ScenarioError, match="cannot read: File name too long"):
+        load_scenario(tmp_path / f"{LONG}.toml")
