@@ -180,6 +180,9 @@ def _scaled(text: str, step: Decimal, what: str, unit: str) -> tuple[int, int]:
         value = None
     if value is None or not value.is_finite():
         raise CommandError(f"{what} must be a number like +1.5 or -0.3, got {text!r}")
+    if value.copy_abs() >= step * 1_000_000:  # 1e999999 overflows abs() and the division; 9 x 5000 the digits of int()
+        raise CommandError(f"{what} {text}{unit and ' ' + unit} is far more than 255 units of {step}; one byte "
+                           f"holds at most 255 ({step * 255}{unit and ' ' + unit})")
     units = abs(value) / step
     if units != units.to_integral_value():
         raise CommandError(f"{what} {text} is not a whole number of {step}{unit and ' ' + unit} steps")
