@@ -229,6 +229,13 @@ def test_every_mistake_names_its_key(text, key, words):
     assert str(error).startswith(f"x.toml:{error.line}:{error.col}: {key}: ")
 
 
+def test_a_number_too_long_for_python_is_a_toml_error_at_its_place():
+    # tomllib let int()'s ValueError (more than 4300 digits) through: a traceback
+    error = error_of('program = "Main"\nseed = 1_' + "9" * 5000 + "\n", Path("x.toml"))
+    assert (error.line, error.col) == (2, 8)
+    assert str(error).startswith("x.toml:2:8: not valid TOML: a whole number of 5001 digits: too long to read")
+
+
 def test_a_missing_scenario_file(tmp_path):
     with pytest.raises(ScenarioError, match="no such scenario file"):
         load_scenario(tmp_path / "none.toml")

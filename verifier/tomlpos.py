@@ -26,6 +26,7 @@ class Place:
 
 
 _KEY_PART = re.compile(r"[^.\[\]]+|\[\d+\]")
+_LONG_NUMBER = re.compile(r"(?<![\w.])[0-9][0-9_]{4300,}")
 _DECODE_POSITION = re.compile(r"\s*\(at line (\d+), column (\d+)\)")
 
 
@@ -78,11 +79,15 @@ def _name(key: str) -> str:
     return f"(?:{name}|\"{name}\"|'{name}')"
 
 
-def decode_error_position(error: tomllib.TOMLDecodeError, source: str = "") -> tuple[str, Place | None]:
+def decode_error_position(error: ValueError, source: str = "") -> tuple[str, Place | None]:
     """A TOML syntax error as (message, place): tomllib writes the place as
     "(at line L, column C)" at the end of its message; callers put it after the file
     name like every other error. `source` (the file's text) lets the message name a cause
-    tomllib cannot: line ends that are lone carriage returns, which TOML does not allow."""
+    tomllib cannot: line ends that are lone carriage returns, which TOML does not allow.
+    `error` may also be the plain ValueError tomllib lets through from int() for a
+    whole number of more than 4300 digits (Python's limit): it is placed in `source`."""
+    if not isinstance(error, tomllib.TOMLDecodeError):
+        return _too_many_digits(source)
     text = str(error)
     if has_lone_cr(source):
         text += ("; the file's line ends are lone carriage returns (classic Mac OS), which TOML "
@@ -91,6 +96,16 @@ def decode_error_position(error: tomllib.TOMLDecodeError, source: str = "") -> t
     if match is None:
         return text, None
     return _DECODE_POSITION.sub("", text), Place(int(match.group(1)), int(match.group(2)))
+
+
+def _too_many_digits(source: str) -> tuple[str, Place | None]:
+    match = _LONG_NUMBER.search(source)
+    if match is None:
+        return "a number too long to read", None
+    before = source[:match.start()]
+    place = Place(before.count("\n") + 1, match.start() - (before.rfind("\n") + 1) + 1)
+    digits = sum(ch.isdigit() for ch in match.group())
+    return f"a whole number of {digits} digits: too long to read (at most 4300), and no setting takes it", place
 
 
 def place_of_key(lines: list[str], key: str, at_name: bool = False) -> Place | None:

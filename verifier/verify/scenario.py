@@ -254,7 +254,7 @@ def load_scenario(path: Path | str) -> Scenario:
 def parse_scenario(text: str, path: Path | None = None) -> Scenario:
     try:
         data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
+    except ValueError as exc:  # TOMLDecodeError, or int()'s limit of 4300 digits
         message, place = decode_error_position(exc, text)
         raise ScenarioError(path, "", f"not valid TOML: {message}", place) from None
     return _Reader(text, path).read(data)
