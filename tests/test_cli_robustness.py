@@ -45,3 +45,31 @@ def test_a_source_name_too_long_in_a_scenario_names_its_key_and_line(tmp_path):
 def test_a_scenario_file_name_too_long_is_a_scenario_error(tmp_path):
     with pytest.raises(ScenarioError, match="cannot read: File name too long"):
         load_scenario(tmp_path / f"{LONG}.toml")
+
+
+@pytest.mark.parametrize("args, words", [
+    (["check", "{loop}.st"], "cannot read: Too many levels of symbolic links"),
+    (["check", "{loop}.toml"], "cannot read: Too many levels of symbolic links"),
+    (["verify", "--scenario", "{loop}.toml"], "a symbolic link to nothing"),
+    (["verify", "{loop}.st"], "a symbolic link to nothing"),
+    (["verify", "--duration", "1s", "--json", "{loop}.st"], "Too many levels of symbolic links"),
+    (["replay", "--json", "{loop}.st", "{capture}"], "Too many levels of symbolic links"),
+    (["export", "--target", "gxworks2", "--out", "{loop}.st", "{program}"], "cannot write"),
+])
+def test_a_symlink_loop_is_an_error_not_a_traceback(args, words, tmp_path):
+    # Python 3.11's Path.resolve() raised RuntimeError("Symlink loop from ...")
+    loop = tmp_path / "loop"
+    for suffix in (".st", ".toml"):
+        (tmp_path / f"a{suffix}").symlink_to(tmp_path / f"b{suffix}")
+        (tmp_path / f"b{suffix}").symlink_to(tmp_path / f"a{suffix}")
+        (tmp_path / f"loop{suffix}").symlink_to(tmp_path / f"a{suffix}")
+    program = tmp_path / "P.st"
+    program.write_text("PROGRAM P\nVAR x : INT; END_VAR\nx := 1;\nEND_PROGRAM\n", encoding="utf-8")
+    capture = tmp_path / "c.txt"
+    capture.write_text("0.000 tx 01 06 01 A0 00 00 88 14\n", encoding="utf-8")
+    fill = {"{loop}": str(loop), "{program}": str(program), "{capture}": str(capture)}
+    for key, value in fill.items():
+        args = [a.replace(key, value) for a in args]
+    result = invoke(*args)
+    assert result.exit_code == 2, result.output
+    assert words in result.output

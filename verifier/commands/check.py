@@ -19,7 +19,7 @@ import click
 from verifier.commands.check_formats import Finding, to_github, to_json, to_sarif
 from verifier.st import TARGETS
 from verifier.st.ast import Diagnostic, SourceFile
-from verifier.textfile import text_lines
+from verifier.textfile import real_path, text_lines
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
 
@@ -35,7 +35,7 @@ def expand_sources(sources: tuple[str, ...]) -> list[Path]:
     for s in sources:
         p = Path(s)
         for path in st_files_in(p) if p.is_dir() else [p]:
-            key = path.resolve()
+            key = real_path(path)
             if key not in seen:
                 seen.add(key)
                 paths.append(path)

@@ -238,6 +238,8 @@ def load_scenario(path: Path | str) -> Scenario:
     path = Path(path)
     try:
         if not path.exists():
+            if path.is_symlink():
+                raise ScenarioError(path, "", "a symbolic link to nothing (its target is missing, or a loop of links)")
             raise ScenarioError(path, "", "no such scenario file")
     except OSError as exc:  # a name too long for the file system, a folder that cannot be read ...
         raise ScenarioError(path, "", f"cannot read: {exc.strerror or exc}") from None

@@ -6,7 +6,7 @@ import glob
 from functools import lru_cache
 from pathlib import Path
 
-from verifier.textfile import file_kind
+from verifier.textfile import file_kind, real_path
 
 GLOB_CHARACTERS = "*?["
 
@@ -45,6 +45,8 @@ def _expand(name: str, base: Path) -> list[Path]:
     if not path.is_file():
         if path.exists():
             raise SourceError(f"{path} is not a regular file ({file_kind(path.stat().st_mode)}); give .st files")
+        if path.is_symlink():
+            raise SourceError(f"{path} is a symbolic link to nothing (its target is missing, or a loop of links)")
         raise SourceError(f"no such file or folder: {path}")
     return [path]
 
@@ -64,4 +66,4 @@ def unique(paths: list[Path]) -> tuple[Path, ...]:
 def _resolved(path: Path) -> Path:
     """`path.resolve()`, remembered: the bundled scenarios name the same 30-odd files
     again and again, and resolving one walks every folder above it."""
-    return path.resolve()
+    return real_path(path)
