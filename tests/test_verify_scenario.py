@@ -32,6 +32,21 @@ def test_bad_durations_are_refused_with_an_example(bad):
         parse_duration_us(bad)
 
 
+@pytest.mark.parametrize("text, us, message", [
+    # Fraction() read none of these: 'Exceeds the limit (4300 digits) for integer string conversion'
+    ("9" * 5000 + "s", None, "a duration of 5000 digits is longer than any run: check the number"),
+    ("0." + "0" * 5000 + "1s", None, "is finer than the virtual clock's microsecond"),
+    ("0" * 5000 + "1s", 1_000_000, ""),
+    ("1." + "0" * 5000 + "s", 1_000_000, ""),
+])
+def test_durations_with_thousands_of_digits(text, us, message):
+    if us is not None:
+        assert parse_duration_us(text) == us
+    else:
+        with pytest.raises(ValueError, match=message):
+            parse_duration_us(text)
+
+
 @given(st.integers(min_value=0, max_value=10**9))
 def test_milliseconds_round_trip(ms):
     assert parse_duration_us(f"{ms}ms") == ms * 1000
