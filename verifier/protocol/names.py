@@ -159,6 +159,9 @@ def _choice(name: str, args: list[str], options: dict):
 
 
 def _integer(text: str, what: str) -> int:
+    if len(text) > 20:  # every value here fits a byte; 5000 digits are more than int() reads or prints
+        raise CommandError(f"{what} must be a small whole number (decimal, or hex as 0x..), got "
+                           f"{len(text)} characters: {text[:20]}...")
     try:
         return int(text, 16) if text.lower().startswith("0x") else int(text, 10)
     except ValueError:
