@@ -429,7 +429,8 @@ class _Reader:
         if "ip" in item:
             ip = self.string(item["ip"], "converter.ip")
             parts = ip.split(".")
-            if len(parts) != 4 or not all(p.isdigit() and int(p) <= 255 for p in parts):
+            if len(parts) != 4 or not all(p.isascii() and p.isdigit() and len(p) <= 3 and int(p) <= 255
+                                          for p in parts):  # '²' is a digit to isdigit(), not to int()
                 raise self.fail("converter.ip", f"expected an IPv4 address like \"192.168.3.50\", got {ip!r}")
             changes["ip"] = ".".join(str(int(p)) for p in parts)
         if "port" in item:
