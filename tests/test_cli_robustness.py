@@ -73,3 +73,10 @@ def test_a_symlink_loop_is_an_error_not_a_traceback(args, words, tmp_path):
     result = invoke(*args)
     assert result.exit_code == 2, result.output
     assert words in result.output
+
+
+def test_a_host_name_the_idna_codec_refuses_is_an_error_not_a_traceback():
+    # socket.create_connection raised UnicodeError ("label empty or too long") for a..b
+    result = invoke("monitor", "--tcp", "a..b:4001", "--duration", "1s")
+    assert result.exit_code == 2
+    assert "cannot connect to a..b:4001: not a host name" in result.output
