@@ -78,6 +78,14 @@ def test_condition_errors_name_the_column(text, column):
     assert info.value.column == column
 
 
+@pytest.mark.parametrize("number", ["9" * 5000, "16#" + "F" * 5000, "1." + "9" * 5000])
+def test_a_number_of_thousands_of_digits_in_a_condition_says_so(number):
+    # was "'99...9' is not a number" (int()'s 4300-digit limit), or read and judged as it was
+    with pytest.raises(ConditionError) as info:
+        parse_condition(f"x = {number}")
+    assert info.value.column == 5 and "digits: no PLC label holds one this long" in info.value.message
+
+
 @pytest.mark.parametrize("text, message", [
     ("(" * 150 + "TRUE" + ")" * 150, "nested too deeply"),
     ("NOT " * 1000 + "TRUE", "nested too deeply"),
