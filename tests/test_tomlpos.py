@@ -97,3 +97,10 @@ def test_quoted_table_names_and_literal_keys_are_found():
     assert place_of_key(lines, "robot.turnaround_ms") == Place(6, 17)
     assert line_of_key(lines, "robot") == 5
     assert line_of_key(lines, "faults[0].kind") == 9
+
+
+def test_dotted_keys_are_found():
+    # robot.turnaround_ms = "x" (a TOML dotted key) gave no place at all (0:0 in uitamr check)
+    lines = ['name = "x"', 'robot.turnaround_ms = "x"', "a.b.c = 1"]
+    assert place_of_key(lines, "robot.turnaround_ms") == Place(2, 23)
+    assert place_of_key(lines, "a", at_name=True) == Place(3, 1)

@@ -64,7 +64,7 @@ def line_of_key(lines: list[str], key: str) -> int | None:
         if start is not None and number > start and re.match(r"^\s*\[", line) \
                 and not re.match(r"^\s*\[\[?\s*" + _name(table) + r"\.", line):
             break  # past its table (and the table's sub-tables): point at the table's header
-        if re.match(r"^\s*" + _name(target) + r"\s*=", line):
+        if re.match(r"^\s*" + _name(target) + r"\s*[=.]", line):  # a dotted key too: robot.pacing = ...
             return number + 1
     if start is None:
         # no header: the table may be written inline (faults = [{ kind = "x" }]); its line
@@ -123,7 +123,7 @@ def place_of_key(lines: list[str], key: str, at_name: bool = False) -> Place | N
         index = int(parts[-1][1:-1])
         parts = parts[:-1]
     name = parts[-1] if parts else ""
-    match = re.search(r"(?:^|[{,])\s*(" + _name(name) + r")\s*=\s*", text) if name else None
+    match = re.search(r"(?:^|[{,.])\s*(" + _name(name) + r")\s*=\s*", text) if name else None
     if match is None:
         return Place(line, len(text) - len(text.lstrip()) + 1)
     if at_name:
