@@ -259,6 +259,12 @@ def test_a_number_too_long_for_python_is_a_toml_error_at_its_place():
     assert str(error).startswith("x.toml:2:8: not valid TOML: a whole number of 5001 digits: too long to read")
 
 
+def test_an_empty_program_name_is_an_error_at_its_line():
+    # was "no PROGRAM '' in the sources" once the sources were loaded, naming no line
+    error = error_of('name = "x"\nprogram = ""\n', Path("x.toml"))
+    assert str(error).startswith("x.toml:2:11: program: is empty: give the name of the PROGRAM to run")
+
+
 def test_a_missing_scenario_file(tmp_path):
     with pytest.raises(ScenarioError, match="no such scenario file"):
         load_scenario(tmp_path / "none.toml")

@@ -345,6 +345,9 @@ class _Reader:
         description = self.string(data.get("description", ""), "description")
         sources = tuple(self.sources(data["sources"])) if "sources" in data else ()
         program = self.string(data["program"], "program") if "program" in data else None
+        if program is not None and not program.strip():  # was "no PROGRAM '' in the sources", without a line
+            raise self.fail("program", "is empty: give the name of the PROGRAM to run, or leave 'program' out "
+                                       "when the sources hold only one")
         platform = self.string(data.get("platform", "fx3u"), "platform").lower()
         if platform not in PLATFORMS:
             raise self.fail("platform", f"unknown platform {platform!r}; expected one of {', '.join(PLATFORMS)}")
