@@ -228,6 +228,9 @@ def test_fault_file_in_toml_loads():
     ([{"kind": "no_reply", "on_request": 1}, {"kind": "no_reply", "at_s": 1}, {"kind": "x", "at_s": 1}],
      "faults[2].kind: unknown fault 'x'; expected one of " + ", ".join(FAULT_KINDS)),
     ([{"at_s": 1}], "faults[0].kind: missing; expected one of"),
+    # an array or a table as the kind was a TypeError (unhashable) and a traceback
+    ([{"kind": ["no_reply"], "at_s": 1}], "faults[0].kind: expected a string, got ['no_reply']; one of"),
+    ([{"kind": {"a": 1}, "at_s": 1}], "faults[0].kind: expected a string, got a table; one of"),
     ([{"kind": "no_reply"}], "faults[0]: give exactly one trigger: at_s or on_request"),
     ([{"kind": "no_reply", "at_s": 1, "on_request": 2}], "faults[0]: give exactly one trigger"),
     ([{"kind": "no_reply", "at_s": 1, "colour": "red"}], "faults[0].colour: unknown key; expected one of"),

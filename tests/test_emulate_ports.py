@@ -496,6 +496,9 @@ def test_the_scripted_fault_line_says_count_duration_and_filter_together(tmp_pat
     (("--tcp", "0", "--turnaround-ms", "1e300"), "--turnaround-ms': '1e300' is out of range", 2),
     (("--serial", "socket://127.0.0.1"), "socket://127.0.0.1 needs a host and a port: socket://HOST:PORT", 2),
     (("--serial", "socket://127.0.0.1:http"), "the port 'http' is not a number from 1 to 65535", 2),
+    # '²' passed str.isdigit() and failed int(); 5000 digits failed int() too: tracebacks
+    (("--serial", "socket://127.0.0.1:²"), "the port '²' is not a number from 1 to 65535", 2),
+    (("--serial", "socket://127.0.0.1:" + "9" * 5000), "is not a number from 1 to 65535", 2),
     # `--serial "$PORT"` with PORT unset: was exit 1, "cannot open serial port : ... ''"
     (("--serial", ""), "the port name is empty: give the serial port", 2),
 ])

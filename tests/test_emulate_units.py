@@ -113,6 +113,8 @@ def test_fault_file_with_robot_table(tmp_path):
     ("[[faults]]\nkind = 'late_reply'\non_request = 2\n\n[[faults]]\nkind = 'late_reply'\n"
      "on_request = 3\ndelay_ms = 5\n", ":1:1: faults[0].delay_ms: missing"),
     ("[[faults]]\nkind = 'no_reply'\non_request = 1\n[[faults]\n", ":4:9: not valid TOML: "),
+    # tomllib let int()'s ValueError (more than 4300 digits) through: a traceback
+    ("[[faults]]\nkind = 'no_reply'\non_request = " + "9" * 5000 + "\n", ":3:14: not valid TOML: a whole number of 5000 digits"),
 ])
 def test_bad_fault_files_name_the_file_the_line_and_the_key(tmp_path, text, where):
     path = tmp_path / "bad.toml"

@@ -424,6 +424,9 @@ def test_an_empty_port_name_is_named_as_empty():
     ('{"t": 0.1, "dir": "tx", "hex": "ZZ"}', "'hex' is 'ZZ'; expected bytes in hex"),
     ('{"t": 0.1, "dir": "tx", "hex": 5}', "'hex' is 5; expected bytes in hex"),
     ('{"t": 0.1, "dir": "tx", "hex": " "}', "'hex' is ' '; expected bytes in hex"),  # was judged as a 0-byte frame
+    # were a ValueError (int() reads at most 4300 digits) and a RecursionError from json.loads
+    ('{"t": ' + "9" * 5000 + ', "dir": "tx", "hex": "01"}', "not a trace record: it holds a number too long"),
+    ('{"t": 0, "x": ' + "[" * 100_000 + "]" * 100_000 + "}", "not a trace record: arrays or objects nested"),
 ])
 def test_a_trace_record_with_a_bad_value_names_the_key(tmp_path, record, message):
     path = tmp_path / "t.jsonl"

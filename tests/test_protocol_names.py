@@ -84,6 +84,13 @@ def test_reads(word, query):
     ("stop now", "stop takes 0 argument"),
     ("move x 30", "300 units of 0.1; one byte holds at most 255 (25.5 m)"),
     ("move x 1.55", "not a whole number of 0.1 m steps"),
+    # were decimal.Overflow (abs() and the division of 1e999999) and int-to-text tracebacks
+    ("move x 1e999999", "far more than 255 units of 0.1; one byte holds at most 255 (25.5 m)"),
+    ("rotate -1e99999999999", "far more than 255 units of 0.01"),
+    ("move x " + "9" * 5000, "far more than 255 units of 0.1"),
+    # int("0x" + 5000 hex digits) is read, but no message could print it
+    ("raw 0x" + "f" * 5000 + " 1", "control code must be a small whole number (decimal, or hex as 0x..), got 5002"),
+    ("run-point " + "9" * 5000, "point number must be a small whole number"),
     ("move z 1", "move takes one of x|front|rear|y"),
     ("move x", "move takes 2 argument"),
     ("move x far", "must be a number"),

@@ -1,6 +1,7 @@
 """Arbitrary input never raises: every problem comes back as a diagnostic with a place."""
 from __future__ import annotations
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -62,3 +63,39 @@ def test_deeply_nested_expression_is_a_diagnostic():
 def test_bad_input_reports_a_syntax_error_with_position():
     diags = run_all("PROGRAM P\nVAR x : INT; END_VAR\nx := (1 + ;\nEND_PROGRAM\n")
     assert any(d.is_error and d.line == 3 for d in diags)
+
+
+LONG = "9" * 5000  # more digits than Python reads (4300) or a float holds in T#...s
+
+
+@pytest.mark.parametrize("decl, body, col", [
+    ("", f"x := {LONG};", 6),
+    ("", f"x := 16#{LONG};", 6),
+    ("", f"x := 1{LONG}.5;", 6),
+    ("", f"t := T#{LONG}s;", 6),             # was OverflowError: float infinity to integer
+    ("", f"x := K{LONG};", 6),
+    ("", f"x := H{LONG};", 6),
+    ("", f"x := D{LONG};", 6),
+    ("", f"D{LONG} := 1;", 1),
+    ("", f"x := U0\\G{LONG};", 6),
+    ("", f"b := x.{LONG};", 8),
+    (f"s : STRING[{LONG}];", "", 5),
+    (f"a : ARRAY[0..{LONG}] OF INT;", "", 5),
+    (f"c : INT := {LONG};", "", 5),
+    (f"w AT D{LONG} : INT;", "", 5),
+])
+def test_numbers_too_long_for_python_are_diagnostics(decl, body, col):
+    # each was a ValueError (int() reads at most 4300 digits) or an OverflowError
+    text = f"PROGRAM P\nVAR x : INT; b : BOOL; t : TIME; {decl} END_VAR\n{body}\nEND_PROGRAM\n"
+    errors = [d for d in run_all(text) if d.is_error]
+    assert any("no PLC type holds one this long" in d.message for d in errors), errors
+    line = 3 if body else 2
+    assert all(d.line == line for d in errors), errors
+    if body:
+        assert errors[0].col == col
+
+
+def test_a_64_bit_binary_literal_is_not_too_long():
+    bits = "_".join(["1111"] * 16)  # 79 characters
+    diags = run_all(f"PROGRAM P\nVAR x : LWORD; END_VAR\nx := 2#{bits};\nEND_PROGRAM\n")
+    assert not any("no PLC type holds" in d.message for d in diags)

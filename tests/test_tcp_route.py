@@ -244,6 +244,8 @@ BASE = 'platform = "fx5u"\n'
 @pytest.mark.parametrize("text, expected", [
     ('platform = "fx3u"\n[converter]\nport = 4001\n', "s.toml:2:1: converter: the TCP route needs"),
     (BASE + '[converter]\nip = "192.168.3"\n', "s.toml:3:6: converter.ip: expected an IPv4 address"),
+    # '²' is a digit to str.isdigit() but not to int(): was a ValueError traceback
+    (BASE + '[converter]\nip = "192.168.3.²"\n', "s.toml:3:6: converter.ip: expected an IPv4 address"),
     (BASE + '[converter]\nport = 70000\n', "s.toml:3:8: converter.port: expected a TCP port 1..65535"),
     (BASE + '[converter]\ndrops = "20s"\n', "s.toml:3:9: converter.drops: expected a list of times"),
     (BASE + '[converter]\ndrops = ["20s", "x"]\n', "s.toml:3:17: converter.drops[1]"),

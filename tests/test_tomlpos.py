@@ -85,3 +85,22 @@ def test_places_point_at_the_value_the_item_or_the_key():
     assert str(place_of_key(lines, "inputs[0].set.D100")) == "8:27"
     assert str(place_of_key(lines, "robot")) == "4:1"
     assert place_of_key(lines, "nowhere.at.all") is None
+
+
+def test_quoted_table_names_and_literal_keys_are_found():
+    # the docs quote buffer memory with single quotes ('U0\G164' = 8); a table's name may
+    # be quoted too. Both pointed at the table's header, or nowhere (0:0 in `uitamr check`).
+    lines = ["[initial]", "D100 = 3", "'U0\\G164' = 8", "", '["robot"]', "turnaround_ms = 'x'",
+             "", "[[ 'faults' ]]", "kind = 'x'"]
+    assert place_of_key(lines, "initial.U0\\G164") == Place(3, 13)
+    assert place_of_key(lines, "initial.U0\\G164", at_name=True) == Place(3, 1)
+    assert place_of_key(lines, "robot.turnaround_ms") == Place(6, 17)
+    assert line_of_key(lines, "robot") == 5
+    assert line_of_key(lines, "faults[0].kind") == 9
+
+
+def test_dotted_keys_are_found():
+    # robot.turnaround_ms = "x" (a TOML dotted key) gave no place at all (0:0 in uitamr check)
+    lines = ['name = "x"', 'robot.turnaround_ms = "x"', "a.b.c = 1"]
+    assert place_of_key(lines, "robot.turnaround_ms") == Place(2, 23)
+    assert place_of_key(lines, "a", at_name=True) == Place(3, 1)

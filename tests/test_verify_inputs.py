@@ -129,6 +129,9 @@ def test_unknown_labels_name_file_line_and_key_once(tmp_path, program, body, lin
     ('[[inputs]]\nat = "0s"\nset = { w = 40000 }\n', "40000 does not fit w"),
     ('[[inputs]]\nat = "0s"\nset = { u = -1 }\n', "-1 does not fit u"),
     ('[[inputs]]\nat = "0s"\nset = { w = 1.5 }\n', "got the float 1.5"),
+    # int(inf) in the device write was an OverflowError traceback; nan said "cannot convert float NaN to integer"
+    ('[[inputs]]\nat = "0s"\nset = { D100 = inf }\n', "D100 is a word device: give a whole number -32768..65535, not inf"),
+    ('[[inputs]]\nat = "0s"\nset = { D100 = nan }\n', "D100 is a word device: give a whole number"),
 ])
 def test_labels_of_the_wrong_type_are_refused(tmp_path, program, body, words):
     result, scenario = _run_scenario(tmp_path, program, body)

@@ -32,6 +32,21 @@ def test_bad_durations_are_refused_with_an_example(bad):
         parse_duration_us(bad)
 
 
+@pytest.mark.parametrize("text, us, message", [
+    # Fraction() read none of these: 'Exceeds the limit (4300 digits) for integer string conversion'
+    ("9" * 5000 + "s", None, "a duration of 5000 digits is longer than any run: check the number"),
+    ("0." + "0" * 5000 + "1s", None, "is finer than the virtual clock's microsecond"),
+    ("0" * 5000 + "1s", 1_000_000, ""),
+    ("1." + "0" * 5000 + "s", 1_000_000, ""),
+])
+def test_durations_with_thousands_of_digits(text, us, message):
+    if us is not None:
+        assert parse_duration_us(text) == us
+    else:
+        with pytest.raises(ValueError, match=message):
+            parse_duration_us(text)
+
+
 @given(st.integers(min_value=0, max_value=10**9))
 def test_milliseconds_round_trip(ms):
     assert parse_duration_us(f"{ms}ms") == ms * 1000
@@ -61,6 +76,14 @@ def test_condition_errors_name_the_column(text, column):
     with pytest.raises(ConditionError) as info:
         parse_condition(text)
     assert info.value.column == column
+
+
+@pytest.mark.parametrize("number", ["9" * 5000, "16#" + "F" * 5000, "1." + "9" * 5000])
+def test_a_number_of_thousands_of_digits_in_a_condition_says_so(number):
+    # was "'99...9' is not a number" (int()'s 4300-digit limit), or read and judged as it was
+    with pytest.raises(ConditionError) as info:
+        parse_condition(f"x = {number}")
+    assert info.value.column == 5 and "digits: no PLC label holds one this long" in info.value.message
 
 
 @pytest.mark.parametrize("text, message", [
@@ -202,6 +225,7 @@ def test_the_nth_table_of_an_array_is_found():
     ('[robot]\nturnaround_ms = -1', "robot.turnaround_ms", "at least"),
     ('[[faults]]\nkind = "meteor"\nat_s = 1', "faults[0].kind", "unknown fault"),
     ('[[faults]]\nkind = "no_reply"', "faults[0]", "trigger"),
+    ('[[faults]]\nkind = ["no_reply"]\nat_s = 1', "faults[0].kind", "expected a string"),
     ('[[inputs]]\nat = "1s"', "inputs[0]", "needs 'at'"),
     ('[[inputs]]\nat = "1s"\nset = { x = "on" }', "inputs[0].set.x", "true/false or a number"),
     ('[[inputs]]\nat = "1s"\nset = { x = 3 }\npulse = "1s"', "inputs[0].pulse", "no BOOL"),
@@ -226,6 +250,19 @@ def test_every_mistake_names_its_key(text, key, words):
     line = source.splitlines()[error.line - 1]
     assert error.col is not None and 1 <= error.col <= len(line), "the column is on the line"
     assert str(error).startswith(f"x.toml:{error.line}:{error.col}: {key}: ")
+
+
+def test_a_number_too_long_for_python_is_a_toml_error_at_its_place():
+    # tomllib let int()'s ValueError (more than 4300 digits) through: a traceback
+    error = error_of('program = "Main"\nseed = 1_' + "9" * 5000 + "\n", Path("x.toml"))
+    assert (error.line, error.col) == (2, 8)
+    assert str(error).startswith("x.toml:2:8: not valid TOML: a whole number of 5001 digits: too long to read")
+
+
+def test_an_empty_program_name_is_an_error_at_its_line():
+    # was "no PROGRAM '' in the sources" once the sources were loaded, naming no line
+    error = error_of('name = "x"\nprogram = ""\n', Path("x.toml"))
+    assert str(error).startswith("x.toml:2:11: program: is empty: give the name of the PROGRAM to run")
 
 
 def test_a_missing_scenario_file(tmp_path):

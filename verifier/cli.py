@@ -23,6 +23,13 @@ SUBCOMMANDS = {
 }
 
 
+class UnusablePath(click.ClickException):
+    """A path given on the command line that cannot be used; exit status 2, as for
+    every other unusable input."""
+
+    exit_code = 2
+
+
 class LazyGroup(click.Group):
     def list_commands(self, ctx: click.Context) -> list[str]:
         return list(SUBCOMMANDS)
@@ -32,6 +39,17 @@ class LazyGroup(click.Group):
             return None
         module = importlib.import_module(f"verifier.commands.{name}")
         return module.command
+
+    def invoke(self, ctx: click.Context):
+        try:
+            return super().invoke(ctx)
+        except OSError as exc:
+            # A path the file system refuses (a name too long, a folder that cannot be read,
+            # a symlink loop) is the user's to fix: say which, never a traceback. An OSError
+            # without a file name is not about a path the user gave, and stays one.
+            if exc.filename is None:
+                raise
+            raise UnusablePath(f"{exc.filename}: {exc.strerror or exc}") from None
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         with formatter.section("Commands"):

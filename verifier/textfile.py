@@ -4,6 +4,7 @@ went wrong: the caller puts it in its own error with the file name. And the one 
 characters a report cannot hold are shown in it (`escape_chars`)."""
 from __future__ import annotations
 
+import os
 import re
 import stat
 from pathlib import Path
@@ -41,6 +42,13 @@ def read_utf8(path: Path) -> str:
         bad = start + exc.start
         line, col = place_of_byte(data, bad)
         raise UnreadableText(f"line {line}, column {col} (byte {bad}): not UTF-8 text", line, col, bad) from None
+
+
+def real_path(path: Path | str) -> Path:
+    """`Path(path).resolve()` for paths users give, which never raises: Python 3.11's
+    `resolve` raises RuntimeError on a symlink loop, which is left as it is here, for
+    whatever reads the file to report ("Too many levels of symbolic links")."""
+    return Path(os.path.realpath(path))
 
 
 def place_of_byte(data: bytes, offset: int) -> tuple[int, int]:

@@ -26,6 +26,7 @@ class Place:
 
 
 _KEY_PART = re.compile(r"[^.\[\]]+|\[\d+\]")
+_LONG_NUMBER = re.compile(r"(?<![\w.])[0-9][0-9_]{4300,}")
 _DECODE_POSITION = re.compile(r"\s*\(at line (\d+), column (\d+)\)")
 
 
@@ -40,8 +41,8 @@ def line_of_key(lines: list[str], key: str) -> int | None:
     if rest and rest[0].startswith("["):
         index = int(rest[0][1:-1])
         rest = rest[1:]
-    header = re.compile(r"^\s*\[\[\s*" + re.escape(table) + r"\s*\]\]")
-    plain_header = re.compile(r"^\s*\[\s*" + re.escape(table) + r"\s*\]")
+    header = re.compile(r"^\s*\[\[\s*" + _name(table) + r"\s*\]\]")
+    plain_header = re.compile(r"^\s*\[\s*" + _name(table) + r"\s*\]")
     start: int | None = None  # the line of the table's header, when the key is in a table
     seen = -1
     for number, line in enumerate(lines):
@@ -61,9 +62,9 @@ def line_of_key(lines: list[str], key: str) -> int | None:
         if start is None and number > 0 and re.match(r"^\s*\[", line):
             break  # a top-level key comes before every table
         if start is not None and number > start and re.match(r"^\s*\[", line) \
-                and not re.match(r"^\s*\[\[?\s*" + re.escape(table) + r"\.", line):
+                and not re.match(r"^\s*\[\[?\s*" + _name(table) + r"\.", line):
             break  # past its table (and the table's sub-tables): point at the table's header
-        if re.match(r"^\s*\"?" + re.escape(target) + r"\"?\s*=", line):
+        if re.match(r"^\s*" + _name(target) + r"\s*[=.]", line):  # a dotted key too: robot.pacing = ...
             return number + 1
     if start is None:
         # no header: the table may be written inline (faults = [{ kind = "x" }]); its line
@@ -71,11 +72,22 @@ def line_of_key(lines: list[str], key: str) -> int | None:
     return start + 1
 
 
-def decode_error_position(error: tomllib.TOMLDecodeError, source: str = "") -> tuple[str, Place | None]:
+def _name(key: str) -> str:
+    """A pattern for `key` as a TOML file may write it: bare, "basic" or 'literal' (as the
+    docs write buffer memory: 'U0\\G164' = 8)."""
+    name = re.escape(key)
+    return f"(?:{name}|\"{name}\"|'{name}')"
+
+
+def decode_error_position(error: ValueError, source: str = "") -> tuple[str, Place | None]:
     """A TOML syntax error as (message, place): tomllib writes the place as
     "(at line L, column C)" at the end of its message; callers put it after the file
     name like every other error. `source` (the file's text) lets the message name a cause
-    tomllib cannot: line ends that are lone carriage returns, which TOML does not allow."""
+    tomllib cannot: line ends that are lone carriage returns, which TOML does not allow.
+    `error` may also be the plain ValueError tomllib lets through from int() for a
+    whole number of more than 4300 digits (Python's limit): it is placed in `source`."""
+    if not isinstance(error, tomllib.TOMLDecodeError):
+        return _too_many_digits(source)
     text = str(error)
     if has_lone_cr(source):
         text += ("; the file's line ends are lone carriage returns (classic Mac OS), which TOML "
@@ -84,6 +96,16 @@ def decode_error_position(error: tomllib.TOMLDecodeError, source: str = "") -> t
     if match is None:
         return text, None
     return _DECODE_POSITION.sub("", text), Place(int(match.group(1)), int(match.group(2)))
+
+
+def _too_many_digits(source: str) -> tuple[str, Place | None]:
+    match = _LONG_NUMBER.search(source)
+    if match is None:
+        return "a number too long to read", None
+    before = source[:match.start()]
+    place = Place(before.count("\n") + 1, match.start() - (before.rfind("\n") + 1) + 1)
+    digits = sum(ch.isdigit() for ch in match.group())
+    return f"a whole number of {digits} digits: too long to read (at most 4300), and no setting takes it", place
 
 
 def place_of_key(lines: list[str], key: str, at_name: bool = False) -> Place | None:
@@ -101,7 +123,7 @@ def place_of_key(lines: list[str], key: str, at_name: bool = False) -> Place | N
         index = int(parts[-1][1:-1])
         parts = parts[:-1]
     name = parts[-1] if parts else ""
-    match = re.search(r"(?:^|[{,])\s*(\"?" + re.escape(name) + r"\"?)\s*=\s*", text) if name else None
+    match = re.search(r"(?:^|[{,.])\s*(" + _name(name) + r")\s*=\s*", text) if name else None
     if match is None:
         return Place(line, len(text) - len(text.lstrip()) + 1)
     if at_name:

@@ -24,6 +24,7 @@ from dataclasses import dataclass, fields
 from typing import Any, Iterable, Mapping
 
 from verifier.amr import schema
+from verifier.tomlpos import shown
 
 FAULT_KINDS: dict[str, str] = {
     "anti_collision": "obstacle: a running task stops, error 01",
@@ -90,8 +91,10 @@ class Fault:
             raise schema.ConfigError(schema.join(path, "kind"),
                                      f"missing; expected one of {', '.join(FAULT_KINDS)}")
         kind = data["kind"]
-        if isinstance(kind, str):
-            kind = kind.replace("-", "_")
+        if not isinstance(kind, str):  # an array or a table is not hashable: no dict lookup
+            raise schema.ConfigError(schema.join(path, "kind"),
+                                     f"expected a string, got {shown(kind)}; one of {', '.join(FAULT_KINDS)}")
+        kind = kind.replace("-", "_")
         if kind not in FAULT_KINDS:
             raise schema.ConfigError(schema.join(path, "kind"), _unknown_kind(data["kind"]))
         allowed = _COMMON_KEYS + _KIND_KEYS[kind]

@@ -25,7 +25,7 @@ from verifier.commands.check_formats import PLATFORM_RULES, RULES, Finding, to_g
 from verifier.sim.cpu import EDITOR_NAMES, PROFILES, TARGET_CPUS
 from verifier.st import TARGETS
 from verifier.st.ast import Diagnostic, SourceFile
-from verifier.textfile import text_lines
+from verifier.textfile import real_path, text_lines
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
 
@@ -41,7 +41,7 @@ def expand_sources(sources: tuple[str, ...]) -> list[Path]:
     for s in sources:
         p = Path(s)
         for path in st_files_in(p) if p.is_dir() else [p]:
-            key = path.resolve()
+            key = real_path(path)
             if key not in seen:
                 seen.add(key)
                 paths.append(path)

@@ -18,6 +18,7 @@ import click
 
 from verifier.bundled import PLC_DIR
 from verifier.commands.check import expand_sources
+from verifier.textfile import real_path
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
 #: the bundled folders each editor gets by default
@@ -58,9 +59,9 @@ def command(sources: tuple[str, ...], target: str, out_dir: str, programs: tuple
         paths = expand_sources(sources)
         # a folder that holds --out: the files of an earlier export there are not sources (bodies
         # without declarations: the second run of the same command failed on them)
-        out = Path(out_dir).resolve()
-        folders = [Path(s).resolve() for s in sources if Path(s).is_dir()]
-        earlier = [p for p in paths if p.resolve().is_relative_to(out)] \
+        out = real_path(out_dir)
+        folders = [real_path(s) for s in sources if Path(s).is_dir()]
+        earlier = [p for p in paths if real_path(p).is_relative_to(out)] \
             if any(out != f and out.is_relative_to(f) for f in folders) else []
         if earlier:
             click.echo(f"uitamr export: {len(earlier)} file(s) in the --out folder {out_dir} left out of the "

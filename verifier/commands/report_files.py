@@ -10,6 +10,8 @@ import click
 from rich.console import Console
 from rich.markup import escape
 
+from verifier.textfile import real_path
+
 
 class _ReportConsole(Console):
     """A console whose reader may go away (`uitamr verify --json r.json | head -1`): the
@@ -57,7 +59,7 @@ def check_folders(*paths: str | None) -> None:
     for path in paths:
         if not path:
             continue
-        resolved = Path(path).resolve()
+        resolved = real_path(path)
         if not resolved.parent.is_dir():
             what = "is a file, not a folder" if resolved.parent.exists() else "does not exist"
             raise ReportError(f"cannot write {path}: the folder {resolved.parent} {what}")
@@ -71,9 +73,9 @@ def check_not_inputs(inputs, *paths: str | None) -> None:
     scenario, an ST source, a capture): the input would be lost."""
     if not any(paths):
         return
-    resolved = {Path(p).resolve() for p in inputs}
+    resolved = {real_path(p) for p in inputs}
     for path in paths:
-        if path and Path(path).resolve() in resolved:
+        if path and real_path(path) in resolved:
             raise ReportError(f"{path} is one of the run's input files: write the report to another file")
 
 

@@ -25,6 +25,7 @@ from verifier.commands.report_files import (ReportError, check_folders, check_no
 from verifier.verify.durations import format_duration, format_seconds, parse_duration_us
 from verifier.verify.result import KEEP_ALL, Keep, ScenarioResult, UnusableInput
 from verifier.bundled import plc_dir as bundled_plc_dir
+from verifier.textfile import real_path
 from verifier.verify.scenario import (
     CHANNELS, DEFAULT_DURATION_US, MAX_DURATION_US, PLATFORMS, Scenario, ScenarioError, default_scenario, load_scenario,
 )
@@ -92,14 +93,14 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
 
     resolved = _source_files(sources) if sources else ()
     scenario_files = _scenario_files(scenario_files)
-    given = {Path(f).resolve() for f in scenario_files}
+    given = {real_path(f) for f in scenario_files}
     own = [load_scenario(f) for f in scenario_files]
     bundled_files: list[Path] = []
     if matrix or (not sources and not scenario_files):
         found = bundled_scenarios()
         if not found:
             raise UnusableInput(f"no bundled scenarios in {bundled_plc_dir() / 'scenarios'}")
-        bundled_files = [f for f in found if f.resolve() not in given]
+        bundled_files = [f for f in found if real_path(f) not in given]
     overrides = {"program": program, "platform": platform, "channel": channel,
                  "duration_us": duration, "scan_us": scan, "seed": seed}
     if resolved:
@@ -317,7 +318,7 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress,
 def _spool_folder(report_path: str, report: str) -> str:
     """A hidden folder beside the report (the trace, or else the page) for the runs' trace
     lines (Keep.frames_to_file)."""
-    folder = Path(report_path).resolve().parent
+    folder = real_path(report_path).parent
     try:
         return tempfile.mkdtemp(prefix=".uitamr-trace-", dir=folder)
     except OSError as exc:

@@ -51,7 +51,7 @@ def load_fault_file(path: str | Path, own_address: int | None = None) -> FaultFi
         raise FaultFileError(f"{path}: {err}") from None
     try:
         data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
+    except ValueError as err:  # TOMLDecodeError, or int()'s limit of 4300 digits
         message, line = decode_error_position(err, text)
         raise FaultFileError(f"{_where(path, line)}: not valid TOML: {message}") from None
     try:

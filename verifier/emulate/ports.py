@@ -246,6 +246,6 @@ def serial_url_problem(url: str) -> str | None:
     host, colon, port = rest.split("/", 1)[0].split("?", 1)[0].rpartition(":")
     if not colon or not host:
         return f"{url} needs a host and a port: {scheme}://HOST:PORT"
-    if not port.isdigit() or not 1 <= int(port) <= 65535:
+    if not (port.isascii() and port.isdigit()) or len(port) > 5 or not 1 <= int(port) <= 65535:  # not '²'
         return f"{url}: the port {port!r} is not a number from 1 to 65535"
     return None

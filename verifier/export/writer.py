@@ -21,7 +21,7 @@ from verifier.export.body import body_text
 from verifier.export.needed import needed, only, type_names
 from verifier.export.labels import LabelRow, initial_text, label_class, label_rows, rows_of
 from verifier.export.types import type_name
-from verifier.textfile import text_lines
+from verifier.textfile import real_path, text_lines
 
 COLUMNS = {
     "gxworks2": ("Class", "Label Name", "Data Type", "Constant", "Comment"),
@@ -200,10 +200,10 @@ def _overwritten_sources(files: list[ast.SourceFile], paths: dict[Path, ast.Sour
     planned = [(f, pou, target) for f in files for pou in f.pous for target in _pou_files(out, pou)]
     planned += [(f, struct, _struct_file(out, struct)) for f in files for struct in f.types]
     planned += [(None, None, out / name) for name in (GLOBAL_TABLE, DROPPED_TABLE, IMPORT_ORDER)]
-    sources = {path.resolve(): f for path, f in paths.items()}
+    sources = {real_path(path): f for path, f in paths.items()}
     problems = []
     for f, node, target in planned:
-        source = sources.get(target.resolve())
+        source = sources.get(real_path(target))
         if source is None and target.exists():  # the same file by another name (a hard link)
             source = next((v for k, v in sources.items() if k.exists() and os.path.samefile(k, target)), None)
         if source is None:

@@ -108,6 +108,12 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
             record = json.loads(raw)
         except json.JSONDecodeError as exc:
             raise CaptureError(f"{name}:{number}:{exc.colno}: not a JSON trace record: {exc.msg}") from None
+        except ValueError:  # int() of more than 4300 digits
+            raise CaptureError(f"{name}:{number}:1: not a trace record: it holds a number too long to read "
+                               "(more than 4300 digits)") from None
+        except RecursionError:
+            raise CaptureError(f"{name}:{number}:1: not a trace record: arrays or objects nested thousands "
+                               "deep") from None
         if not isinstance(record, dict):
             raise CaptureError(f"{name}:{number}:1: a trace record is a JSON object")
         for key in ("t", "dir", "hex"):

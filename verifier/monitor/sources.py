@@ -67,6 +67,9 @@ class TcpSource:
             self.sock = socket.create_connection((host, port), timeout=connect_timeout_s)
         except OSError as exc:
             raise SourceError(f"cannot connect to {host}:{port}: {exc.strerror or exc}") from None
+        except UnicodeError:  # from the idna codec, before any lookup
+            raise SourceError(f"cannot connect to {host}:{port}: not a host name (a part between dots is "
+                              "empty or longer than 63 characters)") from None
         self.sock.settimeout(POLL_S)
         self.description = f"tcp {host}:{port}"
 

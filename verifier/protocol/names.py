@@ -159,6 +159,9 @@ def _choice(name: str, args: list[str], options: dict):
 
 
 def _integer(text: str, what: str) -> int:
+    if len(text) > 20:  # every value here fits a byte; 5000 digits are more than int() reads or prints
+        raise CommandError(f"{what} must be a small whole number (decimal, or hex as 0x..), got "
+                           f"{len(text)} characters: {text[:20]}...")
     try:
         return int(text, 16) if text.lower().startswith("0x") else int(text, 10)
     except ValueError:
@@ -180,6 +183,9 @@ def _scaled(text: str, step: Decimal, what: str, unit: str) -> tuple[int, int]:
         value = None
     if value is None or not value.is_finite():
         raise CommandError(f"{what} must be a number like +1.5 or -0.3, got {text!r}")
+    if value.copy_abs() >= step * 1_000_000:  # 1e999999 overflows abs() and the division; 9 x 5000 the digits of int()
+        raise CommandError(f"{what} {text}{unit and ' ' + unit} is far more than 255 units of {step}; one byte "
+                           f"holds at most 255 ({step * 255}{unit and ' ' + unit})")
     units = abs(value) / step
     if units != units.to_integral_value():
         raise CommandError(f"{what} {text} is not a whole number of {step}{unit and ' ' + unit} steps")

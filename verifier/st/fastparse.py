@@ -38,7 +38,7 @@ from operator import sub
 
 from verifier.st import ast
 from verifier.st.devices import H_CONST_RE, K_CONST_RE, parse_device
-from verifier.st.parser import _section, _time_ms_text, decode_escapes
+from verifier.st.parser import MAX_NUMBER_CHARS, _section, _time_ms_text, decode_escapes, number_too_long
 
 
 class Bail(Exception):
@@ -159,7 +159,9 @@ class Tokenizer:
             f"(?<!{white_rx[:-1]})((?:{skip_rx})*+)({token_rx}|\\Z)").split
         self.comment_style = re.compile(
             "|".join(f"(?P<{t.name}>{t.pattern.to_regexp()})" for t in ignored)).finditer
-        unless = root.callback["IDENT"].scanner  # the keywords an IDENT is turned into
+        ident = root.callback["IDENT"]
+        ident = getattr(ident, "callback1", ident)  # lark's CallChain: the keyword check, then _long_number
+        unless = ident.scanner  # the keywords an IDENT is turned into
         self.keywords = {t.pattern.value.upper(): t.name for t in unless.terminals}
         assert all(k.isascii() for k in self.keywords)
         names = {t.name for t in tokens}
@@ -214,6 +216,8 @@ class Tokenizer:
         CL = list(map(sub, starts, map(text.rfind, repeat("\n"), repeat(0), starts)))
         kinds = self.kinds
         K = list(map(kinds.get, V))
+        if max(map(len, V)) > MAX_NUMBER_CHARS:
+            self._check_numbers(K, V)
         if None in K:
             j = -1
             try:
@@ -232,6 +236,11 @@ class Tokenizer:
             except ValueError:
                 pass
         return K, V, LN, CL
+
+    def _check_numbers(self, K: list, V: list[str]) -> None:
+        for kind, tok in zip(K, V):
+            if number_too_long(kind or self.classify(tok), tok):
+                raise Bail  # the lark path reports it
 
     def _check_comments(self, skips: list[str]) -> None:
         for skip in skips:

@@ -480,6 +480,43 @@ def _comment_style(tok: Token) -> Token:
     return tok
 
 
+#: No ST number needs more characters: LINT/ULINT have 20 digits, a 64-bit 2#... literal 64
+#: (plus its underscores). Longer ones are reported and read as 0: Python reads no whole
+#: number of more than 4300 digits, and prints none in a message; T#<400 digits>s is
+#: no float.
+MAX_NUMBER_CHARS = 100
+_LONG_DIGITS = re.compile(r"[0-9][0-9_]{%d,}" % MAX_NUMBER_CHARS)
+_NUMBER_TOKENS = ("INT", "BASED_INT", "REAL", "TIME_LIT")
+
+
+def number_too_long(kind: str, text: str) -> bool:
+    """Whether token `text` of terminal `kind` is, or holds, a number longer than
+    MAX_NUMBER_CHARS: a literal, a device or buffer-memory number (D999...), a K or H
+    constant."""
+    if len(text) <= MAX_NUMBER_CHARS:
+        return False
+    if kind in _NUMBER_TOKENS:
+        return True
+    return _LONG_DIGITS.search(text) is not None or (kind == "IDENT" and H_CONST_RE.fullmatch(text) is not None)
+
+
+def _long_number(tok: Token) -> Token:
+    """A number too long for any PLC type: reported at its token, then read as 0."""
+    if not number_too_long(tok.type, tok.value):
+        return tok
+    _ctx.error(tok.line, tok.column, f"a number of {len(tok.value)} characters: no PLC type holds one this "
+                                     f"long (LINT has 20 digits); check this literal or device")
+    if tok.type == "BASED_INT":
+        zero = tok.value.split("#", 1)[0] + "#0"
+    elif tok.type in _NUMBER_TOKENS:
+        zero = {"INT": "0", "REAL": "0.0", "TIME_LIT": "T#0s"}[tok.type]
+    elif H_CONST_RE.fullmatch(tok.value):
+        zero = tok.value[0] + "0"
+    else:
+        zero = _LONG_DIGITS.sub("0", tok.value)
+    return tok.update(value=zero)
+
+
 _parser: Lark | None = None
 
 
@@ -496,7 +533,11 @@ def get_parser() -> Lark:
             propagate_positions=False,
             maybe_placeholders=False,
             cache=True,
-            lexer_callbacks={"LINE_COMMENT": _comment_style, "C_COMMENT": _comment_style},
+            # IDENT last: lark 1.x chains a callback on IDENT after its keyword check with a
+            # condition that reads the loop variable late (the last key), so only the last key
+            # may have one
+            lexer_callbacks={"LINE_COMMENT": _comment_style, "C_COMMENT": _comment_style,
+                             **{kind: _long_number for kind in _NUMBER_TOKENS + ("BUFFER_DEVICE", "IDENT")}},
         )
     return _parser
 

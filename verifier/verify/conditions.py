@@ -67,6 +67,8 @@ def _tokenize(text: str) -> list[_Token]:
 
 def _number(token: _Token) -> Value:
     digits = token.text.replace("_", "")
+    if len(digits) > 100:  # int() reads no more than 4300 digits; no label holds even 100
+        raise ConditionError(f"a number of {len(digits)} digits: no PLC label holds one this long", token.column)
     try:
         if "#" in digits:
             base, body = digits.split("#", 1)

@@ -30,7 +30,15 @@ def parse_duration_us(text: object) -> int:
             f"{text!r} is not a duration: write a number and a unit (us, ms, s, min, h), "
             "e.g. \"250ms\" or \"60s\""
         )
-    value = Fraction(match.group(1)) * _UNITS_US[match.group(2)]
+    # Fraction() reads no number of more than 4300 digits: no duration needs 20 either side
+    whole, _, fraction = match.group(1).partition(".")
+    whole, fraction = whole.lstrip("0"), fraction.rstrip("0")
+    if len(whole) > 20:
+        raise ValueError(f"a duration of {len(whole)} digits is longer than any run: check the number, "
+                         "e.g. \"250ms\" or \"60s\"")
+    if len(fraction) > 20:
+        raise ValueError(f"{text!r} is finer than the virtual clock's microsecond")
+    value = Fraction(f"{whole or 0}.{fraction or 0}") * _UNITS_US[match.group(2)]
     if value.denominator != 1:
         raise ValueError(f"{text!r} is finer than the virtual clock's microsecond")
     return int(value)

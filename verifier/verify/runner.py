@@ -6,6 +6,7 @@ after the run (rules, expectations, reports) works on plain data.
 """
 from __future__ import annotations
 
+import math
 import os
 import re
 import time
@@ -295,6 +296,8 @@ def _input_problem(plc: _Plc, name: str, value: Any) -> str | None:
         if isinstance(before, bool):
             return f"{name} is a BOOL (a bit): set it to true or false, not {value!r}"
         return f"{name} is a number: set it to a number, not {str(value).lower()}"
+    if _DEVICE.match(name) and isinstance(value, float) and not math.isfinite(value):  # int(inf): OverflowError
+        return f"{name} is a word device: give a whole number -32768..65535, not {value}"
     try:
         plc.write(name, value)
     except (ValueError, TypeError, AttributeError) as exc:

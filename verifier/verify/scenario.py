@@ -236,8 +236,13 @@ def power_on_stop_expectation(duration_us: int, address: int = 1, after_us: int 
 
 def load_scenario(path: Path | str) -> Scenario:
     path = Path(path)
-    if not path.exists():
-        raise ScenarioError(path, "", "no such scenario file")
+    try:
+        if not path.exists():
+            if path.is_symlink():
+                raise ScenarioError(path, "", "a symbolic link to nothing (its target is missing, or a loop of links)")
+            raise ScenarioError(path, "", "no such scenario file")
+    except OSError as exc:  # a name too long for the file system, a folder that cannot be read ...
+        raise ScenarioError(path, "", f"cannot read: {exc.strerror or exc}") from None
     try:
         text = read_utf8(path)
     except UnreadableText as exc:
@@ -251,7 +256,7 @@ def load_scenario(path: Path | str) -> Scenario:
 def parse_scenario(text: str, path: Path | None = None) -> Scenario:
     try:
         data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
+    except ValueError as exc:  # TOMLDecodeError, or int()'s limit of 4300 digits
         message, place = decode_error_position(exc, text)
         raise ScenarioError(path, "", f"not valid TOML: {message}", place) from None
     return _Reader(text, path).read(data)
@@ -340,6 +345,9 @@ class _Reader:
         description = self.string(data.get("description", ""), "description")
         sources = tuple(self.sources(data["sources"])) if "sources" in data else ()
         program = self.string(data["program"], "program") if "program" in data else None
+        if program is not None and not program.strip():  # was "no PROGRAM '' in the sources", without a line
+            raise self.fail("program", "is empty: give the name of the PROGRAM to run, or leave 'program' out "
+                                       "when the sources hold only one")
         platform = self.string(data.get("platform", "fx3u"), "platform").lower()
         if platform not in PLATFORMS:
             raise self.fail("platform", f"unknown platform {platform!r}; expected one of {', '.join(PLATFORMS)}")
@@ -424,7 +432,8 @@ class _Reader:
         if "ip" in item:
             ip = self.string(item["ip"], "converter.ip")
             parts = ip.split(".")
-            if len(parts) != 4 or not all(p.isdigit() and int(p) <= 255 for p in parts):
+            if len(parts) != 4 or not all(p.isascii() and p.isdigit() and len(p) <= 3 and int(p) <= 255
+                                          for p in parts):  # '²' is a digit to isdigit(), not to int()
                 raise self.fail("converter.ip", f"expected an IPv4 address like \"192.168.3.50\", got {ip!r}")
             changes["ip"] = ".".join(str(int(p)) for p in parts)
         if "port" in item:

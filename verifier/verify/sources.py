@@ -6,7 +6,7 @@ import glob
 from functools import lru_cache
 from pathlib import Path
 
-from verifier.textfile import file_kind
+from verifier.textfile import file_kind, real_path
 
 GLOB_CHARACTERS = "*?["
 
@@ -18,6 +18,13 @@ class SourceError(ValueError):
 def expand(name: str, base: Path) -> list[Path]:
     """The .st files `name` stands for, relative to `base` unless absolute, sorted. A name
     with glob characters that is also an existing path ("[A]/x.st") is that path."""
+    try:
+        return _expand(name, base)
+    except OSError as exc:  # a name too long for the file system, a folder that cannot be read ...
+        raise SourceError(f"{exc.filename or name}: {exc.strerror or exc}") from None
+
+
+def _expand(name: str, base: Path) -> list[Path]:
     literal = Path(name) if Path(name).is_absolute() else base / name
     if any(ch in name for ch in GLOB_CHARACTERS) and not literal.exists():
         pattern = name if Path(name).is_absolute() else str(base / name)
@@ -38,6 +45,8 @@ def expand(name: str, base: Path) -> list[Path]:
     if not path.is_file():
         if path.exists():
             raise SourceError(f"{path} is not a regular file ({file_kind(path.stat().st_mode)}); give .st files")
+        if path.is_symlink():
+            raise SourceError(f"{path} is a symbolic link to nothing (its target is missing, or a loop of links)")
         raise SourceError(f"no such file or folder: {path}")
     return [path]
 
@@ -57,4 +66,4 @@ def unique(paths: list[Path]) -> tuple[Path, ...]:
 def _resolved(path: Path) -> Path:
     """`path.resolve()`, remembered: the bundled scenarios name the same 30-odd files
     again and again, and resolving one walks every folder above it."""
-    return path.resolve()
+    return real_path(path)

@@ -1,0 +1,162 @@
+"""Whatever a hurried integrator or a corrupted file hands a command, it answers with an
+error that names what to fix and an exit status (2: unusable input), never a traceback."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from verifier.cli import main
+from verifier.verify.scenario import ScenarioError, load_scenario
+
+#: longer than any file name a Linux or Windows file system takes (255 bytes)
+LONG = "a" * 300
+
+
+def invoke(*args):
+    return CliRunner().invoke(main, [str(a) for a in args], catch_exceptions=False)
+
+
+@pytest.mark.parametrize("args", [
+    ["check", LONG],
+    ["check", LONG + ".toml"],
+    ["verify", LONG],
+    ["verify", "--scenario", LONG + ".toml"],
+    ["verify", "--duration", "1s", "--json", f"{LONG}/x.json"],
+    ["export", "--target", "gxworks2", "--out", "{tmp}", LONG],
+])
+def test_a_file_name_too_long_is_an_error_not_a_traceback(args, tmp_path):
+    # os.stat raised OSError (ENAMETOOLONG) from Path.is_dir()/exists() before any check
+    result = invoke(*[a.replace("{tmp}", str(tmp_path)) for a in args])
+    assert result.exit_code == 2, result.output
+    assert "File name too long" in result.output and LONG in result.output
+
+
+def test_a_source_name_too_long_in_a_scenario_names_its_key_and_line(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text(f'program = "Main"\nsources = ["{LONG}.st"]\n', encoding="utf-8")
+    with pytest.raises(ScenarioError) as caught:
+        load_scenario(path)
+    assert (caught.value.key, caught.value.line, caught.value.col) == ("sources[0]", 2, 12)
+    assert "File name too long" in caught.value.message
+
+
+def test_a_scenario_file_name_too_long_is_a_scenario_error(tmp_path):
+    with pytest.raises(ScenarioError, match="cannot read: File name too long"):
+        load_scenario(tmp_path / f"{LONG}.toml")
+
+
+@pytest.mark.parametrize("args, words", [
+    (["check", "{loop}.st"], "cannot read: Too many levels of symbolic links"),
+    (["check", "{loop}.toml"], "cannot read: Too many levels of symbolic links"),
+    (["verify", "--scenario", "{loop}.toml"], "a symbolic link to nothing"),
+    (["verify", "{loop}.st"], "a symbolic link to nothing"),
+    (["verify", "--duration", "1s", "--json", "{loop}.st"], "Too many levels of symbolic links"),
+    (["replay", "--json", "{loop}.st", "{capture}"], "Too many levels of symbolic links"),
+    (["export", "--target", "gxworks2", "--out", "{loop}.st", "{program}"], "cannot write"),
+])
+def test_a_symlink_loop_is_an_error_not_a_traceback(args, words, tmp_path):
+    # Python 3.11's Path.resolve() raised RuntimeError("Symlink loop from ...")
+    loop = tmp_path / "loop"
+    for suffix in (".st", ".toml"):
+        (tmp_path / f"a{suffix}").symlink_to(tmp_path / f"b{suffix}")
+        (tmp_path / f"b{suffix}").symlink_to(tmp_path / f"a{suffix}")
+        (tmp_path / f"loop{suffix}").symlink_to(tmp_path / f"a{suffix}")
+    program = tmp_path / "P.st"
+    program.write_text("PROGRAM P\nVAR x : INT; END_VAR\nx := 1;\nEND_PROGRAM\n", encoding="utf-8")
+    capture = tmp_path / "c.txt"
+    capture.write_text("0.000 tx 01 06 01 A0 00 00 88 14\n", encoding="utf-8")
+    fill = {"{loop}": str(loop), "{program}": str(program), "{capture}": str(capture)}
+    for key, value in fill.items():
+        args = [a.replace(key, value) for a in args]
+    result = invoke(*args)
+    assert result.exit_code == 2, result.output
+    assert words in result.output
+
+
+def test_a_host_name_the_idna_codec_refuses_is_an_error_not_a_traceback():
+    # socket.create_connection raised UnicodeError ("label empty or too long") for a..b
+    result = invoke("monitor", "--tcp", "a..b:4001", "--duration", "1s")
+    assert result.exit_code == 2
+    assert "cannot connect to a..b:4001: not a host name" in result.output
+
+
+# --- properties: whatever the file holds ------------------------------------------------------
+
+import datetime  # noqa: E402
+import json  # noqa: E402
+import math  # noqa: E402
+import tempfile  # noqa: E402
+import tomllib  # noqa: E402
+
+from hypothesis import HealthCheck, given, settings, strategies as st  # noqa: E402
+
+from verifier.verify.scenario import parse_scenario  # noqa: E402
+
+BUNDLED = sorted((Path(__file__).parents[1] / "plc" / "scenarios").glob("*.toml"))
+
+
+def toml_value(value) -> str:
+    """`value` as an inline TOML value (every table inline, so any value can go anywhere)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float) and not math.isfinite(value):
+        return "nan" if math.isnan(value) else ("inf" if value > 0 else "-inf")
+    if isinstance(value, (int, float)):
+        return repr(value)
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=False)
+    if isinstance(value, (datetime.datetime, datetime.date, datetime.time)):
+        return value.isoformat()
+    if isinstance(value, list):
+        return "[" + ", ".join(map(toml_value, value)) + "]"
+    return "{" + ", ".join(f"{json.dumps(k, ensure_ascii=False)} = {toml_value(v)}" for k, v in value.items()) + "}"
+
+
+TEXT = st.text(st.characters(blacklist_categories=("Cs",)), max_size=12)
+SCALARS = st.one_of(
+    st.booleans(), st.integers(), st.integers(-2, 30), st.floats(), TEXT,
+    st.sampled_from(["0s", "1s", "-1s", "250ms", "1e3s", "X0", "o_bErr", "o_bErr AND", "fbEngine.o_uErrId",
+                     "no_reply", "late_reply", "exception", "stop", "run-point 3", "none", "fx5u", "q", "q:2",
+                     "192.168.3.50", "U0\\G164", "D100", "1" * 5000]),
+    st.datetimes(), st.dates(), st.times(),
+)
+VALUES = st.recursive(SCALARS, lambda inner: st.one_of(st.lists(inner, max_size=3),
+                                                       st.dictionaries(TEXT, inner, max_size=3)), max_leaves=6)
+
+
+@settings(max_examples=200, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(st.sampled_from(BUNDLED), st.data())
+def test_any_value_anywhere_in_a_scenario_loads_or_is_a_scenario_error(path, data):
+    """A bundled scenario with one value (at any depth) replaced or added: it loads, or
+    it is a ScenarioError that names the file; never another exception (a fault kind
+    given as an array was a TypeError)."""
+    table = tomllib.loads(path.read_text(encoding="utf-8"))
+    node = table
+    while True:
+        key = data.draw(st.sampled_from(sorted(node) + ["new"]), label="key")
+        child = node.get(key)
+        if isinstance(child, list) and child and isinstance(child[0], dict) and data.draw(st.booleans()):
+            node = child[data.draw(st.integers(0, len(child) - 1))]
+        elif isinstance(child, dict) and data.draw(st.booleans()):
+            node = child
+        else:
+            node[key] = data.draw(VALUES, label="value")
+            break
+    text = "".join(f"{json.dumps(k)} = {toml_value(v)}\n" for k, v in table.items())
+    try:
+        parse_scenario(text, path)
+    except ScenarioError as exc:
+        assert str(exc).startswith(str(path))
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(st.binary(max_size=300), st.sampled_from([".st", ".toml"]))
+def test_any_bytes_as_a_source_or_scenario_are_checked_without_a_traceback(content, suffix):
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / f"any{suffix}"
+        path.write_bytes(content)
+        result = invoke("check", path)
+    assert result.exit_code in (0, 1), result.output
+    assert str(path) in result.output or result.exit_code == 0
