@@ -23,6 +23,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from verifier.commands.report_files import (ReportError, check_folders, check_not_inputs, report_options,
                                              text_console, write_reports)
 from verifier.verify.durations import format_duration, format_seconds, parse_duration_us
+from verifier.verify.events_shown import EVENTS_AT_MOST
 from verifier.verify.result import KEEP_ALL, Keep, ScenarioResult, UnusableInput
 from verifier.bundled import plc_dir as bundled_plc_dir
 from verifier.textfile import real_path
@@ -406,8 +407,11 @@ def command(sources, program, platform, channel, response_signal, scenario_files
         with _terminate_as_exit():
             try:
                 # a run holds every frame and watched change only for the reports that list them
+                # the page shows at most EVENTS_AT_MOST events of a run: without --json, which
+                # lists them all, a run keeps no more than the page can show
                 keep = Keep(frames=bool(trace_path or html_path), details=bool(json_path or html_path),
-                            watched=bool(json_path), frames_to_file=spool_folder)
+                            watched=bool(json_path), frames_to_file=spool_folder,
+                            events_at_most=None if json_path else EVENTS_AT_MOST)
                 results = _run_all(scenarios, jobs, progress, every_scan, keep)
             except (ScenarioError, UnusableInput) as exc:
                 progress.stop()

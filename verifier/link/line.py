@@ -278,6 +278,11 @@ class Line:
         merged.sort(key=lambda e: e.t_us)
         return merged
 
+    def event_lists(self) -> tuple[list[LineEvent], list]:
+        """The line's own events and its robot's (`robot.events`), as held: a caller that
+        lists only some of them may thin these lists (verifier.verify.events_shown)."""
+        return self._events, self.robot.events
+
     # ---- the robot's receiver --------------------------------------------------------------
 
     def _hear(self, byte: _Byte) -> None:

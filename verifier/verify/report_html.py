@@ -16,6 +16,7 @@ import jinja2
 from verifier import __version__
 
 from .durations import format_seconds
+from .events_shown import EVENTS_AT_MOST, event_class
 from .report_trace import LineTimes, blamed_frames, frame_count, records
 from .result import ScenarioResult, overall_verdict
 from .rules import RULES
@@ -32,7 +33,6 @@ PAGE_FRAMES_AT_MOST = 20_000
 FRAMES_EACH_AT_LEAST = 500
 CONTEXT_FRAMES = 4  # frames drawn on each side of a frame that is evidence of a violation
 VIOLATIONS_AT_MOST = 1000  # violations marked and listed (every one is in --json)
-EVENTS_AT_MOST = 2000  # line and robot events drawn (the scenario's faults first)
 
 
 def _environment() -> jinja2.Environment:
@@ -51,15 +51,6 @@ def _ms(t_us: int) -> float:
 def _seconds(t_us: int) -> float:
     """A frame's time as its trace line has it (`t`, `t_end`): the page computes from that."""
     return t_us / 1_000_000
-
-
-def _event_class(kind: str) -> str:
-    """Faults the scenario injected, trouble on the line, or the robot's ordinary doings."""
-    if kind == "robot.fault":
-        return "fault"
-    if not kind.startswith("robot."):
-        return "line"
-    return "info"
 
 
 # a 10 h run has 3,600 ten-second ticks; a capture with a gap of years would have millions
@@ -165,7 +156,7 @@ def scenario_view(index: int, result: ScenarioResult, frames_at_most: int = FRAM
     ]
     events = result.events
     if len(events) > EVENTS_AT_MOST:  # the faults first, then the others, in the run's order
-        kept = {id(e) for e in sorted(events, key=lambda e: _event_class(e.kind) != "fault")[:EVENTS_AT_MOST]}
+        kept = {id(e) for e in sorted(events, key=lambda e: event_class(e.kind) != "fault")[:EVENTS_AT_MOST]}
         events = [e for e in events if id(e) in kept]
     major_ms = 1000 if end_ms <= 300_000 else 10_000
     while end_ms / major_ms > MAJOR_TICKS_AT_MOST:  # a capture spanning days or years
@@ -185,11 +176,11 @@ def scenario_view(index: int, result: ScenarioResult, frames_at_most: int = FRAM
         "markers": markers,
         "violations": len(violations),
         "events": [
-            {"t": _ms(e.t_us), "message": e.message, "kind": e.kind, "class": _event_class(e.kind),
+            {"t": _ms(e.t_us), "message": e.message, "kind": e.kind, "class": event_class(e.kind),
              "time": format_seconds(e.t_us)}
             for e in events
         ],
-        "events_left_out": len(result.events) - len(events),
+        "events_left_out": len(result.events) + result.events_dropped - len(events),
         "ticks": ticks,
         "minor_ticks": minor,
         "end_ms": round(end_ms, 3),

@@ -34,6 +34,10 @@ class Keep:
     # them from there. The folder is the caller's to remove (`uitamr verify` makes a hidden
     # one beside the trace or the page), with whatever a run that failed midway left in it
     frames_to_file: str | None = None
+    # with `details`, keep only the events a report that shows at most this many of them
+    # can show (verifier.verify.events_shown; the page: events_shown.EVENTS_AT_MOST), the
+    # others counted in `ScenarioResult.events_dropped`; None: every event (`--json`)
+    events_at_most: int | None = None
 
 
 KEEP_ALL = Keep()
@@ -83,6 +87,7 @@ class ScenarioResult:
     faults: list[str] = field(default_factory=list)
     trace: list[TraceRecord] = field(default_factory=list)
     events: list[LineEvent] = field(default_factory=list)
+    events_dropped: int = 0  # events let go of while the run went (Keep.events_at_most), not in `events`
     violations: dict[str, list[Violation]] = field(default_factory=dict)
     expectations: list[ExpectationResult] = field(default_factory=list)
     diagnostics: list[str] = field(default_factory=list)

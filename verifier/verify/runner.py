@@ -20,6 +20,7 @@ from verifier.link import Line
 from verifier.link.converter import Converter
 from verifier.sim.values import read_together
 
+from .events_shown import thin_line_events
 from .evidence import RunEvidence, Samples
 from .expectations import judge
 from .result import KEEP_ALL, Keep, LineEvent, ScenarioResult, TraceRecord, UnusableInput
@@ -435,6 +436,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
                     keep.frames_to_file if keep.frames else None, scenario.name) if streamed else None
     rule_events = _NewRuleEvents(line, converter, drop_the_rest=not keep.details)
     taken_us = 0
+    events_dropped = 0
     try:
         while plc.now_us < end:
             plc.run(min(end, plc.now_us + PROGRESS_STEP_US), apply_inputs, sample)
@@ -443,6 +445,8 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
                 stream.take(line.take_settled(), line.settled_until_us, rule_events())
                 if not keep.details:
                     robot.events.clear()  # read by no rule, listed by no report asked for
+                elif keep.events_at_most is not None:  # the page's: it shows the first ones
+                    events_dropped += thin_line_events(line, keep.events_at_most, min(plc.now_us, end))
             if progress is not None:
                 progress(plc.now_us, end)
     except SimulationError as exc:
@@ -485,6 +489,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         frame_counts=None if keep.frames and stream is None else (tx_count, rx_count),
         trace_file=stream.trace_file if stream is not None else None,
         events=events if keep.details else [],
+        events_dropped=events_dropped if keep.details else 0,
         violations=violations,
         expectations=outcomes,
         diagnostics=plc.diagnostics(),
