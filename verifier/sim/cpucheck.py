@@ -9,8 +9,6 @@ would stop at, every one of them rather than the first, and no table of its own.
 """
 from __future__ import annotations
 
-import dataclasses
-
 from verifier.st import ast
 
 from .cpu import CpuProfile
@@ -25,15 +23,8 @@ def cpu_diagnostics(files: list[ast.SourceFile], cpu: CpuProfile) -> list[ast.Di
     `verifier.st.check` on the files first."""
     found: list[ast.Diagnostic] = []
     for f in files:
-        stack: list = [f.globals, f.types, f.pous]
         mine: list[ast.Diagnostic] = []
-        while stack:
-            node = stack.pop()
-            if isinstance(node, (list, tuple)):
-                stack.extend(node)
-                continue
-            if not dataclasses.is_dataclass(node):
-                continue
+        for node in ast.walk(f.globals, f.types, f.pous):
             if isinstance(node, ast.Device) and node.module is None:
                 try:
                     locate(node, cpu)
@@ -43,7 +34,6 @@ def cpu_diagnostics(files: list[ast.SourceFile], cpu: CpuProfile) -> list[ast.Di
                 why = not_on_cpu(node.name, cpu)
                 if why:
                     mine.append(_at(node.callee.span, why))
-            stack.extend(ast.syntax_fields(node))
         found += sorted(mine, key=lambda d: (d.line, d.col))
     return found
 

@@ -10,7 +10,6 @@ is still parsed and checked in full: what GX Works would refuse is reported all 
 """
 from __future__ import annotations
 
-import dataclasses
 
 from verifier.st import ast
 
@@ -50,16 +49,5 @@ def _fb_types(t, struct_fields: dict, seen: set) -> list[str]:
 
 def called_functions(pou: ast.Pou, pous: dict) -> list[str]:
     """The user FUNCTIONs called anywhere in `pou` (its body and its initial values)."""
-    called: list[str] = []
-    stack: list = [pou.var_blocks, pou.body]
-    while stack:
-        node = stack.pop()
-        if isinstance(node, (list, tuple)):
-            stack.extend(node)
-            continue
-        if not dataclasses.is_dataclass(node):
-            continue
-        if isinstance(node, ast.Call) and node.key in pous and pous[node.key].kind == "FUNCTION":
-            called.append(node.key)
-        stack.extend(ast.syntax_fields(node))
-    return called
+    return [node.key for node in ast.walk(pou.var_blocks, pou.body)
+            if isinstance(node, ast.Call) and node.key in pous and pous[node.key].kind == "FUNCTION"]

@@ -13,7 +13,8 @@ Python). Only additive changes: new nodes, new optional fields at the end.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, is_dataclass
+from typing import Iterator
 
 
 # ----------------------------------------------------------------------------- places
@@ -40,6 +41,19 @@ def syntax_fields(node) -> list:
     that take part in comparison, so not its span nor what the check filled in. Walkers
     of the tree (the simulator's purity and reach analyses) descend through these."""
     return [getattr(node, f.name) for f in fields(node) if f.compare]
+
+
+def walk(*roots) -> Iterator:
+    """Every node under `roots` (nodes, lists or tuples of them), the roots' own included,
+    through their syntax fields; in no particular order."""
+    stack = list(roots)
+    while stack:
+        node = stack.pop()
+        if isinstance(node, (list, tuple)):
+            stack.extend(node)
+        elif is_dataclass(node) and not isinstance(node, type):
+            yield node
+            stack.extend(syntax_fields(node))
 
 
 @dataclass(slots=True)
