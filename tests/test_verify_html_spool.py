@@ -17,7 +17,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from test_idle_skip import robot_scenarios
-from test_verify_pipeline import FX3_EXAMPLE, VARIANTS, library_copy
+from test_verify_pipeline import FX3_EXAMPLE, VARIANTS, broken_scenario, library_copy
 from verifier.commands import verify as verify_command
 from verifier.commands.verify import command
 from verifier.verify import report_html
@@ -70,13 +70,7 @@ def test_bundled_scenarios_give_the_same_page(path, tmp_path, monkeypatch):
 def test_broken_libraries_give_the_same_page(tmp_path, monkeypatch, variant):
     """The frames each broken rule blames, and those around them, are drawn from the spool
     as from the frames held: with every frame drawn, and with 40 of them."""
-    edits, options, _ = VARIANTS[variant]
-    copy = library_copy(tmp_path, edits)
-    text = FX3_EXAMPLE.format(duration="30s", robot=options.get("robot", ""), faults=options.get("faults", ""),
-                              point_within="10s")
-    folder = tmp_path / "out"
-    folder.mkdir()
-    held, spooled = _runs(parse_scenario(text, copy / "scenario.toml"), folder, monkeypatch)
+    held, spooled = _runs(*broken_scenario(tmp_path, variant), monkeypatch)
     assert held.violation_count > 0
     assert report_html.render([spooled]) == report_html.render([held])
     _caps(monkeypatch, frames=40, context=2)
@@ -186,30 +180,3 @@ def test_the_page_is_the_same_with_every_scan(tmp_path):
     assert _invoke("--scenario", scenario, "--html", tmp_path / "a.html").exit_code == 0
     assert _invoke("--scenario", scenario, "--html", tmp_path / "b.html", "--every-scan").exit_code == 0
     assert (tmp_path / "a.html").read_bytes() == (tmp_path / "b.html").read_bytes()
-
-
-def test_a_folder_the_page_cannot_use_is_said_before_the_run(tmp_path, monkeypatch):
-    def refused(*args, **kwargs):
-        raise PermissionError(13, "Permission denied")
-
-    monkeypatch.setattr(verify_command.tempfile, "mkdtemp", refused)
-    result = _invoke("--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml", "--html", tmp_path / "r.html")
-    assert result.exit_code == 2
-    assert result.output == f"error: cannot write the HTML report in {tmp_path}: Permission denied\n"
-    assert list(tmp_path.iterdir()) == []
-
-
-def test_a_disk_that_fills_up_during_an_html_run_is_said_and_the_spool_removed(tmp_path, monkeypatch):
-    original = stream_module.Stream._give
-
-    def full(self, frames):
-        if self.spool is not None and self.tx_count > 20:
-            raise OSError(28, "No space left on device")
-        return original(self, frames)
-
-    monkeypatch.setattr(stream_module.Stream, "_give", full)
-    result = _invoke("--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml", "--html", tmp_path / "r.html")
-    assert result.exit_code == 2 and "Traceback" not in result.output
-    assert f"cannot write the run's frames in {tmp_path}/.uitamr-trace-" in result.output
-    assert "No space left on device" in result.output
-    assert list(tmp_path.iterdir()) == []

@@ -205,6 +205,18 @@ def library_copy(tmp_path: Path, edits: dict[str, list[tuple[str, str]]]) -> Pat
     return copy
 
 
+def broken_scenario(tmp_path: Path, variant: str) -> tuple[Scenario, Path]:
+    """Thirty seconds of the FX3 example on a copy of the library broken as VARIANTS[variant]
+    says, and an empty folder for the run's reports."""
+    edits, options, _ = VARIANTS[variant]
+    copy = library_copy(tmp_path, edits)
+    text = FX3_EXAMPLE.format(duration="30s", robot=options.get("robot", ""), faults=options.get("faults", ""),
+                              point_within="10s")
+    folder = tmp_path / "out"
+    folder.mkdir()
+    return parse_scenario(text, copy / "scenario.toml"), folder
+
+
 def run_library(tmp_path: Path, edits: dict, *, duration: str = "12s", robot: str = "", faults: str = "",
                 point_within: str = "10s"):
     copy = library_copy(tmp_path, edits)

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from click.testing import CliRunner
 
 from test_idle_skip import robot_scenarios
-from test_verify_pipeline import FX3_EXAMPLE, VARIANTS, library_copy
+from test_verify_pipeline import VARIANTS, broken_scenario
 from verifier.commands.verify import command
 from verifier.verify import report_trace
 from verifier.verify import runner as runner_module
@@ -52,13 +52,7 @@ def test_bundled_scenarios_give_the_same_trace(path, tmp_path, monkeypatch):
 @pytest.mark.parametrize("variant", sorted(VARIANTS))
 def test_broken_libraries_give_the_same_trace_and_blame(tmp_path, monkeypatch, variant):
     """The frames each broken rule blames are marked in the spooled trace as in the held one."""
-    edits, options, _ = VARIANTS[variant]
-    copy = library_copy(tmp_path, edits)
-    text = FX3_EXAMPLE.format(duration="30s", robot=options.get("robot", ""), faults=options.get("faults", ""),
-                              point_within="10s")
-    folder = tmp_path / "out"
-    folder.mkdir()
-    held, spooled = _traces(parse_scenario(text, copy / "scenario.toml"), folder, monkeypatch)
+    held, spooled = _traces(*broken_scenario(tmp_path, variant), monkeypatch)
     assert spooled == held and b'"rules": ["UITAMR-' in held
 
 
@@ -101,16 +95,20 @@ def test_a_run_that_cannot_go_on_leaves_no_spool_file(tmp_path):
     assert list(out.iterdir()) == []
 
 
-def test_a_folder_the_trace_cannot_go_to_is_said_before_the_run(tmp_path, monkeypatch):
+REPORTS = [("--trace", "t.jsonl", "trace"), ("--html", "r.html", "HTML report")]  # both spool the frames
+
+
+@pytest.mark.parametrize("option, name, report", REPORTS)
+def test_a_folder_the_report_cannot_go_to_is_said_before_the_run(tmp_path, monkeypatch, option, name, report):
     def refused(*args, **kwargs):
         raise PermissionError(13, "Permission denied")
 
     from verifier.commands import verify as verify_command
 
     monkeypatch.setattr(verify_command.tempfile, "mkdtemp", refused)
-    result = _invoke("--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml", "--trace", tmp_path / "t.jsonl")
+    result = _invoke("--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml", option, tmp_path / name)
     assert result.exit_code == 2
-    assert result.output == f"error: cannot write the trace in {tmp_path}: Permission denied\n"
+    assert result.output == f"error: cannot write the {report} in {tmp_path}: Permission denied\n"
     assert list(tmp_path.iterdir()) == []
 
 
@@ -123,7 +121,9 @@ def test_a_spool_file_that_cannot_be_made_names_its_folder(tmp_path, monkeypatch
     assert list(tmp_path.iterdir()) == []
 
 
-def test_a_disk_that_fills_up_during_the_run_is_said_and_the_spool_removed(tmp_path, monkeypatch):
+@pytest.mark.parametrize("option, name, report", REPORTS)
+def test_a_disk_that_fills_up_during_the_run_is_said_and_the_spool_removed(tmp_path, monkeypatch, option, name,
+                                                                           report):
     original = stream_module.Stream._give
 
     def full(self, frames):
@@ -132,8 +132,8 @@ def test_a_disk_that_fills_up_during_the_run_is_said_and_the_spool_removed(tmp_p
         return original(self, frames)
 
     monkeypatch.setattr(stream_module.Stream, "_give", full)
-    result = _invoke("--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml", "--trace", tmp_path / "t.jsonl")
-    assert result.exit_code == 2
+    result = _invoke("--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml", option, tmp_path / name)
+    assert result.exit_code == 2 and "Traceback" not in result.output
     assert f"cannot write the run's frames in {tmp_path}/.uitamr-trace-" in result.output
     assert "No space left on device" in result.output
     assert list(tmp_path.iterdir()) == []
