@@ -14,7 +14,7 @@ import dataclasses
 from verifier.st import ast
 
 from .cpu import CpuProfile
-from .devices import DeviceError, locate
+from .devices import DeviceError, fx3_special_elsewhere, locate
 from .instructions import not_on_cpu
 
 
@@ -39,6 +39,10 @@ def cpu_diagnostics(files: list[ast.SourceFile], cpu: CpuProfile) -> list[ast.Di
                     locate(node, cpu)
                 except DeviceError as e:
                     mine.append(_at(node.span, str(e)))
+                else:
+                    why = fx3_special_elsewhere(node, cpu)
+                    if why:
+                        mine.append(_at(node.span, why, "warning"))
             elif isinstance(node, ast.Call) and getattr(node.resolved, "kind", None) == "instruction":
                 why = not_on_cpu(node.name, cpu)
                 if why:
@@ -48,5 +52,5 @@ def cpu_diagnostics(files: list[ast.SourceFile], cpu: CpuProfile) -> list[ast.Di
     return found
 
 
-def _at(span: ast.Span, message: str) -> ast.Diagnostic:
-    return ast.Diagnostic(span.file, span.line, span.col, "error", message, span.end_line, span.end_col)
+def _at(span: ast.Span, message: str, severity: str = "error") -> ast.Diagnostic:
+    return ast.Diagnostic(span.file, span.line, span.col, severity, message, span.end_line, span.end_col)
