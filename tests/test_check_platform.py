@@ -242,3 +242,16 @@ def test_platform_choices_are_the_cpu_profiles(tmp_path):
     done = run("--platform", "fx2n", write(tmp_path, BAD))
     assert done.exit_code == 2
     assert all(name in done.output for name in PROFILES)
+
+
+def test_an_instruction_the_cpu_lacks_is_one_error_not_also_its_other_cpus_operands(tmp_path):
+    # RS2 written into a Q program with a C24 in mind: the fix is another instruction, so
+    # the FX's argument list and operand types are not also held against the call
+    body = "RS2(D200, 8, D220, 8, 1);\nx := 0;"
+    path = write(tmp_path, program(body, "x : INT;"))
+    done = run("--platform", "q", path)
+    assert done.exit_code == 1
+    assert errors(done.output) == [f"{path}:5:1: error: RS2 does not exist on the q (it is a fx3/fx5 instruction)"]
+    on_fx3 = errors(run("--platform", "fx3u", path).output)  # where RS2 exists, they stand
+    assert on_fx3[0] == f"{path}:5:1: error: RS2 takes 6 argument(s) (EN, s, m, n, n1, d), 5 given"
+    assert len(on_fx3) == 3

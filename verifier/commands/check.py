@@ -82,9 +82,13 @@ def check_findings(paths: list[Path], target: str,
     findings += [Finding(d, "UITAMR-ST-CHECK" if d.is_error else "UITAMR-ST-WARNING")
                  for d in check(files, target)]
     if platform is not None:
-        from verifier.sim.cpucheck import cpu_diagnostics
+        from verifier.sim.cpucheck import cpu_diagnostics, foreign_call_finding
 
-        findings += [Finding(d, "UITAMR-ST-CPU") for d in cpu_diagnostics(files, PROFILES[platform])]
+        foreign: list = []
+        cpu_findings = [Finding(d, "UITAMR-ST-CPU") for d in cpu_diagnostics(files, PROFILES[platform], foreign)]
+        findings = [f for f in findings
+                    if not (f.rule == "UITAMR-ST-CHECK" and foreign_call_finding(f.diagnostic, foreign))]
+        findings += cpu_findings
     order = {str(p): i for i, p in enumerate(paths)}
     findings.sort(key=lambda f: (order.get(f.diagnostic.file, len(order)), f.diagnostic.line, f.diagnostic.col))
     return files, findings
