@@ -255,3 +255,17 @@ def test_an_instruction_the_cpu_lacks_is_one_error_not_also_its_other_cpus_opera
     on_fx3 = errors(run("--platform", "fx3u", path).output)  # where RS2 exists, they stand
     assert on_fx3[0] == f"{path}:5:1: error: RS2 takes 6 argument(s) (EN, s, m, n, n1, d), 5 given"
     assert len(on_fx3) == 3
+
+
+def test_check_refuses_the_scenario_devices_verify_refuses_for_its_platform(tmp_path):
+    # [initial] and [[inputs]] devices are checked against the scenario's own platform by
+    # `uitamr verify` (exit 2 at the key); `uitamr check` said 0 errors for the same file
+    scenario = write(tmp_path, 'platform = "fx3u"\n\n[initial]\nD300 = 300\nSM400 = true\n\n'
+                               '[[inputs]]\nat = "1s"\nset = { D9000 = 1 }\n', "s.toml")
+    done = run(scenario)
+    assert done.exit_code == 1, done.output
+    assert errors(done.output) == [
+        f"{scenario}:5:9: error: initial.SM400: device SM400: the fx3u has no SM devices; its special relays "
+        "are M8000..M8511: use M8000 (always ON)",
+        f"{scenario}:9:7: error: inputs[0].set: device D9000 does not exist on the fx3u: D runs D0..D8511"]
+    assert run(write(tmp_path, 'platform = "q"\n\n[initial]\nSM400 = true\nD9000 = 1\n', "q.toml")).exit_code == 0

@@ -115,11 +115,31 @@ def check_scenario(path: Path) -> list[Diagnostic]:
     from verifier.verify.scenario import ScenarioError, load_scenario
 
     try:
-        load_scenario(path)
+        scenario = load_scenario(path)
     except ScenarioError as exc:
         message = f"{exc.key}: {exc.message}" if exc.key else exc.message
         return [Diagnostic(str(path), exc.line or 0, exc.col or 0, "error", message)]
-    return []
+    return _scenario_devices(scenario)
+
+
+def _scenario_devices(scenario) -> list[Diagnostic]:
+    """The devices of [initial] and [[inputs]] that the scenario's platform does not have,
+    each at its key, as `uitamr verify` refuses them (exit 2) before the first scan."""
+    from verifier.sim.cpu import PROFILES
+    from verifier.sim.devices import device_problem
+    from verifier.verify.scenario import BUFFER_MEMORY, DEVICE_NAME
+
+    cpu = PROFILES[scenario.platform]
+    named = [(f"initial.{name}", name) for name, _ in scenario.initial if not BUFFER_MEMORY.match(name)]
+    named += [(f"{step.key}.set", name) for step in scenario.inputs for name in step.values if DEVICE_NAME.match(name)]
+    found = []
+    for key, name in named:
+        problem = device_problem(name, cpu)
+        if problem:
+            place = scenario.key_lines.get(key)
+            found.append(Diagnostic(str(scenario.path), place.line if place else 0, place.col if place else 0,
+                                    "error", f"{key}: {problem}"))
+    return found
 
 
 def render(diag: Diagnostic, lines: list[str] | None) -> str:

@@ -38,14 +38,15 @@ def parse_device(name: str, cpu: CpuProfile) -> DeviceAddress:
         raise DeviceError(f"{name!r} is not a device name")
     digits, area_name, number, bit = m.groups()
     area = cpu.areas.get(area_name)
-    if area is None:
-        raise DeviceError(f"{name!r}: the {cpu.name} has no {area_name} devices")
+    if area is None:  # the words of `locate`, which `uitamr check --platform` reports
+        raise DeviceError(f"device {text}: " + _no_area(_Named(area_name, number), cpu))
     try:
         index = int(number, area.radix)
     except ValueError:
-        raise DeviceError(f"{name!r}: {area_name} numbers are base {area.radix}") from None
+        raise DeviceError(f"device {text}: {area_name} numbers are base {area.radix} on the {cpu.name}") from None
     if index >= area.size:
-        raise DeviceError(f"{name!r}: {area_name} ends at {_fmt(area.size - 1, area.radix)} on the {cpu.name}")
+        raise DeviceError(f"device {text} does not exist on the {cpu.name}: {area_name} runs {area_name}0.."
+                          f"{area_name}{_fmt(area.size - 1, area.radix)}" + _fx3_special(area_name, index, cpu))
     if bit is not None:
         if area.kind != "word" or digits:
             raise DeviceError(f"{name!r}: only word devices have addressable bits")
@@ -58,6 +59,23 @@ def parse_device(name: str, cpu: CpuProfile) -> DeviceAddress:
             raise DeviceError(f"{name!r}: runs past the end of {area_name}")
         return DeviceAddress(area_name, index, "bit", digits=int(digits))
     return DeviceAddress(area_name, index, area.kind)
+
+
+@dataclass(frozen=True)
+class _Named:
+    """A device area and number, as `_no_area` reads them from an `ast.Device`."""
+    kind: str
+    address: str
+
+
+def device_problem(name: str, cpu: CpuProfile) -> str | None:
+    """Why `name` (a device as a scenario writes it: `D300`, `SM400`) is not a device of
+    `cpu`, in the words `uitamr check --platform` uses for ST; None when it is."""
+    try:
+        parse_device(name, cpu)
+    except DeviceError as exc:
+        return str(exc)
+    return None
 
 
 def locate(d, cpu: CpuProfile) -> tuple[Area, int]:
