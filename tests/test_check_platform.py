@@ -269,3 +269,19 @@ def test_check_refuses_the_scenario_devices_verify_refuses_for_its_platform(tmp_
         "are M8000..M8511: use M8000 (always ON)",
         f"{scenario}:9:7: error: inputs[0].set: device D9000 does not exist on the fx3u: D runs D0..D8511"]
     assert run(write(tmp_path, 'platform = "q"\n\n[initial]\nSM400 = true\nD9000 = 1\n', "q.toml")).exit_code == 0
+
+
+@pytest.mark.parametrize("spelling", ["FX3U", "Fx3u"])
+def test_the_cpu_may_be_written_as_mitsubishi_writes_it(tmp_path, spelling):
+    # the scenario's `platform = "FX3U"` is read in any case; so is the option
+    done = run("--platform", spelling, write(tmp_path, BAD))
+    assert done.exit_code == 1, done.output
+    assert done.output.splitlines()[-1] == "1 file(s) checked for gxworks2 on the fx3u CPU: 1 error(s), 0 warning(s)"
+
+
+def test_verify_takes_the_platform_in_any_case(tmp_path):
+    done = CliRunner().invoke(main, ["verify", "--platform", "Q", "--duration", "1s", str(ROOT / "plc" / "core"),
+                                     str(ROOT / "plc" / "q"), str(ROOT / "plc" / "examples" / "common"),
+                                     str(ROOT / "plc" / "examples" / "q" / "UITAMR_ExampleQ.st")])
+    assert "Invalid value for '--platform'" not in done.output
+    assert "on q" in done.output, done.output

@@ -159,7 +159,7 @@ def render(diag: Diagnostic, lines: list[str] | None) -> str:
 @click.option("--target", type=click.Choice(TARGETS), default=None,
               help="Which engineering tool's dialect to accept. Default: the editor of --platform's "
                    "CPU (gxworks3 for fx5u, gxworks2 for the others), else gxworks2.")
-@click.option("--platform", type=click.Choice(sorted(PROFILES)), default=None,
+@click.option("--platform", type=click.Choice(sorted(PROFILES), case_sensitive=False), default=None,
               help="Also check every device (name, range, index register) and instruction against "
                    "this CPU, as `uitamr verify --platform` loads it (fx3g: the FX3G CPU profile, "
                    "which verify has no scenarios for); errors under rule UITAMR-ST-CPU. Implies the "
