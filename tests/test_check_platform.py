@@ -23,6 +23,9 @@ END_PROGRAM
 """
 
 
+SM400_ON_FX3U = "device SM400: the fx3u has no SM devices; its special relays are M8000..M8511: use M8000 (always ON)"
+
+
 def run(*args):
     return CliRunner().invoke(main, ["check", *map(str, args)])
 
@@ -47,22 +50,36 @@ def test_sm400_on_an_fx3u_is_an_error_at_its_place(tmp_path):
     done = run("--platform", "fx3u", bad)
     assert done.exit_code == 1
     lines = done.output.splitlines()
-    assert lines[0] == (f"{bad}:6:1: error: device SM400: the fx3u CPU profile has no SM devices "
-                        "the simulator can run")
+    assert lines[0] == (f"{bad}:6:1: error: device SM400: the fx3u has no SM devices; its special "
+                        "relays are M8000..M8511: use M8000 (always ON)")
     assert lines[1:3] == ["    SM400 := TRUE;", "    ^^^^^"]
     assert lines[-1] == "1 file(s) checked for gxworks2 on the fx3u CPU: 1 error(s), 0 warning(s)"
-    assert run("--platform", "q", bad).exit_code == 0  # SM400 and D8403 are Q devices
+    q = run("--platform", "q", bad)  # SM400 and D8403 are Q devices; D8403 an ordinary one
+    assert q.exit_code == 0
+    assert q.output.splitlines()[0] == (f"{bad}:5:6: warning: D8403 is an ordinary data register on the q "
+                                        "(the CPU never sets it); FX3 special registers are SD devices on the q")
     assert errors(run("--platform", "fx5u", bad).output) == [  # the FX5U has SM400 but D0..D7999
-        f"{bad}:5:6: error: device D8403 does not exist on the fx5u"]
+        f"{bad}:5:6: error: device D8403 does not exist on the fx5u: D runs D0..D7999; "
+        "FX3 special registers are SD devices on the fx5u"]
 
 
 @pytest.mark.parametrize("platform, body, col, message", [
-    ("fx3u", "x := D9000;", 6, "device D9000 does not exist on the fx3u"),
+    ("fx3u", "x := D9000;", 6, "device D9000 does not exist on the fx3u: D runs D0..D8511"),
     ("fx3u", "b := X18;", 6, "device X18: X numbers are base 8 on the fx3u"),
-    ("fx3g", "b := X200;", 6, "device X200 does not exist on the fx3g"),  # X0..X177 on the FX3G
+    ("fx3g", "b := X200;", 6, "device X200 does not exist on the fx3g: X runs X0..X177"),  # octal
     ("fx3u", "x := D0Z8;", 6, "device D0Z8: index register Z8 does not exist on the fx3u (Z0..Z7)"),
-    ("fx5u", "x := D8000;", 6, "device D8000 does not exist on the fx5u"),
-    ("q", "b := M8402;", 6, "device M8402 does not exist on the q"),
+    ("fx5u", "x := D8000;", 6, "device D8000 does not exist on the fx5u: D runs D0..D7999; "
+                               "FX3 special registers are SD devices on the fx5u"),
+    ("fx5u", "x := D8067;", 6, "device D8067 does not exist on the fx5u: D runs D0..D7999; the FX3's special "
+                               "register D8067 (operation error code) is SD0 on the fx5u"),
+    ("q", "b := M8402;", 6, "device M8402 does not exist on the q: M runs M0..M8191; "
+                            "FX3 special relays are SM devices on the q"),
+    ("q", "x := W2000;", 6, "device W2000 does not exist on the q: W runs W0..W1FFF"),  # hexadecimal
+    ("fx3u", "x := SD0;", 6, "device SD0: the fx3u has no SD devices; its special registers are "
+                             "D8000..D8511: use D8067 (operation error code)"),
+    ("fx3u", "b := SM402;", 6, "device SM402: the fx3u has no SM devices; its special relays are "
+                               "M8000..M8511: use M8002 (ON in the first scan)"),
+    ("fx3u", "b := SM8561;", 6, "device SM8561: the fx3u has no SM devices; its special relays are M8000..M8511"),
     ("q", "x := K4M8190;", 6, "K4M8190 runs past the end of M"),
 ])
 def test_device_out_of_range_or_unknown_to_the_cpu(tmp_path, platform, body, col, message):
@@ -70,6 +87,35 @@ def test_device_out_of_range_or_unknown_to_the_cpu(tmp_path, platform, body, col
     done = run("--platform", platform, path)
     assert done.exit_code == 1, done.output
     assert errors(done.output) == [f"{path}:5:{col}: error: {message}"]
+
+
+@pytest.mark.parametrize("platform, body, message", [
+    ("q", "b := M8002;", "M8002 is an ordinary internal relay on the q (the CPU never sets it); "
+                         "the FX3's special relay M8002 (ON in the first scan) is SM402 on the q"),
+    ("q", "b := M8013;", "M8013 is an ordinary internal relay on the q (the CPU never sets it); "
+                         "the FX3's special relay M8013 (1000 ms clock) is SM412 on the q"),
+    ("fx5u", "b := M8000;", "M8000 is an ordinary internal relay on the fx5u (the CPU never sets it); "
+                            "the FX3's special relay M8000 (always ON) is SM400 or SM8000 on the fx5u"),
+    ("q", "x := D8400;", "D8400 is an ordinary data register on the q (the CPU never sets it); "
+                         "FX3 special registers are SD devices on the q"),
+])
+def test_an_fx3_special_number_on_another_cpu_is_a_warning_that_names_its_equivalent(
+        tmp_path, platform, body, message):
+    # an FX3 habit in a Q or FX5U program: the device exists there, as an ordinary one that
+    # nothing sets, so `NOT M8002` is TRUE from the first scan on a Q
+    path = write(tmp_path, program(body, "b : BOOL;" if body.startswith("b") else "x : INT;"))
+    done = run("--platform", platform, path)
+    assert done.exit_code == 0, done.output
+    assert done.output.splitlines()[0] == f"{path}:5:6: warning: {message}"
+    assert done.output.splitlines()[-1].endswith(": 0 error(s), 1 warning(s)")
+    data = json.loads(run("--platform", platform, "--format", "json", path).output)
+    assert [(d["severity"], d["rule"]) for d in data["diagnostics"]] == [("warning", "UITAMR-ST-CPU")]
+
+
+def test_the_fx3_special_numbers_are_the_fx3s_own(tmp_path):
+    body = "b := M8002;\nx := D8400;\nb := M8511;"
+    assert run("--platform", "fx3u", write(tmp_path, program(body))).output.endswith(
+        ": 0 error(s), 0 warning(s)\n")
 
 
 def test_the_cpus_own_devices_pass(tmp_path):
@@ -94,7 +140,7 @@ def test_devices_assigned_to_global_labels_are_checked(tmp_path):
     path = write(tmp_path, "VAR_GLOBAL\n  bRun AT SM400 : BOOL;\nEND_VAR\n", "globals.st")
     done = run("--platform", "fx3u", path)
     assert done.exit_code == 1
-    assert done.output.startswith(f"{path}:2:11: error: device SM400: the fx3u CPU profile has no SM devices")
+    assert done.output.startswith(f"{path}:2:11: error: device SM400: the fx3u has no SM devices")
 
 
 def _bundled_sets() -> list[tuple[str, tuple[Path, ...]]]:
@@ -141,14 +187,14 @@ def test_every_format_carries_the_cpu_errors_with_their_positions(tmp_path, monk
     assert (data["target"], data["platform"], data["errors"]) == ("gxworks2", "fx3u", 1)
     assert data["diagnostics"] == [{
         "file": "bad.st", "line": 6, "col": 1, "end_line": 6, "end_col": 6, "severity": "error",
-        "message": "device SM400: the fx3u CPU profile has no SM devices the simulator can run",
+        "message": SM400_ON_FX3U,
         "rule": "UITAMR-ST-CPU"}]
 
     github = run("--platform", "fx3u", "--format", "github", "bad.st")
     assert github.exit_code == 1
     assert github.output.splitlines() == [
         "::error file=bad.st,line=6,col=1,endLine=6,endColumn=6,title=uitamr check UITAMR-ST-CPU::"
-        "device SM400: the fx3u CPU profile has no SM devices the simulator can run",
+        + SM400_ON_FX3U,
         "1 file(s) checked for gxworks2 on the fx3u CPU: 1 error(s), 0 warning(s)"]
 
     sarif = json.loads(run("--platform", "fx3u", "--format", "sarif", "bad.st").output)
@@ -196,3 +242,46 @@ def test_platform_choices_are_the_cpu_profiles(tmp_path):
     done = run("--platform", "fx2n", write(tmp_path, BAD))
     assert done.exit_code == 2
     assert all(name in done.output for name in PROFILES)
+
+
+def test_an_instruction_the_cpu_lacks_is_one_error_not_also_its_other_cpus_operands(tmp_path):
+    # RS2 written into a Q program with a C24 in mind: the fix is another instruction, so
+    # the FX's argument list and operand types are not also held against the call
+    body = "RS2(D200, 8, D220, 8, 1);\nx := 0;"
+    path = write(tmp_path, program(body, "x : INT;"))
+    done = run("--platform", "q", path)
+    assert done.exit_code == 1
+    assert errors(done.output) == [f"{path}:5:1: error: RS2 does not exist on the q (it is a fx3/fx5 instruction)"]
+    on_fx3 = errors(run("--platform", "fx3u", path).output)  # where RS2 exists, they stand
+    assert on_fx3[0] == f"{path}:5:1: error: RS2 takes 6 argument(s) (EN, s, m, n, n1, d), 5 given"
+    assert len(on_fx3) == 3
+
+
+def test_check_refuses_the_scenario_devices_verify_refuses_for_its_platform(tmp_path):
+    # [initial] and [[inputs]] devices are checked against the scenario's own platform by
+    # `uitamr verify` (exit 2 at the key); `uitamr check` said 0 errors for the same file
+    scenario = write(tmp_path, 'platform = "fx3u"\n\n[initial]\nD300 = 300\nSM400 = true\n\n'
+                               '[[inputs]]\nat = "1s"\nset = { D9000 = 1 }\n', "s.toml")
+    done = run(scenario)
+    assert done.exit_code == 1, done.output
+    assert errors(done.output) == [
+        f"{scenario}:5:9: error: initial.SM400: device SM400: the fx3u has no SM devices; its special relays "
+        "are M8000..M8511: use M8000 (always ON)",
+        f"{scenario}:9:7: error: inputs[0].set: device D9000 does not exist on the fx3u: D runs D0..D8511"]
+    assert run(write(tmp_path, 'platform = "q"\n\n[initial]\nSM400 = true\nD9000 = 1\n', "q.toml")).exit_code == 0
+
+
+@pytest.mark.parametrize("spelling", ["FX3U", "Fx3u"])
+def test_the_cpu_may_be_written_as_mitsubishi_writes_it(tmp_path, spelling):
+    # the scenario's `platform = "FX3U"` is read in any case; so is the option
+    done = run("--platform", spelling, write(tmp_path, BAD))
+    assert done.exit_code == 1, done.output
+    assert done.output.splitlines()[-1] == "1 file(s) checked for gxworks2 on the fx3u CPU: 1 error(s), 0 warning(s)"
+
+
+def test_verify_takes_the_platform_in_any_case(tmp_path):
+    done = CliRunner().invoke(main, ["verify", "--platform", "Q", "--duration", "1s", str(ROOT / "plc" / "core"),
+                                     str(ROOT / "plc" / "q"), str(ROOT / "plc" / "examples" / "common"),
+                                     str(ROOT / "plc" / "examples" / "q" / "UITAMR_ExampleQ.st")])
+    assert "Invalid value for '--platform'" not in done.output
+    assert "on q" in done.output, done.output

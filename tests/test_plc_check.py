@@ -107,3 +107,21 @@ def test_a_program_without_the_library_files_is_told_which_files_to_add(tmp_path
                         "structure or function block, or use a GX Works type")
     assert lines[2] == (f"{main}:8:9: error: unknown function or instruction 'UITAMR_CRC16'; the "
                         f"UITAMR library declares it: add {crc} (or its folder) to the sources")
+
+
+def test_the_file_to_add_is_named_where_the_integrator_vendored_the_library(tmp_path, monkeypatch):
+    # docs/import-gxworks2.md "Your own program": the toolkit as vendor/uitamr (a submodule,
+    # here a symlink), some of its files given, one left out. The file to add is named by
+    # the path the integrator reaches it by, not where the symlink leads.
+    (tmp_path / "vendor").mkdir()
+    (tmp_path / "vendor" / "uitamr").symlink_to(PLC.parent, target_is_directory=True)
+    (tmp_path / "src").mkdir()
+    (tmp_path / "src" / "Main.st").write_text(
+        "PROGRAM Main\nVAR\n    fbPort : UITAMR_PortFx3;\n    uPort : ARRAY[0..39] OF WORD;\nEND_VAR\n"
+        "fbPort(i_bEN := TRUE, i_wChannel := 1, io_uPort := uPort);\nEND_PROGRAM\n", encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = CliRunner().invoke(check_command, ["--platform", "fx3u", "vendor/uitamr/plc/core", "src"])
+    assert result.exit_code == 1, result.output
+    lines = [line for line in result.output.splitlines() if ": error: " in line]
+    assert lines == ["src/Main.st:3:14: error: unknown type 'UITAMR_PortFx3'; the UITAMR library declares it: "
+                     "add vendor/uitamr/plc/fx3/UITAMR_PortFx3.st (or its folder) to the sources"]

@@ -262,7 +262,7 @@ def test_c24_settings_need_the_q_platform(tmp_path, program):
         load_scenario(scenario)
     scenario.write_text('platform = "q"\nduration = "1s"\n\n[initial]\nD99999 = 1\n', encoding="utf-8")
     result = invoke(program, "--scenario", scenario)  # the q has no D99999: found on the loaded CPU
-    assert result.exit_code == 2 and f"{scenario}:5:10: initial.D99999: 'D99999': D ends at" in result.output
+    assert result.exit_code == 2 and f"{scenario}:5:10: initial.D99999: device D99999 does not exist on the q: D runs" in result.output
 
 
 def test_the_bundled_q_exception_scenario_needs_the_no_reception_time():

@@ -82,9 +82,13 @@ def check_findings(paths: list[Path], target: str,
     findings += [Finding(d, "UITAMR-ST-CHECK" if d.is_error else "UITAMR-ST-WARNING")
                  for d in check(files, target)]
     if platform is not None:
-        from verifier.sim.cpucheck import cpu_diagnostics
+        from verifier.sim.cpucheck import cpu_diagnostics, foreign_call_finding
 
-        findings += [Finding(d, "UITAMR-ST-CPU") for d in cpu_diagnostics(files, PROFILES[platform])]
+        foreign: list = []
+        cpu_findings = [Finding(d, "UITAMR-ST-CPU") for d in cpu_diagnostics(files, PROFILES[platform], foreign)]
+        findings = [f for f in findings
+                    if not (f.rule == "UITAMR-ST-CHECK" and foreign_call_finding(f.diagnostic, foreign))]
+        findings += cpu_findings
     order = {str(p): i for i, p in enumerate(paths)}
     findings.sort(key=lambda f: (order.get(f.diagnostic.file, len(order)), f.diagnostic.line, f.diagnostic.col))
     return files, findings
@@ -111,11 +115,31 @@ def check_scenario(path: Path) -> list[Diagnostic]:
     from verifier.verify.scenario import ScenarioError, load_scenario
 
     try:
-        load_scenario(path)
+        scenario = load_scenario(path)
     except ScenarioError as exc:
         message = f"{exc.key}: {exc.message}" if exc.key else exc.message
         return [Diagnostic(str(path), exc.line or 0, exc.col or 0, "error", message)]
-    return []
+    return _scenario_devices(scenario)
+
+
+def _scenario_devices(scenario) -> list[Diagnostic]:
+    """The devices of [initial] and [[inputs]] that the scenario's platform does not have,
+    each at its key, as `uitamr verify` refuses them (exit 2) before the first scan."""
+    from verifier.sim.cpu import PROFILES
+    from verifier.sim.devices import device_problem
+    from verifier.verify.scenario import BUFFER_MEMORY, DEVICE_NAME
+
+    cpu = PROFILES[scenario.platform]
+    named = [(f"initial.{name}", name) for name, _ in scenario.initial if not BUFFER_MEMORY.match(name)]
+    named += [(f"{step.key}.set", name) for step in scenario.inputs for name in step.values if DEVICE_NAME.match(name)]
+    found = []
+    for key, name in named:
+        problem = device_problem(name, cpu)
+        if problem:
+            place = scenario.key_lines.get(key)
+            found.append(Diagnostic(str(scenario.path), place.line if place else 0, place.col if place else 0,
+                                    "error", f"{key}: {problem}"))
+    return found
 
 
 def render(diag: Diagnostic, lines: list[str] | None) -> str:
@@ -135,7 +159,7 @@ def render(diag: Diagnostic, lines: list[str] | None) -> str:
 @click.option("--target", type=click.Choice(TARGETS), default=None,
               help="Which engineering tool's dialect to accept. Default: the editor of --platform's "
                    "CPU (gxworks3 for fx5u, gxworks2 for the others), else gxworks2.")
-@click.option("--platform", type=click.Choice(sorted(PROFILES)), default=None,
+@click.option("--platform", type=click.Choice(sorted(PROFILES), case_sensitive=False), default=None,
               help="Also check every device (name, range, index register) and instruction against "
                    "this CPU, as `uitamr verify --platform` loads it (fx3g: the FX3G CPU profile, "
                    "which verify has no scenarios for); errors under rule UITAMR-ST-CPU. Implies the "

@@ -347,7 +347,7 @@ def _terminate_as_exit():
 @click.command(context_settings={"help_option_names": ["-h", "--help"]})
 @click.argument("sources", nargs=-1, type=click.Path())
 @click.option("--program", help="The PROGRAM POU to run (default: the scenario's, or the only one).")
-@click.option("--platform", type=click.Choice(sorted(PLATFORMS)),
+@click.option("--platform", type=click.Choice(sorted(PLATFORMS), case_sensitive=False),
               help="PLC platform (sets the ST dialect, the CPU and the serial port). Default: the scenario's; with SOURCES and no scenario, told from the devices and instructions the sources use. Without SOURCES: runs the bundled scenarios of that platform.")
 @click.option("--channel", type=click.Choice(CHANNELS),
               help="The PLC serial port the robot hangs on (default: the scenario's, or the platform's first port).")

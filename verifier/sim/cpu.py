@@ -165,3 +165,31 @@ def profile_for(target: str, cpu: str | None = None) -> CpuProfile:
 
 def _cpu_key(cpu: str) -> str:
     return CPU_ALIASES.get(cpu.lower(), cpu.lower())
+
+
+def _special_roles(cpu: CpuProfile) -> list[tuple[str, tuple[str, ...]]]:
+    """What each special relay/register the profile drives is for, as (role, devices)."""
+    roles = [("always ON", cpu.always_on), ("always OFF", cpu.always_off),
+             ("ON in the first scan", cpu.first_scan_on), ("OFF in the first scan", cpu.first_scan_off),
+             ("operation error", cpu.op_error_flags), ("operation error code", (cpu.op_error_code,))]
+    roles += [(f"{ms} ms clock", (relay,)) for relay, ms in cpu.clocks.items()]
+    return roles
+
+
+def special_equivalent(device: str, cpu: CpuProfile) -> tuple[str, tuple[str, ...]] | None:
+    """(role, `cpu`'s devices for it) when `device` (`SM400`, `M8002`) is a special relay or
+    register another CPU profile drives and `cpu` drives another one for the same thing:
+    ("ON in the first scan", ("SM402",)) for M8002 on a Q. None otherwise."""
+    device = device.upper()
+    for other in PROFILES.values():
+        for role, devices in _special_roles(other):
+            if device in devices:
+                mine = dict(_special_roles(cpu)).get(role, ())
+                return (role, mine) if mine and device not in mine else None
+    return None
+
+
+# The FX3's special relays and registers (M8000..M8511, D8000..D8511): on the other CPUs
+# these numbers are ordinary devices or none at all; their special devices are SM and SD.
+FX3_SPECIAL = {"M": ("SM", "relay"), "D": ("SD", "register")}
+FX3_SPECIAL_RANGE = range(8000, 8512)

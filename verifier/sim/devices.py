@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from .cpu import Area, CpuProfile
+from .cpu import FX3_SPECIAL, FX3_SPECIAL_RANGE, Area, CpuProfile, special_equivalent
 from .datatypes import wrap16, wrap32
 
 _DEVICE_RE = re.compile(r"^(?:K([1-8]))?([A-Z]{1,2})([0-9A-F]+)(?:\.([0-9A-F]))?$")
@@ -38,14 +38,15 @@ def parse_device(name: str, cpu: CpuProfile) -> DeviceAddress:
         raise DeviceError(f"{name!r} is not a device name")
     digits, area_name, number, bit = m.groups()
     area = cpu.areas.get(area_name)
-    if area is None:
-        raise DeviceError(f"{name!r}: the {cpu.name} has no {area_name} devices")
+    if area is None:  # the words of `locate`, which `uitamr check --platform` reports
+        raise DeviceError(f"device {text}: " + _no_area(_Named(area_name, number), cpu))
     try:
         index = int(number, area.radix)
     except ValueError:
-        raise DeviceError(f"{name!r}: {area_name} numbers are base {area.radix}") from None
+        raise DeviceError(f"device {text}: {area_name} numbers are base {area.radix} on the {cpu.name}") from None
     if index >= area.size:
-        raise DeviceError(f"{name!r}: {area_name} ends at {_fmt(area.size - 1, area.radix)} on the {cpu.name}")
+        raise DeviceError(f"device {text} does not exist on the {cpu.name}: {area_name} runs {area_name}0.."
+                          f"{area_name}{_fmt(area.size - 1, area.radix)}" + _fx3_special(area_name, index, cpu))
     if bit is not None:
         if area.kind != "word" or digits:
             raise DeviceError(f"{name!r}: only word devices have addressable bits")
@@ -60,6 +61,23 @@ def parse_device(name: str, cpu: CpuProfile) -> DeviceAddress:
     return DeviceAddress(area_name, index, area.kind)
 
 
+@dataclass(frozen=True)
+class _Named:
+    """A device area and number, as `_no_area` reads them from an `ast.Device`."""
+    kind: str
+    address: str
+
+
+def device_problem(name: str, cpu: CpuProfile) -> str | None:
+    """Why `name` (a device as a scenario writes it: `D300`, `SM400`) is not a device of
+    `cpu`, in the words `uitamr check --platform` uses for ST; None when it is."""
+    try:
+        parse_device(name, cpu)
+    except DeviceError as exc:
+        return str(exc)
+    return None
+
+
 def locate(d, cpu: CpuProfile) -> tuple[Area, int]:
     """(area, number) of a device written in ST (`verifier.st.ast.Device`, not buffer
     memory) on `cpu`, or DeviceError saying why the simulator cannot run it there: an area
@@ -71,15 +89,15 @@ def locate(d, cpu: CpuProfile) -> tuple[Area, int]:
     label = d.text or d.key
     area = cpu.areas.get(d.kind)
     if area is None:
-        raise DeviceError(f"device {label}: the {cpu.name} CPU profile has no "
-                          f"{d.kind} devices the simulator can run")
+        raise DeviceError(f"device {label}: " + _no_area(d, cpu))
     try:
         index = int(d.address, area.radix)
     except ValueError:
         raise DeviceError(f"device {label}: {d.kind} numbers are base {area.radix} "
                           f"on the {cpu.name}") from None
     if index >= area.size:
-        raise DeviceError(f"device {label} does not exist on the {cpu.name}")
+        raise DeviceError(f"device {label} does not exist on the {cpu.name}: {d.kind} runs "
+                          f"{d.kind}0..{d.kind}{_fmt(area.size - 1, area.radix)}" + _fx3_special(d.kind, index, cpu))
     if d.index is not None:
         z = cpu.areas.get("Z")
         if z is None:
@@ -98,6 +116,55 @@ def locate(d, cpu: CpuProfile) -> tuple[Area, int]:
         raise DeviceError(f"{label}: only word devices have addressable bits")
     return area, index
 
+
+def _no_area(d, cpu: CpuProfile) -> str:
+    """Why `cpu` has no device of `d`'s area, and what to write instead where that is known:
+    the FX3's special relays and registers are M8000.. and D8000.., not SM and SD."""
+    if cpu.family == "fx3" and d.kind in ("SM", "SD"):
+        kind = {"SM": "M", "SD": "D"}[d.kind]
+        what = {"SM": "relays", "SD": "registers"}[d.kind]
+        first, last = FX3_SPECIAL_RANGE[0], FX3_SPECIAL_RANGE[-1]
+        text = f"the {cpu.name} has no {d.kind} devices; its special {what} are {kind}{first}..{kind}{last}"
+        same = special_equivalent(f"{d.kind}{d.address}", cpu)
+        if same:
+            text += f": use {' or '.join(same[1])} ({same[0]})"
+        return text
+    return f"the {cpu.name} CPU profile has no {d.kind} devices the simulator can run"
+
+
+def _fx3_phrase(kind: str, index: int, cpu: CpuProfile) -> str:
+    """What an FX3 special relay/register number (M8002, D8400) is on `cpu`, whose special
+    devices are SM/SD: its equivalent if `cpu` drives the same thing, else where to look."""
+    area, what = FX3_SPECIAL[kind]
+    same = special_equivalent(f"{kind}{index}", cpu)
+    if same:
+        return (f"the FX3's special {what} {kind}{index} ({same[0]}) is "
+                f"{' or '.join(same[1])} on the {cpu.name}")
+    return f"FX3 special {what}s are {area} devices on the {cpu.name}"
+
+
+def _is_fx3_special_elsewhere(kind: str, index: int, cpu: CpuProfile) -> bool:
+    return cpu.family != "fx3" and kind in FX3_SPECIAL and index in FX3_SPECIAL_RANGE
+
+
+def _fx3_special(kind: str, index: int, cpu: CpuProfile) -> str:
+    """The hint added to 'does not exist' for an FX3 special number on another CPU."""
+    return f"; {_fx3_phrase(kind, index, cpu)}" if _is_fx3_special_elsewhere(kind, index, cpu) else ""
+
+
+def fx3_special_elsewhere(d, cpu: CpuProfile) -> str | None:
+    """A warning for an FX3 special relay/register number (M8002, D8400) that exists on
+    `cpu` as an ordinary device (a Q's M8002 is a plain internal relay, never set by the
+    CPU): what the program most likely meant. None when `d` is not such a device."""
+    if d.index is not None or d.digits is not None or not d.address.isdigit():
+        return None
+    index = int(d.address, 10)
+    area = cpu.areas.get(d.kind)
+    if area is None or index >= area.size or not _is_fx3_special_elsewhere(d.kind, index, cpu):
+        return None
+    plain = {"M": "internal relay", "D": "data register"}[d.kind]
+    return (f"{d.text or d.key} is an ordinary {plain} on the {cpu.name} (the CPU never sets it); "
+            + _fx3_phrase(d.kind, index, cpu))
 
 def _fmt(n: int, radix: int) -> str:
     return {8: f"{n:o}", 16: f"{n:X}"}.get(radix, str(n))

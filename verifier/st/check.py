@@ -11,9 +11,10 @@ from __future__ import annotations
 import functools
 import math
 import re
+from pathlib import Path
 from dataclasses import dataclass, field
 
-from verifier.bundled import library_file
+from verifier.bundled import PLC_DIR, library_file
 from verifier.st import ast, library, structure
 from verifier.st import types as T
 from verifier.st.devices import looks_like_device
@@ -116,6 +117,8 @@ class Checker:
         self.used: set[int] = set()
         #: (caller POU key, callee POU key, call) for every call of a user FB or FUNCTION
         self.calls: list[tuple[str, str, ast.Call]] = []
+        #: the bundled plc/ folder as the sources reach it (vendor/uitamr/plc), if they do
+        self.plc_shown = _plc_as_given([f.filename for f in files])
 
     # ------------------------------------------------------------- declarations
     def collect(self) -> None:
@@ -296,7 +299,7 @@ class Checker:
             self.rep.error(ref, library_missing(key, self.target))
             return T.ANY
         self.rep.error(ref, f"unknown type '{ref.name}'; "
-                       + (_in_library(ref.name) or "declare the structure or function block, or use a GX Works type"))
+                       + (_in_library(ref.name, self.plc_shown) or "declare the structure or function block, or use a GX Works type"))
         return T.ANY
 
     def _fb_type_name(self, ref: ast.TypeRef) -> str | None:
@@ -772,7 +775,7 @@ class Checker:
             self.rep.error(c.callee, f"instruction {name} is not available for {_target_name(self.target)}")
             self._args_only(c)
             return T.ANY
-        hint = _in_library(c.name)
+        hint = _in_library(c.name, self.plc_shown)
         self.rep.error(c.callee, f"unknown function or instruction '{c.name}'" + (f"; {hint}" if hint else ""))
         self._args_only(c)
         return T.ANY
@@ -1029,10 +1032,31 @@ def library_missing(name: str, target: str = "gxworks2") -> str:
     return f"type {name} does not exist in {_target_name(target)}: " + T.MISSING_TYPES.get(name, "")
 
 
-def _in_library(name: str) -> str | None:
-    """What to do when an undeclared name is a POU of the bundled UITAMR library."""
+def _in_library(name: str, plc_shown: Path | None = None) -> str | None:
+    """What to do when an undeclared name is a POU of the bundled UITAMR library: the file
+    to add, under `plc_shown` (the bundled plc/ folder as the sources name it) if given."""
     path = library_file(name)
-    return f"the UITAMR library declares it: add {path} (or its folder) to the sources" if path else None
+    if path is None:
+        return None
+    if plc_shown is not None:
+        path = plc_shown / path.relative_to(PLC_DIR)
+    return f"the UITAMR library declares it: add {path} (or its folder) to the sources"
+
+
+def _plc_as_given(filenames: list[str]) -> Path | None:
+    """The bundled plc/ folder by the path the sources reach it (`vendor/uitamr/plc` for
+    `vendor/uitamr/plc/core/UITAMR_Engine.st` given through a submodule or symlink), so
+    that a missing library file is named the way the integrator writes it; None when no
+    source lies in it."""
+    for name in filenames:
+        given = Path(name)
+        try:
+            inside = given.resolve().relative_to(PLC_DIR)
+        except (ValueError, OSError, RuntimeError):
+            continue
+        if len(inside.parts) < len(given.parts):
+            return given.parents[len(inside.parts) - 1]
+    return None
 
 
 def _target_name(target: str) -> str:
