@@ -123,7 +123,7 @@ class FakePort:
             if request.query == 0 and self.busy_polls > 0:
                 self.busy_polls -= 1
                 value = 1
-            reply = encode(StatusReply(1, self.robot_error, value), SETTINGS, strict=False)
+            reply = encode(StatusReply(request.address, self.robot_error, value), SETTINGS, strict=False)
         if self.corrupt:
             reply = reply[:-1] + bytes([reply[-1] ^ 0xFF])
         return reply
@@ -623,3 +623,41 @@ def test_the_limits_of_the_address_range_are_sent(rig, address):
     port.run(400)
     assert port.kinds() and port.kinds()[0][0] == address
     assert h.fbEngine.o_uErrId != ERR_ADDRESS
+
+
+def test_another_valid_address_is_another_robot_the_stop_goes_first_to_it(rig):
+    """Changing i_wAddress from 1 to 2 while a point runs: the robot at address 2 gets the
+    stop before anything else (it may have just been powered on), the command asked of the
+    robot at address 1 ends with 16#0305, and commands are served at address 2 after."""
+    h, port = rig
+    port.running_polls = 50
+    start_point(h, port)
+    port.run(1000)                                          # the point runs, its task is polled
+    count = len(port.requests)
+    h.wAddress = 2
+    port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)
+    assert h.fbRun.o_bErr and h.fbRun.o_uErrId == 0x0305
+    sent = port.kinds()[count:]
+    assert sent and sent[0] == encode(ControlRequest(2, 1, 0xA0), SETTINGS)
+    assert all(frame[0] == 2 for frame in sent)
+    assert h.fbEngine.o_bInitDone and not h.fbEngine.o_bErr
+    h.bRun = False
+    port.run(50)
+    port.running_polls = 2
+    h.wPoint, h.bRun = 4, True
+    port.run(5000, until=lambda x: x.fbRun.o_bOK or x.fbRun.o_bErr)
+    assert h.fbRun.o_bOK and encode(ControlRequest(2, 1, 4), SETTINGS) in port.kinds()
+    count = len(port.requests)
+    h.wAddress = 0                                          # 0 is address 1: another robot again
+    port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)
+    assert port.kinds()[count] == STOP
+
+
+def test_the_same_robot_by_another_spelling_is_not_a_new_robot(rig):
+    """0 and 1 name the same robot: switching between them sends no new stop."""
+    h, port = rig
+    port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)
+    stops = port.kinds().count(STOP)
+    h.wAddress = 0
+    port.run(2000)
+    assert port.kinds().count(STOP) == stops and h.fbEngine.o_bInitDone
