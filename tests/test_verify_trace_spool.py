@@ -210,6 +210,31 @@ def test_a_worker_killed_midway_is_said_and_leaves_nothing(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_command_killed_outright_leaves_a_spool_the_next_one_removes(tmp_path):
+    """SIGKILL runs no clean-up: the spool folder stays. The next `uitamr verify` that
+    writes a trace or a page in that folder removes it (its process is gone), and leaves
+    the spools of processes that live, or of other hosts, alone."""
+    import os
+    import signal
+
+    from verifier.commands.verify import SPOOL_PREFIX, _spool_owner
+
+    proc = _spawn_matrix(tmp_path)
+    _wait_for_spool(tmp_path, proc)
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.communicate(timeout=60)
+    (orphan,) = tmp_path.glob(f"{SPOOL_PREFIX}*")
+    living = tmp_path / f"{SPOOL_PREFIX}{_spool_owner()}-{os.getpid()}-abc"  # this test's process lives
+    elsewhere = tmp_path / f"{SPOOL_PREFIX}otherhost-{proc.pid}-abc"  # another machine's: not ours to judge
+    for folder in (living, elsewhere):
+        folder.mkdir()
+        (folder / "x.part").write_text("")
+    result = _invoke("--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml", "--html", tmp_path / "r.html")
+    assert result.exit_code == 0, result.output
+    assert not orphan.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["r.html", living.name, elsewhere.name])
+
+
 @pytest.mark.parametrize("extra", [["--every-scan"], [], ["--html"]], ids=["held", "spooled", "spooled-with-html"])
 def test_runs_that_share_a_name_are_apart_in_the_trace_and_replay_reads_them(tmp_path, extra):
     """A copied scenario file that kept its name, and one file given twice: the trace names
