@@ -40,7 +40,13 @@ def syntax_fields(node) -> list:
     """The values of a node's syntax fields (nodes, lists of nodes, plain values): those
     that take part in comparison, so not its span nor what the check filled in. Walkers
     of the tree (the simulator's purity and reach analyses) descend through these."""
-    return [getattr(node, f.name) for f in fields(node) if f.compare]
+    names = _SYNTAX_FIELD_NAMES.get(type(node))
+    if names is None:
+        names = _SYNTAX_FIELD_NAMES[type(node)] = tuple(f.name for f in fields(node) if f.compare)
+    return [getattr(node, name) for name in names]
+
+
+_SYNTAX_FIELD_NAMES: dict[type, tuple[str, ...]] = {}  # by node class: fields() builds its tuple on every call
 
 
 def walk(*roots) -> Iterator:
