@@ -285,3 +285,29 @@ def test_verify_takes_the_platform_in_any_case(tmp_path):
                                      str(ROOT / "plc" / "examples" / "q" / "UITAMR_ExampleQ.st")])
     assert "Invalid value for '--platform'" not in done.output
     assert "on q" in done.output, done.output
+
+
+def test_verify_notes_an_fx3_special_number_in_the_program_it_runs(tmp_path):
+    """The classic FX-to-Q port: `NOT M8002` for the first scan, where the Q's is SM402.
+    The program runs (M8002 is an ordinary relay there), and `uitamr verify` says what it
+    reads, as `check --platform q` warns; only for the POUs the program runs."""
+    source = ROOT / "plc" / "examples" / "q" / "UITAMR_ExampleQ.st"
+    text = source.read_text(encoding="utf-8")
+    assert text.count("bEngineOn := NOT SM402;") == 1
+    (tmp_path / "UITAMR_ExampleQ.st").write_text(text.replace("bEngineOn := NOT SM402;", "bEngineOn := NOT M8002;"),
+                                                 encoding="utf-8")
+    # an FX3 program beside it, not run: not noted
+    (tmp_path / "Fx3Beside.st").write_text(program("b := M8002;").replace("PROGRAM P", "PROGRAM Fx3Beside"),
+                                           encoding="utf-8")
+    scenario = (ROOT / "plc" / "scenarios" / "q-healthy.toml").read_text(encoding="utf-8")
+    scenario = scenario.replace('"../', f'"{(ROOT / "plc").as_posix()}/').replace(
+        f'"{(ROOT / "plc").as_posix()}/examples/q/*.st"', f'"{tmp_path.as_posix()}/*.st"')
+    (tmp_path / "s.toml").write_text(scenario, encoding="utf-8")
+    result = CliRunner().invoke(main, ["verify", "--scenario", str(tmp_path / "s.toml"), "--json",
+                                       str(tmp_path / "r.json")])
+    report = json.loads((tmp_path / "r.json").read_text())
+    notes = [n for s in report["scenarios"] for n in s["notes"]]
+    assert [n for n in notes if "M8002" in n] == [
+        f"{tmp_path / 'UITAMR_ExampleQ.st'}:59:18: M8002 is an ordinary internal relay on the q (the CPU never sets "
+        "it); the FX3's special relay M8002 (ON in the first scan) is SM402 on the q"], result.output
+    assert "Fx3Beside" not in result.output

@@ -34,6 +34,11 @@ PROGRESS_STEP_US = 1_000_000  # report progress every virtual second
 STREAM_EVERY_US = 10_000_000  # how often a run judged as it goes takes the settled frames
 
 _DEVICE = DEVICE_NAME
+# `_Plc.cpu_notes` by (parsed files, CPU, program): worked out once per process, as the
+# parsed files are shared by every scenario on the same sources
+_CPU_NOTES: dict[tuple[int, str, str], list[str]] = {}
+_CPU_NOTES_FILES: dict[tuple[int, str, str], list] = {}
+_CPU_NOTES_MAX = 16
 
 
 class _Plc:
@@ -70,6 +75,31 @@ class _Plc:
             raise UnusableInput(f"{_where(scenario)}: {exc}") from None
         self.name = self._program_name(scenario)
         self.program = self.project.program(self.name)
+
+    def cpu_notes(self) -> list[str]:
+        """Devices the program uses that exist on this CPU but are another CPU family's
+        special relays or registers (M8002 on a Q is an ordinary relay the CPU never sets):
+        `uitamr check --platform`'s warnings, for the POUs this program runs."""
+        project = self.project
+        if project.cpu.family == "fx3":
+            return []  # the FX3's own special numbers: nothing to say
+        key = (id(project.files), project.cpu.name, self.name.upper())
+        notes = _CPU_NOTES.get(key)
+        if notes is None:
+            from verifier.export.needed import needed, only
+            from verifier.sim.cpucheck import cpu_diagnostics
+
+            keys = needed(project.files, [self.name])
+            cwd = os.getcwd()
+            notes = [f"{_relative(f'{d.file}:{d.line}:{d.col}', cwd)}: {d.message}"
+                     for d in cpu_diagnostics([only(f, keys) for f in project.files], project.cpu)
+                     if not d.is_error]
+            if len(_CPU_NOTES) >= _CPU_NOTES_MAX:
+                oldest = next(iter(_CPU_NOTES))
+                del _CPU_NOTES[oldest], _CPU_NOTES_FILES[oldest]
+            _CPU_NOTES[key] = notes
+            _CPU_NOTES_FILES[key] = project.files  # keeps the files alive: their id is not reused
+        return notes
 
     def _program_name(self, scenario: Scenario) -> str:
         programs = self.project.pou_names("PROGRAM")
@@ -497,7 +527,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         aborted=aborted,
         ended_us=end,
         wall_s=time.perf_counter() - wall_start,
-        notes=list(scenario.notes) + (
+        notes=list(scenario.notes) + plc.cpu_notes() + (
             [] if tx_count
             else [f"the program sent nothing on {scenario.serial_channel} in the whole run"
                   + (" (nothing reached the robot's line through the converter)" if converter is not None else "")]
