@@ -101,3 +101,57 @@ def test_restart_puts_a_held_globals_view_back_and_keeps_it_the_cpus():
     g.g_nStep = 5
     project.run_programs(["MAIN"], scans=2)
     assert project.get("MAIN.n") == 10 and project.get("GLOBAL.g_nStep") == 5
+
+
+def test_restart_finds_the_memory_again_for_views_taken_from_other_views():
+    """An FB, an array, a structure and an element of an array of FBs taken out of a PROGRAM
+    (`t = main.fbTimer`) before `project.restart()`: after it they show the initial values
+    and what a test writes through them is what the program reads (they used to hold the
+    memory of the CPU before the restart)."""
+    import verifier
+
+    text = """
+TYPE Pair :
+STRUCT
+    wA : INT;
+    wB : INT;
+END_STRUCT
+END_TYPE
+FUNCTION_BLOCK Counter
+VAR_INPUT
+    i_wStep : INT;
+END_VAR
+VAR_OUTPUT
+    o_wCount : INT;
+END_VAR
+o_wCount := o_wCount + i_wStep;
+END_FUNCTION_BLOCK
+PROGRAM MAIN
+VAR
+    fbOne : Counter;
+    aFbs : ARRAY[1..2] OF Counter;
+    aWords : ARRAY[0..3] OF INT;
+    stPair : Pair;
+    wStep : INT := 1;
+END_VAR
+fbOne(i_wStep := wStep);
+aFbs[2](i_wStep := aWords[1]);
+stPair.wB := stPair.wA + fbOne.o_wCount;
+END_PROGRAM
+"""
+    project = verifier.load(sources={"MAIN.st": text}, target="gxworks3", cpu="fx5u")
+    main = project.program("MAIN")
+    one, fbs, words, pair = main.fbOne, main.aFbs, main.aWords, main.stPair
+    second = fbs[2]
+    words[1] = 7
+    pair.wA = 100
+    project.run_programs(["MAIN"], scans=3)
+    assert (one.o_wCount, second.o_wCount, pair.wB) == (3, 21, 103)
+    project.restart()
+    assert (one.o_wCount, second.o_wCount, list(words), pair.wA, pair.wB) == (0, 0, [0, 0, 0, 0], 0, 0)
+    assert [fb.o_wCount for fb in fbs] == [0, 0]
+    words[1] = 2
+    pair.wA = 10
+    project.run_programs(["MAIN"], scans=2)
+    assert (one.o_wCount, second.o_wCount, pair.wB) == (2, 4, 12)
+    assert (project.get("MAIN.fbOne.o_wCount"), main.aFbs[2].o_wCount) == (2, 4)

@@ -44,6 +44,7 @@ class CompiledModule:
     globals: dict[str, Symbol]
     class_symbols: dict[type, dict[str, Symbol]] = field(default_factory=dict)
     filename: str = GENERATED_FILE
+    restarts: int = 0  # Project.restart's count: views of memory taken before one find it again
 
     def span_at(self, lineno: int):
         if 1 <= lineno <= len(self.spans):

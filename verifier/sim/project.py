@@ -304,6 +304,7 @@ class Project:
         are kept — set them again from Python after the restart if your CPU keeps them."""
         rt = self.rt
         self.idle_scans, rt.dirty_log = None, None  # the labels start again: a new walk needed
+        self.module.restarts += 1  # views taken from others find their memory again (values.py)
         rt.advance_to(rt.now_us + round(off_ms * 1000))
         for cells in rt.dev.areas.values():
             zero = False if cells and isinstance(cells[0], bool) else 0

@@ -50,32 +50,50 @@ def to_st_list(t: ArrayT, values, label: str, default) -> list:
     return out + [default] * (t.size - len(out))
 
 
-def wrap(value, t, label: str, module):
-    """Python view of a stored value."""
+def wrap(value, t, label: str, module, parent=None, step=None):
+    """Python view of a stored value; a view of an instance, structure or array below
+    another view (`parent`, reached by `step`: an attribute name or a list index) finds
+    its memory again through it after `Project.restart`."""
     if isinstance(t, ArrayT):
-        return ArrayView(value, t, label, module)
+        return ArrayView(value, t, label, module, parent, step)
     if isinstance(t, (StructT, FbT)):
-        return InstanceProxy(value, module, label)
+        return InstanceProxy(value, module, label, parent=parent, step=step)
     return value
 
 
 class InstanceProxy:
     """An FB/PROGRAM instance or structure: `fb.i_bExecute = True`, `fb.tmr.Q`."""
 
-    __slots__ = ("_obj", "_module", "_label", "_project")
+    __slots__ = ("_obj", "_module", "_label", "_project", "_parent", "_step", "_seen")
 
-    def __init__(self, obj, module, label: str, project=None):
+    def __init__(self, obj, module, label: str, project=None, parent=None, step=None):
         object.__setattr__(self, "_obj", obj)
         object.__setattr__(self, "_module", module)
         object.__setattr__(self, "_label", label)
         object.__setattr__(self, "_project", project)
+        object.__setattr__(self, "_parent", parent)
+        object.__setattr__(self, "_step", step)
+        object.__setattr__(self, "_seen", module.restarts)
+
+    def _fresh(self) -> None:
+        """After a restart (`CompiledModule.restarts` moved on) a view taken from another
+        one holds memory the CPU no longer has: take it again through the parent."""
+        if self._parent is not None and self._seen != self._module.restarts:
+            object.__setattr__(self, "_obj", self._parent._value_at(self._step))
+            object.__setattr__(self, "_seen", self._module.restarts)
+
+    def _value_at(self, attr: str):
+        self._fresh()
+        return getattr(self._obj, attr)
 
     def _symbols(self) -> dict:
+        self._fresh()
         return self._module.class_symbols.get(type(self._obj), {})
 
     def _find(self, name: str):
         from .stdfbs import FB_PARAM_TYPES, StdFB
 
+        self._fresh()
         key = name.upper()
         if isinstance(self._obj, StdFB):
             t = FB_PARAM_TYPES[self._obj.TYPE_NAME].get(key)
@@ -95,9 +113,8 @@ class InstanceProxy:
         attr, t, sym = self._find(name)
         if sym is not None and sym.code and not sym.code.startswith(("self.", "_G.")):
             value = eval(sym.code, self._module.namespace)  # constants and device-backed globals
-        else:
-            value = getattr(self._obj, attr)
-        return wrap(value, t, f"{self._label}.{name}", self._module)
+            return wrap(value, t, f"{self._label}.{name}", self._module)
+        return wrap(getattr(self._obj, attr), t, f"{self._label}.{name}", self._module, self, attr)
 
     def __setattr__(self, name: str, value) -> None:
         attr, t, sym = self._find(name)
@@ -148,13 +165,26 @@ class ArrayView:
     """An ST array seen from Python, indexed by its ST bounds (`arr[1]` of ARRAY[1..8] is
     its first element); `list(view)` copies the values."""
 
-    __slots__ = ("_cells", "_t", "_label", "_module")
+    __slots__ = ("_cells", "_t", "_label", "_module", "_parent", "_step", "_seen")
 
-    def __init__(self, cells, t: ArrayT, label: str, module):
+    def __init__(self, cells, t: ArrayT, label: str, module, parent=None, step=None):
         self._cells = cells
         self._t = t
         self._label = label
         self._module = module
+        self._parent = parent
+        self._step = step
+        self._seen = module.restarts
+
+    def _fresh(self) -> None:
+        """As InstanceProxy._fresh: the array's memory again after a restart."""
+        if self._parent is not None and self._seen != self._module.restarts:
+            self._cells = self._parent._value_at(self._step)
+            self._seen = self._module.restarts
+
+    def _value_at(self, flat: int):
+        self._fresh()
+        return self._cells[flat]
 
     def _flat(self, index) -> int:
         idx = index if isinstance(index, tuple) else (index,)
@@ -170,17 +200,22 @@ class ArrayView:
     def __getitem__(self, index):
         if isinstance(index, slice):
             return list(self)[index]
-        return wrap(self._cells[self._flat(index)], self._t.elem, f"{self._label}[{index}]", self._module)
+        self._fresh()
+        flat = self._flat(index)
+        return wrap(self._cells[flat], self._t.elem, f"{self._label}[{index}]", self._module, self, flat)
 
     def __setitem__(self, index, value) -> None:
+        self._fresh()
         self._cells[self._flat(index)] = to_st(self._t.elem, value, f"{self._label}[{index}]")
 
     def __len__(self) -> int:
+        self._fresh()
         return len(self._cells)
 
     def __iter__(self):
-        for v in self._cells:
-            yield wrap(v, self._t.elem, f"{self._label}", self._module)
+        self._fresh()
+        for flat, v in enumerate(self._cells):
+            yield wrap(v, self._t.elem, f"{self._label}", self._module, self, flat)
 
     def __eq__(self, other) -> bool:
         try:
