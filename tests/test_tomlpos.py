@@ -104,3 +104,21 @@ def test_dotted_keys_are_found():
     lines = ['name = "x"', 'robot.turnaround_ms = "x"', "a.b.c = 1"]
     assert place_of_key(lines, "robot.turnaround_ms") == Place(2, 23)
     assert place_of_key(lines, "a", at_name=True) == Place(3, 1)
+
+
+def test_items_of_an_array_over_several_lines_are_found_on_their_line():
+    """A watch list written one label a line (with comments, a nested array, a trailing
+    comma): the n-th item's own line and column, not the array's first line."""
+    text = ('watch = [\n'
+            '    "fbEngine.o_wTxCount",   # counts, ["a", "b"] in a comment is no item\n'
+            '\n'
+            '    ["x", "y"], 3,\n'
+            '    "fbCycle.o_wNoSuch",\n'
+            ']\n')
+    lines = text.splitlines()
+    assert tomllib.loads(text)["watch"][3] == "fbCycle.o_wNoSuch"
+    assert place_of_key(lines, "watch[0]") == Place(2, 5)
+    assert place_of_key(lines, "watch[1]") == Place(4, 5)
+    assert place_of_key(lines, "watch[2]") == Place(4, 17)
+    assert place_of_key(lines, "watch[3]") == Place(5, 5)
+    assert place_of_key(lines, "watch[4]") == Place(1, 9)  # no such item: the array

@@ -130,49 +130,48 @@ def place_of_key(lines: list[str], key: str, at_name: bool = False) -> Place | N
         return Place(line, match.start(1) + 1)
     col = match.end()
     if index is not None and col < len(text) and text[col] == "[":
-        item = _array_item(text, col, index)
+        item = _array_item(lines, line - 1, col, index)
         if item is not None:
-            col = item
+            line, col = item
     return Place(line, col + 1)
 
 
-def _array_item(text: str, start: int, index: int) -> int | None:
-    """Offset of the index-th item of the inline array opening at text[start] ('[')."""
+def _array_item(lines: list[str], row: int, start: int, index: int) -> tuple[int, int] | None:
+    """(line, offset) of the index-th item of the array opening at lines[row][start] ('['),
+    which may go on over the following lines (with comments after its items)."""
     depth, count, quote = 0, 0, ""
-    i = start
     expecting = True
-    while i < len(text):
-        ch = text[i]
-        if quote:
-            if ch == "\\" and quote == '"':
-                i += 1
-            elif ch == quote:
-                quote = ""
-        elif ch in "\"'":
-            if depth == 1 and expecting:
-                if count == index:
-                    return i
-                count, expecting = count + 1, False
-            quote = ch
-        elif ch in "[{":
-            if depth == 1 and expecting:
-                if count == index:
-                    return i
-                count, expecting = count + 1, False
-            depth += 1
-        elif ch in "]}":
-            depth -= 1
-            if depth == 0:
-                return None
-        elif ch == "," and depth == 1:
-            expecting = True
-        elif ch == "#":
-            return None
-        elif not ch.isspace() and depth == 1 and expecting:
-            if count == index:
-                return i
-            count, expecting = count + 1, False
-        i += 1
+    i = start
+    while row < len(lines):
+        text = lines[row]
+        while i < len(text):
+            ch = text[i]
+            if quote:
+                if ch == "\\" and quote == '"':
+                    i += 1
+                elif ch == quote:
+                    quote = ""
+            elif ch == "#":
+                break  # a comment: the rest of the line
+            elif ch in "[{\"'" or (not ch.isspace() and ch not in "]},"):
+                if depth == 1 and expecting:
+                    if count == index:
+                        return row + 1, i
+                    count, expecting = count + 1, False
+                if ch in "[{":
+                    depth += 1
+                elif ch in "\"'":
+                    quote = ch
+            elif ch in "]}":
+                depth -= 1
+                if depth == 0:
+                    return None
+            elif ch == "," and depth == 1:
+                expecting = True
+            i += 1
+        if quote or depth == 0:
+            return None  # a string that does not end on its line (a multi-line one): give up
+        row, i = row + 1, 0
     return None
 
 
