@@ -37,16 +37,7 @@ def parse_device(name: str, cpu: CpuProfile) -> DeviceAddress:
     if not m:
         raise DeviceError(f"{name!r} is not a device name")
     digits, area_name, number, bit = m.groups()
-    area = cpu.areas.get(area_name)
-    if area is None:  # the words of `locate`, which `uitamr check --platform` reports
-        raise DeviceError(f"device {text}: " + _no_area(_Named(area_name, number), cpu))
-    try:
-        index = int(number, area.radix)
-    except ValueError:
-        raise DeviceError(f"device {text}: {area_name} numbers are base {area.radix} on the {cpu.name}") from None
-    if index >= area.size:
-        raise DeviceError(f"device {text} does not exist on the {cpu.name}: {area_name} runs {area_name}0.."
-                          f"{area_name}{_fmt(area.size - 1, area.radix)}" + _fx3_special(area_name, index, cpu))
+    area, index = _area_and_index(area_name, number, text, cpu)
     if bit is not None:
         if area.kind != "word" or digits:
             raise DeviceError(f"{name!r}: only word devices have addressable bits")
@@ -59,13 +50,6 @@ def parse_device(name: str, cpu: CpuProfile) -> DeviceAddress:
             raise DeviceError(f"{name!r}: runs past the end of {area_name}")
         return DeviceAddress(area_name, index, "bit", digits=int(digits))
     return DeviceAddress(area_name, index, area.kind)
-
-
-@dataclass(frozen=True)
-class _Named:
-    """A device area and number, as `_no_area` reads them from an `ast.Device`."""
-    kind: str
-    address: str
 
 
 def device_problem(name: str, cpu: CpuProfile) -> str | None:
@@ -87,17 +71,7 @@ def locate(d, cpu: CpuProfile) -> tuple[Area, int]:
     The one check of written devices against a CPU profile: the simulator's compiler and
     `uitamr check --platform` both ask it, so they cannot disagree."""
     label = d.text or d.key
-    area = cpu.areas.get(d.kind)
-    if area is None:
-        raise DeviceError(f"device {label}: " + _no_area(d, cpu))
-    try:
-        index = int(d.address, area.radix)
-    except ValueError:
-        raise DeviceError(f"device {label}: {d.kind} numbers are base {area.radix} "
-                          f"on the {cpu.name}") from None
-    if index >= area.size:
-        raise DeviceError(f"device {label} does not exist on the {cpu.name}: {d.kind} runs "
-                          f"{d.kind}0..{d.kind}{_fmt(area.size - 1, area.radix)}" + _fx3_special(d.kind, index, cpu))
+    area, index = _area_and_index(d.kind, d.address, label, cpu)
     if d.index is not None:
         z = cpu.areas.get("Z")
         if z is None:
@@ -117,19 +91,36 @@ def locate(d, cpu: CpuProfile) -> tuple[Area, int]:
     return area, index
 
 
-def _no_area(d, cpu: CpuProfile) -> str:
-    """Why `cpu` has no device of `d`'s area, and what to write instead where that is known:
+def _area_and_index(kind: str, address: str, label: str, cpu: CpuProfile) -> tuple[Area, int]:
+    """The area and number of device `label` (area `kind`, number `address` as written) on
+    `cpu`, or DeviceError: an area the profile lacks, a number in the wrong radix or past
+    the end. Device names (`parse_device`) and ST devices (`locate`) both ask it."""
+    area = cpu.areas.get(kind)
+    if area is None:
+        raise DeviceError(f"device {label}: " + _no_area(kind, address, cpu))
+    try:
+        index = int(address, area.radix)
+    except ValueError:
+        raise DeviceError(f"device {label}: {kind} numbers are base {area.radix} on the {cpu.name}") from None
+    if index >= area.size:
+        raise DeviceError(f"device {label} does not exist on the {cpu.name}: {kind} runs "
+                          f"{kind}0..{kind}{_fmt(area.size - 1, area.radix)}" + _fx3_special(kind, index, cpu))
+    return area, index
+
+
+def _no_area(kind: str, address: str, cpu: CpuProfile) -> str:
+    """Why `cpu` has no device of area `kind`, and what to write instead where that is known:
     the FX3's special relays and registers are M8000.. and D8000.., not SM and SD."""
-    if cpu.family == "fx3" and d.kind in ("SM", "SD"):
-        kind = {"SM": "M", "SD": "D"}[d.kind]
-        what = {"SM": "relays", "SD": "registers"}[d.kind]
+    if cpu.family == "fx3" and kind in ("SM", "SD"):
+        plain = {"SM": "M", "SD": "D"}[kind]
+        what = {"SM": "relays", "SD": "registers"}[kind]
         first, last = FX3_SPECIAL_RANGE[0], FX3_SPECIAL_RANGE[-1]
-        text = f"the {cpu.name} has no {d.kind} devices; its special {what} are {kind}{first}..{kind}{last}"
-        same = special_equivalent(f"{d.kind}{d.address}", cpu)
+        text = f"the {cpu.name} has no {kind} devices; its special {what} are {plain}{first}..{plain}{last}"
+        same = special_equivalent(f"{kind}{address}", cpu)
         if same:
             text += f": use {' or '.join(same[1])} ({same[0]})"
         return text
-    return f"the {cpu.name} CPU profile has no {d.kind} devices the simulator can run"
+    return f"the {cpu.name} CPU profile has no {kind} devices the simulator can run"
 
 
 def _fx3_phrase(kind: str, index: int, cpu: CpuProfile) -> str:
@@ -165,6 +156,7 @@ def fx3_special_elsewhere(d, cpu: CpuProfile) -> str | None:
     plain = {"M": "internal relay", "D": "data register"}[d.kind]
     return (f"{d.text or d.key} is an ordinary {plain} on the {cpu.name} (the CPU never sets it); "
             + _fx3_phrase(d.kind, index, cpu))
+
 
 def _fmt(n: int, radix: int) -> str:
     return {8: f"{n:o}", 16: f"{n:X}"}.get(radix, str(n))
