@@ -82,13 +82,12 @@ def check_findings(paths: list[Path], target: str,
     findings += [Finding(d, "UITAMR-ST-CHECK" if d.is_error else "UITAMR-ST-WARNING")
                  for d in check(files, target)]
     if platform is not None:
-        from verifier.sim.cpucheck import cpu_diagnostics, foreign_call_finding
+        from verifier.sim.cpucheck import cpu_diagnostics
 
-        foreign: list = []
-        cpu_findings = [Finding(d, "UITAMR-ST-CPU") for d in cpu_diagnostics(files, PROFILES[platform], foreign)]
-        findings = [f for f in findings
-                    if not (f.rule == "UITAMR-ST-CHECK" and foreign_call_finding(f.diagnostic, foreign))]
-        findings += cpu_findings
+        superseded: list = []  # the operand errors of instructions this CPU does not have
+        cpu_findings = [Finding(d, "UITAMR-ST-CPU") for d in cpu_diagnostics(files, PROFILES[platform], superseded)]
+        gone = {id(d) for d in superseded}
+        findings = [f for f in findings if id(f.diagnostic) not in gone] + cpu_findings
     order = {str(p): i for i, p in enumerate(paths)}
     findings.sort(key=lambda f: (order.get(f.diagnostic.file, len(order)), f.diagnostic.line, f.diagnostic.col))
     return files, findings

@@ -17,13 +17,13 @@ from .instructions import not_on_cpu
 
 
 def cpu_diagnostics(files: list[ast.SourceFile], cpu: CpuProfile,
-                    foreign_calls: list[ast.Call] | None = None) -> list[ast.Diagnostic]:
+                    superseded: list[ast.Diagnostic] | None = None) -> list[ast.Diagnostic]:
     """An error for every device (in bodies, initial values and `AT` assignments) and every
     instruction call of `files` that `cpu` does not have, in file order. Instruction calls
     are recognised by the check's resolution (`ast.Call.resolved`): run
-    `verifier.st.check` on the files first. The calls of instructions `cpu` lacks are
-    appended to `foreign_calls` when given (their operands were checked against another
-    CPU's instruction: `foreign_call_finding` tells those findings apart)."""
+    `verifier.st.check` on the files first. The check's errors about the arguments and
+    operands of an instruction `cpu` lacks (judged against another CPU's instruction; the
+    fix is another instruction) are appended to `superseded` when given."""
     found: list[ast.Diagnostic] = []
     for f in files:
         mine: list[ast.Diagnostic] = []
@@ -41,24 +41,11 @@ def cpu_diagnostics(files: list[ast.SourceFile], cpu: CpuProfile,
                 why = not_on_cpu(node.name, cpu)
                 if why:
                     mine.append(_at(node.callee.span, why))
-                    if foreign_calls is not None:
-                        foreign_calls.append(node)
+                    if superseded is not None:
+                        superseded.extend(node.resolved.signature_errors)
         found += sorted(mine, key=lambda d: (d.line, d.col))
     return found
 
 
 def _at(span: ast.Span, message: str, severity: str = "error") -> ast.Diagnostic:
     return ast.Diagnostic(span.file, span.line, span.col, severity, message, span.end_line, span.end_col)
-
-
-def foreign_call_finding(d: ast.Diagnostic, calls: list[ast.Call]) -> bool:
-    """Is `d` the checker's complaint about the arguments or operands of one of `calls`
-    (instructions the CPU lacks: `RS2 takes 6 argument(s)`, `RS2 operand s: ...`)? Those
-    judge the call by an instruction the program cannot use there; the fix is another
-    instruction, so `uitamr check --platform` reports the missing instruction alone."""
-    for c in calls:
-        span = c.span
-        if (d.file == span.file and d.message.startswith((f"{c.name} takes ", f"{c.name} operand "))
-                and (span.line, span.col) <= (d.line, d.col) <= (span.end_line, span.end_col)):
-            return True
-    return False

@@ -895,15 +895,20 @@ class Checker:
             vt = self.expr(a.value)
         self._assign_compat(a.value, param_type, vt, f"argument {name} of {info.pou.name}")
 
+    def _signature_error(self, c: ast.Call, node, message: str) -> None:
+        """An error about call `c` against its signature, recorded on `c.resolved` too."""
+        self.rep.error(node, message)
+        c.resolved.signature_errors.append(self.rep.diagnostics[-1])
+
     def _signature_call(self, c: ast.Call, sig: T.Signature, statement: bool, kind: str) -> T.Type:
         c.resolved = T.CallTarget(kind, sig.name, signature=sig)
         if any(a.name is not None for a in c.args):
             bad = next(a for a in c.args if a.name is not None)
-            self.rep.error(bad, f"{sig.name} takes positional arguments in manual order: "
+            self._signature_error(c, bad, f"{sig.name} takes positional arguments in manual order: "
                                 f"{sig.name}({', '.join(p.name for p in sig.params)})")
         n, np = len(c.args), len(sig.params)
         if n < np or (n > np and not sig.variadic):
-            self.rep.error(c, f"{sig.name} takes {np}{' or more' if sig.variadic else ''} argument(s) "
+            self._signature_error(c, c, f"{sig.name} takes {np}{' or more' if sig.variadic else ''} argument(s) "
                               f"({', '.join(p.name for p in sig.params)}), {n} given")
         generic: T.Type | None = None
         first_type: T.Type | None = None
@@ -914,7 +919,7 @@ class Checker:
                 continue
             if p.direction in ("out", "inout") and _is_literal(a.value):
                 self.expr(a.value)
-                self.rep.error(a.value, f"{sig.name} operand {p.name}: needs a label or device, not a constant")
+                self._signature_error(c, a.value, f"{sig.name} operand {p.name}: needs a label or device, not a constant")
                 continue
             if p.direction in ("out", "inout"):
                 at = self.lvalue(a.value)
@@ -926,7 +931,7 @@ class Checker:
                 first_type = at
             problem = self._accepts(p, at, a.value)
             if problem:
-                self.rep.error(a.value, f"{sig.name} operand {p.name}: {problem}")
+                self._signature_error(c, a.value, f"{sig.name} operand {p.name}: {problem}")
             elif p.accepts.startswith("ANY_") and p.accepts != "ANY_INT" or p.accepts == "ANY" and sig.result == "SAME":
                 if sig.name in ("SHL", "SHR", "ROL", "ROR") and i > 0:
                     continue
@@ -937,13 +942,13 @@ class Checker:
                 else:
                     g = T.unify(generic, at)
                     if g is None:
-                        self.rep.error(a.value, f"{sig.name}: {at} does not match the other operands ({generic}); convert it")
+                        self._signature_error(c, a.value, f"{sig.name}: {at} does not match the other operands ({generic}); convert it")
                     else:
                         generic = g
             elif p.accepts == "ANY_INT" and sig.result == "SAME":
                 g = at if generic is None else T.unify(generic, at)
                 if g is None:
-                    self.rep.error(a.value, f"{sig.name}: {at} does not match the other operands ({generic}); convert it")
+                    self._signature_error(c, a.value, f"{sig.name}: {at} does not match the other operands ({generic}); convert it")
                 else:
                     generic = g
         c.resolved.generic = generic

@@ -328,3 +328,6 @@ class CallTarget:
     signature: Signature | None = None
     generic: Type | None = None
     extra: dict = field(default_factory=dict)
+    # the check's errors about the call against `signature` (argument count, operands): a
+    # CPU check that finds the instruction missing there reports that alone
+    signature_errors: list = field(default_factory=list, compare=False, repr=False)
