@@ -16,18 +16,20 @@ from .devices import DeviceError, fx3_special_elsewhere, locate
 from .instructions import not_on_cpu
 
 
-def cpu_diagnostics(files: list[ast.SourceFile], cpu: CpuProfile,
-                    superseded: list[ast.Diagnostic] | None = None) -> list[ast.Diagnostic]:
+def cpu_diagnostics(files: list[ast.SourceFile], cpu: CpuProfile, superseded: list[ast.Diagnostic] | None = None,
+                    pous: set[str] | None = None) -> list[ast.Diagnostic]:
     """An error for every device (in bodies, initial values and `AT` assignments) and every
     instruction call of `files` that `cpu` does not have, in file order. Instruction calls
     are recognised by the check's resolution (`ast.Call.resolved`): run
     `verifier.st.check` on the files first. The check's errors about the arguments and
     operands of an instruction `cpu` lacks (judged against another CPU's instruction; the
-    fix is another instruction) are appended to `superseded` when given."""
+    fix is another instruction) are appended to `superseded` when given. `pous`: the keys of
+    the POUs to look at (the global labels and structures always), None for all."""
     found: list[ast.Diagnostic] = []
     for f in files:
         mine: list[ast.Diagnostic] = []
-        for node in ast.walk(f.globals, f.types, f.pous):
+        chosen = f.pous if pous is None else [pou for pou in f.pous if pou.key in pous]
+        for node in ast.walk(f.globals, f.types, chosen):
             if isinstance(node, ast.Device) and node.module is None:
                 try:
                     locate(node, cpu)

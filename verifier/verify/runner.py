@@ -34,10 +34,9 @@ PROGRESS_STEP_US = 1_000_000  # report progress every virtual second
 STREAM_EVERY_US = 10_000_000  # how often a run judged as it goes takes the settled frames
 
 _DEVICE = DEVICE_NAME
-# `_Plc.cpu_notes` by (parsed files, CPU, program): worked out once per process, as the
-# parsed files are shared by every scenario on the same sources
-_CPU_NOTES: dict[tuple[int, str, str], list[str]] = {}
-_CPU_NOTES_FILES: dict[tuple[int, str, str], list] = {}
+# `_Plc.cpu_notes` (with the parsed files they are about) by (files, CPU, program, working
+# folder): worked out once per process, as every scenario on the same sources shares the files
+_CPU_NOTES: dict[tuple[int, str, str, str], tuple[list, list[str]]] = {}
 _CPU_NOTES_MAX = 16
 
 
@@ -79,27 +78,23 @@ class _Plc:
     def cpu_notes(self) -> list[str]:
         """Devices the program uses that exist on this CPU but are another CPU family's
         special relays or registers (M8002 on a Q is an ordinary relay the CPU never sets):
-        `uitamr check --platform`'s warnings, for the POUs this program runs."""
+        `uitamr check --platform`'s warnings, for the POUs compiled for this run (those the
+        program uses when the scenario names it)."""
         project = self.project
         if project.cpu.family == "fx3":
             return []  # the FX3's own special numbers: nothing to say
-        key = (id(project.files), project.cpu.name, self.name.upper())
-        notes = _CPU_NOTES.get(key)
-        if notes is None:
-            from verifier.export.needed import needed, only
+        cwd = os.getcwd()
+        key = (id(project.files), project.cpu.name, self.name.upper(), cwd)
+        cached = _CPU_NOTES.get(key)
+        if cached is None:
             from verifier.sim.cpucheck import cpu_diagnostics
 
-            keys = needed(project.files, [self.name])
-            cwd = os.getcwd()
-            notes = [f"{_relative(f'{d.file}:{d.line}:{d.col}', cwd)}: {d.message}"
-                     for d in cpu_diagnostics([only(f, keys) for f in project.files], project.cpu)
-                     if not d.is_error]
+            found = cpu_diagnostics(project.files, project.cpu, pous=set(project.module.pous))
+            notes = [f"{_relative(f'{d.file}:{d.line}:{d.col}', cwd)}: {d.message}" for d in found if not d.is_error]
             if len(_CPU_NOTES) >= _CPU_NOTES_MAX:
-                oldest = next(iter(_CPU_NOTES))
-                del _CPU_NOTES[oldest], _CPU_NOTES_FILES[oldest]
-            _CPU_NOTES[key] = notes
-            _CPU_NOTES_FILES[key] = project.files  # keeps the files alive: their id is not reused
-        return notes
+                del _CPU_NOTES[next(iter(_CPU_NOTES))]
+            cached = _CPU_NOTES[key] = (project.files, notes)  # the files kept alive: their id is not reused
+        return cached[1]
 
     def _program_name(self, scenario: Scenario) -> str:
         programs = self.project.pou_names("PROGRAM")
