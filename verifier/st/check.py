@@ -15,6 +15,7 @@ from pathlib import Path
 from dataclasses import dataclass, field
 
 from verifier.bundled import PLC_DIR, library_file
+from verifier.textfile import real_path
 from verifier.st import ast, library, structure
 from verifier.st import types as T
 from verifier.st.devices import looks_like_device
@@ -1056,8 +1057,8 @@ def _plc_as_given(filenames: list[str]) -> Path | None:
     for name in filenames:
         given = Path(name)
         try:
-            inside = given.resolve().relative_to(PLC_DIR)
-        except (ValueError, OSError, RuntimeError):
+            inside = real_path(given).relative_to(PLC_DIR)
+        except ValueError:
             continue
         if len(inside.parts) < len(given.parts):
             return given.parents[len(inside.parts) - 1]
