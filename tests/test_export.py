@@ -312,8 +312,9 @@ def _bundled_programs():
 @pytest.mark.parametrize("sources, program, platform, target", _bundled_programs(),
                          ids=lambda v: v if isinstance(v, str) else "")
 def test_export_of_a_program_writes_what_the_simulator_runs_of_it(tmp_path, sources, program, platform, target):
-    """--program exports the POUs `uitamr verify` compiles for that program (verifier.sim.reach,
-    worked out on resolved types): the two walks agree on every bundled program."""
+    """--program exports the POUs `uitamr verify` compiles for that program (both ask
+    verifier.sim.reach.needed): the export writes what the compiled module holds, on every
+    bundled program."""
     import verifier
 
     result = run("--target", target, "--out", str(tmp_path), "--program", program, *sources)

@@ -18,7 +18,8 @@ from pathlib import Path
 from verifier import st
 from verifier.st import ast
 from verifier.export.body import body_text
-from verifier.export.needed import needed, only, type_names
+from verifier.export.needed import needed, only
+from verifier.sim.reach import type_names
 from verifier.export.labels import LabelRow, initial_text, label_class, label_rows, rows_of
 from verifier.export.types import type_name
 from verifier.textfile import real_path, text_lines

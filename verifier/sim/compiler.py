@@ -26,7 +26,7 @@ from .refs import AttrRef, BitRef, DwordRef, Ref
 from .stdfbs import STANDARD_FBS, FB_PARAM_TYPES
 from .stdfuncs import make_helpers
 from .purity import pure_functions, remembered
-from .reach import needed_pous
+from .reach import needed
 from .storage import check_storage
 from .typesys import (ArrayT, CompileError, FbT, PouInfo, StringT, StructT, Symbol, anyint_helpers,
                       concrete, is_int, is_real, norm_code)
@@ -371,9 +371,9 @@ class ModuleCompiler:
         check_storage(self.struct_fields, self.pous, self.globals,
                       {key: sd.name for key, sd in self.structs.items()})
         if self.programs is not None:
-            needed = needed_pous(self.pous, self.struct_fields, self.globals, self.programs)
-            self.pous = {key: info for key, info in self.pous.items() if key in needed}
-            self.functions = {key: info for key, info in self.functions.items() if key in needed}
+            wanted = needed(self.files, self.programs)
+            self.pous = {key: info for key, info in self.pous.items() if key in wanted}
+            self.functions = {key: info for key, info in self.functions.items() if key in wanted}
         em = self.em
         for key, sd in self.structs.items():
             self.gen_struct(key, sd)
@@ -649,7 +649,7 @@ _GENERATED_MAX = 8
 def compile_files(files: list[ast.SourceFile], rt, cpu: CpuProfile, inline: bool = True, *,
                   programs: frozenset[str] | None = None) -> CompiledModule:
     """The files compiled for a runtime: every POU, or (`programs`, upper-case PROGRAM
-    names) only what those PROGRAMs need (`reach.needed_pous`)."""
+    names) only what those PROGRAMs need (`reach.needed`)."""
     key = (id(files), cpu.name, inline, programs)
     generated = _GENERATED.get(key)
     if generated is None or generated.files is not files or rt.locations:

@@ -10,41 +10,43 @@ is still parsed and checked in full: what GX Works would refuse is reported all 
 """
 from __future__ import annotations
 
-
 from verifier.st import ast
 
-from .typesys import ArrayT, FbT, StructT
 
-
-def needed_pous(pous: dict, struct_fields: dict, globals_: dict, programs) -> set[str]:
-    """Keys of the POUs (`pous`: PouInfo by upper-case key) that `programs` need."""
-    needed: set[str] = set()
+def needed(files: list[ast.SourceFile], programs) -> set[str]:
+    """Upper-case keys of the POUs and structure types `programs` (POU names) need,
+    themselves included: the types of their labels (FB instances, arrays of them,
+    structures and their members), their result types, the FUNCTIONs they call, and so
+    on down; plus what the global labels need. Worked out on the parsed files, so that
+    `uitamr export --program` asks the same as the simulator's compiler. Names that are
+    no POU of `files` are left out."""
+    pous = {pou.key: pou for f in files for pou in f.pous}
+    structs = {struct.key: struct for f in files for struct in f.types}
+    keys: set[str] = set()
     stack = [name.upper() for name in programs]
-    for sym in globals_.values():
-        stack += _fb_types(sym.type, struct_fields, set())
+    stack += [k for f in files for block in f.globals for v in block.variables for k in type_names(v.type)]
     while stack:
         key = stack.pop()
-        if key in needed or key not in pous:
+        if key in keys:
             continue
-        needed.add(key)
-        info = pous[key]
-        for sym in info.symbols.values():
-            stack += _fb_types(sym.type, struct_fields, set())
-        stack += called_functions(info.pou, pous)
-    return needed
+        if key in structs:
+            keys.add(key)
+            stack += [k for v in structs[key].fields for k in type_names(v.type)]
+        elif key in pous:
+            keys.add(key)
+            pou = pous[key]
+            stack += [k for v in pou.variables for k in type_names(v.type)]
+            if pou.return_type is not None:
+                stack += type_names(pou.return_type)
+            stack += called_functions(pou, pous)
+    return keys
 
 
-def _fb_types(t, struct_fields: dict, seen: set) -> list[str]:
-    """The user FUNCTION_BLOCK types a label of type `t` holds instances of."""
-    if isinstance(t, FbT):
-        return [] if t.standard else [t.name]
-    if isinstance(t, ArrayT):
-        return _fb_types(t.elem, struct_fields, seen)
-    if isinstance(t, StructT) and t.name not in seen:
-        seen.add(t.name)
-        return [k for sym in struct_fields.get(t.name, {}).values()
-                for k in _fb_types(sym.type, struct_fields, seen)]
-    return []
+def type_names(t: ast.TypeRef) -> list[str]:
+    """The type names a declared type refers to (an array's element type's too)."""
+    while isinstance(t, ast.ArrayType):
+        t = t.element
+    return [t.key] if isinstance(t, ast.NamedType) else []
 
 
 def called_functions(pou: ast.Pou, pous: dict) -> list[str]:
