@@ -103,9 +103,9 @@ def test_a_folder_the_report_cannot_go_to_is_said_before_the_run(tmp_path, monke
     def refused(*args, **kwargs):
         raise PermissionError(13, "Permission denied")
 
-    from verifier.commands import verify as verify_command
+    from verifier.verify import spool as spool_module
 
-    monkeypatch.setattr(verify_command.tempfile, "mkdtemp", refused)
+    monkeypatch.setattr(spool_module.tempfile, "mkdtemp", refused)
     result = _invoke("--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml", option, tmp_path / name)
     assert result.exit_code == 2
     assert result.output == f"error: cannot write the {report} in {tmp_path}: Permission denied\n"
@@ -217,14 +217,15 @@ def test_a_command_killed_outright_leaves_a_spool_the_next_one_removes(tmp_path)
     import os
     import signal
 
-    from verifier.commands.verify import SPOOL_PREFIX, _spool_owner
+    from verifier.verify.spool import PREFIX as SPOOL_PREFIX
+    from verifier.verify.spool import owner
 
     proc = _spawn_matrix(tmp_path)
     _wait_for_spool(tmp_path, proc)
     os.killpg(proc.pid, signal.SIGKILL)
     proc.communicate(timeout=60)
     (orphan,) = tmp_path.glob(f"{SPOOL_PREFIX}*")
-    living = tmp_path / f"{SPOOL_PREFIX}{_spool_owner()}-{os.getpid()}-abc"  # this test's process lives
+    living = tmp_path / f"{SPOOL_PREFIX}{owner()}-{os.getpid()}-abc"  # this test's process lives
     elsewhere = tmp_path / f"{SPOOL_PREFIX}otherhost-{proc.pid}-abc"  # another machine's: not ours to judge
     for folder in (living, elsewhere):
         folder.mkdir()

@@ -4,13 +4,9 @@ Exit codes: 0 compliant, 1 violations or failed expectations, 2 unusable input.
 """
 from __future__ import annotations
 
-import os
-import re
 import shutil
 import signal
-import socket
 import sys
-import tempfile
 import time
 from contextlib import contextmanager
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -26,6 +22,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from verifier.commands.report_files import (ReportError, check_folders, check_not_inputs, report_options,
                                              text_console, write_reports)
 from verifier.verify.durations import format_duration, format_seconds, parse_duration_us
+from verifier.verify import spool
 from verifier.verify.events_shown import EVENTS_AT_MOST
 from verifier.verify.result import KEEP_ALL, Keep, ScenarioResult, UnusableInput
 from verifier.bundled import plc_dir as bundled_plc_dir
@@ -319,50 +316,14 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress,
     return results
 
 
-SPOOL_PREFIX = ".uitamr-trace-"
-
-
 def _spool_folder(report_path: str, report: str) -> str:
     """A hidden folder beside the report (the trace, or else the page) for the runs' trace
-    lines (Keep.frames_to_file), named after this host and process; those an earlier
-    command of this host left behind (killed with SIGKILL: no clean-up ran) are removed."""
+    lines (Keep.frames_to_file; verifier.verify.spool)."""
     folder = real_path(report_path).parent
-    _remove_orphaned_spools(folder)
     try:
-        return tempfile.mkdtemp(prefix=f"{SPOOL_PREFIX}{_spool_owner()}-{os.getpid()}-", dir=folder)
+        return spool.make(folder)
     except OSError as exc:
         _unusable(f"cannot write the {report} in {folder}: {exc.strerror or exc}")
-
-
-def _spool_owner() -> str:
-    """This host's name as a spool folder's name may hold it (a shared folder may see the
-    spools of several machines: only this host's processes can be asked whether they live)."""
-    return "".join(ch if ch.isalnum() else "_" for ch in socket.gethostname())[:40] or "host"
-
-
-def _remove_orphaned_spools(folder: Path) -> None:
-    """Remove the spool folders in `folder` of this host's processes that are gone."""
-    mine = re.compile(re.escape(f"{SPOOL_PREFIX}{_spool_owner()}-") + r"(\d+)-")
-    try:
-        names = [entry.name for entry in os.scandir(folder) if entry.is_dir(follow_symlinks=False)]
-    except OSError:
-        return  # the report's own write says what is wrong with the folder
-    for name in names:
-        match = mine.match(name)
-        if match and not _alive(int(match.group(1))):
-            shutil.rmtree(folder / name, ignore_errors=True)
-
-
-def _alive(pid: int) -> bool:
-    if pid == os.getpid():
-        return True
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OverflowError, ValueError):
-        return True  # someone else's process (or a number no process has): leave it
-    return True
 
 
 @contextmanager

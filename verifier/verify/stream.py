@@ -21,6 +21,7 @@ from typing import Any, Sequence, TextIO
 
 from verifier import protocol
 
+from . import spool
 from .evidence import RuleOptions, RunEvidence, Samples, Violation
 from .expectations import Expectation, ExpectationResult, verdict, watch_exchanges
 from .report_trace import spool_lines
@@ -49,7 +50,7 @@ class Stream:
         self.trace_file: str | None = None
         if spool_folder is not None:
             with self._writing():
-                handle, self.trace_file = tempfile.mkstemp(prefix=".uitamr-trace-", suffix=".part", dir=spool_folder)
+                handle, self.trace_file = tempfile.mkstemp(prefix=spool.PREFIX, suffix=".part", dir=spool_folder)
                 self.spool = os.fdopen(handle, "w", encoding="utf-8")
         self.pairing = Pairing(settings, options)
         self.evidence = RunEvidence(settings, (), _OPEN_END_US, [], samples, options)
