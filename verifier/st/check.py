@@ -770,10 +770,12 @@ class Checker:
         sig = library.instruction(name, self.target)
         if sig is not None:
             if self.target not in sig.targets:
-                self.rep.error(c.callee, f"instruction {name} is not available for {_target_name(self.target)}")
+                self.rep.error(c.callee, f"instruction {name} is not available for {_target_name(self.target)}"
+                                         + _other_editor_hint(name, self.target, len(c.args)))
             return self._signature_call(c, sig, statement, "instruction")
         if name in library.INSTRUCTIONS or name == "ADPRW":
-            self.rep.error(c.callee, f"instruction {name} is not available for {_target_name(self.target)}")
+            self.rep.error(c.callee, f"instruction {name} is not available for {_target_name(self.target)}"
+                                     + _other_editor_hint(name, self.target, len(c.args)))
             self._args_only(c)
             return T.ANY
         hint = _in_library(c.name, self.plc_shown)
@@ -909,8 +911,9 @@ class Checker:
                                 f"{sig.name}({', '.join(p.name for p in sig.params)})")
         n, np = len(c.args), len(sig.params)
         if n < np or (n > np and not sig.variadic):
+            hint = _other_editor_hint(sig.name, self.target, n) if kind == "instruction" else ""
             self._signature_error(c, c, f"{sig.name} takes {np}{' or more' if sig.variadic else ''} argument(s) "
-                              f"({', '.join(p.name for p in sig.params)}), {n} given")
+                              f"({', '.join(p.name for p in sig.params)}), {n} given" + hint)
         generic: T.Type | None = None
         first_type: T.Type | None = None
         for i, a in enumerate(c.args):
@@ -1067,6 +1070,31 @@ def _plc_as_given(filenames: list[str]) -> Path | None:
 
 def _target_name(target: str) -> str:
     return {"gxworks2": "GX Works2", "gxworks3": "GX Works3"}.get(target, target)
+
+
+#: the editor a file was written for, and how to check it (README, docs/ci.md)
+_CHECK_FOR = {"gxworks3": ("GX Works3 (FX5U)", "check FX5U sources with --platform fx5u (or --target gxworks3)"),
+              "gxworks2": ("GX Works2 (FX3U/FX3G, Q)", "check FX3 and Q sources with --platform fx3u, fx3g "
+                                                       "or q (or --target gxworks2)")}
+
+
+def _other_editor_hint(name: str, target: str, given: int) -> str:
+    """When instruction `name`, refused or mis-called on `target`, is the other editor's
+    with `given` arguments: a hint that the file was written for that editor (a whole
+    `plc/` folder checked with one target meets both)."""
+    for other, (editor, how) in _CHECK_FOR.items():
+        if other == target:
+            continue
+        sig = library.instruction(name, other)
+        if sig is None or other not in sig.targets:
+            continue
+        n = len(sig.params)
+        if given == n or (sig.variadic and given > n):
+            mine = library.instruction(name, target)
+            if mine is not None and target in mine.targets:
+                return f"; with {given} arguments it is the {editor} {name}: {how}"
+            return f"; {name} is a {editor} instruction: {how}"
+    return ""
 
 
 def _text(e) -> str:
