@@ -440,3 +440,189 @@ def test_the_import_pages_list_what_export_writes_for_the_example(tmp_path, page
     assert result.exit_code == 0, result.output
     written = [line.split("\t")[0] for line in (tmp_path / "IMPORT_ORDER.txt").read_text().splitlines()]
     assert re.findall(r"`(\w+)`", listed) + [example] == written
+
+
+# ---- --platform: what is written, checked against the CPU as `uitamr check --platform` does ----
+
+def export(*args):
+    from verifier.cli import main
+
+    return CliRunner().invoke(main, ["export", *map(str, args)])
+
+
+def checked(platform: str, *paths) -> list[str]:
+    """What `uitamr check --platform` says that export --platform says too: every error and
+    the CPU's warnings (not the check's others, an unused label), as file:line:col lines."""
+    import json
+
+    from verifier.cli import main
+
+    done = CliRunner().invoke(main, ["check", "--platform", platform, "--format", "json", *map(str, paths)])
+    return [f"{d['file']}:{d['line']}:{d['col']}: {d['severity']}: {d['message']}"
+            for d in json.loads(done.stdout)["diagnostics"]
+            if d["severity"] == "error" or d["rule"] == "UITAMR-ST-CPU"]
+
+
+def diagnostic_lines(output: str) -> list[str]:
+    return [line for line in output.splitlines() if re.match(r"\S.*:\d+:\d+: (error|warning): ", line)]
+
+
+def folder(path: Path) -> dict[str, bytes]:
+    return {p.name: p.read_bytes() for p in sorted(path.iterdir())}
+
+
+PORT = """FUNCTION_BLOCK Port
+VAR_OUTPUT
+    o_bBusy : BOOL;
+END_VAR
+o_bBusy := {busy};
+END_FUNCTION_BLOCK
+"""
+
+MAIN = """PROGRAM Main
+VAR
+    fbPort : Port;
+    wCount : INT;
+END_VAR
+fbPort();
+wCount := wCount + 1;
+Y0 := fbPort.o_bBusy;
+END_PROGRAM
+"""
+
+SPARE = """PROGRAM Spare
+VAR
+    bFirst : BOOL;
+END_VAR
+bFirst := {first};
+END_PROGRAM
+"""
+
+
+def _project(tmp_path: Path, busy: str = "M10", first: str = "M11") -> Path:
+    src = tmp_path / "src"
+    src.mkdir(exist_ok=True)
+    (src / "Port.st").write_text(PORT.format(busy=busy), encoding="utf-8")
+    (src / "Main.st").write_text(MAIN, encoding="utf-8")
+    (src / "Spare.st").write_text(SPARE.format(first=first), encoding="utf-8")
+    return src
+
+
+def test_export_refuses_a_device_the_cpu_does_not_have_and_writes_nothing(tmp_path):
+    src = _project(tmp_path, busy="SM8561")  # the FX5U's RS2 send request, written for an FX3U
+    out = tmp_path / "out"
+    done = export("--platform", "fx3u", "--out", out, src)
+    assert done.exit_code == 1, done.output
+    assert done.exception is None or isinstance(done.exception, SystemExit)
+    assert diagnostic_lines(done.stderr) == [
+        f"{src / 'Port.st'}:5:12: error: device SM8561: the fx3u has no SM devices; its special relays are "
+        "M8000..M8511"]
+    assert done.stderr.splitlines()[-1] == "uitamr export: nothing written, 1 error(s)"
+    assert done.stdout == "" and not out.exists()
+    assert checked("fx3u", src) == diagnostic_lines(done.stderr)  # as `uitamr check --platform` says it
+    # an earlier export in --out is left as it was: no partial output
+    (tmp_path / "ok").mkdir()
+    assert export("--target", "gxworks2", "--out", out, _project(tmp_path / "ok")).exit_code == 0
+    before = folder(out)
+    assert export("--platform", "fx3u", "--out", out, src).exit_code == 1
+    assert folder(out) == before
+    # without --platform nothing is asked of the CPU: the export is written as before
+    assert export("--target", "gxworks2", "--out", tmp_path / "plain", src).exit_code == 0
+
+
+@pytest.mark.parametrize("platform, call, message", [
+    ("q", "CRC(TRUE, w[0], 4, x);", "CRC does not exist on the q (it is a fx3/fx5 instruction)"),
+    ("q", "RS2(D200, 8, D220, 8, 1);", "RS2 does not exist on the q (it is a fx3/fx5 instruction)"),
+    ("fx3u", "G_OUTPUT(TRUE, 16#0, w, w, bb);", "G_OUTPUT does not exist on the fx3u (it is a q instruction)"),
+])
+def test_export_refuses_an_instruction_the_cpu_does_not_have(tmp_path, platform, call, message):
+    # RS2 with a Q's C24 in mind (5 arguments): one error, not also the FX's operand errors
+    path = tmp_path / "P.st"
+    path.write_text(f"PROGRAM P\nVAR\n  x : INT; w : ARRAY[0..3] OF WORD; bb : ARRAY[0..1] OF BOOL;\nEND_VAR\n"
+                    f"{call}\nEND_PROGRAM\n", encoding="utf-8")
+    out = tmp_path / "out"
+    done = export("--platform", platform, "--out", out, path)
+    assert done.exit_code == 1, done.output
+    assert diagnostic_lines(done.stderr) == [f"{path}:5:1: error: {message}"]
+    assert checked(platform, path) == diagnostic_lines(done.stderr)
+    assert not out.exists()
+
+
+def test_export_prints_the_cpus_warnings_and_goes_on(tmp_path):
+    # an FX3 habit on a Q: M8002 exists there as an ordinary relay the CPU never sets
+    src = _project(tmp_path, busy="M8002")
+    done = export("--platform", "q", "--out", tmp_path / "q", src)
+    assert done.exit_code == 0, done.output
+    assert diagnostic_lines(done.stderr) == [
+        f"{src / 'Port.st'}:5:12: warning: M8002 is an ordinary internal relay on the q (the CPU never sets it); "
+        "the FX3's special relay M8002 (ON in the first scan) is SM402 on the q"]
+    assert checked("q", src) == diagnostic_lines(done.stderr)
+    assert done.stdout.startswith("3 POU(s) exported for gxworks2 into ")
+    plain = export("--target", "gxworks2", "--out", tmp_path / "plain", src)
+    assert plain.exit_code == 0 and plain.stderr == ""
+    assert folder(tmp_path / "q") == folder(tmp_path / "plain")
+
+
+@pytest.mark.parametrize("platform, target", [("fx3u", "gxworks2"), ("fx3g", "gxworks2"), ("q", "gxworks2"),
+                                              ("fx5u", "gxworks3")])
+def test_a_clean_export_with_platform_is_the_export_without_it(tmp_path, platform, target):
+    """The check adds nothing to what is written; the bundled library of the platform (no
+    SOURCES) is the editor's bundled library without the other CPU families' folders."""
+    family = {"fx3u": "fx3", "fx3g": "fx3", "q": "q", "fx5u": "fx5"}[platform]
+    folders = ["core", family, "examples/common", f"examples/{family}"]
+    with_platform = export("--platform", platform.upper(), "--out", tmp_path / "p")  # any case, as check
+    assert with_platform.exit_code == 0, with_platform.output
+    assert with_platform.stderr == ""
+    without = export("--target", target, "--out", tmp_path / "t", *(ROOT / "plc" / f for f in folders))
+    assert without.exit_code == 0, without.output
+    assert folder(tmp_path / "p") == folder(tmp_path / "t")
+    explicit = export("--platform", platform, "--target", target, "--out", tmp_path / "e", "--program", "Main",
+                      _project(tmp_path))
+    assert explicit.exit_code == 0, explicit.output
+    assert export("--target", target, "--out", tmp_path / "e2", "--program", "Main",
+                  _project(tmp_path)).exit_code == 0
+    assert folder(tmp_path / "e") == folder(tmp_path / "e2")
+
+
+def test_export_with_program_checks_only_the_pous_it_writes(tmp_path):
+    # Spare is not written for --program Main: its FX5U device does not refuse an FX3U export
+    src = _project(tmp_path, first="SM400", busy="M8002")
+    out = tmp_path / "main"
+    done = export("--platform", "fx3u", "--out", out, "--program", "Main", src)
+    assert done.exit_code == 0, done.output
+    assert (out / "IMPORT_ORDER.txt").read_text().split() == ["Port", "FUNCTION_BLOCK", "Main", "PROGRAM"]
+    whole = export("--platform", "fx3u", "--out", tmp_path / "all", src)
+    assert whole.exit_code == 1
+    assert diagnostic_lines(whole.stderr) == [
+        f"{src / 'Spare.st'}:5:11: error: device SM400: the fx3u has no SM devices; its special relays are "
+        "M8000..M8511: use M8000 (always ON)"]
+    spare = export("--platform", "fx3u", "--out", tmp_path / "spare", "--program", "Spare", src)
+    assert spare.exit_code == 1 and diagnostic_lines(spare.stderr) == diagnostic_lines(whole.stderr)
+    assert not (tmp_path / "all").exists() and not (tmp_path / "spare").exists()
+    # the warnings too: M8002 in Port is the Q's concern only when Port is written
+    on_q = export("--platform", "q", "--out", tmp_path / "q", "--program", "Spare", src)
+    assert on_q.exit_code == 0 and on_q.stderr == "", on_q.output
+    assert "M8002" in export("--platform", "q", "--out", tmp_path / "q2", "--program", "Main", src).stderr
+    # every source is still checked by the ST check, as without --platform
+    (src / "Broken.st").write_text("FUNCTION_BLOCK Broken\nVAR\n    x : INT;\nEND_VAR\nx := TRUE;\n"
+                                   "END_FUNCTION_BLOCK\n", encoding="utf-8")
+    broken = export("--platform", "fx3u", "--out", tmp_path / "b", "--program", "Main", src)
+    assert broken.exit_code == 1 and "Broken.st:5:6: error" in broken.stderr
+
+
+@pytest.mark.parametrize("platform, target", [("fx3u", "gxworks3"), ("q", "gxworks3"), ("fx5u", "gxworks2")])
+def test_export_refuses_a_platform_its_target_does_not_program(tmp_path, platform, target):
+    done = export("--platform", platform, "--target", target, "--out", tmp_path / "out", _project(tmp_path))
+    assert done.exit_code == 2
+    assert "Traceback" not in done.output
+    (line,) = done.output.splitlines()
+    assert line.startswith(f"uitamr export: --platform {platform} and --target {target} disagree: ")
+    assert "drop --target" in line
+    assert not (tmp_path / "out").exists()
+
+
+def test_export_needs_a_target_or_a_platform(tmp_path):
+    done = export("--out", tmp_path / "out")
+    assert done.exit_code == 2
+    assert "Missing option '--target'" in done.output
+    assert not (tmp_path / "out").exists()

@@ -508,3 +508,62 @@ def test_a_channel_without_a_platform_picks_the_cpu_it_belongs_to(tmp_path):
     assert (scenario["platform"], scenario["channel"]) == ("q", "q:1")
     refused = invoke(source, "--channel", "q:1", "--platform", "fx3u", "--duration", "2s")
     assert refused.exit_code == 2 and "channel q:1 does not exist on the fx3u CPU" in refused.output
+
+
+def _vendored_project(tmp_path: Path) -> Path:
+    """An integrator's project with the toolkit as vendor/uitamr, a symlink out of it (as
+    a submodule checked out elsewhere), and a scenario whose sources go through it; the
+    pacing rule tightened so that the run has violations with their origins."""
+    project = tmp_path / "project"
+    (project / "vendor").mkdir(parents=True)
+    (project / "vendor" / "uitamr").symlink_to(REPO, target_is_directory=True)
+    (project / "ci").mkdir()
+    (project / "ci" / "healthy.toml").write_text(
+        'name = "vendored"\n'
+        'sources = ["../vendor/uitamr/plc/core/*.st", "../vendor/uitamr/plc/fx3/*.st", '
+        '"../vendor/uitamr/plc/examples/common", "../vendor/uitamr/plc/examples/fx3/UITAMR_ExampleFx3.st"]\n'
+        'program = "UITAMR_ExampleFx3"\nduration = "2s"\n\n[rules]\nmin_period = "400ms"\n', encoding="utf-8")
+    return project
+
+
+@pytest.mark.parametrize("how", [[], ["--every-scan"], ["--jobs", "2", "--scenario", "ci/healthy.toml"]])
+def test_origins_name_the_toolkit_by_the_path_the_sources_reach_it(tmp_path, monkeypatch, how):
+    """The ST location that sent a frame was shown where the symlink leads (/.../plc/fx3/...),
+    a path outside the project, beside the scenario file shown relative to it. It is shown
+    as the sources reach it, relative to the working folder: vendor/uitamr/plc/fx3/..."""
+    monkeypatch.chdir(_vendored_project(tmp_path))
+    result = invoke("--scenario", "ci/healthy.toml", "--json", "r.json", "--trace", "t.jsonl", "--html", "r.html",
+                    *how)
+    assert result.exit_code == 1, result.output
+    origin = re.compile(r"vendor/uitamr/plc/fx3/UITAMR_PortFx3\.st:\d+:\d+")
+    assert re.search(rf"UITAMR-PACING .* sent by {origin.pattern}\n", result.output), result.output
+    for scenario in json.loads(Path("r.json").read_text())["scenarios"]:
+        assert scenario["file"] == "ci/healthy.toml"
+        assert scenario["violations"] and all(origin.fullmatch(v["origin"]) for v in scenario["violations"])
+    sent = [json.loads(line) for line in Path("t.jsonl").read_text().splitlines()]
+    assert sent and all(origin.fullmatch(f["origin"]) for f in sent if f["dir"] == "tx")
+    page = Path("r.html").read_text(encoding="utf-8")
+    assert origin.search(page) and str(REPO / "plc") not in page
+
+
+def test_sources_given_through_a_symlink_are_shown_as_given(tmp_path, monkeypatch):
+    # SOURCES on the command line, a folder of them and a file, absolute and relative
+    project = _vendored_project(tmp_path)
+    monkeypatch.chdir(project)
+    plc = "vendor/uitamr/plc"
+    result = invoke(project / plc / "core", f"{plc}/fx3/", f"{plc}/examples/common",
+                    f"{plc}/examples/fx3/UITAMR_ExampleFx3.st", "--duration", "1s", "--trace", "t.jsonl")
+    assert result.exit_code == 0, result.output
+    first = json.loads(Path("t.jsonl").read_text().splitlines()[0])
+    assert re.fullmatch(r"vendor/uitamr/plc/fx3/UITAMR_PortFx3\.st:\d+:\d+", first["origin"]), first
+    # from the folder above, the same files are that folder's project/vendor/...
+    monkeypatch.chdir(tmp_path)
+    assert invoke("--scenario", "project/ci/healthy.toml", "--trace", "t.jsonl").exit_code == 1
+    first = json.loads(Path("t.jsonl").read_text().splitlines()[0])
+    assert first["origin"].startswith("project/vendor/uitamr/plc/fx3/UITAMR_PortFx3.st:"), first
+    # and the bundled scenarios, run from the toolkit itself, as before
+    monkeypatch.chdir(REPO)
+    assert invoke("--scenario", "plc/scenarios/fx3u-healthy.toml", "--duration", "1s", "--trace",
+                  tmp_path / "b.jsonl").exit_code in (0, 1)
+    first = json.loads((tmp_path / "b.jsonl").read_text().splitlines()[0])
+    assert first["origin"].startswith("plc/fx3/UITAMR_PortFx3.st:"), first

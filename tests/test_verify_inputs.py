@@ -52,6 +52,54 @@ def test_sources_take_absolute_globs_and_folders(tmp_path, program):
     assert load_scenario(scenario).sources == (program.resolve(),)
 
 
+def test_sources_keep_the_path_they_were_reached_by(tmp_path, monkeypatch):
+    """A source reached through a symlinked folder keeps that path (what reports show, as
+    the user wrote it), made absolute; named twice, through the link and directly, it is
+    one source. `..` is folded away only where it names the same file."""
+    from verifier.verify.sources import unique
+
+    outside = tmp_path / "outside"
+    (outside / "deep" / "folder").mkdir(parents=True)
+    (outside / "deep" / "A.st").write_text("FUNCTION A : INT\nA := 1;\nEND_FUNCTION\n", encoding="utf-8")
+    project = tmp_path / "project"
+    (project / "ci").mkdir(parents=True)
+    (project / "lib").symlink_to(outside / "deep", target_is_directory=True)
+    (project / "up").symlink_to(outside / "deep" / "folder", target_is_directory=True)
+    monkeypatch.chdir(project)
+    assert unique([Path("ci/../lib/A.st"), outside / "deep" / "A.st", project / "lib" / "A.st"]) == \
+        (project / "lib" / "A.st",)
+    # up/.. is outside/deep, where A.st is; folded, project/A.st would be no file at all
+    assert unique([Path("up/../A.st")]) == (project / "up" / ".." / "A.st",)
+    scenario = project / "ci" / "s.toml"
+    scenario.write_text('sources = ["../lib/*.st"]\n', encoding="utf-8")
+    assert load_scenario(scenario).sources == (project / "lib" / "A.st",)
+
+
+@pytest.mark.parametrize("given, shown", [
+    ("lib/A.st", "lib/A.st"),                  # through the symlink: as given, not where it leads
+    ("{project}/lib/A.st", "lib/A.st"),        # absolute, inside the working folder
+    ("ci/../lib/A.st", "lib/A.st"),            # `..` folded: the same file
+    ("up/../A.st", "up/../A.st"),              # not folded: after a symlinked folder `..` leads elsewhere
+    ("{outside}/deep/A.st", "{outside}/deep/A.st"),  # outside the working folder: as given
+    ("../outside/deep/A.st", "../outside/deep/A.st"),
+    ("{tmp}/back/project/ci/s.toml", "ci/s.toml"),   # from outside through a link back in: where it is
+])
+def test_report_paths_are_relative_to_the_working_folder_as_the_user_reached_them(tmp_path, given, shown):
+    from verifier.textfile import shown_path
+
+    outside = tmp_path / "outside"
+    (outside / "deep" / "folder").mkdir(parents=True)
+    (outside / "deep" / "A.st").write_text("", encoding="utf-8")
+    project = tmp_path / "project"
+    (project / "ci").mkdir(parents=True)
+    (project / "ci" / "s.toml").write_text("", encoding="utf-8")
+    (project / "lib").symlink_to(outside / "deep", target_is_directory=True)
+    (project / "up").symlink_to(outside / "deep" / "folder", target_is_directory=True)
+    (tmp_path / "back").symlink_to(tmp_path, target_is_directory=True)
+    names = {"project": project, "outside": outside, "tmp": tmp_path}
+    assert shown_path(given.format(**names), project) == shown.format(**names)
+
+
 @pytest.mark.parametrize("entry, words", [
     ("/nowhere/at/all/*.st", "'/nowhere/at/all/*.st' matches no file"),
     ("empty", "holds no .st file"),

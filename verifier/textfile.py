@@ -51,6 +51,28 @@ def real_path(path: Path | str) -> Path:
     return Path(os.path.realpath(path))
 
 
+def reached_path(path: Path | str, cwd: Path | str) -> Path:
+    """`path` against the folder `cwd`, absolute but not resolved: the path the user reached
+    the file by (through a symlinked `vendor/uitamr`, say), where `real_path` says where it
+    really is. A `..` step is folded away (`ci/../vendor` is `vendor`) only where that
+    names the same file: after a symlinked folder, `..` leads elsewhere."""
+    given = Path(cwd) / path
+    folded = Path(os.path.normpath(given))
+    return folded if folded == given or real_path(folded) == real_path(given) else given
+
+
+def shown_path(path: Path | str, cwd: Path | str) -> str:
+    """A path a user gave (or one reached through it, like a scenario's sources) as reports
+    show it: relative to the working folder `cwd` when it lies inside it as reached
+    (`reached_path`: `vendor/uitamr/plc/core/UITAMR_Engine.st`, not where the symlink
+    leads) or else where it really is (`real_path`); otherwise as given."""
+    reached = reached_path(path, cwd)
+    for candidate in (reached, real_path(reached)):
+        if candidate.is_relative_to(cwd):
+            return str(candidate.relative_to(cwd))
+    return str(path)
+
+
 def place_of_byte(data: bytes, offset: int) -> tuple[int, int]:
     """The line and column (1-based) at which byte `offset` of a file's `data` stands, the
     text before it read as UTF-8 (a leading byte order mark is not a column)."""

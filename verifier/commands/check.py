@@ -82,24 +82,23 @@ def check_findings(paths: list[Path], target: str,
     findings += [Finding(d, "UITAMR-ST-CHECK" if d.is_error else "UITAMR-ST-WARNING")
                  for d in check(files, target)]
     if platform is not None:
-        from verifier.sim.cpucheck import cpu_diagnostics
+        from verifier.sim.cpucheck import on_cpu
 
-        superseded: list = []  # the operand errors of instructions this CPU does not have
-        cpu_findings = [Finding(d, "UITAMR-ST-CPU") for d in cpu_diagnostics(files, PROFILES[platform], superseded)]
-        gone = {id(d) for d in superseded}
-        findings = [f for f in findings if id(f.diagnostic) not in gone] + cpu_findings
+        standing, found = on_cpu(files, PROFILES[platform], [f.diagnostic for f in findings])
+        kept = {id(d) for d in standing}
+        findings = [f for f in findings if id(f.diagnostic) in kept] + [Finding(d, "UITAMR-ST-CPU") for d in found]
     order = {str(p): i for i, p in enumerate(paths)}
     findings.sort(key=lambda f: (order.get(f.diagnostic.file, len(order)), f.diagnostic.line, f.diagnostic.col))
     return files, findings
 
 
-def platform_target(platform: str, target: str | None) -> str:
+def platform_target(platform: str, target: str | None, command: str = "check") -> str:
     """The dialect to check `platform`'s sources in: `target` when given and its editor
     programs that CPU, else the editor that does (TARGET_CPUS, as `verifier.load` reads
-    it). A contradictory pair is a usage error (SystemExit 2)."""
+    it). A contradictory pair is a usage error of `uitamr <command>` (SystemExit 2)."""
     editor = next(t for t, cpus in TARGET_CPUS.items() if platform in cpus)
     if target is not None and target != editor:
-        click.echo(f"uitamr check: --platform {platform} and --target {target} disagree: the {platform.upper()} "
+        click.echo(f"uitamr {command}: --platform {platform} and --target {target} disagree: the {platform.upper()} "
                    f"is programmed in {EDITOR_NAMES[editor]} (--target {editor}), not {EDITOR_NAMES[target]}; "
                    f"drop --target (--platform {platform} implies {editor}) or name a CPU {EDITOR_NAMES[target]} "
                    f"programs: --platform {'|'.join(TARGET_CPUS[target])}", err=True)

@@ -8,6 +8,14 @@ An initial value the target's label table cannot carry is never dropped silently
 note line per value (file:line:col) and DROPPED_INITIAL_VALUES.txt in the output folder.
 An --out folder inside a source folder is left out of the sources (an earlier export there
 is bodies without declarations), with a note.
+
+`--platform fx3u|fx3g|fx5u|q` also checks what is written (with --program, the POUs
+written) against that CPU, with `uitamr check --platform`'s own rules
+(verifier.sim.cpucheck): a device or instruction the CPU does not have is an error at its
+file:line:col, as the check prints it, and nothing is written (exit 1); a warning (an FX3
+special relay number on a Q) is printed and the export goes on. The platform implies the
+target (its CPU's editor); a --target whose editor does not program it is refused (exit 2).
+With no SOURCES, the bundled library of that platform is exported.
 """
 from __future__ import annotations
 
@@ -17,7 +25,8 @@ from pathlib import Path
 import click
 
 from verifier.bundled import PLC_DIR
-from verifier.commands.check import expand_sources
+from verifier.commands.check import expand_sources, platform_target
+from verifier.sim.cpu import PROFILES
 from verifier.textfile import real_path
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
@@ -28,29 +37,47 @@ BUNDLED = {
 }
 
 
-def bundled_sources(target: str) -> list[Path]:
-    return [p for folder in BUNDLED[target] for p in sorted((PLC_DIR / folder).glob("*.st"))]
+def bundled_sources(target: str, platform: str | None = None) -> list[Path]:
+    """The bundled files `target` gets; for `platform`, only the folders of its CPU family
+    (the core, the common example, its port and examples, not another family's)."""
+    folders = BUNDLED[target]
+    if platform is not None:
+        family, families = PROFILES[platform].family, {cpu.family for cpu in PROFILES.values()}
+        folders = [f for f in folders if f.rpartition("/")[2] not in families - {family}]
+    return [p for folder in folders for p in sorted((PLC_DIR / folder).glob("*.st"))]
 
 
 @click.command(name="export")
 @click.argument("sources", nargs=-1, type=click.Path())
-@click.option("--target", type=click.Choice(["gxworks2", "gxworks3"]), required=True,
-              help="The engineering tool that will import the files.")
+@click.option("--target", type=click.Choice(["gxworks2", "gxworks3"]), default=None,
+              help="The engineering tool that will import the files. Required, unless --platform "
+                   "names the CPU (its editor: gxworks3 for fx5u, gxworks2 for the others).")
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), required=True,
               help="Folder for <POU>.st, <POU>.labels.tsv, GlobalLabels.labels.tsv, <Type>.struct.tsv and IMPORT_ORDER.txt.")
 @click.option("--program", "programs", multiple=True, metavar="NAME",
               help="Write only this POU (usually your PROGRAM) and every function block, function and "
                    "structure it needs, with the global labels; repeat for more. Every source is still "
                    "checked. Default: every POU of the sources.")
-def command(sources: tuple[str, ...], target: str, out_dir: str, programs: tuple[str, ...]) -> None:
+@click.option("--platform", type=click.Choice(sorted(PROFILES), case_sensitive=False), default=None,
+              help="Also check what is written against this CPU, as `uitamr check --platform` does "
+                   "(devices, index registers, instructions): on an error nothing is written. Implies "
+                   "--target; a --target whose editor does not program the CPU is refused. With no "
+                   "SOURCES: the bundled library of this platform. Default: no CPU check.")
+def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs: tuple[str, ...],
+            platform: str | None) -> None:
     """Write, per POU, the ST body and a tab-separated label table for GX Works.
 
     With no SOURCES: the bundled library (plc/core, the ports and the examples of the
-    target editor's platforms)."""
+    target editor's platforms, or of --platform's)."""
     from verifier.export import ExportError, NothingToExport, export_sources
     from verifier.export.needed import UnknownProgram
     from verifier.export.writer import DROPPED_TABLE, IMPORT_ORDER
 
+    if platform is not None:
+        target = platform_target(platform, target, "export")
+    elif target is None:
+        ctx = click.get_current_context()
+        raise click.MissingParameter(ctx=ctx, param=next(p for p in ctx.command.params if p.name == "target"))
     if sources:
         missing = [s for s in sources if not Path(s).exists()]
         if missing:
@@ -68,7 +95,7 @@ def command(sources: tuple[str, ...], target: str, out_dir: str, programs: tuple
                        "sources (an earlier export)", err=True)
             paths = [p for p in paths if p not in earlier]
     else:
-        paths = bundled_sources(target)
+        paths = bundled_sources(target, platform)
     if not paths:
         click.echo("uitamr export: no .st files to export", err=True)
         sys.exit(EXIT_USAGE)
@@ -84,17 +111,19 @@ def command(sources: tuple[str, ...], target: str, out_dir: str, programs: tuple
         click.echo(f"uitamr export: nothing written, {len(unreadable)} unreadable file(s)", err=True)
         sys.exit(EXIT_ERRORS)
     notes: list = []
+    warnings: list = []  # the CPU's (--platform), printed before whatever follows
     try:
-        written = export_sources(paths, target, Path(out_dir), texts, notes=notes, programs=list(programs))
+        written = export_sources(paths, target, Path(out_dir), texts, notes=notes, programs=list(programs),
+                                 cpu=PROFILES[platform] if platform else None, warnings=warnings)
     except NothingToExport as e:
         for d in e.diagnostics:
             click.echo(str(d), err=True)
         click.echo(f"uitamr export: nothing written, {len(e.diagnostics)} file(s) without a POU", err=True)
         sys.exit(EXIT_USAGE)
     except ExportError as e:
-        for d in e.diagnostics:
+        for d in warnings + e.diagnostics:  # with --platform, the CPU's warnings among the errors
             click.echo(str(d), err=True)
-        click.echo(f"uitamr export: nothing written, {len(e.diagnostics)} error(s)", err=True)
+        click.echo(f"uitamr export: nothing written, {sum(d.is_error for d in e.diagnostics)} error(s)", err=True)
         sys.exit(EXIT_ERRORS)
     except UnknownProgram as e:
         click.echo(f"uitamr export: nothing written: --program: {e}", err=True)
@@ -102,7 +131,7 @@ def command(sources: tuple[str, ...], target: str, out_dir: str, programs: tuple
     except OSError as e:
         click.echo(f"uitamr export: cannot write {out_dir}: {e.strerror or e}", err=True)
         sys.exit(EXIT_USAGE)
-    for note in notes:
+    for note in warnings + notes:
         click.echo(str(note), err=True)
     pous = sum(1 for p in written if p.suffix == ".st")
     click.echo(f"{pous} POU(s) exported for {target} into {out_dir} (import order: "

@@ -19,6 +19,8 @@ from verifier import st
 from verifier.st import ast
 from verifier.export.body import body_text
 from verifier.export.needed import needed, only
+from verifier.sim import reach
+from verifier.sim.cpu import CpuProfile
 from verifier.sim.reach import type_names
 from verifier.export.labels import LabelRow, initial_text, label_class, label_rows, rows_of
 from verifier.export.types import type_name
@@ -227,21 +229,48 @@ def _pous_named_like_the_export_files(files: list[ast.SourceFile], out: Path) ->
             if table.name.lower() == GLOBAL_TABLE.lower()]
 
 
+def _on_cpu(files: list[ast.SourceFile], cpu: CpuProfile, problems: list[ast.Diagnostic],
+            programs: list[str] | None, warnings: list[ast.Diagnostic] | None) -> list[ast.Diagnostic]:
+    """`problems` (the check's errors) as `uitamr check --platform` reports them on `cpu`,
+    with the CPU's findings about the POUs to be written (`programs` and what they need,
+    else all) in file, line and column order as the check lists them; the CPU's warnings
+    go there too when anything refuses the export, else to `warnings`."""
+    from verifier.sim.cpucheck import on_cpu  # the instruction tables: only with --platform
+
+    if programs:  # a name no POU has is left out here, and refused below (UnknownProgram)
+        keys = reach.needed(files, programs)
+        files = [only(f, keys) for f in files]
+    standing, found = on_cpu(files, cpu, problems)
+    errors = standing + [d for d in found if d.is_error]
+    cautions = [d for d in found if not d.is_error]
+    if not errors:
+        if warnings is not None:
+            warnings.extend(cautions)
+        return []
+    order = {f.filename: i for i, f in enumerate(files)}
+    return sorted(errors + cautions, key=lambda d: (order.get(d.file, len(order)), d.line, d.col))
+
+
 def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, str] | None = None,
-                   notes: list[DroppedValue] | None = None, programs: list[str] | None = None) -> list[Path]:
+                   notes: list[DroppedValue] | None = None, programs: list[str] | None = None,
+                   cpu: CpuProfile | None = None, warnings: list[ast.Diagnostic] | None = None) -> list[Path]:
     """Parse and check `paths`, write the export into `out`; returns the files written.
     Raises ExportError (with file:line:col diagnostics) when a source has errors, and
     NothingToExport when a file has nothing in it to export. Initial values the target
     cannot carry are appended to `notes` (and written to DROPPED_INITIAL_VALUES.txt).
     With `programs` (POU names), only those POUs and what they need are written
     (`needed.needed`; UnknownProgram for a name the sources do not define); every file
-    is still checked."""
+    is still checked. With `cpu` (a CPU profile), what is written is also checked against
+    that CPU as `uitamr check --platform` checks it (`_on_cpu`): its errors refuse the
+    export like the check's, its warnings are appended to `warnings`."""
     if target not in COLUMNS:
         raise ValueError(f"unknown target {target!r}; expected gxworks2 or gxworks3")
     texts = texts or {}
     files = [st.parse(texts.get(p) or p.read_text(encoding="utf-8-sig"), str(p), target) for p in paths]
     problems = [d for f in files for d in f.diagnostics if d.is_error]
     problems += [d for d in st.check(files, target) if d.is_error]
+    if cpu is not None:
+        problems = _on_cpu(files, cpu, problems, programs, warnings)
     if problems:
         raise ExportError(problems)
     empty = _empty_files(files)

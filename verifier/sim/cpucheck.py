@@ -49,5 +49,17 @@ def cpu_diagnostics(files: list[ast.SourceFile], cpu: CpuProfile, superseded: li
     return found
 
 
+def on_cpu(files: list[ast.SourceFile], cpu: CpuProfile, diagnostics: list[ast.Diagnostic]
+           ) -> tuple[list[ast.Diagnostic], list[ast.Diagnostic]]:
+    """What `uitamr check --platform` reports about `files` on `cpu`: the check's
+    `diagnostics` that still stand there (not the argument and operand errors of an
+    instruction `cpu` lacks: the fix is another instruction), and `cpu_diagnostics`'
+    findings. `uitamr export --platform` asks the same, of the POUs it writes."""
+    superseded: list[ast.Diagnostic] = []
+    found = cpu_diagnostics(files, cpu, superseded)
+    gone = {id(d) for d in superseded}
+    return [d for d in diagnostics if id(d) not in gone], found
+
+
 def _at(span: ast.Span, message: str, severity: str = "error") -> ast.Diagnostic:
     return ast.Diagnostic(span.file, span.line, span.col, severity, message, span.end_line, span.end_col)

@@ -19,6 +19,7 @@ from verifier.amr.robot import Robot
 from verifier.link import Line
 from verifier.link.converter import Converter
 from verifier.sim.values import read_together
+from verifier.textfile import shown_path
 
 from .events_shown import thin_line_events
 from .evidence import RunEvidence, Samples
@@ -212,24 +213,24 @@ def _where(scenario: Scenario) -> str:
 
 
 def _display_path(path: Path | None) -> str | None:
-    """A path as people want to read it: relative to the working folder when inside it."""
+    """A path as people want to read it: relative to the working folder when inside it, as
+    the user reached it (textfile.shown_path)."""
     if path is None:
         return None
-    try:
-        return str(Path(path).resolve().relative_to(Path.cwd()))
-    except ValueError:
-        return str(path)
+    return shown_path(path, os.getcwd())
 
 
 @lru_cache(maxsize=1024)
 def _relative(origin: str | None, cwd: str) -> str | None:
     """An ST location "file:line:col" with the file relative to the working folder `cwd`
-    when inside it. Worked out once per location: every frame of a long run names the ST
-    line that sent it, and the frames then share one string."""
+    when inside it, by the path the sources reached it (a toolkit vendored by a symlink
+    shows as vendor/uitamr/plc/..., not where the link leads; textfile.shown_path).
+    Worked out once per location: every frame of a long run names the ST line that sent
+    it, and the frames then share one string."""
     if not origin:
         return origin
     file, _, rest = origin.partition(":")
-    return f"{_display_path(Path(file))}:{rest}"
+    return f"{shown_path(file, cwd)}:{rest}"
 
 
 def _trace_records(frames: list, end_us: int) -> list[TraceRecord]:

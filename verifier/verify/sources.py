@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import glob
+import os
 from functools import lru_cache
 from pathlib import Path
 
-from verifier.textfile import file_kind, real_path
+from verifier.textfile import file_kind, reached_path, real_path
 
 GLOB_CHARACTERS = "*?["
 
@@ -58,8 +59,23 @@ def st_files_in(path: Path) -> list[Path]:
 
 
 def unique(paths: list[Path]) -> tuple[Path, ...]:
-    """Resolved, each once, in first-seen order."""
-    return tuple(dict.fromkeys(_resolved(p) for p in paths))
+    """Each file once (named twice, through a folder, a symlink or `..`, it is one: the same
+    real path), in first-seen order, by the path it was first named by, made absolute but
+    not resolved: an ST file's path is where its diagnostics and the frames it sends say
+    they come from, and reports show it as the user reached it (a toolkit vendored by a
+    symlink as vendor/uitamr/plc/..., textfile.shown_path), not where the link leads."""
+    first: dict[Path, Path] = {}
+    cwd = os.getcwd()
+    for p in paths:
+        reached = _reached(p, cwd)
+        first.setdefault(_resolved(reached), reached)
+    return tuple(first.values())
+
+
+@lru_cache(maxsize=4096)
+def _reached(path: Path, cwd: str) -> Path:
+    """`textfile.reached_path`, remembered as `_resolved` is."""
+    return reached_path(path, cwd)
 
 
 @lru_cache(maxsize=4096)
