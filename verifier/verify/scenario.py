@@ -16,6 +16,7 @@ from verifier import protocol
 from verifier.amr.config import RobotConfig
 from verifier.amr.faults import Fault, check_fault_addresses
 from verifier.amr.schema import ConfigError
+from verifier.digits import digit_problem
 from verifier.textfile import UnreadableText, read_utf8, text_lines
 from verifier.tomlpos import Place, decode_error_position, place_of_key, shown
 
@@ -58,13 +59,13 @@ CONVERTER_KEYS = ("ip", "port", "delay", "connect", "packing", "refuse_until", "
 TCP_PLATFORMS = ("fx5u", "q")
 TCP_CHANNEL = "tcp"
 #: Buffer memory of an intelligent module, as GX Works writes it: U0\G164, U3E\G10.
-BUFFER_MEMORY = re.compile(r"^U([0-9A-F]{1,3})\\G(\d+)$", re.IGNORECASE)
+BUFFER_MEMORY = re.compile(r"^U([0-9A-F]{1,3})\\G([0-9]+)$", re.IGNORECASE)
 #: Buffer-memory words the simulator models per module (0..5FFFH). ASSUMPTION: enough for
 #: the QJ71C24N areas and the QJ71E71 status words (5000H, 5005H) the library uses.
 BUFFER_WORDS = 0x6000
 #: Device names (X0, M8000, D100, SM400, ...) address the device memory, not labels.
-DEVICE_NAME = re.compile(r"^(?:(?:X|Y|B|W|SB|SW)[0-9A-F]+|(?:M|L|F|S|T|C|D|R|ZR|SM|SD)\d+)$", re.IGNORECASE)
-_LABEL_PATH = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\[\d+\])*(\.[A-Za-z_][A-Za-z0-9_]*(\[\d+\])*)*$")
+DEVICE_NAME = re.compile(r"^(?:(?:X|Y|B|W|SB|SW)[0-9A-F]+|(?:M|L|F|S|T|C|D|R|ZR|SM|SD)[0-9]+)$", re.IGNORECASE)
+_LABEL_PATH = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\[[0-9]+\])*(\.[A-Za-z_][A-Za-z0-9_]*(\[[0-9]+\])*)*$")
 
 Value = bool | int | float
 
@@ -331,6 +332,8 @@ class _Reader:
 
     def label(self, value: Any, key: str) -> str:
         text = self.string(value, key)
+        if problem := digit_problem(text):  # wBuf[٢]
+            raise self.fail(key, f"{text!r}: {problem}")
         if not _LABEL_PATH.match(text):
             raise self.fail(key, f"{text!r} is not a label path (e.g. o_bOK, fbRobot.o_uState, wBuf[2])")
         return text
@@ -468,6 +471,8 @@ class _Reader:
         result = []
         for name, item in table.items():
             key = f"initial.{name}"
+            if problem := digit_problem(name):  # 'U0\G１６４'
+                raise self.fail(key, problem, at_name=True)
             match = BUFFER_MEMORY.match(name)
             if match and int(match.group(2)) >= BUFFER_WORDS:
                 raise self.fail(key, f"buffer memory ends at G{BUFFER_WORDS - 1} in the simulator")
