@@ -102,7 +102,7 @@ def test_a_capture_time_with_another_script_s_digits_is_an_error_at_its_column(l
     ('[[expect]]\nthat = "wBuf[' + ARABIC_FIVE + '] = 1"\n', "expect[0].that", (2, 14), ARABIC_FIVE),
     ('[[expect]]\nsent = "run-point ' + ARABIC_FIVE + '"\n', "expect[0].sent", (2, 8), ARABIC_FIVE),
     ('watch = ["wBuf[' + FULL_TWO + ']"]\n', "watch[0]", (1, 10), FULL_TWO),
-    ('[[inputs]]\nat = "1s"\nset = { "wBuf[' + FULL_TWO + ']" = 1 }\n', "inputs[0].set", (3, 7), FULL_TWO),
+    ('[[inputs]]\nat = "1s"\nset = { "wBuf[' + FULL_TWO + ']" = 1 }\n', "inputs[0].set", (3, 9), FULL_TWO),
     # buffer memory G１６４ was taken for G164
     ("[initial]\n'U0\\G１６４' = 5\n", "initial.U0\\G１６４", (2, 1), "１"),
     ('[robot]\npoint_durations_s = { "' + ARABIC_FIVE + '" = 2.0 }\n', "robot.point_durations_s." + ARABIC_FIVE,
