@@ -267,7 +267,7 @@ def test_check_refuses_the_scenario_devices_verify_refuses_for_its_platform(tmp_
     assert errors(done.output) == [
         f"{scenario}:5:9: error: initial.SM400: device SM400: the fx3u has no SM devices; its special relays "
         "are M8000..M8511: use M8000 (always ON)",
-        f"{scenario}:9:7: error: inputs[0].set: device D9000 does not exist on the fx3u: D runs D0..D8511"]
+        f"{scenario}:9:9: error: inputs[0].set: device D9000 does not exist on the fx3u: D runs D0..D8511"]
     assert run(write(tmp_path, 'platform = "q"\n\n[initial]\nSM400 = true\nD9000 = 1\n', "q.toml")).exit_code == 0
 
 

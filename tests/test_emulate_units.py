@@ -110,6 +110,9 @@ def test_fault_file_with_robot_table(tmp_path):
     ('[[faults]]\nkind = "no_reply"\non_request = 1\n\n[[faults]]\nkind = "x"\nat_s = 1\n',
      ":6:8: faults[1].kind: unknown fault 'x'"),
     ("# bench\n[robot]\nturnaround_ms = 8\npacing = 'sometimes'\n", ":4:10: robot.pacing: unknown pacing policy"),
+    # a key of a sub-table: its own line, not the first line (was :1:1)
+    ("[robot]\nturnaround_ms = 8\n[robot.point_durations_s]\n3 = 2.0\n4 = 'x'\n",
+     ":5:5: robot.point_durations_s.4: expected a number"),
     ("[[faults]]\nkind = 'late_reply'\non_request = 2\n\n[[faults]]\nkind = 'late_reply'\n"
      "on_request = 3\ndelay_ms = 5\n", ":1:1: faults[0].delay_ms: missing"),
     ("[[faults]]\nkind = 'no_reply'\non_request = 1\n[[faults]\n", ":4:9: not valid TOML: "),

@@ -28,7 +28,7 @@ from monitor_helpers import (BAD_MASTER_FINDINGS, SETTINGS, WAIT_S, Master, bad_
 from verifier import protocol
 from verifier.commands.frame import mbpoll_command
 from verifier.monitor.capture import CaptureError, Chunk, format_plain, parse_plain, read_capture
-from verifier.monitor.framer import Framer, LineTiming
+from verifier.monitor.framer import MAX_FRAME, Framer, LineTiming
 from verifier.monitor.session import CaptureInfo, MonitorSession
 from verifier.verify.runner import run_scenario
 from verifier.verify.scenario import load_scenario
@@ -140,6 +140,82 @@ def test_any_byte_stream_gives_frames_and_findings_never_a_crash(pieces, toleran
         assert before.t_end_us <= after.t_start_us or before.t_end_us <= after.t_end_us
     session.check()
     session.result()
+
+
+# --------------------------------------------------------------------- a capture on one long line
+class _CountsShifts:
+    """A list or bytearray that counts the items a deletion at its front moves down: what
+    dropping the bytes of cut frames costs."""
+
+    shifted = 0
+
+    def __delitem__(self, index):
+        if isinstance(index, slice) and not index.start and index.stop:
+            self.shifted += max(len(self) - index.stop, 0)
+        super().__delitem__(index)
+
+
+class _ShiftCountingList(_CountsShifts, list):
+    pass
+
+
+class _ShiftCountingBytes(_CountsShifts, bytearray):
+    pass
+
+
+def _shifted_cutting_one_chunk(pairs: int) -> int:
+    """Items moved while a framer cuts `pairs` exchanges (request and reply) that came in
+    one chunk, as a capture written on one line gives them; its frames are checked too."""
+    reply = bytes.fromhex("01 01 03 00 00 00 3C 4E")
+    framer = Framer(LineTiming(tolerance_us=20_000))
+    framer._buffer, framer._arrivals = _ShiftCountingBytes(), _ShiftCountingList()
+    frames = framer.feed(Chunk(10_000_000, (READ + reply) * pairs)) + framer.flush()
+    assert [f.data for f in frames] == [READ, reply] * pairs
+    assert all(before.t_end_us <= after.t_start_us for before, after in zip(frames, frames[1:]))
+    return framer._buffer.shifted + framer._arrivals.shifted
+
+
+def test_frames_cut_from_one_long_chunk_cost_in_proportion_to_its_length():
+    """A capture of hours on one line is one chunk of megabytes. Each frame cut from it
+    dropped its bytes from the front of the buffer, moving all the bytes after it: 8 times
+    the bytes cost 64 times the moves (a 6 MB line replayed in ~40 s, a 0.5 MB one in 2 s).
+    Counted, not timed: the moves grow no faster than the chunk."""
+    one, eight = _shifted_cutting_one_chunk(1_000), _shifted_cutting_one_chunk(8_000)
+    assert eight <= 8 * one + MAX_FRAME, (one, eight)
+
+
+def test_a_capture_on_one_line_has_the_findings_of_the_same_bytes_over_many_lines(tmp_path):
+    """The same bytes, once as one line and once a frame a line timed as the one line's
+    bytes arrive: the same frames, the same findings, word for word."""
+    trace = run_scenario(load_scenario(ROOT / "plc" / "scenarios" / "fx3u-late-reply.toml")).trace
+    frames = [f.data for f in sorted(trace, key=lambda f: f.t_start_us)]
+    data, end_us, timing = b"".join(frames), 5_000_000, LineTiming()
+    one = tmp_path / "one.txt"
+    one.write_text(f"{end_us / 1e6:.6f} {protocol.hex_bytes(data)}\n", encoding="utf-8")
+    lines, sent = [], 0
+    for frame_bytes in frames:
+        sent += len(frame_bytes)
+        lines.append(Chunk(end_us - timing.frame_us(len(data) - sent), frame_bytes))
+    many = tmp_path / "many.txt"
+    many.write_text(format_plain(lines), encoding="utf-8")
+    reports = []
+    for capture in (one, many):
+        report = tmp_path / f"{capture.stem}.json"
+        done = subprocess.run(uitamr("replay", capture, "--json", report), capture_output=True, text=True,
+                              timeout=WAIT_S)
+        assert done.returncode == 1, done.stdout + done.stderr  # squeezed together: the pacing rule fails
+        reports.append(json.loads(report.read_text())["scenarios"][0])
+    assert reports[0]["violations"] and reports[0]["violations"] == reports[1]["violations"]
+    assert reports[0]["rules"] == reports[1]["rules"]
+
+
+def test_a_bad_byte_far_into_a_long_line_is_named_by_its_column(tmp_path):
+    capture = tmp_path / "c.txt"
+    good = "0.000000 " + "01 06 01 A0 00 00 88 14 " * 100_000  # 2.4 MB on one line
+    capture.write_text("# one line\n" + good + "0G 01\n", encoding="utf-8")
+    done = subprocess.run(uitamr("replay", capture), capture_output=True, text=True, timeout=WAIT_S)
+    assert done.returncode == 2, done.stdout + done.stderr
+    assert f"{capture}:2:{len(good) + 1}: '0G' is not a byte in hex" in done.stderr
 
 
 # --------------------------------------------------------------------- same rules as `uitamr verify`

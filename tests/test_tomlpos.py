@@ -1,10 +1,14 @@
 """verifier.tomlpos: the line of a key in a TOML file, shared by every TOML loader."""
 from __future__ import annotations
 
+import json
+import re
 import tomllib
 
 import pytest
+from hypothesis import given, settings, strategies as st
 
+from verifier.textfile import text_lines
 from verifier.tomlpos import Place, decode_error_position, line_of_key, place_of_key
 
 TEXT = """\
@@ -43,7 +47,8 @@ LINES = TEXT.splitlines()
     ("faults[1].kind", 13),
     ("faults[1].delay_ms", 12),   # missing in its table: its header, not a later table's key
     ("faults[0].delay_ms", 8),
-    ("inputs[0].set", 16),        # sub-tables belong to their table
+    ("inputs[0].set", 18),        # a sub-table of the last [[inputs]]: its own header (was 16, [[inputs]])
+    ("inputs[0].set.X0", 19),
     ("nosuch", None),
     ("", None),
 ])
@@ -68,7 +73,7 @@ def test_decode_error_position_moves_line_and_column_out_of_the_message():
 def test_keys_in_inline_tables_point_at_the_line_that_holds_them():
     lines = ['name = "x"', 'faults = [{ kind = "no_reply", on_request = 1 },', '  { kind = "x", at_s = 1 }]',
              'robot = { pacing = "sometimes" }']
-    assert line_of_key(lines, "faults[1].kind") == 2
+    assert line_of_key(lines, "faults[1].kind") == 3  # the second table's own line (was 2, the array's)
     assert line_of_key(lines, "robot.pacing") == 4
     assert line_of_key(lines, "nosuch.key") is None
 
@@ -122,3 +127,137 @@ def test_items_of_an_array_over_several_lines_are_found_on_their_line():
     assert place_of_key(lines, "watch[2]") == Place(4, 17)
     assert place_of_key(lines, "watch[3]") == Place(5, 5)
     assert place_of_key(lines, "watch[4]") == Place(1, 9)  # no such item: the array
+
+
+@pytest.mark.parametrize("text, key, place, name", [
+    # a sub-table by a dotted header: was its parent's header, or nothing
+    ("[robot]\npacing = 'answer'\n\n[robot.point_durations_s]\n3 = 2.0\n4 = 'x'\n", "robot.point_durations_s.4",
+     Place(6, 5), Place(6, 1)),
+    ("[robot.point_durations_s]\n3 = 2.0\n", "robot.point_durations_s.3", Place(2, 5), Place(2, 1)),
+    ("[robot.point_durations_s]\n3 = 2.0\n", "robot", Place(1, 1), Place(1, 1)),  # made on the way: that header
+    ("[robot.point_durations_s]\n3 = 2.0\n[robot]\npacing = 1\n", "robot", Place(3, 1), Place(3, 1)),
+    # a sub-table of the last table of an array of tables: was the [[...]] header
+    ("[[inputs]]\nat = '1s'\n[[inputs]]\nat = '2s'\n[inputs.set]\nX0 = true\nD100 = 1\n", "inputs[1].set.D100",
+     Place(7, 8), Place(7, 1)),
+    ("[[inputs]]\nat = '1s'\n[[inputs]]\nat = '2s'\n[inputs.set]\nX0 = true\n", "inputs[1].set", Place(5, 1),
+     Place(5, 1)),
+    ("[[faults]]\nkind = 'x'\n[faults.sub]\ny = 1\n[[faults]]\nkind = 'z'\n[faults.sub]\ny = 2\n", "faults[1].sub.y",
+     Place(8, 5), Place(8, 1)),
+    ("[[a]]\n[[a.b]]\nc = 1\n[[a.b]]\nc = 2\n[[a]]\n[[a.b]]\nc = 3\n", "a[1].b[0].c", Place(8, 5), Place(8, 1)),
+    # dotted keys in a table, quoted parts, spaces around the dots
+    ("[robot]\npoint_durations_s . \"4\" = 'x'\n", "robot.point_durations_s.4", Place(2, 27), Place(2, 21)),
+    # inline tables and arrays: the key inside, on its own line
+    ("faults = [\n  { kind = 'a' },  # one\n  { kind = 'b', at_s = 1 },\n]\n", "faults[1].at_s", Place(3, 24),
+     Place(3, 17)),
+    ("set = { 'fbRobot.i_uPoint' = 3, X0 = true }\n", "set.fbRobot.i_uPoint", Place(1, 30), Place(1, 9)),
+    # names in comments and strings are not keys or headers
+    ("a = '''\n[robot]\nturnaround_ms = 1'''\n# [robot]\n[robot]  # [faults]\nturnaround_ms = 2\n",
+     "robot.turnaround_ms", Place(6, 17), Place(6, 1)),
+    ('s = "a \\" [robot] x = 1"\n[robot]\nx = 2\n', "robot.x", Place(3, 5), Place(3, 1)),
+    # missing: the deepest table it would be in
+    ("[[inputs]]\nat = '1s'\n[inputs.set]\nX0 = true\n", "inputs[0].set.D100", Place(3, 1), Place(3, 1)),
+])
+def test_keys_of_sub_tables_dotted_keys_and_inline_tables_are_at_their_own_place(text, key, place, name):
+    lines = text.splitlines()
+    tomllib.loads(text)  # valid TOML, as every loader has read it before
+    assert place_of_key(lines, key) == place
+    assert place_of_key(lines, key, at_name=True) == name
+
+
+# --- any document: every value is found where it is written ----------------------------------
+
+NAMES = st.text(st.characters(blacklist_characters=".[]", blacklist_categories=("Cs", "Cc")), min_size=1,
+                max_size=6) | st.sampled_from(["a", "b", "kind", "3", "x-y", "set"])
+SCALARS = st.integers(-10**6, 10**6) | st.booleans() | st.text(
+    st.characters(blacklist_categories=("Cs",), blacklist_characters="\r\x7f"), max_size=8) | st.sampled_from(
+    ["[robot]", "a = 1", "# no comment", "'''", '"""', '""', "\\", "x\ny", "}, {"])
+TREES = st.recursive(
+    SCALARS | st.lists(SCALARS, max_size=3),
+    lambda inner: st.dictionaries(NAMES, inner, max_size=4) | st.lists(st.dictionaries(NAMES, inner, max_size=3),
+                                                                        min_size=1, max_size=2),
+    max_leaves=12)
+STYLES = ("basic", "literal", "multi-line")
+
+
+def _key(name: str) -> str:
+    return name if re.fullmatch(r"[A-Za-z0-9_-]+", name) else json.dumps(name, ensure_ascii=False)
+
+
+def _scalar(value, style: str) -> str:
+    """A scalar as TOML writes it; a string in one of the styles, where that style can hold it."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    controls = {ch for ch in value if ord(ch) < 32 and ch != "\t"}
+    if style == "literal" and not controls and "'" not in value:
+        return f"'{value}'"
+    if style == "literal" and controls <= {"\n"} and "'''" not in value and not value.startswith("\n") \
+            and not value.endswith("'"):
+        return f"'''{value}'''"
+    if style == "multi-line":
+        return '"""' + json.dumps(value, ensure_ascii=False)[1:-1] + '"""'
+    return json.dumps(value, ensure_ascii=False)
+
+
+def _inline(value, data) -> str:
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{_key(k)} = {_inline(v, data)}" for k, v in value.items()) + "}"
+    if isinstance(value, list):
+        gap = "\n  " if data.draw(st.booleans()) else " "  # an array over several lines, with comments
+        comment = " # [x] = 1" if gap != " " else ""
+        return "[" + "".join(f"{gap}{_inline(v, data)},{comment}" for v in value) + gap + "]"
+    return _scalar(value, data.draw(st.sampled_from(STYLES)))
+
+
+def _is_tables(value) -> bool:
+    return isinstance(value, list) and bool(value) and all(isinstance(item, dict) for item in value)
+
+
+def _render(table: dict, header: list[str], data, out: list[str]) -> None:
+    """`table` as TOML: its plain keys, then each sub-table as a header (an array of them as
+    [[...]]), inline, or as dotted keys (`sub . key = 1`)."""
+    later = []
+    for name, value in table.items():
+        style = data.draw(st.sampled_from(["header", "inline", "dotted"]))
+        if isinstance(value, dict) and style == "dotted" and value and not any(
+                isinstance(v, (dict, list)) for v in value.values()):
+            out += [f"{_key(name)} . {_key(k)} = {_inline(v, data)}" for k, v in value.items()]
+        elif (isinstance(value, dict) or _is_tables(value)) and style != "inline":
+            later.append((name, value))
+        else:
+            out.append(f"{_key(name)} = {_inline(value, data)}")
+    for name, value in later:
+        path = header + [_key(name)]
+        for item in (value if isinstance(value, list) else [value]):
+            out.append(f"[[{'.'.join(path)}]]" if isinstance(value, list) else f"[ {' . '.join(path)} ]")
+            _render(item, path, data, out)
+
+
+def _leaves(value, key: str):
+    if isinstance(value, dict):
+        for name, item in value.items():
+            yield from _leaves(item, f"{key}.{name}" if key else name)
+    elif isinstance(value, list):
+        for i, item in enumerate(value):
+            yield from _leaves(item, f"{key}[{i}]")
+    else:
+        yield key, value
+
+
+@settings(max_examples=300, deadline=None, derandomize=True)
+@given(st.dictionaries(NAMES, TREES, min_size=1, max_size=4), st.data())
+def test_every_value_of_any_document_is_found_where_it_is_written(document, data):
+    """Random documents, their tables written as headers, sub-tables of arrays of tables,
+    inline tables, dotted keys; arrays over several lines with comments; strings of each
+    kind holding brackets, quotes, '#' and '=': every value is placed where it starts."""
+    out: list[str] = []
+    _render(document, [], data, out)
+    text = "\n".join(out) + "\n"
+    assert tomllib.loads(text) == document, text  # the document is written right
+    lines = text_lines(text)
+    for key, value in _leaves(document, ""):
+        place = place_of_key(lines, key)
+        assert place is not None, (key, text)
+        written = "\n".join(lines[place.line - 1:])[place.col - 1:]
+        assert any(written.startswith(_scalar(value, style)) for style in STYLES), (key, place, text)

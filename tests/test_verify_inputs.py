@@ -155,7 +155,8 @@ def _run_scenario(tmp_path, program, body: str):
     ('\n[[expect]]\nthat = "b"\n[[expect]]\nnever = "tmr.QQ"\n', "7:9", "expect[1].never",
      "no label 'tmr.QQ' in the program Main: tmr has no member 'QQ'"),
     ('watch = ["w", "arr[7]"]\n', "3:15", "watch[1]", "no label 'arr[7]' in the program Main: arr has no element [7]"),
-    ('[[inputs]]\nat = "0s"\nset = { nosuch = true }\n', "5:7", "inputs[0].set", "the program Main has no label 'nosuch'"),
+    # the label's own name in the table, not the table's brace (5:7)
+    ('[[inputs]]\nat = "0s"\nset = { nosuch = true }\n', "5:9", "inputs[0].set", "the program Main has no label 'nosuch'"),
     ('[response_handling]\nsignal = "bErr"\n', "4:10", "response_handling.signal", "the program Main has no label 'bErr'"),
 ])
 def test_unknown_labels_name_file_line_and_key_once(tmp_path, program, body, line, key, message):
@@ -185,7 +186,8 @@ def test_labels_of_the_wrong_type_are_refused(tmp_path, program, body, words):
     result, scenario = _run_scenario(tmp_path, program, body)
     assert result.exit_code == 2, result.output
     line = 4 if body.startswith("[[expect]]") else 5  # the line of `that`/`set`
-    col = body.splitlines()[-1].index("= ") + 3  # its value
+    last = body.splitlines()[-1]
+    col = last.index("= ") + 3 if body.startswith("[[expect]]") else last.index("{ ") + 3  # its value; the label
     assert f"{scenario}:{line}:{col}: " in result.output and words in result.output
 
 
@@ -197,7 +199,7 @@ def test_an_input_to_a_constant_is_refused_not_a_traceback(tmp_path):
                       "w := MAX_W;\nEND_PROGRAM\n", encoding="utf-8")
     result, scenario = _run_scenario(tmp_path, source, '[[inputs]]\nat = "0s"\nset = { MAX_W = 5 }\n')
     assert result.exit_code == 2, result.output
-    assert f"{scenario}:5:7: inputs[0].set: Main.MAX_W is a constant" in result.output
+    assert f"{scenario}:5:9: inputs[0].set: Main.MAX_W is a constant" in result.output
 
 
 @pytest.mark.parametrize("value", ["true", "5"])
@@ -209,7 +211,7 @@ def test_an_input_to_a_string_says_it_is_a_string(tmp_path, value):
                       encoding="utf-8")
     result, scenario = _run_scenario(tmp_path, source, f'[[inputs]]\nat = "0s"\nset = {{ s = {value} }}\n')
     assert result.exit_code == 2, result.output
-    assert f"{scenario}:5:7: inputs[0].set: s is a STRING: an input sets BOOL and number labels only" in result.output
+    assert f"{scenario}:5:9: inputs[0].set: s is a STRING: an input sets BOOL and number labels only" in result.output
 
 
 @pytest.mark.parametrize("body", ['[[expect]]\nthat = "s < 5"\n', '[[expect]]\nnever = "s"\n',

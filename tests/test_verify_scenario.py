@@ -403,3 +403,37 @@ def test_the_scenario_channels_are_the_simulators():
     from verifier.verify.scenario import CHANNELS
 
     assert sorted(CHANNELS) == sorted(SIMULATED)
+
+
+@pytest.mark.parametrize("text, key, place", [
+    # a sub-table by a dotted header: was the first line (1:1) or no place at all
+    ('[robot]\nturnaround_ms = 5\n\n[robot.point_durations_s]\n3 = 2.0\n4 = "x"\n', "robot.point_durations_s.4", (6, 5)),
+    ('name = "n"\n[robot.point_durations_s]\n3 = 2.0\n4 = "x"\n', "robot.point_durations_s.4", (4, 5)),
+    ('[protocol]\naddress = 1\n[robot]\nturnaround_ms = 5\n[robot.point_poses]\n3 = [1.0, 2.0, "x"]\n',
+     "robot.point_poses.3[2]", (6, 16)),
+    ('[robot]\nturnaround_ms = 5\n[robot.point_poses]\n3 = [1.0, 2.0, 0.0]\n[protocol]\naddress = 1\n'
+     '[robot.extra]\na = 1\n', "robot.extra", (7, 1)),  # an unknown sub-table: its own header
+    # a sub-table of the last table of an array: was that table's [[...]] header
+    ('[[inputs]]\nat = "1s"\n[inputs.set]\nX0 = true\nD100 = "x"\n', "inputs[0].set.D100", (5, 8)),
+    ('[[inputs]]\nat = "1s"\nset = { X0 = true }\n[[inputs]]\nat = "2s"\n[inputs.set]\nX0 = true\nD100 = "x"\n',
+     "inputs[1].set.D100", (8, 8)),
+    ('[[inputs]]\nat = "1s"\n[inputs.set]\nX0 = true\n"a b" = 1\n', "inputs[0].set", (5, 1)),  # the label itself
+    ('[[faults]]\nkind = "no_reply"\nat_s = 1.0\n\n[faults.x]\ny = 1\n', "faults[0].x", (5, 1)),
+    ('[[faults]]\nkind = "no_reply"\nat_s = 1.0\n[[faults]]\nkind = "no_reply"\nat_s = 2.0\n[faults.x]\ny = 1\n',
+     "faults[1].x", (7, 1)),
+    # dotted keys inside a table, and at the top
+    ('[robot]\nturnaround_ms = 5\npoint_durations_s.3 = 2.0\npoint_durations_s.4 = "x"\n',
+     "robot.point_durations_s.4", (4, 23)),
+    ('robot.point_durations_s.4 = "x"\n', "robot.point_durations_s.4", (1, 29)),
+    # inline tables: the second table of an inline array on its own line (was the array's line)
+    ('faults = [{ kind = "no_reply", at_s = 1.0 },\n  { kind = "x", at_s = 1.0 }]\n', "faults[1].kind", (2, 12)),
+    ('[[inputs]]\nat = "1s"\nset = { X0 = true, "a b" = 1 }\n', "inputs[0].set", (3, 20)),
+    ('[robot]\npoint_poses = { 3 = [1.0, 2.0, 0.0], 4 = [1.0, 2.0, "x"] }\n', "robot.point_poses.4[2]", (2, 53)),
+    # a name that also stands in a comment or a string before it is not taken for the key
+    ('# [robot.point_durations_s]\ndescription = """\n[robot.point_durations_s]\n4 = 1\n"""\n'
+     '[robot.point_durations_s]\n4 = "x"\n', "robot.point_durations_s.4", (7, 5)),
+])
+def test_a_key_in_a_sub_table_is_placed_on_its_own_line(text, key, place):
+    error = error_of(text, Path("s.toml"))
+    assert (error.key, (error.line, error.col)) == (key, place), str(error)
+    assert str(error).startswith(f"s.toml:{place[0]}:{place[1]}: {key}: ")

@@ -4,9 +4,17 @@
 knows its key path (``faults[1].kind``, ``robot.turnaround_ms``) but not its line. These
 helpers find it again in the text, for every loader of TOML the toolkit has (verifier
 scenarios, ``uitamr emulate --faults``), so all of them say ``file:line: key: message``.
+
+They read the document as TOML does (`_Walk`): table headers, sub-tables of a table or of
+the last table of an array (``[robot.point_durations_s]``, ``[[inputs]]`` then
+``[inputs.set]``), dotted keys, inline tables, arrays over several lines, strings of every
+kind and comments. So every key is found on its own line and column, and a name that
+stands elsewhere (in a comment, a string, another table) is never taken for it.
 """
 from __future__ import annotations
 
+import bisect
+import functools
 import re
 import tomllib
 from dataclasses import dataclass
@@ -25,58 +33,225 @@ class Place:
         return f"{self.line}:{self.col}"
 
 
-_KEY_PART = re.compile(r"[^.\[\]]+|\[\d+\]")
 _LONG_NUMBER = re.compile(r"(?<![\w.])[0-9][0-9_]{4300,}")
 _DECODE_POSITION = re.compile(r"\s*\(at line (\d+), column (\d+)\)")
+_BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
+_INDEX = re.compile(r"\[([0-9]+)\]")
+
+#: Where a value is in the document: table keys and array indices, ("faults", 1, "kind").
+KeyPath = tuple
 
 
 def line_of_key(lines: list[str], key: str) -> int | None:
-    """Best effort: the 1-based line that sets ``key`` ("expect[1].within", "robot.x",
-    "faults[0]"), or the header of its table, or the line of an inline table that holds it;
-    None when it cannot be found."""
-    parts = _KEY_PART.findall(key)
-    if not parts:
+    """Best effort: the 1-based line that sets ``key`` (see `place_of_key`)."""
+    place = place_of_key(lines, key)
+    return place.line if place is not None else None
+
+
+def place_of_key(lines: list[str], key: str, at_name: bool = False) -> Place | None:
+    """Best effort: line and column of what sets ``key`` ("robot.turnaround_ms",
+    "inputs[0].set.D100", "watch[2]", "robot.point_poses.3[2]"): the value after ``name =``
+    (the name itself with `at_name`, for a key that should not be there), the n-th item of
+    an array, the header of a table (``[robot.point_poses]``, ``[[faults]]``). A key the file
+    does not hold is placed at the table or array it would be in; None when not even its
+    first part is in the file."""
+    places = _places("\n".join(lines))
+    path, missing = _find(places, (), key)
+    if not path:
         return None
-    table, index, rest = parts[0], 0, parts[1:]
-    if rest and rest[0].startswith("["):
-        index = int(rest[0][1:-1])
-        rest = rest[1:]
-    header = re.compile(r"^\s*\[\[\s*" + _name(table) + r"\s*\]\]")
-    plain_header = re.compile(r"^\s*\[\s*" + _name(table) + r"\s*\]")
-    start: int | None = None  # the line of the table's header, when the key is in a table
-    seen = -1
-    for number, line in enumerate(lines):
-        if header.match(line):
-            seen += 1
-            if seen == index:
-                start = number
-                break
-        elif plain_header.match(line):
-            start = number
-            break
-    target = rest[0] if rest else table
-    if start is not None and not rest:
-        return start + 1  # the table itself is wrong: point at its header
-    for number in range(start or 0, len(lines)):
-        line = lines[number]
-        if start is None and number > 0 and re.match(r"^\s*\[", line):
-            break  # a top-level key comes before every table
-        if start is not None and number > start and re.match(r"^\s*\[", line) \
-                and not re.match(r"^\s*\[\[?\s*" + _name(table) + r"\.", line):
-            break  # past its table (and the table's sub-tables): point at the table's header
-        if re.match(r"^\s*" + _name(target) + r"\s*[=.]", line):  # a dotted key too: robot.pacing = ...
-            return number + 1
-    if start is None:
-        # no header: the table may be written inline (faults = [{ kind = "x" }]); its line
-        return line_of_key(lines, table) if rest or index else None
-    return start + 1
+    name, value = places[path]
+    return name if at_name and not missing else value
 
 
-def _name(key: str) -> str:
-    """A pattern for `key` as a TOML file may write it: bare, "basic" or 'literal' (as the
-    docs write buffer memory: 'U0\\G164' = 8)."""
-    name = re.escape(key)
-    return f"(?:{name}|\"{name}\"|'{name}')"
+def _find(places: dict[KeyPath, tuple[Place, Place]], path: KeyPath, key: str) -> tuple[KeyPath, str]:
+    """The deepest path in `places` that `key` names from `path` on, and what is left of
+    `key`. A key may hold dots (a label "fbRobot.i_uPoint" in an input's `set`): the table's
+    keys that `key` starts with are tried, the longest first."""
+    if not key:
+        return path, ""
+    index = _INDEX.match(key)
+    if index is not None:
+        item = path + (int(index.group(1)),)
+        return _find(places, item, key[index.end():].removeprefix(".")) if item in places else (path, key)
+    deepest = (path, key)
+    names = {p[len(path)] for p in places if len(p) == len(path) + 1 and p[:len(path)] == path}
+    for name in sorted((n for n in names if isinstance(n, str)), key=len, reverse=True):
+        rest = key[len(name):]
+        if key.startswith(name) and rest[:1] in ("", ".", "["):
+            found = _find(places, path + (name,), rest.removeprefix("."))
+            if not found[1]:
+                return found
+            if len(found[0]) > len(deepest[0]):
+                deepest = found
+    return deepest
+
+
+@functools.lru_cache(maxsize=16)
+def _places(text: str) -> dict[KeyPath, tuple[Place, Place]]:
+    walk = _Walk(text)
+    try:
+        walk.document()
+    except ValueError:  # not TOML after all (every loader reads it with tomllib first): what was found
+        pass
+    return walk.places
+
+
+class _Walk:
+    """Reads a TOML document for the places of its keys and values, without their values:
+    ``places[path] = (where its name is, where its value starts)``; a table that a header
+    makes is at its header, a table that a dotted key or a header makes on the way to
+    another one (``robot`` of ``[robot.point_poses]``) where it is first named."""
+
+    def __init__(self, text: str):
+        self.text = text
+        self.pos = 0
+        self.line_starts = [0] + [i + 1 for i, ch in enumerate(text) if ch == "\n"]
+        self.places: dict[KeyPath, tuple[Place, Place]] = {}
+        self.tables_in: dict[KeyPath, int] = {}  # arrays of tables ([[faults]]): tables so far
+
+    def document(self) -> None:
+        table: KeyPath = ()
+        while True:
+            self.blank(newlines=True)
+            if self.pos >= len(self.text):
+                return
+            if self.text.startswith("[", self.pos):
+                table = self.header()
+            else:
+                self.pair(table)
+
+    def header(self) -> KeyPath:
+        """``[a.b]`` or ``[[a.b]]``: the table it opens, within the last table of an array."""
+        start = self.pos
+        brackets = 2 if self.text.startswith("[[", start) else 1
+        self.pos += brackets
+        names = self.key()
+        self.expect("]" * brackets)
+        path: KeyPath = ()
+        for i, (name, _) in enumerate(names):
+            path += (name,)
+            last = i == len(names) - 1
+            if last and brackets == 2:
+                self.note(path, start, start, made=False)
+                self.tables_in[path] = self.tables_in.get(path, 0) + 1
+            if path in self.tables_in:
+                path += (self.tables_in[path] - 1,)
+            self.note(path, start, start, made=last)
+        return path
+
+    def pair(self, table: KeyPath) -> None:
+        """``key = value`` in `table`; the key may be dotted (``robot.pacing = ...``)."""
+        names = self.key()
+        path = table
+        for name, at in names:
+            path += (name,)
+            self.note(path, at, at, made=False)
+        self.expect("=")
+        self.blank()
+        self.note(path, names[-1][1], self.pos)
+        self.value(path)
+
+    def key(self) -> list[tuple[str, int]]:
+        """A bare, quoted or dotted key: its parts and where each starts."""
+        names = []
+        while True:
+            self.blank()
+            at = self.pos
+            if self.text[at:at + 1] in ("\"", "'"):
+                self.string()
+                names.append((tomllib.loads("k = " + self.text[at:self.pos])["k"], at))
+            else:
+                match = _BARE_KEY.match(self.text, at)
+                if match is None:
+                    raise ValueError(f"no key at {at}")
+                names.append((match.group(), at))
+                self.pos = match.end()
+            self.blank()
+            if not self.text.startswith(".", self.pos):
+                return names
+            self.pos += 1
+
+    def value(self, path: KeyPath) -> None:
+        ch = self.text[self.pos:self.pos + 1]
+        if ch in ("\"", "'"):
+            self.string()
+        elif ch == "[":
+            self.items(path, "]", self.item)
+        elif ch == "{":
+            self.items(path, "}", self.pair)
+        else:  # a number, true or false, a date and time (which may hold a space)
+            while self.pos < len(self.text) and self.text[self.pos] not in ",]}\n#":
+                self.pos += 1
+
+    def item(self, path: KeyPath, index: int) -> None:
+        item = path + (index,)
+        self.note(item, self.pos, self.pos)
+        self.value(item)
+
+    def items(self, path: KeyPath, closing: str, read) -> None:
+        """The items of an array, or the keys of an inline table, up to `closing`."""
+        self.pos += 1
+        count = 0
+        while True:
+            self.blank(newlines=True)
+            if self.text.startswith(closing, self.pos):
+                self.pos += 1
+                return
+            if closing == "]":
+                read(path, count)
+            else:
+                read(path)
+            count += 1
+            self.blank(newlines=True)
+            if self.text.startswith(",", self.pos):
+                self.pos += 1
+            elif not self.text.startswith(closing, self.pos):
+                raise ValueError(f"no ',' or {closing!r} at {self.pos}")
+
+    def string(self) -> None:
+        """Past a string of any of TOML's four kinds."""
+        text, start = self.text, self.pos
+        quote = text[start]
+        delimiter = quote * 3 if text.startswith(quote * 3, start) else quote
+        i = start + len(delimiter)
+        while not text.startswith(delimiter, i):
+            if i >= len(text) or (len(delimiter) == 1 and text[i] == "\n"):
+                raise ValueError(f"a string that does not end, from {start}")
+            i += 2 if quote == "\"" and text[i] == "\\" else 1
+        i += len(delimiter)
+        if len(delimiter) == 3:  # """a"""" ends with one or two quotes of its own
+            for _ in range(2):
+                i += text.startswith(quote, i)
+        self.pos = i
+
+    def blank(self, newlines: bool = False) -> None:
+        """Past spaces, tabs and a comment; with `newlines` past line ends too."""
+        text = self.text
+        while self.pos < len(text):
+            ch = text[self.pos]
+            if ch in " \t" or (newlines and ch in "\r\n"):
+                self.pos += 1
+            elif ch == "#":
+                end = text.find("\n", self.pos)
+                self.pos = len(text) if end < 0 else end
+            else:
+                return
+
+    def expect(self, what: str) -> None:
+        self.blank()
+        if not self.text.startswith(what, self.pos):
+            raise ValueError(f"no {what!r} at {self.pos}")
+        self.pos += len(what)
+
+    def note(self, path: KeyPath, name_at: int, value_at: int, made: bool = True) -> None:
+        """Where `path` is: a key or table it `made`, or one named on the way to another
+        (kept only when it is not placed yet)."""
+        if made or path not in self.places:
+            self.places[path] = (self.place(name_at), self.place(value_at))
+
+    def place(self, offset: int) -> Place:
+        line = bisect.bisect_right(self.line_starts, offset)
+        return Place(line, offset - self.line_starts[line - 1] + 1)
 
 
 def decode_error_position(error: ValueError, source: str = "") -> tuple[str, Place | None]:
@@ -106,73 +281,6 @@ def _too_many_digits(source: str) -> tuple[str, Place | None]:
     place = Place(before.count("\n") + 1, match.start() - (before.rfind("\n") + 1) + 1)
     digits = sum(ch.isdigit() for ch in match.group())
     return f"a whole number of {digits} digits: too long to read (at most 4300), and no setting takes it", place
-
-
-def place_of_key(lines: list[str], key: str, at_name: bool = False) -> Place | None:
-    """Best effort: line and column of what sets ``key``: the value after ``name =`` (the
-    name itself with `at_name`, for a key that should not be there), the n-th item of an
-    inline array for ``watch[2]``, the key inside an inline table, or the table's header;
-    None when the line cannot be found."""
-    line = line_of_key(lines, key)
-    if line is None:
-        return None
-    text = lines[line - 1]
-    parts = _KEY_PART.findall(key)
-    index = None
-    if parts and parts[-1].startswith("["):
-        index = int(parts[-1][1:-1])
-        parts = parts[:-1]
-    name = parts[-1] if parts else ""
-    match = re.search(r"(?:^|[{,.])\s*(" + _name(name) + r")\s*=\s*", text) if name else None
-    if match is None:
-        return Place(line, len(text) - len(text.lstrip()) + 1)
-    if at_name:
-        return Place(line, match.start(1) + 1)
-    col = match.end()
-    if index is not None and col < len(text) and text[col] == "[":
-        item = _array_item(lines, line - 1, col, index)
-        if item is not None:
-            line, col = item
-    return Place(line, col + 1)
-
-
-def _array_item(lines: list[str], row: int, start: int, index: int) -> tuple[int, int] | None:
-    """(line, offset) of the index-th item of the array opening at lines[row][start] ('['),
-    which may go on over the following lines (with comments after its items)."""
-    depth, count, quote = 0, 0, ""
-    expecting = True
-    i = start
-    while row < len(lines):
-        text = lines[row]
-        while i < len(text):
-            ch = text[i]
-            if quote:
-                if ch == "\\" and quote == '"':
-                    i += 1
-                elif ch == quote:
-                    quote = ""
-            elif ch == "#":
-                break  # a comment: the rest of the line
-            elif ch in "[{\"'" or (not ch.isspace() and ch not in "]},"):
-                if depth == 1 and expecting:
-                    if count == index:
-                        return row + 1, i
-                    count, expecting = count + 1, False
-                if ch in "[{":
-                    depth += 1
-                elif ch in "\"'":
-                    quote = ch
-            elif ch in "]}":
-                depth -= 1
-                if depth == 0:
-                    return None
-            elif ch == "," and depth == 1:
-                expecting = True
-            i += 1
-        if quote or depth == 0:
-            return None  # a string that does not end on its line (a multi-line one): give up
-        row, i = row + 1, 0
-    return None
 
 
 def shown(value) -> str:

@@ -10,6 +10,7 @@ import math
 from collections.abc import Iterable, Mapping
 from typing import Any
 
+from verifier.digits import digit_problem
 from verifier.tomlpos import shown
 
 
@@ -111,6 +112,8 @@ def as_int_keyed(value: Any, path: str) -> dict[int, Any]:
     table = require_mapping(value, path)
     result: dict[int, Any] = {}
     for key, item in table.items():
+        if isinstance(key, str) and (problem := digit_problem(key)):  # int() reads "٣" as 3
+            raise ConfigError(join(path, key), f"key {key!r}: {problem}")
         try:
             number = int(key)
         except (TypeError, ValueError):

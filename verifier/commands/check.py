@@ -128,13 +128,15 @@ def _scenario_devices(scenario) -> list[Diagnostic]:
     from verifier.verify.scenario import BUFFER_MEMORY, DEVICE_NAME
 
     cpu = PROFILES[scenario.platform]
-    named = [(f"initial.{name}", name) for name, _ in scenario.initial if not BUFFER_MEMORY.match(name)]
-    named += [(f"{step.key}.set", name) for step in scenario.inputs for name in step.values if DEVICE_NAME.match(name)]
+    named = [(f"initial.{name}", name, f"initial.{name}") for name, _ in scenario.initial
+             if not BUFFER_MEMORY.match(name)]
+    named += [(f"{step.key}.set", name, f"{step.key}.set.{name}") for step in scenario.inputs for name in step.values
+              if DEVICE_NAME.match(name)]
     found = []
-    for key, name in named:
+    for key, name, at in named:
         problem = device_problem(name, cpu)
         if problem:
-            place = scenario.key_lines.get(key)
+            place = scenario.key_lines.get(at)
             found.append(Diagnostic(str(scenario.path), place.line if place else 0, place.col if place else 0,
                                     "error", f"{key}: {problem}"))
     return found

@@ -16,7 +16,9 @@ from verifier.emulate.assembler import DEFAULT_SILENCE_US
 from verifier.emulate.core import Emulator
 from verifier.emulate.faultfile import FaultFileError, load_fault_file
 from verifier.emulate.ports import PortError, serial_url_problem, serve_serial, serve_tcp, t3_5_at
+from verifier.commands.numbers import INT
 from verifier.commands.protocol_options import protocol_settings
+from verifier.digits import digit_problem
 
 
 def _tcp_endpoint(value: str) -> tuple[str, int]:
@@ -30,6 +32,8 @@ def _tcp_endpoint(value: str) -> tuple[str, int]:
         raise click.BadParameter(f"an IPv6 address goes in brackets, e.g. [::1]:4001, got {value!r}",
                                  param_hint="--tcp")
     host = host.strip("[]") or "127.0.0.1"
+    if problem := digit_problem(port):
+        raise click.BadParameter(f"the port {port!r}: {problem}", param_hint="--tcp")
     try:
         number = int(port)
     except ValueError:
@@ -71,6 +75,8 @@ class _FiniteFloat(click.ParamType):
     name = "number"
 
     def convert(self, value, param, ctx):
+        if isinstance(value, str) and (problem := digit_problem(value)):
+            self.fail(problem, param, ctx)
         try:
             number = float(value)
         except (TypeError, ValueError):
@@ -95,6 +101,8 @@ def _exit_after(ctx: click.Context, param: click.Parameter, value: float | None)
 
 def _request_number(value: str, option: str) -> tuple[int, str]:
     number, _, rest = value.partition(":")
+    if problem := digit_problem(value):
+        raise click.BadParameter(f"{value!r}: {problem}", param_hint=option)
     try:
         n = int(number)
     except ValueError:
@@ -157,7 +165,7 @@ def _flag_faults(no_reply, bad_crc, garbage, wrong_address, exception, late,
                    "(not loop://).")
 @click.option("--tcp", "tcp", metavar="HOST:PORT",
               help="Listen for raw RTU frames over TCP (PORT alone binds 127.0.0.1; port 0 = any free port).")
-@click.option("--baud", type=int, default=9600, show_default=True, callback=_baud,
+@click.option("--baud", type=INT, default=9600, show_default=True, callback=_baud,
               help="Serial speed, a standard rate 300-230400 (the robot uses 9600 8N1); --serial only.")
 @protocol_settings
 @click.option("--faults", "faults_file", type=click.Path(dir_okay=False), metavar="FILE.toml",

@@ -32,6 +32,7 @@ from verifier.protocol import (
 from verifier.protocol.describe import looks_like_reply
 from verifier.protocol.names import USAGE
 from verifier.commands.protocol_options import protocol_settings
+from verifier.digits import digit_problem
 
 EXIT_BAD_FRAME = 1
 _HEX_WORD = re.compile(r"(0[xX])?[0-9a-fA-F]+,?")
@@ -58,6 +59,8 @@ def parse_hex(text: str) -> bytes:
     out = bytearray()
     for token in tokens:
         bad = re.search(r"[^0-9a-fA-F]", token)
+        if bad and (problem := digit_problem(bad.group())):  # '１２': the full-width digits
+            raise ValueError(f"not a hex digit in {token!r}: {problem}")
         if bad:
             raise ValueError(f"not a hex digit: {bad.group()!r} in {token!r}")
         if len(token) % 2 and len(token) > 1:

@@ -6,10 +6,11 @@ import functools
 
 import click
 
+from verifier.commands.numbers import IntRange
 from verifier.protocol.settings import CODES_10_13_STYLES, FIELD_ORDERS, STATUS_ORDERS, Settings
 
 _OPTIONS = (
-    click.option("--address", type=click.IntRange(1, 247), default=1, show_default=True,
+    click.option("--address", type=IntRange(1, 247), default=1, show_default=True,
                  help="Robot (slave) address."),
     click.option("--field-order", type=click.Choice(FIELD_ORDERS), default="code-high", show_default=True,
                  help="FC06 register field: control code in the high byte (manual text) "

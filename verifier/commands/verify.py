@@ -19,6 +19,7 @@ from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
+from verifier.commands.numbers import INT, IntRange
 from verifier.commands.report_files import (ReportError, check_folders, check_not_inputs, report_options,
                                              text_console, write_reports)
 from verifier.verify.durations import format_duration, format_seconds, parse_duration_us
@@ -26,6 +27,7 @@ from verifier.verify import spool
 from verifier.verify.events_shown import EVENTS_AT_MOST
 from verifier.verify.result import KEEP_ALL, Keep, ScenarioResult, UnusableInput
 from verifier.bundled import plc_dir as bundled_plc_dir
+from verifier.digits import digit_problem
 from verifier.textfile import real_path
 from verifier.verify.scenario import (
     CHANNELS, DEFAULT_DURATION_US, MAX_DURATION_US, PLATFORMS, Scenario, ScenarioError, default_scenario, load_scenario,
@@ -71,7 +73,10 @@ class _Duration(click.ParamType):
 
 
 def _is_zero(value) -> bool:
-    """'0', '0.00', '-0', '00': a bare number that is zero."""
+    """'0', '0.00', '-0', '00': a bare number that is zero (of the digits 0-9: a '٠' goes on to
+    say what is wrong with it)."""
+    if digit_problem(str(value)):
+        return False
     try:
         return float(str(value).strip()) == 0
     except ValueError:
@@ -359,13 +364,13 @@ def _terminate_as_exit():
               help="Run every bundled scenario. With SOURCES: those of the program's platform and route (serial, or TCP through a converter), with their robot, faults and rules but not their example-specific inputs and expectations (see docs/verifier.md).")
 @click.option("--duration", type=_Duration(MAX_DURATION_US), help="Virtual run time, e.g. 60s (overrides the scenarios'; default 60s).")
 @click.option("--scan", type=_Duration(), help="PLC scan time, e.g. 10ms (overrides the scenarios'; default 10ms).")
-@click.option("--seed", type=int, help="Seed for everything random in the run (overrides the scenarios').")
-@click.option("--jobs", "-j", type=click.IntRange(min=1), default=1, show_default=True, help="Scenarios run in parallel processes.")
+@click.option("--seed", type=INT, help="Seed for everything random in the run (overrides the scenarios').")
+@click.option("--jobs", "-j", type=IntRange(min=1), default=1, show_default=True, help="Scenarios run in parallel processes.")
 @click.option("--every-scan", is_flag=True,
               help="Run every scan and read every watched label by name on each (the reference path; several times slower). The default jumps over idle scans and gives the same report.")
 @report_options
 @click.option("--list-rules", is_flag=True, help="Print the rules (id, title, source) and exit.")
-@click.option("--violations", "first", type=click.IntRange(min=0), default=3, show_default=True,
+@click.option("--violations", "first", type=IntRange(min=0), default=3, show_default=True,
               help="Times listed per broken rule and scenario on the console (0: counts only).")
 def command(sources, program, platform, channel, response_signal, scenario_files, matrix, duration, scan, seed, jobs,
             every_scan, json_path, junit_path, trace_path, html_path, list_rules, first):

@@ -23,6 +23,7 @@ from pathlib import Path
 
 from verifier import protocol
 from verifier.amr.schema import LARGEST  # the largest number of seconds any setting holds
+from verifier.digits import describe, foreign_digit
 from verifier.textfile import UnreadableText, lone_cr_as_line_feed, read_utf8, text_lines
 
 
@@ -43,7 +44,7 @@ class CaptureError(Exception):
     """A capture file that cannot be read; the message is `file:line:col: what`."""
 
 
-_TIME = re.compile(r"\s*(\d+(?:\.\d*)?|\.\d+)(?=\s|$)")
+_TIME = re.compile(r"\s*([0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?=\s|$)")
 _HEX_PAIR = re.compile(r"[0-9A-Fa-f]{2}")
 
 
@@ -56,6 +57,9 @@ def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
         line = raw.split("#", 1)[0].rstrip()
         if not line.strip():
             continue
+        foreign = foreign_digit(line)  # float() reads '٠.٥' as 0.5
+        if foreign is not None:
+            raise CaptureError(f"{name}:{number}:{foreign + 1}: {describe(line[foreign])}")
         time_match = _TIME.match(line)
         if time_match is None:
             col = len(line) - len(line.lstrip()) + 1

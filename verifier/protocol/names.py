@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from decimal import Decimal, InvalidOperation
 
+from verifier.digits import digit_problem
+
 from verifier.protocol.catalogue import (
     is_member,
     POINT_NUMBERS,
@@ -159,6 +161,8 @@ def _choice(name: str, args: list[str], options: dict):
 
 
 def _integer(text: str, what: str) -> int:
+    if problem := digit_problem(text):  # int() reads '１２' as 12
+        raise CommandError(f"{what} {text!r}: {problem}")
     if len(text) > 20:  # every value here fits a byte; 5000 digits are more than int() reads or prints
         raise CommandError(f"{what} must be a small whole number (decimal, or hex as 0x..), got "
                            f"{len(text)} characters: {text[:20]}...")
@@ -177,6 +181,8 @@ def _stage(text: str, what: str) -> int:
 
 def _scaled(text: str, step: Decimal, what: str, unit: str) -> tuple[int, int]:
     """(sign, units) for a signed decimal that must be a whole number of ``step``s ≤ 255."""
+    if problem := digit_problem(text):  # Decimal() reads '٢.٥' as 2.5
+        raise CommandError(f"{what} {text!r}: {problem}")
     try:
         value = Decimal(text)
     except InvalidOperation:

@@ -16,6 +16,8 @@ import re
 from dataclasses import dataclass
 from typing import Callable, Mapping
 
+from verifier.digits import describe, foreign_digit
+
 Value = bool | int | float
 
 
@@ -29,8 +31,8 @@ class ConditionError(ValueError):
 _TOKEN = re.compile(
     r"""
     (?P<space>\s+)
-  | (?P<number>(?:2|8|16)\#[0-9A-Fa-f_]+|\d[\d_]*(?:\.\d+)?)
-  | (?P<name>[A-Za-z_][A-Za-z0-9_]*(?:\[\d+\])*(?:\.[A-Za-z_][A-Za-z0-9_]*(?:\[\d+\])*)*)
+  | (?P<number>(?:2|8|16)\#[0-9A-Fa-f_]+|[0-9][0-9_]*(?:\.[0-9]+)?)
+  | (?P<name>[A-Za-z_][A-Za-z0-9_]*(?:\[[0-9]+\])*(?:\.[A-Za-z_][A-Za-z0-9_]*(?:\[[0-9]+\])*)*)
   | (?P<op><>|<=|>=|=|<|>|&|\(|\)|-)
     """,
     re.VERBOSE,
@@ -49,6 +51,9 @@ class _Token:
 def _tokenize(text: str) -> list[_Token]:
     tokens: list[_Token] = []
     position = 0
+    foreign = foreign_digit(text)  # '٣' in a number or an index: the message says what it is
+    if foreign is not None:
+        raise ConditionError(describe(text[foreign]), foreign + 1)
     while position < len(text):
         match = _TOKEN.match(text, position)
         if not match:

@@ -8,6 +8,8 @@ from __future__ import annotations
 import re
 from fractions import Fraction
 
+from verifier.digits import digit_problem
+
 _UNITS_US = {
     "us": 1,
     "µs": 1,
@@ -17,13 +19,15 @@ _UNITS_US = {
     "h": 3_600_000_000,
 }
 
-_PATTERN = re.compile(r"^\s*(\d+(?:\.\d+)?|\.\d+)\s*(us|µs|ms|s|min|h)\s*$")
+_PATTERN = re.compile(r"^\s*([0-9]+(?:\.[0-9]+)?|\.[0-9]+)\s*(us|µs|ms|s|min|h)\s*$")
 
 
 def parse_duration_us(text: object) -> int:
     """Return `text` ("250ms", "1.5s") in whole microseconds; ValueError on anything else."""
     if not isinstance(text, str):
         raise ValueError(f"expected a duration such as \"250ms\" or \"60s\", got {text!r}")
+    if problem := digit_problem(text):
+        raise ValueError(f"{text!r}: {problem}")
     match = _PATTERN.match(text)
     if not match:
         raise ValueError(

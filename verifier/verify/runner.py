@@ -190,7 +190,7 @@ class _Plc:
 
 
 def _path_parts(name: str) -> list[str]:
-    return re.findall(r"[A-Za-z_][A-Za-z0-9_]*|\[\d+\]", name)
+    return re.findall(r"[A-Za-z_][A-Za-z0-9_]*|\[[0-9]+\]", name)
 
 
 def _platform_hint(scenario: Scenario) -> str:

@@ -16,6 +16,7 @@ from verifier import protocol
 from verifier.amr.config import RobotConfig
 from verifier.amr.faults import Fault, check_fault_addresses
 from verifier.amr.schema import ConfigError
+from verifier.digits import digit_problem
 from verifier.textfile import UnreadableText, read_utf8, text_lines
 from verifier.tomlpos import Place, decode_error_position, place_of_key, shown
 
@@ -58,13 +59,13 @@ CONVERTER_KEYS = ("ip", "port", "delay", "connect", "packing", "refuse_until", "
 TCP_PLATFORMS = ("fx5u", "q")
 TCP_CHANNEL = "tcp"
 #: Buffer memory of an intelligent module, as GX Works writes it: U0\G164, U3E\G10.
-BUFFER_MEMORY = re.compile(r"^U([0-9A-F]{1,3})\\G(\d+)$", re.IGNORECASE)
+BUFFER_MEMORY = re.compile(r"^U([0-9A-F]{1,3})\\G([0-9]+)$", re.IGNORECASE)
 #: Buffer-memory words the simulator models per module (0..5FFFH). ASSUMPTION: enough for
 #: the QJ71C24N areas and the QJ71E71 status words (5000H, 5005H) the library uses.
 BUFFER_WORDS = 0x6000
 #: Device names (X0, M8000, D100, SM400, ...) address the device memory, not labels.
-DEVICE_NAME = re.compile(r"^(?:(?:X|Y|B|W|SB|SW)[0-9A-F]+|(?:M|L|F|S|T|C|D|R|ZR|SM|SD)\d+)$", re.IGNORECASE)
-_LABEL_PATH = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\[\d+\])*(\.[A-Za-z_][A-Za-z0-9_]*(\[\d+\])*)*$")
+DEVICE_NAME = re.compile(r"^(?:(?:X|Y|B|W|SB|SW)[0-9A-F]+|(?:M|L|F|S|T|C|D|R|ZR|SM|SD)[0-9]+)$", re.IGNORECASE)
+_LABEL_PATH = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\[[0-9]+\])*(\.[A-Za-z_][A-Za-z0-9_]*(\[[0-9]+\])*)*$")
 
 Value = bool | int | float
 
@@ -178,9 +179,10 @@ class Scenario:
                 key = f"{expectation.key}.{expectation.kind}"
                 uses.append(LabelUse(key, self.key_lines.get(key), tuple(sorted(expectation.condition.names)),
                                      condition=expectation.condition))
-        for step in self.inputs:
+        for step in self.inputs:  # each label at its own name in the table `set`
             key = f"{step.key}.set"
-            uses.append(LabelUse(key, self.key_lines.get(key), tuple(step.values), values=dict(step.values)))
+            uses += [LabelUse(key, self.key_lines.get(f"{key}.{name}", self.key_lines.get(key)), (name,),
+                              values={name: value}) for name, value in step.values.items()]
         for i, name in enumerate(self.watch):
             uses.append(LabelUse(f"watch[{i}]", self.key_lines.get(f"watch[{i}]"), (name,)))
         signal = self.options.response_signal
@@ -272,10 +274,11 @@ class _Reader:
 
     # --- errors --------------------------------------------------------------------------
 
-    def fail(self, key: str, message: str, offset: int = 0, at_name: bool = False) -> ScenarioError:
-        """The error at `key`'s value (at the key itself with `at_name`); `offset` moves the
-        column into a string value (a condition's own column, 1-based, past the quote)."""
-        place = place_of_key(self.lines, key, at_name)
+    def fail(self, key: str, message: str, offset: int = 0, at_name: bool = False, at: str = "") -> ScenarioError:
+        """The error at `key`'s value (at the key itself with `at_name`; at the key `at` instead
+        when given: a label in an input's `set`); `offset` moves the column into a string value
+        (a condition's own column, 1-based, past the quote)."""
+        place = place_of_key(self.lines, at or key, at_name)
         if place is not None and offset:
             place = Place(place.line, place.col + offset)
         return ScenarioError(self.path, key, message, place)
@@ -329,10 +332,14 @@ class _Reader:
             raise self.fail(key, f"{exc.message} at column {exc.column} of {text!r}",
                             offset=exc.column if self._quoted(key) else 0) from None
 
-    def label(self, value: Any, key: str) -> str:
+    def label(self, value: Any, key: str, at: str = "") -> str:
+        """A label path; `at` is the key that names it, when it is a key (an input's `set`)."""
         text = self.string(value, key)
+        if problem := digit_problem(text):  # wBuf[٢]
+            raise self.fail(key, f"{text!r}: {problem}", at_name=bool(at), at=at)
         if not _LABEL_PATH.match(text):
-            raise self.fail(key, f"{text!r} is not a label path (e.g. o_bOK, fbRobot.o_uState, wBuf[2])")
+            raise self.fail(key, f"{text!r} is not a label path (e.g. o_bOK, fbRobot.o_uState, wBuf[2])",
+                            at_name=bool(at), at=at)
         return text
 
     # --- the document ----------------------------------------------------------------------
@@ -418,8 +425,14 @@ class _Reader:
             platform=platform, channel=channel, duration_us=duration, scan_us=scan, scan_jitter_us=jitter, seed=seed,
             watch=watch, settings=settings, robot=robot, faults=faults, inputs=inputs,
             expectations=expectations, options=options, response_signal_given=signal_given,
-            key_lines={key: self.line_of(key) for key in keys}, initial=initial, c24=c24, converter=converter,
+            key_lines={key: self.line_of(key) for key in keys} | self.set_names(inputs), initial=initial, c24=c24,
+            converter=converter,
         )
+
+    def set_names(self, inputs: tuple[InputStep, ...]) -> dict[str, Place | None]:
+        """Where each label an input sets is named (`inputs[0].set.X0`), for the errors about it."""
+        return {f"{step.key}.set.{name}": place_of_key(self.lines, f"{step.key}.set.{name}", at_name=True)
+                for step in inputs for name in step.values}
 
     def converter(self, value: Any, platform: str, duration: int) -> ConverterConfig:
         item = self.table(value, "converter")
@@ -468,6 +481,8 @@ class _Reader:
         result = []
         for name, item in table.items():
             key = f"initial.{name}"
+            if problem := digit_problem(name):  # 'U0\G１６４'
+                raise self.fail(key, problem, at_name=True)
             match = BUFFER_MEMORY.match(name)
             if match and int(match.group(2)) >= BUFFER_WORDS:
                 raise self.fail(key, f"buffer memory ends at G{BUFFER_WORDS - 1} in the simulator")
@@ -560,7 +575,7 @@ class _Reader:
             raise self.fail(f"{key}.set", "sets nothing")
         checked: dict[str, Value] = {}
         for name, value in values.items():
-            self.label(name, f"{key}.set")
+            self.label(name, f"{key}.set", at=f"{key}.set.{name}")
             if isinstance(value, (bool, int, float)):
                 checked[name] = value
             else:
