@@ -45,11 +45,19 @@ def wait_for_line(proc: subprocess.Popen, words: str, timeout_s: float = WAIT_S)
 
 
 class Master:
-    """A PLC stand-in on the line's PLC end: writes requests at chosen times, reads replies."""
+    """A PLC stand-in on the line's PLC end: writes requests at chosen times, reads replies.
+
+    It also notes when the host stalled the run (`stalls`): when it woke up late for a
+    request, or a reply it waited for did not come in time (the emulator was not run).
+    `sent_at` holds when each request was written (monotonic seconds)."""
+
+    LATE_S = 0.05  # what the tests allow the host (the monitor's --tolerance)
 
     def __init__(self, device: str):
         self.fd = os.open(device, os.O_RDWR | os.O_NOCTTY)
         self.t0 = time.monotonic()
+        self.sent_at: list[float] = []
+        self.stalls: list[str] = []
 
     def at(self, t_s: float) -> None:
         """Wait until `t_s` after the start. A master that is late (a loaded host) moves
@@ -60,9 +68,12 @@ class Master:
         if now < target:
             time.sleep(target - now)
             now = time.monotonic()
+        if now - target > self.LATE_S:
+            self.stalls.append(f"woke {(now - target) * 1000:.0f} ms late for the request at {t_s:.3f} s")
         self.t0 += now - target if now > target else 0.0
 
     def send(self, data: bytes, reply_length: int | None = 8, timeout_s: float = 0.2) -> bytes:
+        self.sent_at.append(time.monotonic())
         os.write(self.fd, data)
         got = b""
         deadline = time.monotonic() + timeout_s
@@ -70,6 +81,9 @@ class Master:
             ready, _, _ = select.select([self.fd], [], [], 0.01)
             if ready:
                 got += os.read(self.fd, 64)
+        if reply_length and len(got) < reply_length:
+            self.stalls.append(f"{len(got)} of {reply_length} reply bytes within {timeout_s * 1000:.0f} ms "
+                               f"of request {len(self.sent_at)}")
         return got
 
     def close(self) -> None:

@@ -9,12 +9,14 @@ from __future__ import annotations
 
 import json
 import random
+import re
 import signal
 import socket
 import os
 import subprocess
 import threading
 import time
+import warnings
 from collections import Counter
 from pathlib import Path
 
@@ -320,25 +322,69 @@ def test_mbpoll_and_the_emulator_seen_by_the_monitor(line, tmp_path):
     assert report["scenarios"][0]["frames"] == {"tx": 3, "rx": 3}
 
 
+_SEEN_REQUEST = re.compile(r"^\s*([0-9]+\.[0-9]+) s  PLC → robot ", re.M)
+
+
+def _host_stalls(master: Master, out: str) -> list[str]:
+    """How the host stalled a real-time run, as measured apart from what is tested: the
+    master woke late or waited in vain for a reply (Master.stalls), or the monitor saw two
+    requests further apart or closer than the master wrote them (its tap was not run)."""
+    stalls = list(master.stalls)
+    seen = [float(t) for t in _SEEN_REQUEST.findall(out)]
+    if len(seen) == len(master.sent_at):
+        for k in range(1, len(seen)):
+            wrote, saw = master.sent_at[k] - master.sent_at[k - 1], seen[k] - seen[k - 1]
+            if abs(saw - wrote) > Master.LATE_S:
+                stalls.append(f"requests {k} and {k + 1}: written {wrote * 1000:.0f} ms apart, "
+                              f"seen {saw * 1000:.0f} ms apart")
+    return stalls
+
+
 @pytest.mark.serial
-def test_the_simulated_plc_driving_the_emulator_is_compliant(line, tmp_path):
+def test_the_simulated_plc_driving_the_emulator_is_compliant(tmp_path):
     """The requests of `uitamr verify`'s FX3U example, sent at their times on the real
-    line to the emulated robot: the monitor finds nothing to blame."""
+    line to the emulated robot: the monitor finds nothing to blame.
+
+    Real time on a loaded host: an attempt with findings while the host demonstrably
+    stalled it (measured by the master and by comparing what it wrote with what the
+    monitor saw, `_host_stalls`) proves nothing and runs again on a fresh line. Findings
+    without a stall fail at once; three stalled attempts fail too, saying so."""
     result = run_scenario(load_scenario(ROOT / "plc" / "scenarios" / "fx3u-healthy.toml"))
     requests = [f for f in result.trace if f.direction == "tx" and f.t_start_us < 4_000_000]
     assert len(requests) >= 8
-    monitor = monitor_on(line, tmp_path, "--duration", "5.5s", "--tolerance", "50ms")  # host scheduling
-    master = Master(line.plc)
-    try:
-        for request in requests:
-            master.at(request.t_start_us / 1_000_000)
-            master.send(request.data)
-    finally:
-        master.close()
-    out, err = monitor.communicate(timeout=WAIT_S)
-    assert monitor.returncode == 0, out + err
-    assert findings(tmp_path / "m.json") == Counter()
-    assert out.count("PLC → robot") == len(requests)
+    stalled = []
+    for attempt in range(3):
+        folder = tmp_path / f"attempt{attempt}"
+        folder.mkdir()
+        bus = LineBus(folder)
+        robot = start("emulate", "--serial", bus.robot)
+        try:
+            wait_for_line(robot, "listening")
+            monitor = monitor_on(bus, folder, "--duration", "5.5s", "--tolerance", "50ms")  # host scheduling
+            master = Master(bus.plc)
+            try:
+                for request in requests:
+                    master.at(request.t_start_us / 1_000_000)
+                    master.send(request.data)
+            finally:
+                master.close()
+            out, err = monitor.communicate(timeout=WAIT_S)
+        finally:
+            robot.terminate()
+            robot.communicate(timeout=WAIT_S)
+            bus.close()
+        clean = monitor.returncode == 0 and findings(folder / "m.json") == Counter()
+        stalls = _host_stalls(master, out)
+        if not clean and stalls:  # findings the host's stall can explain: this attempt proves nothing
+            stalled.append(f"attempt {attempt + 1}: " + "; ".join(stalls) + "\n" + out)
+            continue
+        assert monitor.returncode == 0, out + err
+        assert findings(folder / "m.json") == Counter()
+        assert out.count("PLC → robot") == len(requests)
+        if stalled:  # shown in the run's warnings summary: how often the host got in the way
+            warnings.warn("host stalls before the clean attempt: " + " | ".join(s.splitlines()[0] for s in stalled))
+        return
+    pytest.fail("the host stalled every attempt, nothing was tested:\n" + "\n".join(stalled))
 
 
 @pytest.mark.serial
