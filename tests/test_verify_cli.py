@@ -201,6 +201,25 @@ def test_matrix_of_a_tcp_program_runs_the_converter_scenarios_only(tmp_path):
     assert [e["expectation"] for e in refused["expectations"]] == ["sent stop within 5 s after 3 s"]
 
 
+def test_a_plain_run_of_a_tcp_program_puts_the_robot_behind_a_healthy_converter(tmp_path):
+    """`uitamr verify SOURCES` of a program that opens a TCP connection (the FX5U Ethernet
+    example, its library folder holding the serial ports too) runs the healthy robot behind
+    the default converter, as --matrix does, instead of on the silent serial port fx5:1."""
+    report = tmp_path / "tcp.json"
+    sources = [PLC / d for d in ("core", "fx5", "examples/common")] + \
+        [PLC / "examples" / "fx5" / "UITAMR_ExampleTcpFx5.st"]
+    result = invoke(*sources, "--duration", "3s", "--json", report)
+    assert result.exit_code == 0, result.output
+    (scenario,) = json.loads(report.read_text())["scenarios"]
+    assert (scenario["platform"], scenario["channel"]) == ("fx5u", "tcp")
+    assert scenario["frames"]["tx"] >= 5 and scenario["expectations"][0]["passed"]
+    assert "192.168.3.50:4001" in scenario["description"]
+    serial = [PLC / d for d in ("core", "fx5", "examples/common")] + [PLC / "examples" / "fx5" / "UITAMR_ExampleFx5.st"]
+    result = invoke(*serial, "--duration", "2s", "--json", report)
+    assert result.exit_code == 0, result.output
+    assert json.loads(report.read_text())["scenarios"][0]["channel"] == "fx5:1"
+
+
 def test_matrix_needs_a_platform_it_can_tell(tmp_path):
     plain = tmp_path / "Plain.st"
     plain.write_text("PROGRAM Plain\nVAR\n    w : INT;\nEND_VAR\nw := w + 1;\nEND_PROGRAM\n", encoding="utf-8")

@@ -89,6 +89,7 @@ _CHANNEL_PLATFORMS = {channel.split(":")[0]: platform for platform, (_, channel)
 
 
 def _scenarios(sources, program, platform, channel, scenario_files, matrix, duration, scan, seed) -> list[Scenario]:
+    from verifier.link.converter import ConverterConfig
     from verifier.verify.matrix import for_user_sources, without_repeats
     from verifier.verify.platform import infer_platform, platforms_that_load, uses_tcp_route
 
@@ -134,6 +135,13 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
                 platform = fits[0] if len(fits) == 1 else None  # else the default, fx3u (ST errors show there)
                 overrides["platform"] = platform
             own = [replace(default_scenario(duration_us=duration or DEFAULT_DURATION_US), sources=resolved)]
+            if resolved and uses_tcp_route(resolved, program):
+                # a program that opens a TCP connection reaches the robot through a
+                # converter, as --matrix runs it: the healthy one of [converter]'s defaults
+                converter = ConverterConfig()
+                own = [replace(own[0], converter=converter, description=(
+                    f"default: a healthy robot behind a healthy converter at {converter.ip}:{converter.port}, "
+                    "no faults, no inputs"))]
         scenarios = [s.with_overrides(**overrides) for s in own]
         scenarios += [s.with_overrides(**{**overrides, "platform": None}) for s in bundled]
     if duration is not None:
