@@ -498,6 +498,42 @@ def test_the_fx5_second_port_can_carry_the_robot(tmp_path):
     assert result["channel"] == "fx5:2" and result["frames"]["tx"] > 10
     failed = invoke("--scenario", copy, "--channel", "fx5:1")
     assert failed.exit_code == 1 and "the program sent nothing on fx5:1 in the whole run" in failed.output
+    assert "frame(s) on fx5:2: the robot hangs on fx5:1 in this run: give --channel fx5:2" in failed.output
+
+
+def test_a_silent_run_says_where_the_program_did_talk(tmp_path):
+    """Nothing on the robot's line: the note names the route the program used instead and
+    the setting that puts the robot there - the ADPRW port (adp:1), a TCP connection with no
+    [converter], a converter at another address, a serial port under a [converter]."""
+    fx5 = [PLC / "core", PLC / "fx5", PLC / "examples" / "common"]
+    adprw = invoke(*fx5, PLC / "examples" / "fx5" / "UITAMR_ExampleAdpFx5.st", "--duration", "2s")
+    assert adprw.exit_code == 1
+    assert ("the program sent nothing on fx5:1 in the whole run; it sent 1 frame(s) on adp:1: the robot hangs on "
+            'fx5:1 in this run: give --channel adp:1, or channel = "adp:1" in the scenario') in adprw.output
+    assert invoke(*fx5, PLC / "examples" / "fx5" / "UITAMR_ExampleAdpFx5.st", "--duration", "2s",
+                  "--channel", "adp:1").exit_code == 0
+    healthy = (PLC / "scenarios" / "fx5u-tcp-healthy.toml").read_text(encoding="utf-8")
+    healthy = healthy.replace('"../', f'"{PLC.as_posix()}/')
+    serial = tmp_path / "tcp-without-converter.toml"
+    serial.write_text(healthy.replace("[converter]", "[robot.unused]").split("[robot.unused]")[0]
+                      + "[[expect]]\nsent = \"stop\"\n", encoding="utf-8")
+    result = invoke("--scenario", serial, "--duration", "3s")
+    assert result.exit_code == 1
+    assert "it opened TCP connections" in result.output and "add a [converter] table" in result.output
+    elsewhere = tmp_path / "converter-elsewhere.toml"
+    elsewhere.write_text(healthy.replace('ip = "192.168.3.50"', 'ip = "192.168.3.60"'), encoding="utf-8")
+    result = invoke("--scenario", elsewhere, "--duration", "3s")
+    assert result.exit_code == 1
+    assert ("nothing reached the robot's line through the converter: the PLC opens a connection to "
+            "192.168.3.50:4001: nothing answers there (the converter is at 192.168.3.60:4001); set the "
+            "scenario's [converter] ip and port to what the program opens") in result.output
+    rs2 = (PLC / "scenarios" / "fx5u-healthy.toml").read_text(encoding="utf-8").replace('"../', f'"{PLC.as_posix()}/')
+    behind = tmp_path / "rs2-behind-a-converter.toml"
+    behind.write_text(rs2.replace("[robot]", "[converter]\n\n[robot]"), encoding="utf-8")
+    result = invoke("--scenario", behind, "--duration", "3s")
+    assert result.exit_code == 1
+    assert "the program opened no connection to it)" in result.output
+    assert "frame(s) on fx5:1: a serial port, not the TCP route: drop [converter] from the scenario" in result.output
 
 
 def test_a_reader_that_goes_away_loses_no_report(tmp_path):

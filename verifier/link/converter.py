@@ -86,6 +86,8 @@ class Converter:
         self.events: list[LineEvent] = []
         self.event_count = 0  # events made so far (a run judged as it goes may drop old ones)
         self.connection = 0  # current accepted connection (0: none)
+        self.open_count = 0  # opens the PLC tried
+        self.first_failed_open: str | None = None  # why the first open that failed did (for a silent run's note)
         self._count = 0
         self._closed_at: dict[int, int] = {}  # connection the converter dropped -> when the PLC learns it
         self._to_line: deque[tuple[int, int, bytes, str | None]] = deque()  # (t, connection, data, origin)
@@ -94,11 +96,17 @@ class Converter:
         self._drops = sorted(self.config.drops)
         self.now_us = 0
 
+    @property
+    def accepted_count(self) -> int:
+        """Connections the converter has accepted so far."""
+        return self._count
+
     # ---- the PLC's side ------------------------------------------------------------------
 
     def open(self, t_us: int, ip: str, port: int) -> OpenResult:
         """An active open from the PLC at `t_us` to ip:port."""
         self._work_until(t_us)
+        self.open_count += 1
         cfg = self.config
         done = t_us + cfg.connect_us
         target = f"{ip}:{port}"
@@ -259,5 +267,7 @@ class Converter:
         self._to_line.clear()
 
     def _event(self, t_us: int, kind: str, message: str, frames: tuple[bytes, ...] = ()) -> None:
+        if kind in ("converter.unreachable", "converter.refused") and self.first_failed_open is None:
+            self.first_failed_open = message
         self.events.append(LineEvent(t_us, kind, message, frames))
         self.event_count += 1

@@ -381,6 +381,39 @@ def _input_schedule(scenario: Scenario) -> list[tuple[int, dict[str, Any]]]:
     return sorted(steps, key=lambda s: s[0])
 
 
+def _silence_note(scenario: Scenario, plc: _Plc, converter: Converter | None) -> str:
+    """What a run in which nothing reached the robot's line says: and, where the program did
+    talk, where to (another serial port, a TCP connection, a converter that was not there),
+    with the setting that puts the robot on that route."""
+    from verifier.sim.instructions.tcp import TcpPort
+
+    rt = plc.project.rt
+    channel = scenario.serial_channel
+    note = f"the program sent nothing on {channel} in the whole run"
+    other = {name: port.sent_count for name, port in sorted(rt.ports.items())
+             if port.sent_count and name != channel}
+    sent = "; ".join(f"it sent {count} frame(s) on {name}" for name, count in other.items())
+    if converter is not None:
+        note += " (nothing reached the robot's line through the converter"
+        if converter.open_count == 0:
+            note += ": the program opened no connection to it"
+        elif converter.first_failed_open is not None and converter.accepted_count == 0:
+            note += f": {converter.first_failed_open}; set the scenario's [converter] ip and port to what the program opens"
+        note += ")"
+        if sent:
+            note += f"; {sent}: a serial port, not the TCP route: drop [converter] from the scenario"
+        return note
+    opens = sum(poller.open_count for poller in rt.pollers if isinstance(poller, TcpPort))
+    if sent:
+        first = next(iter(other))
+        note += (f"; {sent}: the robot hangs on {channel} in this run: give --channel {first}, "
+                 f'or channel = "{first}" in the scenario')
+    elif opens:
+        note += (f"; it opened TCP connections ({opens} open(s)): the robot is behind a serial-to-TCP converter "
+                 "on that route: add a [converter] table to the scenario (docs/scenarios.md)")
+    return note
+
+
 def _judge_whole(scenario: Scenario, trace: list[TraceRecord], end_us: int, events: list[LineEvent],
                  samples: Samples, stopped_early: bool):
     """Every rule's violations and every expectation's result, the run judged as a whole."""
@@ -522,9 +555,5 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         aborted=aborted,
         ended_us=end,
         wall_s=time.perf_counter() - wall_start,
-        notes=list(scenario.notes) + plc.cpu_notes() + (
-            [] if tx_count
-            else [f"the program sent nothing on {scenario.serial_channel} in the whole run"
-                  + (" (nothing reached the robot's line through the converter)" if converter is not None else "")]
-        ),
+        notes=list(scenario.notes) + plc.cpu_notes() + ([] if tx_count else [_silence_note(scenario, plc, converter)]),
     )
