@@ -23,6 +23,7 @@ END_PROGRAM
 """
 
 
+Q_SERIAL = "a QJ71C24N is driven with G_OUTPUT / G_INPUT and its switch settings (UITAMR_PortQC24, docs/import-gxworks2.md)"
 SM400_ON_FX3U = "device SM400: the fx3u has no SM devices; its special relays are M8000..M8511: use M8000 (always ON)"
 
 
@@ -57,10 +58,12 @@ def test_sm400_on_an_fx3u_is_an_error_at_its_place(tmp_path):
     q = run("--platform", "q", bad)  # SM400 and D8403 are Q devices; D8403 an ordinary one
     assert q.exit_code == 0
     assert q.output.splitlines()[0] == (f"{bad}:5:6: warning: D8403 is an ordinary data register on the q "
-                                        "(the CPU never sets it); FX3 special registers are SD devices on the q")
+                                        "(the CPU never sets it); the FX3's D8403 (RS2 ch1 received byte count) "
+                                        "has no device on the q: a QJ71C24N is driven with G_OUTPUT / G_INPUT and "
+                                        "its switch settings (UITAMR_PortQC24, docs/import-gxworks2.md)")
     assert errors(run("--platform", "fx5u", bad).output) == [  # the FX5U has SM400 but D0..D7999
         f"{bad}:5:6: error: device D8403 does not exist on the fx5u: D runs D0..D7999; "
-        "FX3 special registers are SD devices on the fx5u"]
+        "the FX3's D8403 (RS2 ch1 received byte count) is SD8561 on the fx5u (docs/instructions.md §8)"]
 
 
 @pytest.mark.parametrize("platform, body, col, message", [
@@ -72,8 +75,18 @@ def test_sm400_on_an_fx3u_is_an_error_at_its_place(tmp_path):
                                "FX3 special registers are SD devices on the fx5u"),
     ("fx5u", "x := D8067;", 6, "device D8067 does not exist on the fx5u: D runs D0..D7999; the FX3's special "
                                "register D8067 (operation error code) is SD0 on the fx5u"),
-    ("q", "b := M8402;", 6, "device M8402 does not exist on the q: M runs M0..M8191; "
+    ("q", "b := M8402;", 6, "device M8402 does not exist on the q: M runs M0..M8191; the FX3's M8402 (RS2 ch1 "
+                            "send request) has no device on the q: a QJ71C24N is driven with G_OUTPUT / G_INPUT "
+                            "and its switch settings (UITAMR_PortQC24, docs/import-gxworks2.md)"),
+    ("q", "b := M8500;", 6, "device M8500 does not exist on the q: M runs M0..M8191; "
                             "FX3 special relays are SM devices on the q"),
+    # the FX3's serial devices, moved to an FX5U: its own RS2 devices, or the module parameters
+    ("fx5u", "x := D8400;", 6, "device D8400 does not exist on the fx5u: D runs D0..D7999; the FX3's D8400 "
+                               "(RS2 ch1 communication format) has no device on the fx5u: its serial ports take "
+                               "the line settings from the module parameters (GX Works3: Module Parameter > 485 "
+                               "Serial Port, docs/import-gxworks3.md §4)"),
+    ("fx5u", "x := D8429;", 6, "device D8429 does not exist on the fx5u: D runs D0..D7999; the FX3's D8429 "
+                               "(RS2 ch2 receive time-out) is SD8631 on the fx5u, in ms (docs/instructions.md §8)"),
     ("q", "x := W2000;", 6, "device W2000 does not exist on the q: W runs W0..W1FFF"),  # hexadecimal
     ("fx3u", "x := SD0;", 6, "device SD0: the fx3u has no SD devices; its special registers are "
                              "D8000..D8511: use D8067 (operation error code)"),
@@ -96,8 +109,15 @@ def test_device_out_of_range_or_unknown_to_the_cpu(tmp_path, platform, body, col
                          "the FX3's special relay M8013 (1000 ms clock) is SM412 on the q"),
     ("fx5u", "b := M8000;", "M8000 is an ordinary internal relay on the fx5u (the CPU never sets it); "
                             "the FX3's special relay M8000 (always ON) is SM400 or SM8000 on the fx5u"),
-    ("q", "x := D8400;", "D8400 is an ordinary data register on the q (the CPU never sets it); "
+    ("q", "x := D8400;", "D8400 is an ordinary data register on the q (the CPU never sets it); the FX3's "
+                         "D8400 (RS2 ch1 communication format) has no device on the q: " + Q_SERIAL),
+    ("q", "x := D8100;", "D8100 is an ordinary data register on the q (the CPU never sets it); "
                          "FX3 special registers are SD devices on the q"),
+    ("fx5u", "b := M8402;", "M8402 is an ordinary internal relay on the fx5u (the CPU never sets it); the FX3's "
+                            "M8402 (RS2 ch1 send request) is SM8561 on the fx5u (docs/instructions.md §8)"),
+    ("fx5u", "b := M8161;", "M8161 is an ordinary internal relay on the fx5u (the CPU never sets it); the FX3's "
+                            "M8161 (8-bit mode of CRC) is SM8161 on the fx5u (docs/instructions.md §6); RS2's "
+                            "8-bit mode is SD8622 / SD8632 there"),
 ])
 def test_an_fx3_special_number_on_another_cpu_is_a_warning_that_names_its_equivalent(
         tmp_path, platform, body, message):

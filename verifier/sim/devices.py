@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from .cpu import FX3_SPECIAL, FX3_SPECIAL_RANGE, Area, CpuProfile, special_equivalent
+from .cpu import FX3_SPECIAL, FX3_SPECIAL_RANGE, Area, CpuProfile, fx3_serial_equivalent, special_equivalent
 from .datatypes import wrap16, wrap32
 
 _DEVICE_RE = re.compile(r"^(?:K([1-8]))?([A-Z]{1,2})([0-9A-F]+)(?:\.([0-9A-F]))?$")
@@ -127,6 +127,9 @@ def _fx3_phrase(kind: str, index: int, cpu: CpuProfile) -> str:
     """What an FX3 special relay/register number (M8002, D8400) is on `cpu`, whose special
     devices are SM/SD: its equivalent if `cpu` drives the same thing, else where to look."""
     area, what = FX3_SPECIAL[kind]
+    serial = fx3_serial_equivalent(f"{kind}{index}", cpu)
+    if serial is not None:
+        return serial
     same = special_equivalent(f"{kind}{index}", cpu)
     if same:
         return (f"the FX3's special {what} {kind}{index} ({same[0]}) is "
