@@ -563,3 +563,31 @@ def test_a_channel_without_a_platform_picks_the_cpu_it_belongs_to(tmp_path):
     assert (scenario["platform"], scenario["channel"]) == ("q", "q:1")
     refused = invoke(source, "--channel", "q:1", "--platform", "fx3u", "--duration", "2s")
     assert refused.exit_code == 2 and "channel q:1 does not exist on the fx3u CPU" in refused.output
+
+
+def test_a_scenario_without_expectations_expects_the_answered_power_on_stop(tmp_path):
+    """Judged by the rules alone, a program that never reaches the robot breaks none: a
+    scenario with no [[expect]] expects the power-on stop, as a run without a scenario file
+    does - a TCP program whose converter is elsewhere fails, the healthy one passes."""
+    healthy = (PLC / "scenarios" / "fx5u-tcp-healthy.toml").read_text(encoding="utf-8")
+    healthy = healthy.replace('"../', f'"{PLC.as_posix()}/').split("[[inputs]]")[0]
+    assert "[[expect]]" not in healthy
+    fine = tmp_path / "rules-only.toml"
+    fine.write_text(healthy, encoding="utf-8")
+    report = tmp_path / "r.json"
+    result = invoke("--scenario", fine, "--duration", "3s", "--json", report)
+    assert result.exit_code == 0, result.output
+    (scenario,) = json.loads(report.read_text())["scenarios"]
+    assert [e["expectation"] for e in scenario["expectations"]] == ["sent stop within 3 s"]
+    assert scenario["notes"][0].startswith("no [[expect]] in the scenario: it expects what every program must do")
+    elsewhere = tmp_path / "converter-elsewhere.toml"
+    elsewhere.write_text(healthy.replace('ip = "192.168.3.50"', 'ip = "192.168.3.60"'), encoding="utf-8")
+    result = invoke("--scenario", elsewhere, "--duration", "3s")
+    assert result.exit_code == 1, result.output
+    assert "expected sent stop within 3 s: stop (01/A0)" in result.output
+    refused = tmp_path / "refused.toml"
+    refused.write_text(healthy.replace("delay = ", 'refuse_until = "4s"\ndelay = '), encoding="utf-8")
+    result = invoke("--scenario", refused, "--duration", "20s", "--json", report)
+    assert result.exit_code == 0, result.output
+    assert json.loads(report.read_text())["scenarios"][0]["expectations"][0]["expectation"] == \
+        "sent stop within 5 s after 4 s"

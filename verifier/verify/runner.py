@@ -25,7 +25,7 @@ from .evidence import RunEvidence, Samples
 from .expectations import judge
 from .result import KEEP_ALL, Keep, LineEvent, ScenarioResult, TraceRecord, UnusableInput
 from .rules import check_all
-from .scenario import BUFFER_MEMORY, DEVICE_NAME, Scenario
+from .scenario import BUFFER_MEMORY, DEVICE_NAME, Scenario, power_on_stop_expectation
 from .stream import Stream
 from .traffic import analyse, converter_drops
 
@@ -381,6 +381,20 @@ def _input_schedule(scenario: Scenario) -> list[tuple[int, dict[str, Any]]]:
     return sorted(steps, key=lambda s: s[0])
 
 
+def _expecting_something(scenario: Scenario) -> Scenario:
+    """A scenario with no expectation expects what every program must do - the power-on
+    stop sent and answered, after a converter's refusals - as the run without a scenario
+    file and --matrix do: judged by the rules alone, a program that never reaches the robot
+    (a wrong channel, a converter at another address) would break none and pass."""
+    if scenario.expectations:
+        return scenario
+    converter = scenario.converter
+    reachable = min(converter.refuse_until_us, scenario.duration_us // 2) if converter is not None else 0
+    stop = power_on_stop_expectation(scenario.duration_us, scenario.settings.address, reachable)
+    note = "no [[expect]] in the scenario: it expects what every program must do, the power-on stop sent and answered"
+    return replace(scenario, expectations=(stop,), notes=(note,) + scenario.notes)
+
+
 def _silence_note(scenario: Scenario, plc: _Plc, converter: Converter | None) -> str:
     """What a run in which nothing reached the robot's line says: and, where the program did
     talk, where to (another serial port, a TCP connection, a converter that was not there),
@@ -435,6 +449,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     watched labels by their names on each, recording them all: the reference the fast
     path is tested against (same result, byte for byte; `uitamr verify --every-scan`)."""
     wall_start = time.perf_counter()
+    scenario = _expecting_something(scenario)
     robot = Robot(scenario.settings, scenario.robot, list(scenario.faults))
     line = Line(robot)
     # the TCP route: the PLC talks to a converter, the rules judge the line behind it
