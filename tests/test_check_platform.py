@@ -331,3 +331,23 @@ def test_verify_notes_an_fx3_special_number_in_the_program_it_runs(tmp_path):
         f"{tmp_path / 'UITAMR_ExampleQ.st'}:59:18: M8002 is an ordinary internal relay on the q (the CPU never sets "
         "it); the FX3's special relay M8002 (ON in the first scan) is SM402 on the q"], result.output
     assert "Fx3Beside" not in result.output
+
+
+@pytest.mark.parametrize("platform, call, dotted, st", [
+    ("fx5u", "SP.SOCOPEN(TRUE, 'U0', 1, w[0], b[0]);", "SP.SOCOPEN", "SP_SOCOPEN"),
+    ("fx5u", "SP.SOCSND(TRUE, 'U0', 1, w[0], w[2], b[0]);", "SP.SOCSND", "SP_SOCSND"),
+    ("q", "ZP.OPEN(TRUE, 'U0', 1, w[0], b[0]);", "ZP.OPEN", "ZP_OPEN"),
+    ("q", "G.OUTPUT(TRUE, 16#0, w[0], w[3], b[0]);", "G.OUTPUT", "G_OUTPUT"),
+])
+def test_an_instruction_in_its_ladder_spelling_is_one_error_that_gives_the_st_name(
+        tmp_path, platform, call, dotted, st):
+    """An integrator copies SP.SOCOPEN from the FX5 manual's ladder: one error that names
+    the ST spelling (st-dialect.md §1), not 'undefined label SP' plus 'only labels ... can be
+    called'."""
+    path = write(tmp_path, program(call, "w : ARRAY[0..9] OF WORD; b : ARRAY[0..1] OF BOOL;"))
+    done = run("--platform", platform, path)
+    assert done.exit_code == 1
+    assert errors(done.output) == [f"{path}:5:1: error: {dotted} is how ladder writes the instruction; ST writes "
+                                   f"it with an underscore: {st}(...)"]
+    member = write(tmp_path, program("fbX.o_bOK(1);", "fbX : TON;"), "m.st")  # a real label's member: as before
+    assert "only labels, functions and instructions can be called" in run("--platform", platform, member).output
