@@ -277,6 +277,22 @@ def test_an_instruction_the_cpu_lacks_is_one_error_not_also_its_other_cpus_opera
     assert len(on_fx3) == 3
 
 
+@pytest.mark.parametrize("platform, call, message", [
+    ("fx5u", "ZP_OPEN(TRUE, 'U0', 1, w[0], b[0]);", "ZP_OPEN does not exist on the fx5u (it is a q instruction)"),
+    ("q", "SP_SOCOPEN(TRUE, 'U0', 1, w[0], b[0]);", "SP_SOCOPEN does not exist on the q (it is a fx5 instruction)"),
+])
+def test_an_instruction_of_the_other_editor_is_one_error_too(tmp_path, platform, call, message):
+    # the QJ71E71's ZP_OPEN in an FX5U program is not also 'not available for GX Works3': the
+    # CPU's error names the CPU that has it; without --platform the editor's error stands
+    path = write(tmp_path, program(call, "w : ARRAY[0..9] OF WORD; b : ARRAY[0..1] OF BOOL;"))
+    assert errors(run("--platform", platform, path).output) == [f"{path}:5:1: error: {message}"]
+    editor = "GX Works3" if platform == "fx5u" else "GX Works2"
+    target = "gxworks3" if platform == "fx5u" else "gxworks2"
+    name = call.split("(")[0]
+    assert errors(run("--target", target, path).output) == [
+        f"{path}:5:1: error: instruction {name} is not available for {editor}"]
+
+
 def test_check_refuses_the_scenario_devices_verify_refuses_for_its_platform(tmp_path):
     # [initial] and [[inputs]] devices are checked against the scenario's own platform by
     # `uitamr verify` (exit 2 at the key); `uitamr check` said 0 errors for the same file

@@ -777,6 +777,11 @@ class Checker:
         if sig is not None:
             if self.target not in sig.targets:
                 self.rep.error(c.callee, f"instruction {name} is not available for {_target_name(self.target)}")
+                wrong_editor = self.rep.diagnostics[-1]
+                result = self._signature_call(c, sig, statement, "instruction")
+                # with --platform, 'SP_SOCOPEN does not exist on the q' says it better: one error
+                c.resolved.signature_errors.insert(0, wrong_editor)
+                return result
             return self._signature_call(c, sig, statement, "instruction")
         if name in library.INSTRUCTIONS or name == "ADPRW":
             self.rep.error(c.callee, f"instruction {name} is not available for {_target_name(self.target)}")
