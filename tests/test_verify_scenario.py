@@ -403,3 +403,26 @@ def test_the_scenario_channels_are_the_simulators():
     from verifier.verify.scenario import CHANNELS
 
     assert sorted(CHANNELS) == sorted(SIMULATED)
+
+
+@pytest.mark.parametrize("text, place", [
+    ('[robot]\npoint_duraton_s = 8.0\n', "s.toml:2:1: robot.point_duraton_s: unknown key"),
+    ('[[faults]]\nkind = "no_reply"\nat = 3\n', "s.toml:3:1: faults[0].at: unknown key"),
+    ('[[faults]]\nkind = "anti_collision"\nat_s = 1\ncount = 2\n',
+     "s.toml:4:1: faults[0].count: not used by fault 'anti_collision'"),
+    ('[robot]\npoint_duration_s = "8s"\n', "s.toml:2:20: robot.point_duration_s: "),  # a bad value: at the value
+])
+def test_an_unknown_robot_or_fault_key_is_pointed_at_by_its_name(tmp_path, text, place):
+    """scenarios.md: the column is the key itself for an unknown key - in [robot] and
+    [[faults]] too, as at the top level and in [converter]; the emulator's fault files, which
+    hold the same tables, say the same."""
+    with pytest.raises(ScenarioError) as caught:
+        parse_scenario(text, path=Path("s.toml"))
+    assert str(caught.value).startswith(place), str(caught.value)
+    from verifier.emulate.faultfile import FaultFileError, load_fault_file
+
+    bench = tmp_path / "s.toml"
+    bench.write_text(text, encoding="utf-8")
+    with pytest.raises(FaultFileError) as caught:
+        load_fault_file(bench)
+    assert str(caught.value).startswith(str(tmp_path / place)), str(caught.value)

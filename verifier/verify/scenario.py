@@ -535,7 +535,7 @@ class _Reader:
         try:
             return RobotConfig.from_dict(self.table(value, "robot"), "robot")
         except ConfigError as exc:
-            raise self.fail(exc.path, exc.message) from None
+            raise self.fail(exc.path, exc.message, at_name=exc.at_name) from None
 
     def faults(self, value: Any) -> tuple[Fault, ...]:
         items = self.array_of_tables(value, "faults")
@@ -545,7 +545,7 @@ class _Reader:
                 result.append(Fault.from_dict(item, f"faults[{i}]"))
             except ConfigError as exc:
                 path = exc.path if exc.path.startswith("faults[") else f"faults[{i}]"
-                raise self.fail(path, exc.message) from None
+                raise self.fail(path, exc.message, at_name=exc.at_name) from None
         return tuple(result)
 
     def input_step(self, item: dict, key: str, duration: int) -> InputStep:
