@@ -213,7 +213,7 @@ def test_a_plain_run_of_a_tcp_program_puts_the_robot_behind_a_healthy_converter(
     (scenario,) = json.loads(report.read_text())["scenarios"]
     assert (scenario["platform"], scenario["channel"]) == ("fx5u", "tcp")
     assert scenario["frames"]["tx"] >= 5 and scenario["expectations"][0]["passed"]
-    assert "192.168.3.50:4001" in scenario["description"]
+    assert "converter at the address the program opens" in scenario["description"]
     serial = [PLC / d for d in ("core", "fx5", "examples/common")] + [PLC / "examples" / "fx5" / "UITAMR_ExampleFx5.st"]
     result = invoke(*serial, "--duration", "2s", "--json", report)
     assert result.exit_code == 0, result.output
@@ -591,3 +591,30 @@ def test_a_scenario_without_expectations_expects_the_answered_power_on_stop(tmp_
     assert result.exit_code == 0, result.output
     assert json.loads(report.read_text())["scenarios"][0]["expectations"][0]["expectation"] == \
         "sent stop within 5 s after 4 s"
+
+
+def test_matrix_runs_a_tcp_program_with_its_own_converter_address(tmp_path):
+    """The bundled converter's 192.168.3.50:4001 is the example's CONVERTER_IP/PORT: an FX5U
+    program opening its own converter (192.168.10.20:502) passes the TCP scenarios under
+    --matrix, and the note says the example's address was not applied."""
+    from test_verify_pipeline import library_copy
+
+    plc = library_copy(tmp_path, {"examples/fx5/UITAMR_ExampleTcpFx5.st": [
+        ("CONVERTER_IP : DWORD := 16#C0A80332;", "CONVERTER_IP : DWORD := 16#C0A80A14;"),
+        ("CONVERTER_PORT : WORD := 4001;", "CONVERTER_PORT : WORD := 502;")]})
+    sources = [plc / "core", plc / "fx5" / "UITAMR_PortTcpFx5.st", plc / "examples" / "common",
+               plc / "examples" / "fx5" / "UITAMR_ExampleTcpFx5.st"]
+    report = tmp_path / "m.json"
+    result = invoke(*sources, "--matrix", "--duration", "6s", "--json", report)
+    assert result.exit_code == 0, result.output
+    data = json.loads(report.read_text())
+    assert len(data["scenarios"]) == 5
+    for scenario in data["scenarios"]:
+        assert scenario["frames"]["tx"] >= 1 and scenario["expectations"][0]["passed"]
+        assert any("its converter address (192.168.3.50:4001)" in note for note in scenario["notes"])
+    plain = invoke(*sources, "--duration", "3s", "--json", report)
+    assert plain.exit_code == 0, plain.output
+    own = tmp_path / "own.toml"  # a scenario of one's own still tests the address
+    own.write_text("platform = \"fx5u\"\n[converter]\n[[expect]]\nsent = \"stop\"\n", encoding="utf-8")
+    result = invoke(*sources, "--scenario", own, "--duration", "5s")
+    assert result.exit_code == 1 and "192.168.10.20:502: nothing answers there" in result.output

@@ -137,10 +137,9 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
             own = [replace(default_scenario(duration_us=duration or DEFAULT_DURATION_US), sources=resolved)]
             if resolved and uses_tcp_route(resolved, program):
                 # a program that opens a TCP connection reaches the robot through a
-                # converter, as --matrix runs it: the healthy one of [converter]'s defaults
-                converter = ConverterConfig()
-                own = [replace(own[0], converter=converter, description=(
-                    f"default: a healthy robot behind a healthy converter at {converter.ip}:{converter.port}, "
+                # converter, as --matrix runs it: a healthy one, wherever the program opens
+                own = [replace(own[0], converter=ConverterConfig(any_address=True), description=(
+                    "default: a healthy robot behind a healthy converter at the address the program opens, "
                     "no faults, no inputs"))]
         scenarios = [s.with_overrides(**overrides) for s in own]
         scenarios += [s.with_overrides(**{**overrides, "platform": None}) for s in bundled]

@@ -33,7 +33,7 @@ scenario settings because they depend on the module (docs/tcp-converter.md).
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from verifier.link.line import Line
 from verifier.link.trace import LineEvent
@@ -54,9 +54,14 @@ class ConverterConfig:
     drops: tuple[int, ...] = ()
     split_reply: bool = False
     split_gap_us: int = 20_000
+    # listen wherever the PLC opens (ip and port unused): a run whose converter was not
+    # written for the program's constants (a bundled scenario under --matrix, the run
+    # without a scenario file) tests the program, not its converter address
+    any_address: bool = False
 
     def describe(self) -> str:
-        parts = [f"converter {self.ip}:{self.port}", f"delay {self.delay_us / 1000:g} ms",
+        where = "at the address the program opens" if self.any_address else f"{self.ip}:{self.port}"
+        parts = [f"converter {where}", f"delay {self.delay_us / 1000:g} ms",
                  f"packing {self.pack_us / 1000:g} ms"]
         if self.refuse_until_us:
             parts.append(f"refuses connections before {self.refuse_until_us / 1e6:g} s")
@@ -110,6 +115,8 @@ class Converter:
         cfg = self.config
         done = t_us + cfg.connect_us
         target = f"{ip}:{port}"
+        if cfg.any_address:
+            cfg = replace(cfg, ip=ip, port=port)
         if ip != cfg.ip:
             self._event(t_us, "converter.unreachable",
                         f"the PLC opens a connection to {target}: nothing answers there (the converter is at "
