@@ -307,6 +307,33 @@ def test_check_refuses_the_scenario_devices_verify_refuses_for_its_platform(tmp_
     assert run(write(tmp_path, 'platform = "q"\n\n[initial]\nSM400 = true\nD9000 = 1\n', "q.toml")).exit_code == 0
 
 
+def test_a_scenario_without_platform_is_judged_for_the_platform_given(tmp_path):
+    """An FX5U project's scenario that names no platform, checked and verified with
+    --platform fx5u as ci.md does: its FX5U devices and its [converter] are judged for the
+    FX5U both commands run it on, not for the file's default fx3u - check said
+    'SD8621: the fx3u has no SD devices' of a file verify ran, and verify refused the
+    [converter] it would run on the FX5U."""
+    from verifier.commands.verify import command as verify
+
+    plc = ROOT / "plc"
+    text = ('[initial]\nSD8621 = 5\n\n[[inputs]]\nat = "1s"\nset = { SM8561 = false }\n\n'
+            '[converter]\n\n[[expect]]\nsent = "stop"\n')
+    scenario = write(tmp_path, text, "own.toml")
+    done = run("--platform", "fx5u", scenario)
+    assert done.exit_code == 0, done.output
+    assert done.output.splitlines()[-1] == "1 file(s) checked for gxworks3 on the fx5u CPU: 0 error(s), 0 warning(s)"
+    alone = run(scenario)  # no --platform: the file's own default, fx3u
+    assert alone.exit_code == 1
+    assert errors(alone.output)[0] == (
+        f"{scenario}:8:1: error: converter: the TCP route needs a PLC with an Ethernet port the library drives "
+        "(fx5u or q); this scenario names no platform, so it is 'fx3u' (the default): add platform = \"fx5u\" "
+        "(or \"q\") to the file, or give --platform")
+    sources = [plc / "core", plc / "fx5", plc / "examples" / "common", plc / "examples" / "fx5" / "UITAMR_ExampleTcpFx5.st"]
+    ran = CliRunner().invoke(verify, [*map(str, sources), "--scenario", str(scenario), "--platform", "fx5u",
+                                      "--duration", "3s"])
+    assert ran.exit_code == 0, ran.output
+
+
 @pytest.mark.parametrize("spelling", ["FX3U", "Fx3u"])
 def test_the_cpu_may_be_written_as_mitsubishi_writes_it(tmp_path, spelling):
     # the scenario's `platform = "FX3U"` is read in any case; so is the option

@@ -72,7 +72,7 @@ def check_findings(paths: list[Path], target: str,
     findings: list[Finding] = []
     for p in paths:
         if p.suffix.lower() == ".toml":
-            findings += [Finding(d, "UITAMR-SCENARIO") for d in check_scenario(p)]
+            findings += [Finding(d, "UITAMR-SCENARIO") for d in check_scenario(p, platform)]
             continue
         text, problems = read_source(p)
         findings += [Finding(d, "UITAMR-ST-SOURCE") for d in problems]
@@ -107,14 +107,15 @@ def platform_target(platform: str, target: str | None) -> str:
     return editor
 
 
-def check_scenario(path: Path) -> list[Diagnostic]:
+def check_scenario(path: Path, platform: str | None = None) -> list[Diagnostic]:
     """A scenario file read as `uitamr verify` reads it: its TOML, keys, values and the
     sources it names (not the labels it uses: those need the program loaded, which
-    `uitamr verify` does)."""
-    from verifier.verify.scenario import ScenarioError, load_scenario
+    `uitamr verify` does). `platform` (--platform): the CPU of a file that names none, as
+    `uitamr verify --platform` runs it."""
+    from verifier.verify.scenario import PLATFORMS, ScenarioError, load_scenario
 
     try:
-        scenario = load_scenario(path)
+        scenario = load_scenario(path, platform if platform in PLATFORMS else None)
     except ScenarioError as exc:
         message = f"{exc.key}: {exc.message}" if exc.key else exc.message
         return [Diagnostic(str(path), exc.line or 0, exc.col or 0, "error", message)]

@@ -96,7 +96,7 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
     resolved = _source_files(sources) if sources else ()
     scenario_files = _scenario_files(scenario_files)
     given = {real_path(f) for f in scenario_files}
-    own = [load_scenario(f) for f in scenario_files]
+    own = [load_scenario(f, platform) for f in scenario_files]  # --platform: the CPU they run on
     bundled_files: list[Path] = []
     if matrix or (not sources and not scenario_files):
         found = bundled_scenarios()
