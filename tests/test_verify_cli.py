@@ -618,3 +618,23 @@ def test_matrix_runs_a_tcp_program_with_its_own_converter_address(tmp_path):
     own.write_text("platform = \"fx5u\"\n[converter]\n[[expect]]\nsent = \"stop\"\n", encoding="utf-8")
     result = invoke(*sources, "--scenario", own, "--duration", "5s")
     assert result.exit_code == 1 and "192.168.10.20:502: nothing answers there" in result.output
+
+
+def test_a_healthy_converter_is_not_reported_as_a_fault(tmp_path):
+    """The TCP route's converter (its address, delays, and its own scripted drops) is the
+    run's `converter`, not one of the robot's `faults`: the JUnit text of a healthy TCP run
+    said 'fault: converter 192.168.3.50:4001, delay 3 ms, packing 5 ms'."""
+    paths = {kind: tmp_path / f"r.{kind}" for kind in ("json", "xml", "html")}
+    scenario = PLC / "scenarios" / "fx5u-tcp-healthy.toml"
+    result = invoke("--scenario", scenario, "--duration", "3s", "--json", paths["json"], "--junit", paths["xml"],
+                    "--html", paths["html"])
+    assert result.exit_code == 1, result.output  # its point-3 expectation needs the whole run
+    (run,) = json.loads(paths["json"].read_text())["scenarios"]
+    assert run["faults"] == [] and run["converter"] == "converter 192.168.3.50:4001, delay 3 ms, packing 5 ms"
+    out = ET.parse(paths["xml"]).getroot().find(".//system-out").text
+    assert "fault:" not in out and "\nconverter 192.168.3.50:4001, delay 3 ms, packing 5 ms" in out
+    assert "<b>TCP route:</b> converter 192.168.3.50:4001" in paths["html"].read_text()
+    assert "<b>Faults:</b>" not in paths["html"].read_text()
+    serial = invoke("--scenario", PLC / "scenarios" / "fx5u-no-reply.toml", "--duration", "2s", "--json", paths["json"])
+    (run,) = json.loads(paths["json"].read_text())["scenarios"]
+    assert run["converter"] is None and run["faults"] == ["no_reply at 4 s for 4 s"], serial.output

@@ -556,8 +556,8 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         settings=scenario.settings,
         min_period_us=scenario.options.min_period_us,
         reply_timeout_us=scenario.options.reply_timeout_us,
-        faults=[fault.describe() for fault in scenario.faults]
-        + ([scenario.converter.describe()] if scenario.converter is not None else []),
+        faults=[fault.describe() for fault in scenario.faults],
+        converter=scenario.converter.describe() if scenario.converter is not None else None,
         trace=trace if keep.frames else [],
         frame_counts=None if keep.frames and stream is None else (tx_count, rx_count),
         trace_file=stream.trace_file if stream is not None else None,
