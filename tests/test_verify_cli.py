@@ -270,6 +270,21 @@ def test_a_scenario_on_the_wrong_platform_says_which_platform_to_set(tmp_path):
     assert result.exit_code == 2 and "Broken.st:5:" in result.output and "platform:" not in result.output
 
 
+def test_a_wrong_platform_option_is_not_blamed_on_a_scenario_file(tmp_path):
+    """`--platform fx3u` given for FX5U sources: the message names the option the user gave
+    and what to give instead - not 'fx3u (the default)' nor 'set platform = ... in the
+    scenario' for a run that has no scenario file, or whose file says fx5u."""
+    fx5 = [PLC / "core", PLC / "fx5", PLC / "examples" / "common", PLC / "examples" / "fx5" / "UITAMR_ExampleFx5.st"]
+    result = invoke(*fx5, "--platform", "fx3u", "--duration", "2s")
+    assert result.exit_code == 2
+    assert ("scenario 'healthy robot': the sources load on fx5u, not on fx3u (--platform fx3u): give --platform fx5u"
+            in result.output)
+    assert "(the default)" not in result.output and "in the scenario" not in result.output
+    result = invoke("--scenario", PLC / "scenarios" / "fx5u-healthy.toml", "--platform", "q")
+    assert result.exit_code == 2
+    assert "fx5u-healthy.toml: the sources load on fx5u, not on q (--platform q): give --platform fx5u" in result.output
+
+
 def test_platform_without_sources_picks_the_bundled_scenarios_of_that_platform(tmp_path):
     from verifier.verify.scenario import load_scenario
 

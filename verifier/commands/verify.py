@@ -93,6 +93,7 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
     from verifier.verify.matrix import for_user_sources, without_repeats
     from verifier.verify.platform import infer_platform, platforms_that_load, uses_tcp_route
 
+    platform_given = platform is not None  # --platform, as against told from the sources
     resolved = _source_files(sources) if sources else ()
     scenario_files = _scenario_files(scenario_files)
     given = {real_path(f) for f in scenario_files}
@@ -145,6 +146,8 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
         scenarios += [s.with_overrides(**{**overrides, "platform": None}) for s in bundled]
     if duration is not None:
         scenarios = [_cut_short(s) for s in scenarios]
+    if platform_given:
+        scenarios = [replace(s, platform_from_option=True) for s in scenarios]
     for scenario in scenarios:
         if scenario.scan_us > scenario.duration_us:
             raise UnusableInput(f"{scenario.name}: the scan time is longer than the whole run")

@@ -200,6 +200,10 @@ def _platform_hint(scenario: Scenario) -> str:
     fits, _ = platforms_that_load(scenario.sources)
     if not fits or scenario.platform in fits:
         return ""
+    if scenario.platform_from_option or scenario.path is None:  # no file's key to point at
+        told = f"--platform {scenario.platform}" if scenario.platform_from_option else f"the default, {scenario.platform}"
+        return (f"\n{_where(scenario)}: the sources load on {', '.join(fits)}, not on {scenario.platform} "
+                f"({told}): give --platform {fits[0]}")
     line = scenario.key_lines.get("platform")
     defaulted = "platform" not in scenario.key_lines and scenario.platform == "fx3u"
     now = f"{scenario.platform} (the default)" if defaulted else scenario.platform

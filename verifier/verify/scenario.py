@@ -145,6 +145,7 @@ class Scenario:
     converter: ConverterConfig | None = None  # the TCP route: the robot behind a converter
     notes: tuple[str, ...] = ()  # for the reports: how this run differs from its file
     response_signal_key: str = "response_handling.signal"  # or "--response-signal" when given there
+    platform_from_option: bool = False  # the platform is --platform's, not the file's (for messages)
 
     @property
     def target(self) -> str:
