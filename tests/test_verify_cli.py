@@ -653,3 +653,20 @@ def test_a_healthy_converter_is_not_reported_as_a_fault(tmp_path):
     serial = invoke("--scenario", PLC / "scenarios" / "fx5u-no-reply.toml", "--duration", "2s", "--json", paths["json"])
     (run,) = json.loads(paths["json"].read_text())["scenarios"]
     assert run["converter"] is None and run["faults"] == ["no_reply at 4 s for 4 s"], serial.output
+
+
+def test_a_misspelt_label_in_a_scenario_offers_the_label_meant(tmp_path):
+    """'fbBat.o_bOK' for the instance fbBatt, 'o_bOkay' for o_bOK: the error says which label
+    was probably meant; a name like no label gets no guess."""
+    base = (PLC / "scenarios" / "fx5u-healthy.toml").read_text(encoding="utf-8").replace('"../', f'"{PLC.as_posix()}/')
+    for wrong, message in (
+            ("fbEngin.o_bErr", "the program UITAMR_ExampleFx5 has no label 'fbEngin.o_bErr'; did you mean 'fbEngine'?"),
+            ("fbEngine.o_bErrr", "no label 'fbEngine.o_bErrr' in the program UITAMR_ExampleFx5: fbEngine has no "
+                                 "member 'o_bErrr'; did you mean 'o_bErr'?"),
+            ("zzz", "the program UITAMR_ExampleFx5 has no label 'zzz'")):
+        path = tmp_path / "s.toml"
+        path.write_text(base.replace('never = "fbEngine.o_bErr OR fbCycle.o_bErr"', f'never = "{wrong}"'),
+                        encoding="utf-8")
+        result = invoke("--scenario", path, "--duration", "2s")
+        assert result.exit_code == 2
+        assert result.output.strip().endswith(f"expect[2].never: {message}"), result.output

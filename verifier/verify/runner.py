@@ -142,12 +142,14 @@ class _Plc:
         target, shown = self.program, ""
         for part in _path_parts(name):
             try:
+                inside = target
                 target = target[int(part[1:-1])] if part.startswith("[") else getattr(target, part)
             except (AttributeError, KeyError, IndexError, TypeError, ValueError, LookupError):
+                hint = "" if part.startswith("[") else _did_you_mean(part, inside)
                 if not shown:
-                    return f"the program {self.name} has no label {name!r}"
+                    return f"the program {self.name} has no label {name!r}{hint}"
                 what = f"element {part}" if part.startswith("[") else f"member {part!r}"
-                return f"no label {name!r} in the program {self.name}: {shown} has no {what}"
+                return f"no label {name!r} in the program {self.name}: {shown} has no {what}{hint}"
             shown += part if part.startswith("[") or not shown else f".{part}"
         if not isinstance(_plain(target), (bool, int, float, str)):
             return (f"{name!r} in {self.name} is not a single value (an array or FB instance?); "
@@ -186,6 +188,21 @@ class _Plc:
 
     def diagnostics(self) -> list[str]:
         return [str(d) for d in self.project.diagnostics]
+
+
+def _did_you_mean(part: str, instance: Any) -> str:
+    """'; did you mean 'fbBatt'?' when `instance` (a program or FB) has a label spelt
+    nearly as `part` (a scenario's typo of an instance or member name), else ''."""
+    import difflib
+
+    symbols = getattr(instance, "_symbols", None)
+    try:
+        names = [sym.name for sym in symbols().values()] if symbols is not None else []
+    except Exception:  # a value without labels (a number, a standard FB): nothing to offer
+        return ""
+    by_key = {n.upper(): n for n in names}
+    close = difflib.get_close_matches(part.upper(), list(by_key), n=1, cutoff=0.8)
+    return f"; did you mean {by_key[close[0]]!r}?" if close else ""
 
 
 def _path_parts(name: str) -> list[str]:
