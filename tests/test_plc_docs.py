@@ -88,3 +88,12 @@ def test_the_rs2_ports_say_in_which_scan_rs2_is_first_driven(tmp_path):
         header = " ".join((ROOT / "plc" / port).read_text(encoding="utf-8").split("*)", 1)[0].split())
         assert "RS2 is driven from that same scan on, after these writes" in header, name
         assert "from the next scan" not in (ROOT / "plc" / port).read_text(encoding="utf-8"), name
+
+
+def test_how_the_pieces_fit_names_every_port_fb():
+    """plc-library.md's overview shows where each port FB plugs in: an FX5U integrator on
+    the TCP route finds UITAMR_PortTcpFx5 there, not only the serial ports."""
+    text = DOC.read_text(encoding="utf-8")
+    section = text.split("## How the pieces fit", 1)[1].split("### ", 1)[0]
+    ports = sorted(p.stem for p in (ROOT / "plc").glob("*/UITAMR_Port*.st") if p.parent.name != "core")
+    assert ports and [p for p in ports if p not in section] == []
