@@ -440,3 +440,21 @@ def test_the_import_pages_list_what_export_writes_for_the_example(tmp_path, page
     assert result.exit_code == 0, result.output
     written = [line.split("\t")[0] for line in (tmp_path / "IMPORT_ORDER.txt").read_text().splitlines()]
     assert re.findall(r"`(\w+)`", listed) + [example] == written
+
+
+def test_sources_of_the_other_editors_cpu_are_exported_with_a_warning_naming_the_right_target(tmp_path):
+    """An FX5U program (RS2 with SM8561) exported with --target gxworks2: no GX Works2 CPU
+    loads it, so the export says to use --target gxworks3; the right target says nothing."""
+    plc = Path(__file__).resolve().parents[1] / "plc"
+    sources = [str(plc / "core"), str(plc / "fx5" / "UITAMR_PortFx5.st"), str(plc / "examples" / "common"),
+               str(plc / "examples" / "fx5" / "UITAMR_ExampleFx5.st")]
+    wrong = CliRunner().invoke(command, ["--target", "gxworks2", "--out", str(tmp_path / "a"), *sources])
+    assert wrong.exit_code == 0
+    assert ("uitamr export: warning: the sources load on fx5u only, which GX Works3 programs, not GX Works2: "
+            "export them with --target gxworks3") in wrong.output
+    right = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(tmp_path / "b"), *sources])
+    assert right.exit_code == 0 and "warning" not in right.output
+    fx3 = [str(plc / "core"), str(plc / "fx3" / "UITAMR_PortFx3.st"), str(plc / "examples" / "common"),
+           str(plc / "examples" / "fx3" / "UITAMR_ExampleFx3.st")]
+    back = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(tmp_path / "c"), *fx3])
+    assert "export them with --target gxworks2" in back.output
