@@ -394,3 +394,21 @@ def test_an_instruction_in_its_ladder_spelling_is_one_error_that_gives_the_st_na
                                    f"it with an underscore: {st}(...)"]
     member = write(tmp_path, program("fbX.o_bOK(1);", "fbX : TON;"), "m.st")  # a real label's member: as before
     assert "only labels, functions and instructions can be called" in run("--platform", platform, member).output
+
+
+def test_a_scenario_that_sets_an_fx3_special_number_on_another_cpu_gets_the_st_warning(tmp_path):
+    """[[inputs]] M8402 = true (or [initial] M8002) in an FX5U scenario sets an ordinary
+    relay nothing reads: the warning check gives the same device in ST, at its key; the
+    FX3U's own scenario says nothing."""
+    text = ('platform = "fx5u"\n\n[initial]\nM8002 = true\n\n[[inputs]]\nat = "1s"\nset = { M8402 = true }\n')
+    scenario = write(tmp_path, text, "s.toml")
+    done = run(scenario)
+    assert done.exit_code == 0, done.output  # warnings only
+    warnings = [line for line in done.output.splitlines() if ": warning: " in line]
+    assert warnings == [
+        f"{scenario}:4:9: warning: initial.M8002: M8002 is an ordinary internal relay on the fx5u (the CPU never "
+        "sets it); the FX3's special relay M8002 (ON in the first scan) is SM402 or SM8002 on the fx5u",
+        f"{scenario}:8:7: warning: inputs[0].set: M8402 is an ordinary internal relay on the fx5u (the CPU never "
+        "sets it); the FX3's M8402 (RS2 ch1 send request) is SM8561 on the fx5u (docs/instructions.md §8)"]
+    fx3 = write(tmp_path, text.replace('"fx5u"', '"fx3u"'), "fx3.toml")
+    assert run(fx3).output.splitlines()[-1].endswith(": 0 error(s), 0 warning(s)")

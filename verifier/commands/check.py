@@ -126,7 +126,7 @@ def _scenario_devices(scenario) -> list[Diagnostic]:
     """The devices of [initial] and [[inputs]] that the scenario's platform does not have,
     each at its key, as `uitamr verify` refuses them (exit 2) before the first scan."""
     from verifier.sim.cpu import PROFILES
-    from verifier.sim.devices import device_problem
+    from verifier.sim.devices import device_problem, device_warning
     from verifier.verify.scenario import BUFFER_MEMORY, DEVICE_NAME
 
     cpu = PROFILES[scenario.platform]
@@ -135,10 +135,13 @@ def _scenario_devices(scenario) -> list[Diagnostic]:
     found = []
     for key, name in named:
         problem = device_problem(name, cpu)
+        severity = "error"
+        if problem is None:
+            problem, severity = device_warning(name, cpu), "warning"  # M8402 on an FX5U: sets nothing
         if problem:
             place = scenario.key_lines.get(key)
             found.append(Diagnostic(str(scenario.path), place.line if place else 0, place.col if place else 0,
-                                    "error", f"{key}: {problem}"))
+                                    severity, f"{key}: {problem}"))
     return found
 
 

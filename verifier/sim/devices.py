@@ -62,6 +62,22 @@ def device_problem(name: str, cpu: CpuProfile) -> str | None:
     return None
 
 
+def device_warning(name: str, cpu: CpuProfile) -> str | None:
+    """For a device as a scenario writes it (`M8002`): the warning `uitamr check --platform`
+    gives the same device in ST when it is an FX3 special number that is an ordinary device
+    on `cpu` (setting M8402 on an FX5U sends nothing); None otherwise."""
+    m = _DEVICE_RE.match(name.strip().upper())
+    if not m:
+        return None
+    digits, area_name, number, bit = m.groups()
+    if digits or bit is not None or not number.isdigit():
+        return None
+    from types import SimpleNamespace
+
+    return fx3_special_elsewhere(SimpleNamespace(index=None, digits=None, address=number, kind=area_name,
+                                                 text=name.strip(), key=name.strip().upper()), cpu)
+
+
 def locate(d, cpu: CpuProfile) -> tuple[Area, int]:
     """(area, number) of a device written in ST (`verifier.st.ast.Device`, not buffer
     memory) on `cpu`, or DeviceError saying why the simulator cannot run it there: an area
