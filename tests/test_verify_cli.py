@@ -671,3 +671,19 @@ def test_a_misspelt_label_in_a_scenario_offers_the_label_meant(tmp_path):
         result = invoke("--scenario", path, "--duration", "2s")
         assert result.exit_code == 2
         assert result.output.strip().endswith(f"expect[2].never: {message}"), result.output
+
+
+def test_the_converter_drop_a_scenario_scripts_is_marked_as_its_fault_on_the_page(tmp_path):
+    """verifier.md: the scenario's faults are large orange marks, also on the overview strip.
+    The TCP route's scripted drop (converter.dropped) is one - a healthy converter run has none."""
+    from verifier.verify.events_shown import event_class
+
+    assert event_class("converter.dropped") == "fault" and event_class("converter.accepted") == "line"
+    pages = {}
+    for name in ("fx5u-tcp-dropped", "fx5u-tcp-healthy"):
+        page = tmp_path / f"{name}.html"
+        invoke("--scenario", PLC / "scenarios" / f"{name}.toml", "--duration", "25s", "--html", page)
+        pages[name] = page.read_text(encoding="utf-8")
+    marks = re.findall(r'class="ovfault" x="([\d.]+)"', pages["fx5u-tcp-dropped"])
+    assert len(marks) == 1
+    assert re.findall(r'class="ovfault" x="', pages["fx5u-tcp-healthy"]) == []
