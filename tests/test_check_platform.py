@@ -23,6 +23,7 @@ END_PROGRAM
 """
 
 
+Q_SERIAL = "a QJ71C24N is driven with G_OUTPUT / G_INPUT and its switch settings (UITAMR_PortQC24, docs/import-gxworks2.md)"
 SM400_ON_FX3U = "device SM400: the fx3u has no SM devices; its special relays are M8000..M8511: use M8000 (always ON)"
 
 
@@ -57,10 +58,12 @@ def test_sm400_on_an_fx3u_is_an_error_at_its_place(tmp_path):
     q = run("--platform", "q", bad)  # SM400 and D8403 are Q devices; D8403 an ordinary one
     assert q.exit_code == 0
     assert q.output.splitlines()[0] == (f"{bad}:5:6: warning: D8403 is an ordinary data register on the q "
-                                        "(the CPU never sets it); FX3 special registers are SD devices on the q")
+                                        "(the CPU never sets it); the FX3's D8403 (RS2 ch1 received byte count) "
+                                        "has no device on the q: a QJ71C24N is driven with G_OUTPUT / G_INPUT and "
+                                        "its switch settings (UITAMR_PortQC24, docs/import-gxworks2.md)")
     assert errors(run("--platform", "fx5u", bad).output) == [  # the FX5U has SM400 but D0..D7999
         f"{bad}:5:6: error: device D8403 does not exist on the fx5u: D runs D0..D7999; "
-        "FX3 special registers are SD devices on the fx5u"]
+        "the FX3's D8403 (RS2 ch1 received byte count) is SD8561 on the fx5u (docs/instructions.md §8)"]
 
 
 @pytest.mark.parametrize("platform, body, col, message", [
@@ -72,8 +75,18 @@ def test_sm400_on_an_fx3u_is_an_error_at_its_place(tmp_path):
                                "FX3 special registers are SD devices on the fx5u"),
     ("fx5u", "x := D8067;", 6, "device D8067 does not exist on the fx5u: D runs D0..D7999; the FX3's special "
                                "register D8067 (operation error code) is SD0 on the fx5u"),
-    ("q", "b := M8402;", 6, "device M8402 does not exist on the q: M runs M0..M8191; "
+    ("q", "b := M8402;", 6, "device M8402 does not exist on the q: M runs M0..M8191; the FX3's M8402 (RS2 ch1 "
+                            "send request) has no device on the q: a QJ71C24N is driven with G_OUTPUT / G_INPUT "
+                            "and its switch settings (UITAMR_PortQC24, docs/import-gxworks2.md)"),
+    ("q", "b := M8500;", 6, "device M8500 does not exist on the q: M runs M0..M8191; "
                             "FX3 special relays are SM devices on the q"),
+    # the FX3's serial devices, moved to an FX5U: its own RS2 devices, or the module parameters
+    ("fx5u", "x := D8400;", 6, "device D8400 does not exist on the fx5u: D runs D0..D7999; the FX3's D8400 "
+                               "(RS2 ch1 communication format) has no device on the fx5u: its serial ports take "
+                               "the line settings from the module parameters (GX Works3: Module Parameter > 485 "
+                               "Serial Port, docs/import-gxworks3.md §4)"),
+    ("fx5u", "x := D8429;", 6, "device D8429 does not exist on the fx5u: D runs D0..D7999; the FX3's D8429 "
+                               "(RS2 ch2 receive time-out) is SD8631 on the fx5u, in ms (docs/instructions.md §8)"),
     ("q", "x := W2000;", 6, "device W2000 does not exist on the q: W runs W0..W1FFF"),  # hexadecimal
     ("fx3u", "x := SD0;", 6, "device SD0: the fx3u has no SD devices; its special registers are "
                              "D8000..D8511: use D8067 (operation error code)"),
@@ -96,8 +109,15 @@ def test_device_out_of_range_or_unknown_to_the_cpu(tmp_path, platform, body, col
                          "the FX3's special relay M8013 (1000 ms clock) is SM412 on the q"),
     ("fx5u", "b := M8000;", "M8000 is an ordinary internal relay on the fx5u (the CPU never sets it); "
                             "the FX3's special relay M8000 (always ON) is SM400 or SM8000 on the fx5u"),
-    ("q", "x := D8400;", "D8400 is an ordinary data register on the q (the CPU never sets it); "
+    ("q", "x := D8400;", "D8400 is an ordinary data register on the q (the CPU never sets it); the FX3's "
+                         "D8400 (RS2 ch1 communication format) has no device on the q: " + Q_SERIAL),
+    ("q", "x := D8100;", "D8100 is an ordinary data register on the q (the CPU never sets it); "
                          "FX3 special registers are SD devices on the q"),
+    ("fx5u", "b := M8402;", "M8402 is an ordinary internal relay on the fx5u (the CPU never sets it); the FX3's "
+                            "M8402 (RS2 ch1 send request) is SM8561 on the fx5u (docs/instructions.md §8)"),
+    ("fx5u", "b := M8161;", "M8161 is an ordinary internal relay on the fx5u (the CPU never sets it); the FX3's "
+                            "M8161 (8-bit mode of CRC) is SM8161 on the fx5u (docs/instructions.md §6); RS2's "
+                            "8-bit mode is SD8622 / SD8632 there"),
 ])
 def test_an_fx3_special_number_on_another_cpu_is_a_warning_that_names_its_equivalent(
         tmp_path, platform, body, message):
@@ -257,6 +277,28 @@ def test_an_instruction_the_cpu_lacks_is_one_error_not_also_its_other_cpus_opera
     assert len(on_fx3) == 3
 
 
+@pytest.mark.parametrize("platform, call, message", [
+    ("fx5u", "ZP_OPEN(TRUE, 'U0', 1, w[0], b[0]);", "ZP_OPEN does not exist on the fx5u (it is a q instruction)"),
+    ("q", "SP_SOCOPEN(TRUE, 'U0', 1, w[0], b[0]);", "SP_SOCOPEN does not exist on the q (it is a fx5 instruction)"),
+])
+def test_an_instruction_of_the_other_editor_is_one_error_too(tmp_path, platform, call, message):
+    # the QJ71E71's ZP_OPEN in an FX5U program is not also 'not available for GX Works3': the
+    # CPU's error names the CPU that has it; without --platform the editor's error stands
+    path = write(tmp_path, program(call, "w : ARRAY[0..9] OF WORD; b : ARRAY[0..1] OF BOOL;"))
+    assert errors(run("--platform", platform, path).output) == [f"{path}:5:1: error: {message}"]
+    editor = "GX Works3" if platform == "fx5u" else "GX Works2"
+    target = "gxworks3" if platform == "fx5u" else "gxworks2"
+    name = call.split("(")[0]
+    assert errors(run("--target", target, path).output) == [
+        f"{path}:5:1: error: instruction {name} is not available for {editor}; {name} is a {HOME[platform]} "
+        "instruction: check " + HOW[platform]]
+
+
+HOME = {"fx5u": "GX Works2 (FX3U/FX3G, Q)", "q": "GX Works3 (FX5U)"}  # the editor the call is from
+HOW = {"fx5u": "FX3 and Q sources with --platform fx3u, fx3g or q (or --target gxworks2)",
+       "q": "FX5U sources with --platform fx5u (or --target gxworks3)"}
+
+
 def test_check_refuses_the_scenario_devices_verify_refuses_for_its_platform(tmp_path):
     # [initial] and [[inputs]] devices are checked against the scenario's own platform by
     # `uitamr verify` (exit 2 at the key); `uitamr check` said 0 errors for the same file
@@ -269,6 +311,33 @@ def test_check_refuses_the_scenario_devices_verify_refuses_for_its_platform(tmp_
         "are M8000..M8511: use M8000 (always ON)",
         f"{scenario}:9:9: error: inputs[0].set: device D9000 does not exist on the fx3u: D runs D0..D8511"]
     assert run(write(tmp_path, 'platform = "q"\n\n[initial]\nSM400 = true\nD9000 = 1\n', "q.toml")).exit_code == 0
+
+
+def test_a_scenario_without_platform_is_judged_for_the_platform_given(tmp_path):
+    """An FX5U project's scenario that names no platform, checked and verified with
+    --platform fx5u as ci.md does: its FX5U devices and its [converter] are judged for the
+    FX5U both commands run it on, not for the file's default fx3u - check said
+    'SD8621: the fx3u has no SD devices' of a file verify ran, and verify refused the
+    [converter] it would run on the FX5U."""
+    from verifier.commands.verify import command as verify
+
+    plc = ROOT / "plc"
+    text = ('[initial]\nSD8621 = 5\n\n[[inputs]]\nat = "1s"\nset = { SM8561 = false }\n\n'
+            '[converter]\n\n[[expect]]\nsent = "stop"\n')
+    scenario = write(tmp_path, text, "own.toml")
+    done = run("--platform", "fx5u", scenario)
+    assert done.exit_code == 0, done.output
+    assert done.output.splitlines()[-1] == "1 file(s) checked for gxworks3 on the fx5u CPU: 0 error(s), 0 warning(s)"
+    alone = run(scenario)  # no --platform: the file's own default, fx3u
+    assert alone.exit_code == 1
+    assert errors(alone.output)[0] == (
+        f"{scenario}:8:1: error: converter: the TCP route needs a PLC with an Ethernet port the library drives "
+        "(fx5u or q); this scenario names no platform, so it is 'fx3u' (the default): add platform = \"fx5u\" "
+        "(or \"q\") to the file, or give --platform")
+    sources = [plc / "core", plc / "fx5", plc / "examples" / "common", plc / "examples" / "fx5" / "UITAMR_ExampleTcpFx5.st"]
+    ran = CliRunner().invoke(verify, [*map(str, sources), "--scenario", str(scenario), "--platform", "fx5u",
+                                      "--duration", "3s"])
+    assert ran.exit_code == 0, ran.output
 
 
 @pytest.mark.parametrize("spelling", ["FX3U", "Fx3u"])
@@ -311,3 +380,41 @@ def test_verify_notes_an_fx3_special_number_in_the_program_it_runs(tmp_path):
         f"{tmp_path / 'UITAMR_ExampleQ.st'}:59:18: M8002 is an ordinary internal relay on the q (the CPU never sets "
         "it); the FX3's special relay M8002 (ON in the first scan) is SM402 on the q"], result.output
     assert "Fx3Beside" not in result.output
+
+
+@pytest.mark.parametrize("platform, call, dotted, st", [
+    ("fx5u", "SP.SOCOPEN(TRUE, 'U0', 1, w[0], b[0]);", "SP.SOCOPEN", "SP_SOCOPEN"),
+    ("fx5u", "SP.SOCSND(TRUE, 'U0', 1, w[0], w[2], b[0]);", "SP.SOCSND", "SP_SOCSND"),
+    ("q", "ZP.OPEN(TRUE, 'U0', 1, w[0], b[0]);", "ZP.OPEN", "ZP_OPEN"),
+    ("q", "G.OUTPUT(TRUE, 16#0, w[0], w[3], b[0]);", "G.OUTPUT", "G_OUTPUT"),
+])
+def test_an_instruction_in_its_ladder_spelling_is_one_error_that_gives_the_st_name(
+        tmp_path, platform, call, dotted, st):
+    """An integrator copies SP.SOCOPEN from the FX5 manual's ladder: one error that names
+    the ST spelling (st-dialect.md §1), not 'undefined label SP' plus 'only labels ... can be
+    called'."""
+    path = write(tmp_path, program(call, "w : ARRAY[0..9] OF WORD; b : ARRAY[0..1] OF BOOL;"))
+    done = run("--platform", platform, path)
+    assert done.exit_code == 1
+    assert errors(done.output) == [f"{path}:5:1: error: {dotted} is how ladder writes the instruction; ST writes "
+                                   f"it with an underscore: {st}(...)"]
+    member = write(tmp_path, program("fbX.o_bOK(1);", "fbX : TON;"), "m.st")  # a real label's member: as before
+    assert "only labels, functions and instructions can be called" in run("--platform", platform, member).output
+
+
+def test_a_scenario_that_sets_an_fx3_special_number_on_another_cpu_gets_the_st_warning(tmp_path):
+    """[[inputs]] M8402 = true (or [initial] M8002) in an FX5U scenario sets an ordinary
+    relay nothing reads: the warning check gives the same device in ST, at its key; the
+    FX3U's own scenario says nothing."""
+    text = ('platform = "fx5u"\n\n[initial]\nM8002 = true\n\n[[inputs]]\nat = "1s"\nset = { M8402 = true }\n')
+    scenario = write(tmp_path, text, "s.toml")
+    done = run(scenario)
+    assert done.exit_code == 0, done.output  # warnings only
+    warnings = [line for line in done.output.splitlines() if ": warning: " in line]
+    assert warnings == [
+        f"{scenario}:4:9: warning: initial.M8002: M8002 is an ordinary internal relay on the fx5u (the CPU never "
+        "sets it); the FX3's special relay M8002 (ON in the first scan) is SM402 or SM8002 on the fx5u",
+        f"{scenario}:8:9: warning: inputs[0].set: M8402 is an ordinary internal relay on the fx5u (the CPU never "
+        "sets it); the FX3's M8402 (RS2 ch1 send request) is SM8561 on the fx5u (docs/instructions.md §8)"]
+    fx3 = write(tmp_path, text.replace('"fx5u"', '"fx3u"'), "fx3.toml")
+    assert run(fx3).output.splitlines()[-1].endswith(": 0 error(s), 0 warning(s)")

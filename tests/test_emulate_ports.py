@@ -329,6 +329,21 @@ def test_raw_socket_faults_and_noise_over_tcp(start_emulator):
     assert code == 0 and "3 fault events" in summary and "50000 flood bytes dropped" in summary
 
 
+def test_a_modbus_tcp_client_is_told_the_route_is_rtu_over_tcp(start_emulator):
+    """mbpoll -m tcp, or a converter left in 'Modbus TCP gateway' mode, sends MBAP frames:
+    the log says so and what to set (tcp-converter.md), instead of only 'too long for an
+    FC01 request' about a frame that is no FC01 request."""
+    emulator, port = tcp_emulator(start_emulator)
+    done = subprocess.run(["mbpoll", "-m", "tcp", "-a", "1", "-t", "4", "-r", "417", "-1", "-o", "1",
+                           "-p", str(port), "127.0.0.1", "0"], capture_output=True, text=True, timeout=WAIT_S)
+    assert done.returncode != 0  # no reply: the robot stays silent
+    line = emulator.wait_for(r"<- 00 01 00 00 00 06 01 06 01 A0 00 00 .*").group(0)
+    assert ("this is a Modbus TCP frame (MBAP header 00 01 00 00 00 06, unit 1; as RTU: stop (01/A0)): the "
+            "robot's route carries Modbus RTU frames with their CRC inside TCP: set the master or the converter "
+            "to RTU over TCP (transparent mode), not Modbus TCP (docs/tcp-converter.md)") in line
+    assert emulator.stop()[0] == 0
+
+
 def test_tcp_serves_two_clients_on_one_robot(start_emulator):
     emulator, port = tcp_emulator(start_emulator)
     with socket.create_connection(("127.0.0.1", port), timeout=5) as first, \

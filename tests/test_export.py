@@ -296,6 +296,7 @@ def test_a_file_without_a_pou_is_a_usage_error_naming_it(tmp_path, text):
 
 # ---- --program: only what a program needs ---------------------------------------------------
 
+
 def _bundled_programs():
     """(sources, program, target) of every bundled scenario, each set once."""
     import tomllib
@@ -443,6 +444,7 @@ def test_the_import_pages_list_what_export_writes_for_the_example(tmp_path, page
 
 
 # ---- --platform: what is written, checked against the CPU as `uitamr check --platform` does ----
+
 
 def export(*args):
     from verifier.cli import main
@@ -626,3 +628,21 @@ def test_export_needs_a_target_or_a_platform(tmp_path):
     assert done.exit_code == 2
     assert "Missing option '--target'" in done.output
     assert not (tmp_path / "out").exists()
+
+
+def test_sources_of_the_other_editors_cpu_are_exported_with_a_warning_naming_the_right_target(tmp_path):
+    """An FX5U program (RS2 with SM8561) exported with --target gxworks2: no GX Works2 CPU
+    loads it, so the export says to use --target gxworks3; the right target says nothing."""
+    plc = Path(__file__).resolve().parents[1] / "plc"
+    sources = [str(plc / "core"), str(plc / "fx5" / "UITAMR_PortFx5.st"), str(plc / "examples" / "common"),
+               str(plc / "examples" / "fx5" / "UITAMR_ExampleFx5.st")]
+    wrong = CliRunner().invoke(command, ["--target", "gxworks2", "--out", str(tmp_path / "a"), *sources])
+    assert wrong.exit_code == 0
+    assert ("uitamr export: warning: the sources load on fx5u only, which GX Works3 programs, not GX Works2: "
+            "export them with --target gxworks3") in wrong.output
+    right = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(tmp_path / "b"), *sources])
+    assert right.exit_code == 0 and "warning" not in right.output
+    fx3 = [str(plc / "core"), str(plc / "fx3" / "UITAMR_PortFx3.st"), str(plc / "examples" / "common"),
+           str(plc / "examples" / "fx3" / "UITAMR_ExampleFx3.st")]
+    back = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(tmp_path / "c"), *fx3])
+    assert "export them with --target gxworks2" in back.output

@@ -237,3 +237,17 @@ def test_mbpoll_with_an_empty_device_is_an_error_not_a_silent_nothing(device):
     result = run("stop", "--mbpoll", device)
     assert result.exit_code == 2
     assert "--mbpoll" in result.output and "the device is empty" in result.output
+
+
+def test_decode_names_a_modbus_tcp_frame_and_the_route_setting():
+    """A frame copied from a Wireshark capture of a PLC or converter set to Modbus TCP: the
+    decode says it is MBAP and what it would be as RTU."""
+    from click.testing import CliRunner
+    from verifier.cli import main
+
+    done = CliRunner().invoke(main, ["frame", "--decode", "00 07 00 00 00 06 01 01 00 00 00 16"])
+    assert done.exit_code == 1
+    assert ("this is a Modbus TCP frame (MBAP header 00 07 00 00 00 06, unit 1; as RTU: read task status (query 0)): "
+            "the robot's route carries Modbus RTU frames") in done.output
+    plain = CliRunner().invoke(main, ["frame", "--decode", "01 06 01 A0 00 00 88 15"])  # a bad CRC: no such hint
+    assert plain.exit_code == 1 and "Modbus TCP" not in plain.output

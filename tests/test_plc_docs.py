@@ -62,3 +62,38 @@ def test_the_power_on_stop_goes_out_when_import_gxworks2_says():
     first = result.trace[0]
     assert (first.direction, first.data.hex(" ").upper()) == ("tx", "01 06 01 A0 00 00 88 14")
     assert first.t_start_us == round(float(claim.group(2)) * 1e6)
+
+
+def test_the_rs2_ports_say_in_which_scan_rs2_is_first_driven(tmp_path):
+    """The FX3 and FX5 port FBs' headers say when RS2 is first driven relative to the
+    settings they write (receive time-out, 16-bit mode, communication format): in the scan
+    that writes them, after the writes - what the FB does, seen scan by scan."""
+    import verifier
+
+    for cpu, target, port, settings in (
+            ("fx5u", "gxworks3", "fx5/UITAMR_PortFx5.st", {"SD8621": 5, "SD8622": 0}),
+            ("fx3u", "gxworks2", "fx3/UITAMR_PortFx3.st", {"D8400": 0x1C81})):
+        name = Path(port).stem
+        main = tmp_path / f"Main{cpu}.st"
+        main.write_text(f"PROGRAM Main{cpu}\nVAR\n    fbPort : {name};\n    uPort : ARRAY[0..39] OF WORD;\n"
+                        "END_VAR\nfbPort(i_bEN := TRUE, i_wChannel := 1, io_uPort := uPort);\nEND_PROGRAM\n",
+                        encoding="utf-8")
+        project = verifier.load(str(ROOT / "plc" / "core"), str(ROOT / "plc" / port), str(main),
+                                target=target, cpu=cpu)
+        project.run_programs([f"Main{cpu}"], until_us=1)  # the first scan
+        fb = project.program(f"Main{cpu}").fbPort
+        assert fb.bConfigured and fb.bDriveCh1, name  # RS2 runs in this scan ...
+        for device, value in settings.items():  # ... after the writes
+            assert project.devices[device] == value, (name, device)
+        header = " ".join((ROOT / "plc" / port).read_text(encoding="utf-8").split("*)", 1)[0].split())
+        assert "RS2 is driven from that same scan on, after these writes" in header, name
+        assert "from the next scan" not in (ROOT / "plc" / port).read_text(encoding="utf-8"), name
+
+
+def test_how_the_pieces_fit_names_every_port_fb():
+    """plc-library.md's overview shows where each port FB plugs in: an FX5U integrator on
+    the TCP route finds UITAMR_PortTcpFx5 there, not only the serial ports."""
+    text = DOC.read_text(encoding="utf-8")
+    section = text.split("## How the pieces fit", 1)[1].split("### ", 1)[0]
+    ports = sorted(p.stem for p in (ROOT / "plc").glob("*/UITAMR_Port*.st") if p.parent.name != "core")
+    assert ports and [p for p in ports if p not in section] == []

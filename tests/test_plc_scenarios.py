@@ -10,7 +10,8 @@ import pytest
 from verifier.verify.runner import run_scenario
 from verifier.verify.scenario import load_scenario
 
-SCENARIOS = sorted((Path(__file__).resolve().parents[1] / "plc" / "scenarios").glob("*.toml"))
+ROOT = Path(__file__).resolve().parents[1]
+SCENARIOS = sorted((ROOT / "plc" / "scenarios").glob("*.toml"))
 
 
 def test_there_are_bundled_scenarios_for_every_platform():
@@ -89,3 +90,27 @@ within = "0.5s"
     assert result.tx_count == 0
     assert not result.failed_expectations, [str(e.message if hasattr(e, "message") else e)
                                             for e in result.failed_expectations]
+
+
+def test_the_fx5_adprw_example_under_a_silent_robot_times_out_as_import_gxworks3_sets_it(tmp_path):
+    """The FX5's MODBUS master takes its slave response time-out from the module
+    parameters, which import-gxworks3.md §4 sets to 400 ms (less than the engine's 500 ms):
+    the FX3U ADPRW no-reply scenario run on the FX5U example shows the engine's three
+    attempts on the line and 16#0108 (ADPRW 16#0309), as on the FX3U. With the 3 s the
+    simulator took before, one frame went out and the engine's own time-outs said 16#0101."""
+    import json
+
+    guide = " ".join((ROOT / "docs" / "import-gxworks3.md").read_text(encoding="utf-8").split())
+    assert "**Slave Response Timeout 400 ms** (less than the engine's 500 ms)" in guide
+    plc = (ROOT / "plc").as_posix()
+    text = (ROOT / "plc" / "scenarios" / "fx3u-adprw-no-reply.toml").read_text(encoding="utf-8")
+    text = (text.replace('"../fx3/UITAMR_PortAdpFx3.st"', '"../fx5/UITAMR_PortAdpFx5.st"')
+            .replace("UITAMR_ExampleAdpFx3", "UITAMR_ExampleAdpFx5").replace("examples/fx3/", "examples/fx5/")
+            .replace('platform = "fx3u"', 'platform = "fx5u"').replace('"../', f'"{plc}/'))
+    path = tmp_path / "fx5u-adprw-no-reply.toml"
+    path.write_text(text, encoding="utf-8")
+    result = run_scenario(load_scenario(path))
+    assert result.passed, (result.all_violations(), [e.detail for e in result.expectations])
+    silent = [f for f in result.trace if f.direction == "tx" and 4_000_000 <= f.t_start_us < 6_000_000]
+    assert len(silent) == 3  # the engine's three attempts, each ended by the 400 ms time-out
+    assert json.dumps(result.watched["fbEngine.o_uErrId"]).count("264") >= 1  # 16#0108

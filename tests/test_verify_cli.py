@@ -201,6 +201,25 @@ def test_matrix_of_a_tcp_program_runs_the_converter_scenarios_only(tmp_path):
     assert [e["expectation"] for e in refused["expectations"]] == ["sent stop within 5 s after 3 s"]
 
 
+def test_a_plain_run_of_a_tcp_program_puts_the_robot_behind_a_healthy_converter(tmp_path):
+    """`uitamr verify SOURCES` of a program that opens a TCP connection (the FX5U Ethernet
+    example, its library folder holding the serial ports too) runs the healthy robot behind
+    the default converter, as --matrix does, instead of on the silent serial port fx5:1."""
+    report = tmp_path / "tcp.json"
+    sources = [PLC / d for d in ("core", "fx5", "examples/common")] + \
+        [PLC / "examples" / "fx5" / "UITAMR_ExampleTcpFx5.st"]
+    result = invoke(*sources, "--duration", "3s", "--json", report)
+    assert result.exit_code == 0, result.output
+    (scenario,) = json.loads(report.read_text())["scenarios"]
+    assert (scenario["platform"], scenario["channel"]) == ("fx5u", "tcp")
+    assert scenario["frames"]["tx"] >= 5 and scenario["expectations"][0]["passed"]
+    assert "converter at the address the program opens" in scenario["description"]
+    serial = [PLC / d for d in ("core", "fx5", "examples/common")] + [PLC / "examples" / "fx5" / "UITAMR_ExampleFx5.st"]
+    result = invoke(*serial, "--duration", "2s", "--json", report)
+    assert result.exit_code == 0, result.output
+    assert json.loads(report.read_text())["scenarios"][0]["channel"] == "fx5:1"
+
+
 def test_matrix_needs_a_platform_it_can_tell(tmp_path):
     plain = tmp_path / "Plain.st"
     plain.write_text("PROGRAM Plain\nVAR\n    w : INT;\nEND_VAR\nw := w + 1;\nEND_PROGRAM\n", encoding="utf-8")
@@ -249,6 +268,21 @@ def test_a_scenario_on_the_wrong_platform_says_which_platform_to_set(tmp_path):
     broken.write_text("PROGRAM Broken\nVAR\n    w : INT;\nEND_VAR\nw := w + ;\nEND_PROGRAM\n", encoding="utf-8")
     result = invoke("--scenario", unset, broken)
     assert result.exit_code == 2 and "Broken.st:5:" in result.output and "platform:" not in result.output
+
+
+def test_a_wrong_platform_option_is_not_blamed_on_a_scenario_file(tmp_path):
+    """`--platform fx3u` given for FX5U sources: the message names the option the user gave
+    and what to give instead - not 'fx3u (the default)' nor 'set platform = ... in the
+    scenario' for a run that has no scenario file, or whose file says fx5u."""
+    fx5 = [PLC / "core", PLC / "fx5", PLC / "examples" / "common", PLC / "examples" / "fx5" / "UITAMR_ExampleFx5.st"]
+    result = invoke(*fx5, "--platform", "fx3u", "--duration", "2s")
+    assert result.exit_code == 2
+    assert ("scenario 'healthy robot': the sources load on fx5u, not on fx3u (--platform fx3u): give --platform fx5u"
+            in result.output)
+    assert "(the default)" not in result.output and "in the scenario" not in result.output
+    result = invoke("--scenario", PLC / "scenarios" / "fx5u-healthy.toml", "--platform", "q")
+    assert result.exit_code == 2
+    assert "fx5u-healthy.toml: the sources load on fx5u, not on q (--platform q): give --platform fx5u" in result.output
 
 
 def test_platform_without_sources_picks_the_bundled_scenarios_of_that_platform(tmp_path):
@@ -479,6 +513,43 @@ def test_the_fx5_second_port_can_carry_the_robot(tmp_path):
     assert result["channel"] == "fx5:2" and result["frames"]["tx"] > 10
     failed = invoke("--scenario", copy, "--channel", "fx5:1")
     assert failed.exit_code == 1 and "the program sent nothing on fx5:1 in the whole run" in failed.output
+    assert "frame(s) on fx5:2: the robot hangs on fx5:1 in this run: give --channel fx5:2" in failed.output
+
+
+def test_a_silent_run_says_where_the_program_did_talk(tmp_path):
+    """Nothing on the robot's line: the note names the route the program used instead and
+    the setting that puts the robot there - the ADPRW port (adp:1), a TCP connection with no
+    [converter], a converter at another address, a serial port under a [converter]."""
+    fx5 = [PLC / "core", PLC / "fx5", PLC / "examples" / "common"]
+    adprw = invoke(*fx5, PLC / "examples" / "fx5" / "UITAMR_ExampleAdpFx5.st", "--duration", "2s")
+    assert adprw.exit_code == 1
+    assert re.search(r"the program sent nothing on fx5:1 in the whole run; it sent \d+ frame\(s\) on adp:1: the robot "
+                     r'hangs on fx5:1 in this run: give --channel adp:1, or channel = "adp:1" in the scenario',
+                     " ".join(adprw.output.split())), adprw.output
+    assert invoke(*fx5, PLC / "examples" / "fx5" / "UITAMR_ExampleAdpFx5.st", "--duration", "2s",
+                  "--channel", "adp:1").exit_code == 0
+    healthy = (PLC / "scenarios" / "fx5u-tcp-healthy.toml").read_text(encoding="utf-8")
+    healthy = healthy.replace('"../', f'"{PLC.as_posix()}/')
+    serial = tmp_path / "tcp-without-converter.toml"
+    serial.write_text(healthy.replace("[converter]", "[robot.unused]").split("[robot.unused]")[0]
+                      + "[[expect]]\nsent = \"stop\"\n", encoding="utf-8")
+    result = invoke("--scenario", serial, "--duration", "3s")
+    assert result.exit_code == 1
+    assert "it opened TCP connections" in result.output and "add a [converter] table" in result.output
+    elsewhere = tmp_path / "converter-elsewhere.toml"
+    elsewhere.write_text(healthy.replace('ip = "192.168.3.50"', 'ip = "192.168.3.60"'), encoding="utf-8")
+    result = invoke("--scenario", elsewhere, "--duration", "3s")
+    assert result.exit_code == 1
+    assert ("nothing reached the robot's line through the converter: the PLC opens a connection to "
+            "192.168.3.50:4001: nothing answers there (the converter is at 192.168.3.60:4001); set the "
+            "scenario's [converter] ip and port to what the program opens") in result.output
+    rs2 = (PLC / "scenarios" / "fx5u-healthy.toml").read_text(encoding="utf-8").replace('"../', f'"{PLC.as_posix()}/')
+    behind = tmp_path / "rs2-behind-a-converter.toml"
+    behind.write_text(rs2.replace("[robot]", "[converter]\n\n[robot]"), encoding="utf-8")
+    result = invoke("--scenario", behind, "--duration", "3s")
+    assert result.exit_code == 1
+    assert "the program opened no connection to it)" in result.output
+    assert "frame(s) on fx5:1: a serial port, not the TCP route: drop [converter] from the scenario" in result.output
 
 
 def test_a_reader_that_goes_away_loses_no_report(tmp_path):
@@ -567,3 +638,111 @@ def test_sources_given_through_a_symlink_are_shown_as_given(tmp_path, monkeypatc
                   tmp_path / "b.jsonl").exit_code in (0, 1)
     first = json.loads((tmp_path / "b.jsonl").read_text().splitlines()[0])
     assert first["origin"].startswith("plc/fx3/UITAMR_PortFx3.st:"), first
+
+
+def test_a_scenario_without_expectations_expects_the_answered_power_on_stop(tmp_path):
+    """Judged by the rules alone, a program that never reaches the robot breaks none: a
+    scenario with no [[expect]] expects the power-on stop, as a run without a scenario file
+    does - a TCP program whose converter is elsewhere fails, the healthy one passes."""
+    healthy = (PLC / "scenarios" / "fx5u-tcp-healthy.toml").read_text(encoding="utf-8")
+    healthy = healthy.replace('"../', f'"{PLC.as_posix()}/').split("[[inputs]]")[0]
+    assert "[[expect]]" not in healthy
+    fine = tmp_path / "rules-only.toml"
+    fine.write_text(healthy, encoding="utf-8")
+    report = tmp_path / "r.json"
+    result = invoke("--scenario", fine, "--duration", "3s", "--json", report)
+    assert result.exit_code == 0, result.output
+    (scenario,) = json.loads(report.read_text())["scenarios"]
+    assert [e["expectation"] for e in scenario["expectations"]] == ["sent stop within 3 s"]
+    assert scenario["notes"][0].startswith("no [[expect]] in the scenario: it expects what every program must do")
+    elsewhere = tmp_path / "converter-elsewhere.toml"
+    elsewhere.write_text(healthy.replace('ip = "192.168.3.50"', 'ip = "192.168.3.60"'), encoding="utf-8")
+    result = invoke("--scenario", elsewhere, "--duration", "3s")
+    assert result.exit_code == 1, result.output
+    assert "expected sent stop within 3 s: stop (01/A0)" in result.output
+    refused = tmp_path / "refused.toml"
+    refused.write_text(healthy.replace("delay = ", 'refuse_until = "4s"\ndelay = '), encoding="utf-8")
+    result = invoke("--scenario", refused, "--duration", "20s", "--json", report)
+    assert result.exit_code == 0, result.output
+    assert json.loads(report.read_text())["scenarios"][0]["expectations"][0]["expectation"] == \
+        "sent stop within 5 s after 4 s"
+
+
+def test_matrix_runs_a_tcp_program_with_its_own_converter_address(tmp_path):
+    """The bundled converter's 192.168.3.50:4001 is the example's CONVERTER_IP/PORT: an FX5U
+    program opening its own converter (192.168.10.20:502) passes the TCP scenarios under
+    --matrix, and the note says the example's address was not applied."""
+    from test_verify_pipeline import library_copy
+
+    plc = library_copy(tmp_path, {"examples/fx5/UITAMR_ExampleTcpFx5.st": [
+        ("CONVERTER_IP : DWORD := 16#C0A80332;", "CONVERTER_IP : DWORD := 16#C0A80A14;"),
+        ("CONVERTER_PORT : WORD := 4001;", "CONVERTER_PORT : WORD := 502;")]})
+    sources = [plc / "core", plc / "fx5" / "UITAMR_PortTcpFx5.st", plc / "examples" / "common",
+               plc / "examples" / "fx5" / "UITAMR_ExampleTcpFx5.st"]
+    report = tmp_path / "m.json"
+    result = invoke(*sources, "--matrix", "--duration", "6s", "--json", report)
+    assert result.exit_code == 0, result.output
+    data = json.loads(report.read_text())
+    assert len(data["scenarios"]) == 5
+    for scenario in data["scenarios"]:
+        assert scenario["frames"]["tx"] >= 1 and scenario["expectations"][0]["passed"]
+        assert any("its converter address (192.168.3.50:4001)" in note for note in scenario["notes"])
+    plain = invoke(*sources, "--duration", "3s", "--json", report)
+    assert plain.exit_code == 0, plain.output
+    own = tmp_path / "own.toml"  # a scenario of one's own still tests the address
+    own.write_text("platform = \"fx5u\"\n[converter]\n[[expect]]\nsent = \"stop\"\n", encoding="utf-8")
+    result = invoke(*sources, "--scenario", own, "--duration", "5s")
+    assert result.exit_code == 1 and "192.168.10.20:502: nothing answers there" in result.output
+
+
+def test_a_healthy_converter_is_not_reported_as_a_fault(tmp_path):
+    """The TCP route's converter (its address, delays, and its own scripted drops) is the
+    run's `converter`, not one of the robot's `faults`: the JUnit text of a healthy TCP run
+    said 'fault: converter 192.168.3.50:4001, delay 3 ms, packing 5 ms'."""
+    paths = {kind: tmp_path / f"r.{kind}" for kind in ("json", "xml", "html")}
+    scenario = PLC / "scenarios" / "fx5u-tcp-healthy.toml"
+    result = invoke("--scenario", scenario, "--duration", "3s", "--json", paths["json"], "--junit", paths["xml"],
+                    "--html", paths["html"])
+    assert result.exit_code == 1, result.output  # its point-3 expectation needs the whole run
+    (run,) = json.loads(paths["json"].read_text())["scenarios"]
+    assert run["faults"] == [] and run["converter"] == "converter 192.168.3.50:4001, delay 3 ms, packing 5 ms"
+    out = ET.parse(paths["xml"]).getroot().find(".//system-out").text
+    assert "fault:" not in out and "\nconverter 192.168.3.50:4001, delay 3 ms, packing 5 ms" in out
+    assert "<b>TCP route:</b> converter 192.168.3.50:4001" in paths["html"].read_text()
+    assert "<b>Faults:</b>" not in paths["html"].read_text()
+    serial = invoke("--scenario", PLC / "scenarios" / "fx5u-no-reply.toml", "--duration", "2s", "--json", paths["json"])
+    (run,) = json.loads(paths["json"].read_text())["scenarios"]
+    assert run["converter"] is None and run["faults"] == ["no_reply at 4 s for 4 s"], serial.output
+
+
+def test_a_misspelt_label_in_a_scenario_offers_the_label_meant(tmp_path):
+    """'fbBat.o_bOK' for the instance fbBatt, 'o_bOkay' for o_bOK: the error says which label
+    was probably meant; a name like no label gets no guess."""
+    base = (PLC / "scenarios" / "fx5u-healthy.toml").read_text(encoding="utf-8").replace('"../', f'"{PLC.as_posix()}/')
+    for wrong, message in (
+            ("fbEngin.o_bErr", "the program UITAMR_ExampleFx5 has no label 'fbEngin.o_bErr'; did you mean 'fbEngine'?"),
+            ("fbEngine.o_bErrr", "no label 'fbEngine.o_bErrr' in the program UITAMR_ExampleFx5: fbEngine has no "
+                                 "member 'o_bErrr'; did you mean 'o_bErr'?"),
+            ("zzz", "the program UITAMR_ExampleFx5 has no label 'zzz'")):
+        path = tmp_path / "s.toml"
+        path.write_text(base.replace('never = "fbEngine.o_bErr OR fbCycle.o_bErr"', f'never = "{wrong}"'),
+                        encoding="utf-8")
+        result = invoke("--scenario", path, "--duration", "2s")
+        assert result.exit_code == 2
+        assert result.output.strip().endswith(f"expect[2].never: {message}"), result.output
+
+
+def test_the_converter_drop_a_scenario_scripts_is_marked_as_its_fault_on_the_page(tmp_path):
+    """verifier.md: the scenario's faults are large orange marks, also on the overview strip.
+    The TCP route's scripted drop (converter.dropped) is one - a healthy converter run has none."""
+    from verifier.verify.events_shown import event_class
+
+    assert event_class("converter.dropped") == "fault" and event_class("converter.accepted") == "line"
+    pages = {}
+    for name in ("fx5u-tcp-dropped", "fx5u-tcp-healthy"):
+        page = tmp_path / f"{name}.html"
+        invoke("--scenario", PLC / "scenarios" / f"{name}.toml", "--duration", "25s", "--html", page)
+        pages[name] = page.read_text(encoding="utf-8")
+    marks = re.findall(r'class="ovfault" x="([\d.]+)"', pages["fx5u-tcp-dropped"])
+    assert len(marks) == 1
+    assert re.findall(r'class="ovfault" x="', pages["fx5u-tcp-healthy"]) == []

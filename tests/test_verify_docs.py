@@ -177,3 +177,44 @@ def test_the_missing_function_input_messages_of_st_dialect_are_the_checkers():
     assert len(messages) == 2
     for message in messages:
         assert f"`{message.replace('...', '')}" in text.replace("...", ""), message
+
+
+def test_sent_by_names_the_statement_of_every_fx5u_and_tcp_route(tmp_path):
+    """verifier.md's "sent by" paragraph names the statement each route's port FB starts a
+    frame with: the send request on FX5U RS2, the ADPRW call, and on the TCP route the send
+    instruction (SP_SOCSND, ZP_BUFSND) - read here from the first frame of a real run."""
+    import json
+    from click.testing import CliRunner
+    from verifier.commands.verify import command
+
+    text = " ".join(VERIFIER_MD.split("The ST location is the statement that started", 1)[1]
+                    .split("### `--json FILE`", 1)[0].split())
+    for name in ("fx5u-healthy", "fx5u-adprw-healthy", "fx5u-tcp-healthy", "q-tcp-healthy"):
+        trace = tmp_path / f"{name}.jsonl"
+        scenario = Path(__file__).resolve().parents[1] / "plc" / "scenarios" / f"{name}.toml"
+        done = CliRunner().invoke(command, ["--scenario", str(scenario), "--duration", "1s", "--trace", str(trace)])
+        assert done.exit_code in (0, 1), done.output
+        origin = json.loads(trace.read_text().splitlines()[0])["origin"]
+        file, line, col = origin.rsplit(":", 2)
+        statement = (Path(__file__).resolve().parents[1] / file).read_text().splitlines()[int(line) - 1]
+        word = re.match(r"[A-Za-z0-9_]+", statement[int(col) - 1:]).group(0)
+        assert f"`{word}`" in text, (name, statement)
+
+
+def test_the_troubleshooting_rows_that_name_an_fx3_serial_device_name_the_fx5s_too():
+    """An FX5U integrator reading the bench-test and commissioning tables finds the device of
+    its own CPU next to the FX3's (the equivalents `uitamr check --platform fx5u` names)."""
+    from verifier.sim.cpu import FX3_SERIAL
+
+    rows = [line for doc in ("emulator.md", "commissioning.md")
+            for line in (DOCS / doc).read_text(encoding="utf-8").splitlines() if line.startswith("|")]
+    checked = 0
+    for row in rows:
+        for device in re.findall(r"\b[MD]8[0-9]{3}\b", row):
+            if device not in FX3_SERIAL:
+                continue
+            fx5 = FX3_SERIAL[device][1]["fx5"]
+            wanted = re.match(r"S[MD]\d+", fx5)
+            assert (wanted.group(0) if wanted else "module parameters") in row, (device, row)
+            checked += 1
+    assert checked >= 4

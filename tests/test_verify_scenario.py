@@ -18,6 +18,7 @@ from verifier.verify.traffic import analyse
 
 # --- durations --------------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("text, us", [
     ("250ms", 250_000), ("60s", 60_000_000), ("1.5 s", 1_500_000), ("2min", 120_000_000),
     ("500us", 500), ("0s", 0), (".5s", 500_000),
@@ -53,6 +54,7 @@ def test_milliseconds_round_trip(ms):
 
 
 # --- conditions -------------------------------------------------------------------------------
+
 
 def test_conditions_read_like_st():
     condition = parse_condition("o_bErr AND o_uErrId = 16#0101")
@@ -437,3 +439,26 @@ def test_a_key_in_a_sub_table_is_placed_on_its_own_line(text, key, place):
     error = error_of(text, Path("s.toml"))
     assert (error.key, (error.line, error.col)) == (key, place), str(error)
     assert str(error).startswith(f"s.toml:{place[0]}:{place[1]}: {key}: ")
+
+
+@pytest.mark.parametrize("text, place", [
+    ('[robot]\npoint_duraton_s = 8.0\n', "s.toml:2:1: robot.point_duraton_s: unknown key"),
+    ('[[faults]]\nkind = "no_reply"\nat = 3\n', "s.toml:3:1: faults[0].at: unknown key"),
+    ('[[faults]]\nkind = "anti_collision"\nat_s = 1\ncount = 2\n',
+     "s.toml:4:1: faults[0].count: not used by fault 'anti_collision'"),
+    ('[robot]\npoint_duration_s = "8s"\n', "s.toml:2:20: robot.point_duration_s: "),  # a bad value: at the value
+])
+def test_an_unknown_robot_or_fault_key_is_pointed_at_by_its_name(tmp_path, text, place):
+    """scenarios.md: the column is the key itself for an unknown key - in [robot] and
+    [[faults]] too, as at the top level and in [converter]; the emulator's fault files, which
+    hold the same tables, say the same."""
+    with pytest.raises(ScenarioError) as caught:
+        parse_scenario(text, path=Path("s.toml"))
+    assert str(caught.value).startswith(place), str(caught.value)
+    from verifier.emulate.faultfile import FaultFileError, load_fault_file
+
+    bench = tmp_path / "s.toml"
+    bench.write_text(text, encoding="utf-8")
+    with pytest.raises(FaultFileError) as caught:
+        load_fault_file(bench)
+    assert str(caught.value).startswith(str(tmp_path / place)), str(caught.value)

@@ -103,7 +103,7 @@ class Fault:
                 known = {f.name for f in fields(cls)}
                 why = f"not used by fault '{kind}'" if key in known else "unknown key"
                 raise schema.ConfigError(schema.join(path, str(key)),
-                                         f"{why}; expected one of {', '.join(allowed)}")
+                                         f"{why}; expected one of {', '.join(allowed)}", at_name=True)
         at_s = data.get("at_s")
         on_request = data.get("on_request")
         if (at_s is None) == (on_request is None):

@@ -17,10 +17,11 @@ from verifier.tomlpos import shown
 class ConfigError(ValueError):
     """A bad value in a robot configuration or fault list; ``path`` names the key."""
 
-    def __init__(self, path: str, message: str) -> None:
+    def __init__(self, path: str, message: str, at_name: bool = False) -> None:
         super().__init__(f"{path}: {message}" if path else message)
         self.path = path
         self.message = message
+        self.at_name = at_name  # the key itself is the mistake (unknown key): point at its name
 
 
 def join(path: str, key: str | int) -> str:
@@ -41,7 +42,7 @@ def reject_unknown_keys(data: Mapping[str, Any], allowed: Iterable[str], path: s
     for key in data:
         if key not in allowed:
             raise ConfigError(
-                join(path, str(key)), f"unknown key; expected one of {', '.join(allowed)}"
+                join(path, str(key)), f"unknown key; expected one of {', '.join(allowed)}", at_name=True
             )
 
 

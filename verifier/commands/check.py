@@ -72,7 +72,7 @@ def check_findings(paths: list[Path], target: str,
     findings: list[Finding] = []
     for p in paths:
         if p.suffix.lower() == ".toml":
-            findings += [Finding(d, "UITAMR-SCENARIO") for d in check_scenario(p)]
+            findings += [Finding(d, "UITAMR-SCENARIO") for d in check_scenario(p, platform)]
             continue
         text, problems = read_source(p)
         findings += [Finding(d, "UITAMR-ST-SOURCE") for d in problems]
@@ -106,14 +106,15 @@ def platform_target(platform: str, target: str | None, command: str = "check") -
     return editor
 
 
-def check_scenario(path: Path) -> list[Diagnostic]:
+def check_scenario(path: Path, platform: str | None = None) -> list[Diagnostic]:
     """A scenario file read as `uitamr verify` reads it: its TOML, keys, values and the
     sources it names (not the labels it uses: those need the program loaded, which
-    `uitamr verify` does)."""
-    from verifier.verify.scenario import ScenarioError, load_scenario
+    `uitamr verify` does). `platform` (--platform): the CPU of a file that names none, as
+    `uitamr verify --platform` runs it."""
+    from verifier.verify.scenario import PLATFORMS, ScenarioError, load_scenario
 
     try:
-        scenario = load_scenario(path)
+        scenario = load_scenario(path, platform if platform in PLATFORMS else None)
     except ScenarioError as exc:
         message = f"{exc.key}: {exc.message}" if exc.key else exc.message
         return [Diagnostic(str(path), exc.line or 0, exc.col or 0, "error", message)]
@@ -124,7 +125,7 @@ def _scenario_devices(scenario) -> list[Diagnostic]:
     """The devices of [initial] and [[inputs]] that the scenario's platform does not have,
     each at its key, as `uitamr verify` refuses them (exit 2) before the first scan."""
     from verifier.sim.cpu import PROFILES
-    from verifier.sim.devices import device_problem
+    from verifier.sim.devices import device_problem, device_warning
     from verifier.verify.scenario import BUFFER_MEMORY, DEVICE_NAME
 
     cpu = PROFILES[scenario.platform]
@@ -135,10 +136,13 @@ def _scenario_devices(scenario) -> list[Diagnostic]:
     found = []
     for key, name, at in named:
         problem = device_problem(name, cpu)
+        severity = "error"
+        if problem is None:
+            problem, severity = device_warning(name, cpu), "warning"  # M8402 on an FX5U: sets nothing
         if problem:
             place = scenario.key_lines.get(at)
             found.append(Diagnostic(str(scenario.path), place.line if place else 0, place.col if place else 0,
-                                    "error", f"{key}: {problem}"))
+                                    severity, f"{key}: {problem}"))
     return found
 
 

@@ -133,9 +133,27 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
         sys.exit(EXIT_USAGE)
     for note in warnings + notes:
         click.echo(str(note), err=True)
+    if sources:
+        _warn_of_another_editor(tuple(paths), target)
     pous = sum(1 for p in written if p.suffix == ".st")
     click.echo(f"{pous} POU(s) exported for {target} into {out_dir} (import order: "
                f"{Path(out_dir) / IMPORT_ORDER})")
     if notes:
         click.echo(f"{len(notes)} initial value(s) not carried by the {target} label tables: "
                    f"see {Path(out_dir) / DROPPED_TABLE}")
+
+
+def _warn_of_another_editor(paths: tuple[Path, ...], target: str) -> None:
+    """A warning when the sources load only on CPUs another editor programs (FX5U sources,
+    SM8561 and RS2, exported with --target gxworks2): the files are written, but their label
+    tables are in the wrong editor's type names and that editor cannot open such a project."""
+    from verifier.sim.cpu import EDITOR_NAMES, TARGET_CPUS
+    from verifier.verify.platform import platforms_that_load
+
+    fits, _ = platforms_that_load(paths)
+    if not fits or any(platform in TARGET_CPUS[target] for platform in fits):
+        return
+    editors = sorted({editor for editor, cpus in TARGET_CPUS.items() for platform in fits if platform in cpus})
+    click.echo(f"uitamr export: warning: the sources load on {', '.join(fits)} only, which "
+               f"{' and '.join(EDITOR_NAMES[e] for e in editors)} programs, not {EDITOR_NAMES[target]}: "
+               f"export them with --target {editors[0]}", err=True)

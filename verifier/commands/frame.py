@@ -29,7 +29,7 @@ from verifier.protocol import (
     explain_table,
     hex_bytes,
 )
-from verifier.protocol.describe import looks_like_reply
+from verifier.protocol.describe import looks_like_reply, modbus_tcp_hint
 from verifier.protocol.names import USAGE
 from verifier.commands.protocol_options import protocol_settings
 from verifier.digits import digit_problem
@@ -231,6 +231,9 @@ def _decode_and_print(data: bytes, settings: Settings, direction, request, show_
             frame = decode_frame(data, settings, direction)
     except FrameError as exc:
         click.echo(f"invalid frame: {exc}")
+        hint = modbus_tcp_hint(data, settings)
+        if hint:
+            click.echo(hint[2:])
         guessed = direction or ("reply" if request is not None or looks_like_reply(data) else "request")
         if guessed == "request":
             click.echo("the robot would " + _robot_answer(exc, settings))

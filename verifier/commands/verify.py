@@ -94,13 +94,15 @@ _CHANNEL_PLATFORMS = {channel.split(":")[0]: platform for platform, (_, channel)
 
 
 def _scenarios(sources, program, platform, channel, scenario_files, matrix, duration, scan, seed) -> list[Scenario]:
+    from verifier.link.converter import ConverterConfig
     from verifier.verify.matrix import for_user_sources, without_repeats
     from verifier.verify.platform import infer_platform, platforms_that_load, uses_tcp_route
 
+    platform_given = platform is not None  # --platform, as against told from the sources
     resolved = _source_files(sources) if sources else ()
     scenario_files = _scenario_files(scenario_files)
     given = {real_path(f) for f in scenario_files}
-    own = [load_scenario(f) for f in scenario_files]
+    own = [load_scenario(f, platform) for f in scenario_files]  # --platform: the CPU they run on
     bundled_files: list[Path] = []
     if matrix or (not sources and not scenario_files):
         found = bundled_scenarios()
@@ -139,10 +141,18 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
                 platform = fits[0] if len(fits) == 1 else None  # else the default, fx3u (ST errors show there)
                 overrides["platform"] = platform
             own = [replace(default_scenario(duration_us=duration or DEFAULT_DURATION_US), sources=resolved)]
+            if resolved and uses_tcp_route(resolved, program):
+                # a program that opens a TCP connection reaches the robot through a
+                # converter, as --matrix runs it: a healthy one, wherever the program opens
+                own = [replace(own[0], converter=ConverterConfig(any_address=True), description=(
+                    "default: a healthy robot behind a healthy converter at the address the program opens, "
+                    "no faults, no inputs"))]
         scenarios = [s.with_overrides(**overrides) for s in own]
         scenarios += [s.with_overrides(**{**overrides, "platform": None}) for s in bundled]
     if duration is not None:
         scenarios = [_cut_short(s) for s in scenarios]
+    if platform_given:
+        scenarios = [replace(s, platform_from_option=True) for s in scenarios]
     for scenario in scenarios:
         if scenario.scan_us > scenario.duration_us:
             raise UnusableInput(f"{scenario.name}: the scan time is longer than the whole run")

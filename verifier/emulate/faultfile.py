@@ -64,7 +64,7 @@ def load_fault_file(path: str | Path, own_address: int | None = None) -> FaultFi
         if own_address is not None:
             check_fault_addresses(faults, own_address)
     except ConfigError as err:
-        place = place_of_key(text_lines(text), err.path)
+        place = place_of_key(text_lines(text), err.path, err.at_name)
         raise FaultFileError(f"{_where(path, place)}: {err}") from None
     return FaultFile(robot, faults)
 

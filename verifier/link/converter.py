@@ -33,7 +33,7 @@ scenario settings because they depend on the module (docs/tcp-converter.md).
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from verifier.link.line import Line
 from verifier.link.trace import LineEvent
@@ -54,9 +54,14 @@ class ConverterConfig:
     drops: tuple[int, ...] = ()
     split_reply: bool = False
     split_gap_us: int = 20_000
+    # listen wherever the PLC opens (ip and port unused): a run whose converter was not
+    # written for the program's constants (a bundled scenario under --matrix, the run
+    # without a scenario file) tests the program, not its converter address
+    any_address: bool = False
 
     def describe(self) -> str:
-        parts = [f"converter {self.ip}:{self.port}", f"delay {self.delay_us / 1000:g} ms",
+        where = "at the address the program opens" if self.any_address else f"{self.ip}:{self.port}"
+        parts = [f"converter {where}", f"delay {self.delay_us / 1000:g} ms",
                  f"packing {self.pack_us / 1000:g} ms"]
         if self.refuse_until_us:
             parts.append(f"refuses connections before {self.refuse_until_us / 1e6:g} s")
@@ -86,6 +91,8 @@ class Converter:
         self.events: list[LineEvent] = []
         self.event_count = 0  # events made so far (a run judged as it goes may drop old ones)
         self.connection = 0  # current accepted connection (0: none)
+        self.open_count = 0  # opens the PLC tried
+        self.first_failed_open: str | None = None  # why the first open that failed did (for a silent run's note)
         self._count = 0
         self._closed_at: dict[int, int] = {}  # connection the converter dropped -> when the PLC learns it
         self._to_line: deque[tuple[int, int, bytes, str | None]] = deque()  # (t, connection, data, origin)
@@ -94,14 +101,22 @@ class Converter:
         self._drops = sorted(self.config.drops)
         self.now_us = 0
 
+    @property
+    def accepted_count(self) -> int:
+        """Connections the converter has accepted so far."""
+        return self._count
+
     # ---- the PLC's side ------------------------------------------------------------------
 
     def open(self, t_us: int, ip: str, port: int) -> OpenResult:
         """An active open from the PLC at `t_us` to ip:port."""
         self._work_until(t_us)
+        self.open_count += 1
         cfg = self.config
         done = t_us + cfg.connect_us
         target = f"{ip}:{port}"
+        if cfg.any_address:
+            cfg = replace(cfg, ip=ip, port=port)
         if ip != cfg.ip:
             self._event(t_us, "converter.unreachable",
                         f"the PLC opens a connection to {target}: nothing answers there (the converter is at "
@@ -259,5 +274,7 @@ class Converter:
         self._to_line.clear()
 
     def _event(self, t_us: int, kind: str, message: str, frames: tuple[bytes, ...] = ()) -> None:
+        if kind in ("converter.unreachable", "converter.refused") and self.first_failed_open is None:
+            self.first_failed_open = message
         self.events.append(LineEvent(t_us, kind, message, frames))
         self.event_count += 1

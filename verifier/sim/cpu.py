@@ -193,3 +193,46 @@ def special_equivalent(device: str, cpu: CpuProfile) -> tuple[str, tuple[str, ..
 # these numbers are ordinary devices or none at all; their special devices are SM and SD.
 FX3_SPECIAL = {"M": ("SM", "relay"), "D": ("SD", "register")}
 FX3_SPECIAL_RANGE = range(8000, 8512)
+
+# The FX3's serial-communication devices (RS2 ch1 / ch2, docs/instructions.md §7) and what
+# stands for each on the other CPU families: the FX5's RS2 devices (§8, ASSUMPTION there
+# but for SD8621/SD8631), or nothing, with where the setting lives instead. A program moved
+# from an FX3U to an FX5U or a Q names these first; "FX3 special registers are SD devices"
+# would send it to SD8400, an unrelated number nothing reads.
+_FX5_SERIAL_SOURCE = "docs/instructions.md §8"
+_FX5_LINE_SETTINGS = ("no device on the fx5u: its serial ports take the line settings from the module "
+                      "parameters (GX Works3: Module Parameter > 485 Serial Port, docs/import-gxworks3.md §4)")
+_Q_SERIAL = ("no device on the q: a QJ71C24N is driven with G_OUTPUT / G_INPUT and its switch settings "
+             "(UITAMR_PortQC24, docs/import-gxworks2.md)")
+FX3_SERIAL: dict[str, tuple[str, dict[str, str]]] = {}
+for _ch, (_fx3, _fx5) in enumerate(((("8400", "8402", "8403", "8409"), ("8560", "8561", "8621", "8565", "8561", "8562")),
+                                    (("8420", "8422", "8423", "8429"), ("8570", "8571", "8631", "8575", "8571", "8572"))),
+                                   start=1):
+    _format, _send, _recv, _timeout = _fx3
+    _left, _count, _timeout_reg, _timeout_flag, _send_flag, _recv_flag = _fx5
+    for _device, _role, _fx5_text in (
+        (f"D{_format}", f"RS2 ch{_ch} communication format", _FX5_LINE_SETTINGS),
+        (f"D{_send}", f"RS2 ch{_ch} bytes left to send", f"SD{_left} on the fx5u ({_FX5_SERIAL_SOURCE})"),
+        (f"D{_recv}", f"RS2 ch{_ch} received byte count", f"SD{_count} on the fx5u ({_FX5_SERIAL_SOURCE})"),
+        (f"D{_timeout}", f"RS2 ch{_ch} receive time-out",
+         f"SD{_timeout_reg} on the fx5u, in ms ({_FX5_SERIAL_SOURCE})"),
+        (f"M{_send}", f"RS2 ch{_ch} send request", f"SM{_send_flag} on the fx5u ({_FX5_SERIAL_SOURCE})"),
+        (f"M{_recv}", f"RS2 ch{_ch} receive complete", f"SM{_recv_flag} on the fx5u ({_FX5_SERIAL_SOURCE})"),
+        (f"M{_timeout}", f"RS2 ch{_ch} time-out flag", f"SM{_timeout_flag} on the fx5u ({_FX5_SERIAL_SOURCE})"),
+    ):
+        FX3_SERIAL[_device] = (_role, {"fx5": _fx5_text, "q": _Q_SERIAL})
+FX3_SERIAL["M8161"] = ("8-bit mode of CRC", {
+    "fx5": "SM8161 on the fx5u (docs/instructions.md §6); RS2's 8-bit mode is SD8622 / SD8632 there",
+    "q": "no device on the q: it has no CRC instruction (the library computes the CRC in ST)"})
+
+
+def fx3_serial_equivalent(device: str, cpu: CpuProfile) -> str | None:
+    """'the FX3's M8402 (RS2 ch1 send request) is SM8561 on the fx5u (...)' for an FX3
+    serial-communication device named on another CPU family; None for other devices."""
+    entry = FX3_SERIAL.get(device.upper())
+    if entry is None or cpu.family not in entry[1]:
+        return None
+    role, texts = entry
+    text = texts[cpu.family]
+    verb = "has" if text.startswith("no device") else "is"
+    return f"the FX3's {device.upper()} ({role}) {verb} {text}"

@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from .cpu import FX3_SPECIAL, FX3_SPECIAL_RANGE, Area, CpuProfile, special_equivalent
+from .cpu import FX3_SPECIAL, FX3_SPECIAL_RANGE, Area, CpuProfile, fx3_serial_equivalent, special_equivalent
 from .datatypes import wrap16, wrap32
 
 _DEVICE_RE = re.compile(r"^(?:K([1-8]))?([A-Z]{1,2})([0-9A-F]+)(?:\.([0-9A-F]))?$")
@@ -60,6 +60,22 @@ def device_problem(name: str, cpu: CpuProfile) -> str | None:
     except DeviceError as exc:
         return str(exc)
     return None
+
+
+def device_warning(name: str, cpu: CpuProfile) -> str | None:
+    """For a device as a scenario writes it (`M8002`): the warning `uitamr check --platform`
+    gives the same device in ST when it is an FX3 special number that is an ordinary device
+    on `cpu` (setting M8402 on an FX5U sends nothing); None otherwise."""
+    m = _DEVICE_RE.match(name.strip().upper())
+    if not m:
+        return None
+    digits, area_name, number, bit = m.groups()
+    if digits or bit is not None or not number.isdigit():
+        return None
+    from types import SimpleNamespace
+
+    return fx3_special_elsewhere(SimpleNamespace(index=None, digits=None, address=number, kind=area_name,
+                                                 text=name.strip(), key=name.strip().upper()), cpu)
 
 
 def locate(d, cpu: CpuProfile) -> tuple[Area, int]:
@@ -127,6 +143,9 @@ def _fx3_phrase(kind: str, index: int, cpu: CpuProfile) -> str:
     """What an FX3 special relay/register number (M8002, D8400) is on `cpu`, whose special
     devices are SM/SD: its equivalent if `cpu` drives the same thing, else where to look."""
     area, what = FX3_SPECIAL[kind]
+    serial = fx3_serial_equivalent(f"{kind}{index}", cpu)
+    if serial is not None:
+        return serial
     same = special_equivalent(f"{kind}{index}", cpu)
     if same:
         return (f"the FX3's special {what} {kind}{index} ({same[0]}) is "

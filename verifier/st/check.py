@@ -732,6 +732,12 @@ class Checker:
     # ------------------------------------------------------------- calls
     def call(self, c: ast.Call, statement: bool) -> T.Type:
         name = c.key
+        dotted = _ladder_spelling(c.callee, self.table, self.pou)
+        if dotted is not None:  # SP.SOCOPEN(...): the ladder name of SP_SOCOPEN, not a member of a label 'SP'
+            self.rep.error(c.callee, f"{dotted[0]} is how ladder writes the instruction; ST writes it with an "
+                                     f"underscore: {dotted[1]}(...)")
+            self._args_only(c)
+            return T.ANY
         if not isinstance(c.callee, ast.Name):
             ct = self.expr(c.callee)
             if isinstance(ct, T.FbType):
@@ -772,6 +778,11 @@ class Checker:
             if self.target not in sig.targets:
                 self.rep.error(c.callee, f"instruction {name} is not available for {_target_name(self.target)}"
                                          + _other_editor_hint(name, self.target, len(c.args)))
+                wrong_editor = self.rep.diagnostics[-1]
+                result = self._signature_call(c, sig, statement, "instruction")
+                # with --platform, 'SP_SOCOPEN does not exist on the q' says it better: one error
+                c.resolved.signature_errors.insert(0, wrong_editor)
+                return result
             return self._signature_call(c, sig, statement, "instruction")
         if name in library.INSTRUCTIONS or name == "ADPRW":
             self.rep.error(c.callee, f"instruction {name} is not available for {_target_name(self.target)}"
@@ -1183,3 +1194,17 @@ def check_project(files: list[ast.SourceFile], target: str = "gxworks2") -> tupl
 def check(files: list[ast.SourceFile], target: str = "gxworks2") -> list[ast.Diagnostic]:
     """Diagnostics for `files` checked together (parse diagnostics not included)."""
     return check_project(files, target)[0]
+
+
+def _ladder_spelling(callee: ast.Expr, table, pou) -> tuple[str, str] | None:
+    """(`SP.SOCOPEN`, `SP_SOCOPEN`) when a call's callee is an instruction written with the
+    ladder's dot (SP.SOCOPEN, ZP.OPEN, G.OUTPUT), not a member of a label of that name;
+    st-dialect.md §1: the dot is not an ST character, the instruction takes an underscore."""
+    if not (isinstance(callee, ast.Member) and isinstance(callee.base, ast.Name)):
+        return None
+    if table.lookup(pou, callee.base.name) is not None:
+        return None
+    joined = f"{callee.base.name}_{callee.member}"
+    if joined.upper() not in library.INSTRUCTIONS:
+        return None
+    return f"{callee.base.name}.{callee.member}", joined

@@ -16,10 +16,15 @@ from typing import Callable, Sequence
 EVENTS_AT_MOST = 2000  # line and robot events the HTML page draws of a run (the scenario's faults first)
 
 
+#: the events of the faults a scenario scripts: the robot's [[faults]], and the converter's
+#: `drops` (the TCP route's dropped connection strikes as one event, like a robot fault)
+SCRIPTED = frozenset({"robot.fault", "converter.dropped"})
+
+
 def event_class(kind: str) -> str:
     """Faults the scenario injected, trouble on the line, or the robot's ordinary doings
     (`kind` as a run's result has it: the robot's own kinds prefixed with ``robot.``)."""
-    if kind == "robot.fault":
+    if kind in SCRIPTED:
         return "fault"
     if not kind.startswith("robot."):
         return "line"

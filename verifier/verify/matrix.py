@@ -6,7 +6,8 @@ labels name that program's labels, its [initial] device values are that program'
 response signal is that program's error output. None of that means anything for another
 program, so against user sources a bundled scenario keeps only what is about the robot,
 the line and the serial module: the platform, the converter of the TCP route (only for
-programs that use it: `platform.uses_tcp_route`), the robot, the faults and their timing, the
+programs that use it: `platform.uses_tcp_route`; listening at whatever address the program
+opens, as the example's converter address is the example's), the robot, the faults and their timing, the
 protocol settings, the run and scan times, the QJ71C24N settings ([[c24]], which every
 installation must make in GX Works — docs/import-gxworks2.md) and every rule. It expects what every program must do — send the
 power-on stop and have it answered within 5 s — and UITAMR-RESPONSE-HANDLING watches
@@ -35,6 +36,12 @@ def for_user_sources(scenario: Scenario, sources: tuple[Path, ...], program: str
         left_out.append("its [initial] device values")
     if scenario.response_signal_given:
         left_out.append(f"its response signal ({scenario.options.response_signal})")
+    converter = scenario.converter
+    if converter is not None and not converter.any_address:
+        # the example's CONVERTER_IP / CONVERTER_PORT are the example's: the converter
+        # listens wherever the user's program opens
+        left_out.append(f"its converter address ({converter.ip}:{converter.port})")
+        converter = replace(converter, any_address=True)
     example = scenario.program or "the bundled example"
     # a converter that refuses connections at first: the stop can only be answered after
     reachable_from = min(scenario.converter.refuse_until_us, scenario.duration_us // 2) if scenario.converter else 0
@@ -49,6 +56,7 @@ def for_user_sources(scenario: Scenario, sources: tuple[Path, ...], program: str
         sources=sources,
         program=program,
         channel=None if scenario.converter is not None else channel,
+        converter=converter,
         inputs=(),
         expectations=(power_on_stop_expectation(scenario.duration_us, scenario.settings.address, reachable_from),),
         watch=(),

@@ -68,6 +68,7 @@ def scenario_dict(result: ScenarioResult) -> dict[str, Any]:
         "seed": result.seed,
         "protocol": asdict(result.settings),
         "faults": result.faults,
+        "converter": result.converter,
         "frames": {
             "tx": result.tx_count,
             "rx": result.rx_count,

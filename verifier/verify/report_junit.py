@@ -81,6 +81,7 @@ def to_element(results: list[ScenarioResult]) -> ET.Element:
                 f"{tx} requests, {rx} replies",
                 *(f"note: {note}" for note in result.notes),
                 *(f"fault: {fault}" for fault in result.faults),
+                *([result.converter] if result.converter else []),
                 *(f"expectation met: {e.expectation.label}: {e.detail}" for e in result.expectations if e.passed),
             ]
         )

@@ -85,6 +85,7 @@ class ScenarioResult:
     min_period_us: int = protocol.MIN_PERIOD_US
     reply_timeout_us: int = protocol.DEFAULT_REPLY_TIMEOUT_US
     faults: list[str] = field(default_factory=list)
+    converter: str | None = None  # the TCP route's converter, its settings and faults (not a fault itself)
     trace: list[TraceRecord] = field(default_factory=list)
     events: list[LineEvent] = field(default_factory=list)
     events_dropped: int = 0  # events let go of while the run went (Keep.events_at_most), not in `events`

@@ -26,7 +26,7 @@ from .evidence import RunEvidence, Samples
 from .expectations import judge
 from .result import KEEP_ALL, Keep, LineEvent, ScenarioResult, TraceRecord, UnusableInput
 from .rules import check_all
-from .scenario import BUFFER_MEMORY, DEVICE_NAME, Scenario
+from .scenario import BUFFER_MEMORY, DEVICE_NAME, Scenario, power_on_stop_expectation
 from .stream import Stream
 from .traffic import analyse, converter_drops
 
@@ -143,12 +143,14 @@ class _Plc:
         target, shown = self.program, ""
         for part in _path_parts(name):
             try:
+                inside = target
                 target = target[int(part[1:-1])] if part.startswith("[") else getattr(target, part)
             except (AttributeError, KeyError, IndexError, TypeError, ValueError, LookupError):
+                hint = "" if part.startswith("[") else _did_you_mean(part, inside)
                 if not shown:
-                    return f"the program {self.name} has no label {name!r}"
+                    return f"the program {self.name} has no label {name!r}{hint}"
                 what = f"element {part}" if part.startswith("[") else f"member {part!r}"
-                return f"no label {name!r} in the program {self.name}: {shown} has no {what}"
+                return f"no label {name!r} in the program {self.name}: {shown} has no {what}{hint}"
             shown += part if part.startswith("[") or not shown else f".{part}"
         if not isinstance(_plain(target), (bool, int, float, str)):
             return (f"{name!r} in {self.name} is not a single value (an array or FB instance?); "
@@ -189,6 +191,21 @@ class _Plc:
         return [str(d) for d in self.project.diagnostics]
 
 
+def _did_you_mean(part: str, instance: Any) -> str:
+    """'; did you mean 'fbBatt'?' when `instance` (a program or FB) has a label spelt
+    nearly as `part` (a scenario's typo of an instance or member name), else ''."""
+    import difflib
+
+    symbols = getattr(instance, "_symbols", None)
+    try:
+        names = [sym.name for sym in symbols().values()] if symbols is not None else []
+    except Exception:  # a value without labels (a number, a standard FB): nothing to offer
+        return ""
+    by_key = {n.upper(): n for n in names}
+    close = difflib.get_close_matches(part.upper(), list(by_key), n=1, cutoff=0.8)
+    return f"; did you mean {by_key[close[0]]!r}?" if close else ""
+
+
 def _path_parts(name: str) -> list[str]:
     return re.findall(r"[A-Za-z_][A-Za-z0-9_]*|\[[0-9]+\]", name)
 
@@ -201,6 +218,10 @@ def _platform_hint(scenario: Scenario) -> str:
     fits, _ = platforms_that_load(scenario.sources)
     if not fits or scenario.platform in fits:
         return ""
+    if scenario.platform_from_option or scenario.path is None:  # no file's key to point at
+        told = f"--platform {scenario.platform}" if scenario.platform_from_option else f"the default, {scenario.platform}"
+        return (f"\n{_where(scenario)}: the sources load on {', '.join(fits)}, not on {scenario.platform} "
+                f"({told}): give --platform {fits[0]}")
     line = scenario.key_lines.get("platform")
     defaulted = "platform" not in scenario.key_lines and scenario.platform == "fx3u"
     now = f"{scenario.platform} (the default)" if defaulted else scenario.platform
@@ -382,6 +403,53 @@ def _input_schedule(scenario: Scenario) -> list[tuple[int, dict[str, Any]]]:
     return sorted(steps, key=lambda s: s[0])
 
 
+def _expecting_something(scenario: Scenario) -> Scenario:
+    """A scenario with no expectation expects what every program must do - the power-on
+    stop sent and answered, after a converter's refusals - as the run without a scenario
+    file and --matrix do: judged by the rules alone, a program that never reaches the robot
+    (a wrong channel, a converter at another address) would break none and pass."""
+    if scenario.expectations:
+        return scenario
+    converter = scenario.converter
+    reachable = min(converter.refuse_until_us, scenario.duration_us // 2) if converter is not None else 0
+    stop = power_on_stop_expectation(scenario.duration_us, scenario.settings.address, reachable)
+    note = "no [[expect]] in the scenario: it expects what every program must do, the power-on stop sent and answered"
+    return replace(scenario, expectations=(stop,), notes=(note,) + scenario.notes)
+
+
+def _silence_note(scenario: Scenario, plc: _Plc, converter: Converter | None) -> str:
+    """What a run in which nothing reached the robot's line says: and, where the program did
+    talk, where to (another serial port, a TCP connection, a converter that was not there),
+    with the setting that puts the robot on that route."""
+    from verifier.sim.instructions.tcp import TcpPort
+
+    rt = plc.project.rt
+    channel = scenario.serial_channel
+    note = f"the program sent nothing on {channel} in the whole run"
+    other = {name: port.sent_count for name, port in sorted(rt.ports.items())
+             if port.sent_count and name != channel}
+    sent = "; ".join(f"it sent {count} frame(s) on {name}" for name, count in other.items())
+    if converter is not None:
+        note += " (nothing reached the robot's line through the converter"
+        if converter.open_count == 0:
+            note += ": the program opened no connection to it"
+        elif converter.first_failed_open is not None and converter.accepted_count == 0:
+            note += f": {converter.first_failed_open}; set the scenario's [converter] ip and port to what the program opens"
+        note += ")"
+        if sent:
+            note += f"; {sent}: a serial port, not the TCP route: drop [converter] from the scenario"
+        return note
+    opens = sum(poller.open_count for poller in rt.pollers if isinstance(poller, TcpPort))
+    if sent:
+        first = next(iter(other))
+        note += (f"; {sent}: the robot hangs on {channel} in this run: give --channel {first}, "
+                 f'or channel = "{first}" in the scenario')
+    elif opens:
+        note += (f"; it opened TCP connections ({opens} open(s)): the robot is behind a serial-to-TCP converter "
+                 "on that route: add a [converter] table to the scenario (docs/scenarios.md)")
+    return note
+
+
 def _judge_whole(scenario: Scenario, trace: list[TraceRecord], end_us: int, events: list[LineEvent],
                  samples: Samples, stopped_early: bool):
     """Every rule's violations and every expectation's result, the run judged as a whole."""
@@ -403,6 +471,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     watched labels by their names on each, recording them all: the reference the fast
     path is tested against (same result, byte for byte; `uitamr verify --every-scan`)."""
     wall_start = time.perf_counter()
+    scenario = _expecting_something(scenario)
     robot = Robot(scenario.settings, scenario.robot, list(scenario.faults))
     line = Line(robot)
     # the TCP route: the PLC talks to a converter, the rules judge the line behind it
@@ -509,8 +578,8 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         settings=scenario.settings,
         min_period_us=scenario.options.min_period_us,
         reply_timeout_us=scenario.options.reply_timeout_us,
-        faults=[fault.describe() for fault in scenario.faults]
-        + ([scenario.converter.describe()] if scenario.converter is not None else []),
+        faults=[fault.describe() for fault in scenario.faults],
+        converter=scenario.converter.describe() if scenario.converter is not None else None,
         trace=trace if keep.frames else [],
         frame_counts=None if keep.frames and stream is None else (tx_count, rx_count),
         trace_file=stream.trace_file if stream is not None else None,
@@ -523,9 +592,5 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         aborted=aborted,
         ended_us=end,
         wall_s=time.perf_counter() - wall_start,
-        notes=list(scenario.notes) + plc.cpu_notes() + (
-            [] if tx_count
-            else [f"the program sent nothing on {scenario.serial_channel} in the whole run"
-                  + (" (nothing reached the robot's line through the converter)" if converter is not None else "")]
-        ),
+        notes=list(scenario.notes) + plc.cpu_notes() + ([] if tx_count else [_silence_note(scenario, plc, converter)]),
     )

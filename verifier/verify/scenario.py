@@ -57,6 +57,7 @@ CONVERTER_KEYS = ("ip", "port", "delay", "connect", "packing", "refuse_until", "
                   "split_reply", "split_gap")
 #: The platforms with an Ethernet port the library drives (FX5U built-in, Q + QJ71E71-100).
 TCP_PLATFORMS = ("fx5u", "q")
+DEFAULT_PLATFORM = "fx3u"  # of a scenario file that names none
 TCP_CHANNEL = "tcp"
 #: Buffer memory of an intelligent module, as GX Works writes it: U0\G164, U3E\G10.
 BUFFER_MEMORY = re.compile(r"^U([0-9A-F]{1,3})\\G([0-9]+)$", re.IGNORECASE)
@@ -145,6 +146,7 @@ class Scenario:
     converter: ConverterConfig | None = None  # the TCP route: the robot behind a converter
     notes: tuple[str, ...] = ()  # for the reports: how this run differs from its file
     response_signal_key: str = "response_handling.signal"  # or "--response-signal" when given there
+    platform_from_option: bool = False  # the platform is --platform's, not the file's (for messages)
 
     @property
     def target(self) -> str:
@@ -236,7 +238,10 @@ def power_on_stop_expectation(duration_us: int, address: int = 1, after_us: int 
 # --- loading -------------------------------------------------------------------------------
 
 
-def load_scenario(path: Path | str) -> Scenario:
+def load_scenario(path: Path | str, platform: str | None = None) -> Scenario:
+    """The scenario file at `path`. `platform`: the CPU the run is on when the file names
+    none (`--platform` of verify and check), else the default fx3u: its [converter],
+    [[c24]] and devices are judged for the CPU they will run on."""
     path = Path(path)
     try:
         if not path.exists():
@@ -252,24 +257,25 @@ def load_scenario(path: Path | str) -> Scenario:
             raise ScenarioError(path, "", str(exc)) from None
         raise ScenarioError(path, "", f"not UTF-8 text (byte {exc.byte}): save the file as UTF-8",
                             Place(exc.line, exc.col)) from None
-    return parse_scenario(text, path)
+    return parse_scenario(text, path, platform)
 
 
-def parse_scenario(text: str, path: Path | None = None) -> Scenario:
+def parse_scenario(text: str, path: Path | None = None, platform: str | None = None) -> Scenario:
     try:
         data = tomllib.loads(text)
     except ValueError as exc:  # TOMLDecodeError, or int()'s limit of 4300 digits
         message, place = decode_error_position(exc, text)
         raise ScenarioError(path, "", f"not valid TOML: {message}", place) from None
-    return _Reader(text, path).read(data)
+    return _Reader(text, path, platform).read(data)
 
 
 class _Reader:
     """Turns the parsed TOML into a Scenario; every error names its key and line."""
 
-    def __init__(self, text: str, path: Path | None):
+    def __init__(self, text: str, path: Path | None, platform: str | None = None):
         self.lines = text_lines(text)
         self.path = path
+        self.default_platform = platform.lower() if platform else DEFAULT_PLATFORM  # when the file names none
         self.base = path.parent if path is not None else Path.cwd()
 
     # --- errors --------------------------------------------------------------------------
@@ -355,7 +361,7 @@ class _Reader:
         if program is not None and not program.strip():  # was "no PROGRAM '' in the sources", without a line
             raise self.fail("program", "is empty: give the name of the PROGRAM to run, or leave 'program' out "
                                        "when the sources hold only one")
-        platform = self.string(data.get("platform", "fx3u"), "platform").lower()
+        platform = self.string(data.get("platform", self.default_platform), "platform").lower()
         if platform not in PLATFORMS:
             raise self.fail("platform", f"unknown platform {platform!r}; expected one of {', '.join(PLATFORMS)}")
         channel = None
@@ -411,7 +417,9 @@ class _Reader:
             if first != setting.key:
                 raise self.fail(setting.key, f"U{setting.unit:X} channel {setting.channel} is already set in "
                                              f"{first}: one [[c24]] table per module channel", at_name=True)
-        converter = self.converter(data["converter"], platform, duration) if "converter" in data else None
+        converter = (self.converter(data["converter"], platform, duration,
+                                    "platform" in data or platform != DEFAULT_PLATFORM)
+                     if "converter" in data else None)
         if converter is not None and channel is not None:
             raise self.fail("channel", "a scenario with [converter] reaches the robot over TCP: "
                                        "it has no serial channel; remove 'channel'")
@@ -434,12 +442,15 @@ class _Reader:
         return {f"{step.key}.set.{name}": place_of_key(self.lines, f"{step.key}.set.{name}", at_name=True)
                 for step in inputs for name in step.values}
 
-    def converter(self, value: Any, platform: str, duration: int) -> ConverterConfig:
+    def converter(self, value: Any, platform: str, duration: int, platform_given: bool = True) -> ConverterConfig:
         item = self.table(value, "converter")
         self.only(item, CONVERTER_KEYS, "converter")
         if platform not in TCP_PLATFORMS:
+            why = (f"this scenario's platform is {platform!r}" if platform_given else
+                   f"this scenario names no platform, so it is {platform!r} (the default): add "
+                   f"platform = \"{TCP_PLATFORMS[0]}\" (or \"{TCP_PLATFORMS[-1]}\") to the file, or give --platform")
             raise self.fail("converter", f"the TCP route needs a PLC with an Ethernet port the library drives "
-                                         f"({' or '.join(TCP_PLATFORMS)}); this scenario's platform is {platform!r}")
+                                         f"({' or '.join(TCP_PLATFORMS)}); {why}")
         config = ConverterConfig()
         changes: dict[str, Any] = {}
         if "ip" in item:
@@ -550,7 +561,7 @@ class _Reader:
         try:
             return RobotConfig.from_dict(self.table(value, "robot"), "robot")
         except ConfigError as exc:
-            raise self.fail(exc.path, exc.message) from None
+            raise self.fail(exc.path, exc.message, at_name=exc.at_name) from None
 
     def faults(self, value: Any) -> tuple[Fault, ...]:
         items = self.array_of_tables(value, "faults")
@@ -560,7 +571,7 @@ class _Reader:
                 result.append(Fault.from_dict(item, f"faults[{i}]"))
             except ConfigError as exc:
                 path = exc.path if exc.path.startswith("faults[") else f"faults[{i}]"
-                raise self.fail(path, exc.message) from None
+                raise self.fail(path, exc.message, at_name=exc.at_name) from None
         return tuple(result)
 
     def input_step(self, item: dict, key: str, duration: int) -> InputStep:

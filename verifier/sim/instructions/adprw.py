@@ -22,6 +22,9 @@ ERR_FUNCTION = 4
 ERR_EXCEPTION = 0x100  # + MODBUS exception code
 
 
+FX5_RESPONSE_TIMEOUT_US = 400_000  # "Slave Response Timeout 400 ms" (docs/import-gxworks3.md §4)
+
+
 class AdprwMaster:
     """One MODBUS master channel: one transaction at a time."""
 
@@ -62,7 +65,9 @@ class AdprwMaster:
 
     def timeout_us(self) -> int:
         if self._timeout is None:
-            return 3_000_000  # FX5: from the module parameters (ASSUMPTION: 3 s)
+            # FX5: a module parameter, not a device: the 400 ms docs/import-gxworks3.md §4 has
+            # the integrator set (less than the engine's 500 ms reply time-out, 0 retries)
+            return FX5_RESPONSE_TIMEOUT_US
         raw = self._get(self._timeout)
         return (raw if raw > 0 else 3000) * 1000
 

@@ -72,6 +72,7 @@ class TcpPort:
         self.pulses: list[tuple] = []  # (ref, bit) ON for one scan
         self.pending: list[tuple] = []  # (ref, bit) to turn ON from the next scan
         self._active = False
+        self.open_count = 0  # opens the program ran (a silent run's note says so)
         rt.pollers.append(self)
 
     # ---- the status words (the platform names them) ---------------------------------------
@@ -115,6 +116,7 @@ class TcpPort:
 
     # ---- instructions --------------------------------------------------------------------------
     def open(self, number, control, done, loc_id) -> None:
+        self.open_count += 1
         conn = self.connection(number, control, done, loc_id)
         if conn is None:
             return
