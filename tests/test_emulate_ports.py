@@ -367,7 +367,7 @@ def test_tcp_answers_a_client_that_shut_its_sending_side(start_emulator):
     assert got == STOP_FRAME  # then the emulator closed its side
     emulator.wait_for(r"client 127\.0\.0\.1:\d+ disconnected")
     code, summary = emulator.stop()
-    assert code == 0 and "1 replies out" in summary and "not sent" not in summary
+    assert code == 0 and "1 reply out" in summary and "not sent" not in summary
 
 
 def test_quiet_still_says_which_port_it_listens_on(start_emulator):
@@ -423,7 +423,7 @@ def test_the_log_says_what_a_closing_tcp_client_left_behind(start_emulator):
     emulator.wait_for(r"disconnected$")  # nothing left behind: nothing more said
     code, summary = emulator.stop()
     # the reply owed to the client that left is counted (the summary used to lose it)
-    assert code == 0 and "1 frames in, 0 replies out, 0 unanswered, 1 reply not sent," in summary
+    assert code == 0 and "1 frame in, 0 replies out, 0 unanswered, 1 reply not sent," in summary
 
 
 def test_replies_still_owed_when_the_emulator_stops_are_logged_and_counted(pty_pair, start_emulator):
@@ -437,7 +437,7 @@ def test_replies_still_owed_when_the_emulator_stops_are_logged_and_counted(pty_p
         emulator.wait_for(r"\*\* fault: request 1: late_reply")
         code, summary = emulator.stop()
     assert code == 0
-    assert "1 frames in, 0 replies out, 0 unanswered, 1 reply not sent, 1 fault events" in summary
+    assert "1 frame in, 0 replies out, 0 unanswered, 1 reply not sent, 1 fault event," in summary
     emulator.wait_for(rf"-- serial {re.escape(robot_end)} closed; 1 reply not sent$")
 
     emulator, port = tcp_emulator(start_emulator, "--turnaround-ms", "60000")
@@ -445,7 +445,7 @@ def test_replies_still_owed_when_the_emulator_stops_are_logged_and_counted(pty_p
         sock.sendall(STATUS_TASK)
         emulator.wait_for(r"<- 01 01 00 00 00 16 BD C4")
         code, summary = emulator.stop()
-    assert code == 0 and "1 frames in, 0 replies out, 0 unanswered, 1 reply not sent," in summary
+    assert code == 0 and "1 frame in, 0 replies out, 0 unanswered, 1 reply not sent," in summary
     emulator.wait_for(r"-- client 127\.0\.0\.1:\d+ closed: the emulator stops; 1 reply not sent$")
 
 

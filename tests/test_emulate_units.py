@@ -186,7 +186,7 @@ def test_core_schedules_the_reply_after_the_turnaround_and_logs_both_ways():
     assert lines[0] == "     2.000 s  <- 01 06 01 A0 00 00 88 14  stop (01/A0)"
     assert lines[1].startswith("     2.000 s  ** command: stop")
     assert lines[2] == "     2.005 s  -> 01 06 01 A0 00 00 88 14  echo: stop (01/A0)"
-    assert "1 frames in, 1 replies out" in emulator.summary()
+    assert "1 frame in, 1 reply out" in emulator.summary()
 
 
 @pytest.mark.parametrize("turnaround_ms, t3_5_us, delay_us", [
