@@ -296,3 +296,18 @@ def test_finding_a_key_looks_up_its_own_parts_not_every_key_of_the_document(monk
         assert place_of_key(lines, f"inputs[{count - 1}].set.X0", at_name=True) == Place(3 * count, 9)
         reads.append(Counting.read)
     assert reads[1] == reads[0] < 40, reads
+
+
+def test_an_array_nested_deeper_than_the_walk_can_follow_is_no_crash():
+    """tomllib reads an array nested 400 deep; the walk that places keys takes more frames
+    per level and ran out of them: `uitamr check` and `verify` of such a file ended in a
+    RecursionError traceback instead of the file's own error. Its places are best effort:
+    those found before it are kept."""
+    from verifier.verify.scenario import ScenarioError, parse_scenario
+
+    text = "name = 5\nwatch = " + "[" * 400 + "]" * 400 + "\n"
+    assert tomllib.loads(text)["name"] == 5
+    assert place_of_key(text_lines(text), "name") == Place(1, 8)
+    with pytest.raises(ScenarioError) as error:
+        parse_scenario(text)
+    assert error.value.line == 1 and "name" in str(error.value)

@@ -95,6 +95,8 @@ def _places(text: str) -> dict[KeyPath, tuple[Place, Place]]:
         walk.document()
     except ValueError:  # not TOML after all (every loader reads it with tomllib first): what was found
         pass
+    except RecursionError:  # arrays nested deeper than the walk can follow (tomllib reads a little deeper)
+        pass
     return walk.places
 
 
