@@ -340,6 +340,23 @@ def test_a_scenario_without_platform_is_judged_for_the_platform_given(tmp_path):
     assert ran.exit_code == 0, ran.output
 
 
+def test_a_converter_on_the_platform_option_is_blamed_on_the_option(tmp_path):
+    """--platform fx3u given for a scenario that names none and has a [converter]: the
+    message said "so it is 'fx3u' (the default) ... or give --platform" to a user who gave
+    --platform fx3u. It names the option, and the platforms to give instead."""
+    from verifier.commands.verify import command as verify
+
+    scenario = write(tmp_path, '[converter]\n\n[[expect]]\nsent = "stop"\n', "own.toml")
+    expected = (f"{scenario}:1:1: error: converter: the TCP route needs a PLC with an Ethernet port the library "
+                "drives (fx5u or q); this scenario names no platform and --platform fx3u runs it on the fx3u: give "
+                "--platform fx5u (or q), or leave --platform out and add platform = \"fx5u\" (or \"q\") to the file")
+    done = run("--platform", "fx3u", scenario)
+    assert done.exit_code == 1 and errors(done.output)[0] == expected, done.output
+    ran = CliRunner().invoke(verify, [str(ROOT / "plc" / "core"), "--scenario", str(scenario), "--platform", "fx3u"])
+    where, message = expected.split(": error: ")
+    assert ran.exit_code == 2 and f"error: {where}: {message}" in " ".join(ran.output.split()), ran.output
+
+
 @pytest.mark.parametrize("spelling", ["FX3U", "Fx3u"])
 def test_the_cpu_may_be_written_as_mitsubishi_writes_it(tmp_path, spelling):
     # the scenario's `platform = "FX3U"` is read in any case; so is the option

@@ -251,3 +251,20 @@ def test_decode_names_a_modbus_tcp_frame_and_the_route_setting():
             "the robot's route carries Modbus RTU frames") in done.output
     plain = CliRunner().invoke(main, ["frame", "--decode", "01 06 01 A0 00 00 88 15"])  # a bad CRC: no such hint
     assert plain.exit_code == 1 and "Modbus TCP" not in plain.output
+
+
+def test_an_rtu_frame_with_a_bad_crc_is_never_called_modbus_tcp():
+    """An 8-byte RTU frame whose bytes 3-6 read 00 00 00 02 (read 2 coils from 0, a write of
+    2 to register 0) fits an MBAP header with nothing after the unit but a function code; no
+    Modbus TCP frame is that short (its PDU has a function code and data: 9 bytes at the
+    least, an exception reply). With a bad CRC it was called a Modbus TCP frame and the
+    converter blamed; it is the RTU frame with a bad CRC it is."""
+    from click.testing import CliRunner
+    from verifier.cli import main
+    from verifier.protocol.describe import modbus_tcp_hint
+
+    for frame in ("01 01 00 00 00 02 00 00", "01 06 00 00 00 02 12 34"):
+        done = CliRunner().invoke(main, ["frame", "--decode", frame])
+        assert done.exit_code == 1 and "bad CRC" in done.output
+        assert "Modbus TCP" not in done.output, done.output
+    assert modbus_tcp_hint(bytes.fromhex("00 01 00 00 00 03 01 81 02"))  # the shortest: an exception reply

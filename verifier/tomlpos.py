@@ -66,7 +66,9 @@ def place_of_key(lines: list[str], key: str, at_name: bool = False) -> Place | N
 def _find(places: dict[KeyPath, tuple[Place, Place]], path: KeyPath, key: str) -> tuple[KeyPath, str]:
     """The deepest path in `places` that `key` names from `path` on, and what is left of
     `key`. A key may hold dots (a label "fbRobot.i_uPoint" in an input's `set`): the table's
-    keys that `key` starts with are tried, the longest first."""
+    keys that `key` starts with are tried, the longest first. Only those are looked up: the
+    loader places every key it knows, and reading all of a long document's keys for each
+    took time in the square of its length."""
     if not key:
         return path, ""
     index = _INDEX.match(key)
@@ -74,10 +76,10 @@ def _find(places: dict[KeyPath, tuple[Place, Place]], path: KeyPath, key: str) -
         item = path + (int(index.group(1)),)
         return _find(places, item, key[index.end():].removeprefix(".")) if item in places else (path, key)
     deepest = (path, key)
-    names = {p[len(path)] for p in places if len(p) == len(path) + 1 and p[:len(path)] == path}
-    for name in sorted((n for n in names if isinstance(n, str)), key=len, reverse=True):
-        rest = key[len(name):]
-        if key.startswith(name) and rest[:1] in ("", ".", "["):
+    ends = [i for i, ch in enumerate(key) if ch in ".["] + [len(key)]  # where a name of the table may end
+    for end in reversed(ends):
+        name, rest = key[:end], key[end:]
+        if path + (name,) in places:
             found = _find(places, path + (name,), rest.removeprefix("."))
             if not found[1]:
                 return found
@@ -92,6 +94,8 @@ def _places(text: str) -> dict[KeyPath, tuple[Place, Place]]:
     try:
         walk.document()
     except ValueError:  # not TOML after all (every loader reads it with tomllib first): what was found
+        pass
+    except RecursionError:  # arrays nested deeper than the walk can follow (tomllib reads a little deeper)
         pass
     return walk.places
 

@@ -47,8 +47,10 @@ def describe(
 def modbus_tcp_hint(data: bytes, settings: Settings = DEFAULT_SETTINGS) -> str:
     """'; this is a Modbus TCP frame ...' when `data` is a whole MBAP frame (protocol id 0,
     its length field matching): a master, PLC or converter set to Modbus TCP where the
-    robot's route carries Modbus RTU inside TCP (docs/tcp-converter.md). '' otherwise."""
-    if len(data) < 8 or data[2:4] != b"\x00\x00" or int.from_bytes(data[4:6], "big") != len(data) - 6:
+    robot's route carries Modbus RTU inside TCP (docs/tcp-converter.md). '' otherwise. At
+    least 9 bytes (an exception reply: unit, function, code): an 8-byte "MBAP frame" would
+    be a function code without data, and is an RTU frame of this protocol."""
+    if len(data) < 9 or data[2:4] != b"\x00\x00" or int.from_bytes(data[4:6], "big") != len(data) - 6:
         return ""
     from verifier.protocol.crc import with_crc
 

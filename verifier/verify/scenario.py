@@ -276,6 +276,7 @@ class _Reader:
         self.lines = text_lines(text)
         self.path = path
         self.default_platform = platform.lower() if platform else DEFAULT_PLATFORM  # when the file names none
+        self.platform_option = platform is not None  # that default is --platform's, not fx3u's
         self.base = path.parent if path is not None else Path.cwd()
 
     # --- errors --------------------------------------------------------------------------
@@ -418,7 +419,7 @@ class _Reader:
                 raise self.fail(setting.key, f"U{setting.unit:X} channel {setting.channel} is already set in "
                                              f"{first}: one [[c24]] table per module channel", at_name=True)
         converter = (self.converter(data["converter"], platform, duration,
-                                    "platform" in data or platform != DEFAULT_PLATFORM)
+                                    "file" if "platform" in data else "option" if self.platform_option else "")
                      if "converter" in data else None)
         if converter is not None and channel is not None:
             raise self.fail("channel", "a scenario with [converter] reaches the robot over TCP: "
@@ -442,13 +443,19 @@ class _Reader:
         return {f"{step.key}.set.{name}": place_of_key(self.lines, f"{step.key}.set.{name}", at_name=True)
                 for step in inputs for name in step.values}
 
-    def converter(self, value: Any, platform: str, duration: int, platform_given: bool = True) -> ConverterConfig:
+    def converter(self, value: Any, platform: str, duration: int, platform_from: str = "file") -> ConverterConfig:
+        """The [converter] table; `platform_from` says who named the platform: "file", "option"
+        (--platform, for a file that names none) or "" (nobody: the default)."""
         item = self.table(value, "converter")
         self.only(item, CONVERTER_KEYS, "converter")
         if platform not in TCP_PLATFORMS:
-            why = (f"this scenario's platform is {platform!r}" if platform_given else
-                   f"this scenario names no platform, so it is {platform!r} (the default): add "
-                   f"platform = \"{TCP_PLATFORMS[0]}\" (or \"{TCP_PLATFORMS[-1]}\") to the file, or give --platform")
+            tcp = f"\"{TCP_PLATFORMS[0]}\" (or \"{TCP_PLATFORMS[-1]}\")"
+            why = {"file": f"this scenario's platform is {platform!r}",
+                   "option": f"this scenario names no platform and --platform {platform} runs it on the {platform}: "
+                             f"give --platform {TCP_PLATFORMS[0]} (or {TCP_PLATFORMS[-1]}), or leave --platform out "
+                             f"and add platform = {tcp} to the file"}.get(platform_from) or (
+                f"this scenario names no platform, so it is {platform!r} (the default): add "
+                f"platform = {tcp} to the file, or give --platform")
             raise self.fail("converter", f"the TCP route needs a PLC with an Ethernet port the library drives "
                                          f"({' or '.join(TCP_PLATFORMS)}); {why}")
         config = ConverterConfig()
