@@ -19,7 +19,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from .conditions import parse_condition
-from .scenario import DEFAULT_RESPONSE_SIGNAL, Scenario, power_on_stop_expectation
+from .scenario import DEFAULT_RESPONSE_SIGNAL, Scenario, scenario_power_on_stop
 
 
 def for_user_sources(scenario: Scenario, sources: tuple[Path, ...], program: str | None,
@@ -43,8 +43,6 @@ def for_user_sources(scenario: Scenario, sources: tuple[Path, ...], program: str
         left_out.append(f"its converter address ({converter.ip}:{converter.port})")
         converter = replace(converter, any_address=True)
     example = scenario.program or "the bundled example"
-    # a converter that refuses connections at first: the stop can only be answered after
-    reachable_from = min(scenario.converter.refuse_until_us, scenario.duration_us // 2) if scenario.converter else 0
     note = (
         f"bundled scenario run against your sources: robot, faults, timing{', C24 settings' if scenario.c24 else ''} "
         f"and every rule applied, "
@@ -58,7 +56,8 @@ def for_user_sources(scenario: Scenario, sources: tuple[Path, ...], program: str
         channel=None if scenario.converter is not None else channel,
         converter=converter,
         inputs=(),
-        expectations=(power_on_stop_expectation(scenario.duration_us, scenario.settings.address, reachable_from),),
+        # a converter that refuses connections at first: the stop can only be answered after
+        expectations=(scenario_power_on_stop(scenario),),
         watch=(),
         initial=(),
         options=replace(scenario.options, response_signal=parse_condition(DEFAULT_RESPONSE_SIGNAL)),

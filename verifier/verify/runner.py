@@ -26,7 +26,7 @@ from .evidence import RunEvidence, Samples
 from .expectations import judge
 from .result import KEEP_ALL, Keep, LineEvent, ScenarioResult, TraceRecord, UnusableInput
 from .rules import check_all
-from .scenario import BUFFER_MEMORY, DEVICE_NAME, Scenario, power_on_stop_expectation
+from .scenario import BUFFER_MEMORY, DEVICE_NAME, Scenario, scenario_power_on_stop
 from .stream import Stream
 from .traffic import analyse, converter_drops
 
@@ -410,9 +410,7 @@ def _expecting_something(scenario: Scenario) -> Scenario:
     (a wrong channel, a converter at another address) would break none and pass."""
     if scenario.expectations:
         return scenario
-    converter = scenario.converter
-    reachable = min(converter.refuse_until_us, scenario.duration_us // 2) if converter is not None else 0
-    stop = power_on_stop_expectation(scenario.duration_us, scenario.settings.address, reachable)
+    stop = scenario_power_on_stop(scenario)
     note = "no [[expect]] in the scenario: it expects what every program must do, the power-on stop sent and answered"
     return replace(scenario, expectations=(stop,), notes=(note,) + scenario.notes)
 

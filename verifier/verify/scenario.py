@@ -235,6 +235,14 @@ def power_on_stop_expectation(duration_us: int, address: int = 1, after_us: int 
     return replace(stop, label=f"sent stop {describe_window(stop)}")
 
 
+def scenario_power_on_stop(scenario: "Scenario") -> Expectation:
+    """`power_on_stop_expectation` for `scenario`'s robot and run: after a converter's
+    refusals (at most half the run), when it has one."""
+    converter = scenario.converter
+    reachable = min(converter.refuse_until_us, scenario.duration_us // 2) if converter is not None else 0
+    return power_on_stop_expectation(scenario.duration_us, scenario.settings.address, reachable)
+
+
 # --- loading -------------------------------------------------------------------------------
 
 
