@@ -95,3 +95,32 @@ def test_a_monitor_trace_replays_to_the_monitors_findings(tmp_path):
                            timeout=60)
     assert exact.returncode == 1 and "UITAMR-PACING ×2" in exact.stdout
     assert all(json.loads(line)["tolerance"] == DEFAULT_TOLERANCE_US / 1e6 for line in trace.read_text().splitlines())
+
+
+def test_an_unreadable_capture_is_reported_as_section_6_quotes(tmp_path):
+    """§6: file, line and column of the bad byte, the message, exit status 2."""
+    quoted = re.search(r"\(`(uitamr replay: site\.txt:12:9: [^`]*)`\) and exit status 2", " ".join(DOC.split())).group(1)
+    capture = tmp_path / "site.txt"
+    capture.write_text("# comment\n" * 11 + "0.01 01 G0\n", encoding="utf-8")
+    import os
+
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
+    done = subprocess.run(uitamr("replay", "site.txt"), capture_output=True, text=True, timeout=60, cwd=tmp_path,
+                          env=env)
+    assert done.returncode == 2
+    assert done.stderr.strip() == quoted
+
+
+def test_an_exactly_timed_capture_is_not_said_to_be_timed_by_the_host(tmp_path):
+    """§4: a capture with tx/rx lines (as a verify trace) has exact times, tolerance 0; its
+    replay must not call them host times with "0 ms for the adapter's latency"."""
+    capture = tmp_path / "exact.txt"
+    capture.write_text("0.000000 tx 01 06 01 A0 00 00 88 14\n0.013333 rx 01 06 01 A0 00 00 88 14\n",
+                       encoding="utf-8")
+    exact = subprocess.run(uitamr("replay", capture), capture_output=True, text=True, timeout=60)
+    assert exact.returncode == 0, exact.stdout + exact.stderr
+    assert "timed by the host" not in exact.stdout
+    assert "note: frames taken as exactly timed; timing rules allow 0 ms for latency (--tolerance)" in exact.stdout
+    host = subprocess.run(uitamr("replay", CAPTURES / "bad-master.txt"), capture_output=True, text=True, timeout=60)
+    assert "note: frames timed by the host; timing rules allow 20 ms for the adapter's latency (--tolerance)" \
+        in host.stdout

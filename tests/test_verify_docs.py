@@ -218,3 +218,67 @@ def test_the_troubleshooting_rows_that_name_an_fx3_serial_device_name_the_fx5s_t
             assert (wanted.group(0) if wanted else "module parameters") in row, (device, row)
             checked += 1
     assert checked >= 4
+
+
+def _block_after(text: str, marker: str) -> list[str]:
+    """The lines of the first code block after `marker`."""
+    return text.split(marker, 1)[1].split("```\n", 1)[1].split("```", 1)[0].rstrip("\n").splitlines()
+
+
+def test_the_console_example_is_what_verify_prints_for_a_library_paced_at_200ms(tmp_path, monkeypatch):
+    """verifier.md, "Console": the FAIL block of a copy of the library with PACE_TIME set to
+    200 ms, line for line (the rule table after it is the console's own)."""
+    import shutil
+    from click.testing import CliRunner
+
+    from verifier.cli import main
+
+    shutil.copytree(DOCS.parent / "plc", tmp_path / "lib")
+    engine = tmp_path / "lib" / "core" / "UITAMR_Engine.st"
+    text = engine.read_text(encoding="utf-8")
+    assert "PACE_TIME : TIME := T#300ms;" in text
+    engine.write_text(text.replace("PACE_TIME : TIME := T#300ms;", "PACE_TIME : TIME := T#200ms;"), encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = CliRunner().invoke(main, ["verify", "--scenario", "lib/scenarios/fx3u-healthy.toml"])
+    assert result.exit_code == 1, result.output
+    documented = _block_after(VERIFIER_MD, "### Console")
+    assert result.output.splitlines()[:len(documented)] == documented
+
+
+def test_the_matrix_note_example_is_what_verify_prints_for_an_adprw_program(tmp_path, monkeypatch):
+    """verifier.md, "Your program under the bundled fault sets": the result of the ADPRW
+    example run as MAIN with --matrix --channel adp:1, notes and all."""
+    from click.testing import CliRunner
+
+    from verifier.cli import main
+
+    sources = _example_as_main(tmp_path, "fx3", "UITAMR_ExampleAdpFx3", "fx3")
+    monkeypatch.chdir(DOCS.parent)
+    result = CliRunner().invoke(main, ["verify", str(sources), "--program", "MAIN", "--matrix",
+                                       "--channel", "adp:1"])
+    assert result.exit_code in (0, 1), result.output
+    documented = _block_after(VERIFIER_MD, "Each result says what was left out:")
+    lines = result.output.splitlines()
+    start = lines.index(documented[0]) if documented[0] in lines else -1
+    assert start >= 0, "\n".join(line for line in lines if "adprw-no-reply" in line)
+    assert lines[start:start + len(documented)] == documented
+
+
+def test_the_device_messages_scenarios_md_quotes_are_what_check_prints(tmp_path):
+    """scenarios.md: a device an FX3U scenario's CPU lacks is an error, an FX3 special number
+    in an FX5U scenario the ST warning, both as `uitamr check` prints them."""
+    from click.testing import CliRunner
+
+    from verifier.cli import main
+
+    (tmp_path / "MAIN.st").write_text("PROGRAM MAIN\nVAR\n    iX : INT;\nEND_VAR\niX := iX + 1;\nEND_PROGRAM\n",
+                                      encoding="utf-8")
+    (tmp_path / "fx3.toml").write_text('platform = "fx3u"\nsources = ["MAIN.st"]\n[initial]\nSM400 = true\n',
+                                       encoding="utf-8")
+    (tmp_path / "fx5.toml").write_text('platform = "fx5u"\nsources = ["MAIN.st"]\n[initial]\nM8402 = true\n',
+                                       encoding="utf-8")
+    text = " ".join(SCENARIOS_MD.split())
+    for name, severity in (("fx3.toml", "error"), ("fx5.toml", "warning")):
+        result = CliRunner().invoke(main, ["check", str(tmp_path / name)])
+        message = re.search(rf": {severity}: (initial\..*)", result.output).group(1)
+        assert f"`{message}`" in text, message

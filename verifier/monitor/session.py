@@ -214,8 +214,11 @@ class MonitorSession:
         on which nothing was seen)."""
         end = self.last_us
         notes = list(self.info.notes)
-        notes.append(f"frames timed by the host; timing rules allow {self.timing.tolerance_us / 1000:g} ms "
-                     "for the adapter's latency (--tolerance)")
+        if self.timing.tolerance_us:
+            notes.append(f"frames timed by the host; timing rules allow {self.timing.tolerance_us / 1000:g} ms "
+                         "for the adapter's latency (--tolerance)")
+        else:  # a verify trace, tx/rx lines or --tolerance 0: the times are the wire's
+            notes.append("frames taken as exactly timed; timing rules allow 0 ms for latency (--tolerance)")
         if not self.from_power_on:
             notes.append(f"the capture began after power-on: {POWER_ON_RULE} is not judged")
         no_traffic = None
