@@ -704,7 +704,9 @@ def test_a_healthy_converter_is_not_reported_as_a_fault(tmp_path):
     result = invoke("--scenario", scenario, "--duration", "3s", "--json", paths["json"], "--junit", paths["xml"],
                     "--html", paths["html"])
     assert result.exit_code == 1, result.output  # its point-3 expectation needs the whole run
-    (run,) = json.loads(paths["json"].read_text())["scenarios"]
+    report = json.loads(paths["json"].read_text())
+    assert report["schema"] == 2  # the converter's move out of "faults" (docs/verifier.md)
+    (run,) = report["scenarios"]
     assert run["faults"] == [] and run["converter"] == "converter 192.168.3.50:4001, delay 3 ms, packing 5 ms"
     out = ET.parse(paths["xml"]).getroot().find(".//system-out").text
     assert "fault:" not in out and "\nconverter 192.168.3.50:4001, delay 3 ms, packing 5 ms" in out

@@ -282,3 +282,12 @@ def test_the_device_messages_scenarios_md_quotes_are_what_check_prints(tmp_path)
         result = CliRunner().invoke(main, ["check", str(tmp_path / name)])
         message = re.search(rf": {severity}: (initial\..*)", result.output).group(1)
         assert f"`{message}`" in text, message
+
+
+def test_the_json_example_shows_the_schema_the_reports_carry():
+    from verifier.verify.report_json import SCHEMA_VERSION
+
+    page = (DOCS / "verifier.md").read_text(encoding="utf-8")
+    example = page.split("### `--json FILE`", 1)[1].split("```", 2)[1]
+    assert f'"schema": {SCHEMA_VERSION},' in example
+    assert f"**{SCHEMA_VERSION}**: " in page  # and what that number means
