@@ -106,7 +106,7 @@ def test_a_capture_time_with_another_script_s_digits_is_an_error_at_its_column(l
     # buffer memory G１６４ was taken for G164
     ("[initial]\n'U0\\G１６４' = 5\n", "initial.U0\\G１６４", (2, 1), "１"),
     ('[robot]\npoint_durations_s = { "' + ARABIC_FIVE + '" = 2.0 }\n', "robot.point_durations_s." + ARABIC_FIVE,
-     (2, 29), ARABIC_FIVE),
+     (2, 23), ARABIC_FIVE),  # at the key, which is the mistake
 ])
 def test_a_scenario_string_with_another_script_s_digits_names_key_place_and_character(text, key, place, char):
     with pytest.raises(ScenarioError) as caught:

@@ -447,6 +447,10 @@ def test_a_key_in_a_sub_table_is_placed_on_its_own_line(text, key, place):
     ('[[faults]]\nkind = "anti_collision"\nat_s = 1\ncount = 2\n',
      "s.toml:4:1: faults[0].count: not used by fault 'anti_collision'"),
     ('[robot]\npoint_duration_s = "8s"\n', "s.toml:2:20: robot.point_duration_s: "),  # a bad value: at the value
+    # a point number that is no whole number (int() would read " 4", "+4", "4_0"): the key is the mistake
+    ('[robot.point_durations_s]\n1 = 2.0\n"+4" = 6.0\n', "s.toml:3:1: robot.point_durations_s.+4: key '+4' must be"),
+    ('[robot]\npoint_durations_s = { 1 = 2.0, "4_0" = 6.0 }\n',
+     "s.toml:2:32: robot.point_durations_s.4_0: key '4_0' must be"),
 ])
 def test_an_unknown_robot_or_fault_key_is_pointed_at_by_its_name(tmp_path, text, place):
     """scenarios.md: the column is the key itself for an unknown key - in [robot] and

@@ -109,16 +109,17 @@ def as_hex_bytes(value: Any, path: str) -> bytes:
 
 
 def as_int_keyed(value: Any, path: str) -> dict[int, Any]:
-    """A table whose keys are whole numbers; TOML keys are strings ("3" = 3)."""
+    """A table whose keys are whole numbers written with 0-9 ("3" = 3; TOML keys are
+    strings). A bad key is the mistake, so its error points at the key's name."""
     table = require_mapping(value, path)
     result: dict[int, Any] = {}
     for key, item in table.items():
         if isinstance(key, str) and (problem := digit_problem(key)):  # int() reads "٣" as 3
-            raise ConfigError(join(path, key), f"key {key!r}: {problem}")
-        try:
-            number = int(key)
-        except (TypeError, ValueError):
-            raise ConfigError(join(path, str(key)), "key must be a whole number") from None
+            raise ConfigError(join(path, key), f"key {key!r}: {problem}", at_name=True)
+        if not (isinstance(key, str) and key.isascii() and key.isdigit()):  # int() takes " 4", "+4", "4_0"
+            raise ConfigError(join(path, str(key)), f"key {key!r} must be a whole number written with 0-9, "
+                                                    'e.g. "3"', at_name=True)
+        number = int(key)
         result[number] = item
     return result
 
