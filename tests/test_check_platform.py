@@ -435,3 +435,16 @@ def test_a_scenario_that_sets_an_fx3_special_number_on_another_cpu_gets_the_st_w
         "sets it); the FX3's M8402 (RS2 ch1 send request) is SM8561 on the fx5u (docs/instructions.md §8)"]
     fx3 = write(tmp_path, text.replace('"fx5u"', '"fx3u"'), "fx3.toml")
     assert run(fx3).output.splitlines()[-1].endswith(": 0 error(s), 0 warning(s)")
+
+
+def test_a_scenario_without_platform_is_judged_for_an_fx3g_with_its_ranges(tmp_path):
+    # ci.md: a file that names no platform is judged for --platform; verify runs an FX3G
+    # program as an fx3u (no scenario platform of its own), but its devices are the FX3G's
+    scenario = write(tmp_path, '[initial]\nX200 = true\n', "s.toml")
+    on_fx3g = run("--platform", "fx3g", scenario)
+    assert on_fx3g.exit_code == 1, on_fx3g.output
+    assert errors(on_fx3g.output) == [f"{scenario}:2:8: error: initial.X200: device X200 does not exist on the fx3g: "
+                                      "X runs X0..X177"]
+    assert run("--platform", "fx3u", scenario).exit_code == 0  # the FX3U has X200
+    named = write(tmp_path, 'platform = "fx3u"\n\n[initial]\nX200 = true\n', "named.toml")
+    assert run("--platform", "fx3g", named).exit_code == 0  # the file's own platform decides

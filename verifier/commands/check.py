@@ -118,17 +118,20 @@ def check_scenario(path: Path, platform: str | None = None) -> list[Diagnostic]:
     except ScenarioError as exc:
         message = f"{exc.key}: {exc.message}" if exc.key else exc.message
         return [Diagnostic(str(path), exc.line or 0, exc.col or 0, "error", message)]
-    return _scenario_devices(scenario)
+    # an FX3G (no scenario platform of its own: verify runs it as an fx3u) has its own ranges
+    cpu = platform if platform == "fx3g" and "platform" not in scenario.key_lines else scenario.platform
+    return _scenario_devices(scenario, cpu)
 
 
-def _scenario_devices(scenario) -> list[Diagnostic]:
-    """The devices of [initial] and [[inputs]] that the scenario's platform does not have,
-    each at its key, as `uitamr verify` refuses them (exit 2) before the first scan."""
+def _scenario_devices(scenario, cpu_name: str) -> list[Diagnostic]:
+    """The devices of [initial] and [[inputs]] that CPU `cpu_name` (the scenario's platform,
+    or --platform's fx3g for a file that names none) does not have, each at its key, as
+    `uitamr verify` refuses them (exit 2) before the first scan."""
     from verifier.sim.cpu import PROFILES
     from verifier.sim.devices import device_problem, device_warning
     from verifier.verify.scenario import BUFFER_MEMORY, DEVICE_NAME
 
-    cpu = PROFILES[scenario.platform]
+    cpu = PROFILES[cpu_name]
     named = [(f"initial.{name}", name, f"initial.{name}") for name, _ in scenario.initial
              if not BUFFER_MEMORY.match(name)]
     named += [(f"{step.key}.set", name, f"{step.key}.set.{name}") for step in scenario.inputs for name in step.values
