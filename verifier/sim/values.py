@@ -86,6 +86,14 @@ class InstanceProxy:
         self._fresh()
         return getattr(self._obj, attr)
 
+    def _holder(self, sym):
+        """The object that stores a label: this instance's memory, or for a global label
+        (a VAR_EXTERNAL of an FB or PROGRAM is the global itself) the globals object,
+        which a restart re-initialises in place."""
+        if sym is not None and sym.code and sym.code.startswith("_G."):
+            return self._module.namespace["_G"]
+        return self._obj
+
     def _symbols(self) -> dict:
         self._fresh()
         return self._module.class_symbols.get(type(self._obj), {})
@@ -114,6 +122,10 @@ class InstanceProxy:
         if sym is not None and sym.code and not sym.code.startswith(("self.", "_G.")):
             value = eval(sym.code, self._module.namespace)  # constants and device-backed globals
             return wrap(value, t, f"{self._label}.{name}", self._module)
+        holder = self._holder(sym)
+        if holder is not self._obj:  # a VAR_EXTERNAL: found again after a restart through the globals
+            parent = InstanceProxy(holder, self._module, "GLOBAL")
+            return wrap(getattr(holder, attr), t, f"{self._label}.{name}", self._module, parent, attr)
         return wrap(getattr(self._obj, attr), t, f"{self._label}.{name}", self._module, self, attr)
 
     def __setattr__(self, name: str, value) -> None:
@@ -125,7 +137,7 @@ class InstanceProxy:
             if not isinstance(t.elem, (str, StringT)):
                 raise AttributeError(f"{label} is an array of {t.elem}: set its members one by one")
             default = datatypes.TYPES[t.elem].default if isinstance(t.elem, str) else ""
-            getattr(self._obj, attr)[:] = to_st_list(t, value, label, default)
+            getattr(self._holder(sym), attr)[:] = to_st_list(t, value, label, default)
             return
         if isinstance(t, (StructT, FbT)):
             raise AttributeError(f"{label} is a {t}: set its members one by one")
@@ -135,7 +147,7 @@ class InstanceProxy:
             ns["_v_"] = st_value
             exec(sym.write.format(v="_v_"), ns)
             return
-        setattr(self._obj, attr, st_value)
+        setattr(self._holder(sym), attr, st_value)
 
     def __dir__(self):
         return [s.name for s in self._symbols().values()]
@@ -253,8 +265,7 @@ def reader(root: "InstanceProxy", parts: list[str]):
     computed = sym is not None and sym.code and not sym.code.startswith(("self.", "_G."))
     if computed or not isinstance(t, (str, StringT)):
         return lambda: getattr(target, last)
-    obj = target._obj
-    return _slot_reader(obj, attr)
+    return _slot_reader(target._holder(sym), attr)
 
 
 def _slot_reader(obj, attr: str):
