@@ -149,27 +149,37 @@ class InstanceProxy:
             return
         setattr(self._holder(sym), attr, st_value)
 
-    def __dir__(self):
+    def _names(self) -> list[str]:
+        """The labels' names: a standard FB's (TON ...) inputs and outputs, else the
+        declared labels."""
+        from .stdfbs import FB_PARAM_TYPES, StdFB
+
+        self._fresh()
+        if isinstance(self._obj, StdFB):
+            return list(FB_PARAM_TYPES[self._obj.TYPE_NAME])
         return [s.name for s in self._symbols().values()]
+
+    def __dir__(self):
+        return self._names()
 
     def __repr__(self) -> str:
         parts = []
-        for sym in self._symbols().values():
+        for name in self._names():
             try:
-                v = getattr(self, sym.name)
+                v = getattr(self, name)
             except Exception:
                 continue
             if isinstance(v, (InstanceProxy,)):
                 continue
-            parts.append(f"{sym.name}={v!r}")
+            parts.append(f"{name}={v!r}")
         return f"<{self._label}: {', '.join(parts)}>"
 
     def state(self) -> dict:
         """Current values of the elementary labels and arrays (for reports)."""
         out = {}
-        for sym in self._symbols().values():
-            v = getattr(self, sym.name)
-            out[sym.name] = list(v) if isinstance(v, ArrayView) else v
+        for name in self._names():
+            v = getattr(self, name)
+            out[name] = list(v) if isinstance(v, ArrayView) else v
         return out
 
 
