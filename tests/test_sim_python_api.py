@@ -68,3 +68,68 @@ def test_a_var_external_structure_taken_before_a_restart_is_the_cpus_after_it():
     assert home.iX == 0
     home.iX = 7
     assert project.globals.g_stHome.iX == 7
+
+
+DELAY = """
+FUNCTION_BLOCK FB_Delay
+VAR_INPUT i_bExecute : BOOL; END_VAR
+VAR_OUTPUT o_bDone : BOOL; END_VAR
+VAR fbTimer : TON; END_VAR
+fbTimer(IN := i_bExecute, PT := T#3s);
+o_bDone := fbTimer.Q;
+END_FUNCTION_BLOCK
+PROGRAM MAIN
+VAR fb : FB_Delay; END_VAR
+fb(i_bExecute := TRUE);
+END_PROGRAM
+"""
+
+
+def _error(call) -> BaseException:
+    try:
+        call()
+    except Exception as exc:  # the type and message are what the tests look at
+        return exc
+    raise AssertionError("no error")
+
+
+def test_run_until_with_ms_or_scans_says_to_give_timeout_ms():
+    """`fb.run(ms=100, until=...)` used to ignore ms and wait up to the default 60 s,
+    then say "condition not met within 60000 ms" although the test said 100."""
+    fb = verifier.load(sources={"d.st": DELAY}).instance("FB_Delay")
+    fb.i_bExecute = True
+    for kwargs in ({"ms": 100}, {"scans": 3}):
+        err = _error(lambda: fb.run(until=lambda f: f.o_bDone, **kwargs))
+        assert isinstance(err, TypeError)
+        assert "give the most virtual time to wait as timeout_ms=..., not ms= or scans=" in str(err)
+    assert fb._project.scan_count == 0
+    err = _error(lambda: fb.run(until=lambda f: f.o_bDone, timeout_ms="5s"))
+    assert isinstance(err, ValueError) and "timeout_ms must be a finite number of milliseconds" in str(err)
+    fb.run(until=lambda f: f.o_bDone, timeout_ms=5000)
+    assert fb._project.now_us == 3_010_000
+
+
+def test_run_until_a_value_rather_than_a_function_says_what_until_is():
+    """`fb.run(until=fb.o_bDone)` (the value, not a function) used to fail inside the
+    toolkit with "'bool' object is not callable"."""
+    fb = verifier.load(sources={"d.st": DELAY}).instance("FB_Delay")
+    err = _error(lambda: fb.run(until=fb.o_bDone))
+    assert isinstance(err, TypeError)
+    assert str(err) == ("until is a function of the instance that says when to stop, e.g. "
+                        "until=lambda fb: fb.o_bDone; got False")
+
+
+def test_a_run_given_two_lengths_says_to_give_one():
+    """`run(ms=..., scans=...)` used to stop at whichever came first, silently."""
+    project = verifier.load(sources={"d.st": DELAY})
+    fb = project.instance("FB_Delay")
+    err = _error(lambda: fb.run(ms=100, scans=5))
+    assert isinstance(err, ValueError)
+    assert str(err) == ("say how long to run once: ms= and scans= are both given; "
+                        "give one of ms=..., scans=... or until_us=...")
+    err = _error(lambda: project.run_programs(["MAIN"], scans=2, until_us=50_000))
+    assert "scans= and until_us= are both given" in str(err)
+    assert project.scan_count == 0
+    project.run_programs(["MAIN"], scans=2)
+    fb.run(scans=2)
+    assert project.scan_count == 4

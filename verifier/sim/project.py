@@ -242,7 +242,7 @@ class Project:
         for n in names:
             if self._pou(n).kind != "PROGRAM":
                 raise TypeError(f"{n} is not a PROGRAM")
-        stop = _stop_time(self.rt.now_us, ms, until_us)
+        stop = _stop_time(self.rt.now_us, ms, until_us, scans)
         if on_scan is not None:
             self.before_scan.append(on_scan)
         try:
@@ -482,20 +482,30 @@ class Instance(InstanceProxy):
         `until(instance)` is true — at most `timeout_ms`)."""
         p = self._project
         if until is not None:
-            stop = p.rt.now_us + round(timeout_ms * 1000)
+            if not callable(until):
+                raise TypeError(f"until is a function of the instance that says when to stop, e.g. "
+                                f"until=lambda fb: fb.o_bDone; got {until!r:.60}")
+            if ms is not None or scans is not None:
+                raise TypeError("run(until=...) scans until the condition holds: give the most virtual "
+                                "time to wait as timeout_ms=..., not ms= or scans=")
+            stop = _stop_time(p.rt.now_us, timeout_ms, None, what="timeout_ms")
             while not until(self):
                 if p.rt.now_us >= stop:
                     raise TimeoutError(f"{self._label}: condition not met within {timeout_ms} ms of virtual time")
                 p._run([self._obj._body], None, 1)
             return self
-        p._run([self._obj._body], _stop_time(p.rt.now_us, ms, None), scans)
+        p._run([self._obj._body], _stop_time(p.rt.now_us, ms, None, scans), scans)
         return self
 
 
-def _stop_time(now: int, ms, until_us):
+def _stop_time(now: int, ms, until_us, scans=None, what: str = "ms"):
+    given = [f"{name}=" for name, v in (("ms", ms), ("scans", scans), ("until_us", until_us)) if v is not None]
+    if len(given) > 1 and what == "ms":
+        raise ValueError(f"say how long to run once: {' and '.join(given)} are both given; "
+                         "give one of ms=..., scans=... or until_us=...")
     if ms is not None:
         if isinstance(ms, bool) or not isinstance(ms, (int, float)) or not math.isfinite(ms) or ms < 0:
-            raise ValueError(f"ms must be a finite number of milliseconds, 0 or more; got {ms!r}")
+            raise ValueError(f"{what} must be a finite number of milliseconds, 0 or more; got {ms!r}")
         return now + round(ms * 1000)
     if until_us is not None and (isinstance(until_us, bool) or not isinstance(until_us, int)):
         raise ValueError(f"until_us must be a whole number of microseconds; got {until_us!r}")
