@@ -133,3 +133,30 @@ def test_a_run_given_two_lengths_says_to_give_one():
     project.run_programs(["MAIN"], scans=2)
     fb.run(scans=2)
     assert project.scan_count == 4
+
+
+def test_a_device_set_from_python_to_a_value_of_the_wrong_kind_is_refused():
+    """`devices["D10"] = 1.5` used to store 1, `devices["X0"] = 5` or `= 'a'` TRUE and
+    `devices["D10"] = "7"` 7, silently, where a label refuses the same mistake."""
+    project = verifier.load(sources={"d.st": DELAY})
+    devices = project.devices
+    refused = {
+        ("D10", 1.5): "D10 is a word device: give a whole number, got the float 1.5",
+        ("D10", True): "D10 is a word device: give a whole number, got True",
+        ("D10", "7"): "D10 is a word device: give a whole number, got '7'",
+        ("D10", None): "D10 is a word device: give a whole number, got None",
+        ("X0", 5): "X0 is a bit device: give True or False (or 1/0), got 5",
+        ("M0", "yes"): "M0 is a bit device: give True or False (or 1/0), got 'yes'",
+        ("D10.3", 2): "D10.3 is a bit of a word device: give True or False (or 1/0), got 2",
+        ("K4M0", 1.0): "K4M0 is a digit group of bit devices: give a whole number, got the float 1.0",
+    }
+    for (name, value), message in refused.items():
+        err = _error(lambda: devices.__setitem__(name, value))
+        assert isinstance(err, ValueError) and str(err) == message
+    assert devices["D10"] == 0 and devices["X0"] is False and devices["K4M0"] == 0
+    devices["X0"], devices["M100"], devices["D12.3"] = True, 1, True
+    devices["D10"] = 0xFFFF
+    devices["D11"] = 70000                 # wrapped to 16 bits, as an INT label is
+    devices["K4M0"] = 0x1234
+    assert devices["X0"] is True and devices["M100"] is True and devices["D12"] == 8
+    assert devices["D10"] == -1 and devices["D11"] == 4464 and devices["K4M0"] == 0x1234
