@@ -160,3 +160,25 @@ def test_a_device_set_from_python_to_a_value_of_the_wrong_kind_is_refused():
     devices["K4M0"] = 0x1234
     assert devices["X0"] is True and devices["M100"] is True and devices["D12"] == 8
     assert devices["D10"] == -1 and devices["D11"] == 4464 and devices["K4M0"] == 0x1234
+
+
+def test_load_options_of_the_wrong_type_are_load_errors_naming_the_option():
+    """`verifier.load(..., scan_ms="10")` failed inside the toolkit ("type str doesn't
+    define __round__ method"), `scan_ms=inf` with OverflowError, `target=None` with
+    AttributeError, and `stop_on_operation_error="yes"` was taken as True."""
+    from verifier.sim import LoadError
+
+    cases = {
+        "scan_ms": ("10", "scan_ms must be a finite number of milliseconds; got '10'"),
+        "jitter_ms": (None, "jitter_ms must be a finite number of milliseconds; got None"),
+        "stop_on_operation_error": ("yes", "stop_on_operation_error is True, False or None (the CPU's "
+                                           "default); got 'yes'"),
+    }
+    for option, (value, message) in cases.items():
+        err = _error(lambda: verifier.load(sources={"d.st": DELAY}, **{option: value}))
+        assert isinstance(err, LoadError) and f"<options>:0:0: error: {message}" in str(err)
+    err = _error(lambda: verifier.load(sources={"d.st": DELAY}, scan_ms=float("inf")))
+    assert isinstance(err, LoadError) and "scan_ms must be a finite number" in str(err)
+    err = _error(lambda: verifier.load(sources={"d.st": DELAY}, target=None))
+    assert isinstance(err, TypeError) and str(err) == "target is a name such as 'gxworks2'; got None"
+    assert verifier.load(sources={"d.st": DELAY}, scan_ms=2.5).rt.scan_us == 2500

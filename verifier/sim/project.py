@@ -74,6 +74,13 @@ class Project:
         files, warnings = _parsed_and_checked(texts, editor)
         self.warnings = list(warnings)
         self.files = files
+        for name, value in (("scan_ms", scan_ms), ("jitter_ms", jitter_ms)):
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise LoadError([ast.Diagnostic("<options>", 0, 0, "error", f"{name} must be a finite number "
+                                                f"of milliseconds; got {value!r:.60}")])
+        if stop_on_operation_error is not None and not isinstance(stop_on_operation_error, bool):
+            raise LoadError([ast.Diagnostic("<options>", 0, 0, "error", "stop_on_operation_error is True, False "
+                                            f"or None (the CPU's default); got {stop_on_operation_error!r:.60}")])
         try:
             self.rt = Runtime(self.cpu, scan_us=round(scan_ms * 1000), jitter_us=round(jitter_ms * 1000),
                               seed=seed, stop_on_operation_error=stop_on_operation_error,
