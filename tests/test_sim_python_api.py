@@ -182,3 +182,21 @@ def test_load_options_of_the_wrong_type_are_load_errors_naming_the_option():
     err = _error(lambda: verifier.load(sources={"d.st": DELAY}, target=None))
     assert isinstance(err, TypeError) and str(err) == "target is a name such as 'gxworks2'; got None"
     assert verifier.load(sources={"d.st": DELAY}, scan_ms=2.5).rt.scan_us == 2500
+
+
+def test_a_folder_without_st_files_of_its_own_is_a_load_error_naming_the_subfolders(tmp_path):
+    """`verifier.load("plc")` loaded nothing, silently: the next `instance("UITAMR_Stop")`
+    said only "no POU named 'UITAMR_Stop'; loaded: " (an empty list)."""
+    from verifier.sim import LoadError
+
+    (tmp_path / "lib" / "core").mkdir(parents=True)
+    (tmp_path / "lib" / "core" / "FB_Delay.st").write_text(DELAY, encoding="utf-8")
+    (tmp_path / "empty").mkdir()
+    err = _error(lambda: verifier.load(tmp_path / "lib"))
+    assert isinstance(err, LoadError)
+    assert str(err).endswith(f"{tmp_path / 'lib'}:0:0: error: no .st files in this folder (load reads a "
+                             "folder's own *.st files, not its subfolders); name the folders that hold "
+                             f"them: '{tmp_path / 'lib' / 'core'}'")
+    err = _error(lambda: verifier.load(tmp_path / "empty"))
+    assert isinstance(err, LoadError) and str(err).endswith("not its subfolders)")
+    assert "FB_Delay" in verifier.load(tmp_path / "lib" / "core").pou_names()

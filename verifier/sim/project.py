@@ -45,6 +45,8 @@ def load(*paths, target: str = "gxworks2", cpu: str | None = None, scan_ms: floa
                             f"or load(*files); got {p!r:.60}")
         path = Path(p)
         files = sorted(path.glob("*.st")) if path.is_dir() else [path]
+        if path.is_dir() and not files:
+            problems.append(_empty_folder(path))
         for f in files:
             # the one ST reader (UTF-8, else Shift-JIS), shared with check and export
             text, unreadable = read_source(f)
@@ -56,6 +58,18 @@ def load(*paths, target: str = "gxworks2", cpu: str | None = None, scan_ms: floa
     return Project(texts, target=target, cpu=cpu, scan_ms=scan_ms, jitter_ms=jitter_ms, seed=seed,
                    stop_on_operation_error=stop_on_operation_error, timer_resolution_ms=timer_resolution_ms,
                    programs=programs)
+
+
+def _empty_folder(path: Path) -> ast.Diagnostic:
+    """The error for a folder given to `load` that has no .st file of its own (`load("plc")`
+    would otherwise load nothing, and `instance(...)` say only that no POU is loaded)."""
+    below = sorted({f.parent for f in path.rglob("*.st") if f.is_file()})
+    hint = ""
+    if below:
+        named = ", ".join(repr(str(d)) for d in below[:6]) + (", ..." if len(below) > 6 else "")
+        hint = f"; name the folders that hold them: {named}"
+    return ast.Diagnostic(str(path), 0, 0, "error", "no .st files in this folder (load reads a folder's own "
+                          f"*.st files, not its subfolders){hint}")
 
 
 class Project:
