@@ -200,3 +200,34 @@ def test_a_folder_without_st_files_of_its_own_is_a_load_error_naming_the_subfold
     err = _error(lambda: verifier.load(tmp_path / "empty"))
     assert isinstance(err, LoadError) and str(err).endswith("not its subfolders)")
     assert "FB_Delay" in verifier.load(tmp_path / "lib" / "core").pou_names()
+
+
+def test_an_instance_or_structure_read_as_a_value_says_which_label_to_read():
+    """`assert fb.fbTimer` (meant: fbTimer.Q) passed whatever the timer did, and
+    `fb.fbTimer == True` was silently False: a proxy was truthy and compared by identity."""
+    text = DELAY + ("TYPE ST_Pos :\nSTRUCT\n    iX : INT;\nEND_STRUCT\nEND_TYPE\n"
+                    "FUNCTION_BLOCK FB_Holder\nVAR_OUTPUT o_bOk : BOOL; END_VAR\n"
+                    "VAR fbDelay : FB_Delay; stPos : ST_Pos; fbEdge : R_TRIG; END_VAR\n"
+                    "fbDelay(i_bExecute := TRUE);\nfbEdge(CLK := fbDelay.o_bDone);\nEND_FUNCTION_BLOCK\n")
+    project = verifier.load(sources={"d.st": text})
+    fb = project.instance("FB_Holder")
+    expected = {
+        "FB_Holder.fbDelay.fbTimer": "FB_Holder.fbDelay.fbTimer is an instance of TON, not a value: read one "
+                                     "of its labels, e.g. FB_Holder.fbDelay.fbTimer.Q",
+        "FB_Holder.fbEdge": "FB_Holder.fbEdge is an instance of R_TRIG, not a value: read one of its labels, "
+                            "e.g. FB_Holder.fbEdge.Q",
+        "FB_Holder.fbDelay": "FB_Holder.fbDelay is an instance of FB_Delay, not a value: read one of its "
+                             "labels, e.g. FB_Holder.fbDelay.o_bDone",
+        "FB_Holder.stPos": "FB_Holder.stPos is a structure, not a value: read one of its labels, "
+                           "e.g. FB_Holder.stPos.iX",
+        "MAIN": "MAIN is the PROGRAM MAIN, not a value: read one of its labels, e.g. MAIN.fb",
+    }
+    views = {"FB_Holder.fbDelay.fbTimer": fb.fbDelay.fbTimer, "FB_Holder.fbEdge": fb.fbEdge,
+             "FB_Holder.fbDelay": fb.fbDelay, "FB_Holder.stPos": fb.stPos, "MAIN": project.program("MAIN")}
+    for label, view in views.items():
+        for misuse in (lambda: bool(view), lambda: view == 1, lambda: view != True):  # noqa: E712
+            err = _error(misuse)
+            assert isinstance(err, TypeError) and str(err) == expected[label]
+    assert fb.fbDelay.fbTimer == fb.fbDelay.fbTimer           # the same memory: equal
+    assert fb.fbDelay.fbTimer in {fb.fbDelay.fbTimer}
+    assert fb.fbDelay.fbTimer != project.instance("FB_Delay").fbTimer

@@ -162,6 +162,39 @@ class InstanceProxy:
     def __dir__(self):
         return self._names()
 
+    def _not_a_value(self) -> TypeError:
+        """`assert fb.fbTimer`, `fb.stPos == 3`: an instance or structure read as a value."""
+        from .stdfbs import StdFB
+
+        self._fresh()
+        names = self._names()
+        cls = type(self._obj).__name__
+        if isinstance(self._obj, StdFB):
+            what, example = f"an instance of {self._obj.TYPE_NAME}", next((n for n in names if n.startswith("Q")), names[-1])
+        else:
+            outputs = [s.name for s in self._symbols().values() if s.section == "VAR_OUTPUT"]
+            example = (outputs or names or ["label"])[0]
+            info = self._module.pous.get(cls.partition("_")[2]) if cls.startswith(("FB_", "PRG_")) else None
+            if cls.startswith("S_"):
+                what = "a structure"
+            elif info is not None:
+                what = f"{'the PROGRAM' if info.kind == 'PROGRAM' else 'an instance of'} {info.pou.name}"
+            else:
+                what = "the global labels"
+        return TypeError(f"{self._label} is {what}, not a value: read one of its labels, "
+                         f"e.g. {self._label}.{example}")
+
+    def __bool__(self):
+        raise self._not_a_value()
+
+    def __eq__(self, other):
+        if isinstance(other, (bool, int, float, str)):
+            raise self._not_a_value()
+        return isinstance(other, InstanceProxy) and other._obj is self._obj
+
+    def __hash__(self):
+        return hash(id(self._obj))
+
     def __repr__(self) -> str:
         parts = []
         for name in self._names():
