@@ -231,3 +231,23 @@ def test_an_instance_or_structure_read_as_a_value_says_which_label_to_read():
     assert fb.fbDelay.fbTimer == fb.fbDelay.fbTimer           # the same memory: equal
     assert fb.fbDelay.fbTimer in {fb.fbDelay.fbTimer}
     assert fb.fbDelay.fbTimer != project.instance("FB_Delay").fbTimer
+
+
+def test_an_array_indexed_by_something_else_than_a_whole_number_says_so():
+    """`fb.a["1"]` failed inside the toolkit ("'<=' not supported between instances of
+    'int' and 'str'"), `fb.a[1.0]` with "list indices must be integers", and `fb.a[True]`
+    read element 1."""
+    text = ("FUNCTION_BLOCK FB_A\nVAR a : ARRAY[1..4] OF INT; m : ARRAY[0..1, 1..2] OF INT; END_VAR\n"
+            "a[2] := 7;\nEND_FUNCTION_BLOCK\n")
+    fb = verifier.load(sources={"a.st": text}).instance("FB_A")
+    fb.scan()
+    for index in ("1", 1.0, True):
+        for use in (lambda: fb.a[index], lambda: fb.a.__setitem__(index, 3)):
+            err = _error(use)
+            assert isinstance(err, TypeError)
+            assert str(err) == f"FB_A.a is indexed by whole numbers within its ST bounds [1..4]; got {index!r}"
+    err = _error(lambda: fb.m[0, "2"])
+    assert str(err) == "FB_A.m is indexed by whole numbers within its ST bounds [0..1, 1..2]; got '2'"
+    assert fb.a[2] == 7 and list(fb.a) == [0, 7, 0, 0]
+    fb.m[1, 2] = 5
+    assert fb.m[1, 2] == 5

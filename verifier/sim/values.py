@@ -247,6 +247,11 @@ class ArrayView:
             raise IndexError(f"{self._label} has {len(self._t.dims)} dimension(s)")
         flat = 0
         for (lo, hi), i in zip(self._t.dims, idx):
+            if isinstance(i, bool) or not isinstance(i, numbers.Integral):
+                bounds = ", ".join(f"{a}..{b}" for a, b in self._t.dims)
+                raise TypeError(f"{self._label} is indexed by whole numbers within its ST bounds "
+                                f"[{bounds}]; got {i!r:.60}")
+            i = operator.index(i)
             if not lo <= i <= hi:
                 raise IndexError(f"index {i} is outside {self._label}[{lo}..{hi}]")
             flat = flat * (hi - lo + 1) + (i - lo)
