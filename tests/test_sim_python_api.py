@@ -251,3 +251,18 @@ def test_an_array_indexed_by_something_else_than_a_whole_number_says_so():
     assert fb.a[2] == 7 and list(fb.a) == [0, 7, 0, 0]
     fb.m[1, 2] = 5
     assert fb.m[1, 2] == 5
+
+
+def test_an_array_slice_counts_in_st_indexes_as_an_index_does():
+    """`fb.a[1:3]` of ARRAY[1..4] gave Python positions 1 and 2 (elements 2 and 3) while
+    `fb.a[1]` is element 1: the doc promises a view indexed by the ST bounds."""
+    text = ("FUNCTION_BLOCK FB_A\nVAR a : ARRAY[1..4] OF INT; b : ARRAY[-2..2] OF INT; END_VAR\n"
+            "a[1] := 1; a[2] := 2; a[3] := 3; a[4] := 4; b[-2] := -2; b[0] := 10;\nEND_FUNCTION_BLOCK\n")
+    fb = verifier.load(sources={"a.st": text}).instance("FB_A")
+    fb.scan()
+    assert fb.a[1:3] == [1, 2] and fb.a[2:] == [2, 3, 4] and fb.a[:] == [1, 2, 3, 4]
+    assert fb.a[0:10] == [1, 2, 3, 4] and fb.a[::-1] == [4, 3, 2, 1] and fb.a[4:1:-1] == [4, 3, 2]
+    assert fb.b[-2:1] == [-2, 0, 10] and fb.b[:0] == [-2, 0]
+    err = _error(lambda: fb.a["1":])
+    assert isinstance(err, TypeError)
+    assert str(err) == "FB_A.a is sliced by whole numbers within its ST bounds [1..4]; got '1'"

@@ -259,10 +259,33 @@ class ArrayView:
 
     def __getitem__(self, index):
         if isinstance(index, slice):
-            return list(self)[index]
+            return self._slice(index)
         self._fresh()
         flat = self._flat(index)
         return wrap(self._cells[flat], self._t.elem, f"{self._label}[{index}]", self._module, self, flat)
+
+    def _slice(self, index: slice) -> list:
+        """`a[2:5]` of ARRAY[1..8]: elements 2, 3, 4 by their ST indexes (start and stop
+        default to the bounds, and are kept within them, as Python keeps a slice in a list)."""
+        if len(self._t.dims) != 1:
+            raise TypeError(f"{self._label} has {len(self._t.dims)} dimensions: slice one-dimensional "
+                            "arrays only; read elements as a[i, j] or list(a) in storage order")
+        (lo, hi), = self._t.dims
+        for part in (index.start, index.stop, index.step):
+            if part is not None and (isinstance(part, bool) or not isinstance(part, numbers.Integral)):
+                raise TypeError(f"{self._label} is sliced by whole numbers within its ST bounds [{lo}..{hi}]; "
+                                f"got {part!r:.60}")
+        step = 1 if index.step is None else index.step
+        if step == 0:
+            raise ValueError("slice step cannot be zero")
+        if step > 0:
+            start = lo if index.start is None else max(index.start, lo)
+            stop = hi + 1 if index.stop is None else min(index.stop, hi + 1)
+        else:
+            start = hi if index.start is None else min(index.start, hi)
+            stop = lo - 1 if index.stop is None else max(index.stop, lo - 1)
+        values = list(self)
+        return [values[i - lo] for i in range(start, stop, step)]
 
     def __setitem__(self, index, value) -> None:
         self._fresh()
