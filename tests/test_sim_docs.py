@@ -155,3 +155,21 @@ END_PROGRAM
     project.run_programs(["MAIN"], scans=2)
     assert (one.o_wCount, second.o_wCount, pair.wB) == (2, 4, 12)
     assert (project.get("MAIN.fbOne.o_wCount"), main.aFbs[2].o_wCount) == (2, 4)
+
+
+def test_the_st_state_shown_in_the_doc_is_what_a_failing_test_prints(pytester):
+    """The ST state block of the pytest section, for the doc's `test_delay` failing right
+    after `fb.run(ms=1000)`: a TON shows IN/PT/Q/ET (it used to show `'<instance>'`, and
+    `repr(fb.fbTimer)` was `<FB_Delay.fbTimer: >`, hiding the ET a timer test needs)."""
+    st_block = blocks("iecst")[0]
+    pytester.makefile(".st", FB_Delay=st_block)
+    test = blocks("python")[2].split("def test_delay")[1]
+    test = "def test_delay" + test.replace("    fb.scan()\n", "")
+    assert "fb.run(ms=3000)" in test
+    pytester.makepyfile(test_doc_example=test.replace("fb.run(ms=3000)", "fb.run(ms=1000)"))
+    result = pytester.runpytest("-p", "no:cacheprovider")
+    result.assert_outcomes(failed=1)
+    shown = re.search(r"```\n(-+ ST state 1 -+\n.*?)```", DOC.read_text(encoding="utf-8"), re.S).group(1)
+    out = result.stdout.str()
+    for line in shown.splitlines()[1:]:
+        assert line in out, line

@@ -63,7 +63,11 @@ def describe_project(project) -> str:
             except Exception as e:  # a label the proxy cannot show: say why
                 value = f"<{e}>"
             if hasattr(value, "_symbols") and not hasattr(value, "__len__"):
-                value = "<instance>"
+                # a TON's IN/PT/Q/ET and a structure's members in one line; an instance
+                # of a user FB (maybe large) by name: the test can create or read it
+                standard = getattr(sym.type, "standard", True)
+                if not standard:
+                    value = "<instance>"
             elif hasattr(value, "__iter__") and not isinstance(value, str):
                 value = list(value)
             where = f"  ({sym.decl.span})" if sym.decl is not None else ""

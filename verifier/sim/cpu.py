@@ -142,7 +142,7 @@ def profile_for(target: str, cpu: str | None = None) -> CpuProfile:
     """CPU profile for an editor target ("gxworks2", "gxworks3") or a "target:cpu" pair
     ("gxworks2:q"), refusing a CPU the editor does not program."""
     for what, value in (("target", target), ("cpu", cpu)):
-        if value is not None and not isinstance(value, str):
+        if (value is not None or what == "target") and not isinstance(value, str):
             raise TypeError(f"{what} is a name such as {'gxworks2' if what == 'target' else 'fx3u'!r}; got {value!r:.60}")
     editor, colon, named = target.partition(":")
     editor = editor.lower()  # 'GXWorks2' as 'gxworks2:Q' already was

@@ -8,6 +8,7 @@ of bit devices (`K4M0`: 16 consecutive bits as one word; K1..K4 -> 16-bit, K5..K
 """
 from __future__ import annotations
 
+import operator
 import re
 from dataclasses import dataclass
 
@@ -181,6 +182,23 @@ def _fmt(n: int, radix: int) -> str:
     return {8: f"{n:o}", 16: f"{n:X}"}.get(radix, str(n))
 
 
+def device_value(name: str, a: DeviceAddress, value):
+    """`value` checked for the device `a` (named `name`); ValueError says what it takes."""
+    if a.bit is not None or (a.kind == "bit" and a.digits is None):
+        if isinstance(value, bool) or (type(value) is int and value in (0, 1)):
+            return bool(value)
+        what = f"{name} is a bit of a word device" if a.bit is not None else f"{name} is a bit device"
+        raise ValueError(f"{what}: give True or False (or 1/0), got {value!r:.60}")
+    what = f"{name} is a digit group of bit devices" if a.digits is not None else f"{name} is a word device"
+    if isinstance(value, bool) or isinstance(value, float):
+        raise ValueError(f"{what}: give a whole number, got {'the float ' if isinstance(value, float) else ''}"
+                         f"{value!r}")
+    try:
+        return operator.index(value)  # int, or an integer type such as numpy's
+    except TypeError:
+        raise ValueError(f"{what}: give a whole number, got {value!r:.60}") from None
+
+
 class DeviceMemory:
     """All devices of one CPU.  `mem.D` is the list of D registers, `mem.M` the M relays...
     (generated code indexes these lists directly).  `mem["D100"]` reads by name."""
@@ -213,7 +231,12 @@ class DeviceMemory:
         return lambda: self.read(a)
 
     def __setitem__(self, name: str, value) -> None:
-        self.write(self.address(name), value)
+        """`mem["D100"] = 5` from Python: a value of the wrong kind is refused, as for a
+        label (a bit takes True/False or 0/1, a word or digit group a whole number, which
+        wraps to the device's width as an INT label's does); the generated code and the
+        instructions write through `write`."""
+        a = self.address(name)
+        self.write(a, device_value(name, a, value))
 
     def read(self, a: DeviceAddress):
         cells = self.areas[a.area]

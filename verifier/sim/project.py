@@ -45,6 +45,8 @@ def load(*paths, target: str = "gxworks2", cpu: str | None = None, scan_ms: floa
                             f"or load(*files); got {p!r:.60}")
         path = Path(p)
         files = sorted(path.glob("*.st")) if path.is_dir() else [path]
+        if path.is_dir() and not files:
+            problems.append(_empty_folder(path))
         for f in files:
             # the one ST reader (UTF-8, else Shift-JIS), shared with check and export
             text, unreadable = read_source(f)
@@ -56,6 +58,18 @@ def load(*paths, target: str = "gxworks2", cpu: str | None = None, scan_ms: floa
     return Project(texts, target=target, cpu=cpu, scan_ms=scan_ms, jitter_ms=jitter_ms, seed=seed,
                    stop_on_operation_error=stop_on_operation_error, timer_resolution_ms=timer_resolution_ms,
                    programs=programs)
+
+
+def _empty_folder(path: Path) -> ast.Diagnostic:
+    """The error for a folder given to `load` that has no .st file of its own (`load("plc")`
+    would otherwise load nothing, and `instance(...)` say only that no POU is loaded)."""
+    below = sorted({f.parent for f in path.rglob("*.st") if f.is_file()})
+    hint = ""
+    if below:
+        named = ", ".join(repr(str(d)) for d in below[:6]) + (", ..." if len(below) > 6 else "")
+        hint = f"; name the folders that hold them: {named}"
+    return ast.Diagnostic(str(path), 0, 0, "error", "no .st files in this folder (load reads a folder's own "
+                          f"*.st files, not its subfolders){hint}")
 
 
 class Project:
@@ -74,6 +88,13 @@ class Project:
         files, warnings = _parsed_and_checked(texts, editor)
         self.warnings = list(warnings)
         self.files = files
+        for name, value in (("scan_ms", scan_ms), ("jitter_ms", jitter_ms)):
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise LoadError([ast.Diagnostic("<options>", 0, 0, "error", f"{name} must be a finite number "
+                                                f"of milliseconds; got {value!r:.60}")])
+        if stop_on_operation_error is not None and not isinstance(stop_on_operation_error, bool):
+            raise LoadError([ast.Diagnostic("<options>", 0, 0, "error", "stop_on_operation_error is True, False "
+                                            f"or None (the CPU's default); got {stop_on_operation_error!r:.60}")])
         try:
             self.rt = Runtime(self.cpu, scan_us=round(scan_ms * 1000), jitter_us=round(jitter_ms * 1000),
                               seed=seed, stop_on_operation_error=stop_on_operation_error,
@@ -242,7 +263,7 @@ class Project:
         for n in names:
             if self._pou(n).kind != "PROGRAM":
                 raise TypeError(f"{n} is not a PROGRAM")
-        stop = _stop_time(self.rt.now_us, ms, until_us)
+        stop = _stop_time(self.rt.now_us, ms, until_us, scans)
         if on_scan is not None:
             self.before_scan.append(on_scan)
         try:
@@ -482,20 +503,30 @@ class Instance(InstanceProxy):
         `until(instance)` is true — at most `timeout_ms`)."""
         p = self._project
         if until is not None:
-            stop = p.rt.now_us + round(timeout_ms * 1000)
+            if not callable(until):
+                raise TypeError(f"until is a function of the instance that says when to stop, e.g. "
+                                f"until=lambda fb: fb.o_bDone; got {until!r:.60}")
+            if ms is not None or scans is not None:
+                raise TypeError("run(until=...) scans until the condition holds: give the most virtual "
+                                "time to wait as timeout_ms=..., not ms= or scans=")
+            stop = _stop_time(p.rt.now_us, timeout_ms, None, what="timeout_ms")
             while not until(self):
                 if p.rt.now_us >= stop:
                     raise TimeoutError(f"{self._label}: condition not met within {timeout_ms} ms of virtual time")
                 p._run([self._obj._body], None, 1)
             return self
-        p._run([self._obj._body], _stop_time(p.rt.now_us, ms, None), scans)
+        p._run([self._obj._body], _stop_time(p.rt.now_us, ms, None, scans), scans)
         return self
 
 
-def _stop_time(now: int, ms, until_us):
+def _stop_time(now: int, ms, until_us, scans=None, what: str = "ms"):
+    given = [f"{name}=" for name, v in (("ms", ms), ("scans", scans), ("until_us", until_us)) if v is not None]
+    if len(given) > 1 and what == "ms":
+        raise ValueError(f"say how long to run once: {' and '.join(given)} are both given; "
+                         "give one of ms=..., scans=... or until_us=...")
     if ms is not None:
         if isinstance(ms, bool) or not isinstance(ms, (int, float)) or not math.isfinite(ms) or ms < 0:
-            raise ValueError(f"ms must be a finite number of milliseconds, 0 or more; got {ms!r}")
+            raise ValueError(f"{what} must be a finite number of milliseconds, 0 or more; got {ms!r}")
         return now + round(ms * 1000)
     if until_us is not None and (isinstance(until_us, bool) or not isinstance(until_us, int)):
         raise ValueError(f"until_us must be a whole number of microseconds; got {until_us!r}")

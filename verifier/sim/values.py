@@ -86,6 +86,14 @@ class InstanceProxy:
         self._fresh()
         return getattr(self._obj, attr)
 
+    def _holder(self, sym):
+        """The object that stores a label: this instance's memory, or for a global label
+        (a VAR_EXTERNAL of an FB or PROGRAM is the global itself) the globals object,
+        which a restart re-initialises in place."""
+        if sym is not None and sym.code and sym.code.startswith("_G."):
+            return self._module.namespace["_G"]
+        return self._obj
+
     def _symbols(self) -> dict:
         self._fresh()
         return self._module.class_symbols.get(type(self._obj), {})
@@ -114,6 +122,10 @@ class InstanceProxy:
         if sym is not None and sym.code and not sym.code.startswith(("self.", "_G.")):
             value = eval(sym.code, self._module.namespace)  # constants and device-backed globals
             return wrap(value, t, f"{self._label}.{name}", self._module)
+        holder = self._holder(sym)
+        if holder is not self._obj:  # a VAR_EXTERNAL: found again after a restart through the globals
+            parent = InstanceProxy(holder, self._module, "GLOBAL")
+            return wrap(getattr(holder, attr), t, f"{self._label}.{name}", self._module, parent, attr)
         return wrap(getattr(self._obj, attr), t, f"{self._label}.{name}", self._module, self, attr)
 
     def __setattr__(self, name: str, value) -> None:
@@ -125,7 +137,7 @@ class InstanceProxy:
             if not isinstance(t.elem, (str, StringT)):
                 raise AttributeError(f"{label} is an array of {t.elem}: set its members one by one")
             default = datatypes.TYPES[t.elem].default if isinstance(t.elem, str) else ""
-            getattr(self._obj, attr)[:] = to_st_list(t, value, label, default)
+            getattr(self._holder(sym), attr)[:] = to_st_list(t, value, label, default)
             return
         if isinstance(t, (StructT, FbT)):
             raise AttributeError(f"{label} is a {t}: set its members one by one")
@@ -135,29 +147,72 @@ class InstanceProxy:
             ns["_v_"] = st_value
             exec(sym.write.format(v="_v_"), ns)
             return
-        setattr(self._obj, attr, st_value)
+        setattr(self._holder(sym), attr, st_value)
+
+    def _names(self) -> list[str]:
+        """The labels' names: a standard FB's (TON ...) inputs and outputs, else the
+        declared labels."""
+        from .stdfbs import FB_PARAM_TYPES, StdFB
+
+        self._fresh()
+        if isinstance(self._obj, StdFB):
+            return list(FB_PARAM_TYPES[self._obj.TYPE_NAME])
+        return [s.name for s in self._symbols().values()]
 
     def __dir__(self):
-        return [s.name for s in self._symbols().values()]
+        return self._names()
+
+    def _not_a_value(self) -> TypeError:
+        """`assert fb.fbTimer`, `fb.stPos == 3`: an instance or structure read as a value."""
+        from .stdfbs import StdFB
+
+        self._fresh()
+        names = self._names()
+        cls = type(self._obj).__name__
+        if isinstance(self._obj, StdFB):
+            what, example = f"an instance of {self._obj.TYPE_NAME}", next((n for n in names if n.startswith("Q")), names[-1])
+        else:
+            outputs = [s.name for s in self._symbols().values() if s.section == "VAR_OUTPUT"]
+            example = (outputs or names or ["label"])[0]
+            info = self._module.pous.get(cls.partition("_")[2]) if cls.startswith(("FB_", "PRG_")) else None
+            if cls.startswith("S_"):
+                what = "a structure"
+            elif info is not None:
+                what = f"{'the PROGRAM' if info.kind == 'PROGRAM' else 'an instance of'} {info.pou.name}"
+            else:
+                what = "the global labels"
+        return TypeError(f"{self._label} is {what}, not a value: read one of its labels, "
+                         f"e.g. {self._label}.{example}")
+
+    def __bool__(self):
+        raise self._not_a_value()
+
+    def __eq__(self, other):
+        if isinstance(other, (bool, int, float, str)):
+            raise self._not_a_value()
+        return isinstance(other, InstanceProxy) and other._obj is self._obj
+
+    def __hash__(self):
+        return hash(id(self._obj))
 
     def __repr__(self) -> str:
         parts = []
-        for sym in self._symbols().values():
+        for name in self._names():
             try:
-                v = getattr(self, sym.name)
+                v = getattr(self, name)
             except Exception:
                 continue
             if isinstance(v, (InstanceProxy,)):
                 continue
-            parts.append(f"{sym.name}={v!r}")
+            parts.append(f"{name}={v!r}")
         return f"<{self._label}: {', '.join(parts)}>"
 
     def state(self) -> dict:
         """Current values of the elementary labels and arrays (for reports)."""
         out = {}
-        for sym in self._symbols().values():
-            v = getattr(self, sym.name)
-            out[sym.name] = list(v) if isinstance(v, ArrayView) else v
+        for name in self._names():
+            v = getattr(self, name)
+            out[name] = list(v) if isinstance(v, ArrayView) else v
         return out
 
 
@@ -192,6 +247,11 @@ class ArrayView:
             raise IndexError(f"{self._label} has {len(self._t.dims)} dimension(s)")
         flat = 0
         for (lo, hi), i in zip(self._t.dims, idx):
+            if isinstance(i, bool) or not isinstance(i, numbers.Integral):
+                bounds = ", ".join(f"{a}..{b}" for a, b in self._t.dims)
+                raise TypeError(f"{self._label} is indexed by whole numbers within its ST bounds "
+                                f"[{bounds}]; got {i!r:.60}")
+            i = operator.index(i)
             if not lo <= i <= hi:
                 raise IndexError(f"index {i} is outside {self._label}[{lo}..{hi}]")
             flat = flat * (hi - lo + 1) + (i - lo)
@@ -199,10 +259,33 @@ class ArrayView:
 
     def __getitem__(self, index):
         if isinstance(index, slice):
-            return list(self)[index]
+            return self._slice(index)
         self._fresh()
         flat = self._flat(index)
         return wrap(self._cells[flat], self._t.elem, f"{self._label}[{index}]", self._module, self, flat)
+
+    def _slice(self, index: slice) -> list:
+        """`a[2:5]` of ARRAY[1..8]: elements 2, 3, 4 by their ST indexes (start and stop
+        default to the bounds, and are kept within them, as Python keeps a slice in a list)."""
+        if len(self._t.dims) != 1:
+            raise TypeError(f"{self._label} has {len(self._t.dims)} dimensions: slice one-dimensional "
+                            "arrays only; read elements as a[i, j] or list(a) in storage order")
+        (lo, hi), = self._t.dims
+        for part in (index.start, index.stop, index.step):
+            if part is not None and (isinstance(part, bool) or not isinstance(part, numbers.Integral)):
+                raise TypeError(f"{self._label} is sliced by whole numbers within its ST bounds [{lo}..{hi}]; "
+                                f"got {part!r:.60}")
+        step = 1 if index.step is None else index.step
+        if step == 0:
+            raise ValueError("slice step cannot be zero")
+        if step > 0:
+            start = lo if index.start is None else max(index.start, lo)
+            stop = hi + 1 if index.stop is None else min(index.stop, hi + 1)
+        else:
+            start = hi if index.start is None else min(index.start, hi)
+            stop = lo - 1 if index.stop is None else max(index.stop, lo - 1)
+        values = list(self)
+        return [values[i - lo] for i in range(start, stop, step)]
 
     def __setitem__(self, index, value) -> None:
         self._fresh()
@@ -253,8 +336,7 @@ def reader(root: "InstanceProxy", parts: list[str]):
     computed = sym is not None and sym.code and not sym.code.startswith(("self.", "_G."))
     if computed or not isinstance(t, (str, StringT)):
         return lambda: getattr(target, last)
-    obj = target._obj
-    return _slot_reader(obj, attr)
+    return _slot_reader(target._holder(sym), attr)
 
 
 def _slot_reader(obj, attr: str):
