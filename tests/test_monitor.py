@@ -119,6 +119,35 @@ def test_the_fc06_echo_is_the_reply_and_a_hasty_master_is_a_master():
     assert rules["UITAMR-PACING"] == 1  # the second stop request came 52 ms after the first
 
 
+def test_a_wrong_status_request_inside_the_reply_window_is_the_plcs_and_its_exception_the_robots():
+    """Seen on a bench line: a stop with swapped CRC bytes (the robot stays silent), 400 ms
+    later a status read asking for 23 coils, and the robot's exception 03. The read came
+    inside the stop's reply window, so it was taken for a broken reply, and the exception
+    for a request (a FORMAT finding against the PLC for the robot's bytes)."""
+    bad_stop = STOP[:6] + STOP[7:5:-1]
+    wrong_read = protocol.with_crc(READ[:5] + b"\x17")
+    exception = protocol.with_crc(b"\x01\x81\x03")
+    session = session_of([Chunk(10_000, bad_stop), Chunk(410_000, wrong_read), Chunk(420_000, exception)])
+    assert [(f.direction, f.data) for f in session.frames] == [
+        ("tx", bad_stop), ("tx", wrong_read), ("rx", exception)]
+    formats = [v.message for v in session.violations().get("UITAMR-FORMAT", [])]
+    assert len(formats) == 1 and "quantity" in formats[0]
+
+
+def test_a_status_read_repeated_to_a_silent_robot_is_a_request_not_its_echo():
+    """An FC01 reply carries a byte count, so a frame equal to the status read is never
+    its reply (only FC06 replies echo the request)."""
+    session = session_of([Chunk(10_000, READ), Chunk(310_000, READ)])
+    assert [f.direction for f in session.frames] == ["tx", "tx"]
+
+
+def test_an_exception_reply_after_the_reply_time_out_is_the_robots():
+    wrong_read = protocol.with_crc(READ[:5] + b"\x17")
+    exception = protocol.with_crc(b"\x01\x81\x03")
+    session = session_of([Chunk(10_000, wrong_read), Chunk(900_000, exception)])
+    assert [f.direction for f in session.frames] == ["tx", "rx"]
+
+
 def test_unknown_bytes_end_at_the_silence():
     session = session_of([Chunk(1_000, b"\x01\x99\x00"), Chunk(50_000, STOP)])
     assert [f.data for f in session.frames] == [b"\x01\x99\x00", STOP]
