@@ -624,6 +624,33 @@ def test_a_port_that_cannot_be_opened_exits_2_with_its_name(tmp_path):
     assert done.returncode == 2 and "127.0.0.1:1" in done.stderr
 
 
+@pytest.mark.serial
+def test_a_port_another_reader_holds_is_refused_not_shared(tmp_path):
+    """Seen on the bench: a monitor started on the port `uitamr emulate` was serving read
+    a share of its bytes, lost the port and called it NO TRAFFIC with "check the wiring".
+    Two readers of one port each get only part of the line: the second one is refused."""
+    bus = LineBus(tmp_path)
+    robot = start("emulate", "--serial", bus.robot)
+    first = None
+    try:
+        wait_for_line(robot, "listening")
+        done = subprocess.run(uitamr("monitor", "--serial", bus.robot, "--duration", "1s"), capture_output=True,
+                              text=True, timeout=WAIT_S)
+        assert done.returncode == 2, done.stdout + done.stderr
+        assert f"cannot open {bus.robot}: another program has it open and locked" in done.stderr
+        first = start("monitor", "--serial", bus.tap, "--duration", "20s")
+        wait_for_line(first, "listening")
+        done = subprocess.run(uitamr("monitor", "--serial", bus.tap, "--duration", "1s"), capture_output=True,
+                              text=True, timeout=WAIT_S)
+        assert done.returncode == 2 and "another uitamr monitor?" in done.stderr, done.stdout + done.stderr
+    finally:
+        for process in (robot, first):
+            if process is not None:
+                process.send_signal(signal.SIGINT)
+                process.communicate(timeout=WAIT_S)
+        bus.close()
+
+
 def test_an_empty_port_name_is_named_as_empty():
     done = subprocess.run(uitamr("monitor", "--serial", "", "--duration", "1s"), capture_output=True, text=True,
                           timeout=WAIT_S)
