@@ -149,6 +149,16 @@ def test_an_exception_reply_after_the_reply_time_out_is_the_robots():
     assert [f.direction for f in session.frames] == ["tx", "rx"]
 
 
+def test_a_silent_robot_finding_says_what_to_check_on_site():
+    """The commonest site fault, a robot that never answers: the finding said only to check
+    the PLC program's error output, not what commissioning.md §5 says to look at."""
+    session = session_of([Chunk(10_000 + k * 600_000, STOP) for k in range(12)])
+    (finding,) = session.violations()["UITAMR-RESPONSE-HANDLING"]
+    assert "no reply" in finding.message and "o_bErr" in finding.message
+    assert "its power, its address (the requests go to slave 1), the pair's wiring and polarity (A, B, GND)" \
+        in finding.message
+
+
 def test_unknown_bytes_end_at_the_silence():
     session = session_of([Chunk(1_000, b"\x01\x99\x00"), Chunk(50_000, STOP)])
     assert [f.data for f in session.frames] == [b"\x01\x99\x00", STOP]
