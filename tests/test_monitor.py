@@ -159,6 +159,26 @@ def test_a_silent_robot_finding_says_what_to_check_on_site():
         in finding.message
 
 
+def test_a_timing_finding_against_noise_says_the_frame_may_be_noise():
+    """Noise (or bytes at a wrong baud rate) is taken for a request: the PLC's next request
+    then broke PACING or ONE-AT-A-TIME "after the previous request", sending the engineer
+    to the PLC's pace and time-out settings. The message now says the previous frame had
+    a bad CRC and may not be the PLC's."""
+    echo = STOP
+    noise = bytes.fromhex("E0 00 F8 80 00 00 78 E0 F8 80")
+    session = session_of([Chunk(10_000, STOP), Chunk(20_000, echo), Chunk(450_000, noise), Chunk(600_000, READ)])
+    found = session.violations()
+    (pacing,) = found["UITAMR-PACING"]
+    (one,) = found["UITAMR-ONE-AT-A-TIME"]
+    for finding in (pacing, one):
+        assert "(the previous frame, E0 00 F8 80 00 00 78 E0 F8 80, has a bad CRC: if the PLC did not send it, " \
+               "it is noise on the line or a wrong baud rate - see its UITAMR-CRC finding)" in finding.message
+    # a real request with a good CRC before: no such words
+    session = session_of([Chunk(10_000, STOP), Chunk(160_000, READ)])
+    (pacing,) = session.violations()["UITAMR-PACING"]
+    assert "noise" not in pacing.message
+
+
 def test_unknown_bytes_end_at_the_silence():
     session = session_of([Chunk(1_000, b"\x01\x99\x00"), Chunk(50_000, STOP)])
     assert [f.data for f in session.frames] == [b"\x01\x99\x00", STOP]
