@@ -135,6 +135,24 @@ def test_a_wrong_status_request_inside_the_reply_window_is_the_plcs_and_its_exce
     assert len(formats) == 1 and "quantity" in formats[0]
 
 
+def test_an_exception_answers_the_request_after_an_unanswered_bad_crc_one():
+    """The robot stays silent to a request with a bad CRC, so the exception that follows
+    the next request answers that one: it was paired with the bad-CRC request instead,
+    and the next read was blamed (ONE-AT-A-TIME) for not waiting for a reply that came."""
+    bad_stop = STOP[:6] + STOP[7:5:-1]
+    wrong_read = protocol.with_crc(READ[:5] + b"\x17")
+    exception = protocol.with_crc(b"\x01\x81\x03")
+    reply = bytes.fromhex("01 01 03 00 00 00 3C 4E")
+    session = session_of([Chunk(10_000, STOP), Chunk(20_000, STOP), Chunk(350_000, READ), Chunk(360_000, reply),
+                          Chunk(700_000, bad_stop), Chunk(1_100_000, wrong_read), Chunk(1_106_000, exception),
+                          Chunk(1_500_000, READ), Chunk(1_506_000, reply)])
+    assert [f.direction for f in session.frames] == ["tx", "rx", "tx", "rx", "tx", "tx", "rx", "tx", "rx"]
+    rules = rules_of(session)
+    assert rules["UITAMR-ONE-AT-A-TIME"] == 1  # the wrong read, 400 ms after the bad stop: too early
+    (one,) = session.violations()["UITAMR-ONE-AT-A-TIME"]
+    assert one.t_us < 1_200_000
+
+
 def test_a_status_read_repeated_to_a_silent_robot_is_a_request_not_its_echo():
     """An FC01 reply carries a byte count, so a frame equal to the status read is never
     its reply (only FC06 replies echo the request)."""
