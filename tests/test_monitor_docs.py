@@ -8,7 +8,7 @@ from pathlib import Path
 
 from monitor_helpers import uitamr
 from verifier.monitor.capture import parse_plain, read_capture
-from verifier.monitor.framer import DEFAULT_TOLERANCE_US
+from verifier.monitor.framer import DEFAULT_TOLERANCE_US, LineTiming
 from verifier.monitor.session import CaptureInfo, MonitorSession
 from verifier.monitor.view import finding_lines, frame_line
 from verifier import protocol
@@ -124,3 +124,15 @@ def test_an_exactly_timed_capture_is_not_said_to_be_timed_by_the_host(tmp_path):
     host = subprocess.run(uitamr("replay", CAPTURES / "bad-master.txt"), capture_output=True, text=True, timeout=60)
     assert "note: frames timed by the host; timing rules allow 20 ms for the adapter's latency (--tolerance)" \
         in host.stdout
+
+
+def test_the_time_of_a_capture_line_is_when_its_last_byte_arrived():
+    """The docs did not say whether a line's time is the start or the end of its bytes; a
+    capture written by hand from a logic analyser's frame starts needs to know."""
+    assert "The time is when the line's **last** byte arrived" in DOC
+    session = MonitorSession(CaptureInfo("doc", "doc"), timing=LineTiming(tolerance_us=0))
+    for chunk in parse_plain("0.100000 tx 01 06 01 A0 00 00 88 14\n"):
+        session.feed(chunk)
+    session.close()
+    (frame,) = session.frames
+    assert frame.t_end_us - frame.t_start_us == 8333  # 8 bytes at 9600 8N1, ending at the line's time

@@ -32,3 +32,26 @@ def test_the_help_says_which_captures_get_no_tolerance():
     done = subprocess.run(uitamr("replay", "--help"), capture_output=True, text=True, timeout=WAIT_S)
     text = " ".join(done.stdout.split())
     assert "Default 20ms" in text and "tx/rx lines: 0" in text, text
+
+
+@pytest.mark.parametrize("command", ["replay", "monitor"])
+@pytest.mark.parametrize("tolerance", ["20s", "250ms", "1min"])
+def test_a_tolerance_that_no_pacing_violation_could_beat_is_refused(tmp_path, command, tolerance):
+    """`--tolerance 20s` for 20ms passed the bad master's 100 ms pacing without a word
+    (a period plus the tolerance must be 250 ms or less to be a violation)."""
+    capture = tmp_path / "c.txt"
+    capture.write_text(CHUNKS, encoding="utf-8")
+    where = [capture] if command == "replay" else ["--serial", tmp_path / "nope"]
+    done = subprocess.run(uitamr(command, "--tolerance", tolerance, *where), capture_output=True, text=True,
+                          timeout=WAIT_S)
+    assert done.returncode == 2, done.stdout + done.stderr
+    assert f"'{tolerance}' is not below the pacing period of 250 ms" in done.stderr
+    assert "was the unit mistyped?" in done.stderr and "Traceback" not in done.stderr
+
+
+def test_a_tolerance_just_below_the_period_is_taken(tmp_path):
+    capture = tmp_path / "c.txt"
+    capture.write_text(CHUNKS, encoding="utf-8")
+    done = subprocess.run(uitamr("replay", "--tolerance", "249ms", capture), capture_output=True, text=True,
+                          timeout=WAIT_S)
+    assert done.returncode in (0, 1) and "timing rules allow 249 ms" in done.stdout, done.stdout + done.stderr

@@ -19,6 +19,7 @@ import click
 from rich.console import Console
 from rich.markup import escape
 
+from verifier import protocol
 from verifier.commands.emulate import STANDARD_BAUD_RATES, _tcp_endpoint
 from verifier.commands.protocol_options import protocol_settings
 from verifier.commands.report_files import ReportError, check_folders, report_options, text_console, write_reports
@@ -37,6 +38,21 @@ EXIT_CLEAN, EXIT_FINDINGS, EXIT_UNUSABLE, EXIT_NO_TRAFFIC = 0, 1, 2, 3
 CHECK_EVERY_S = 0.5
 
 
+class _Tolerance(_Duration):
+    """--tolerance: below the pacing period. At 250 ms or more UITAMR-PACING cannot find a
+    violation at all (a period plus the tolerance must be 250 ms or less), nor the other
+    timing rules most: a mistyped unit (`20s` for `20ms`) would pass a PLC pacing at 100 ms."""
+
+    def convert(self, value, param, ctx):
+        us = super().convert(value, param, ctx)
+        if us >= protocol.MIN_PERIOD_US:
+            self.fail(f"{value!r} is not below the pacing period of {protocol.MIN_PERIOD_US // 1000} ms: with it no "
+                      "UITAMR-PACING violation could be found. A USB adapter needs its latency timer "
+                      f"(16 ms by default: the default {DEFAULT_TOLERANCE_US // 1000}ms covers it); was the unit "
+                      "mistyped?", param, ctx)
+        return us
+
+
 def line_options(command):
     """Options shared by monitor and replay: the line's timing, the tolerance, power-on."""
     options = (
@@ -44,7 +60,7 @@ def line_options(command):
                      show_default=True, help="Line speed (the robot uses 9600)."),
         click.option("--framing", "line_format", type=click.Choice(["8N1", "8E1", "8O1", "8N2"]), default="8N1",
                      show_default=True, help="Data bits, parity, stop bits (the robot uses 8N1)."),
-        click.option("--tolerance", type=_Duration(zero_ok=True),
+        click.option("--tolerance", type=_Tolerance(zero_ok=True),
                      help="How far host timestamps may be off (USB adapter latency): timing rules "
                           f"blame only what is beyond it. Default {DEFAULT_TOLERANCE_US // 1000}ms "
                           "(replay of a capture whose frames say their side - a verify trace, tx/rx lines: 0; "

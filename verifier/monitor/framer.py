@@ -115,6 +115,10 @@ class Framer:
         self._drop(len(self._buffer))
         return [frame]
 
+    def discard(self) -> None:
+        """Forget the pending bytes (the end of a capture cut them)."""
+        self._drop(len(self._buffer))
+
     def _frame(self, at: int, length: int) -> Frame:
         """`length` buffered bytes from `at` on as a frame: it ends when its last byte arrived
         and lasted its length at the line's speed, but began no earlier than its first byte

@@ -21,7 +21,7 @@ from verifier.verify.traffic import Exchange, Pairing, analyse
 
 from .capture import Chunk
 from .classify import Classifier
-from .framer import MAX_FRAME, Framer, LineTiming
+from .framer import MAX_FRAME, Framer, LineTiming, frame_length_either_side
 
 POWER_ON_RULE = "UITAMR-POWERON-STOP"
 PROVISIONAL_RULE = "UITAMR-RESPONSE-HANDLING"  # the one rule with early word (Judgement.provisional)
@@ -64,6 +64,7 @@ class MonitorSession:
         self._in_line_order = True  # every frame started after the one before it ended
         self._closed = False
         self._shown: set = set()  # early findings (Judgement.provisional) check has returned
+        self.cut_off = b""  # the start of a frame the end of the capture cut (`close`)
 
     # --- input ---------------------------------------------------------------------------
     def feed(self, chunk: Chunk) -> list[TraceRecord]:
@@ -92,8 +93,18 @@ class MonitorSession:
             raise RuntimeError("the monitoring session has ended: it takes no more bytes")
 
     def close(self) -> list[TraceRecord]:
-        """The end of the capture: the pending bytes as a frame; nothing more comes."""
-        frames = self._take(self.framer.flush())
+        """The end of the capture: the pending bytes as a frame; nothing more comes. Bytes
+        that begin a frame of known length but stop short of it were cut by the end of the
+        capture (Ctrl-C, --duration, a converter that dropped the connection, the end of
+        the file), not sent short by the PLC: they are noted (`cut_off`), not judged."""
+        pending = self.framer.pending
+        length = frame_length_either_side(pending)
+        if length is not None and len(pending) < length:
+            self.cut_off = pending
+            self.framer.discard()
+            frames = []
+        else:
+            frames = self._take(self.framer.flush())
         self._closed = True
         return frames
 
@@ -221,6 +232,9 @@ class MonitorSession:
             notes.append("frames taken as exactly timed; timing rules allow 0 ms for latency (--tolerance)")
         if not self.from_power_on:
             notes.append(f"the capture began after power-on: {POWER_ON_RULE} is not judged")
+        if self.cut_off:
+            notes.append(f"the capture ended inside a frame: its first {len(self.cut_off)} byte(s) "
+                         f"({protocol.hex_bytes(self.cut_off)}) were not judged")
         no_traffic = None
         if not self.frames:
             no_traffic = self._silence(listened_us)

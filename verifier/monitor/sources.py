@@ -9,6 +9,7 @@ to a server that streams the line's bytes (a serial-to-Ethernet converter port s
 """
 from __future__ import annotations
 
+import errno
 import socket
 import time
 from typing import Protocol
@@ -41,9 +42,18 @@ class SerialSource:
         import serial
 
         try:
+            # exclusive (Linux/macOS: flock; Windows ports always are): a second reader of the
+            # same port - `uitamr emulate`, another monitor - takes every byte it reads away
+            # from this one, and both would judge a line with holes in it
             self.port = serial.serial_for_url(port, baudrate=baud, bytesize=bytesize, parity=parity,
-                                              stopbits=stopbits, timeout=POLL_S, do_not_open=False)
-        except (serial.SerialException, ValueError) as exc:
+                                              stopbits=stopbits, timeout=POLL_S, do_not_open=False,
+                                              exclusive=True)
+        except (serial.SerialException, ValueError, OSError) as exc:
+            if getattr(exc, "errno", None) in (errno.EAGAIN, errno.EWOULDBLOCK):
+                raise SourceError(f"cannot open {port}: another program has it open and locked (uitamr "
+                                  "emulate, or another uitamr monitor?); each would read only part of the "
+                                  "line's bytes: stop that one first, or tap the line with a second "
+                                  "adapter") from None
             raise SourceError(f"cannot open {port}: {exc}") from None
         self.description = port
         self._error = serial.SerialException

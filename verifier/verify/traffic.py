@@ -214,7 +214,8 @@ class Pairing:
     request, in order.
 
     A robot frame goes to the oldest request that has ended, has no reply yet and whose
-    time-out has not run out — preferring one it is a valid reply to. When no request is
+    time-out has not run out — preferring one it is a valid reply to, then one with a good
+    CRC (a slave never answers a request with a bad one). When no request is
     waiting, it joins the latest request that ended before it (a late reply, garbage).
 
     Frames are given in `analyse`'s order (by start; a request before a robot frame that
@@ -253,7 +254,11 @@ class Pairing:
             self._oldest += 1
         waiting = [e for e in exchanges[self._oldest:count] if not e.rx and t <= e.deadline_us]
         if waiting:
-            owner = next((e for e in waiting if _is_reply_to(frame, e)), waiting[0])
+            # a slave never answers a request whose CRC is wrong (MODBUS over Serial Line
+            # V1.02 §2.4.1): a frame that is no valid reply to any waiting request goes to
+            # the oldest one with a good CRC
+            owner = next((e for e in waiting if _is_reply_to(frame, e)), None) \
+                or next((e for e in waiting if protocol.crc_ok(bytes(e.request.data))), waiting[0])
         else:
             owner = exchanges[count - 1]
         owner.rx.append(frame)

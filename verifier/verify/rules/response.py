@@ -84,6 +84,28 @@ class ResponseHandling(Judge):
                 self._told = episode.first.index
                 yield violation
 
+    def _on_site(self, episode: Episode) -> str:
+        """What to look at on site for the failures a line shows (docs/commissioning.md §5)."""
+        hints = []
+        for kind in episode.counts:
+            if kind in ("no reply", "no reply so far"):
+                hint = (f"why the robot does not answer: its power, its address (the requests go to "
+                        f"slave {self.evidence.settings.address}), the pair's wiring and polarity (A, B, GND) "
+                        f"and its line settings")
+            elif kind in ("bad CRC", "garbled"):
+                hint = "the line for noise: the shield, a termination at both ends, GND joined"
+            elif kind == "late":
+                hint = "the robot's or a converter's delay against the PLC's reply time-out"
+            elif kind == "wrong address":
+                hint = "the robot's address setting against the PLC's requests"
+            elif kind == "exception":
+                hint = "why the robot refused the requests: the exception code in the replies"
+            else:
+                hint = "the route between the PLC and the robot"
+            if hint not in hints:
+                hints.append(hint)
+        return "; ".join(hints)
+
     def _judge(self, episode: Episode, run_end_us: int) -> Iterator[Violation]:
         """The episode's violation, if the run ended at `run_end_us` (at or after the end of a
         closed episode: an episode is judged when it closes or when the run ends)."""
@@ -100,7 +122,8 @@ class ResponseHandling(Judge):
             message = (
                 f"the robot's replies failed from {format_seconds(start)} {lasted} "
                 f"({episode.summary()}); the PLC's outputs are not on the line: check that the "
-                f"program showed it (e.g. its o_bErr) within {within / 1_000_000:g} s"
+                f"program showed it (e.g. its o_bErr) within {within / 1_000_000:g} s; on site, "
+                f"check {self._on_site(episode)}"
             )
         elif options.response_signal is None:
             message = (

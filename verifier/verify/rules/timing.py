@@ -15,6 +15,16 @@ def _ms(t_us: int) -> str:
     return f"{t_us / 1000:.1f} ms"
 
 
+def _maybe_noise(evidence: RunEvidence, previous) -> str:
+    """On a captured line (the monitor cannot tell who put a frame there) a previous
+    "request" with a bad CRC may be noise or bytes at a wrong baud rate rather than the
+    PLC's: the timing finding against it says so, and points at its CRC finding."""
+    if evidence.options.outputs_visible or protocol.crc_ok(previous.data):
+        return ""
+    return (f" (the previous frame, {protocol.hex_bytes(previous.data)}, has a bad CRC: if the PLC did not "
+            f"send it, it is noise on the line or a wrong baud rate - see its UITAMR-CRC finding)")
+
+
 class Pacing(Judge):
     def request(self, index: int) -> Iterator[Violation]:
         if index == 0:
@@ -27,7 +37,8 @@ class Pacing(Judge):
                 "UITAMR-PACING",
                 frame.t_start_us,
                 f"request started {_ms(gap)} after the start of the previous request; "
-                f"the period must be more than {_ms(options.min_period_us)}",
+                f"the period must be more than {_ms(options.min_period_us)}"
+                f"{_maybe_noise(self.evidence, previous)}",
                 (frame_ref(previous, self.evidence.settings), frame_ref(frame, self.evidence.settings)),
                 frame.origin,
             )
@@ -107,7 +118,7 @@ class OneAtATime(Judge):
         yield Violation(
             "UITAMR-ONE-AT-A-TIME",
             start,
-            f"a new request started {why}",
+            f"a new request started {why}{_maybe_noise(self.evidence, previous.request)}",
             previous.refs() + (frame_ref(current.request, self.evidence.settings),),
             current.request.origin,
         )
