@@ -136,7 +136,7 @@ def test_a_capture_with_any_line_end_is_replayed_line_by_line(tmp_path, end):
     trace.write_bytes((end.join(records) + end).encode())
     for capture in (plain, trace):
         result = CliRunner().invoke(main, ["replay", str(capture)])
-        assert "1 requests" in result.output, result.output
+        assert "1 request in" in result.output, result.output
         assert result.exit_code == 0, result.output
 
 

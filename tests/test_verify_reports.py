@@ -366,3 +366,11 @@ def test_the_docs_explain_every_rule():
     docs = (Path(__file__).resolve().parents[1] / "docs" / "verifier.md").read_text(encoding="utf-8")
     for rule in RULES:
         assert f"`{rule.id}`" in docs, f"docs/verifier.md does not explain {rule.id}"
+
+
+def test_console_counts_one_request_in_the_singular():
+    one = _result("one", _frames(0, STOP, protocol.ControlReply.echo(STOP)), 1_000_000)
+    out = io.StringIO()
+    report_console.render([one, good_result()], Console(file=out, width=200, color_system=None))
+    text = out.getvalue()
+    assert "on fx3u, 1 request in 1.000 s" in text and "on fx3u, 20 requests in 6.000 s" in text

@@ -43,7 +43,7 @@ def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
         else f"{len(result.expectations)} expectation(s) met"
     )
     console.print(
-        f"{mark} [bold]{escape(escape_chars(result.name, str.isprintable))}[/]{where}: {escape(result.program or 'the PLC')} on {result.platform}, {tx} requests in "
+        f"{mark} [bold]{escape(escape_chars(result.name, str.isprintable))}[/]{where}: {escape(result.program or 'the PLC')} on {result.platform}, {tx} request{'' if tx == 1 else 's'} in "
         f"{format_seconds(result.ended_us)}, {result.violation_count} violation(s), {expectations}"
     )
     for note in result.notes:
