@@ -10,29 +10,9 @@ from __future__ import annotations
 
 from verifier import protocol
 from verifier.protocol.codec import REQUEST_LENGTH
+from verifier.protocol.describe import side_by_content
 
 from .framer import Frame
-
-#: an FC01 reply to the manual's 22 coils carries 3 data bytes: 01 01 03 b b b CRC CRC
-_FC01_REPLY_BYTE_COUNT = 3
-#: address, function | 0x80, exception code, CRC
-_EXCEPTION_LENGTH = 5
-
-
-def _side_by_content(data: bytes) -> str | None:
-    """The side that sent `data` where its content alone says it, whatever the turn: an
-    exception reply (5 bytes, the function code with the exception flag 0x80) comes only
-    from a slave (Modbus Application Protocol V1.1b3 §7), and an 8-byte FC01 frame whose third byte is not the
-    byte count 3 is no reply of the robot's (a reply of 22 coils is 01 01 03 + 3 bytes +
-    CRC) but a request, however wrong its query or quantity; an FC06 reply echoes its
-    request, so there only the turn can tell."""
-    if len(data) < 2:
-        return None
-    if data[1] & 0x80 and len(data) == _EXCEPTION_LENGTH:
-        return "rx"
-    if data[1] == 0x01 and len(data) == REQUEST_LENGTH and data[2] != _FC01_REPLY_BYTE_COUNT:
-        return "tx"
-    return None
 
 
 def _looks_like_request(data: bytes, settings: protocol.Settings) -> bool:
@@ -80,7 +60,7 @@ class Classifier:
         return True
 
     def _guess(self, frame: Frame) -> str:
-        by_content = _side_by_content(frame.data)
+        by_content = side_by_content(frame.data)
         if by_content is not None:
             return by_content
         waiting = self._waiting

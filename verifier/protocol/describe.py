@@ -3,7 +3,10 @@ from __future__ import annotations
 
 from verifier.protocol.catalogue import (
     ERROR_TITLES,
+    EXCEPTION_FLAG,
     EXCEPTION_TITLES,
+    FC_READ_COILS,
+    STATUS_BYTE_COUNT,
     QUERY_TITLES,
     QUERY_VALUES,
     ControlCode,
@@ -12,7 +15,7 @@ from verifier.protocol.catalogue import (
     wire_code,
     wire_query,
 )
-from verifier.protocol.codec import decode_reply, decode_request
+from verifier.protocol.codec import EXCEPTION_REPLY_LENGTH, REQUEST_LENGTH, decode_reply, decode_request
 from verifier.protocol.frames import (
     ControlReply,
     ControlRequest,
@@ -87,7 +90,24 @@ def decode_frame(data: bytes, settings: Settings = DEFAULT_SETTINGS, direction: 
 
 def looks_like_reply(data: bytes) -> bool:
     """Bytes only a robot sends: an exception reply, or FC01 with byte count 03."""
-    return len(data) >= 3 and (data[1] & 0x80 or (data[1] == 0x01 and data[2] == 0x03))
+    return len(data) >= 3 and bool(data[1] & EXCEPTION_FLAG
+                                   or (data[1] == FC_READ_COILS and data[2] == STATUS_BYTE_COUNT))
+
+
+def side_by_content(data: bytes) -> str | None:
+    """"rx" or "tx" where a whole frame's content alone says which side sent it, whatever
+    the turn on the line; None where only the turn can tell (an FC06 reply echoes its
+    request). An exception reply (5 bytes, the function code with EXCEPTION_FLAG) comes
+    only from a slave (Modbus Application Protocol V1.1b3 §7); an 8-byte FC01 frame whose
+    third byte is not the byte count 03 is no reply of the robot's (22 coils: 01 01 03, 3
+    bytes, CRC) but a request, however wrong its query or quantity."""
+    if len(data) < 3:
+        return None
+    if data[1] & EXCEPTION_FLAG and len(data) == EXCEPTION_REPLY_LENGTH:
+        return "rx"
+    if data[1] == FC_READ_COILS and len(data) == REQUEST_LENGTH and data[2] != STATUS_BYTE_COUNT:
+        return "tx"
+    return None
 
 
 def _address_note(address: int, settings: Settings) -> str:
