@@ -725,7 +725,10 @@ def test_a_misspelt_label_in_a_scenario_offers_the_label_meant(tmp_path):
             ("fbEngin.o_bErr", "the program UITAMR_ExampleFx5 has no label 'fbEngin.o_bErr'; did you mean 'fbEngine'?"),
             ("fbEngine.o_bErrr", "no label 'fbEngine.o_bErrr' in the program UITAMR_ExampleFx5: fbEngine has no "
                                  "member 'o_bErrr'; did you mean 'o_bErr'?"),
-            ("zzz", "the program UITAMR_ExampleFx5 has no label 'zzz'")):
+            ("zzz", "the program UITAMR_ExampleFx5 has no label 'zzz'"),
+            # a standard FB's member too (its inputs and outputs are its labels)
+            ("fbEngine.tmrPace.PTT", "no label 'fbEngine.tmrPace.PTT' in the program UITAMR_ExampleFx5: "
+                                     "fbEngine.tmrPace has no member 'PTT'; did you mean 'PT'?")):
         path = tmp_path / "s.toml"
         path.write_text(base.replace('never = "fbEngine.o_bErr OR fbCycle.o_bErr"', f'never = "{wrong}"'),
                         encoding="utf-8")

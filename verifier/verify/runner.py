@@ -18,7 +18,7 @@ from typing import Any, Callable
 from verifier.amr.robot import Robot
 from verifier.link import Line
 from verifier.link.converter import Converter
-from verifier.sim.values import read_together
+from verifier.sim.values import InstanceProxy, read_together
 from verifier.textfile import shown_path
 
 from .events_shown import thin_line_events
@@ -196,12 +196,9 @@ def _did_you_mean(part: str, instance: Any) -> str:
     nearly as `part` (a scenario's typo of an instance or member name), else ''."""
     import difflib
 
-    symbols = getattr(instance, "_symbols", None)
-    try:
-        names = [sym.name for sym in symbols().values()] if symbols is not None else []
-    except Exception:  # a value without labels (a number, a standard FB): nothing to offer
-        return ""
-    by_key = {n.upper(): n for n in names}
+    if not isinstance(instance, InstanceProxy):
+        return ""  # a value or an array: no labels to offer
+    by_key = {n.upper(): n for n in instance._names()}  # a standard FB's (TON) too
     close = difflib.get_close_matches(part.upper(), list(by_key), n=1, cutoff=0.8)
     return f"; did you mean {by_key[close[0]]!r}?" if close else ""
 
