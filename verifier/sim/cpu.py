@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from .rs2_devices import FX3_CHANNELS, FX5_CHANNELS
+
 
 @dataclass(frozen=True)
 class Area:
@@ -204,26 +206,31 @@ _FX5_LINE_SETTINGS = ("no device on the fx5u: its serial ports take the line set
                       "parameters (GX Works3: Module Parameter > 485 Serial Port, docs/import-gxworks3.md §4)")
 _Q_SERIAL = ("no device on the q: a QJ71C24N is driven with G_OUTPUT / G_INPUT and its switch settings "
              "(UITAMR_PortQC24, docs/import-gxworks2.md)")
-FX3_SERIAL: dict[str, tuple[str, dict[str, str]]] = {}
-for _ch, (_fx3, _fx5) in enumerate(((("8400", "8402", "8403", "8409"), ("8560", "8561", "8621", "8565", "8561", "8562")),
-                                    (("8420", "8422", "8423", "8429"), ("8570", "8571", "8631", "8575", "8571", "8572"))),
-                                   start=1):
-    _format, _send, _recv, _timeout = _fx3
-    _left, _count, _timeout_reg, _timeout_flag, _send_flag, _recv_flag = _fx5
-    for _device, _role, _fx5_text in (
-        (f"D{_format}", f"RS2 ch{_ch} communication format", _FX5_LINE_SETTINGS),
-        (f"D{_send}", f"RS2 ch{_ch} bytes left to send", f"SD{_left} on the fx5u ({_FX5_SERIAL_SOURCE})"),
-        (f"D{_recv}", f"RS2 ch{_ch} received byte count", f"SD{_count} on the fx5u ({_FX5_SERIAL_SOURCE})"),
-        (f"D{_timeout}", f"RS2 ch{_ch} receive time-out",
-         f"SD{_timeout_reg} on the fx5u, in ms ({_FX5_SERIAL_SOURCE})"),
-        (f"M{_send}", f"RS2 ch{_ch} send request", f"SM{_send_flag} on the fx5u ({_FX5_SERIAL_SOURCE})"),
-        (f"M{_recv}", f"RS2 ch{_ch} receive complete", f"SM{_recv_flag} on the fx5u ({_FX5_SERIAL_SOURCE})"),
-        (f"M{_timeout}", f"RS2 ch{_ch} time-out flag", f"SM{_timeout_flag} on the fx5u ({_FX5_SERIAL_SOURCE})"),
-    ):
-        FX3_SERIAL[_device] = (_role, {"fx5": _fx5_text, "q": _Q_SERIAL})
-FX3_SERIAL["M8161"] = ("8-bit mode of CRC", {
-    "fx5": "SM8161 on the fx5u (docs/instructions.md §6); RS2's 8-bit mode is SD8622 / SD8632 there",
-    "q": "no device on the q: it has no CRC instruction (the library computes the CRC in ST)"})
+#: each FX3 RS2 device's role (a field of Rs2Devices) as the messages name it, and its unit on the FX5
+_RS2_ROLES = (("format_register", "communication format", ""), ("send_remaining", "bytes left to send", ""),
+              ("receive_count", "received byte count", ""), ("timeout_setting", "receive time-out", ", in ms"),
+              ("send_request", "send request", ""), ("receive_complete", "receive complete", ""),
+              ("timeout_flag", "time-out flag", ""))
+
+
+def _fx3_serial() -> dict[str, tuple[str, dict[str, str]]]:
+    """FX3 device -> (its role, what stands for it per family), from the RS2 port model's
+    own device tables (rs2_devices), so the check and the simulator name the same devices."""
+    table: dict[str, tuple[str, dict[str, str]]] = {}
+    for channel, fx3 in FX3_CHANNELS.items():
+        fx5 = FX5_CHANNELS[channel]
+        for field_name, role, unit in _RS2_ROLES:
+            theirs = getattr(fx5, field_name)
+            text = _FX5_LINE_SETTINGS if theirs is None else f"{theirs} on the fx5u{unit} ({_FX5_SERIAL_SOURCE})"
+            table[getattr(fx3, field_name)] = (f"RS2 ch{channel} {role}", {"fx5": text, "q": _Q_SERIAL})
+    eight_bit = " / ".join(c.eight_bit_mode for c in FX5_CHANNELS.values() if c.eight_bit_mode)
+    table["M8161"] = ("8-bit mode of CRC", {
+        "fx5": f"SM8161 on the fx5u (docs/instructions.md §6); RS2's 8-bit mode is {eight_bit} there",
+        "q": "no device on the q: it has no CRC instruction (the library computes the CRC in ST)"})
+    return table
+
+
+FX3_SERIAL = _fx3_serial()
 
 
 def fx3_serial_equivalent(device: str, cpu: CpuProfile) -> str | None:

@@ -6,35 +6,10 @@ bytes to receive, n1 channel, d receive head.  Behaviour and devices: docs/instr
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from ..refs import operand_key
+from ..rs2_devices import FX3_CHANNELS, FX5_CHANNELS, Rs2Devices  # noqa: F401  (the port's devices)
 from ..serial import LineFormat, SerialChannel
 
-
-@dataclass(frozen=True)
-class Rs2Devices:
-    """The special devices of one RS2 channel."""
-
-    send_request: str
-    receive_complete: str
-    timeout_flag: str
-    send_remaining: str
-    receive_count: str
-    timeout_setting: str
-    timeout_unit_ms: int  # FX3: 10 ms per count (0 = 100 ms); FX5: 1 ms (out of range = 10 ms)
-    format_register: str | None = None  # FX3 only; FX5 takes the format from parameters
-    eight_bit_mode: str | None = None  # FX5 SD8622/SD8632
-
-
-FX3_CHANNELS = {
-    1: Rs2Devices("M8402", "M8403", "M8409", "D8402", "D8403", "D8409", 10, "D8400"),
-    2: Rs2Devices("M8422", "M8423", "M8429", "D8422", "D8423", "D8429", 10, "D8420"),
-}
-FX5_CHANNELS = {
-    1: Rs2Devices("SM8561", "SM8562", "SM8565", "SD8560", "SD8561", "SD8621", 1, None, "SD8622"),
-    2: Rs2Devices("SM8571", "SM8572", "SM8575", "SD8570", "SD8571", "SD8631", 1, None, "SD8632"),
-}
 
 _FX3_BAUD = {0b0011: 300, 0b0100: 600, 0b0101: 1200, 0b0110: 2400, 0b0111: 4800,
              0b1000: 9600, 0b1001: 19200, 0b1010: 38400, 0b1011: 57600, 0b1101: 115200}
