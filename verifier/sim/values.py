@@ -174,8 +174,8 @@ class InstanceProxy:
         else:
             outputs = [s.name for s in self._symbols().values() if s.section == "VAR_OUTPUT"]
             example = (outputs or names or ["label"])[0]
-            info = self._module.pous.get(cls.partition("_")[2]) if cls.startswith(("FB_", "PRG_")) else None
-            if cls.startswith("S_"):
+            info = next((i for i in self._module.pous.values() if i.class_name == cls), None)
+            if cls.startswith("S_"):  # the compiler's structure classes (compiler.py)
                 what = "a structure"
             elif info is not None:
                 what = f"{'the PROGRAM' if info.kind == 'PROGRAM' else 'an instance of'} {info.pou.name}"
