@@ -59,6 +59,20 @@ def test_absolute_paths_below_the_working_directory_become_relative():
     assert "file=tests/corpus/broken/if_else_not_closed.st," in done.stdout
 
 
+def test_a_file_in_a_symlinked_vendor_folder_is_annotated_by_the_path_in_the_repository(tmp_path):
+    # vendor/lib links to a folder outside the repository: the annotation must name the
+    # file as the repository holds it (vendor/lib/...), as the reports do, not by where the
+    # link leads nor by the absolute path
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    (outside / "bad.st").write_bytes(BROKEN.read_bytes())
+    repo = tmp_path / "repo"
+    (repo / "vendor").mkdir(parents=True)
+    (repo / "vendor" / "lib").symlink_to(outside, target_is_directory=True)
+    done = run("--format", "github", repo / "vendor" / "lib" / "bad.st", cwd=repo)
+    assert done.stdout.startswith("::error file=vendor/lib/bad.st,line=12,col=1,"), done.stdout
+
+
 def _sarif(*args, cwd=ROOT) -> dict:
     done = run("--format", "sarif", *args, cwd=cwd)
     return json.loads(done.stdout)

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from verifier.st.ast import Diagnostic
+from verifier.textfile import shown_path
 
 TOOL_NAME = "uitamr check"
 SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
@@ -49,15 +50,13 @@ class Finding:
 
 def relative(file: str) -> str:
     """The path as CI annotations want it: relative to the working directory (the
-    repository root in a CI job) when it lies below it, with forward slashes."""
+    repository root in a CI job) when it lies below it, as reached (a symlinked
+    vendor/uitamr stays vendor/uitamr/...: textfile.shown_path, as the reports show paths),
+    with forward slashes."""
     path = Path(file)
-    try:
-        shown = os.path.relpath(path.resolve(), Path.cwd().resolve()) if path.is_absolute() else str(path)
-    except ValueError:  # another drive on Windows
+    if not path.is_absolute():
         return path.as_posix()
-    if shown.startswith(".."):
-        return path.as_posix()
-    return Path(shown).as_posix()
+    return Path(shown_path(path, os.getcwd())).as_posix()
 
 
 def to_json(findings: list[Finding], target: str, files: list[str], platform: str | None = None) -> str:
