@@ -552,3 +552,31 @@ def test_serial_pyserial_socket_url_reaches_a_serial_server(start_emulator):
     emulator.wait_for(r"uitamr emulate: stopped after .* 2 frames in, 2 replies out")
     assert emulator.proc.wait(timeout=WAIT_S) == 1
     assert "socket disconnected" in emulator.wait_for(r"Error: serial port socket://\S+ failed").string
+
+
+def test_a_log_reader_that_leaves_does_not_take_the_robot_off_the_line():
+    """`uitamr emulate ... | head -1`: the reader closes the pipe after the first line.
+    The robot keeps answering (a bench test goes on), and at the stop the summary goes to
+    stderr with status 0, instead of exit 1 and no summary at all."""
+    read_end, write_end = os.pipe()
+    proc = subprocess.Popen([sys.executable, "-m", "verifier.cli", "emulate", "--tcp", "127.0.0.1:0"],
+                            stdout=write_end, stderr=subprocess.PIPE, text=True)
+    os.close(write_end)
+    try:
+        with os.fdopen(read_end, "rb") as reader:  # the first line, then the reader is gone
+            first = reader.readline().decode()
+        port = int(re.search(r"listening on tcp 127\.0\.0\.1:(\d+)", first).group(1))
+        with socket.create_connection(("127.0.0.1", port), timeout=5) as sock:
+            for _ in range(3):  # each exchange writes log lines into the closed pipe
+                assert exchange(sock, STOP_FRAME, 8) == STOP_FRAME
+            assert exchange(sock, STATUS_TASK, 8) == with_crc(bytes.fromhex("010103000000"))
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=WAIT_S)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait(timeout=WAIT_S)
+    assert proc.returncode == 0, err
+    assert "Traceback" not in err
+    assert re.search(r"uitamr emulate: stopped after [\d.]+ s: 4 frames in, 4 replies out, .*"
+                     r"\(the log's reader closed stdout; the robot kept serving until the stop\)", err), err

@@ -3,6 +3,7 @@ tests of a real PLC (docs/emulator.md)."""
 from __future__ import annotations
 
 import math
+import os
 import signal
 import sys
 import threading
@@ -233,9 +234,23 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
                                  f"the default is {DEFAULT_SILENCE_US / 1000:g}", param_hint="--frame-gap-ms")
     endpoint = _tcp_endpoint(tcp) if tcp is not None else None
 
+    log_closed = False
+
     def log_anyway(line: str) -> None:
-        click.echo(line)
-        sys.stdout.flush()
+        # A reader that leaves (`uitamr emulate ... | head`) must not take the robot off
+        # the line in the middle of a bench test, nor lose the summary: the log goes to
+        # /dev/null from then on and the summary to stderr.
+        nonlocal log_closed
+        if log_closed:
+            return
+        try:
+            click.echo(line)
+            sys.stdout.flush()
+        except BrokenPipeError:
+            log_closed = True
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+            os.close(devnull)
 
     def log(line: str) -> None:
         if not quiet:
@@ -265,11 +280,14 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
                       on_listening=(lambda host, port: log_anyway(f"listening on tcp {host}:{port}")) if quiet else None)
     except PortError as err:
         if err.in_use:
-            click.echo(emulator.summary())  # what it did before the port failed
+            log_anyway(emulator.summary())  # what it did before the port failed
         raise click.ClickException(str(err)) from None
     finally:
         if timer is not None:
             timer.cancel()
         for sig, handler in previous.items():
             signal.signal(sig, handler)
-    click.echo(emulator.summary())
+    log_anyway(emulator.summary())
+    if log_closed:
+        click.echo(f"{emulator.summary()} (the log's reader closed stdout; the robot kept serving "
+                   "until the stop)", err=True)
