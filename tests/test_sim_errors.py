@@ -285,3 +285,31 @@ def test_api_calls_in_the_wrong_shape_say_the_right_shape():
     with pytest.raises(KeyError, match="no POU named 'NOPE' and not a device; the POUs are FB_T, Main"):
         project.get("NOPE.x")
     assert project.get("D100.5") is False and project.get("Main.x") == 0
+
+
+def test_attaching_a_second_line_to_a_channel_is_refused_not_silent():
+    """A second attach used to replace the first line: a fixture's line then never heard
+    another frame, with no word why. The same line twice is harmless."""
+    from verifier.amr import Robot
+    from verifier.link import Line
+    from verifier.link.converter import Converter, ConverterConfig
+
+    project = load_st("PROGRAM P\nEND_PROGRAM\n")
+    first = FakeEndpoint()
+    project.attach_serial("fx3:1", first)
+    project.attach_serial("fx3:1", first)
+    with pytest.raises(ValueError) as err:
+        project.attach_serial("fx3:1", FakeEndpoint())
+    assert str(err.value) == ("channel fx3:1 is already attached to a FakeEndpoint; a channel has one line: "
+                              "load the project again (verifier.load) to attach another")
+    project.attach_serial("fx3:2", Line(Robot()))  # the other channel is free
+    project.run_programs(["P"], scans=1)
+
+    fx5 = load_st("PROGRAM P\nEND_PROGRAM\n", target="gxworks3")
+    peer = Converter(Line(Robot()), ConverterConfig())
+    fx5.attach_tcp(peer)
+    fx5.attach_tcp(peer)
+    with pytest.raises(ValueError) as err:
+        fx5.attach_tcp(Converter(Line(Robot()), ConverterConfig()))
+    assert str(err.value) == ("the Ethernet port is already attached to a Converter; it has one peer: "
+                              "load the project again (verifier.load) to attach another")

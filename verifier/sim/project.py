@@ -388,6 +388,9 @@ class Project:
         for attr in ("open", "send", "receive_until", "peer_closed", "close"):
             if not callable(getattr(endpoint, attr, None)):
                 raise TypeError(f"TCP endpoint needs a {attr}() method (the verifier.link.converter.Converter interface)")
+        if self.rt.tcp_endpoint is not None and self.rt.tcp_endpoint is not endpoint:
+            raise ValueError(f"the Ethernet port is already attached to a {type(self.rt.tcp_endpoint).__name__}; it has one "
+                             "peer: load the project again (verifier.load) to attach another")
         self.rt.tcp_endpoint = endpoint
 
     def serial_log(self, channel: str):

@@ -68,6 +68,11 @@ class SerialChannel:
             if not callable(getattr(endpoint, attr, None)):
                 raise TypeError(f"serial endpoint for {self.name} needs a {attr}() method "
                                 "(the verifier.link.Line master interface)")
+        if self.endpoint is not None and self.endpoint is not endpoint:
+            # replacing it would leave the first line deaf from here on (a fixture's line
+            # that never hears a frame), and lose a frame half sent on it
+            raise ValueError(f"channel {self.name} is already attached to a {type(self.endpoint).__name__}; a channel "
+                             "has one line: load the project again (verifier.load) to attach another")
         self.endpoint = endpoint
         # an endpoint with `quiet_until_us` and `now_us` (verifier.link.Line) promises that
         # receive_until(t) for now_us <= t < quiet_until_us only sets now_us = t: the port
