@@ -37,7 +37,9 @@ def test_unknown_target_and_cpu():
 def test_a_cpu_the_editor_does_not_program_is_refused(target, cpu, message):
     with pytest.raises(LoadError) as err:
         load_st("PROGRAM P\nEND_PROGRAM\n", target=target, cpu=cpu)
-    assert f"<target>:0:0: error: {message}" in str(err.value)
+    given = f"target={target!r}" + ("" if cpu is None else f", cpu={cpu!r}")
+    assert str(err.value).startswith(f"verifier.load was given an option it cannot use:\n"
+                                     f"  verifier.load({given}): error: {message}")
 
 
 @pytest.mark.parametrize("target, cpu", [("gxworks2", "fx3u"), ("gxworks2", "fx3gc"), ("gxworks2", "qnu"),
@@ -313,3 +315,20 @@ def test_attaching_a_second_line_to_a_channel_is_refused_not_silent():
         fx5.attach_tcp(Converter(Line(Robot()), ConverterConfig()))
     assert str(err.value) == ("the Ethernet port is already attached to a Converter; it has one peer: "
                               "load the project again (verifier.load) to attach another")
+
+
+@pytest.mark.parametrize("options, place, message", [
+    ({"scan_ms": 0}, "scan_ms=0", "the scan time must be at least 0.001 ms"),
+    ({"scan_ms": 0.0004}, "scan_ms=0.0004", "the scan time must be at least 0.001 ms"),
+    ({"jitter_ms": 10}, "jitter_ms=10, scan_ms=10", "the jitter must be at least 0 and less than the scan time (10 ms)"),
+    ({"jitter_ms": -1, "scan_ms": 5}, "jitter_ms=-1, scan_ms=5",
+     "the jitter must be at least 0 and less than the scan time (5 ms)"),
+])
+def test_a_bad_load_option_is_named_with_its_value_not_placed_in_the_sources(options, place, message):
+    """These said `<options>:0:0: error: scan time must be positive` under "ST sources have
+    errors": no option name, no value, and a place in no file."""
+    with pytest.raises(LoadError) as err:
+        load_st("PROGRAM P\nEND_PROGRAM\n", **options)
+    assert str(err.value).startswith(f"verifier.load was given an option it cannot use:\n"
+                                     f"  verifier.load({place}): error: {message}")
+    assert "<options>" not in str(err.value) and ":0:0" not in str(err.value)

@@ -142,5 +142,5 @@ def test_bad_scan_options_are_load_errors():
 def test_a_timer_resolution_no_cpu_timer_has_is_refused_naming_the_ones_it_has(resolution):
     with pytest.raises(LoadError) as err:
         load_st(TIMERS, timer_resolution_ms=resolution)
-    assert ("<options>:0:0: error: the timer resolution (timer_resolution_ms) must be 1, 10 or 100 ms, "
+    assert (f"verifier.load(timer_resolution_ms={resolution!r}): error: the timer resolution (timer_resolution_ms) must be 1, 10 or 100 ms, "
             f"the resolutions the CPU's timers count in; got {resolution!r}") in str(err.value)

@@ -10,7 +10,23 @@ class LoadError(Exception):
     def __init__(self, diagnostics):
         self.diagnostics = list(diagnostics)
         lines = [_format_diag(d) for d in self.diagnostics]
-        super().__init__("ST sources have errors:\n" + "\n".join("  " + s for s in lines))
+        options = all(getattr(d, "file", "").startswith(OPTION_PLACE) for d in self.diagnostics)
+        heading = "verifier.load was given an option it cannot use" if options else "ST sources have errors"
+        super().__init__(f"{heading}:\n" + "\n".join("  " + s for s in lines))
+
+
+#: the "file" of a diagnostic about an argument of verifier.load, not about a source:
+#: `verifier.load(scan_ms=0)`
+OPTION_PLACE = "verifier.load("
+
+
+def option_error(message: str, **given) -> "LoadError":
+    """A LoadError about arguments of verifier.load, placed by their names and values:
+    `verifier.load(scan_ms=0): error: ...`."""
+    from verifier.st import ast
+
+    args = ", ".join(f"{name}={value!r:.60}" for name, value in given.items())
+    return LoadError([ast.Diagnostic(f"{OPTION_PLACE}{args})", 0, 0, "error", message)])
 
 
 def _format_diag(d) -> str:
@@ -19,6 +35,8 @@ def _format_diag(d) -> str:
     col = getattr(d, "col", 0)
     sev = getattr(d, "severity", "error")
     msg = getattr(d, "message", str(d))
+    if file.startswith(OPTION_PLACE):  # a call's argument has no line and column
+        return f"{file}: {sev}: {msg}"
     return f"{file}:{line}:{col}: {sev}: {msg}"
 
 

@@ -14,7 +14,7 @@ from verifier.textfile import text_lines
 
 from .compiler import GENERATED_FILE, CompiledModule, compile_files, default_code
 from .cpu import profile_for
-from .errors import LoadError, SimulationError
+from .errors import LoadError, SimulationError, option_error
 from .instructions import InstructionSet
 from .runtime import Runtime
 from .serial import CHANNELS, NOT_SIMULATED
@@ -82,7 +82,7 @@ class Project:
         try:
             self.cpu = profile_for(target, cpu)
         except ValueError as e:
-            raise LoadError([ast.Diagnostic("<target>", 0, 0, "error", str(e))]) from None
+            raise option_error(str(e), **({"target": target} if cpu is None else {"target": target, "cpu": cpu})) from None
         editor = target.split(":", 1)[0].lower()  # as profile_for reads it
         self.target = editor
         files, warnings = _parsed_and_checked(texts, editor)
@@ -90,17 +90,24 @@ class Project:
         self.files = files
         for name, value in (("scan_ms", scan_ms), ("jitter_ms", jitter_ms)):
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise LoadError([ast.Diagnostic("<options>", 0, 0, "error", f"{name} must be a finite number "
-                                                f"of milliseconds; got {value!r:.60}")])
+                raise option_error(f"{name} must be a finite number of milliseconds; got {value!r:.60}",
+                                   **{name: value})
+        scan_us, jitter_us = round(scan_ms * 1000), round(jitter_ms * 1000)
+        if scan_us <= 0:
+            raise option_error("the scan time must be at least 0.001 ms (1 µs; the virtual clock counts whole µs)",
+                               scan_ms=scan_ms)
+        if not 0 <= jitter_us < scan_us:
+            raise option_error(f"the jitter must be at least 0 and less than the scan time ({scan_ms:g} ms)",
+                               jitter_ms=jitter_ms, scan_ms=scan_ms)
         if stop_on_operation_error is not None and not isinstance(stop_on_operation_error, bool):
-            raise LoadError([ast.Diagnostic("<options>", 0, 0, "error", "stop_on_operation_error is True, False "
-                                            f"or None (the CPU's default); got {stop_on_operation_error!r:.60}")])
+            raise option_error("stop_on_operation_error is True, False or None (the CPU's default); "
+                               f"got {stop_on_operation_error!r:.60}", stop_on_operation_error=stop_on_operation_error)
         try:
-            self.rt = Runtime(self.cpu, scan_us=round(scan_ms * 1000), jitter_us=round(jitter_ms * 1000),
+            self.rt = Runtime(self.cpu, scan_us=scan_us, jitter_us=jitter_us,
                               seed=seed, stop_on_operation_error=stop_on_operation_error,
                               timer_resolution_ms=timer_resolution_ms)
-        except ValueError as e:
-            raise LoadError([ast.Diagnostic("<options>", 0, 0, "error", str(e))]) from None
+        except ValueError as e:  # the timer resolution (scan and jitter are checked above)
+            raise option_error(str(e), timer_resolution_ms=timer_resolution_ms) from None
         try:
             self.programs = _only_programs(files, programs)
             self.module: CompiledModule = compile_files(files, self.rt, self.cpu, programs=self.programs)
