@@ -111,3 +111,83 @@ def test_forgetting_the_buffer_memory_writes_breaks_the_link():
     word units and an end code, and the stop is never seen as answered."""
     prog, _ = run_at_x020(moved_example(MOVE_TO_X020[:2]))
     assert not prog.fbEngine.o_bInitDone
+
+
+# ------------------------------------------------------- a program of one's own in another slot
+USER_MAIN = """PROGRAM Main
+VAR
+    fbPort : UITAMR_PortQC24;
+    fbEngine : UITAMR_Engine;
+    uMbx : ARRAY[0..15] OF WORD;
+    uPort : ARRAY[0..39] OF WORD;
+END_VAR
+IF SM402 THEN
+    U2\\G310 := 1;
+    U2\\G324 := 8;
+    U2\\G325 := 16#FFFF;
+END_IF;
+fbPort(i_bEN := TRUE, i_uUnit := 16#2, i_wChannel := 2, i_bReadReq := X2A, io_uPort := uPort);
+fbEngine(i_bEN := NOT SM402, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);
+"""
+LIBRARY = [PLC / "core", PLC / "q" / "UITAMR_PortQC24.st"]
+
+
+def test_matrix_runs_a_program_whose_c24_sits_in_another_slot_on_ch2(tmp_path):
+    """The bundled q-exception.toml sets timer 0 for the example's module (U0, CH1). Under
+    --matrix those settings once made a module at U0 that took the robot's replies off the
+    line, so a program driving its C24 at U2 on CH2 never saw an answer and failed
+    (UITAMR-CYCLE: stop after stop). The settings now go to the module the program drives."""
+    import json
+
+    from click.testing import CliRunner
+
+    from verifier.commands.verify import command
+
+    (tmp_path / "Main.st").write_text(USER_MAIN)
+    report = tmp_path / "m.json"
+    result = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--matrix",
+                                          "--channel", "q:2", "--duration", "8s", "--json", str(report)],
+                                catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    runs = {s["name"]: s for s in json.loads(report.read_text())["scenarios"]}
+    exception = next(s for name, s in runs.items() if "exception" in name)
+    assert exception["verdict"] == "pass" and not exception["violations"]
+    assert any("C24 settings (on the module your program drives)" in n for n in exception["notes"])
+
+
+def test_c24_settings_for_the_module_the_program_drives():
+    """configure_c24(None, ...) sets timer 0 on whichever module the program addresses: the
+    5-byte exception to a status read at U2/CH2 is reported as such, and the replies after
+    it stay aligned."""
+    fault = Fault(kind="exception", at_s=2.0, count=1, code=3, requests="status")
+    robot = Robot(Settings(), RobotConfig(), [fault])
+    line = Line(robot)
+    project = verifier.load(*LIBRARY, sources={"Main.st": USER_MAIN}, cpu="q")
+    project.attach_serial("q:2", line)
+    project.configure_c24(None, 2, no_reception_ms=5)
+    errors = set()
+    project.run_programs(["Main"], ms=6000,
+                         on_scan=lambda p: errors.add(p.program("Main").fbEngine.o_uErrId))
+    assert project.c24_addressed() == [2]
+    assert 0x0103 in errors
+    assert project.program("Main").fbEngine.o_wCommErrCount == 0
+
+
+def test_a_c24_setting_for_a_slot_the_program_does_not_drive_is_noted(tmp_path):
+    """A [[c24]] for U0 while the program drives its module at U2: before, the setting
+    made a phantom module that swallowed the replies (the run failed with no hint why);
+    now the run goes on, and a note at the [[c24]]'s line says the settings were not in
+    force and which unit to give."""
+    from click.testing import CliRunner
+
+    from verifier.commands.verify import command
+
+    (tmp_path / "Main.st").write_text(USER_MAIN)
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('program = "Main"\nplatform = "q"\nchannel = "q:2"\nduration = "3s"\n\n'
+                        '[[c24]]\nunit = 0\nchannel = 2\nno_reception = "5ms"\n')
+    result = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--scenario", str(scenario)],
+                                catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    assert f"{scenario}:6:1: c24[0]: unit = 0 (U0) is not the QJ71C24N the program drives" in result.output
+    assert "give unit = 2" in result.output

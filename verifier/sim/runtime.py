@@ -50,6 +50,9 @@ class Runtime:
         self.ports: dict[str, SerialChannel] = {}  # channel name ("fx3:1") -> byte stream
         self.keep_sent = True  # the channels log what they send (Project.keep_serial_log)
         self.buffers: dict[int, list[int]] = {}  # module start I/O -> buffer memory words
+        # QJ71C24N channel -> settings for whichever module the program's G_OUTPUT/G_INPUT
+        # address first (Project.configure_c24 with un=None)
+        self.c24_for_program: dict[int, dict] = {}
         self.origins: dict[str, str] = {}  # channel -> location of the last send-request flag write
         self.tcp_endpoint = None  # the Ethernet port's peer (verifier.link.converter.Converter)
         self.stop_on_operation_error = (cpu.stops_on_op_error if stop_on_operation_error is None

@@ -368,6 +368,7 @@ def _apply_plc_settings(plc: _Plc, scenario: Scenario) -> None:
         where = scenario.where(setting.key, scenario.key_lines.get(setting.key))
         if scenario.platform != "q":
             raise UnusableInput(f"{where}: the QJ71C24N is a Q-series module; the platform is {scenario.platform}")
+        # unit None (--matrix): the settings go to whichever module the program drives
         try:
             plc.project.configure_c24(
                 setting.unit, setting.channel, byte_units=setting.byte_units, receive_count=setting.receive_count,
@@ -388,6 +389,27 @@ def _apply_plc_settings(plc: _Plc, scenario: Scenario) -> None:
         if problem:
             raise UnusableInput(f"{where}: {problem}")
         plc.write(name, value)
+
+
+def _c24_notes(scenario: Scenario, plc: _Plc) -> list[str]:
+    """A [[c24]] for a module the program never drove changed nothing: the robot hangs on
+    the module the program's G_OUTPUT / G_INPUT address (a slot the program does not use
+    has no robot on it), so its settings - the no-reception time a fault set may rely on -
+    were not in force. Said, with the module the program did use."""
+    if scenario.platform != "q" or not scenario.c24:
+        return []
+    used = plc.project.c24_addressed()
+    if not used:
+        return []
+    notes = []
+    for setting in scenario.c24:
+        if setting.unit is None or setting.unit in used:
+            continue
+        where = scenario.where(setting.key, scenario.key_lines.get(setting.key))
+        notes.append(f"{where}: unit = {setting.unit} (U{setting.unit:X}) is not the QJ71C24N the program drives "
+                     f"(its G_OUTPUT/G_INPUT address {', '.join(f'U{u:X}' for u in used)}); these settings "
+                     f"were not in force: give unit = {used[0]}")
+    return notes
 
 
 def _input_schedule(scenario: Scenario) -> list[tuple[int, dict[str, Any]]]:
@@ -587,5 +609,6 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         aborted=aborted,
         ended_us=end,
         wall_s=time.perf_counter() - wall_start,
-        notes=list(scenario.notes) + plc.cpu_notes() + ([] if tx_count else [_silence_note(scenario, plc, converter)]),
+        notes=list(scenario.notes) + plc.cpu_notes() + _c24_notes(scenario, plc)
+        + ([] if tx_count else [_silence_note(scenario, plc, converter)]),
     )

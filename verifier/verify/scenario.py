@@ -95,9 +95,10 @@ class InputStep:
 @dataclass(frozen=True)
 class C24Setting:
     """QJ71C24N settings made in GX Works (switch settings / various control specification)
-    for one channel of the module at start I/O `unit` (U0 = X/Y000, U2 = X/Y020)."""
+    for one channel of the module at start I/O `unit` (U0 = X/Y000, U2 = X/Y020); `unit`
+    None: the module the program drives, wherever it is (--matrix against user sources)."""
 
-    unit: int = 0
+    unit: int | None = 0
     channel: int = 1
     no_reception_us: int | None = None  # no-reception monitoring time (timer 0)
     byte_units: bool | None = None

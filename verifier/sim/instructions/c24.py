@@ -47,6 +47,10 @@ class C24Module:
                 if self.buffer[addr] == 0:
                     self.buffer[addr] = DEFAULTS[name] - (0x10000 if DEFAULTS[name] > 0x7FFF else 0)
         self.channels = {ch: _Channel(self, ch) for ch in (1, 2)}
+        # a module no G_OUTPUT / G_INPUT has addressed yet is not wired to the robot's line:
+        # settings made for it (configure_c24) must not let it take the bytes the program's
+        # own module is waiting for
+        self.addressed = False
         self.pulses: list[tuple] = []  # (ref, bit offset) ON for one scan
         self.pending: list[tuple] = []  # completion bits to turn ON at the next END
         rt.pollers.append(self)
@@ -78,8 +82,30 @@ class C24Module:
         if not ok:
             self.pending.append((d_ref, 1))
 
+    def configure(self, channel: int, *, byte_units: bool | None = None, receive_count: int | None = None,
+                  end_code: int | None = None, no_reception_ms: float | None = None) -> None:
+        """Settings made in GX Works for one channel (None: left as they are)."""
+        addr = BUFFER[channel]
+        if byte_units is not None:
+            self.buffer[addr["unit"]] = 1 if byte_units else 0
+        if receive_count is not None:
+            self.buffer[addr["recv_count"]] = receive_count
+        if end_code is not None:
+            self.buffer[addr["end_code"]] = ((end_code & 0xFFFF) + 0x8000 & 0xFFFF) - 0x8000
+        if no_reception_ms is not None:
+            self.channels[channel].no_reception_us = round(no_reception_ms * 1000)
+
+    def _addressed_now(self) -> None:
+        """The first G_OUTPUT / G_INPUT on this module: it is the program's, so it is on the
+        line, and settings made for "the module the program drives" apply to it."""
+        self.addressed = True
+        for channel, settings in self.rt.c24_for_program.items():
+            self.configure(channel, **settings)
+
     # -- G_OUTPUT ----------------------------------------------------------------------------
     def output(self, s1, s2, d, loc_id) -> bool:
+        if not self.addressed:
+            self._addressed_now()
         chan = self._channel(s1, loc_id)
         if chan is None:
             s1.set(1, ERR_CHANNEL)
@@ -97,6 +123,8 @@ class C24Module:
 
     # -- G_INPUT -------------------------------------------------------------------------------
     def input(self, s, d1, d2, loc_id) -> bool:
+        if not self.addressed:
+            self._addressed_now()
         chan = self._channel(s, loc_id)
         if chan is None:
             s.set(1, ERR_CHANNEL)
@@ -134,7 +162,8 @@ class C24Module:
                 s1.set(1, 0)
                 d.set(0, True)
                 self.pulses.append((d, 0))
-            self._receive(chan, now)
+            if self.addressed:
+                self._receive(chan, now)
 
     # -- idle-scan skipping (verifier.sim.idle) -------------------------------------------
     def idle_deadline(self, now: int) -> float | None:
@@ -143,6 +172,8 @@ class C24Module:
         if self.pulses or self.pending:
             return None
         deadline = float("inf")
+        if not self.addressed:
+            return deadline  # not on the line: nothing arrives for it (an instruction call is a scan)
         for chan in self.channels.values():
             if chan.sending_until is not None:
                 deadline = min(deadline, chan.sending_until)
@@ -161,7 +192,7 @@ class C24Module:
             (c.sending_until, None if c.out_done is None else tuple(map(operand_key, c.out_done)),
              bytes(c.rx), c.rx_last_t, tuple(c.frames), c.no_reception_us, c.port.sent_count)
             for c in self.channels.values())
-        return channels, pulse_keys(self.pulses), pulse_keys(self.pending)
+        return self.addressed, channels, pulse_keys(self.pulses), pulse_keys(self.pending)
 
     def skipped(self, scan_count: int, scans: int) -> None:
         """Nothing here depends on the scan count."""
