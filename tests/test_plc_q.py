@@ -54,6 +54,30 @@ def test_exception_reply_is_reported_and_the_line_stays_aligned():
     assert len(done) >= 2 and not prog.fbCycle.o_bErr       # the cycle ran on after the acknowledge
 
 
+def test_a_reception_error_is_read_and_the_line_stays_aligned():
+    """Timer 0 in format 0 ends a short message with a reception error: the module turns on
+    the reception abnormal detection X4, not X3 (C24 (Application) 6.1), and the data up to
+    the error wait for G_INPUT (C24 (Basic) 6.1.5). The port read only on X3, so the error
+    message was never taken off the module and every reply after it waited behind it: the
+    link stayed dead. Now X4 starts a read too; the engine sees a transport error for that
+    attempt and the replies after it are read in step."""
+    fault = Fault(kind="exception", on_request=5, count=1, code=2)   # request 5 = run point 1
+    project, line, robot = rig([fault], no_reception_ms=5)
+    project.configure_c24(0, 1, no_reception_format=0)
+    prog = project.program("UITAMR_ExampleQ")
+    seen = set()
+
+    def watch(p):
+        seen.add((p.program("UITAMR_ExampleQ").fbPort.o_uErrId, p.devices["X4"]))
+    run(project, 12000, pulse(project, "X20", 1000), watch)
+    assert any(x4 for _, x4 in seen)                         # X4 came on ...
+    assert any(err == 0x0307 for err, _ in seen)             # ... and the read ended in error
+    assert prog.fbEngine.o_wRetryCount > 0                   # that attempt was repeated
+    assert prog.fbEngine.o_wCommErrCount == 1 and not project.devices["X3"]   # nothing after it misread
+    done = [e for e in robot.events if e.kind == "task" and e.message.endswith("done")]
+    assert len(done) >= 2 and not prog.fbCycle.o_bErr       # the cycle ran on
+
+
 def test_requests_keep_the_pacing_on_q():
     project, line, _ = rig([], no_reception_ms=5)
     run(project, 8000, pulse(project, "X20", 1000))
@@ -66,7 +90,7 @@ def test_requests_keep_the_pacing_on_q():
 EXAMPLE_Q = PLC / "examples" / "q" / "UITAMR_ExampleQ.st"
 MOVE_TO_X020 = [   # the places the example's header and import-gxworks2.md §5 list
     ("C24_UNIT : WORD := 16#0;", "C24_UNIT : WORD := 16#2;"),
-    ("i_bReadReq := X3,", "i_bReadReq := X23,"),
+    ("i_bReadReq := X3,", "i_bReadReq := X23,"), ("i_bRecvErr := X4,", "i_bRecvErr := X24,"),
     ("U0\\G150", "U2\\G150"), ("U0\\G164", "U2\\G164"), ("U0\\G165", "U2\\G165"),
 ]
 
@@ -99,17 +123,17 @@ def test_the_example_lists_every_place_that_names_the_module():
     body = text.split("PROGRAM UITAMR_ExampleQ", 1)[1]
     assert set(re.findall(r"U[0-9A-F]+\\G\d+", body)) == {"U0\\G150", "U0\\G164", "U0\\G165"}
     header = text.split("PROGRAM UITAMR_ExampleQ", 1)[0]
-    for place in ("C24_UNIT", "i_bReadReq", "U0\\G", "C24_CHANNEL", "G310 / G324 / G325"):
+    for place in ("C24_UNIT", "i_bReadReq", "i_bRecvErr", "U0\\G", "C24_CHANNEL", "G310 / G324 / G325"):
         assert place in header
     guide = (PLC.parent / "docs" / "import-gxworks2.md").read_text()
-    for place in ("`C24_UNIT`", "X(start + 3)", "`U0\\G150`", "`G310`", "`C24_CHANNEL`"):
+    for place in ("`C24_UNIT`", "X(start + 3)", "X(start + 4)", "`U0\\G150`", "`G310`", "`C24_CHANNEL`"):
         assert place in guide
 
 
 def test_forgetting_the_buffer_memory_writes_breaks_the_link():
     """Why the U\\G writes are on the list: with them left at U0 the module at X/Y020 keeps
     word units and an end code, and the stop is never seen as answered."""
-    prog, _ = run_at_x020(moved_example(MOVE_TO_X020[:2]))
+    prog, _ = run_at_x020(moved_example(MOVE_TO_X020[:3]))
     assert not prog.fbEngine.o_bInitDone
 
 

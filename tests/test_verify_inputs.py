@@ -295,6 +295,7 @@ def test_initial_devices_and_buffer_memory_are_there_at_the_first_scan(tmp_path)
     ('[[c24]]\nchannel = 3\n', "c24[0].channel", "1..2"),
     ('[[c24]]\nno_reception = 5\n', "c24[0].no_reception", "expected a duration"),
     ('[[c24]]\nbaud = 9600\n', "c24[0].baud", "unknown key"),
+    ('[[c24]]\nno_reception_format = 2\n', "c24[0].no_reception_format", "0..1"),
     ('[[c24]]\nchannel = 1\n[[c24]]\nunit = 0\n', "c24[1]", "U0 channel 1 is already set in c24[0]"),
 ])
 def test_plc_settings_mistakes_name_their_key(tmp_path, body, key, words):

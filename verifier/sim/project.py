@@ -409,10 +409,12 @@ class Project:
 
     def configure_c24(self, un: int | None = 0, channel: int = 1, *, byte_units: bool | None = None,
                       receive_count: int | None = None, end_code: int | None = None,
-                      no_reception_ms: float | None = None) -> None:
+                      no_reception_ms: float | None = None, no_reception_format: int | None = None) -> None:
         """QJ71C24N settings normally made in GX Works (switch settings / buffer memory):
-        word or byte units, received data count, receive end code (0xFFFF = none) and the
-        no-reception monitoring time that ends a message on a silent line. `un=None` makes
+        word or byte units, received data count, receive end code (0xFFFF = none), the
+        no-reception monitoring time that ends a message on a silent line and its format
+        (1: the message is read normally, X3/XA - the default here; 0: a reception error,
+        X4/XB). `un=None` makes
         them for the module the program drives, wherever it is: the first one its
         G_OUTPUT / G_INPUT address. Only a module the program addresses is on the robot's
         line; settings for another one change nothing (`c24_addressed` tells which are)."""
@@ -423,8 +425,12 @@ class Project:
                              f"configure_c24 needs a Q CPU (verifier.load(..., cpu='q'))")
         if type(channel) is not int or channel not in BUFFER:
             raise ValueError(f"the QJ71C24N has channels {' and '.join(map(str, BUFFER))}; got channel={channel!r}")
+        if no_reception_format is not None and (type(no_reception_format) is not int
+                                                or no_reception_format not in (0, 1)):
+            raise ValueError(f"no_reception_format is 0 or 1 (timer 0's format 0 or format 1); "
+                             f"got {no_reception_format!r}")
         settings = dict(byte_units=byte_units, receive_count=receive_count, end_code=end_code,
-                        no_reception_ms=no_reception_ms)
+                        no_reception_ms=no_reception_ms, no_reception_format=no_reception_format)
         if un is None:
             self.rt.c24_for_program[channel] = settings
             for module in self._instructions()._c24.values():

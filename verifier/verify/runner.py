@@ -374,6 +374,7 @@ def _apply_plc_settings(plc: _Plc, scenario: Scenario) -> None:
                 setting.unit, setting.channel, byte_units=setting.byte_units, receive_count=setting.receive_count,
                 end_code=setting.end_code,
                 no_reception_ms=None if setting.no_reception_us is None else setting.no_reception_us / 1000,
+                no_reception_format=setting.no_reception_format,
             )
         except (ValueError, KeyError) as exc:
             raise UnusableInput(f"{where}: {exc}") from None

@@ -52,7 +52,7 @@ INPUT_KEYS = ("at", "set", "pulse")
 EXPECT_KEYS = KINDS + ("after", "within", "name")
 RULES_KEYS = ("min_period", "reply_timeout")
 RESPONSE_KEYS = ("signal", "within")
-C24_KEYS = ("unit", "channel", "no_reception", "byte_units", "receive_count", "end_code")
+C24_KEYS = ("unit", "channel", "no_reception", "no_reception_format", "byte_units", "receive_count", "end_code")
 CONVERTER_KEYS = ("ip", "port", "delay", "connect", "packing", "refuse_until", "unreachable", "drops",
                   "split_reply", "split_gap")
 #: The platforms with an Ethernet port the library drives (FX5U built-in, Q + QJ71E71-100).
@@ -104,6 +104,7 @@ class C24Setting:
     byte_units: bool | None = None
     receive_count: int | None = None
     end_code: int | None = None  # 0xFFFF = no receive end code
+    no_reception_format: int | None = None  # timer 0: 1 ends the message (X3), 0 an error (X4)
     key: str = ""
 
 
@@ -547,7 +548,8 @@ class _Reader:
             end_code = whole("end_code", 0, 0xFFFF)
         return C24Setting(
             unit=unit or 0, channel=channel or 1, no_reception_us=no_reception, byte_units=byte_units,
-            receive_count=whole("receive_count", 1, 0xFFFF), end_code=end_code, key=key,
+            receive_count=whole("receive_count", 1, 0xFFFF), end_code=end_code,
+            no_reception_format=whole("no_reception_format", 0, 1), key=key,
         )
 
     def sources(self, value: Any) -> list[Path]:

@@ -22,6 +22,9 @@ ABNORMAL = {1: 0x4, 2: 0xB}
 # result codes the simulator writes (ASSUMPTION: the module's own codes are not modelled)
 ERR_CHANNEL = 0x7FF1
 ERR_TOO_LONG = 0x7FF2
+# the code stored for a message ended by timer 0 in format 0 (ASSUMPTION: the module's own
+# code for a no-reception time-out is not modelled)
+ERR_NO_RECEPTION = 0x7FF3
 
 
 class _Channel:
@@ -33,8 +36,12 @@ class _Channel:
         self.out_done = None  # (s1 ref, d ref) awaiting completion
         self.rx = bytearray()
         self.rx_last_t = 0
-        self.frames: list[bytes] = []
-        self.no_reception_us: int | None = None  # timer 0 (format 1), off by default
+        # messages waiting for G_INPUT: (data, error code; 0 = a normal reception)
+        self.frames: list[tuple[bytes, int]] = []
+        self.no_reception_us: int | None = None  # timer 0, off by default
+        # what timer 0 running out does (C24 (Application) 6.1): format 1 ends the message
+        # normally (X3/XA), format 0 reports a reception error (X4/XB, error code)
+        self.no_reception_format = 1
 
 
 class C24Module:
@@ -83,7 +90,8 @@ class C24Module:
             self.pending.append((d_ref, 1))
 
     def configure(self, channel: int, *, byte_units: bool | None = None, receive_count: int | None = None,
-                  end_code: int | None = None, no_reception_ms: float | None = None) -> None:
+                  end_code: int | None = None, no_reception_ms: float | None = None,
+                  no_reception_format: int | None = None) -> None:
         """Settings made in GX Works for one channel (None: left as they are)."""
         addr = BUFFER[channel]
         if byte_units is not None:
@@ -94,6 +102,8 @@ class C24Module:
             self.buffer[addr["end_code"]] = ((end_code & 0xFFFF) + 0x8000 & 0xFFFF) - 0x8000
         if no_reception_ms is not None:
             self.channels[channel].no_reception_us = round(no_reception_ms * 1000)
+        if no_reception_format is not None:
+            self.channels[channel].no_reception_format = no_reception_format
 
     def _addressed_now(self) -> None:
         """The first G_OUTPUT / G_INPUT on this module: it is the program's, so it is on the
@@ -132,20 +142,26 @@ class C24Module:
             return True
         if not chan.frames:
             return True  # nothing received: the instruction does nothing (ASSUMPTION)
-        data = chan.frames.pop(0)
+        data, error = chan.frames.pop(0)
         words = (len(data) + 1) // 2
         count = len(data) if self._word(chan.ch, "unit") == 1 else words
         if count > s.get(3):
             s.set(1, ERR_TOO_LONG)
             self._finish(d2, ok=False)
         else:
+            # a reception error: the data up to the error are read, the instruction ends with
+            # its completion device + 1 ON and the code in (s)+1 (C24 (Basic) 6.1.5)
             d1.put_bytes(data)
             s.set(2, count)
-            s.set(1, 0)
-            self._finish(d2, ok=True)
-        if not chan.frames:
-            self._set_x(READ_REQUEST[chan.ch], False)
+            s.set(1, error)
+            self._finish(d2, ok=not error)
+        self._signals(chan)
         return True
+
+    def _signals(self, chan: _Channel) -> None:
+        """X3/XA while a normal message waits, X4/XB while one ended by an error waits."""
+        self._set_x(READ_REQUEST[chan.ch], any(not error for _, error in chan.frames))
+        self._set_x(ABNORMAL[chan.ch], any(error for _, error in chan.frames))
 
     # -- between scans ---------------------------------------------------------------------------
     def poll(self, now: int) -> None:
@@ -190,7 +206,8 @@ class C24Module:
         """Everything the instructions and `poll` change (nothing counts scans)."""
         channels = tuple(
             (c.sending_until, None if c.out_done is None else tuple(map(operand_key, c.out_done)),
-             bytes(c.rx), c.rx_last_t, tuple(c.frames), c.no_reception_us, c.port.sent_count)
+             bytes(c.rx), c.rx_last_t, tuple(c.frames), c.no_reception_us, c.no_reception_format,
+             c.port.sent_count)
             for c in self.channels.values())
         return self.addressed, channels, pulse_keys(self.pulses), pulse_keys(self.pending)
 
@@ -203,7 +220,7 @@ class C24Module:
         end_code = self._word(chan.ch, "end_code")
         for value, t in chan.port.receive_until(now):
             if chan.rx and chan.no_reception_us is not None and t - chan.rx_last_t > chan.no_reception_us:
-                self._frame(chan)
+                self._timed_out(chan)
             chan.rx.append(value)
             chan.rx_last_t = t
             if (end_code != 0xFFFF and len(chan.rx) >= 2
@@ -212,9 +229,12 @@ class C24Module:
             elif target and len(chan.rx) >= target:
                 self._frame(chan)
         if chan.rx and chan.no_reception_us is not None and now - chan.rx_last_t > chan.no_reception_us:
-            self._frame(chan)
+            self._timed_out(chan)
 
-    def _frame(self, chan: _Channel) -> None:
-        chan.frames.append(bytes(chan.rx))
+    def _timed_out(self, chan: _Channel) -> None:
+        self._frame(chan, 0 if chan.no_reception_format == 1 else ERR_NO_RECEPTION)
+
+    def _frame(self, chan: _Channel, error: int = 0) -> None:
+        chan.frames.append((bytes(chan.rx), error))
         chan.rx.clear()
-        self._set_x(READ_REQUEST[chan.ch], True)
+        self._signals(chan)
