@@ -413,6 +413,23 @@ def _c24_notes(scenario: Scenario, plc: _Plc) -> list[str]:
     return notes
 
 
+def _missed_fault_notes(scenario: Scenario, robot) -> list[str]:
+    """A reply fault that met no request (a window in which the program sent nothing, a
+    request number never reached, `requests = "control"` while only status reads went
+    out) tested nothing, though the run may pass: said, at the fault's line."""
+    notes = []
+    for index, fault in robot.reply_faults_missed():
+        key = f"faults[{index}]"
+        where = scenario.where(key, scenario.key_lines.get(key))
+        if fault.at_s is not None:
+            window = f"from {fault.at_s:g} s" + (f" for {fault.duration_s:g} s" if fault.duration_s else "")
+            why = f"no {fault.requests + ' ' if fault.requests != 'any' else ''}request reached the robot {window}"
+        else:
+            why = f"request {fault.on_request} never reached the robot"
+        notes.append(f"{where}: {fault.describe()}: {why}, so this fault was not tested")
+    return notes
+
+
 def _input_schedule(scenario: Scenario) -> list[tuple[int, dict[str, Any]]]:
     steps: list[tuple[int, dict[str, Any]]] = []
     for step in scenario.inputs:
@@ -610,6 +627,6 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         aborted=aborted,
         ended_us=end,
         wall_s=time.perf_counter() - wall_start,
-        notes=list(scenario.notes) + plc.cpu_notes() + _c24_notes(scenario, plc)
+        notes=list(scenario.notes) + plc.cpu_notes() + _c24_notes(scenario, plc) + _missed_fault_notes(scenario, robot)
         + ([] if tx_count else [_silence_note(scenario, plc, converter)]),
     )

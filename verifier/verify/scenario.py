@@ -435,6 +435,7 @@ class _Reader:
             raise self.fail("channel", "a scenario with [converter] reaches the robot over TCP: "
                                        "it has no serial channel; remove 'channel'")
         keys = [f"initial.{name}" for name, _ in initial] + [setting.key for setting in c24]
+        keys += [f"faults[{i}]" for i in range(len(faults))]
         keys += [f"{e.key}.{e.kind}" for e in expectations if e.condition is not None]
         keys += [f"{step.key}.set" for step in inputs] + [f"watch[{i}]" for i in range(len(watch))]
         keys += ["response_handling.signal"] if signal_given else []
