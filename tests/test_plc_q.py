@@ -215,3 +215,23 @@ def test_a_c24_setting_for_a_slot_the_program_does_not_drive_is_noted(tmp_path):
     assert result.exit_code == 0, result.output
     assert f"{scenario}:6:1: c24[0]: unit = 0 (U0) is not the QJ71C24N the program drives" in result.output
     assert "give unit = 2" in result.output
+
+
+def test_replies_left_in_the_module_are_noted_with_the_signal_to_read_on(tmp_path):
+    """Moving the C24 to U2/CH2 but leaving i_bReadReq at X3: every reply stayed in the
+    module and the report only said UITAMR-CYCLE (stop after stop), far from the cause.
+    Now a note names the unread messages and the module's own read request, X2A."""
+    from click.testing import CliRunner
+
+    from verifier.commands.verify import command
+
+    (tmp_path / "Main.st").write_text(USER_MAIN.replace("i_bReadReq := X2A", "i_bReadReq := X3"))
+    result = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--channel", "q:2",
+                                          "--duration", "5s"], catch_exceptions=False)
+    assert result.exit_code == 1
+    assert ("note: QJ71C24N U2 CH2: 5 received message(s) never read by G_INPUT, the oldest since 0.252 s; "
+            "the module's reception data read request for CH2 is X2A (reception abnormal detection X2B)") in result.output
+    (tmp_path / "Main.st").write_text(USER_MAIN)
+    fixed = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--channel", "q:2",
+                                         "--duration", "5s"], catch_exceptions=False)
+    assert fixed.exit_code == 0 and "never read" not in fixed.output

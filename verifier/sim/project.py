@@ -443,6 +443,13 @@ class Project:
                              f"(0 for X/Y000, 2 for X/Y020); got un={un!r}")
         self._instructions().c24(un).configure(channel, **settings)
 
+    def c24_unread(self) -> list[tuple[int, int, int, int]]:
+        """(start I/O, channel, messages, since µs) for the received messages that wait in
+        a QJ71C24N the program drives, not read by G_INPUT: a program that reads on the
+        wrong input signal leaves every reply there."""
+        return [(un, *waiting) for un, module in sorted(self._instructions()._c24.items())
+                if module.addressed for waiting in module.unread()]
+
     def c24_addressed(self) -> list[int]:
         """Start I/O numbers (U0 -> 0) of the QJ71C24N modules the program's G_OUTPUT /
         G_INPUT have addressed so far."""

@@ -392,17 +392,29 @@ def _apply_plc_settings(plc: _Plc, scenario: Scenario) -> None:
         plc.write(name, value)
 
 
+UNREAD_NOTE_US = 1_000_000  # a message unread this long at the end of the run is not being read
+
+
 def _c24_notes(scenario: Scenario, plc: _Plc) -> list[str]:
-    """A [[c24]] for a module the program never drove changed nothing: the robot hangs on
-    the module the program's G_OUTPUT / G_INPUT address (a slot the program does not use
-    has no robot on it), so its settings - the no-reception time a fault set may rely on -
-    were not in force. Said, with the module the program did use."""
-    if scenario.platform != "q" or not scenario.c24:
+    """Replies left in the program's QJ71C24N (the port reads on another input signal than
+    the module's read request: the run shows only repeated attempts), and a [[c24]] for a
+    module the program never drove, which changed nothing: the robot hangs on the module
+    the program's G_OUTPUT / G_INPUT address, so its settings - the no-reception time a
+    fault set may rely on - were not in force. Said, with the module the program did use."""
+    if scenario.platform != "q":
         return []
     used = plc.project.c24_addressed()
     if not used:
         return []
     notes = []
+    for un, channel, count, since_us in plc.project.c24_unread():
+        if plc.now_us - since_us < UNREAD_NOTE_US:
+            continue  # a reply that came in the last moments of the run
+        read, error = (0x3, 0x4) if channel == 1 else (0xA, 0xB)
+        notes.append(f"QJ71C24N U{un:X} CH{channel}: {count} received message(s) never read by G_INPUT, the "
+                     f"oldest since {since_us / 1e6:.3f} s; the module's reception data read request for "
+                     f"CH{channel} is X{un * 16 + read:X} (reception abnormal detection X{un * 16 + error:X}): "
+                     f"is that what the program passes to the port (i_bReadReq, i_bRecvErr)?")
     for setting in scenario.c24:
         if setting.unit is None or setting.unit in used:
             continue
