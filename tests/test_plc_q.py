@@ -235,3 +235,38 @@ def test_replies_left_in_the_module_are_noted_with_the_signal_to_read_on(tmp_pat
     fixed = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--channel", "q:2",
                                          "--duration", "5s"], catch_exceptions=False)
     assert fixed.exit_code == 0 and "never read" not in fixed.output
+
+
+TCP_MAIN = """PROGRAM TcpMain
+VAR
+    fbPort : UITAMR_PortE71;
+    fbEngine : UITAMR_Engine;
+    uMbx : ARRAY[0..15] OF WORD;
+    uPort : ARRAY[0..39] OF WORD;
+END_VAR
+fbPort(i_bEN := TRUE, i_sUnit := 'U2', i_wConnection := 3, i_udIpAddress := 16#C0A8010A,
+       i_uTcpPort := 502, i_uLocalPort := 5000,
+       i_uOpenSignal := U2\\G20480, i_uRecvSignal := U2\\G20485, io_uPort := uPort);
+fbEngine(i_bEN := NOT SM402, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);
+"""
+
+
+def test_an_e71_program_reading_another_modules_open_signal_is_told_which_words_to_pass(tmp_path):
+    """E71 at U2 but the open and reception signals still read from U0\\G20480 / U0\\G20485:
+    the module opened, the port never saw it open and closed it again, over and over, and
+    the report said only that nothing reached the robot. The note now says the program
+    closed every open connection unused and names the module's words to pass."""
+    from click.testing import CliRunner
+
+    from verifier.commands.verify import command
+
+    (tmp_path / "TcpMain.st").write_text(TCP_MAIN.replace("U2\\G2048", "U0\\G2048"))
+    sources = [PLC / "core", PLC / "q" / "UITAMR_PortE71.st", tmp_path / "TcpMain.st"]
+    result = CliRunner().invoke(command, [*map(str, sources), "--duration", "5s"], catch_exceptions=False)
+    assert result.exit_code == 1
+    assert ("the QJ71E71 at U2 opened the connection (10 open(s)) and the program closed it again each time "
+            "without sending") in result.output
+    assert "does the program pass U2\\G20480 (and U2\\G20485 as i_uRecvSignal)?" in result.output
+    (tmp_path / "TcpMain.st").write_text(TCP_MAIN)
+    fixed = CliRunner().invoke(command, [*map(str, sources), "--duration", "5s"], catch_exceptions=False)
+    assert fixed.exit_code == 0, fixed.output

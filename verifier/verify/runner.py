@@ -483,6 +483,15 @@ def _silence_note(scenario: Scenario, plc: _Plc, converter: Converter | None) ->
         elif converter.first_failed_open is not None and converter.accepted_count == 0:
             note += f": {converter.first_failed_open}; set the scenario's [converter] ip and port to what the program opens"
         note += ")"
+        from verifier.sim.instructions.tcp import FixedBufferPort
+
+        for port in rt.pollers:
+            if isinstance(port, FixedBufferPort) and port.closes_while_open and not port.sends:
+                # opened, then closed by the program itself, never used: it did not see it open
+                note += (f"; the {port.name} opened the connection ({port.open_count} open(s)) and the "
+                         f"program closed it again each time without sending: the port learns of the open "
+                         f"from i_uOpenSignal, the module's open completion signal - does the program pass "
+                         f"U{port.un:X}\\G20480 (and U{port.un:X}\\G20485 as i_uRecvSignal)?")
         if sent:
             note += f"; {sent}: a serial port, not the TCP route: drop [converter] from the scenario"
         return note
