@@ -270,3 +270,19 @@ def test_an_e71_program_reading_another_modules_open_signal_is_told_which_words_
     (tmp_path / "TcpMain.st").write_text(TCP_MAIN)
     fixed = CliRunner().invoke(command, [*map(str, sources), "--duration", "5s"], catch_exceptions=False)
     assert fixed.exit_code == 0, fixed.output
+
+
+def test_the_e71_split_reply_scan_limit_is_what_tcp_converter_md_says():
+    """tcp-converter.md: the E71 reads one segment per receive and receives every other
+    scan, so a two-segment reply needs four scans; at 125 ms that is the 500 ms reply
+    time-out. The bundled q-tcp-split passes at 120 ms and fails at 125 ms."""
+    from dataclasses import replace
+
+    from verifier.commands.verify import bundled_plc_dir
+    from verifier.verify.runner import run_scenario
+    from verifier.verify.scenario import load_scenario
+
+    split = load_scenario(bundled_plc_dir() / "scenarios" / "q-tcp-split.toml")
+    assert "`--scan 120ms` and fails at `--scan 125ms`" in (PLC.parent / "docs" / "tcp-converter.md").read_text()
+    assert run_scenario(replace(split, scan_us=120_000)).passed
+    assert not run_scenario(replace(split, scan_us=125_000)).passed
