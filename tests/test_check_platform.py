@@ -393,8 +393,9 @@ def test_verify_notes_an_fx3_special_number_in_the_program_it_runs(tmp_path):
                                        str(tmp_path / "r.json")])
     report = json.loads((tmp_path / "r.json").read_text())
     notes = [n for s in report["scenarios"] for n in s["notes"]]
+    line = text.splitlines().index("bEngineOn := NOT SM402;") + 1  # the example's own line, wherever it moves
     assert [n for n in notes if "M8002" in n] == [
-        f"{tmp_path / 'UITAMR_ExampleQ.st'}:59:18: M8002 is an ordinary internal relay on the q (the CPU never sets "
+        f"{tmp_path / 'UITAMR_ExampleQ.st'}:{line}:18: M8002 is an ordinary internal relay on the q (the CPU never sets "
         "it); the FX3's special relay M8002 (ON in the first scan) is SM402 on the q"], result.output
     assert "Fx3Beside" not in result.output
 
