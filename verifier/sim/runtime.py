@@ -12,7 +12,7 @@ from __future__ import annotations
 import random
 
 from .cpu import TIMER_RESOLUTIONS_MS, CpuProfile
-from .devices import DeviceMemory
+from .devices import BUFFER_WORDS, DeviceMemory
 from .errors import SimDiagnostic, SimulationError
 from .serial import SerialChannel
 
@@ -79,7 +79,7 @@ class Runtime:
         """Buffer memory of the intelligent module at start I/O `module` (U0\\G...)."""
         buf = self.buffers.get(module)
         if buf is None:
-            buf = self.buffers[module] = [0] * 0x6000  # up to 5FFFH (QJ71E71 status area)
+            buf = self.buffers[module] = [0] * BUFFER_WORDS  # up to 5FFFH (QJ71E71 status area)
         return buf
 
     def channel(self, name: str) -> SerialChannel:

@@ -19,6 +19,7 @@ from verifier.amr.schema import ConfigError
 from verifier.digits import digit_problem
 from verifier.textfile import UnreadableText, read_utf8, text_lines
 from verifier.tomlpos import Place, decode_error_position, place_of_key, shown
+from verifier.sim.devices import BUFFER_WORDS  # buffer-memory words modelled per module (0..5FFFH)
 
 from verifier.link.converter import ConverterConfig
 
@@ -61,9 +62,6 @@ DEFAULT_PLATFORM = "fx3u"  # of a scenario file that names none
 TCP_CHANNEL = "tcp"
 #: Buffer memory of an intelligent module, as GX Works writes it: U0\G164, U3E\G10.
 BUFFER_MEMORY = re.compile(r"^U([0-9A-F]{1,3})\\G([0-9]+)$", re.IGNORECASE)
-#: Buffer-memory words the simulator models per module (0..5FFFH). ASSUMPTION: enough for
-#: the QJ71C24N areas and the QJ71E71 status words (5000H, 5005H) the library uses.
-BUFFER_WORDS = 0x6000
 #: Device names (X0, M8000, D100, SM400, ...) address the device memory, not labels.
 DEVICE_NAME = re.compile(r"^(?:(?:X|Y|B|W|SB|SW)[0-9A-F]+|(?:M|L|F|S|T|C|D|R|ZR|SM|SD)[0-9]+)$", re.IGNORECASE)
 _LABEL_PATH = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\[[0-9]+\])*(\.[A-Za-z_][A-Za-z0-9_]*(\[[0-9]+\])*)*$")
