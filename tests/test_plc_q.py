@@ -286,3 +286,13 @@ def test_the_e71_split_reply_scan_limit_is_what_tcp_converter_md_says():
     assert "`--scan 120ms` and fails at `--scan 125ms`" in (PLC.parent / "docs" / "tcp-converter.md").read_text()
     assert run_scenario(replace(split, scan_us=120_000)).passed
     assert not run_scenario(replace(split, scan_us=125_000)).passed
+
+
+def test_the_q_example_says_where_automatic_io_assignment_puts_the_output_module():
+    """Slot 0 C24 (32 points) + slot 1 input + slot 2 output: by automatic assignment the
+    output module starts at Y40 only if the input module has 32 points; the guide said
+    'an input module at X20-X2F and an output module at Y40-Y4F', which automatic
+    assignment never gives. Both the guide and the example's header now say so."""
+    guide = (PLC.parent / "docs" / "import-gxworks2.md").read_text()
+    assert "it is at Y30" in guide and "q00cpu/manual?p=166" in guide
+    assert "else it is at Y30" in EXAMPLE_Q.read_text().split("PROGRAM UITAMR_ExampleQ", 1)[0]
