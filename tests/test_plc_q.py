@@ -5,6 +5,8 @@ so this test wires robot, line and simulator itself."""
 from __future__ import annotations
 
 import re
+
+import pytest
 from pathlib import Path
 
 import verifier
@@ -296,3 +298,21 @@ def test_the_q_example_says_where_automatic_io_assignment_puts_the_output_module
     guide = (PLC.parent / "docs" / "import-gxworks2.md").read_text()
     assert "it is at Y30" in guide and "q00cpu/manual?p=166" in guide
     assert "else it is at Y30" in EXAMPLE_Q.read_text().split("PROGRAM UITAMR_ExampleQ", 1)[0]
+
+
+@pytest.mark.parametrize("no_reception_ms, recovers", [(None, False), (5, True)])
+def test_one_stray_byte_breaks_the_link_for_good_without_timer_0(no_reception_ms, recovers):
+    """plc-library.md, Q notes: without the no-reception monitoring time one stray byte
+    after a reply shifts every later 8-byte message by one byte, for as long as the CPU
+    runs - the robot answering perfectly. With timer 0 (format 1) the stray byte ends as
+    a message of its own and the next exchanges are whole again - now that the port reads
+    while X3 is ON: reading on its rising edge only, the stray byte waited behind the
+    reply, X3 never went OFF, and nothing was read again (30 failed exchanges in 20 s)."""
+    fault = Fault(kind="garbage", on_request=3, count=1, data=b"\xA5", position="after")
+    project, line, robot = rig([fault], no_reception_ms=no_reception_ms)
+    prog = project.program("UITAMR_ExampleQ")
+    run(project, 3000)
+    errors_before = prog.fbEngine.o_wCommErrCount
+    run(project, 20000)
+    assert robot.requests > 40                                  # polled all along, answered all along
+    assert (prog.fbEngine.o_wCommErrCount == errors_before) == recovers
