@@ -94,6 +94,12 @@ def test_sm400_on_an_fx3u_is_an_error_at_its_place(tmp_path):
                                "M8000..M8511: use M8002 (ON in the first scan)"),
     ("fx3u", "b := SM8561;", 6, "device SM8561: the fx3u has no SM devices; its special relays are M8000..M8511"),
     ("q", "x := K4M8190;", 6, "K4M8190 runs past the end of M"),
+    # buffer memory: before, check passed these and verify stopped with an internal
+    # "simulator fault ... IndexError" at the statement
+    ("q", "x := U0\\G30000;", 6, "U0\\G30000: buffer memory word 30000 is past G24575 (5FFFH), the end of "
+                                   "what the simulator models per module (docs/instructions.md)"),
+    ("q", "x := U200\\G1;", 6, "U200\\G1: module U200 would start at I/O 2000, past the q's X/Y1FFF; Un is "
+                                "the start I/O number without its last digit (U2 for X/Y020)"),
 ])
 def test_device_out_of_range_or_unknown_to_the_cpu(tmp_path, platform, body, col, message):
     path = write(tmp_path, program(body))
@@ -393,8 +399,9 @@ def test_verify_notes_an_fx3_special_number_in_the_program_it_runs(tmp_path):
                                        str(tmp_path / "r.json")])
     report = json.loads((tmp_path / "r.json").read_text())
     notes = [n for s in report["scenarios"] for n in s["notes"]]
+    line = text.splitlines().index("bEngineOn := NOT SM402;") + 1  # the example's own line, wherever it moves
     assert [n for n in notes if "M8002" in n] == [
-        f"{tmp_path / 'UITAMR_ExampleQ.st'}:59:18: M8002 is an ordinary internal relay on the q (the CPU never sets "
+        f"{tmp_path / 'UITAMR_ExampleQ.st'}:{line}:18: M8002 is an ordinary internal relay on the q (the CPU never sets "
         "it); the FX3's special relay M8002 (ON in the first scan) is SM402 on the q"], result.output
     assert "Fx3Beside" not in result.output
 
@@ -448,3 +455,15 @@ def test_a_scenario_without_platform_is_judged_for_an_fx3g_with_its_ranges(tmp_p
     assert run("--platform", "fx3u", scenario).exit_code == 0  # the FX3U has X200
     named = write(tmp_path, 'platform = "fx3u"\n\n[initial]\nX200 = true\n', "named.toml")
     assert run("--platform", "fx3g", named).exit_code == 0  # the file's own platform decides
+
+
+def test_buffer_memory_past_the_model_is_a_load_error_at_its_place(tmp_path):
+    """`verify` (through the loader) stopped at U0\\G30000 with "simulator fault while
+    running this statement: IndexError(...)"; it is now the check's error at load."""
+    import verifier
+    from verifier.sim import LoadError
+
+    path = write(tmp_path, program("x := U0\\G30000;"))
+    with pytest.raises(LoadError) as err:
+        verifier.load(path, cpu="q")
+    assert str(err.value.diagnostics[0]).startswith(f"{path}:5:6: error: U0\\G30000: buffer memory word 30000")

@@ -97,3 +97,14 @@ def test_how_the_pieces_fit_names_every_port_fb():
     section = text.split("## How the pieces fit", 1)[1].split("### ", 1)[0]
     ports = sorted(p.stem for p in (ROOT / "plc").glob("*/UITAMR_Port*.st") if p.parent.name != "core")
     assert ports and [p for p in ports if p not in section] == []
+
+
+def test_the_wiring_checklist_catches_a_port_that_reads_its_own_frame():
+    """On two-wire RS-485 the FC06 request is byte for byte the robot's echo reply: a C24
+    that receives its own transmission (an UNCONFIRMED QJ71C24N behaviour the simulator
+    does not model) would see every command acknowledged with no robot. The checklist had
+    no step that would catch it; now a bench step with the robot unplugged does, and says
+    what is unconfirmed."""
+    wiring = (ROOT / "docs" / "wiring-rs485.md").read_text()
+    step = wiring.split("6. Once, with the pair unplugged at the robot", 1)[1]
+    assert "16#0101" in step and "**UNCONFIRMED**" in step and "echo" in step

@@ -5,6 +5,8 @@ so this test wires robot, line and simulator itself."""
 from __future__ import annotations
 
 import re
+
+import pytest
 from pathlib import Path
 
 import verifier
@@ -54,6 +56,30 @@ def test_exception_reply_is_reported_and_the_line_stays_aligned():
     assert len(done) >= 2 and not prog.fbCycle.o_bErr       # the cycle ran on after the acknowledge
 
 
+def test_a_reception_error_is_read_and_the_line_stays_aligned():
+    """Timer 0 in format 0 ends a short message with a reception error: the module turns on
+    the reception abnormal detection X4, not X3 (C24 (Application) 6.1), and the data up to
+    the error wait for G_INPUT (C24 (Basic) 6.1.5). The port read only on X3, so the error
+    message was never taken off the module and every reply after it waited behind it: the
+    link stayed dead. Now X4 starts a read too; the engine sees a transport error for that
+    attempt and the replies after it are read in step."""
+    fault = Fault(kind="exception", on_request=5, count=1, code=2)   # request 5 = run point 1
+    project, line, robot = rig([fault], no_reception_ms=5)
+    project.configure_c24(0, 1, no_reception_format=0)
+    prog = project.program("UITAMR_ExampleQ")
+    seen = set()
+
+    def watch(p):
+        seen.add((p.program("UITAMR_ExampleQ").fbPort.o_uErrId, p.devices["X4"]))
+    run(project, 12000, pulse(project, "X20", 1000), watch)
+    assert any(x4 for _, x4 in seen)                         # X4 came on ...
+    assert any(err == 0x0307 for err, _ in seen)             # ... and the read ended in error
+    assert prog.fbEngine.o_wRetryCount > 0                   # that attempt was repeated
+    assert prog.fbEngine.o_wCommErrCount == 1 and not project.devices["X3"]   # nothing after it misread
+    done = [e for e in robot.events if e.kind == "task" and e.message.endswith("done")]
+    assert len(done) >= 2 and not prog.fbCycle.o_bErr       # the cycle ran on
+
+
 def test_requests_keep_the_pacing_on_q():
     project, line, _ = rig([], no_reception_ms=5)
     run(project, 8000, pulse(project, "X20", 1000))
@@ -66,7 +92,7 @@ def test_requests_keep_the_pacing_on_q():
 EXAMPLE_Q = PLC / "examples" / "q" / "UITAMR_ExampleQ.st"
 MOVE_TO_X020 = [   # the places the example's header and import-gxworks2.md §5 list
     ("C24_UNIT : WORD := 16#0;", "C24_UNIT : WORD := 16#2;"),
-    ("i_bReadReq := X3,", "i_bReadReq := X23,"),
+    ("i_bReadReq := X3,", "i_bReadReq := X23,"), ("i_bRecvErr := X4,", "i_bRecvErr := X24,"),
     ("U0\\G150", "U2\\G150"), ("U0\\G164", "U2\\G164"), ("U0\\G165", "U2\\G165"),
 ]
 
@@ -99,15 +125,194 @@ def test_the_example_lists_every_place_that_names_the_module():
     body = text.split("PROGRAM UITAMR_ExampleQ", 1)[1]
     assert set(re.findall(r"U[0-9A-F]+\\G\d+", body)) == {"U0\\G150", "U0\\G164", "U0\\G165"}
     header = text.split("PROGRAM UITAMR_ExampleQ", 1)[0]
-    for place in ("C24_UNIT", "i_bReadReq", "U0\\G", "C24_CHANNEL", "G310 / G324 / G325"):
+    for place in ("C24_UNIT", "i_bReadReq", "i_bRecvErr", "U0\\G", "C24_CHANNEL", "G310 / G324 / G325"):
         assert place in header
     guide = (PLC.parent / "docs" / "import-gxworks2.md").read_text()
-    for place in ("`C24_UNIT`", "X(start + 3)", "`U0\\G150`", "`G310`", "`C24_CHANNEL`"):
+    for place in ("`C24_UNIT`", "X(start + 3)", "X(start + 4)", "`U0\\G150`", "`G310`", "`C24_CHANNEL`"):
         assert place in guide
 
 
 def test_forgetting_the_buffer_memory_writes_breaks_the_link():
     """Why the U\\G writes are on the list: with them left at U0 the module at X/Y020 keeps
     word units and an end code, and the stop is never seen as answered."""
-    prog, _ = run_at_x020(moved_example(MOVE_TO_X020[:2]))
+    prog, _ = run_at_x020(moved_example(MOVE_TO_X020[:3]))
     assert not prog.fbEngine.o_bInitDone
+
+
+# ------------------------------------------------------- a program of one's own in another slot
+USER_MAIN = """PROGRAM Main
+VAR
+    fbPort : UITAMR_PortQC24;
+    fbEngine : UITAMR_Engine;
+    uMbx : ARRAY[0..15] OF WORD;
+    uPort : ARRAY[0..39] OF WORD;
+END_VAR
+IF SM402 THEN
+    U2\\G310 := 1;
+    U2\\G324 := 8;
+    U2\\G325 := 16#FFFF;
+END_IF;
+fbPort(i_bEN := TRUE, i_uUnit := 16#2, i_wChannel := 2, i_bReadReq := X2A, io_uPort := uPort);
+fbEngine(i_bEN := NOT SM402, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);
+"""
+LIBRARY = [PLC / "core", PLC / "q" / "UITAMR_PortQC24.st"]
+
+
+def test_matrix_runs_a_program_whose_c24_sits_in_another_slot_on_ch2(tmp_path):
+    """The bundled q-exception.toml sets timer 0 for the example's module (U0, CH1). Under
+    --matrix those settings once made a module at U0 that took the robot's replies off the
+    line, so a program driving its C24 at U2 on CH2 never saw an answer and failed
+    (UITAMR-CYCLE: stop after stop). The settings now go to the module the program drives."""
+    import json
+
+    from click.testing import CliRunner
+
+    from verifier.commands.verify import command
+
+    (tmp_path / "Main.st").write_text(USER_MAIN)
+    report = tmp_path / "m.json"
+    result = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--matrix",
+                                          "--channel", "q:2", "--duration", "8s", "--json", str(report)],
+                                catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    runs = {s["name"]: s for s in json.loads(report.read_text())["scenarios"]}
+    exception = next(s for name, s in runs.items() if "exception" in name)
+    assert exception["verdict"] == "pass" and not exception["violations"]
+    assert any("C24 settings (on the module your program drives)" in n for n in exception["notes"])
+
+
+def test_c24_settings_for_the_module_the_program_drives():
+    """configure_c24(None, ...) sets timer 0 on whichever module the program addresses: the
+    5-byte exception to a status read at U2/CH2 is reported as such, and the replies after
+    it stay aligned."""
+    fault = Fault(kind="exception", at_s=2.0, count=1, code=3, requests="status")
+    robot = Robot(Settings(), RobotConfig(), [fault])
+    line = Line(robot)
+    project = verifier.load(*LIBRARY, sources={"Main.st": USER_MAIN}, cpu="q")
+    project.attach_serial("q:2", line)
+    project.configure_c24(None, 2, no_reception_ms=5)
+    errors = set()
+    project.run_programs(["Main"], ms=6000,
+                         on_scan=lambda p: errors.add(p.program("Main").fbEngine.o_uErrId))
+    assert project.c24_addressed() == [2]
+    assert 0x0103 in errors
+    assert project.program("Main").fbEngine.o_wCommErrCount == 0
+
+
+def test_a_c24_setting_for_a_slot_the_program_does_not_drive_is_noted(tmp_path):
+    """A [[c24]] for U0 while the program drives its module at U2: before, the setting
+    made a phantom module that swallowed the replies (the run failed with no hint why);
+    now the run goes on, and a note at the [[c24]]'s line says the settings were not in
+    force and which unit to give."""
+    from click.testing import CliRunner
+
+    from verifier.commands.verify import command
+
+    (tmp_path / "Main.st").write_text(USER_MAIN)
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('program = "Main"\nplatform = "q"\nchannel = "q:2"\nduration = "3s"\n\n'
+                        '[[c24]]\nunit = 0\nchannel = 2\nno_reception = "5ms"\n')
+    result = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--scenario", str(scenario)],
+                                catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    assert f"{scenario}:6:1: c24[0]: unit = 0 (U0) is not the QJ71C24N the program drives" in result.output
+    assert "give unit = 2" in result.output
+
+
+def test_replies_left_in_the_module_are_noted_with_the_signal_to_read_on(tmp_path):
+    """Moving the C24 to U2/CH2 but leaving i_bReadReq at X3: every reply stayed in the
+    module and the report only said UITAMR-CYCLE (stop after stop), far from the cause.
+    Now a note names the unread messages and the module's own read request, X2A."""
+    from click.testing import CliRunner
+
+    from verifier.commands.verify import command
+
+    (tmp_path / "Main.st").write_text(USER_MAIN.replace("i_bReadReq := X2A", "i_bReadReq := X3"))
+    result = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--channel", "q:2",
+                                          "--duration", "5s"], catch_exceptions=False)
+    assert result.exit_code == 1
+    assert ("note: QJ71C24N U2 CH2: 5 received message(s) never read by G_INPUT, the oldest since 0.252 s; "
+            "the module's reception data read request for CH2 is X2A (reception abnormal detection X2B)") in result.output
+    (tmp_path / "Main.st").write_text(USER_MAIN)
+    fixed = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--channel", "q:2",
+                                         "--duration", "5s"], catch_exceptions=False)
+    assert fixed.exit_code == 0 and "never read" not in fixed.output
+
+
+TCP_MAIN = """PROGRAM TcpMain
+VAR
+    fbPort : UITAMR_PortE71;
+    fbEngine : UITAMR_Engine;
+    uMbx : ARRAY[0..15] OF WORD;
+    uPort : ARRAY[0..39] OF WORD;
+END_VAR
+fbPort(i_bEN := TRUE, i_sUnit := 'U2', i_wConnection := 3, i_udIpAddress := 16#C0A8010A,
+       i_uTcpPort := 502, i_uLocalPort := 5000,
+       i_uOpenSignal := U2\\G20480, i_uRecvSignal := U2\\G20485, io_uPort := uPort);
+fbEngine(i_bEN := NOT SM402, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);
+"""
+
+
+def test_an_e71_program_reading_another_modules_open_signal_is_told_which_words_to_pass(tmp_path):
+    """E71 at U2 but the open and reception signals still read from U0\\G20480 / U0\\G20485:
+    the module opened, the port never saw it open and closed it again, over and over, and
+    the report said only that nothing reached the robot. The note now says the program
+    closed every open connection unused and names the module's words to pass."""
+    from click.testing import CliRunner
+
+    from verifier.commands.verify import command
+
+    (tmp_path / "TcpMain.st").write_text(TCP_MAIN.replace("U2\\G2048", "U0\\G2048"))
+    sources = [PLC / "core", PLC / "q" / "UITAMR_PortE71.st", tmp_path / "TcpMain.st"]
+    result = CliRunner().invoke(command, [*map(str, sources), "--duration", "5s"], catch_exceptions=False)
+    assert result.exit_code == 1
+    assert ("the QJ71E71 at U2 opened the connection (10 open(s)) and the program closed it again each time "
+            "without sending") in result.output
+    assert "does the program pass U2\\G20480 (and U2\\G20485 as i_uRecvSignal)?" in result.output
+    (tmp_path / "TcpMain.st").write_text(TCP_MAIN)
+    fixed = CliRunner().invoke(command, [*map(str, sources), "--duration", "5s"], catch_exceptions=False)
+    assert fixed.exit_code == 0, fixed.output
+
+
+def test_the_e71_split_reply_scan_limit_is_what_tcp_converter_md_says():
+    """tcp-converter.md: the E71 reads one segment per receive and receives every other
+    scan, so a two-segment reply needs four scans; at 125 ms that is the 500 ms reply
+    time-out. The bundled q-tcp-split passes at 120 ms and fails at 125 ms."""
+    from dataclasses import replace
+
+    from verifier.commands.verify import bundled_plc_dir
+    from verifier.verify.runner import run_scenario
+    from verifier.verify.scenario import load_scenario
+
+    split = load_scenario(bundled_plc_dir() / "scenarios" / "q-tcp-split.toml")
+    assert "`--scan 120ms` and fails at `--scan 125ms`" in (PLC.parent / "docs" / "tcp-converter.md").read_text()
+    assert run_scenario(replace(split, scan_us=120_000)).passed
+    assert not run_scenario(replace(split, scan_us=125_000)).passed
+
+
+def test_the_q_example_says_where_automatic_io_assignment_puts_the_output_module():
+    """Slot 0 C24 (32 points) + slot 1 input + slot 2 output: by automatic assignment the
+    output module starts at Y40 only if the input module has 32 points; the guide said
+    'an input module at X20-X2F and an output module at Y40-Y4F', which automatic
+    assignment never gives. Both the guide and the example's header now say so."""
+    guide = (PLC.parent / "docs" / "import-gxworks2.md").read_text()
+    assert "it is at Y30" in guide and "q00cpu/manual?p=166" in guide
+    assert "else it is at Y30" in EXAMPLE_Q.read_text().split("PROGRAM UITAMR_ExampleQ", 1)[0]
+
+
+@pytest.mark.parametrize("no_reception_ms, recovers", [(None, False), (5, True)])
+def test_one_stray_byte_breaks_the_link_for_good_without_timer_0(no_reception_ms, recovers):
+    """plc-library.md, Q notes: without the no-reception monitoring time one stray byte
+    after a reply shifts every later 8-byte message by one byte, for as long as the CPU
+    runs - the robot answering perfectly. With timer 0 (format 1) the stray byte ends as
+    a message of its own and the next exchanges are whole again - now that the port reads
+    while X3 is ON: reading on its rising edge only, the stray byte waited behind the
+    reply, X3 never went OFF, and nothing was read again (30 failed exchanges in 20 s)."""
+    fault = Fault(kind="garbage", on_request=3, count=1, data=b"\xA5", position="after")
+    project, line, robot = rig([fault], no_reception_ms=no_reception_ms)
+    prog = project.program("UITAMR_ExampleQ")
+    run(project, 3000)
+    errors_before = prog.fbEngine.o_wCommErrCount
+    run(project, 20000)
+    assert robot.requests > 40                                  # polled all along, answered all along
+    assert (prog.fbEngine.o_wCommErrCount == errors_before) == recovers

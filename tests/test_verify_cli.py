@@ -751,3 +751,23 @@ def test_the_converter_drop_a_scenario_scripts_is_marked_as_its_fault_on_the_pag
     marks = re.findall(r'class="ovfault" x="([\d.]+)"', pages["fx5u-tcp-dropped"])
     assert len(marks) == 1
     assert re.findall(r'class="ovfault" x="', pages["fx5u-tcp-healthy"]) == []
+
+
+def test_a_fault_that_met_no_request_is_noted_at_its_line(tmp_path):
+    """A scenario's fault whose window saw no request of its kind (here control commands
+    while only status reads went out) or whose request number never came tested nothing,
+    yet the run passed without a word: now each such fault is a note at its line."""
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('program = "UITAMR_ExampleFx3"\nduration = "5s"\n\n'
+                        '[[faults]]\nkind = "bad_crc"\nat_s = 2.0\nduration_s = 1.0\nrequests = "control"\n\n'
+                        '[[faults]]\nkind = "exception"\non_request = 500\n\n'
+                        '[[faults]]\nkind = "no_reply"\nat_s = 3.0\n', encoding="utf-8")
+    report = tmp_path / "r.json"
+    result = invoke(*FX3_SOURCES, "--scenario", scenario, "--json", report)
+    assert result.exit_code == 0, result.output
+    assert (f"{scenario}:4:1: faults[0]: bad_crc at 2 s for 1 s, control requests only: no control request "
+            "reached the robot from 2 s for 1 s, so this fault was not tested") in result.output
+    assert f"{scenario}:10:1: faults[1]: exception (code 04) on request 500: request 500 never reached" in result.output
+    assert "faults[2]" not in result.output                  # the no_reply at 3 s met a status read
+    notes = json.loads(report.read_text())["scenarios"][0]["notes"]
+    assert sum("was not tested" in note for note in notes) == 2

@@ -27,8 +27,8 @@ def test_the_plc_settings_example_is_a_valid_scenario():
     scenario = parse_scenario('platform = "q"\n' + block)
     assert dict(scenario.initial) == {"D100": 3, "U0\\G164": 8}
     (c24,) = scenario.c24
-    assert (c24.unit, c24.channel, c24.no_reception_us, c24.byte_units, c24.receive_count, c24.end_code) == \
-        (0, 1, 5000, True, 8, 0xFFFF)
+    assert (c24.unit, c24.channel, c24.no_reception_us, c24.byte_units, c24.receive_count, c24.end_code,
+            c24.no_reception_format) == (0, 1, 5000, True, 8, 0xFFFF, 1)
 
 
 def _section(number: int) -> str:

@@ -295,6 +295,7 @@ def test_initial_devices_and_buffer_memory_are_there_at_the_first_scan(tmp_path)
     ('[[c24]]\nchannel = 3\n', "c24[0].channel", "1..2"),
     ('[[c24]]\nno_reception = 5\n', "c24[0].no_reception", "expected a duration"),
     ('[[c24]]\nbaud = 9600\n', "c24[0].baud", "unknown key"),
+    ('[[c24]]\nno_reception_format = 2\n', "c24[0].no_reception_format", "0..1"),
     ('[[c24]]\nchannel = 1\n[[c24]]\nunit = 0\n', "c24[1]", "U0 channel 1 is already set in c24[0]"),
 ])
 def test_plc_settings_mistakes_name_their_key(tmp_path, body, key, words):
@@ -331,12 +332,16 @@ def test_the_bundled_q_exception_scenario_needs_the_no_reception_time():
 
 
 def test_a_bundled_scenario_aimed_at_user_sources_keeps_robot_faults_and_c24_only(program):
+    from dataclasses import replace
+
     from verifier.commands.verify import bundled_plc_dir
     from verifier.verify.matrix import for_user_sources
 
     bundled = load_scenario(bundled_plc_dir() / "scenarios" / "q-exception.toml")
     mine = for_user_sources(bundled, (program,), None, None)
-    assert (mine.robot, mine.faults, mine.c24, mine.settings) == (bundled.robot, bundled.faults, bundled.c24, bundled.settings)
+    assert (mine.robot, mine.faults, mine.settings) == (bundled.robot, bundled.faults, bundled.settings)
+    # the C24 settings are the installation's: made for the module the program drives
+    assert mine.c24 == tuple(replace(c24, unit=None) for c24 in bundled.c24)
     assert (mine.sources, mine.program, mine.inputs, mine.watch) == ((program,), None, (), ())
     assert [e.label for e in mine.expectations] == ["sent stop within 5 s"]
     assert str(mine.options.response_signal) == "o_bErr" and not mine.response_signal_given

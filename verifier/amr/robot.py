@@ -204,6 +204,12 @@ class Robot:
             "requests": self.requests,
         }
 
+    def reply_faults_missed(self) -> list[tuple[int, Fault]]:
+        """The reply faults (index in the fault list, fault) that no request met: their
+        window passed, or their request never came, with nothing to disturb. A run that
+        lists one here did not test that fault at all."""
+        return [(state.index, state.fault) for state in self._reply_faults if state.hits == 0]
+
     # ---- time ----------------------------------------------------------------------------
 
     def advance(self, t_us: int) -> None:

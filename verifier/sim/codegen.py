@@ -16,7 +16,7 @@ from verifier.st import ast
 from . import datatypes
 from .calls import CallCompiler
 from .cpu import SEND_FLAGS
-from .devices import DeviceError, locate
+from .devices import DeviceError, locate, locate_buffer
 from .typesys import (ANYINT, ANYREAL, ArrayT, CompileError, FbT, PouInfo, StringT, StructT,
                       Symbol, concrete, is_int, is_real, is_string, norm_code, unify)
 
@@ -323,8 +323,11 @@ class BodyCompiler(CallCompiler):
         cpu = self.m.cpu
         label = d.text or d.key
         if d.module is not None:
-            g = self.m.buffer_global(int(d.module, 16))
-            idx = d.number
+            try:
+                module, idx = locate_buffer(d, cpu)
+            except DeviceError as e:
+                raise CompileError(d.span, str(e)) from None
+            g = self.m.buffer_global(module)
             return LValue("INT", f"{g}[{idx}]", f"{g}[{idx}] = {{v}}", label=label)
         try:
             area, index = locate(d, cpu)

@@ -12,7 +12,7 @@ from __future__ import annotations
 from verifier.st import ast
 
 from .cpu import CpuProfile
-from .devices import DeviceError, fx3_special_elsewhere, locate
+from .devices import DeviceError, fx3_special_elsewhere, locate, locate_buffer
 from .instructions import not_on_cpu
 
 
@@ -30,7 +30,12 @@ def cpu_diagnostics(files: list[ast.SourceFile], cpu: CpuProfile, superseded: li
         mine: list[ast.Diagnostic] = []
         chosen = f.pous if pous is None else [pou for pou in f.pous if pou.key in pous]
         for node in ast.walk(f.globals, f.types, chosen):
-            if isinstance(node, ast.Device) and node.module is None:
+            if isinstance(node, ast.Device) and node.module is not None:
+                try:
+                    locate_buffer(node, cpu)
+                except DeviceError as e:
+                    mine.append(_at(node.span, str(e)))
+            elif isinstance(node, ast.Device):
                 try:
                     locate(node, cpu)
                 except DeviceError as e:

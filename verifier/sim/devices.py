@@ -79,6 +79,30 @@ def device_warning(name: str, cpu: CpuProfile) -> str | None:
                                                  text=name.strip(), key=name.strip().upper()), cpu)
 
 
+#: Buffer-memory words the simulator models per module (0..5FFFH). ASSUMPTION: enough for
+#: the QJ71C24N areas and the QJ71E71 status words (5000H, 5005H) the library uses.
+BUFFER_WORDS = 0x6000
+
+
+def locate_buffer(d, cpu: CpuProfile) -> tuple[int, int]:
+    """(module, word) of buffer memory written in ST (`U2\\G164`: module 2, word 164) on
+    `cpu`, or DeviceError: a module number past the CPU's I/O range, or a word past what
+    the simulator models per module (G0..G24575). Asked by the compiler and by `uitamr
+    check --platform`, as `locate` is for devices."""
+    label = d.text or d.key
+    module = int(d.module, 16)
+    xs = cpu.areas.get("X")
+    if xs is not None and module * 16 >= xs.size:
+        raise DeviceError(f"{label}: module U{d.module} would start at I/O {module * 16:X}, past the "
+                          f"{cpu.name}'s X/Y{xs.size - 1:X}; Un is the start I/O number without its last "
+                          f"digit (U2 for X/Y020)")
+    if d.number >= BUFFER_WORDS:
+        raise DeviceError(f"{label}: buffer memory word {d.number} is past G{BUFFER_WORDS - 1} "
+                          f"({BUFFER_WORDS - 1:X}H), the end of what the simulator models per module "
+                          f"(docs/instructions.md)")
+    return module, d.number
+
+
 def locate(d, cpu: CpuProfile) -> tuple[Area, int]:
     """(area, number) of a device written in ST (`verifier.st.ast.Device`, not buffer
     memory) on `cpu`, or DeviceError saying why the simulator cannot run it there: an area

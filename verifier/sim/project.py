@@ -417,12 +417,17 @@ class Project:
         for channel in self.rt.ports.values():
             channel.keep_sent = keep
 
-    def configure_c24(self, un: int = 0, channel: int = 1, *, byte_units: bool | None = None,
+    def configure_c24(self, un: int | None = 0, channel: int = 1, *, byte_units: bool | None = None,
                       receive_count: int | None = None, end_code: int | None = None,
-                      no_reception_ms: float | None = None) -> None:
+                      no_reception_ms: float | None = None, no_reception_format: int | None = None) -> None:
         """QJ71C24N settings normally made in GX Works (switch settings / buffer memory):
-        word or byte units, received data count, receive end code (0xFFFF = none) and the
-        no-reception monitoring time that ends a message on a silent line."""
+        word or byte units, received data count, receive end code (0xFFFF = none), the
+        no-reception monitoring time that ends a message on a silent line and its format
+        (1: the message is read normally, X3/XA - the default here; 0: a reception error,
+        X4/XB). `un=None` makes
+        them for the module the program drives, wherever it is: the first one its
+        G_OUTPUT / G_INPUT address. Only a module the program addresses is on the robot's
+        line; settings for another one change nothing (`c24_addressed` tells which are)."""
         from .instructions.c24 import BUFFER
 
         if self.cpu.family != "q":
@@ -430,21 +435,35 @@ class Project:
                              f"configure_c24 needs a Q CPU (verifier.load(..., cpu='q'))")
         if type(channel) is not int or channel not in BUFFER:
             raise ValueError(f"the QJ71C24N has channels {' and '.join(map(str, BUFFER))}; got channel={channel!r}")
+        if no_reception_format is not None and (type(no_reception_format) is not int
+                                                or no_reception_format not in (0, 1)):
+            raise ValueError(f"no_reception_format is 0 or 1 (timer 0's format 0 or format 1); "
+                             f"got {no_reception_format!r}")
+        settings = dict(byte_units=byte_units, receive_count=receive_count, end_code=end_code,
+                        no_reception_ms=no_reception_ms, no_reception_format=no_reception_format)
+        if un is None:
+            self.rt.c24_for_program[channel] = settings
+            for module in self._instructions()._c24.values():
+                if module.addressed:
+                    module.configure(channel, **settings)
+            return
         last_un = self.cpu.areas["X"].size // 16 - 1  # the start I/O's upper digits: U0 = X/Y000
         if type(un) is not int or not 0 <= un <= last_un:
             raise ValueError(f"un is the module's start I/O number without its last digit, 0..{last_un:X}H "
                              f"(0 for X/Y000, 2 for X/Y020); got un={un!r}")
-        module = self._instructions().c24(un)
-        addr = BUFFER[channel]
-        buf = module.buffer
-        if byte_units is not None:
-            buf[addr["unit"]] = 1 if byte_units else 0
-        if receive_count is not None:
-            buf[addr["recv_count"]] = receive_count
-        if end_code is not None:
-            buf[addr["end_code"]] = ((end_code & 0xFFFF) + 0x8000 & 0xFFFF) - 0x8000
-        if no_reception_ms is not None:
-            module.channels[channel].no_reception_us = round(no_reception_ms * 1000)
+        self._instructions().c24(un).configure(channel, **settings)
+
+    def c24_unread(self) -> list[tuple[int, int, int, int]]:
+        """(start I/O, channel, messages, since µs) for the received messages that wait in
+        a QJ71C24N the program drives, not read by G_INPUT: a program that reads on the
+        wrong input signal leaves every reply there."""
+        return [(un, *waiting) for un, module in sorted(self._instructions()._c24.items())
+                if module.addressed for waiting in module.unread()]
+
+    def c24_addressed(self) -> list[int]:
+        """Start I/O numbers (U0 -> 0) of the QJ71C24N modules the program's G_OUTPUT /
+        G_INPUT have addressed so far."""
+        return sorted(un for un, module in self._instructions()._c24.items() if module.addressed)
 
     def _instructions(self):
         return self.module.namespace["_I"]

@@ -12,7 +12,7 @@ from __future__ import annotations
 import random
 
 from .cpu import TIMER_RESOLUTIONS_MS, CpuProfile
-from .devices import DeviceMemory
+from .devices import BUFFER_WORDS, DeviceMemory
 from .errors import SimDiagnostic, SimulationError
 from .serial import SerialChannel
 
@@ -50,6 +50,9 @@ class Runtime:
         self.ports: dict[str, SerialChannel] = {}  # channel name ("fx3:1") -> byte stream
         self.keep_sent = True  # the channels log what they send (Project.keep_serial_log)
         self.buffers: dict[int, list[int]] = {}  # module start I/O -> buffer memory words
+        # QJ71C24N channel -> settings for whichever module the program's G_OUTPUT/G_INPUT
+        # address first (Project.configure_c24 with un=None)
+        self.c24_for_program: dict[int, dict] = {}
         self.origins: dict[str, str] = {}  # channel -> location of the last send-request flag write
         self.tcp_endpoint = None  # the Ethernet port's peer (verifier.link.converter.Converter)
         self.stop_on_operation_error = (cpu.stops_on_op_error if stop_on_operation_error is None
@@ -76,7 +79,7 @@ class Runtime:
         """Buffer memory of the intelligent module at start I/O `module` (U0\\G...)."""
         buf = self.buffers.get(module)
         if buf is None:
-            buf = self.buffers[module] = [0] * 0x6000  # up to 5FFFH (QJ71E71 status area)
+            buf = self.buffers[module] = [0] * BUFFER_WORDS  # up to 5FFFH (QJ71E71 status area)
         return buf
 
     def channel(self, name: str) -> SerialChannel:

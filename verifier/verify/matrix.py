@@ -9,7 +9,8 @@ the line and the serial module: the platform, the converter of the TCP route (on
 programs that use it: `platform.uses_tcp_route`; listening at whatever address the program
 opens, as the example's converter address is the example's), the robot, the faults and their timing, the
 protocol settings, the run and scan times, the QJ71C24N settings ([[c24]], which every
-installation must make in GX Works — docs/import-gxworks2.md) and every rule. It expects what every program must do — send the
+installation must make in GX Works — docs/import-gxworks2.md; made for the module the user's
+program drives and the channel of the run, not for the example's slot and channel) and every rule. It expects what every program must do — send the
 power-on stop and have it answered within 5 s — and UITAMR-RESPONSE-HANDLING watches
 `o_bErr` when the program has it. Each result says what was left out.
 """
@@ -42,9 +43,14 @@ def for_user_sources(scenario: Scenario, sources: tuple[Path, ...], program: str
         # listens wherever the user's program opens
         left_out.append(f"its converter address ({converter.ip}:{converter.port})")
         converter = replace(converter, any_address=True)
+    # the example's C24 sits at U0 and uses CH1; the user's may sit anywhere and use CH2:
+    # the settings are the installation's, so they follow the module the program drives
+    run_channel = int(channel.split(":")[1]) if channel and channel.startswith("q:") else None
+    c24 = tuple(replace(setting, unit=None, channel=run_channel or setting.channel) for setting in scenario.c24)
     example = scenario.program or "the bundled example"
     note = (
-        f"bundled scenario run against your sources: robot, faults, timing{', C24 settings' if scenario.c24 else ''} "
+        f"bundled scenario run against your sources: robot, faults, timing"
+        f"{', C24 settings (on the module your program drives)' if scenario.c24 else ''} "
         f"and every rule applied, "
         f"plus the answered power-on stop; not applied, being written for {example}: "
         f"{', '.join(left_out) or 'nothing'}"
@@ -60,6 +66,7 @@ def for_user_sources(scenario: Scenario, sources: tuple[Path, ...], program: str
         expectations=(scenario_power_on_stop(scenario),),
         watch=(),
         initial=(),
+        c24=c24,
         options=replace(scenario.options, response_signal=parse_condition(DEFAULT_RESPONSE_SIGNAL)),
         response_signal_given=False,
         key_lines={},

@@ -368,11 +368,13 @@ def _apply_plc_settings(plc: _Plc, scenario: Scenario) -> None:
         where = scenario.where(setting.key, scenario.key_lines.get(setting.key))
         if scenario.platform != "q":
             raise UnusableInput(f"{where}: the QJ71C24N is a Q-series module; the platform is {scenario.platform}")
+        # unit None (--matrix): the settings go to whichever module the program drives
         try:
             plc.project.configure_c24(
                 setting.unit, setting.channel, byte_units=setting.byte_units, receive_count=setting.receive_count,
                 end_code=setting.end_code,
                 no_reception_ms=None if setting.no_reception_us is None else setting.no_reception_us / 1000,
+                no_reception_format=setting.no_reception_format,
             )
         except (ValueError, KeyError) as exc:
             raise UnusableInput(f"{where}: {exc}") from None
@@ -388,6 +390,56 @@ def _apply_plc_settings(plc: _Plc, scenario: Scenario) -> None:
         if problem:
             raise UnusableInput(f"{where}: {problem}")
         plc.write(name, value)
+
+
+UNREAD_NOTE_US = 1_000_000  # a message unread this long at the end of the run is not being read
+
+
+def _c24_notes(scenario: Scenario, plc: _Plc) -> list[str]:
+    """Replies left in the program's QJ71C24N (the port reads on another input signal than
+    the module's read request: the run shows only repeated attempts), and a [[c24]] for a
+    module the program never drove, which changed nothing: the robot hangs on the module
+    the program's G_OUTPUT / G_INPUT address, so its settings - the no-reception time a
+    fault set may rely on - were not in force. Said, with the module the program did use."""
+    if scenario.platform != "q":
+        return []
+    used = plc.project.c24_addressed()
+    if not used:
+        return []
+    notes = []
+    for un, channel, count, since_us in plc.project.c24_unread():
+        if plc.now_us - since_us < UNREAD_NOTE_US:
+            continue  # a reply that came in the last moments of the run
+        read, error = (0x3, 0x4) if channel == 1 else (0xA, 0xB)
+        notes.append(f"QJ71C24N U{un:X} CH{channel}: {count} received message(s) never read by G_INPUT, the "
+                     f"oldest since {since_us / 1e6:.3f} s; the module's reception data read request for "
+                     f"CH{channel} is X{un * 16 + read:X} (reception abnormal detection X{un * 16 + error:X}): "
+                     f"is that what the program passes to the port (i_bReadReq, i_bRecvErr)?")
+    for setting in scenario.c24:
+        if setting.unit is None or setting.unit in used:
+            continue
+        where = scenario.where(setting.key, scenario.key_lines.get(setting.key))
+        notes.append(f"{where}: unit = {setting.unit} (U{setting.unit:X}) is not the QJ71C24N the program drives "
+                     f"(its G_OUTPUT/G_INPUT address {', '.join(f'U{u:X}' for u in used)}); these settings "
+                     f"were not in force: give unit = {used[0]}")
+    return notes
+
+
+def _missed_fault_notes(scenario: Scenario, robot) -> list[str]:
+    """A reply fault that met no request (a window in which the program sent nothing, a
+    request number never reached, `requests = "control"` while only status reads went
+    out) tested nothing, though the run may pass: said, at the fault's line."""
+    notes = []
+    for index, fault in robot.reply_faults_missed():
+        key = f"faults[{index}]"
+        where = scenario.where(key, scenario.key_lines.get(key))
+        if fault.at_s is not None:
+            window = f"from {fault.at_s:g} s" + (f" for {fault.duration_s:g} s" if fault.duration_s else "")
+            why = f"no {fault.requests + ' ' if fault.requests != 'any' else ''}request reached the robot {window}"
+        else:
+            why = f"request {fault.on_request} never reached the robot"
+        notes.append(f"{where}: {fault.describe()}: {why}, so this fault was not tested")
+    return notes
 
 
 def _input_schedule(scenario: Scenario) -> list[tuple[int, dict[str, Any]]]:
@@ -431,6 +483,15 @@ def _silence_note(scenario: Scenario, plc: _Plc, converter: Converter | None) ->
         elif converter.first_failed_open is not None and converter.accepted_count == 0:
             note += f": {converter.first_failed_open}; set the scenario's [converter] ip and port to what the program opens"
         note += ")"
+        from verifier.sim.instructions.tcp import FixedBufferPort
+
+        for port in rt.pollers:
+            if isinstance(port, FixedBufferPort) and port.closes_while_open and not port.sends:
+                # opened, then closed by the program itself, never used: it did not see it open
+                note += (f"; the {port.name} opened the connection ({port.open_count} open(s)) and the "
+                         f"program closed it again each time without sending: the port learns of the open "
+                         f"from i_uOpenSignal, the module's open completion signal - does the program pass "
+                         f"U{port.un:X}\\G20480 (and U{port.un:X}\\G20485 as i_uRecvSignal)?")
         if sent:
             note += f"; {sent}: a serial port, not the TCP route: drop [converter] from the scenario"
         return note
@@ -587,5 +648,6 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         aborted=aborted,
         ended_us=end,
         wall_s=time.perf_counter() - wall_start,
-        notes=list(scenario.notes) + plc.cpu_notes() + ([] if tx_count else [_silence_note(scenario, plc, converter)]),
+        notes=list(scenario.notes) + plc.cpu_notes() + _c24_notes(scenario, plc) + _missed_fault_notes(scenario, robot)
+        + ([] if tx_count else [_silence_note(scenario, plc, converter)]),
     )

@@ -19,6 +19,7 @@ from verifier.amr.schema import ConfigError
 from verifier.digits import digit_problem
 from verifier.textfile import UnreadableText, read_utf8, text_lines
 from verifier.tomlpos import Place, decode_error_position, place_of_key, shown
+from verifier.sim.devices import BUFFER_WORDS  # buffer-memory words modelled per module (0..5FFFH)
 
 from verifier.link.converter import ConverterConfig
 
@@ -52,7 +53,7 @@ INPUT_KEYS = ("at", "set", "pulse")
 EXPECT_KEYS = KINDS + ("after", "within", "name")
 RULES_KEYS = ("min_period", "reply_timeout")
 RESPONSE_KEYS = ("signal", "within")
-C24_KEYS = ("unit", "channel", "no_reception", "byte_units", "receive_count", "end_code")
+C24_KEYS = ("unit", "channel", "no_reception", "no_reception_format", "byte_units", "receive_count", "end_code")
 CONVERTER_KEYS = ("ip", "port", "delay", "connect", "packing", "refuse_until", "unreachable", "drops",
                   "split_reply", "split_gap")
 #: The platforms with an Ethernet port the library drives (FX5U built-in, Q + QJ71E71-100).
@@ -61,9 +62,6 @@ DEFAULT_PLATFORM = "fx3u"  # of a scenario file that names none
 TCP_CHANNEL = "tcp"
 #: Buffer memory of an intelligent module, as GX Works writes it: U0\G164, U3E\G10.
 BUFFER_MEMORY = re.compile(r"^U([0-9A-F]{1,3})\\G([0-9]+)$", re.IGNORECASE)
-#: Buffer-memory words the simulator models per module (0..5FFFH). ASSUMPTION: enough for
-#: the QJ71C24N areas and the QJ71E71 status words (5000H, 5005H) the library uses.
-BUFFER_WORDS = 0x6000
 #: Device names (X0, M8000, D100, SM400, ...) address the device memory, not labels.
 DEVICE_NAME = re.compile(r"^(?:(?:X|Y|B|W|SB|SW)[0-9A-F]+|(?:M|L|F|S|T|C|D|R|ZR|SM|SD)[0-9]+)$", re.IGNORECASE)
 _LABEL_PATH = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\[[0-9]+\])*(\.[A-Za-z_][A-Za-z0-9_]*(\[[0-9]+\])*)*$")
@@ -95,14 +93,16 @@ class InputStep:
 @dataclass(frozen=True)
 class C24Setting:
     """QJ71C24N settings made in GX Works (switch settings / various control specification)
-    for one channel of the module at start I/O `unit` (U0 = X/Y000, U2 = X/Y020)."""
+    for one channel of the module at start I/O `unit` (U0 = X/Y000, U2 = X/Y020); `unit`
+    None: the module the program drives, wherever it is (--matrix against user sources)."""
 
-    unit: int = 0
+    unit: int | None = 0
     channel: int = 1
     no_reception_us: int | None = None  # no-reception monitoring time (timer 0)
     byte_units: bool | None = None
     receive_count: int | None = None
     end_code: int | None = None  # 0xFFFF = no receive end code
+    no_reception_format: int | None = None  # timer 0: 1 ends the message (X3), 0 an error (X4)
     key: str = ""
 
 
@@ -433,6 +433,7 @@ class _Reader:
             raise self.fail("channel", "a scenario with [converter] reaches the robot over TCP: "
                                        "it has no serial channel; remove 'channel'")
         keys = [f"initial.{name}" for name, _ in initial] + [setting.key for setting in c24]
+        keys += [f"faults[{i}]" for i in range(len(faults))]
         keys += [f"{e.key}.{e.kind}" for e in expectations if e.condition is not None]
         keys += [f"{step.key}.set" for step in inputs] + [f"watch[{i}]" for i in range(len(watch))]
         keys += ["response_handling.signal"] if signal_given else []
@@ -546,7 +547,8 @@ class _Reader:
             end_code = whole("end_code", 0, 0xFFFF)
         return C24Setting(
             unit=unit or 0, channel=channel or 1, no_reception_us=no_reception, byte_units=byte_units,
-            receive_count=whole("receive_count", 1, 0xFFFF), end_code=end_code, key=key,
+            receive_count=whole("receive_count", 1, 0xFFFF), end_code=end_code,
+            no_reception_format=whole("no_reception_format", 0, 1), key=key,
         )
 
     def sources(self, value: Any) -> list[Path]:

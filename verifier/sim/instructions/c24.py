@@ -22,6 +22,9 @@ ABNORMAL = {1: 0x4, 2: 0xB}
 # result codes the simulator writes (ASSUMPTION: the module's own codes are not modelled)
 ERR_CHANNEL = 0x7FF1
 ERR_TOO_LONG = 0x7FF2
+# the code stored for a message ended by timer 0 in format 0 (ASSUMPTION: the module's own
+# code for a no-reception time-out is not modelled)
+ERR_NO_RECEPTION = 0x7FF3
 
 
 class _Channel:
@@ -33,8 +36,13 @@ class _Channel:
         self.out_done = None  # (s1 ref, d ref) awaiting completion
         self.rx = bytearray()
         self.rx_last_t = 0
-        self.frames: list[bytes] = []
-        self.no_reception_us: int | None = None  # timer 0 (format 1), off by default
+        # messages waiting for G_INPUT: (data, error code; 0 = a normal reception)
+        self.frames: list[tuple[bytes, int]] = []
+        self.no_reception_us: int | None = None  # timer 0, off by default
+        # what timer 0 running out does (C24 (Application) 6.1): format 1 ends the message
+        # normally (X3/XA), format 0 reports a reception error (X4/XB, error code)
+        self.no_reception_format = 1
+        self.unread_since: int | None = None  # when the oldest message still waiting arrived
 
 
 class C24Module:
@@ -47,6 +55,10 @@ class C24Module:
                 if self.buffer[addr] == 0:
                     self.buffer[addr] = DEFAULTS[name] - (0x10000 if DEFAULTS[name] > 0x7FFF else 0)
         self.channels = {ch: _Channel(self, ch) for ch in (1, 2)}
+        # a module no G_OUTPUT / G_INPUT has addressed yet is not wired to the robot's line:
+        # settings made for it (configure_c24) must not let it take the bytes the program's
+        # own module is waiting for
+        self.addressed = False
         self.pulses: list[tuple] = []  # (ref, bit offset) ON for one scan
         self.pending: list[tuple] = []  # completion bits to turn ON at the next END
         rt.pollers.append(self)
@@ -78,8 +90,33 @@ class C24Module:
         if not ok:
             self.pending.append((d_ref, 1))
 
+    def configure(self, channel: int, *, byte_units: bool | None = None, receive_count: int | None = None,
+                  end_code: int | None = None, no_reception_ms: float | None = None,
+                  no_reception_format: int | None = None) -> None:
+        """Settings made in GX Works for one channel (None: left as they are)."""
+        addr = BUFFER[channel]
+        if byte_units is not None:
+            self.buffer[addr["unit"]] = 1 if byte_units else 0
+        if receive_count is not None:
+            self.buffer[addr["recv_count"]] = receive_count
+        if end_code is not None:
+            self.buffer[addr["end_code"]] = ((end_code & 0xFFFF) + 0x8000 & 0xFFFF) - 0x8000
+        if no_reception_ms is not None:
+            self.channels[channel].no_reception_us = round(no_reception_ms * 1000)
+        if no_reception_format is not None:
+            self.channels[channel].no_reception_format = no_reception_format
+
+    def _addressed_now(self) -> None:
+        """The first G_OUTPUT / G_INPUT on this module: it is the program's, so it is on the
+        line, and settings made for "the module the program drives" apply to it."""
+        self.addressed = True
+        for channel, settings in self.rt.c24_for_program.items():
+            self.configure(channel, **settings)
+
     # -- G_OUTPUT ----------------------------------------------------------------------------
     def output(self, s1, s2, d, loc_id) -> bool:
+        if not self.addressed:
+            self._addressed_now()
         chan = self._channel(s1, loc_id)
         if chan is None:
             s1.set(1, ERR_CHANNEL)
@@ -97,6 +134,8 @@ class C24Module:
 
     # -- G_INPUT -------------------------------------------------------------------------------
     def input(self, s, d1, d2, loc_id) -> bool:
+        if not self.addressed:
+            self._addressed_now()
         chan = self._channel(s, loc_id)
         if chan is None:
             s.set(1, ERR_CHANNEL)
@@ -104,20 +143,32 @@ class C24Module:
             return True
         if not chan.frames:
             return True  # nothing received: the instruction does nothing (ASSUMPTION)
-        data = chan.frames.pop(0)
+        data, error = chan.frames.pop(0)
+        chan.unread_since = self.rt.now_us if chan.frames else None
         words = (len(data) + 1) // 2
         count = len(data) if self._word(chan.ch, "unit") == 1 else words
         if count > s.get(3):
             s.set(1, ERR_TOO_LONG)
             self._finish(d2, ok=False)
         else:
+            # a reception error: the data up to the error are read, the instruction ends with
+            # its completion device + 1 ON and the code in (s)+1 (C24 (Basic) 6.1.5)
             d1.put_bytes(data)
             s.set(2, count)
-            s.set(1, 0)
-            self._finish(d2, ok=True)
-        if not chan.frames:
-            self._set_x(READ_REQUEST[chan.ch], False)
+            s.set(1, error)
+            self._finish(d2, ok=not error)
+        self._signals(chan)
         return True
+
+    def _signals(self, chan: _Channel) -> None:
+        """X3/XA while a normal message waits, X4/XB while one ended by an error waits."""
+        self._set_x(READ_REQUEST[chan.ch], any(not error for _, error in chan.frames))
+        self._set_x(ABNORMAL[chan.ch], any(error for _, error in chan.frames))
+
+    def unread(self) -> list[tuple[int, int, int]]:
+        """(channel, messages waiting, since when in µs) for each channel whose received
+        messages no G_INPUT has taken."""
+        return [(ch, len(c.frames), c.unread_since) for ch, c in self.channels.items() if c.frames]
 
     # -- between scans ---------------------------------------------------------------------------
     def poll(self, now: int) -> None:
@@ -134,7 +185,8 @@ class C24Module:
                 s1.set(1, 0)
                 d.set(0, True)
                 self.pulses.append((d, 0))
-            self._receive(chan, now)
+            if self.addressed:
+                self._receive(chan, now)
 
     # -- idle-scan skipping (verifier.sim.idle) -------------------------------------------
     def idle_deadline(self, now: int) -> float | None:
@@ -143,6 +195,8 @@ class C24Module:
         if self.pulses or self.pending:
             return None
         deadline = float("inf")
+        if not self.addressed:
+            return deadline  # not on the line: nothing arrives for it (an instruction call is a scan)
         for chan in self.channels.values():
             if chan.sending_until is not None:
                 deadline = min(deadline, chan.sending_until)
@@ -159,9 +213,10 @@ class C24Module:
         """Everything the instructions and `poll` change (nothing counts scans)."""
         channels = tuple(
             (c.sending_until, None if c.out_done is None else tuple(map(operand_key, c.out_done)),
-             bytes(c.rx), c.rx_last_t, tuple(c.frames), c.no_reception_us, c.port.sent_count)
+             bytes(c.rx), c.rx_last_t, tuple(c.frames), c.no_reception_us, c.no_reception_format,
+             c.port.sent_count)
             for c in self.channels.values())
-        return channels, pulse_keys(self.pulses), pulse_keys(self.pending)
+        return self.addressed, channels, pulse_keys(self.pulses), pulse_keys(self.pending)
 
     def skipped(self, scan_count: int, scans: int) -> None:
         """Nothing here depends on the scan count."""
@@ -172,7 +227,7 @@ class C24Module:
         end_code = self._word(chan.ch, "end_code")
         for value, t in chan.port.receive_until(now):
             if chan.rx and chan.no_reception_us is not None and t - chan.rx_last_t > chan.no_reception_us:
-                self._frame(chan)
+                self._timed_out(chan)
             chan.rx.append(value)
             chan.rx_last_t = t
             if (end_code != 0xFFFF and len(chan.rx) >= 2
@@ -181,9 +236,14 @@ class C24Module:
             elif target and len(chan.rx) >= target:
                 self._frame(chan)
         if chan.rx and chan.no_reception_us is not None and now - chan.rx_last_t > chan.no_reception_us:
-            self._frame(chan)
+            self._timed_out(chan)
 
-    def _frame(self, chan: _Channel) -> None:
-        chan.frames.append(bytes(chan.rx))
+    def _timed_out(self, chan: _Channel) -> None:
+        self._frame(chan, 0 if chan.no_reception_format == 1 else ERR_NO_RECEPTION)
+
+    def _frame(self, chan: _Channel, error: int = 0) -> None:
+        if not chan.frames:
+            chan.unread_since = chan.rx_last_t
+        chan.frames.append((bytes(chan.rx), error))
         chan.rx.clear()
-        self._set_x(READ_REQUEST[chan.ch], True)
+        self._signals(chan)

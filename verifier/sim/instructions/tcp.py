@@ -73,6 +73,8 @@ class TcpPort:
         self.pending: list[tuple] = []  # (ref, bit) to turn ON from the next scan
         self._active = False
         self.open_count = 0  # opens the program ran (a silent run's note says so)
+        self.sends = 0  # frames handed to the converter
+        self.closes_while_open = 0  # closes the program ran on a connection that was open
         rt.pollers.append(self)
 
     # ---- the status words (the platform names them) ---------------------------------------
@@ -165,6 +167,7 @@ class TcpPort:
             payload += bytes((word & 0xFF, word >> 8))
         ok = self.endpoint.send(self.rt.now_us, conn.remote, bytes(payload[:byte_count]),
                                 self.rt.locations[loc_id])
+        self.sends += ok
         self.finish(control, done, 0 if ok else ERR_NOT_OPEN)
 
     def receive(self, conn: _Connection, control, data, done) -> None:
@@ -196,6 +199,7 @@ class TcpPort:
         if conn.state == CLOSED:
             self.finish(control, done, ERR_NOT_OPEN)
             return
+        self.closes_while_open += conn.state == OPEN  # the program's own close of a live connection
         if self.endpoint is not None and conn.remote:
             self.endpoint.close(self.rt.now_us, conn.remote)
         self._reset(conn)
@@ -337,6 +341,7 @@ class FixedBufferPort(TcpPort):
 
     def __init__(self, rt, un: int):
         super().__init__(rt, f"QJ71E71 at U{un:X}")
+        self.un = un
         self.status_cells = rt.buffer(un)
         self.direction: dict[int, str] = {}  # connection -> "send" | "receive"
 
