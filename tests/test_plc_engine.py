@@ -275,8 +275,11 @@ def test_out_of_range_parameters_send_nothing(rig):
     assert len(port.requests) == count
 
 
+# 1.3 m / 0.1 and 0.59 m / 0.2 are 12.999999 and 2.9499998 in REAL: an FX3 CPU's
+# REAL_TO_INT drops the fraction (docs/instructions.md §3), the FBs must still send 13 and 3
 @pytest.mark.parametrize("axis,value,code,units", [(1, 1.5, 6, 15), (1, -2.0, 7, 20), (2, 0.3, 8, 3),
-                                                   (3, -25.5, 11, 255), (4, -0.25, 13, 25), (4, 2.55, 12, 255)])
+                                                   (3, -25.5, 11, 255), (4, -0.25, 13, 25), (4, 2.55, 12, 255),
+                                                   (1, 1.3, 6, 13), (1, -1.3, 7, 13), (4, 0.29, 12, 29)])
 def test_relative_moves_in_engineering_units(rig, axis, value, code, units):
     h, port = rig
     port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)
@@ -285,7 +288,8 @@ def test_relative_moves_in_engineering_units(rig, axis, value, code, units):
     assert encode(ControlRequest(1, code, units), SETTINGS, strict=False) in port.kinds()
 
 
-@pytest.mark.parametrize("metres,step", [(0.0, 0), (0.2, 1), (0.4, 2), (0.61, 3)])
+@pytest.mark.parametrize("metres,step", [(0.0, 0), (0.2, 1), (0.4, 2), (0.61, 3), (0.59, 3), (0.39, 2),
+                                         (-0.04, 0)])
 def test_collision_range_steps(rig, metres, step):
     h, port = rig
     port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)

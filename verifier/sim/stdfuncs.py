@@ -71,13 +71,18 @@ def make_helpers(rt) -> dict:
             return 0.0
         return r
 
+    # REAL -> integer as the CPU's conversion instruction does it (docs/instructions.md §3):
+    # FX3 INT (FNC 129) rounds down, dropping the fraction; FX5/Q round the first digit
+    # after the decimal point off (halves away from zero)
+    truncates = rt.cpu.family == "fx3"
+
     def _r2i(x, type_name, k):
-        """REAL -> integer: rounded to the nearest whole number, halves away from zero
-        (ASSUMPTION: as the INT/DINT conversion instructions round; see docs)."""
+        """REAL -> integer: truncated on an FX3 CPU, rounded to the nearest whole number
+        (halves away from zero) on FX5 and Q; see docs/instructions.md §3."""
         if math.isnan(x) or math.isinf(x):
             op_error(k, f"{x} cannot be converted to {type_name}")
             return 0
-        v = int(math.floor(abs(x) + 0.5))
+        v = int(abs(x)) if truncates else int(math.floor(abs(x) + 0.5))
         v = v if x >= 0 else -v
         t = datatypes.TYPES[type_name]
         lo, hi = ((-(1 << (t.bits - 1)), (1 << (t.bits - 1)) - 1) if t.kind == "signed"
