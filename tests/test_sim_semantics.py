@@ -267,7 +267,18 @@ def test_division_by_zero_stops_a_q_cpu():
 
 
 def test_division_by_zero_on_fx5_sets_sm0():
+    # FX5 Programming Manual (Instructions) 6.2 "/": error code 3400 "0 is specified for
+    # (s2) value" (3405H is the out-of-range class, below)
     project, _ = run_fb("x := 3 MOD z;", "x, z : INT;", target="gxworks3")
+    assert project.devices["SM0"] is True
+    assert project.devices["SD0"] == 0x3400
+    project, _ = run_fb("x := 3 / z;", "x, z : INT;", target="gxworks3")
+    assert project.devices["SD0"] == 0x3400
+
+
+def test_other_operation_errors_on_fx5_keep_the_out_of_range_code():
+    project, _ = run_fb("i := 20000; w := INT_TO_BCD(i);", "i : INT; w : WORD;",
+                        target="gxworks3")
     assert project.devices["SM0"] is True
     assert project.devices["SD0"] == 0x3405
 

@@ -23,10 +23,11 @@ ELEMENTARY = ("BOOL", "INT", "DINT", "WORD", "DWORD", "UINT", "UDINT", "REAL", "
 def make_helpers(rt) -> dict:
     """Functions bound to one runtime, installed as globals of the generated module."""
     op_error = rt.operation_error
+    div_zero = rt.cpu.div_zero_code
 
     def _idiv(a, b, k):
         if b == 0:
-            op_error(k, "division by zero")
+            op_error(k, "division by zero", div_zero)
             return 0
         q = abs(a) // abs(b)
         return q if (a >= 0) == (b >= 0) else -q
@@ -35,21 +36,21 @@ def make_helpers(rt) -> dict:
         """Quotient, or None after an operation error (the destination keeps its value,
         as the CPU skips the instruction)."""
         if b == 0:
-            op_error(k, "division by zero")
+            op_error(k, "division by zero", div_zero)
             return None
         q = abs(a) // abs(b)
         return q if (a >= 0) == (b >= 0) else -q
 
     def _imod(a, b, k):
         if b == 0:
-            op_error(k, "MOD by zero")
+            op_error(k, "MOD by zero", div_zero)
             return 0
         r = abs(a) % abs(b)
         return r if a >= 0 else -r
 
     def _rdiv(a, b, k):
         if b == 0:
-            op_error(k, "division by zero")
+            op_error(k, "division by zero", div_zero)
             return 0.0
         return a / b
 
