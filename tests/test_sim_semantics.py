@@ -524,3 +524,13 @@ def test_cannot_fail_accepts_only_plain_reads():
     for code in ("_oob(_t4, 5)", "(a[_t] if 0 <= (_t := x) <= 3 else _oob(_t, 1))", "l_F(x)",
                  "(x // 2) == 1", "a[i]", "(_t := 1)", "'text' == s", "x if y else z", "(a) or (l_F(x))", "True (x)"):
         assert not cannot_fail(code), code
+
+
+def test_lreal_is_refused_when_loading_for_an_fx3():
+    """LREAL exists under GX Works2 on the Universal model QCPU only (docs/st-dialect.md §3):
+    loading it for the default FX3U was accepted and simulated as a double."""
+    with pytest.raises(LoadError) as err:
+        run_fb("l := 1.5;", "l : LREAL;")
+    assert "t.st:3:5: error: LREAL (FLOAT [Double Precision]) does not exist on the fx3u" in str(err.value)
+    _, fb = run_fb("l := 1.5;", "l : LREAL;", cpu="q", target="gxworks2:q")
+    assert fb.l == 1.5

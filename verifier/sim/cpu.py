@@ -121,6 +121,18 @@ QCPU = CpuProfile(
     stops_on_op_error=True,
 )
 
+
+
+def type_not_on_cpu(type_key: str, cpu: CpuProfile) -> str | None:
+    """Why the elementary type `type_key` (upper case) has no place on `cpu`, or None.
+    FLOAT [Double Precision] (LREAL) is "used for the Universal model QCPU only" among the
+    GX Works2 CPUs (docs/st-dialect.md section 3): an FX3 CPU has no double-precision
+    data. The simulator's compiler and `uitamr check --platform` both ask this."""
+    if type_key == "LREAL" and cpu.family == "fx3":
+        return (f"LREAL (FLOAT [Double Precision]) does not exist on the {cpu.name}: under "
+                f"GX Works2 only the Universal model QCPU has it; use REAL")
+    return None
+
 PROFILES = {p.name: p for p in (FX3U, FX3G, FX5U, QCPU)}
 # Accepted spellings of a CPU, and the default CPU of each editor target.
 CPU_ALIASES = {"fx3": "fx3u", "fx3uc": "fx3u", "fx3gc": "fx3g", "fx5": "fx5u",
