@@ -665,3 +665,20 @@ def test_the_same_robot_by_another_spelling_is_not_a_new_robot(rig):
     h.wAddress = 0
     port.run(2000)
     assert port.kinds().count(STOP) == stops and h.fbEngine.o_bInitDone
+
+
+@pytest.mark.parametrize("scan_ms", [7, 10, 13])
+def test_pacing_keeps_the_robots_250_ms_with_100_ms_timers(scan_ms):
+    """An FX5 TON may count in 100 ms units (docs/instructions.md §4): the pace timer then
+    ends up to a tick early, and start-to-start must still exceed the robot's 250 ms."""
+    project = verifier.load(CORE, sources={"T_Engine.st": HARNESS}, timer_resolution_ms=100,
+                            scan_ms=scan_ms)
+    h = project.program("T_Engine")
+    port = FakePort(h, project)
+    h.wAddress, h.bEnable = 1, True
+    port.running_polls = 20
+    start_point(h, port)
+    port.run(4000)
+    starts = [t for t, _ in port.requests]
+    assert len(starts) >= 8
+    assert min(b - a for a, b in zip(starts, starts[1:])) > 250_000
