@@ -467,3 +467,24 @@ def test_buffer_memory_past_the_model_is_a_load_error_at_its_place(tmp_path):
     with pytest.raises(LoadError) as err:
         verifier.load(path, cpu="q")
     assert str(err.value.diagnostics[0]).startswith(f"{path}:5:6: error: U0\\G30000: buffer memory word 30000")
+
+
+LREAL_ON_FX3 = ("LREAL (FLOAT [Double Precision]) does not exist on the {cpu}: under GX Works2 "
+                "only the Universal model QCPU has it; use REAL")
+
+
+@pytest.mark.parametrize("platform", ["fx3u", "fx3g"])
+def test_lreal_is_an_error_on_an_fx3(tmp_path, platform):
+    """The QCPU structured programming manual's elementary data types give FLOAT (Double
+    Precision) as 'used for the Universal model QCPU only': an FX3 project has none."""
+    path = write(tmp_path, program("x := 1;", "x : INT; l : LREAL; a : ARRAY[0..1] OF LREAL;"))
+    result = run("--platform", platform, path)
+    assert result.exit_code == 1
+    assert errors(result.output) == [f"{path}:3:16: error: {LREAL_ON_FX3.format(cpu=platform)}",
+                                     f"{path}:3:42: error: {LREAL_ON_FX3.format(cpu=platform)}"]
+
+
+def test_lreal_passes_on_q_and_fx5(tmp_path):
+    path = write(tmp_path, program("l := 1.5;", "l : LREAL;"))
+    assert run("--platform", "q", path).exit_code == 0
+    assert run("--target", "gxworks3", "--platform", "fx5u", path).exit_code == 0

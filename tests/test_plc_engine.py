@@ -275,8 +275,11 @@ def test_out_of_range_parameters_send_nothing(rig):
     assert len(port.requests) == count
 
 
+# 1.3 m / 0.1 and 0.59 m / 0.2 are 12.999999 and 2.9499998 in REAL: an FX3 CPU's
+# REAL_TO_INT drops the fraction (docs/instructions.md §3), the FBs must still send 13 and 3
 @pytest.mark.parametrize("axis,value,code,units", [(1, 1.5, 6, 15), (1, -2.0, 7, 20), (2, 0.3, 8, 3),
-                                                   (3, -25.5, 11, 255), (4, -0.25, 13, 25), (4, 2.55, 12, 255)])
+                                                   (3, -25.5, 11, 255), (4, -0.25, 13, 25), (4, 2.55, 12, 255),
+                                                   (1, 1.3, 6, 13), (1, -1.3, 7, 13), (4, 0.29, 12, 29)])
 def test_relative_moves_in_engineering_units(rig, axis, value, code, units):
     h, port = rig
     port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)
@@ -285,7 +288,8 @@ def test_relative_moves_in_engineering_units(rig, axis, value, code, units):
     assert encode(ControlRequest(1, code, units), SETTINGS, strict=False) in port.kinds()
 
 
-@pytest.mark.parametrize("metres,step", [(0.0, 0), (0.2, 1), (0.4, 2), (0.61, 3)])
+@pytest.mark.parametrize("metres,step", [(0.0, 0), (0.2, 1), (0.4, 2), (0.61, 3), (0.59, 3), (0.39, 2),
+                                         (-0.04, 0)])
 def test_collision_range_steps(rig, metres, step):
     h, port = rig
     port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)
@@ -661,3 +665,20 @@ def test_the_same_robot_by_another_spelling_is_not_a_new_robot(rig):
     h.wAddress = 0
     port.run(2000)
     assert port.kinds().count(STOP) == stops and h.fbEngine.o_bInitDone
+
+
+@pytest.mark.parametrize("scan_ms", [7, 10, 13])
+def test_pacing_keeps_the_robots_250_ms_with_100_ms_timers(scan_ms):
+    """An FX5 TON may count in 100 ms units (docs/instructions.md §4): the pace timer then
+    ends up to a tick early, and start-to-start must still exceed the robot's 250 ms."""
+    project = verifier.load(CORE, sources={"T_Engine.st": HARNESS}, timer_resolution_ms=100,
+                            scan_ms=scan_ms)
+    h = project.program("T_Engine")
+    port = FakePort(h, project)
+    h.wAddress, h.bEnable = 1, True
+    port.running_polls = 20
+    start_point(h, port)
+    port.run(4000)
+    starts = [t for t, _ in port.requests]
+    assert len(starts) >= 8
+    assert min(b - a for a, b in zip(starts, starts[1:])) > 250_000

@@ -3,6 +3,8 @@ CPU's arithmetic (every intermediate result wraps to the type; division truncate
 zero; MOD takes the dividend's sign)."""
 from __future__ import annotations
 
+import math
+
 import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
@@ -114,4 +116,7 @@ def test_real_expressions_round_to_single_precision_after_every_operation(a, b, 
     expected = f32({"+": first + c, "-": first - c, "*": first * c, "/": first / c if c else 0.0}[ops[1]])
     src = (f"FUNCTION F : REAL\nVAR_INPUT a, b, c : REAL; END_VAR\n"
            f"F := (a {ops[0]} b) {ops[1]} c;\nEND_FUNCTION\n")
-    assert load_st(src).call("F", a, b, c) == expected
+    got = load_st(src).call("F", a, b, c)
+    # 1.0 / 1.4E-45 overflows to inf in single precision and inf * 0.0 is NaN: NaN is the
+    # right answer there, and NaN == NaN is False
+    assert got == expected or (math.isnan(got) and math.isnan(expected))

@@ -72,8 +72,7 @@ def test_rotation_of_dword_uses_32_bits():
     ("INT_TO_WORD(-1)", "WORD", 0xFFFF), ("WORD_TO_INT(16#FFFF)", "INT", -1),
     ("DINT_TO_INT(70000)", "INT", 70000 - 65536), ("INT_TO_DINT(-5)", "DINT", -5),
     ("INT_TO_BCD(1234)", "WORD", 0x1234), ("BCD_TO_INT(16#0987)", "INT", 987),
-    ("BOOL_TO_INT(TRUE)", "INT", 1), ("REAL_TO_INT(2.5)", "INT", 3), ("REAL_TO_INT(-2.5)", "INT", -3),
-    ("REAL_TO_INT(2.4)", "INT", 2), ("TIME_TO_DINT(T#1m2s)", "DINT", 62000),
+    ("BOOL_TO_INT(TRUE)", "INT", 1), ("TIME_TO_DINT(T#1m2s)", "DINT", 62000),
     ("MAX(3, 9, 4)", "INT", 9), ("MIN(3, 9, 4)", "INT", 3), ("LIMIT(0, 15, 10)", "INT", 10),
     ("SEL(TRUE, 1, 2)", "INT", 2), ("MUX(2, 10, 20, 30)", "INT", 30), ("ABS(-4)", "INT", 4),
     ("ADD(1, 2, 3)", "INT", 6), ("MOD(-9, 4)", "INT", -1), ("DINT_TO_REAL(3)", "REAL", 3.0),
@@ -81,6 +80,25 @@ def test_rotation_of_dword_uses_32_bits():
 def test_standard_functions(expr, rtype, expected):
     _, fb = run_fb(f"r := {expr};", f"r : {rtype};")
     assert fb.r == expected
+
+
+@pytest.mark.parametrize("cpu, expr, expected", [
+    # FX3: INT (FNC 129) "rounded down to the nearest integer value" (FX programming
+    # manual §5.11.10) -- the fraction is dropped, so 12.999999 (1.3 / 0.1 in REAL) is 12
+    ("fx3u", "REAL_TO_INT(2.5)", 2), ("fx3u", "REAL_TO_INT(-2.5)", -2),
+    ("fx3u", "REAL_TO_INT(a / r)", 12), ("fx3g", "REAL_TO_INT(2.9)", 2),
+    ("fx3u", "REAL_TO_DINT(-70000.7)", -70000),
+    # FX5 / Q: "the first digit after the decimal point ... is rounded off"
+    ("fx5u", "REAL_TO_INT(2.5)", 3), ("fx5u", "REAL_TO_INT(-2.5)", -3),
+    ("q", "REAL_TO_INT(2.4)", 2), ("q", "REAL_TO_INT(a / r)", 13),
+    ("q", "REAL_TO_DINT(-123456.7)", -123457),
+])
+def test_real_to_integer_follows_the_cpu(cpu, expr, expected):
+    rtype = "DINT" if "DINT" in expr else "INT"
+    target = {"fx5u": "gxworks3", "q": "gxworks2:q"}.get(cpu, "gxworks2")
+    _, fb = run_fb(f"r := 0.1; a := 1.3; x := {expr};", f"x : {rtype}; r, a : REAL;", cpu=cpu,
+                   target=target)
+    assert fb.x == expected
 
 
 def test_int_to_bool_and_comparisons():
@@ -249,7 +267,18 @@ def test_division_by_zero_stops_a_q_cpu():
 
 
 def test_division_by_zero_on_fx5_sets_sm0():
+    # FX5 Programming Manual (Instructions) 6.2 "/": error code 3400 "0 is specified for
+    # (s2) value" (3405H is the out-of-range class, below)
     project, _ = run_fb("x := 3 MOD z;", "x, z : INT;", target="gxworks3")
+    assert project.devices["SM0"] is True
+    assert project.devices["SD0"] == 0x3400
+    project, _ = run_fb("x := 3 / z;", "x, z : INT;", target="gxworks3")
+    assert project.devices["SD0"] == 0x3400
+
+
+def test_other_operation_errors_on_fx5_keep_the_out_of_range_code():
+    project, _ = run_fb("i := 20000; w := INT_TO_BCD(i);", "i : INT; w : WORD;",
+                        target="gxworks3")
     assert project.devices["SM0"] is True
     assert project.devices["SD0"] == 0x3405
 
@@ -495,3 +524,13 @@ def test_cannot_fail_accepts_only_plain_reads():
     for code in ("_oob(_t4, 5)", "(a[_t] if 0 <= (_t := x) <= 3 else _oob(_t, 1))", "l_F(x)",
                  "(x // 2) == 1", "a[i]", "(_t := 1)", "'text' == s", "x if y else z", "(a) or (l_F(x))", "True (x)"):
         assert not cannot_fail(code), code
+
+
+def test_lreal_is_refused_when_loading_for_an_fx3():
+    """LREAL exists under GX Works2 on the Universal model QCPU only (docs/st-dialect.md §3):
+    loading it for the default FX3U was accepted and simulated as a double."""
+    with pytest.raises(LoadError) as err:
+        run_fb("l := 1.5;", "l : LREAL;")
+    assert "t.st:3:5: error: LREAL (FLOAT [Double Precision]) does not exist on the fx3u" in str(err.value)
+    _, fb = run_fb("l := 1.5;", "l : LREAL;", cpu="q", target="gxworks2:q")
+    assert fb.l == 1.5

@@ -17,7 +17,7 @@ from verifier.st import ast
 
 from . import datatypes
 from .codegen import BodyCompiler, Emitter, attr_name
-from .cpu import CpuProfile
+from .cpu import CpuProfile, type_not_on_cpu
 from .errors import SimulationError
 from .inline import Body, Inliner
 from .instructions import InstructionSet
@@ -106,6 +106,9 @@ class ModuleCompiler:
         if isinstance(t, ast.NamedType):
             key = t.key
             et = datatypes.lookup(key)
+            why = type_not_on_cpu(key, self.cpu) if et is not None else None
+            if why:
+                raise CompileError(t.span, why)
             if et is not None:
                 return StringT(32) if et.name == "STRING" else et.name
             if key in self.structs:

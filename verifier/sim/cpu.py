@@ -29,7 +29,7 @@ class CpuProfile:
     first_scan_off: tuple[str, ...]
     op_error_flags: tuple[str, ...]  # set on an operation error
     op_error_code: str  # word device receiving the error code
-    div_zero_code: int
+    div_zero_code: int  # error code of a division (or MOD) by zero
     # clock relays: device -> period in ms (OFF for the first half of each period, ON for
     # the second; docs/instructions.md §2)
     clocks: dict[str, int] = field(default_factory=dict)
@@ -38,6 +38,13 @@ class CpuProfile:
     settable_clocks: dict[str, tuple[str, int, int]] = field(default_factory=dict)
     # does an operation error stop the CPU by default?
     stops_on_op_error: bool = False
+    # error code of the other operation errors (operand or value out of range); None: the
+    # division-by-zero code
+    range_error_code: int | None = None
+
+    @property
+    def op_error_default_code(self) -> int:
+        return self.div_zero_code if self.range_error_code is None else self.range_error_code
 
 
 def _areas(*areas: Area) -> dict[str, Area]:
@@ -90,7 +97,9 @@ FX5U = CpuProfile(
     always_on=("SM400", "SM8000"), always_off=("SM401", "SM8001"),
     first_scan_on=("SM402", "SM8002"), first_scan_off=("SM403", "SM8003"),
     op_error_flags=("SM0", "SM1"), op_error_code="SD0",
-    div_zero_code=0x3405,
+    # FX5 Programming Manual (Instructions) 6.2, "/": error code 3400 "0 is specified for
+    # (s2) value"; 3405H for values out of range (docs/instructions.md section 2)
+    div_zero_code=0x3400, range_error_code=0x3405,
     clocks=_SM_CLOCKS, settable_clocks=_SM_SETTABLE_CLOCKS,
 )
 
@@ -111,6 +120,18 @@ QCPU = CpuProfile(
     clocks=_SM_CLOCKS, settable_clocks=_SM_SETTABLE_CLOCKS,
     stops_on_op_error=True,
 )
+
+
+
+def type_not_on_cpu(type_key: str, cpu: CpuProfile) -> str | None:
+    """Why the elementary type `type_key` (upper case) has no place on `cpu`, or None.
+    FLOAT [Double Precision] (LREAL) is "used for the Universal model QCPU only" among the
+    GX Works2 CPUs (docs/st-dialect.md section 3): an FX3 CPU has no double-precision
+    data. The simulator's compiler and `uitamr check --platform` both ask this."""
+    if type_key == "LREAL" and cpu.family == "fx3":
+        return (f"LREAL (FLOAT [Double Precision]) does not exist on the {cpu.name}: under "
+                f"GX Works2 only the Universal model QCPU has it; use REAL")
+    return None
 
 PROFILES = {p.name: p for p in (FX3U, FX3G, FX5U, QCPU)}
 # Accepted spellings of a CPU, and the default CPU of each editor target.

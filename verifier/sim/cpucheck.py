@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from verifier.st import ast
 
-from .cpu import CpuProfile
+from .cpu import CpuProfile, type_not_on_cpu
 from .devices import DeviceError, fx3_special_elsewhere, locate, locate_buffer
 from .instructions import not_on_cpu
 
@@ -44,6 +44,10 @@ def cpu_diagnostics(files: list[ast.SourceFile], cpu: CpuProfile, superseded: li
                     why = fx3_special_elsewhere(node, cpu)
                     if why:
                         mine.append(_at(node.span, why, "warning"))
+            elif isinstance(node, ast.NamedType):
+                why = type_not_on_cpu(node.key, cpu)
+                if why:
+                    mine.append(_at(node.span, why))
             elif isinstance(node, ast.Call) and getattr(node.resolved, "kind", None) == "instruction":
                 why = not_on_cpu(node.name, cpu)
                 if why:

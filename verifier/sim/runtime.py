@@ -140,7 +140,7 @@ class Runtime:
         """What the CPU does on an operation error (division by zero, operand out of range):
         set SM0/M8067 (and the latched flag), store the error code, and either continue
         (FX default) or stop (Q default: 'operation error: stop' in the PLC parameters)."""
-        code = self.cpu.div_zero_code if code is None else code
+        code = self.cpu.op_error_default_code if code is None else code
         dev = self.dev
         for a in self._op_flags:
             dev.areas[a.area][a.index] = True

@@ -23,10 +23,11 @@ ELEMENTARY = ("BOOL", "INT", "DINT", "WORD", "DWORD", "UINT", "UDINT", "REAL", "
 def make_helpers(rt) -> dict:
     """Functions bound to one runtime, installed as globals of the generated module."""
     op_error = rt.operation_error
+    div_zero = rt.cpu.div_zero_code
 
     def _idiv(a, b, k):
         if b == 0:
-            op_error(k, "division by zero")
+            op_error(k, "division by zero", div_zero)
             return 0
         q = abs(a) // abs(b)
         return q if (a >= 0) == (b >= 0) else -q
@@ -35,21 +36,21 @@ def make_helpers(rt) -> dict:
         """Quotient, or None after an operation error (the destination keeps its value,
         as the CPU skips the instruction)."""
         if b == 0:
-            op_error(k, "division by zero")
+            op_error(k, "division by zero", div_zero)
             return None
         q = abs(a) // abs(b)
         return q if (a >= 0) == (b >= 0) else -q
 
     def _imod(a, b, k):
         if b == 0:
-            op_error(k, "MOD by zero")
+            op_error(k, "MOD by zero", div_zero)
             return 0
         r = abs(a) % abs(b)
         return r if a >= 0 else -r
 
     def _rdiv(a, b, k):
         if b == 0:
-            op_error(k, "division by zero")
+            op_error(k, "division by zero", div_zero)
             return 0.0
         return a / b
 
@@ -71,13 +72,18 @@ def make_helpers(rt) -> dict:
             return 0.0
         return r
 
+    # REAL -> integer as the CPU's conversion instruction does it (docs/instructions.md §3):
+    # FX3 INT (FNC 129) rounds down, dropping the fraction; FX5/Q round the first digit
+    # after the decimal point off (halves away from zero)
+    truncates = rt.cpu.family == "fx3"
+
     def _r2i(x, type_name, k):
-        """REAL -> integer: rounded to the nearest whole number, halves away from zero
-        (ASSUMPTION: as the INT/DINT conversion instructions round; see docs)."""
+        """REAL -> integer: truncated on an FX3 CPU, rounded to the nearest whole number
+        (halves away from zero) on FX5 and Q; see docs/instructions.md §3."""
         if math.isnan(x) or math.isinf(x):
             op_error(k, f"{x} cannot be converted to {type_name}")
             return 0
-        v = int(math.floor(abs(x) + 0.5))
+        v = int(abs(x)) if truncates else int(math.floor(abs(x) + 0.5))
         v = v if x >= 0 else -v
         t = datatypes.TYPES[type_name]
         lo, hi = ((-(1 << (t.bits - 1)), (1 << (t.bits - 1)) - 1) if t.kind == "signed"

@@ -61,7 +61,7 @@ def crc(rt, en, s, n, d, loc_id, eight_bit_device: str):
     if not en:
         return False
     if not 1 <= n <= 256:
-        rt.operation_error(loc_id, f"CRC: n={n} is outside 1..256", code=rt.cpu.div_zero_code)
+        rt.operation_error(loc_id, f"CRC: n={n} is outside 1..256")
         return True
     a = rt.dev.address(eight_bit_device)
     eight_bit = bool(rt.dev.areas[a.area][a.index])
