@@ -116,6 +116,24 @@ def test_real_is_rounded_to_single_precision():
     assert fb.l == 0.1 + 0.2
 
 
+@pytest.mark.parametrize("cpu, target", [("fx3u", "gxworks2"), ("q", "gxworks2:q"), ("fx5u", "gxworks3")])
+def test_a_constant_meeting_a_real_is_a_real(cpu, target):
+    """A REAL constant is single precision on the CPU, as a REAL label holding it is:
+    `1.3 / r` computed 1.3 in double precision (13.0 for r = 0.1, where the label gives
+    12.999999), and `r = 0.1` was FALSE right after `r := 0.1`. LREAL keeps double."""
+    _, fb = run_fb("r := 0.1; c := 1.3; a := 1.3 / r; b := c / r; e := r = 0.1; f := 0.1 = r; "
+                   "g := r * 2.0 = 0.2; i := REAL_TO_INT(1.3 / r); "
+                   "j := REAL_TO_INT(c / r); k := r < 0.1; "
+                   + ("l := 0.1; m := l = 0.1; n := l * 1.3;" if cpu != "fx3u" else ""),
+                   "r, c, a, b : REAL; e, f, g, k : BOOL; i, j : INT;"
+                   + (" l, n : LREAL; m : BOOL;" if cpu != "fx3u" else ""), cpu=cpu, target=target)
+    assert fb.a == fb.b == f32(f32(1.3) / f32(0.1))
+    assert (fb.e, fb.f, fb.g, fb.k) == (True, True, True, False)
+    assert fb.i == fb.j == (12 if cpu == "fx3u" else 13)
+    if cpu != "fx3u":
+        assert (fb.l, fb.m, fb.n) == (0.1, True, 0.1 * 1.3)
+
+
 def test_real_division_and_sqrt():
     _, fb = run_fb("r := 1.0 / 3.0; s := SQRT(2.0);", "r, s : REAL;")
     assert fb.r == f32(1 / 3)

@@ -225,6 +225,8 @@ class BodyCompiler(CallCompiler):
     def binary_code(self, op, lc, lt, rc, rt_, span):
         if op in ("=", "<>", "<", ">", "<=", ">="):
             py = {"=": "==", "<>": "!="}.get(op, op)
+            # a REAL operand against a constant: the constant is a REAL too
+            lc, rc = _real_typed(lc, lt, rt_), _real_typed(rc, rt_, lt)
             return f"(({lc}) {py} ({rc}))", "BOOL"
         if op in ("AND", "OR", "XOR"):
             py = {"AND": "&", "OR": "|", "XOR": "^"}[op]
@@ -260,6 +262,7 @@ class BodyCompiler(CallCompiler):
             return f"_anyint(({lc}) {op} ({rc}))", ANYINT
         if is_real(t) or t == ANYREAL:
             real_t = concrete(t)
+            lc, rc = _real_typed(lc, lt, t), _real_typed(rc, rt_, t)
             if op == "/":
                 raw = f"_rdiv({lc}, {rc}, {k})"
             elif op == "MOD":
@@ -719,6 +722,20 @@ def _typed_literal(code: str, src, dst) -> str:
     if src == ANYINT and not _is_number(code):
         return norm_code(dst, code)
     return code
+
+
+def _real_typed(code: str, src, dst) -> str:
+    """A constant (`1.3`, or a constant expression) meeting a REAL operand is a REAL on
+    the CPU: single precision before the operation, as a REAL label holding it would be
+    (`1.3 / r` and `c / r` with c := 1.3 give the same 12.999999 for r = 0.1). LREAL and
+    labels are left as they are."""
+    if src not in (ANYREAL, ANYINT) or not is_real(dst) or concrete(dst) != "REAL":
+        return code
+    try:
+        value = float(code)
+    except ValueError:
+        return norm_code("REAL", code) if src == ANYREAL else code
+    return repr(datatypes.NORMALIZERS["REAL"](value))
 
 
 def _is_number(code: str) -> bool:
