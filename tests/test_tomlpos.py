@@ -311,3 +311,23 @@ def test_an_array_nested_deeper_than_the_walk_can_follow_is_no_crash():
     with pytest.raises(ScenarioError) as error:
         parse_scenario(text)
     assert error.value.line == 1 and "name" in str(error.value)
+
+
+@pytest.mark.parametrize("text, place, words", [
+    ('name = "x"\nprogram = "P', (2, 13), "Unterminated string at the end of the file"),
+    ('name = "x"\nprogram', (2, 8), "Expected '=' after a key in a key/value pair at the end of the file"),
+    ('name = "x"\nprogram = """P\n\n', (4, 1), "Unterminated string at the end of the file"),
+])
+def test_a_file_that_ends_inside_a_value_is_placed_at_its_end(text, place, words, tmp_path):
+    # tomllib (Python < 3.14) says "(at end of document)" with no line: `uitamr check`
+    # printed file:0:0 and `uitamr verify` the file name alone
+    with pytest.raises(tomllib.TOMLDecodeError) as caught:
+        tomllib.loads(text)
+    message, found = decode_error_position(caught.value, text)
+    assert (found.line, found.col) == place and message == words
+    path = tmp_path / "cut.toml"
+    path.write_text(text, encoding="utf-8")
+    from click.testing import CliRunner
+    from verifier.cli import main
+    result = CliRunner().invoke(main, ["check", str(path)], catch_exceptions=False)
+    assert result.output.startswith(f"{path}:{place[0]}:{place[1]}: error: not valid TOML: {words}\n")

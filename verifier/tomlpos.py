@@ -35,6 +35,7 @@ class Place:
 
 _LONG_NUMBER = re.compile(r"(?<![\w.])[0-9][0-9_]{4300,}")
 _DECODE_POSITION = re.compile(r"\s*\(at line (\d+), column (\d+)\)")
+_DECODE_AT_END = re.compile(r"\s*\(at end of document\)")
 _BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
 _INDEX = re.compile(r"\[([0-9]+)\]")
 
@@ -273,6 +274,12 @@ def decode_error_position(error: ValueError, source: str = "") -> tuple[str, Pla
                  "does not allow: save it with LF or CRLF line ends")
     match = _DECODE_POSITION.search(text)
     if match is None:
+        if source and _DECODE_AT_END.search(text):
+            # a file that ends inside a string, a key, a table header: tomllib names no line
+            # (Python < 3.14); the place is just past the last character, as tomllib counts
+            end = len(source)
+            place = Place(source.count("\n") + 1, end - source.rfind("\n"))
+            return _DECODE_AT_END.sub(" at the end of the file", text), place
         return text, None
     return _DECODE_POSITION.sub("", text), Place(int(match.group(1)), int(match.group(2)))
 
