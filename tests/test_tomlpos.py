@@ -331,3 +331,25 @@ def test_a_file_that_ends_inside_a_value_is_placed_at_its_end(text, place, words
     from verifier.cli import main
     result = CliRunner().invoke(main, ["check", str(path)], catch_exceptions=False)
     assert result.output.startswith(f"{path}:{place[0]}:{place[1]}: error: not valid TOML: {words}\n")
+
+
+@pytest.mark.parametrize("text, key, place", [
+    ('name = "x"\n"" = 1\n', "", (2, 1)),
+    ('name = "x"\n[robot]\nturnaround_ms = 5\n"" = 1\n', "robot.", (4, 1)),
+    ('[[faults]]\nkind = "no_reply"\n"" = 2\n', "faults[0].", (3, 1)),
+    ('robot = { pacing = "late", "" = 1 }\n', "robot.", (1, 28)),
+])
+def test_an_empty_key_is_found_where_it_is_written(text, key, place):
+    # TOML allows the quoted key "": a scenario's unknown key "" at the top had no place
+    # (`uitamr check` printed file:0:0), one in a table was placed at the table's header
+    found = place_of_key(text_lines(text), key, at_name=True)
+    assert (found.line, found.col) == place
+
+
+def test_a_scenario_with_an_empty_key_names_its_line(tmp_path):
+    path = tmp_path / "empty-key.toml"
+    path.write_text('name = "x"\n"" = 1\n', encoding="utf-8")
+    from click.testing import CliRunner
+    from verifier.cli import main
+    result = CliRunner().invoke(main, ["check", str(path)], catch_exceptions=False)
+    assert result.output.startswith(f"{path}:2:1: error: unknown key; expected one of name,")

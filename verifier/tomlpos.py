@@ -57,7 +57,8 @@ def place_of_key(lines: list[str], key: str, at_name: bool = False) -> Place | N
     does not hold is placed at the table or array it would be in; None when not even its
     first part is in the file."""
     places = _places("\n".join(lines))
-    path, missing = _find(places, (), key)
+    # a key of the document named "" (TOML allows an empty quoted key) is its own path
+    path, missing = (("",), "") if key == "" and ("",) in places else _find(places, (), key)
     if not path:
         return None
     name, value = places[path]
@@ -75,12 +76,16 @@ def _find(places: dict[KeyPath, tuple[Place, Place]], path: KeyPath, key: str) -
     index = _INDEX.match(key)
     if index is not None:
         item = path + (int(index.group(1)),)
+        if key[index.end():] == "." and item + ("",) in places:  # "faults[0]." names its key ""
+            return item + ("",), ""
         return _find(places, item, key[index.end():].removeprefix(".")) if item in places else (path, key)
     deepest = (path, key)
     ends = [i for i, ch in enumerate(key) if ch in ".["] + [len(key)]  # where a name of the table may end
     for end in reversed(ends):
         name, rest = key[:end], key[end:]
         if path + (name,) in places:
+            if rest == "." and path + (name, "") in places:  # "robot." names the key "" of [robot]
+                return path + (name, ""), ""
             found = _find(places, path + (name,), rest.removeprefix("."))
             if not found[1]:
                 return found
