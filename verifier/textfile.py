@@ -12,6 +12,12 @@ from typing import Callable
 
 BOM = b"\xef\xbb\xbf"  # a UTF-8 byte order mark, as Windows editors write it: skipped
 
+#: the error handler of every text the tool writes (reports, traces, the console): a file
+#: or folder name that is not UTF-8 comes to Python with its bad bytes as lone surrogates
+#: (b"\xfe" as "\udcfe"), which UTF-8 cannot encode; they are written as "\udcfe", as
+#: Python's own stderr shows them (in JSON, the escape of the same character)
+UNENCODABLE = "backslashreplace"
+
 
 class UnreadableText(Exception):
     """Why a text file could not be read: `cannot read: ...` or `line L, column C (byte N):
