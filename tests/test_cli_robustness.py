@@ -206,3 +206,43 @@ def test_verify_reports_of_a_source_whose_name_is_not_utf8_are_whole(tmp_path):
     assert json.loads(reports[0].read_text(encoding="utf-8"))["scenarios"][0]["sources"] == [str(source)]
     assert reports[1].exists()  # (no frames: the program sends nothing)
     assert reports[2].read_text(encoding="utf-8").rstrip().endswith("</html>")
+
+
+# --- a file that cannot be written to its end -----------------------------------------------------
+
+import resource  # noqa: E402
+import signal  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def run_with_file_size_limit(limit: int, *args, cwd: Path):
+    """`uitamr ARGS` in a process that may write no file larger than `limit` bytes: a write
+    past it fails with EFBIG ("File too large") as on a full disk, half-way through a file."""
+    def limit_files():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a failed write, not a killed process
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+    return subprocess.run([sys.executable, "-m", "verifier.cli", *map(str, args)], cwd=cwd, capture_output=True,
+                          text=True, preexec_fn=limit_files, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=120)
+
+
+@pytest.mark.parametrize("option, name", [("--json", "r.json"), ("--junit", "r.xml"), ("--trace", "r.jsonl"),
+                                          ("--html", "r.html")])
+def test_a_report_that_cannot_be_written_to_its_end_is_not_left_half_written(option, name, tmp_path):
+    # the first 1000 bytes of r.json stayed behind: a report that no reader can read
+    result = run_with_file_size_limit(1000, "replay", ROOT / "tests" / "captures" / "bad-master.txt", option, name,
+                                      cwd=tmp_path)
+    assert result.returncode == 2, result.stderr
+    assert result.stderr.endswith(f"uitamr: cannot write {name}: File too large\n")
+    assert not (tmp_path / name).exists()
+
+
+def test_an_export_file_that_cannot_be_written_to_its_end_is_named_and_not_left_half_written(tmp_path):
+    # half of UITAMR_AdpBridge.st stayed behind, and the error named only the --out folder
+    result = run_with_file_size_limit(3000, "export", "--platform", "fx3u", "--out", "out", cwd=tmp_path)
+    assert result.returncode == 2, result.stderr
+    assert result.stderr.endswith("uitamr export: cannot write out/UITAMR_AdpBridge.st: File too large\n")
+    assert all(path.stat().st_size < 3000 for path in (tmp_path / "out").iterdir())
+    assert not (tmp_path / "out" / "UITAMR_AdpBridge.st").exists()
