@@ -353,3 +353,28 @@ def test_a_scenario_with_an_empty_key_names_its_line(tmp_path):
     from verifier.cli import main
     result = CliRunner().invoke(main, ["check", str(path)], catch_exceptions=False)
     assert result.output.startswith(f"{path}:2:1: error: unknown key; expected one of name,")
+
+
+@pytest.mark.parametrize("text, place", [
+    ("name = 'x'\nwatch = " + "[" * 1000 + "]" * 1000 + "\n", (2, 9)),
+    ("name = 'x'\n[robot]\nx = " + "{a=" * 1000 + "1" + "}" * 1000 + "\n", (3, 5)),
+])
+def test_values_nested_too_deep_for_tomllib_are_an_error_at_their_key(text, place, tmp_path):
+    # tomllib raised RecursionError (not a TOMLDecodeError) some 400 levels deep: check,
+    # verify --scenario and emulate --faults ended in a traceback
+    from click.testing import CliRunner
+    from verifier.cli import main
+    from verifier.emulate.faultfile import FaultFileError, load_fault_file
+    from verifier.verify.scenario import ScenarioError, parse_scenario
+
+    with pytest.raises(ScenarioError) as error:
+        parse_scenario(text)
+    assert (error.value.line, error.value.col) == place
+    assert error.value.message == ("not valid TOML: arrays or inline tables nested hundreds deep: too deep to "
+                                   "read, and no setting takes them")
+    path = tmp_path / "deep.toml"
+    path.write_text(text, encoding="utf-8")
+    result = CliRunner().invoke(main, ["check", str(path)], catch_exceptions=False)
+    assert result.output.startswith(f"{path}:{place[0]}:{place[1]}: error: not valid TOML: arrays")
+    with pytest.raises(FaultFileError, match=rf"^{path}:{place[0]}:{place[1]}: not valid TOML: arrays or inline tables"):
+        load_fault_file(path)

@@ -264,13 +264,16 @@ class _Walk:
         return Place(line, offset - self.line_starts[line - 1] + 1)
 
 
-def decode_error_position(error: ValueError, source: str = "") -> tuple[str, Place | None]:
+def decode_error_position(error: ValueError | RecursionError, source: str = "") -> tuple[str, Place | None]:
     """A TOML syntax error as (message, place): tomllib writes the place as
     "(at line L, column C)" at the end of its message; callers put it after the file
     name like every other error. `source` (the file's text) lets the message name a cause
     tomllib cannot: line ends that are lone carriage returns, which TOML does not allow.
     `error` may also be the plain ValueError tomllib lets through from int() for a
-    whole number of more than 4300 digits (Python's limit): it is placed in `source`."""
+    whole number of more than 4300 digits (Python's limit): it is placed in `source`; or
+    the RecursionError tomllib ends in on arrays or inline tables nested some 400 deep."""
+    if isinstance(error, RecursionError):
+        return _nested_too_deep(source)
     if not isinstance(error, tomllib.TOMLDecodeError):
         return _too_many_digits(source)
     text = str(error)
@@ -287,6 +290,19 @@ def decode_error_position(error: ValueError, source: str = "") -> tuple[str, Pla
             return _DECODE_AT_END.sub(" at the end of the file", text), place
         return text, None
     return _DECODE_POSITION.sub("", text), Place(int(match.group(1)), int(match.group(2)))
+
+
+def _nested_too_deep(source: str) -> tuple[str, Place | None]:
+    """Where the value nested too deep for tomllib begins: the value of the outermost
+    `key = ...` on the way to the deepest place the walk found."""
+    message = "arrays or inline tables nested hundreds deep: too deep to read, and no setting takes them"
+    places = _places(source)
+    deepest = max(places, key=len, default=())
+    for depth in range(1, len(deepest) + 1):
+        name, value = places[deepest[:depth]]
+        if name != value:  # a key = value pair (a table header is placed at its name)
+            return message, value
+    return message, None
 
 
 def _too_many_digits(source: str) -> tuple[str, Place | None]:
