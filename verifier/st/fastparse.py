@@ -201,6 +201,13 @@ class Tokenizer:
         """Kinds, values, lines and columns (1-based, as lark counts) of the significant
         tokens, then the end marker. Raises Bail on a character no terminal reads and on
         a comment GX Works2 does not accept."""
+        for opener, closer in (("(*", "*)"), ("/*", "*/")):
+            # a comment opened after the last closer is never closed; the split tries each
+            # such opener as a comment to the end of the text, in the square of its length
+            # (20,000 of them: 12 s), where lark stops at the first
+            last = text.rfind(opener)
+            if last >= 0 and text.find(closer, last + 2) < 0:
+                raise Bail
         parts = self.split(text)  # "", ignored, token, "", ignored, token, ..., "", ignored, "", ...
         if any(parts[0::3]):  # text no terminal reads
             raise Bail
