@@ -129,6 +129,11 @@ def _noncapturing(rx: str) -> str:
     return result
 
 
+#: longer lines that hold a quote go to the reference parser (see `Tokenizer.tokenize`);
+#: those of the PLC library and the corpus are at most 200 characters
+LONG_LINE = 500
+
+
 class Tokenizer:
     """lark's root lexer for `st.lark`, run as C loops: `re.split` on one regular
     expression — (ignored text)(token) — cuts the text into what lark skips (white space,
@@ -208,6 +213,11 @@ class Tokenizer:
             last = text.rfind(opener)
             if last >= 0 and text.find(closer, last + 2) < 0:
                 raise Bail
+        if len(text) > LONG_LINE and any(len(line) > LONG_LINE and ("'" in line or '"' in line)
+                                         for line in text.split("\n")):
+            # likewise each quote of a string not closed on its line is tried to the line's
+            # end: on a line of 40,000 characters, 8 s
+            raise Bail
         parts = self.split(text)  # "", ignored, token, "", ignored, token, ..., "", ignored, "", ...
         if any(parts[0::3]):  # text no terminal reads
             raise Bail
