@@ -160,3 +160,89 @@ def test_any_bytes_as_a_source_or_scenario_are_checked_without_a_traceback(conte
         result = invoke("check", path)
     assert result.exit_code in (0, 1), result.output
     assert str(path) in result.output or result.exit_code == 0
+
+
+# --- file names that are not UTF-8 --------------------------------------------------------------
+
+import os  # noqa: E402
+
+
+def not_utf8(folder: Path, name: bytes) -> Path:
+    """A path whose name holds bytes that are not UTF-8 (a Shift-JIS name from a Windows share):
+    Python hands it around with lone surrogates in place of the bad bytes."""
+    return folder / os.fsdecode(name)
+
+
+def test_check_prints_a_file_name_that_is_not_utf8(tmp_path):
+    # the console (a UTF-8 stdout with strict errors, as CliRunner's is) raised UnicodeEncodeError
+    path = not_utf8(tmp_path, b"\x83v\x83\x8d.st")  # "プロ" in Shift-JIS
+    path.write_text("PROGRAM P\nVAR x : INT; END_VAR\nx := ;\nEND_PROGRAM\n", encoding="utf-8")
+    result = invoke("check", path)
+    assert result.exit_code == 1
+    assert result.output.startswith(f"{tmp_path}/\\udc83v\\udc83\\udc8d.st:3:6: error: expected an expression")
+
+
+def test_replay_reports_of_a_capture_whose_name_is_not_utf8_are_whole(tmp_path):
+    # report_json raised UnicodeEncodeError half-way through r.json, and left it half-written
+    capture = not_utf8(tmp_path, b"site\xff.txt")
+    capture.write_bytes((Path(__file__).parent / "captures" / "bad-master.txt").read_bytes())
+    reports = [tmp_path / f"r.{suffix}" for suffix in ("json", "xml", "jsonl", "html")]
+    result = invoke("replay", capture, "--json", reports[0], "--junit", reports[1], "--trace", reports[2],
+                    "--html", reports[3])
+    assert result.exit_code == 1, result.output
+    assert json.loads(reports[0].read_text(encoding="utf-8"))["scenarios"][0]["name"] == capture.name
+    assert "site\\udcff.txt" in reports[3].read_text(encoding="utf-8")
+    assert json.loads(reports[2].read_text(encoding="utf-8").splitlines()[0])["scenario"] == capture.name
+    assert invoke("replay", reports[2]).exit_code == 1  # the trace reads back
+
+
+def test_verify_reports_of_a_source_whose_name_is_not_utf8_are_whole(tmp_path):
+    source = not_utf8(tmp_path, b"Main\xfe.st")
+    source.write_text("PROGRAM Main\nVAR x : INT; END_VAR\nx := x + 1;\nEND_PROGRAM\n", encoding="utf-8")
+    reports = [tmp_path / f"v.{suffix}" for suffix in ("json", "jsonl", "html")]
+    result = invoke("verify", source, "--duration", "1s", "--json", reports[0], "--trace", reports[1],
+                    "--html", reports[2])
+    assert result.exit_code in (0, 1), result.output
+    assert json.loads(reports[0].read_text(encoding="utf-8"))["scenarios"][0]["sources"] == [str(source)]
+    assert reports[1].exists()  # (no frames: the program sends nothing)
+    assert reports[2].read_text(encoding="utf-8").rstrip().endswith("</html>")
+
+
+# --- a file that cannot be written to its end -----------------------------------------------------
+
+import resource  # noqa: E402
+import signal  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def run_with_file_size_limit(limit: int, *args, cwd: Path):
+    """`uitamr ARGS` in a process that may write no file larger than `limit` bytes: a write
+    past it fails with EFBIG ("File too large") as on a full disk, half-way through a file."""
+    def limit_files():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a failed write, not a killed process
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+    return subprocess.run([sys.executable, "-m", "verifier.cli", *map(str, args)], cwd=cwd, capture_output=True,
+                          text=True, preexec_fn=limit_files, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=120)
+
+
+@pytest.mark.parametrize("option, name", [("--json", "r.json"), ("--junit", "r.xml"), ("--trace", "r.jsonl"),
+                                          ("--html", "r.html")])
+def test_a_report_that_cannot_be_written_to_its_end_is_not_left_half_written(option, name, tmp_path):
+    # the first 1000 bytes of r.json stayed behind: a report that no reader can read
+    result = run_with_file_size_limit(1000, "replay", ROOT / "tests" / "captures" / "bad-master.txt", option, name,
+                                      cwd=tmp_path)
+    assert result.returncode == 2, result.stderr
+    assert result.stderr.endswith(f"uitamr: cannot write {name}: File too large\n")
+    assert not (tmp_path / name).exists()
+
+
+def test_an_export_file_that_cannot_be_written_to_its_end_is_named_and_not_left_half_written(tmp_path):
+    # half of UITAMR_AdpBridge.st stayed behind, and the error named only the --out folder
+    result = run_with_file_size_limit(3000, "export", "--platform", "fx3u", "--out", "out", cwd=tmp_path)
+    assert result.returncode == 2, result.stderr
+    assert result.stderr.endswith("uitamr export: cannot write out/UITAMR_AdpBridge.st: File too large\n")
+    assert all(path.stat().st_size < 3000 for path in (tmp_path / "out").iterdir())
+    assert not (tmp_path / "out" / "UITAMR_AdpBridge.st").exists()

@@ -2,6 +2,7 @@
 whose frames say their side (our JSONL traces, `tx`/`rx` lines), as `--help` says."""
 from __future__ import annotations
 
+import json
 import subprocess
 
 import pytest
@@ -55,3 +56,26 @@ def test_a_tolerance_just_below_the_period_is_taken(tmp_path):
     done = subprocess.run(uitamr("replay", "--tolerance", "249ms", capture), capture_output=True, text=True,
                           timeout=WAIT_S)
     assert done.returncode in (0, 1) and "timing rules allow 249 ms" in done.stdout, done.stdout + done.stderr
+
+
+@pytest.mark.parametrize("recorded, refused", [(20, True), (0.25, True), (0.249, False), (0.02, False)])
+def test_a_trace_that_records_a_tolerance_no_pacing_violation_could_beat_is_refused(tmp_path, recorded, refused):
+    """A monitor trace whose records say "tolerance": 20 (a hand edit that lost "0.0") was
+    replayed with 20 s and the bad master's three PACING violations were gone; only a note
+    said so. `--tolerance 20s` is refused for the same reason."""
+    from click.testing import CliRunner
+
+    from verifier.cli import main
+
+    trace = tmp_path / "site.jsonl"
+    record = {"scenario": "site", "t": 0.0, "t_end": 0.0011, "dir": "tx", "hex": "01 06 01 01 00 00 D9 F6",
+              "tolerance": recorded}
+    later = dict(record, t=0.1, t_end=0.1011)
+    trace.write_text(json.dumps(record) + "\n" + json.dumps(later) + "\n", encoding="utf-8")
+    result = CliRunner().invoke(main, ["replay", str(trace)], catch_exceptions=False)
+    if refused:
+        assert result.exit_code == 2
+        assert result.stderr == (f"uitamr replay: {trace}:1:1: 'tolerance' is {recorded} s; a monitor records its "
+                                 "--tolerance, which is below the pacing period of 0.25 s\n")
+    else:
+        assert result.exit_code == 1 and "UITAMR-PACING" in result.output, result.output

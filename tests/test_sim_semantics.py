@@ -325,6 +325,22 @@ def test_endless_loop_is_stopped_as_a_watchdog_error():
     assert err.value.location == "t.st:5:1"
 
 
+@pytest.mark.parametrize("loop", ["FOR i := 0 TO 2000000000 DO\n  n := n + 1;\nEND_FOR;",
+                                  "FOR i := 2000000000 TO 0 BY -1 DO\n  n := n + 1;\nEND_FOR;"])
+def test_a_for_loop_with_constant_bounds_past_the_watchdog_is_stopped_as_one(loop):
+    # constant bounds ran as a Python range without the guard: two billion iterations in
+    # one scan, uitamr verify of such a program ran for hours instead of stopping
+    with pytest.raises(SimulationError) as err:
+        run_fb(loop, "i : DINT; n : DINT;")
+    assert "watchdog" in str(err.value)
+    assert err.value.location == "t.st:5:1"
+
+
+def test_a_for_loop_of_a_million_iterations_runs_in_its_scan():
+    _, fb = run_fb("FOR i := 1 TO 1000000 DO\n  n := n + 1;\nEND_FOR;", "i : DINT; n : DINT;")
+    assert (fb.i, fb.n) == (1000001, 1000000)
+
+
 def test_return_leaves_the_pou():
     _, fb = run_fb("n := 1;\nRETURN;\nn := 2;", "n : INT;")
     assert fb.n == 1

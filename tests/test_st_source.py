@@ -2,6 +2,8 @@
 Shift-JIS, else an error naming the byte — the same answer for check, export and load."""
 from __future__ import annotations
 
+import re
+
 import pytest
 from hypothesis import given, strategies as st_
 
@@ -82,3 +84,25 @@ def test_export_reads_with_the_same_reader(tmp_path):
     refused = CliRunner().invoke(main, ["export", "--target", "gxworks2", "--out", str(out), str(junk)])
     assert refused.exit_code == 1
     assert f"{junk}:2:1: error: byte 0xFF" in refused.output
+
+
+def test_after_a_byte_order_mark_the_byte_named_is_the_one_that_is_not_utf8(tmp_path):
+    # the offset was counted from after the mark: "byte 0x28 at offset 13" and column 1,
+    # the '(' three bytes before the 0x82 that is not UTF-8
+    path = tmp_path / "bom.st"
+    path.write_bytes(b"\xef\xbb\xbfPROGRAM P\n(* \x82\xa0 \xff *)\nEND_PROGRAM\n")
+    text, (problem,) = st.read_source(path)
+    assert (problem.line, problem.col) == (2, 4)
+    assert "byte 0x82 at offset 16 is neither UTF-8 nor Shift-JIS" in problem.message
+
+
+@given(st_.sampled_from([b"", b"\xef\xbb\xbf"]), st_.binary(max_size=200))
+def test_the_byte_an_error_names_is_at_the_offset_it_names(bom, body):
+    data = bom + body
+    _, problems = decode_source(data, "x.st")
+    for problem in problems:
+        named, offset = re.match(r"byte 0x([0-9A-F]{2}) at offset (\d+)", problem.message).groups()
+        assert data[int(offset)] == int(named, 16)
+        data[len(bom):int(offset)].decode("utf-8")  # what comes before it is UTF-8 text
+        with pytest.raises(UnicodeDecodeError):
+            data[int(offset):].decode("utf-8")

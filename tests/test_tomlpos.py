@@ -311,3 +311,70 @@ def test_an_array_nested_deeper_than_the_walk_can_follow_is_no_crash():
     with pytest.raises(ScenarioError) as error:
         parse_scenario(text)
     assert error.value.line == 1 and "name" in str(error.value)
+
+
+@pytest.mark.parametrize("text, place, words", [
+    ('name = "x"\nprogram = "P', (2, 13), "Unterminated string at the end of the file"),
+    ('name = "x"\nprogram', (2, 8), "Expected '=' after a key in a key/value pair at the end of the file"),
+    ('name = "x"\nprogram = """P\n\n', (4, 1), "Unterminated string at the end of the file"),
+])
+def test_a_file_that_ends_inside_a_value_is_placed_at_its_end(text, place, words, tmp_path):
+    # tomllib (Python < 3.14) says "(at end of document)" with no line: `uitamr check`
+    # printed file:0:0 and `uitamr verify` the file name alone
+    with pytest.raises(tomllib.TOMLDecodeError) as caught:
+        tomllib.loads(text)
+    message, found = decode_error_position(caught.value, text)
+    assert (found.line, found.col) == place and message == words
+    path = tmp_path / "cut.toml"
+    path.write_text(text, encoding="utf-8")
+    from click.testing import CliRunner
+    from verifier.cli import main
+    result = CliRunner().invoke(main, ["check", str(path)], catch_exceptions=False)
+    assert result.output.startswith(f"{path}:{place[0]}:{place[1]}: error: not valid TOML: {words}\n")
+
+
+@pytest.mark.parametrize("text, key, place", [
+    ('name = "x"\n"" = 1\n', "", (2, 1)),
+    ('name = "x"\n[robot]\nturnaround_ms = 5\n"" = 1\n', "robot.", (4, 1)),
+    ('[[faults]]\nkind = "no_reply"\n"" = 2\n', "faults[0].", (3, 1)),
+    ('robot = { pacing = "late", "" = 1 }\n', "robot.", (1, 28)),
+])
+def test_an_empty_key_is_found_where_it_is_written(text, key, place):
+    # TOML allows the quoted key "": a scenario's unknown key "" at the top had no place
+    # (`uitamr check` printed file:0:0), one in a table was placed at the table's header
+    found = place_of_key(text_lines(text), key, at_name=True)
+    assert (found.line, found.col) == place
+
+
+def test_a_scenario_with_an_empty_key_names_its_line(tmp_path):
+    path = tmp_path / "empty-key.toml"
+    path.write_text('name = "x"\n"" = 1\n', encoding="utf-8")
+    from click.testing import CliRunner
+    from verifier.cli import main
+    result = CliRunner().invoke(main, ["check", str(path)], catch_exceptions=False)
+    assert result.output.startswith(f"{path}:2:1: error: unknown key; expected one of name,")
+
+
+@pytest.mark.parametrize("text, place", [
+    ("name = 'x'\nwatch = " + "[" * 1000 + "]" * 1000 + "\n", (2, 9)),
+    ("name = 'x'\n[robot]\nx = " + "{a=" * 1000 + "1" + "}" * 1000 + "\n", (3, 5)),
+])
+def test_values_nested_too_deep_for_tomllib_are_an_error_at_their_key(text, place, tmp_path):
+    # tomllib raised RecursionError (not a TOMLDecodeError) some 400 levels deep: check,
+    # verify --scenario and emulate --faults ended in a traceback
+    from click.testing import CliRunner
+    from verifier.cli import main
+    from verifier.emulate.faultfile import FaultFileError, load_fault_file
+    from verifier.verify.scenario import ScenarioError, parse_scenario
+
+    with pytest.raises(ScenarioError) as error:
+        parse_scenario(text)
+    assert (error.value.line, error.value.col) == place
+    assert error.value.message == ("not valid TOML: arrays or inline tables nested hundreds deep: too deep to "
+                                   "read, and no setting takes them")
+    path = tmp_path / "deep.toml"
+    path.write_text(text, encoding="utf-8")
+    result = CliRunner().invoke(main, ["check", str(path)], catch_exceptions=False)
+    assert result.output.startswith(f"{path}:{place[0]}:{place[1]}: error: not valid TOML: arrays")
+    with pytest.raises(FaultFileError, match=rf"^{path}:{place[0]}:{place[1]}: not valid TOML: arrays or inline tables"):
+        load_fault_file(path)

@@ -7,10 +7,13 @@ command object called `command`; modules are imported only when their command ru
 from __future__ import annotations
 
 import importlib
+import io
+import sys
 
 import click
 
 from verifier import __version__
+from verifier.textfile import UNENCODABLE
 
 SUBCOMMANDS = {
     "verify": "Run PLC programs against the emulated robot and check the traffic.",
@@ -60,6 +63,13 @@ class LazyGroup(click.Group):
 @click.version_option(__version__, prog_name="uitamr")
 def main() -> None:
     """UITAMR PLC toolkit: verify, emulate and export."""
+    # A file name that is not UTF-8 (b"\xfe.st" from a Shift-JIS or Big5 share) holds lone
+    # surrogates, which a UTF-8 stdout with strict errors (a UTF-8 locale other than C, a
+    # pipe, PYTHONIOENCODING) cannot print: `uitamr check` ended in a traceback. Such
+    # characters are printed as stderr prints them ("\udcfe"), in the reports too.
+    for stream in (sys.stdout, sys.stderr):
+        if isinstance(stream, io.TextIOWrapper) and stream.errors == "strict":
+            stream.reconfigure(errors=UNENCODABLE)
 
 
 if __name__ == "__main__":  # pragma: no cover

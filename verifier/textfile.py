@@ -7,10 +7,17 @@ from __future__ import annotations
 import os
 import re
 import stat
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Callable
+from typing import IO, Callable, Iterator
 
 BOM = b"\xef\xbb\xbf"  # a UTF-8 byte order mark, as Windows editors write it: skipped
+
+#: the error handler of every text the tool writes (reports, traces, the console): a file
+#: or folder name that is not UTF-8 comes to Python with its bad bytes as lone surrogates
+#: (b"\xfe" as "\udcfe"), which UTF-8 cannot encode; they are written as "\udcfe", as
+#: Python's own stderr shows them (in JSON, the escape of the same character)
+UNENCODABLE = "backslashreplace"
 
 
 class UnreadableText(Exception):
@@ -128,3 +135,29 @@ def escape_chars(text: str, keep: Callable[[str], bool]) -> str:
         return text
     return "".join(c if keep(c) else f"\\x{ord(c):02x}" if ord(c) < 0x100 else f"\\u{ord(c):04x}"
                    for c in text)
+
+
+@contextmanager
+def whole_file(path: Path | str, mode: str = "w", **options) -> Iterator[IO]:
+    """`open(path, mode, **options)` for a file the tool writes (a report, an export) that
+    is to be whole or not there at all: when writing fails (a full disk, a file size limit,
+    Ctrl-C), the part written is removed and the OSError names the file. A path that is not
+    a regular file (/dev/stdout, a pipe) is left as it is."""
+    out = open(path, mode, **options)
+    try:
+        yield out
+        out.close()  # the last of the text may fail only here
+    except BaseException as exc:
+        try:
+            out.close()
+        except OSError:
+            pass
+        try:
+            real = real_path(path)
+            if stat.S_ISREG(real.stat().st_mode):
+                real.unlink()
+        except OSError:
+            pass
+        if isinstance(exc, OSError) and exc.filename is None:
+            exc.filename = str(path)
+        raise

@@ -35,6 +35,7 @@ class Place:
 
 _LONG_NUMBER = re.compile(r"(?<![\w.])[0-9][0-9_]{4300,}")
 _DECODE_POSITION = re.compile(r"\s*\(at line (\d+), column (\d+)\)")
+_DECODE_AT_END = re.compile(r"\s*\(at end of document\)")
 _BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
 _INDEX = re.compile(r"\[([0-9]+)\]")
 
@@ -56,7 +57,8 @@ def place_of_key(lines: list[str], key: str, at_name: bool = False) -> Place | N
     does not hold is placed at the table or array it would be in; None when not even its
     first part is in the file."""
     places = _places("\n".join(lines))
-    path, missing = _find(places, (), key)
+    # a key of the document named "" (TOML allows an empty quoted key) is its own path
+    path, missing = (("",), "") if key == "" and ("",) in places else _find(places, (), key)
     if not path:
         return None
     name, value = places[path]
@@ -74,12 +76,16 @@ def _find(places: dict[KeyPath, tuple[Place, Place]], path: KeyPath, key: str) -
     index = _INDEX.match(key)
     if index is not None:
         item = path + (int(index.group(1)),)
+        if key[index.end():] == "." and item + ("",) in places:  # "faults[0]." names its key ""
+            return item + ("",), ""
         return _find(places, item, key[index.end():].removeprefix(".")) if item in places else (path, key)
     deepest = (path, key)
     ends = [i for i, ch in enumerate(key) if ch in ".["] + [len(key)]  # where a name of the table may end
     for end in reversed(ends):
         name, rest = key[:end], key[end:]
         if path + (name,) in places:
+            if rest == "." and path + (name, "") in places:  # "robot." names the key "" of [robot]
+                return path + (name, ""), ""
             found = _find(places, path + (name,), rest.removeprefix("."))
             if not found[1]:
                 return found
@@ -258,13 +264,16 @@ class _Walk:
         return Place(line, offset - self.line_starts[line - 1] + 1)
 
 
-def decode_error_position(error: ValueError, source: str = "") -> tuple[str, Place | None]:
+def decode_error_position(error: ValueError | RecursionError, source: str = "") -> tuple[str, Place | None]:
     """A TOML syntax error as (message, place): tomllib writes the place as
     "(at line L, column C)" at the end of its message; callers put it after the file
     name like every other error. `source` (the file's text) lets the message name a cause
     tomllib cannot: line ends that are lone carriage returns, which TOML does not allow.
     `error` may also be the plain ValueError tomllib lets through from int() for a
-    whole number of more than 4300 digits (Python's limit): it is placed in `source`."""
+    whole number of more than 4300 digits (Python's limit): it is placed in `source`; or
+    the RecursionError tomllib ends in on arrays or inline tables nested some 400 deep."""
+    if isinstance(error, RecursionError):
+        return _nested_too_deep(source)
     if not isinstance(error, tomllib.TOMLDecodeError):
         return _too_many_digits(source)
     text = str(error)
@@ -273,8 +282,27 @@ def decode_error_position(error: ValueError, source: str = "") -> tuple[str, Pla
                  "does not allow: save it with LF or CRLF line ends")
     match = _DECODE_POSITION.search(text)
     if match is None:
+        if source and _DECODE_AT_END.search(text):
+            # a file that ends inside a string, a key, a table header: tomllib names no line
+            # (Python < 3.14); the place is just past the last character, as tomllib counts
+            end = len(source)
+            place = Place(source.count("\n") + 1, end - source.rfind("\n"))
+            return _DECODE_AT_END.sub(" at the end of the file", text), place
         return text, None
     return _DECODE_POSITION.sub("", text), Place(int(match.group(1)), int(match.group(2)))
+
+
+def _nested_too_deep(source: str) -> tuple[str, Place | None]:
+    """Where the value nested too deep for tomllib begins: the value of the outermost
+    `key = ...` on the way to the deepest place the walk found."""
+    message = "arrays or inline tables nested hundreds deep: too deep to read, and no setting takes them"
+    places = _places(source)
+    deepest = max(places, key=len, default=())
+    for depth in range(1, len(deepest) + 1):
+        name, value = places[deepest[:depth]]
+        if name != value:  # a key = value pair (a table header is placed at its name)
+            return message, value
+    return message, None
 
 
 def _too_many_digits(source: str) -> tuple[str, Place | None]:

@@ -129,7 +129,7 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
         click.echo(f"uitamr export: nothing written: --program: {e}", err=True)
         sys.exit(EXIT_USAGE)
     except OSError as e:
-        click.echo(f"uitamr export: cannot write {out_dir}: {e.strerror or e}", err=True)
+        click.echo(f"uitamr export: cannot write {e.filename or out_dir}: {e.strerror or e}", err=True)
         sys.exit(EXIT_USAGE)
     for note in warnings + notes:
         click.echo(str(note), err=True)

@@ -51,7 +51,8 @@ def load_fault_file(path: str | Path, own_address: int | None = None) -> FaultFi
         raise FaultFileError(f"{path}: {err}") from None
     try:
         data = tomllib.loads(text)
-    except ValueError as err:  # TOMLDecodeError, or int()'s limit of 4300 digits
+    except (ValueError, RecursionError) as err:
+        # TOMLDecodeError, int()'s limit of 4300 digits, or arrays nested too deep for tomllib
         message, line = decode_error_position(err, text)
         raise FaultFileError(f"{_where(path, line)}: not valid TOML: {message}") from None
     try:

@@ -24,7 +24,7 @@ from verifier.sim.cpu import CpuProfile
 from verifier.sim.reach import type_names
 from verifier.export.labels import LabelRow, initial_text, label_class, label_rows, rows_of
 from verifier.export.types import type_name
-from verifier.textfile import real_path, text_lines
+from verifier.textfile import real_path, text_lines, whole_file
 
 COLUMNS = {
     "gxworks2": ("Class", "Label Name", "Data Type", "Constant", "Comment"),
@@ -293,27 +293,27 @@ def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, 
             body = body_text(pou, f.text)
             rows = label_rows(pou, f.text, target)
             body_path, table_path = _pou_files(out, pou)
-            body_path.write_text(body, encoding="utf-8")
-            table_path.write_text(label_table(rows, target), encoding="utf-8")
+            _write(body_path, body)
+            _write(table_path, label_table(rows, target))
             written += [body_path, table_path]
             result = type_name(pou.return_type, target) if pou.return_type is not None else ""
             exported.append(ExportedPou(pou.name, pou.kind, f.filename, result, _uses(pou, body, known)))
     for f in files:
         for struct in f.types:
             path = _struct_file(out, struct)
-            path.write_text(struct_table(rows_of(struct.fields, f.text, target), target), encoding="utf-8")
+            _write(path, struct_table(rows_of(struct.fields, f.text, target), target))
             written.append(path)
             members = {k for v in struct.fields for k in type_names(v.type) if k in structs}
             exported.append(ExportedPou(struct.name, "STRUCT", f.filename, uses=members - {struct.key}))
     global_rows = [row for f in files for block in f.globals for row in rows_of(block.variables, f.text, target)]
     if global_rows:
         path = out / GLOBAL_TABLE
-        path.write_text(global_table(global_rows, target), encoding="utf-8")
+        _write(path, global_table(global_rows, target))
         written.append(path)
     dropped = dropped_initial_values(files, target)
     stale = out / DROPPED_TABLE
     if dropped:
-        stale.write_text("".join(str(d) + "\n" for d in dropped), encoding="utf-8")
+        _write(stale, "".join(str(d) + "\n" for d in dropped))
         written.append(stale)
     elif stale.exists():
         stale.unlink()                     # from an earlier export into the same folder
@@ -322,6 +322,12 @@ def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, 
     order = out / IMPORT_ORDER
     by_name = {p.name: p for p in exported}
     rows = [(name, by_name[name].kind, by_name[name].result) for name in import_order(exported)]
-    order.write_text("".join("\t".join(filter(None, row)) + "\n" for row in rows), encoding="utf-8")
+    _write(order, "".join("\t".join(filter(None, row)) + "\n" for row in rows))
     written.append(order)
     return written
+
+
+def _write(path: Path, text: str) -> None:
+    """One file of the export, whole or not at all (a full disk left half a body behind)."""
+    with whole_file(path, encoding="utf-8") as out:
+        out.write(text)

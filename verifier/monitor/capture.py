@@ -142,6 +142,12 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
                                f"{scenario!r} ({chunks[-1].t_start_us / 1_000_000:g} s); a trace is in time "
                                "order, and two runs in one trace need names of their own")
         tolerance = _seconds(record["tolerance"], "tolerance", where) if record.get("tolerance") is not None else None
+        if tolerance is not None and round(tolerance * 1_000_000) >= protocol.MIN_PERIOD_US:
+            # what `--tolerance` refuses: with it no UITAMR-PACING violation could be found, and
+            # a digit lost in a hand edit (20 for 0.020) would pass a PLC pacing at 100 ms
+            raise CaptureError(f"{where}: 'tolerance' is {json.dumps(record['tolerance'])} s; a monitor records its "
+                               f"--tolerance, which is below the pacing period of "
+                               f"{protocol.MIN_PERIOD_US / 1_000_000:g} s")
         chunks.append(Chunk(round(t_end * 1_000_000), data, record["dir"], round(t_start * 1_000_000),
                             None if tolerance is None else round(tolerance * 1_000_000)))
     return scenarios

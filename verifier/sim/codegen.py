@@ -636,8 +636,11 @@ class BodyCompiler(CallCompiler):
         t = var.type
         lo_t, hi_t = _int_range(t)
         if (start is not None and end is not None and step not in (None, 0)
-                and lo_t <= end + step <= hi_t and not _assigns(s.body, s.var)):
-            # constant bounds and a body that leaves the counter alone: a Python range
+                and lo_t <= end + step <= hi_t and not _assigns(s.body, s.var)
+                and _iterations(start, end, step) <= LOOP_LIMIT):
+            # constant bounds and a body that leaves the counter alone: a Python range (more
+            # iterations than the watchdog allows go the guarded way: FOR i := 0 TO 2000000000
+            # ran for hours instead of stopping with the CPU's watchdog timer error)
             v = self.new_tmp("_i")
             self.em.line(f"for {v} in range({start}, {end + (1 if step > 0 else -1)}, {step}):")
             self.em.indent()
@@ -652,7 +655,7 @@ class BodyCompiler(CallCompiler):
                 if known:
                     self.loop_vars.pop(s.var.key, None)
             self.em.dedent()
-            n = max(0, (end - start) // step + 1) if (end - start) * step >= 0 else 0
+            n = _iterations(start, end, step)
             self.em.line("else:")
             self.em.indent()
             self.emit_lines(var.write(repr(start + n * step)))
@@ -716,6 +719,11 @@ class BodyCompiler(CallCompiler):
 
 
 LONG_CHAIN = 16  # operators in a left-deep chain compiled step by step (see chain())
+
+
+def _iterations(start: int, end: int, step: int) -> int:
+    """How often FOR start TO end BY step runs its body (step not 0)."""
+    return max(0, (end - start) // step + 1) if (end - start) * step >= 0 else 0
 
 
 def _typed_literal(code: str, src, dst) -> str:

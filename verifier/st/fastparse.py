@@ -129,6 +129,11 @@ def _noncapturing(rx: str) -> str:
     return result
 
 
+#: longer lines that hold a quote go to the reference parser (see `Tokenizer.tokenize`);
+#: those of the PLC library and the corpus are at most 200 characters
+LONG_LINE = 500
+
+
 class Tokenizer:
     """lark's root lexer for `st.lark`, run as C loops: `re.split` on one regular
     expression — (ignored text)(token) — cuts the text into what lark skips (white space,
@@ -201,6 +206,18 @@ class Tokenizer:
         """Kinds, values, lines and columns (1-based, as lark counts) of the significant
         tokens, then the end marker. Raises Bail on a character no terminal reads and on
         a comment GX Works2 does not accept."""
+        for opener, closer in (("(*", "*)"), ("/*", "*/")):
+            # a comment opened after the last closer is never closed; the split tries each
+            # such opener as a comment to the end of the text, in the square of its length
+            # (20,000 of them: 12 s), where lark stops at the first
+            last = text.rfind(opener)
+            if last >= 0 and text.find(closer, last + 2) < 0:
+                raise Bail
+        if len(text) > LONG_LINE and any(len(line) > LONG_LINE and ("'" in line or '"' in line)
+                                         for line in text.split("\n")):
+            # likewise each quote of a string not closed on its line is tried to the line's
+            # end: on a line of 40,000 characters, 8 s
+            raise Bail
         parts = self.split(text)  # "", ignored, token, "", ignored, token, ..., "", ignored, "", ...
         if any(parts[0::3]):  # text no terminal reads
             raise Bail

@@ -12,7 +12,7 @@ import stat
 from pathlib import Path
 
 from verifier.st.ast import Diagnostic
-from verifier.textfile import file_kind, place_of_byte
+from verifier.textfile import BOM, file_kind, place_of_byte
 
 ENCODINGS = ("utf-8-sig", "cp932")
 #: Python's cp932 decodes these single bytes to control or private-use characters that
@@ -48,7 +48,9 @@ def decode_source(data: bytes, name: str = "<bytes>") -> tuple[str, list[Diagnos
     try:
         return data.decode("utf-8-sig"), []
     except UnicodeDecodeError as utf8_error:
-        bad = utf8_error.start
+        # "utf-8-sig" counts from after a byte order mark; the offset, line and column
+        # are the file's
+        bad = utf8_error.start + (len(BOM) if data.startswith(BOM) else 0)
     try:
         text = data.decode("cp932")
     except UnicodeDecodeError:

@@ -14,6 +14,7 @@ from typing import Iterator
 import jinja2
 
 from verifier import __version__
+from verifier.textfile import UNENCODABLE, whole_file
 
 from .durations import format_seconds
 from .events_shown import EVENTS_AT_MOST, event_class
@@ -217,5 +218,5 @@ def render(results: list[ScenarioResult]) -> str:
 def write(results: list[ScenarioResult], path: Path) -> None:
     # written as the template goes: the page of a --matrix of soak tests is tens of MB, and
     # the whole text at once (with its pieces) was the largest thing the command held
-    with open(path, "w", encoding="utf-8") as out:
+    with whole_file(path, encoding="utf-8", errors=UNENCODABLE) as out:
         out.writelines(_pieces(results))

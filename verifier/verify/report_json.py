@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from verifier import __version__
+from verifier.textfile import UNENCODABLE, whole_file
 
 from .evidence import Violation
 from .expectations import ExpectationResult
@@ -118,6 +119,6 @@ def to_dict(results: list[ScenarioResult]) -> dict[str, Any]:
 def write(results: list[ScenarioResult], path: Path) -> None:
     # streamed to the file: an indented dumps() of a long capture's findings (a 1 MB burst on
     # the monitor: 60,000 violations) holds every piece of the text in one list at once
-    with open(path, "w", encoding="utf-8") as out:
+    with whole_file(path, encoding="utf-8", errors=UNENCODABLE) as out:
         json.dump(to_dict(results), out, indent=2, ensure_ascii=False)
         out.write("\n")

@@ -10,7 +10,7 @@ import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from verifier.textfile import escape_chars
+from verifier.textfile import escape_chars, whole_file
 
 from .durations import format_seconds
 from .result import ScenarioResult, run_names
@@ -111,4 +111,5 @@ def write(results: list[ScenarioResult], path: Path) -> None:
             element.set(name, _xml_safe(value))
     tree = ET.ElementTree(root)
     ET.indent(tree)
-    tree.write(path, encoding="utf-8", xml_declaration=True)
+    with whole_file(path, "wb") as out:
+        tree.write(out, encoding="utf-8", xml_declaration=True)

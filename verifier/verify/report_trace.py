@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Collection, Iterator
 
 from verifier import protocol
+from verifier.textfile import UNENCODABLE, whole_file
 
 from .evidence import RuleOptions
 from .result import ScenarioResult, run_names
@@ -148,7 +149,7 @@ def _scenario_field(name: str) -> str:
 def write(results: list[ScenarioResult], path: Path) -> None:
     """The trace of `results`, run after run; runs that share a name are told apart as the
     JUnit report tells them (`run_names`), so that `uitamr replay` reads them as two."""
-    with open(path, "w", encoding="utf-8") as out:
+    with whole_file(path, encoding="utf-8", errors=UNENCODABLE) as out:
         for result, name in zip(results, run_names(results)):
             if result.trace_file is not None:
                 out.writelines(_spooled(result, name))

@@ -271,7 +271,8 @@ def load_scenario(path: Path | str, platform: str | None = None) -> Scenario:
 def parse_scenario(text: str, path: Path | None = None, platform: str | None = None) -> Scenario:
     try:
         data = tomllib.loads(text)
-    except ValueError as exc:  # TOMLDecodeError, or int()'s limit of 4300 digits
+    except (ValueError, RecursionError) as exc:
+        # TOMLDecodeError, int()'s limit of 4300 digits, or arrays nested too deep for tomllib
         message, place = decode_error_position(exc, text)
         raise ScenarioError(path, "", f"not valid TOML: {message}", place) from None
     return _Reader(text, path, platform).read(data)

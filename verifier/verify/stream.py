@@ -20,6 +20,7 @@ from contextlib import contextmanager
 from typing import Any, Sequence, TextIO
 
 from verifier import protocol
+from verifier.textfile import UNENCODABLE
 
 from . import spool
 from .evidence import RuleOptions, RunEvidence, Samples, Violation
@@ -51,7 +52,7 @@ class Stream:
         if spool_folder is not None:
             with self._writing():
                 handle, self.trace_file = tempfile.mkstemp(prefix=spool.PREFIX, suffix=".part", dir=spool_folder)
-                self.spool = os.fdopen(handle, "w", encoding="utf-8")
+                self.spool = os.fdopen(handle, "w", encoding="utf-8", errors=UNENCODABLE)
         self.pairing = Pairing(settings, options)
         self.evidence = RunEvidence(settings, (), _OPEN_END_US, [], samples, options)
         self.judgement = Judgement(self.evidence, self.pairing.traffic)
