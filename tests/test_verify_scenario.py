@@ -315,6 +315,22 @@ def test_a_window_past_the_end_of_the_run_fails_with_advice():
     assert not result.passed and "make the scenario's duration longer" in result.detail
 
 
+@pytest.mark.parametrize("kind, condition", [("that", "ok"), ("always", "ok"), ("never", "NOT ok")])
+def test_a_window_that_opens_after_the_run_fails_with_advice(kind, condition):
+    # `after` past the end with no `within` passed every kind: the window was empty
+    evidence = _evidence({"ok": [(0, True)]}, end_us=10_000_000)
+    (result,) = _judge(f'[[expect]]\n{kind} = "{condition}"\nafter = "12s"\n', evidence)
+    assert not result.passed
+    assert result.detail == ("the run ended at 10.000 s, before the window opened at 12.000 s: "
+                             "make the scenario's duration longer")
+
+
+def test_a_sent_or_reached_point_window_that_opens_after_the_run_fails():
+    for text in ('sent = "stop"', "reached_point = 1"):
+        (result,) = _judge(f'[[expect]]\n{text}\nafter = "10s"\n', _evidence({}))
+        assert not result.passed and "before the window opened at 10.000 s" in result.detail
+
+
 def _tx(t_ms, request):
     data = protocol.encode(request, S)
     return TraceRecord(t_ms * 1000, t_ms * 1000 + protocol.frame_time_us(8), "tx", data)

@@ -85,6 +85,15 @@ def verdict(expectation: Expectation, evidence: RunEvidence, watch: "ExchangeWat
     """The result of `expectation` once the run has ended: from `watch` (every exchange of
     the run given to it) for the kinds about exchanges, from the samples for the others."""
     start, end = expectation.window(evidence.end_us)
+    if expectation.after_us >= evidence.end_us:
+        # the window would be empty (or end before it begins): nothing could be judged
+        opens = format_seconds(expectation.after_us)
+        if evidence.stopped_early:
+            why = f"the simulation stopped at {format_seconds(evidence.end_us)}, before the window opened at {opens}"
+        else:
+            why = (f"the run ended at {format_seconds(evidence.end_us)}, before the window opened at {opens}: "
+                   "make the scenario's duration longer")
+        return ExpectationResult(expectation, False, why)
     short = expectation.within_us is not None and expectation.after_us + expectation.within_us > evidence.end_us
     if short:
         closes = format_seconds(expectation.after_us + expectation.within_us)
