@@ -381,6 +381,31 @@ def test_reached_point_needs_the_task_to_run_and_end_without_error():
     assert not result.passed and "error 01" in result.detail
 
 
+def _error_read(t_ms, error):
+    request = _tx(t_ms, protocol.StatusRequest(1, protocol.Query.TASK))
+    return [request, _rx(request, protocol.StatusReply(1, error, 0))]
+
+
+def test_reached_point_names_when_the_task_ended_not_the_last_status_read():
+    # the robot keeps reporting error 01 on every later poll: the finding named the last
+    # of them (8.900 s in a run where the obstacle stopped the task at 5.060 s)
+    trace = (_control(0, STOP) + _control(600, POINT3) + _read(900, 1) + _error_read(1500, 1)
+             + _error_read(1800, 1) + _error_read(2100, 1))
+    (result,) = _judge('[[expect]]\nreached_point = 3\n', _evidence({}, trace))
+    assert not result.passed
+    assert result.detail == "the task of run-point 3 ended with error 01 at 1.500 s"
+
+
+def test_a_task_stopped_by_an_error_is_not_reached_once_the_error_clears():
+    # after error 01 ended the task, the next poll with the error gone ("idle, error 00")
+    # counted as the point reached: the robot never got there
+    trace = (_control(0, STOP) + _control(600, POINT3) + _read(900, 1) + _error_read(1500, 1)
+             + _read(1800, 0))
+    (result,) = _judge('[[expect]]\nreached_point = 3\n', _evidence({}, trace))
+    assert not result.passed
+    assert result.detail == "the task of run-point 3 ended with error 01 at 1.500 s"
+
+
 # --- conditions: property test against Python's own evaluation ----------------------------------
 
 _VALUES = {"a": True, "b": False, "n": 5, "fb.m": 0x101}

@@ -272,6 +272,8 @@ class _ReachedPoint(ExchangeWatch):
             error = int(reply.error)
             self.progress = lambda start, end: (
                 f"the task of run-point {point} ended with error {error:02d} at {format_seconds(t)}")
+            # the task is over: later polls that still show the error do not move its end
+            self.accepted_at, self.running_seen = None, False
 
     def result(self, start: int, end: int) -> ExpectationResult:
         point = self.expectation.point
