@@ -751,3 +751,49 @@ def test_the_converter_drop_a_scenario_scripts_is_marked_as_its_fault_on_the_pag
     marks = re.findall(r'class="ovfault" x="([\d.]+)"', pages["fx5u-tcp-dropped"])
     assert len(marks) == 1
     assert re.findall(r'class="ovfault" x="', pages["fx5u-tcp-healthy"]) == []
+
+
+NEVER_REARMED = """PROGRAM MAIN
+VAR
+    uSend : ARRAY[0..3] OF WORD;
+    uRecv : ARRAY[0..3] OF WORD;
+    tPoll : TON;
+    wReplies : INT;
+END_VAR
+IF M8002 THEN
+    D8400 := 16#1C81;
+    D8409 := 5;
+    uSend[0] := 16#0601;
+    uSend[1] := 16#A001;
+    uSend[2] := 16#0000;
+    uSend[3] := 16#1488;
+END_IF;
+tPoll(IN := NOT tPoll.Q, PT := T#400ms);
+IF tPoll.Q AND NOT M8402 THEN
+    M8402 := TRUE;
+END_IF;
+IF M8403 THEN
+    wReplies := wReplies + 1;
+END_IF;
+RS2(TRUE, uSend[0], 8, 8, 1, uRecv[0]);
+END_PROGRAM
+"""
+
+
+def test_a_reception_never_rearmed_is_named_on_the_console_and_in_junit(tmp_path, monkeypatch):
+    # the program sends the stop every 400 ms and never resets M8403: every reply after the
+    # first is discarded. Only the JSON report said so, without a place; the console and
+    # the JUnit report, what a CI user reads, said nothing
+    (tmp_path / "MAIN.st").write_text(NEVER_REARMED, encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("MAIN.st", "--platform", "fx3u", "--duration", "3s", "--junit", "v.xml", "--json", "v.json")
+    lines = [line for line in result.output.splitlines() if line.startswith("    simulator ")]
+    assert len(lines) == 1, result.output  # one line for every discarded reply
+    assert re.fullmatch(
+        r"    simulator ×\d+, first at \d\.\d{3} s: RS2 fx3:1: \d received byte\(s\) discarded because M8403 was "
+        r"still ON: reset M8403 \(receive complete\) once the received data is read, or RS2 receives nothing "
+        r"more \(docs/instructions\.md §7\)  at MAIN\.st:23:1", lines[0]), lines[0]
+    out = ET.parse(tmp_path / "v.xml").getroot().find(".//system-out").text
+    assert lines[0].strip() in out.splitlines()
+    every = json.loads((tmp_path / "v.json").read_text())["scenarios"][0]["simulator_diagnostics"]
+    assert int(re.search(r"×(\d+)", lines[0]).group(1)) == len(every) > 1

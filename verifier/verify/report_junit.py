@@ -80,6 +80,7 @@ def to_element(results: list[ScenarioResult]) -> ET.Element:
                 f"{format_seconds(result.ended_us)} of virtual time, scan {result.scan_us / 1000:g} ms, seed {result.seed}",
                 f"{tx} requests, {rx} replies",
                 *(f"note: {note}" for note in result.notes),
+                *(f"simulator {line}" for line in result.diagnostic_summary),
                 *(f"fault: {fault}" for fault in result.faults),
                 *([result.converter] if result.converter else []),
                 *(f"expectation met: {e.expectation.label}: {e.detail}" for e in result.expectations if e.passed),

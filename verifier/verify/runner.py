@@ -190,6 +190,12 @@ class _Plc:
     def diagnostics(self) -> list[str]:
         return [str(d) for d in self.project.diagnostics]
 
+    def diagnostic_summary(self) -> list[str]:
+        from verifier.sim.errors import summarize_diagnostics
+
+        cwd = os.getcwd()
+        return summarize_diagnostics(self.project.diagnostics, lambda location: _relative(location, cwd))
+
 
 def _did_you_mean(part: str, instance: Any) -> str:
     """'; did you mean 'fbBatt'?' when `instance` (a program or FB) has a label spelt
@@ -583,6 +589,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         violations=violations,
         expectations=outcomes,
         diagnostics=plc.diagnostics(),
+        diagnostic_summary=plc.diagnostic_summary(),
         watched={name: list(samples.changes.get(name, [])) for name in scenario.watch} if keep.details and keep.watched else {},
         aborted=aborted,
         ended_us=end,
