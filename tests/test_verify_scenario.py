@@ -370,6 +370,23 @@ def test_sent_and_reached_point():
     assert "running" in results[3].detail and "did not finish" in results[3].detail
 
 
+SPEED_STAGE_2 = protocol.ControlRequest(1, protocol.ControlCode.SPEED_TRACKLESS, 1)
+
+
+def test_a_control_command_not_sent_names_what_was_sent_instead():
+    # FB stage 2 (UITAMR_SetSpeed i_wStage) is 02/01 on the wire, 'speed trackless 1' in
+    # the words: the finding only said 'trackless speed stage 3 (02/02) ... was not sent'
+    trace = _control(0, STOP) + _read(300, 0) + _control(600, SPEED_STAGE_2) + _control(900, POINT3)
+    results = _judge('[[expect]]\nsent = "speed trackless 2"\n'
+                     '[[expect]]\nsent = "run-point 4"\n'
+                     '[[expect]]\nsent = "read battery"\n', _evidence({}, trace))
+    assert [r.passed for r in results] == [False, False, False]
+    assert results[0].detail == ("trackless speed stage 3 (02/02) (01 06 02 02 00 00 29 B2) was not sent between "
+                                 "0.000 s and 10.000 s; sent instead: trackless speed stage 2 (02/01) at 0.600 s")
+    assert results[1].detail.endswith("; sent instead: stop (01/A0) at 0.000 s, run point/script 3 (01/03) at 0.900 s")
+    assert "instead" not in results[2].detail  # the other reads would be noise
+
+
 def test_reached_point_needs_the_task_to_run_and_end_without_error():
     never_runs = _control(0, STOP) + _read(300, 0) + _control(600, POINT3) + _read(900, 0)
     (result,) = _judge('[[expect]]\nreached_point = 3\n', _evidence({}, never_runs))

@@ -26,6 +26,7 @@ from .evidence import FrameRef, RunEvidence
 from .traffic import Traffic
 
 KINDS = ("that", "always", "never", "sent", "reached_point")
+SENT_INSTEAD = 3  # other control commands a failed `sent` names
 #: Robot errors that stop a running task (a battery warning does not; docs/emulator.md).
 TASK_STOPPING_ERRORS = (protocol.RobotError.ANTI_COLLISION, protocol.RobotError.OFF_TAPE)
 
@@ -199,9 +200,17 @@ class _Sent(ExchangeWatch):
         self.wanted = protocol.encode(expectation.request, settings)
         self.answered = None  # the first exchange of the request that was answered
         self.unanswered = None  # else the first one sent
+        # other control commands sent in the window, for a control command that was not:
+        # those with its control code first ("speed trackless 2" expected, stage 2 = 02/01
+        # sent), the first few distinct ones (meaning, time)
+        self.instead: dict[str, int] = {}
+        self.instead_other: dict[str, int] = {}
 
     def in_window(self, exchange, t: int) -> None:
-        if self.answered is not None or bytes(exchange.request.data) != self.wanted:
+        if self.answered is not None:
+            return
+        if bytes(exchange.request.data) != self.wanted:
+            self._other(exchange, t)
             return
         if exchange.answered:
             self.answered = exchange
@@ -223,10 +232,26 @@ class _Sent(ExchangeWatch):
                 f"{meaning} was sent at {format_seconds(t)} but never answered {_span(start, end)}",
                 t, self.unanswered.refs(),
             )
+        instead = self.instead or self.instead_other
+        sent = ""
+        if instead:
+            sent = "; sent instead: " + ", ".join(
+                f"{other} at {format_seconds(t)}" for other, t in list(instead.items())[:SENT_INSTEAD])
+            if len(instead) > SENT_INSTEAD:
+                sent += ", ..."
         return ExpectationResult(
             expectation, False,
-            f"{meaning} ({protocol.hex_bytes(self.wanted)}) was not sent {_span(start, end)}",
+            f"{meaning} ({protocol.hex_bytes(self.wanted)}) was not sent {_span(start, end)}{sent}",
         )
+
+    def _other(self, exchange, t: int) -> None:
+        wanted = self.expectation.request
+        request = exchange.decoded_request
+        if not (isinstance(wanted, protocol.ControlRequest) and isinstance(request, protocol.ControlRequest)):
+            return  # a status read expected: the polls of every other query would only be noise
+        found = self.instead if request.code == wanted.code else self.instead_other
+        if len(found) <= SENT_INSTEAD:
+            found.setdefault(protocol.describe(request, self.settings), t)
 
 
 class _ReachedPoint(ExchangeWatch):
