@@ -261,6 +261,41 @@ def test_a_number_too_long_for_python_is_a_toml_error_at_its_place():
     assert str(error).startswith("x.toml:2:8: not valid TOML: a whole number of 5001 digits: too long to read")
 
 
+def test_a_duration_of_another_type_is_shown_as_the_file_writes_it():
+    # 'got True' (Python's spelling) for `within = true`; a bare number got no remedy
+    error = error_of('program = "M"\n[[expect]]\nthat = "a"\nwithin = true\n', Path("x.toml"))
+    assert str(error) == 'x.toml:4:10: expect[0].within: expected a duration such as "250ms" or "60s", got true'
+    error = error_of('program = "M"\n[[expect]]\nthat = "a"\nwithin = 5\n', Path("x.toml"))
+    assert str(error) == ('x.toml:4:10: expect[0].within: expected a duration such as "250ms" or "60s", got the '
+                          'bare number 5: write it in quotes with its unit, e.g. "5s" or "5ms"')
+
+
+@pytest.mark.parametrize("text, key, meant", [
+    ('scna = "10ms"\n', "scna", "scan"),
+    ('[[expect]]\ntaht = "a"\n', "expect[0].taht", "that"),
+    ('[robot]\nbattery_percent = 80\n', "robot.battery_percent", "battery_pct"),
+    ('[[faults]]\nkind = "no_reply"\nat = 3\n', "faults[0].at", "at_s"),
+    ('[[inputs]]\nat = "1s"\nset = { a = true }\npluse = "1s"\n', "inputs[0].pluse", "pulse"),
+])
+def test_a_misspelt_key_names_the_key_probably_meant(text, key, meant):
+    # the message listed every key there is (24 under [robot]) and left the search to the user
+    error = error_of('program = "M"\n' + text, Path("s.toml"))
+    assert f"{key}: unknown key; expected one of " in str(error)
+    assert str(error).endswith(f"; did you mean '{meant}'?")
+
+
+def test_an_unknown_key_like_none_there_is_gets_no_guess():
+    error = error_of('program = "M"\n[rules]\nbogus = 1\n', Path("s.toml"))
+    assert str(error).endswith("expected one of min_period, reply_timeout")
+
+
+def test_an_empty_expectation_name_is_an_error_at_its_line():
+    # was accepted: the console then said "expected : 'Y0' became true at 0.570 s"
+    error = error_of('program = "M"\n[[expect]]\nname = " "\nnever = "Y0"\n', Path("x.toml"))
+    assert str(error) == ("x.toml:3:8: expect[0].name: is empty: name the expectation for the reports, "
+                          "or leave 'name' out to have it described ('never Y0')")
+
+
 def test_an_empty_program_name_is_an_error_at_its_line():
     # was "no PROGRAM '' in the sources" once the sources were loaded, naming no line
     error = error_of('name = "x"\nprogram = ""\n', Path("x.toml"))

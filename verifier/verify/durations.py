@@ -25,7 +25,12 @@ _PATTERN = re.compile(r"^\s*([0-9]+(?:\.[0-9]+)?|\.[0-9]+)\s*(us|µs|ms|s|min|h)
 def parse_duration_us(text: object) -> int:
     """Return `text` ("250ms", "1.5s") in whole microseconds; ValueError on anything else."""
     if not isinstance(text, str):
-        raise ValueError(f"expected a duration such as \"250ms\" or \"60s\", got {text!r}")
+        from verifier.tomlpos import shown
+
+        if isinstance(text, (int, float)) and not isinstance(text, bool):
+            raise ValueError(f"expected a duration such as \"250ms\" or \"60s\", got the bare number {shown(text)}: "
+                             f"write it in quotes with its unit, e.g. \"{text}s\" or \"{text}ms\"")
+        raise ValueError(f"expected a duration such as \"250ms\" or \"60s\", got {shown(text)}")
     if problem := digit_problem(text):
         raise ValueError(f"{text!r}: {problem}")
     match = _PATTERN.match(text)

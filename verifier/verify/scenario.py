@@ -15,7 +15,7 @@ from typing import Any
 from verifier import protocol
 from verifier.amr.config import RobotConfig
 from verifier.amr.faults import Fault, check_fault_addresses
-from verifier.amr.schema import ConfigError
+from verifier.amr.schema import ConfigError, unknown_key
 from verifier.digits import digit_problem
 from verifier.textfile import UnreadableText, read_utf8, text_lines
 from verifier.tomlpos import Place, decode_error_position, place_of_key, shown
@@ -323,7 +323,7 @@ class _Reader:
         for name in data:
             if name not in allowed:
                 where = f"{key}.{name}" if key else name
-                raise self.fail(where, f"unknown key; expected one of {', '.join(allowed)}", at_name=True)
+                raise self.fail(where, unknown_key(name, allowed), at_name=True)
 
     def string(self, value: Any, key: str) -> str:
         if not isinstance(value, str):
@@ -640,6 +640,9 @@ class _Reader:
         label = item.get("name")
         if label is None:
             label = f"{what} {describe_window(expectation)}".strip()
+        elif not self.string(label, f"{key}.name").strip():
+            raise self.fail(f"{key}.name", "is empty: name the expectation for the reports, or leave 'name' out "
+                                           f"to have it described ({what!r})")
         return replace(expectation, label=self.string(label, f"{key}.name"))
 
     def options(self, rules: Any, response: Any) -> tuple[RuleOptions, bool]:
