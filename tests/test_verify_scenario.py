@@ -340,8 +340,9 @@ def test_that_always_never():
     )
     assert [r.passed for r in results] == [True, False, True, False, True, False, True]
     assert results[0].t_us == 3_000_000
-    assert "never became true" in results[1].detail and "ok = False" in results[1].detail
-    assert "false at 6.000 s" in results[3].detail
+    # the values as ST writes them, as the condition does (was Python's 'ok = False')
+    assert results[1].detail == "'ok' never became true between 0.000 s and 2.000 s (at the end: ok = FALSE)"
+    assert results[3].detail == "'ok' was false at 6.000 s (ok = FALSE)"
     assert "became true at 5.000 s" in results[5].detail
 
 

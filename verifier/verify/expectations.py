@@ -118,9 +118,16 @@ def _span(start: int, end: int) -> str:
     return f"between {format_seconds(start)} and {format_seconds(end)}"
 
 
+def _st_value(value) -> str:
+    """A label's value as the condition writes it: TRUE/FALSE, not Python's True/False."""
+    if isinstance(value, bool):
+        return "TRUE" if value else "FALSE"
+    return repr(value)
+
+
 def _values_at(evidence: RunEvidence, condition: Condition, t_us: int) -> str:
     return ", ".join(
-        f"{name} = {evidence.samples.value_at(name, t_us)!r}" for name in sorted(condition.names)
+        f"{name} = {_st_value(evidence.samples.value_at(name, t_us))}" for name in sorted(condition.names)
     )
 
 
