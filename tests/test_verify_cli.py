@@ -797,3 +797,61 @@ def test_a_reception_never_rearmed_is_named_on_the_console_and_in_junit(tmp_path
     assert lines[0].strip() in out.splitlines()
     every = json.loads((tmp_path / "v.json").read_text())["scenarios"][0]["simulator_diagnostics"]
     assert int(re.search(r"×(\d+)", lines[0]).group(1)) == len(every) > 1
+
+
+BACK_TO_BACK = """PROGRAM MAIN
+VAR
+    uSend : ARRAY[0..3] OF WORD;
+    uRecv : ARRAY[0..3] OF WORD;
+    wStep : INT;
+END_VAR
+IF M8002 THEN
+    D8400 := 16#1C81;
+    D8409 := 5;
+END_IF;
+(* scan 1: the stop; scan 2, as soon as the CPU has sent it: the point command *)
+IF wStep = 1 THEN
+    uSend[0] := 16#0601;
+    uSend[1] := 16#A001;
+    uSend[2] := 16#0000;
+    uSend[3] := 16#1488;
+    M8402 := TRUE;
+    wStep := 2;
+ELSIF wStep = 2 AND NOT M8402 THEN
+    uSend[0] := 16#0601;
+    uSend[1] := 16#0201;
+    uSend[2] := 16#0000;
+    uSend[3] := POINT2_CRC;
+    M8402 := TRUE;
+    wStep := 3;
+ELSIF wStep = 0 THEN
+    wStep := 1;
+END_IF;
+M8403 := FALSE;
+RS2(TRUE, uSend[0], 8, 8, 1, uRecv[0]);
+END_PROGRAM
+"""
+
+
+@pytest.mark.parametrize("crc, crc_finding", [
+    ("16#F629", None),  # 01 06 01 02 00 00 29 F6: both requests right, sent too close
+    ("16#F6D9", "UITAMR-CRC: 1 violation(s); first at 0.010 s: the second of two requests ran together: "
+                "01 06 01 02 00 00 D9 F6 followed 01 06 01 A0 00 00 88 14 after a silence of 1.667 ms, less than "
+                "t3.5 = 3.65 ms, so the robot takes them for one frame and discards it; its CRC bytes are D9 F6, "
+                "expected 29 F6 (CRC-16/MODBUS of the first 6 bytes, low byte first)"),
+])
+def test_two_requests_run_together_are_judged_one_by_one(tmp_path, monkeypatch, crc, crc_finding):
+    # the line makes one 16-byte frame of two requests 1.7 ms apart: UITAMR-CRC said
+    # 'expected 29 ED (CRC-16/MODBUS of the first 14 bytes)' of a frame no one built, and
+    # UITAMR-FORMAT only 'too long for an FC06 request: 16 bytes', not why
+    (tmp_path / "MAIN.st").write_text(BACK_TO_BACK.replace("POINT2_CRC", crc), encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("MAIN.st", "--platform", "fx3u", "--duration", "1s", "--junit", "v.xml")
+    assert result.exit_code == 1, result.output
+    failures = {f.get("type"): f.get("message") for f in ET.parse(tmp_path / "v.xml").getroot().iter("failure")}
+    assert failures.get("UITAMR-CRC") == crc_finding
+    assert failures["UITAMR-FORMAT"] == (
+        "UITAMR-FORMAT: 1 violation(s); first at 0.010 s: two requests ran together: 01 06 01 02 00 00 "
+        + ("D9 F6" if crc_finding else "29 F6") + " followed 01 06 01 A0 00 00 88 14 after a silence of 1.667 ms, "
+        "less than t3.5 = 3.65 ms, so the robot takes them for one frame and discards it: leave at least t3.5 of "
+        "silence between two requests (and wait for the reply, or its time-out, before the next)")
