@@ -855,3 +855,30 @@ def test_two_requests_run_together_are_judged_one_by_one(tmp_path, monkeypatch, 
         + ("D9 F6" if crc_finding else "29 F6") + " followed 01 06 01 A0 00 00 88 14 after a silence of 1.667 ms, "
         "less than t3.5 = 3.65 ms, so the robot takes them for one frame and discards it: leave at least t3.5 of "
         "silence between two requests (and wait for the reply, or its time-out, before the next)")
+
+
+def test_a_program_the_sources_lack_is_reported_at_the_scenarios_program_line(tmp_path, monkeypatch):
+    # 'verify/healthy.toml: no PROGRAM ...' named the file only, though the line is known
+    (tmp_path / "MAIN.st").write_text(NEVER_REARMED, encoding="utf-8")
+    (tmp_path / "s.toml").write_text('name = "x"\nsources = ["MAIN.st"]\nprogram = "CELL_MAIN"\n', encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("--scenario", "s.toml")
+    assert result.exit_code == 2
+    assert "error: s.toml:3:11: program: no PROGRAM 'CELL_MAIN' in the sources; they define: MAIN" in result.output
+    # --program replaces the file's: then the file's line is not the place
+    result = invoke("--scenario", "s.toml", "--program", "OTHER")
+    assert result.exit_code == 2
+    assert "error: s.toml: no PROGRAM 'OTHER' in the sources; they define: MAIN" in result.output
+
+
+def test_matrix_with_two_programs_asks_for_program_without_naming_a_bundled_file(tmp_path, monkeypatch):
+    # the error named plc/scenarios/fx3u-address-out-of-range.toml and its 'program' key,
+    # a file the user did not write and cannot change
+    (tmp_path / "MAIN.st").write_text(NEVER_REARMED, encoding="utf-8")
+    (tmp_path / "OTHER.st").write_text(NEVER_REARMED.replace("PROGRAM MAIN", "PROGRAM OTHER"), encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("MAIN.st", "OTHER.st", "--platform", "fx3u", "--matrix")
+    assert result.exit_code == 2
+    assert ("error: --matrix runs one PROGRAM of your sources under the bundled fault sets: say which with "
+            "--program; the sources define: MAIN, OTHER") in result.output
+    assert "scenarios/" not in result.output

@@ -111,13 +111,18 @@ class _Plc:
         if scenario.program is None:
             if len(programs) == 1:
                 return programs[0]
+            if scenario.for_sources:  # the bundled file is not the user's to change
+                raise UnusableInput(f"--matrix runs one PROGRAM of your sources under the bundled fault sets: say which "
+                                    f"with --program; the sources define: {listing}")
             raise UnusableInput(
                 f"{_where(scenario)}: say which PROGRAM to run (--program or 'program'); the sources define: {listing}"
             )
         for name in programs:
             if name.upper() == scenario.program.upper():
                 return name
-        raise UnusableInput(f"{_where(scenario)}: no PROGRAM {scenario.program!r} in the sources; they define: {listing}")
+        where = (scenario.where("program", scenario.key_lines["program"]) if "program" in scenario.key_lines
+                 else _where(scenario))
+        raise UnusableInput(f"{where}: no PROGRAM {scenario.program!r} in the sources; they define: {listing}")
 
     @property
     def now_us(self) -> int:

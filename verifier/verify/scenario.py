@@ -147,6 +147,7 @@ class Scenario:
     notes: tuple[str, ...] = ()  # for the reports: how this run differs from its file
     response_signal_key: str = "response_handling.signal"  # or "--response-signal" when given there
     platform_from_option: bool = False  # the platform is --platform's, not the file's (for messages)
+    for_sources: bool = False  # a bundled scenario run against the user's sources (--matrix)
 
     @property
     def target(self) -> str:
@@ -202,7 +203,11 @@ class Scenario:
         return f"{text}: {key}" if key else text
 
     def with_overrides(self, **changes: Any) -> "Scenario":
-        return replace(self, **{k: v for k, v in changes.items() if v is not None})
+        changes = {k: v for k, v in changes.items() if v is not None}
+        if "program" in changes and "program" in self.key_lines:
+            # --program replaces the file's: its errors are no longer at the file's line
+            changes["key_lines"] = {k: v for k, v in self.key_lines.items() if k != "program"}
+        return replace(self, **changes)
 
 
 DEFAULT_STOP_WITHIN_US = 5_000_000
@@ -437,6 +442,7 @@ class _Reader:
         keys += [f"{step.key}.set" for step in inputs] + [f"watch[{i}]" for i in range(len(watch))]
         keys += ["response_handling.signal"] if signal_given else []
         keys += ["platform"] if "platform" in data else []
+        keys += ["program"] if program is not None else []
         return Scenario(
             name=name, path=self.path, description=description, sources=sources, program=program,
             platform=platform, channel=channel, duration_us=duration, scan_us=scan, scan_jitter_us=jitter, seed=seed,
