@@ -882,3 +882,17 @@ def test_matrix_with_two_programs_asks_for_program_without_naming_a_bundled_file
     assert ("error: --matrix runs one PROGRAM of your sources under the bundled fault sets: say which with "
             "--program; the sources define: MAIN, OTHER") in result.output
     assert "scenarios/" not in result.output
+
+
+def test_no_response_signal_names_the_error_outputs_the_program_has(tmp_path):
+    # 'set [response_handling] signal ... (e.g. "o_bErr")' for a program that has no
+    # o_bErr: the user had to find which of its FB outputs to name
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(
+        'name = "bad CRC for 8 s"\nprogram = "UITAMR_ExampleFx3"\nduration = "20s"\n'
+        '[[faults]]\nkind = "bad_crc"\nat_s = 5.0\nduration_s = 8.0\n', encoding="utf-8")
+    result = invoke(*FX3_SOURCES, "--scenario", scenario)
+    assert result.exit_code == 1, result.output
+    assert ("and the scenario names no output to show it: set [response_handling] signal in the scenario or "
+            "--response-signal (the program has no o_bErr; its FB instances have fbPort.o_bErr, fbEngine.o_bErr, "
+            "fbCycle.o_bErr)") in " ".join(result.output.split())

@@ -325,7 +325,8 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
     for use in scenario.label_uses():
         missing = next((problem for problem in map(plc.problem, use.names) if problem), None)
         if missing is not None and use.optional:
-            scenario = replace(scenario, options=replace(scenario.options, response_signal=None))
+            scenario = replace(scenario, options=replace(scenario.options, response_signal=None,
+                                                         response_signal_hint=_error_outputs(plc)))
             continue
         if missing is not None:
             raise UnusableInput(f"{scenario.where(use.key, use.line)}: {missing}")
@@ -336,10 +337,26 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
         for name, value in (use.values or {}).items():
             problem = problem or _input_problem(plc, name, value)
         if problem and use.optional:  # the default signal: an o_bErr that is not a BOOL is not it
-            scenario = replace(scenario, options=replace(scenario.options, response_signal=None))
+            scenario = replace(scenario, options=replace(scenario.options, response_signal=None,
+                                                         response_signal_hint=_error_outputs(plc)))
         elif problem:
             raise UnusableInput(f"{scenario.where(use.key, use.line)}: {problem}")
     return scenario
+
+
+def _error_outputs(plc: _Plc) -> str:
+    """The BOOL `o_bErr` outputs of the program's FB instances ("fbEngine.o_bErr, ..."), at
+    most three, in declaration order: what a scenario may name as the response signal when the
+    program has no `o_bErr` of its own. "" when it has none."""
+    program = plc.program
+    if not isinstance(program, InstanceProxy):
+        return ""
+    found = []
+    for name in program._names():
+        label = f"{name}.o_bErr"
+        if plc.problem(label) is None and isinstance(_plain(plc.read(label)), bool):
+            found.append(label)
+    return ", ".join(found[:3]) + (", ..." if len(found) > 3 else "")
 
 
 def _input_problem(plc: _Plc, name: str, value: Any) -> str | None:
