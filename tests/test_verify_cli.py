@@ -333,6 +333,20 @@ def test_a_duration_that_ends_the_run_before_a_fault_says_the_fault_was_not_test
     assert "not tested" not in result.output
 
 
+def test_a_duration_that_ends_the_run_before_an_input_says_it_was_not_applied(tmp_path):
+    # --duration 15s on a scenario that presses X4 at 20 s: the run went on as if no one
+    # pressed it, and only the expectations on its outcome hinted at why
+    sources = [str(p) for p in FX3_SOURCES]
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(f'sources = {json.dumps(sources)}\nprogram = "UITAMR_ExampleFx3"\nduration = "30s"\n'
+                        '[[inputs]]\nat = "1s"\nset = {{ X0 = true }}\npulse = "300ms"\n'
+                        '[[inputs]]\nat = "20s"\nset = {{ X1 = true }}\n'.replace("{{", "{").replace("}}", "}"))
+    result = invoke("--scenario", scenario, "--duration", "15s")
+    assert ("note: --duration 15s ends the run before 1 of its operator input(s), not applied: inputs[1] at 20.000 s"
+            in result.output), result.output
+    assert "not applied" not in invoke("--scenario", scenario, "--duration", "21s").output
+
+
 def test_jobs_beyond_the_batches_start_no_idle_workers(tmp_path, monkeypatch):
     """The process pool forks all its workers at once: --jobs 5000 for two scenarios
     forked 5000 processes and the run never ended. It gets a worker per batch at most."""

@@ -166,17 +166,22 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
 
 def _cut_short(scenario: Scenario) -> Scenario:
     """`scenario` with a note when --duration ends its run before some of its scripted faults
-    or converter drops: they were not tested, though the run may pass (with --matrix nothing
+    or converter drops, or before some of its operator inputs: they were not tested, though the run may pass (with --matrix nothing
     else says so: the scenario's own expectations are not applied)."""
     end = scenario.duration_us
     missed = [f.describe() for f in scenario.faults if f.at_s is not None and f.at_s * 1_000_000 >= end]
     if scenario.converter is not None:
         missed += [f"converter drop at {format_seconds(t)}" for t in scenario.converter.drops if t >= end]
-    if not missed:
-        return scenario
-    note = (f"--duration {format_duration(end)} ends the run before {len(missed)} of its scripted fault(s), "
-            f"not tested: {'; '.join(missed)}")
-    return replace(scenario, notes=scenario.notes + (note,))
+    notes = []
+    if missed:
+        notes.append(f"--duration {format_duration(end)} ends the run before {len(missed)} of its scripted fault(s), "
+                     f"not tested: {'; '.join(missed)}")
+    # operator inputs too: the run would go on as if no one pressed them
+    late = [f"{step.key} at {format_seconds(step.at_us)}" for step in scenario.inputs if step.at_us >= end]
+    if late:
+        notes.append(f"--duration {format_duration(end)} ends the run before {len(late)} of its operator input(s), "
+                     f"not applied: {'; '.join(late)}")
+    return replace(scenario, notes=scenario.notes + tuple(notes)) if notes else scenario
 
 
 def _with_signal(scenario: Scenario, text: str) -> Scenario:
