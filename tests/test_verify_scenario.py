@@ -289,6 +289,14 @@ def test_an_unknown_key_like_none_there_is_gets_no_guess():
     assert str(error).endswith("expected one of min_period, reply_timeout")
 
 
+def test_an_input_after_the_run_says_the_run_length_and_what_to_do():
+    # 'inputs[0].at: is at or after the end of the run' gave neither, unlike a late fault
+    error = error_of('program = "M"\nduration = "20s"\n[[inputs]]\nat = "30s"\nset = { X0 = true }\n',
+                     Path("x.toml"))
+    assert str(error) == ("x.toml:4:6: inputs[0].at: is at or after the end of the run (20s): the input would never "
+                          "be applied; make 'duration' longer")
+
+
 def test_an_empty_expectation_name_is_an_error_at_its_line():
     # was accepted: the console then said "expected : 'Y0' became true at 0.570 s"
     error = error_of('program = "M"\n[[expect]]\nname = " "\nnever = "Y0"\n', Path("x.toml"))

@@ -601,7 +601,8 @@ class _Reader:
             raise self.fail(key, "an input needs 'at' (when) and 'set' (labels and values)")
         at = self.duration(item["at"], f"{key}.at", positive=False)
         if at >= duration:
-            raise self.fail(f"{key}.at", "is at or after the end of the run")
+            raise self.fail(f"{key}.at", f"is at or after the end of the run ({format_duration(duration)}): "
+                                         "the input would never be applied; make 'duration' longer")
         values = self.table(item["set"], f"{key}.set")
         if not values:
             raise self.fail(f"{key}.set", "sets nothing")
