@@ -297,6 +297,21 @@ def test_an_input_after_the_run_says_the_run_length_and_what_to_do():
                           "be applied; make 'duration' longer")
 
 
+@pytest.mark.parametrize("text, place", [
+    # the ')' on the second line of a condition in three quotes: was 3:26, past the end of line 3
+    ('[[expect]]\nthat = """Y0 AND\n   (Y1 OR ) """\n', (4, 11)),
+    ('[[expect]]\nthat = """\nY0 AND\n   (Y1 OR ) """\n', (5, 11)),  # the newline after """ is not the value's
+    ("[[expect]]\nthat = \'\'\'Y0 AND\n   (Y1 OR ) \'\'\'\n", (4, 11)),
+    ('[[expect]]\nthat = "Y0 AND (Y1 OR )"\n', (3, 23)),
+    ("[[expect]]\nthat = 'Y0 AND (Y1 OR )'\n", (3, 23)),
+    ('[[expect]]\nthat = "Y0 AND\\t(Y1 OR )"\n', (3, 8)),  # an escape: the value's own place
+])
+def test_a_condition_that_does_not_parse_is_placed_where_it_fails_in_the_file(text, place):
+    error = error_of('program = "M"\n' + text, Path("x.toml"))
+    assert (error.line, error.col) == place, str(error)
+    assert "found ')'" in str(error)
+
+
 def test_an_empty_expectation_name_is_an_error_at_its_line():
     # was accepted: the console then said "expected : 'Y0' became true at 0.570 s"
     error = error_of('program = "M"\n[[expect]]\nname = " "\nnever = "Y0"\n', Path("x.toml"))

@@ -300,17 +300,48 @@ class _Reader:
         (a condition's own column, 1-based, past the quote)."""
         place = place_of_key(self.lines, at or key, at_name)
         if place is not None and offset:
-            place = Place(place.line, place.col + offset)
+            place = self._inside_string(place, offset)
         return ScenarioError(self.path, key, message, place)
+
+    def _inside_string(self, place: Place, offset: int) -> Place:
+        """The place of character `offset` (1-based) of the string value that starts at
+        `place`: past a one-line string's quote, or inside a multi-line string, line by line
+        (a condition written over several lines with three quotes). Where the text cannot be
+        followed back to the file (an escape in a basic string), the value's own place."""
+        line = self.lines[place.line - 1]
+        start = place.col - 1
+        quote = line[start:start + 3]
+        if quote not in ('"""', "\'\'\'"):
+            if line[start:start + 1] not in ("'", '"'):
+                return place
+            if line[start] == '"' and "\\" in line[start:]:
+                return place  # an escape: the value is shorter than its text in the file
+            return Place(place.line, place.col + offset)
+        row, col = place.line, place.col + 3  # the 1-based column of the value's first character
+        if col > len(line):  # a newline right after the opening quotes is not part of the value
+            row, col = row + 1, 1
+        if quote == '"""':
+            body, end = [], row
+            while end - 1 < len(self.lines):
+                text = self.lines[end - 1][(col - 1) if end == row else 0:]
+                body.append(text.split('"""')[0])
+                if '"""' in text:
+                    break
+                end += 1
+            if any("\\" in text for text in body):
+                return place
+        left = offset - 1  # characters to step over
+        while row - 1 < len(self.lines):
+            rest = len(self.lines[row - 1]) - (col - 1)
+            if left <= rest:
+                return Place(row, col + left)
+            left -= rest + 1  # the line's characters and its newline
+            row, col = row + 1, 1
+        return place
 
     def line_of(self, key: str) -> Place | None:
         """Best effort: line and column of what sets `key` (e.g. "expect[1].within", "robot.x")."""
         return place_of_key(self.lines, key)
-
-    def _quoted(self, key: str) -> bool:
-        """True when `key`'s value is a one-line string starting at its column."""
-        place = self.line_of(key)
-        return place is not None and self.lines[place.line - 1][place.col - 1:place.col] in ("'", '"')
 
     # --- helpers -------------------------------------------------------------------------
 
@@ -350,7 +381,7 @@ class _Reader:
             return parse_condition(text)
         except ConditionError as exc:
             raise self.fail(key, f"{exc.message} at column {exc.column} of {text!r}",
-                            offset=exc.column if self._quoted(key) else 0) from None
+                            offset=exc.column) from None
 
     def label(self, value: Any, key: str, at: str = "") -> str:
         """A label path; `at` is the key that names it, when it is a key (an input's `set`)."""
