@@ -193,7 +193,12 @@ class _Plc:
             setattr(target, last, value)
 
     def diagnostics(self) -> list[str]:
-        return [str(d) for d in self.project.diagnostics]
+        """Each of the simulator's diagnostics, its ST file as the reports show ST files
+        (relative to the working folder when inside it, as the frames' origins)."""
+        import dataclasses
+
+        cwd = os.getcwd()
+        return [str(dataclasses.replace(d, location=_relative(d.location, cwd))) for d in self.project.diagnostics]
 
     def diagnostic_summary(self) -> list[str]:
         from verifier.sim.errors import summarize_diagnostics
