@@ -304,6 +304,28 @@ def test_html_diagram_zooms_in_the_browser(tmp_path):
     assert root.find(".//*[@id='s0-scale']").text == "8.0 px/ms"
 
 
+def test_html_violations_table_fits_the_window_with_a_long_frame(tmp_path):
+    """Two requests run together make a 16-byte frame with a long meaning: its cell, kept on
+    one line, pushed the ST location out of a 1400 px window and squeezed 'what' to one word
+    per line. Measured in Chromium: a script added to a copy of the page writes the cells'
+    boxes into the DOM that --dump-dom returns."""
+    merged = protocol.encode(READ, S) + bytes.fromhex("01 06 01 02 00 00 D9 F6")
+    trace = [TraceRecord(0, protocol.frame_time_us(16), "tx", merged, "plc/CELL_BUGGY.st:47:5")]
+    page = tmp_path / "report.html"
+    report_html.write([_result("merged", trace, 2_000_000)], page)
+    probe = tmp_path / "probe.html"
+    probe.write_text(page.read_text().replace("</body>", """<script>
+      const cells = document.querySelector('.violations-table tr.violation-row').querySelectorAll('td');
+      document.body.setAttribute('data-layout', JSON.stringify({
+        view: document.documentElement.clientWidth,
+        location: cells[4].getBoundingClientRect().right,
+        what: cells[2].getBoundingClientRect().width}));
+    </script></body>"""))
+    layout = json.loads(_rendered(probe.as_uri()).find(".//body").get("data-layout"))
+    assert layout["location"] <= layout["view"], layout  # the ST location is in sight
+    assert layout["what"] >= 200, layout  # the message reads as lines, not a column of words
+
+
 def test_html_screenshot_is_taken(tmp_path):
     page = tmp_path / "report.html"
     report_html.write([bad_result()], page)
