@@ -884,7 +884,7 @@ def test_a_program_the_sources_lack_is_reported_at_the_scenarios_program_line(tm
     # --program replaces the file's: then the file's line is not the place
     result = invoke("--scenario", "s.toml", "--program", "OTHER")
     assert result.exit_code == 2
-    assert "error: s.toml: no PROGRAM 'OTHER' in the sources; they define: MAIN" in result.output
+    assert "error: --program: no PROGRAM 'OTHER' in the sources; they define: MAIN" in result.output
 
 
 def test_matrix_with_two_programs_asks_for_program_without_naming_a_bundled_file(tmp_path, monkeypatch):

@@ -153,6 +153,8 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
         scenarios = [_cut_short(s) for s in scenarios]
     if platform_given:
         scenarios = [replace(s, platform_from_option=True) for s in scenarios]
+    if program is not None:
+        scenarios = [replace(s, program_from_option=True) for s in scenarios]
     for scenario in scenarios:
         if scenario.scan_us > scenario.duration_us:
             raise UnusableInput(f"{scenario.name}: the scan time is longer than the whole run")

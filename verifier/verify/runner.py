@@ -120,8 +120,12 @@ class _Plc:
         for name in programs:
             if name.upper() == scenario.program.upper():
                 return name
-        where = (scenario.where("program", scenario.key_lines["program"]) if "program" in scenario.key_lines
-                 else _where(scenario))
+        if "program" in scenario.key_lines:
+            where = scenario.where("program", scenario.key_lines["program"])
+        elif scenario.program_from_option:
+            where = "--program"  # given on the command line: no file is where to look
+        else:
+            where = _where(scenario)
         raise UnusableInput(f"{where}: no PROGRAM {scenario.program!r} in the sources; they define: {listing}")
 
     @property

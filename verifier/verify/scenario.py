@@ -148,6 +148,7 @@ class Scenario:
     response_signal_key: str = "response_handling.signal"  # or "--response-signal" when given there
     platform_from_option: bool = False  # the platform is --platform's, not the file's (for messages)
     for_sources: bool = False  # a bundled scenario run against the user's sources (--matrix)
+    program_from_option: bool = False  # the program is --program's, not the file's (for messages)
 
     @property
     def target(self) -> str:
