@@ -312,6 +312,17 @@ def test_a_condition_that_does_not_parse_is_placed_where_it_fails_in_the_file(te
     assert "found ')'" in str(error)
 
 
+def test_reaching_a_point_the_robot_was_not_taught_is_an_impossible_expectation():
+    # the run failed with 'accepted ..., but the robot never reported the task running'
+    # and left the user to find the [robot] setting that made it so
+    error = error_of('program = "M"\n[robot]\ntaught_points = [1, 2, 3]\n[[expect]]\nreached_point = 5\n',
+                     Path("x.toml"))
+    assert str(error) == ("x.toml:5:17: expect[0].reached_point: point 5 is not among the robot's taught_points "
+                          "[1, 2, 3]: the robot accepts run-point 5 and does nothing, so it is never reached; add it "
+                          "to [robot] taught_points")
+    parse_scenario('program = "M"\n[robot]\ntaught_points = [1, 5]\n[[expect]]\nreached_point = 5\n')
+
+
 def test_an_empty_expectation_name_is_an_error_at_its_line():
     # was accepted: the console then said "expected : 'Y0' became true at 0.570 s"
     error = error_of('program = "M"\n[[expect]]\nname = " "\nnever = "Y0"\n', Path("x.toml"))

@@ -451,6 +451,12 @@ class _Reader:
             self.expectation(item, f"expect[{i}]", settings)
             for i, item in enumerate(self.array_of_tables(data.get("expect", []), "expect"))
         )
+        for expectation in expectations:
+            if expectation.kind == "reached_point" and not robot.is_taught(expectation.point):
+                raise self.fail(f"{expectation.key}.reached_point",
+                                f"point {expectation.point} is not among the robot's taught_points "
+                                f"{list(robot.taught_points)}: the robot accepts run-point {expectation.point} and "
+                                "does nothing, so it is never reached; add it to [robot] taught_points")
         options, signal_given = self.options(data.get("rules", {}), data.get("response_handling", None))
         initial = self.initial(data.get("initial", {}))
         c24 = tuple(
