@@ -33,6 +33,20 @@ def test_bad_durations_are_refused_with_an_example(bad):
         parse_duration_us(bad)
 
 
+@pytest.mark.parametrize("text, hint", [
+    ("5sec", '; did you mean "5s"?'), ("250 msec", '; did you mean "250ms"?'), ("2 minutes", '; did you mean "2min"?'),
+    ("1hr", '; did you mean "1h"?'), ("3m", '; did you mean "3min"?'), ("1.5 Seconds", '; did you mean "1.5s"?'),
+    ("-1s", "; a duration counts forward (from power-on, or from the window's start): it cannot be negative"),
+    ("5 parsecs", ""), ("soon", ""),
+])
+def test_a_duration_with_a_unit_spelt_otherwise_names_the_one_meant(text, hint):
+    # '5sec' and '-1s' got only 'is not a duration: write a number and a unit'
+    with pytest.raises(ValueError) as info:
+        parse_duration_us(text)
+    assert str(info.value).startswith(f"{text!r} is not a duration: write a number and a unit")
+    assert str(info.value).endswith('e.g. "250ms" or "60s"' + hint)
+
+
 @pytest.mark.parametrize("text, us, message", [
     # Fraction() read none of these: 'Exceeds the limit (4300 digits) for integer string conversion'
     ("9" * 5000 + "s", None, "a duration of 5000 digits is longer than any run: check the number"),
