@@ -577,6 +577,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
             if progress is not None:
                 progress(plc.now_us, end)
     except SimulationError as exc:
+        exc.location = _relative(exc.location, os.getcwd())  # as the frames' origins name ST files
         aborted = str(exc)
         end = min(end, plc.now_us)
     if converter is not None:
