@@ -856,13 +856,14 @@ END_PROGRAM
                 "t3.5 = 3.65 ms, so the robot takes them for one frame and discards it; its CRC bytes are D9 F6, "
                 "expected 29 F6 (CRC-16/MODBUS of the first 6 bytes, low byte first)"),
 ])
-def test_two_requests_run_together_are_judged_one_by_one(tmp_path, monkeypatch, crc, crc_finding):
+@pytest.mark.parametrize("path", [[], ["--every-scan"]])  # judged as it goes, and as a whole
+def test_two_requests_run_together_are_judged_one_by_one(tmp_path, monkeypatch, crc, crc_finding, path):
     # the line makes one 16-byte frame of two requests 1.7 ms apart: UITAMR-CRC said
     # 'expected 29 ED (CRC-16/MODBUS of the first 14 bytes)' of a frame no one built, and
     # UITAMR-FORMAT only 'too long for an FC06 request: 16 bytes', not why
     (tmp_path / "MAIN.st").write_text(BACK_TO_BACK.replace("POINT2_CRC", crc), encoding="utf-8")
     monkeypatch.chdir(tmp_path)
-    result = invoke("MAIN.st", "--platform", "fx3u", "--duration", "1s", "--junit", "v.xml")
+    result = invoke("MAIN.st", "--platform", "fx3u", "--duration", "1s", "--junit", "v.xml", *path)
     assert result.exit_code == 1, result.output
     failures = {f.get("type"): f.get("message") for f in ET.parse(tmp_path / "v.xml").getroot().iter("failure")}
     assert failures.get("UITAMR-CRC") == crc_finding

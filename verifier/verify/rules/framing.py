@@ -37,10 +37,14 @@ def _run_together(frame, gap) -> tuple[int, int] | None:
     """(k, silence in µs) when `frame` is two requests sent with less than t3.5 between
     them, so that the line made one frame of them: its first k bytes, up to the pause, are a
     whole request with a good CRC, and more bytes follow. None otherwise."""
-    if gap is None or not getattr(gap, "frames", ()):
+    if gap is None:
         return None
     data = bytes(frame.data)
-    k = len(gap.frames[0])
+    # from the frame's times, as every report keeps them (a run judged as a whole has the
+    # events without the bytes before the pause): the silence is what the frame took beyond
+    # its bytes, and the bytes before it are those sent before the pause began
+    silence = frame.t_end_us - frame.t_start_us - protocol.frame_time_us(len(data))
+    k = round((gap.t_us - frame.t_start_us - silence) / protocol.BYTE_TIME_EXACT_US)
     if not 4 <= k < len(data) or not protocol.crc_ok(data[:k]):
         return None
     return k, gap.t_us - (frame.t_start_us + protocol.frame_time_us(k))
