@@ -337,6 +337,18 @@ def test_reaching_a_point_the_robot_was_not_taught_is_an_impossible_expectation(
     parse_scenario('program = "M"\n[robot]\ntaught_points = [1, 5]\n[[expect]]\nreached_point = 5\n')
 
 
+@pytest.mark.parametrize("text, expected", [
+    ('program = "M"\nduration = "20s"\nduration = "30s"\n',
+     "x.toml:3:1: not valid TOML: 'duration' is given twice (first on line 2): keep one"),
+    ('program = "M"\n[robot]\nbattery_pct = 50\n  battery_pct = 40\n',
+     "x.toml:4:3: not valid TOML: 'battery_pct' is given twice (first on line 3): keep one"),
+])
+def test_a_key_given_twice_is_named_with_its_first_line(text, expected):
+    # tomllib's 'Cannot overwrite a value' at the end of the second value's line named
+    # neither the key nor where it was given first
+    assert str(error_of(text, Path("x.toml"))) == expected
+
+
 def test_an_empty_expectation_name_is_an_error_at_its_line():
     # was accepted: the console then said "expected : 'Y0' became true at 0.570 s"
     error = error_of('program = "M"\n[[expect]]\nname = " "\nnever = "Y0"\n', Path("x.toml"))
