@@ -811,8 +811,12 @@ def test_a_reception_never_rearmed_is_named_on_the_console_and_in_junit(tmp_path
     assert lines[0].strip() in out.splitlines()
     every = json.loads((tmp_path / "v.json").read_text())["scenarios"][0]["simulator_diagnostics"]
     assert int(re.search(r"×(\d+)", lines[0]).group(1)) == len(every) > 1
-    # the JSON (and HTML) list name the file as the console does, not by its absolute path
+    # the JSON list names the file as the console does, not by its absolute path
     assert all(entry.startswith("MAIN.st:23:1: t=") for entry in every), every[0]
+    # the HTML page: the console's line, not one item per discarded reply
+    invoke("MAIN.st", "--platform", "fx3u", "--duration", "3s", "--html", "v.html")
+    notes = re.findall(r'<li class="mono simulator-note">(.*?)</li>', (tmp_path / "v.html").read_text())
+    assert notes == [lines[0].strip().removeprefix("simulator ")]
 
 
 BACK_TO_BACK = """PROGRAM MAIN
