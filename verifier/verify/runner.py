@@ -332,13 +332,17 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
     missing default response signal is dropped. Errors name the file, line and key."""
     kinds: dict[str, str] = {}
     for use in scenario.label_uses():
-        missing = next((problem for problem in map(plc.problem, use.names) if problem), None)
+        missing, line = None, use.line
+        for name in use.names:
+            if (missing := plc.problem(name)) is not None:
+                line = scenario.key_lines.get(f"{use.key}:{name}", use.line)  # the label inside a condition
+                break
         if missing is not None and use.optional:
             scenario = replace(scenario, options=replace(scenario.options, response_signal=None,
                                                          response_signal_hint=_error_outputs(plc)))
             continue
         if missing is not None:
-            raise UnusableInput(f"{scenario.where(use.key, use.line)}: {missing}")
+            raise UnusableInput(f"{scenario.where(use.key, line)}: {missing}")
         for name in use.names:
             value = _plain(plc.read(name))
             kinds[name] = "bool" if isinstance(value, bool) else "STRING" if isinstance(value, str) else "number"

@@ -481,14 +481,32 @@ class _Reader:
         keys += ["response_handling.signal"] if signal_given else []
         keys += ["platform"] if "platform" in data else []
         keys += ["program"] if program is not None else []
+        conditions = [(f"{e.key}.{e.kind}", e.condition) for e in expectations if e.condition is not None]
+        conditions += [("response_handling.signal", options.response_signal)] if signal_given else []
         return Scenario(
             name=name, path=self.path, description=description, sources=sources, program=program,
             platform=platform, channel=channel, duration_us=duration, scan_us=scan, scan_jitter_us=jitter, seed=seed,
             watch=watch, settings=settings, robot=robot, faults=faults, inputs=inputs,
             expectations=expectations, options=options, response_signal_given=signal_given,
-            key_lines={key: self.line_of(key) for key in keys} | self.set_names(inputs), initial=initial, c24=c24,
+            key_lines={key: self.line_of(key) for key in keys} | self.set_names(inputs)
+            | self.names_in_conditions(conditions), initial=initial, c24=c24,
             converter=converter,
         )
+
+    def names_in_conditions(self, conditions) -> dict[str, Place | None]:
+        """Where each label of a condition stands in the file (`expect[0].that:fbEngine.o_bErr`),
+        so that a label the program lacks is reported there, not at the condition's start."""
+        places: dict[str, Place | None] = {}
+        for key, condition in conditions:
+            start = place_of_key(self.lines, key)
+            if start is None:
+                continue
+            for name in condition.names:
+                found = re.search(r"(?<![A-Za-z0-9_.#\]])" + re.escape(name) + r"(?![A-Za-z0-9_\[.])",
+                                  condition.text, re.IGNORECASE)
+                if found is not None:
+                    places[f"{key}:{name}"] = self._inside_string(start, found.start() + 1)
+        return places
 
     def set_names(self, inputs: tuple[InputStep, ...]) -> dict[str, Place | None]:
         """Where each label an input sets is named (`inputs[0].set.X0`), for the errors about it."""
