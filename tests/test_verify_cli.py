@@ -917,3 +917,17 @@ def test_no_response_signal_names_the_error_outputs_the_program_has(tmp_path):
     assert ("and the scenario names no output to show it: set [response_handling] signal in the scenario or "
             "--response-signal (the program has no o_bErr; its FB instances have fbPort.o_bErr, fbEngine.o_bErr, "
             "fbCycle.o_bErr)") in " ".join(result.output.split())
+
+
+def test_junit_error_of_a_stopped_cpu_says_where_and_why_in_its_message(tmp_path, monkeypatch):
+    # <error message="simulation stopped">: a CI server's list showed no place and no reason
+    (tmp_path / "Crash.st").write_text(
+        "PROGRAM Crash\nVAR\n    a : ARRAY[0..3] OF INT;\n    i : INT;\nEND_VAR\ni := i + 1;\na[i] := 1;\nEND_PROGRAM\n",
+        encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("Crash.st", "--platform", "fx3u", "--duration", "1s", "--junit", "v.xml")
+    assert result.exit_code == 1
+    (error,) = ET.parse(tmp_path / "v.xml").getroot().iter("error")
+    assert error.get("type") == "simulation"
+    assert re.fullmatch(r"simulation stopped: Crash\.st:7:3: index 4 is outside a\[0\.\.3\].*\(at t=0\.\d+ s\)",
+                        error.get("message")), error.get("message")

@@ -54,7 +54,9 @@ def to_element(results: list[ScenarioResult]) -> ET.Element:
             case.set("file", result.file)
         if result.aborted:
             errors += 1
-            element = ET.SubElement(case, "error", message="simulation stopped", type="simulation")
+            # the message is what a CI server lists: the ST place and the reason, as for a rule
+            first = result.aborted.splitlines()[0]
+            element = ET.SubElement(case, "error", message=f"simulation stopped: {first}", type="simulation")
             element.text = result.aborted
         if result.no_traffic:
             errors += 1  # nothing was verified: not a pass, and not a rule the PLC broke
