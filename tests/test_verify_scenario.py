@@ -483,6 +483,17 @@ def test_a_control_command_not_sent_names_what_was_sent_instead():
     assert "instead" not in results[2].detail  # the other reads would be noise
 
 
+def test_a_command_answered_with_an_exception_says_so():
+    # 'was sent at 0.600 s but never answered' for a command the robot refused with an
+    # exception: the user looked for a silent robot
+    frame = _tx(600, POINT3)
+    refused = protocol.encode(protocol.ExceptionReply(1, 0x06, 4), S)
+    rx = TraceRecord(frame.t_end_us + 5000, frame.t_end_us + 5000 + protocol.frame_time_us(len(refused)), "rx", refused)
+    (result,) = _judge('[[expect]]\nsent = "run-point 3"\n', _evidence({}, _control(0, STOP) + [frame, rx]))
+    assert result.detail == ("run point/script 3 (01/03) was sent at 0.600 s but never answered between 0.000 s and "
+                             "10.000 s (the first time: exception 04 (slave device failure) to function 06)")
+
+
 def test_reached_point_needs_the_task_to_run_and_end_without_error():
     never_runs = _control(0, STOP) + _read(300, 0) + _control(600, POINT3) + _read(900, 0)
     (result,) = _judge('[[expect]]\nreached_point = 3\n', _evidence({}, never_runs))

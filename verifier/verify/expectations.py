@@ -23,7 +23,7 @@ from verifier import protocol
 from .conditions import Condition
 from .durations import format_seconds
 from .evidence import FrameRef, RunEvidence
-from .traffic import Traffic
+from .traffic import ReplyStatus, Traffic
 
 KINDS = ("that", "always", "never", "sent", "reached_point")
 SENT_INSTEAD = 3  # other control commands a failed `sent` names
@@ -234,9 +234,11 @@ class _Sent(ExchangeWatch):
         meaning = protocol.describe(expectation.request, self.settings)
         if self.unanswered is not None:
             t = self.unanswered.request.t_start_us
+            status, why = self.unanswered.reply_status
+            got = "" if status is ReplyStatus.NONE else f" (the first time: {why})"
             return ExpectationResult(
                 expectation, False,
-                f"{meaning} was sent at {format_seconds(t)} but never answered {_span(start, end)}",
+                f"{meaning} was sent at {format_seconds(t)} but never answered {_span(start, end)}{got}",
                 t, self.unanswered.refs(),
             )
         instead = self.instead or self.instead_other
