@@ -931,3 +931,13 @@ def test_junit_error_of_a_stopped_cpu_says_where_and_why_in_its_message(tmp_path
     assert error.get("type") == "simulation"
     assert re.fullmatch(r"simulation stopped: Crash\.st:7:3: index 4 is outside a\[0\.\.3\].*\(at t=0\.\d+ s\)",
                         error.get("message")), error.get("message")
+
+
+def test_a_scenario_without_sources_says_the_file_can_list_them(tmp_path, monkeypatch):
+    # 'no ST sources: give them as arguments' left out the scenario's own 'sources' key
+    (tmp_path / "s.toml").write_text('program = "MAIN"\n', encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("--scenario", "s.toml")
+    assert result.exit_code == 2
+    assert ('error: s.toml: no ST sources: list them in the file (sources = ["plc/*.st"], relative to it) or give '
+            "them as arguments (uitamr verify FILE.st ...)") in " ".join(result.output.split())

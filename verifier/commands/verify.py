@@ -161,8 +161,10 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
         if scenario.scan_jitter_us >= scenario.scan_us:
             raise UnusableInput(f"{scenario.path or scenario.name}: scan_jitter must be shorter than the scan time")
         if not scenario.sources:
-            where = scenario.path or "the default scenario"
-            raise UnusableInput(f"{where}: no ST sources: give them as arguments (uitamr verify FILE.st ...)")
+            if scenario.path is None:
+                raise UnusableInput("the default scenario: no ST sources: give them as arguments (uitamr verify FILE.st ...)")
+            raise UnusableInput(f"{scenario.path}: no ST sources: list them in the file (sources = [\"plc/*.st\"], "
+                                "relative to it) or give them as arguments (uitamr verify FILE.st ...)")
     return scenarios
 
 
