@@ -941,3 +941,10 @@ def test_a_scenario_without_sources_says_the_file_can_list_them(tmp_path, monkey
     assert result.exit_code == 2
     assert ('error: s.toml: no ST sources: list them in the file (sources = ["plc/*.st"], relative to it) or give '
             "them as arguments (uitamr verify FILE.st ...)") in " ".join(result.output.split())
+
+
+def test_a_response_signal_that_reads_no_label_is_refused():
+    # --response-signal TRUE made every failure 'noticed': the rule could not fail
+    result = invoke(*FX3_SOURCES, "--program", "UITAMR_ExampleFx3", "--duration", "1s", "--response-signal", "TRUE")
+    assert result.exit_code == 2
+    assert "--response-signal: 'TRUE' reads no label" in result.output

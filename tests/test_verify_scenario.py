@@ -349,6 +349,19 @@ def test_a_key_given_twice_is_named_with_its_first_line(text, expected):
     assert str(error_of(text, Path("x.toml"))) == expected
 
 
+@pytest.mark.parametrize("text, key, shown", [
+    ('[[expect]]\nalways = "TRUE"\n', "expect[0].always", "TRUE"),  # passed whatever the program did
+    ('[[expect]]\nnever = "FALSE"\n', "expect[0].never", "FALSE"),
+    ('[[expect]]\nthat = "1 < 2"\n', "expect[0].that", "1 < 2"),
+    ('[response_handling]\nsignal = "TRUE"\n', "response_handling.signal", "TRUE"),  # every failure 'noticed'
+])
+def test_a_condition_that_reads_no_label_is_an_error(text, key, shown):
+    error = error_of('program = "M"\n' + text, Path("x.toml"))
+    assert str(error).startswith(f"x.toml:3:")
+    assert str(error).endswith(f"{key}: '{shown}' reads no label: it is the same at every moment and says nothing "
+                               "about the program; name the program's labels (e.g. fbRobot.o_bErr) or devices (Y0)")
+
+
 def test_an_empty_expectation_name_is_an_error_at_its_line():
     # was accepted: the console then said "expected : 'Y0' became true at 0.570 s"
     error = error_of('program = "M"\n[[expect]]\nname = " "\nnever = "Y0"\n', Path("x.toml"))

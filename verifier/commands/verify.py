@@ -195,6 +195,9 @@ def _with_signal(scenario: Scenario, text: str) -> Scenario:
         signal = parse_condition(text)
     except ConditionError as exc:
         raise UnusableInput(f"--response-signal: {exc.message} at column {exc.column} of {text!r}") from None
+    if not signal.names:
+        raise UnusableInput(f"--response-signal: '{signal}' reads no label: it is the same at every moment and says "
+                            "nothing about the program; name the program's output (e.g. fbRobot.o_bErr)")
     options = replace(scenario.options, response_signal=signal)
     return replace(scenario, options=options, response_signal_given=True, response_signal_key="--response-signal")
 

@@ -384,6 +384,15 @@ class _Reader:
             raise self.fail(key, f"{exc.message} at column {exc.column} of {text!r}",
                             offset=exc.column) from None
 
+    def constant_refused(self, condition, key: str):
+        """`condition`, when it reads a label: one that reads none (`that = "TRUE"`) is the
+        same at every moment, so it tells nothing about the program - it always passes, or
+        can never pass."""
+        if not condition.names:
+            raise self.fail(key, f"'{condition}' reads no label: it is the same at every moment and says nothing "
+                                 "about the program; name the program's labels (e.g. fbRobot.o_bErr) or devices (Y0)")
+        return condition
+
     def label(self, value: Any, key: str, at: str = "") -> str:
         """A label path; `at` is the key that names it, when it is a key (an input's `set`)."""
         text = self.string(value, key)
@@ -685,7 +694,7 @@ class _Reader:
         value = item[kind]
         fields: dict[str, Any] = {}
         if kind in ("that", "always", "never"):
-            fields["condition"] = self.condition(value, f"{key}.{kind}")
+            fields["condition"] = self.constant_refused(self.condition(value, f"{key}.{kind}"), f"{key}.{kind}")
             what = {"that": "", "always": "always ", "never": "never "}[kind] + str(fields["condition"])
         elif kind == "sent":
             words = self.string(value, f"{key}.sent")
@@ -721,7 +730,8 @@ class _Reader:
         response = self.table(response, "response_handling")
         self.only(response, RESPONSE_KEYS, "response_handling")
         if "signal" in response:
-            options = replace(options, response_signal=self.condition(response["signal"], "response_handling.signal"))
+            key = "response_handling.signal"
+            options = replace(options, response_signal=self.constant_refused(self.condition(response["signal"], key), key))
         if "within" in response:
             options = replace(
                 options, response_within_us=self.duration(response["within"], "response_handling.within")
