@@ -362,6 +362,17 @@ def test_a_condition_that_reads_no_label_is_an_error(text, key, shown):
                                "about the program; name the program's labels (e.g. fbRobot.o_bErr) or devices (Y0)")
 
 
+def test_reaching_a_point_in_a_window_shorter_than_its_run_is_an_impossible_expectation():
+    # the run failed with 'run-point 1 was running ... but did not finish' however right the program
+    text = ('program = "M"\n[robot]\npoint_duration_s = 6.0\n[robot.point_durations_s]\n2 = 3.0\n'
+            '[[expect]]\nreached_point = 1\nwithin = "5s"\n')
+    error = error_of(text, Path("x.toml"))
+    assert str(error) == ("x.toml:8:10: expect[0].within: point 1 takes the robot 6s ([robot] point_duration_s / "
+                          "point_durations_s), longer than this window of 5s: it can never be reached in it; make "
+                          "'within' longer")
+    parse_scenario(text.replace("reached_point = 1", "reached_point = 2"))  # 3 s: may be reached in 5 s
+
+
 def test_an_empty_expectation_name_is_an_error_at_its_line():
     # was accepted: the console then said "expected : 'Y0' became true at 0.570 s"
     error = error_of('program = "M"\n[[expect]]\nname = " "\nnever = "Y0"\n', Path("x.toml"))

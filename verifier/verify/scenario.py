@@ -461,6 +461,14 @@ class _Reader:
             for i, item in enumerate(self.array_of_tables(data.get("expect", []), "expect"))
         )
         for expectation in expectations:
+            if (expectation.kind == "reached_point" and expectation.within_us is not None and robot.is_taught(
+                    expectation.point) and expectation.within_us < robot.point_duration_us(expectation.point)):
+                takes = format_duration(robot.point_duration_us(expectation.point))
+                raise self.fail(f"{expectation.key}.within",
+                                f"point {expectation.point} takes the robot {takes} ([robot] point_duration_s / "
+                                f"point_durations_s), longer than this window of "
+                                f"{format_duration(expectation.within_us)}: it can never be reached in it; make "
+                                "'within' longer")
             if expectation.kind == "reached_point" and not robot.is_taught(expectation.point):
                 raise self.fail(f"{expectation.key}.reached_point",
                                 f"point {expectation.point} is not among the robot's taught_points "
