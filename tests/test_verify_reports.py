@@ -151,6 +151,20 @@ def test_console_summary_shows_verdict_counts_and_first_violations():
     assert text.rstrip().endswith("FAIL: 1 of 2 scenario(s) failed")
 
 
+def test_console_lists_five_kinds_of_simulator_note_and_counts_the_rest():
+    from verifier.sim.errors import SimDiagnostic, summarize_diagnostics
+
+    diagnostics = [SimDiagnostic(1000 * i, f"Main.st:{i % 7 + 1}:1", 0, f"note kind {chr(65 + i % 7)}: {i} byte(s)")
+                   for i in range(70)]
+    result = good_result()
+    result.diagnostic_summary = summarize_diagnostics(diagnostics)
+    assert result.diagnostic_summary[0] == "×10, first at 0.000 s: note kind A: 0 byte(s)  at Main.st:1:1"
+    out = io.StringIO()
+    report_console.render([result], Console(file=out, width=200, color_system=None))
+    lines = [line for line in out.getvalue().splitlines() if line.startswith("    simulator ")]
+    assert len(lines) == 6 and lines[-1] == "    simulator and 2 more kind(s) of note (see --json or --html)"
+
+
 def test_a_capture_with_no_traffic_neither_passes_nor_fails():
     """A monitored line or a capture with no bytes verified nothing: its verdict is
     "no-traffic" (any failure elsewhere still makes the whole run fail)."""
