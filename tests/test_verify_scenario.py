@@ -479,6 +479,7 @@ POINT3 = protocol.ControlRequest(1, protocol.ControlCode.ROBOT, 3)
 def test_sent_and_reached_point():
     trace = _control(0, STOP) + _read(300, 0) + _control(600, POINT3) + _read(900, 1) + _read(1200, 1) + _read(1500, 0)
     results = _judge(
+        '[robot]\npoint_duration_s = 0.5\n'  # as fast as the trace's robot: 1 s can hold the run
         '[[expect]]\nsent = "stop"\nwithin = "1s"\n'
         '[[expect]]\nsent = "run-point 4"\n'
         '[[expect]]\nreached_point = 3\nwithin = "2s"\n'
