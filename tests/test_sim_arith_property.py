@@ -89,6 +89,10 @@ def test_expressions_wrap_like_the_cpu(type_name, data):
         project = project_for(type_name, st_text(tree))
     except LoadError as e:  # the checker folds constant sub-expressions and refuses overflow
         assume("range" not in str(e))
+        # folded exactly, a constant divisor can be 0 where the model, which wraps every
+        # step, has none: (226 * 9502141) MOD 9502141 is 0 exactly and -9501705 wrapped
+        # in DINT. The model found no division by zero, so this is that case.
+        assume("by zero" not in str(e))
         raise
     assert project.call("F", env["a"], env["b"], env["c"]) == expected
     assert not project.diagnostics

@@ -179,6 +179,22 @@ def test_rs2_receives_by_count_then_waits_for_m8403_reset():
     assert project.devices["D8403"] == 0     # ...and the count goes with it
 
 
+def test_bytes_discarded_for_a_reception_never_rearmed_name_the_rs2_call_and_the_fix():
+    # the diagnostic named no place and no remedy: a program that forgets to reset M8403
+    # only saw "6 received byte(s) discarded because M8403 was still ON" in the JSON report
+    ep = FakeEndpoint()
+    project, p = rs2_project(ep)
+    ep.reply_at(25_000, bytes.fromhex("0101030000003c4e"))
+    project.run_programs(["P"], scans=3)
+    ep.reply_at(45_000, b"\x99")
+    project.run_programs(["P"], scans=1)
+    last = project.diagnostics[-1]
+    assert last.location == "t.st:16:1"      # the RS2 call
+    assert last.message == ("RS2 fx3:1: 1 received byte(s) discarded because M8403 was still ON: reset M8403 "
+                            "(receive complete) once the received data is read, or RS2 receives nothing more "
+                            "(docs/instructions.md §7)")
+
+
 def test_rs2_receive_ends_on_the_d8409_time_out():
     ep = FakeEndpoint()
     project, p = rs2_project(ep)

@@ -333,6 +333,20 @@ def test_a_duration_that_ends_the_run_before_a_fault_says_the_fault_was_not_test
     assert "not tested" not in result.output
 
 
+def test_a_duration_that_ends_the_run_before_an_input_says_it_was_not_applied(tmp_path):
+    # --duration 15s on a scenario that presses X4 at 20 s: the run went on as if no one
+    # pressed it, and only the expectations on its outcome hinted at why
+    sources = [str(p) for p in FX3_SOURCES]
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(f'sources = {json.dumps(sources)}\nprogram = "UITAMR_ExampleFx3"\nduration = "30s"\n'
+                        '[[inputs]]\nat = "1s"\nset = {{ X0 = true }}\npulse = "300ms"\n'
+                        '[[inputs]]\nat = "20s"\nset = {{ X1 = true }}\n'.replace("{{", "{").replace("}}", "}"))
+    result = invoke("--scenario", scenario, "--duration", "15s")
+    assert ("note: --duration 15s ends the run before 1 of its operator input(s), not applied: inputs[1] at 20.000 s"
+            in result.output), result.output
+    assert "not applied" not in invoke("--scenario", scenario, "--duration", "21s").output
+
+
 def test_jobs_beyond_the_batches_start_no_idle_workers(tmp_path, monkeypatch):
     """The process pool forks all its workers at once: --jobs 5000 for two scenarios
     forked 5000 processes and the run never ended. It gets a worker per batch at most."""
@@ -771,3 +785,186 @@ def test_a_fault_that_met_no_request_is_noted_at_its_line(tmp_path):
     assert "faults[2]" not in result.output                  # the no_reply at 3 s met a status read
     notes = json.loads(report.read_text())["scenarios"][0]["notes"]
     assert sum("was not tested" in note for note in notes) == 2
+
+
+NEVER_REARMED = """PROGRAM MAIN
+VAR
+    uSend : ARRAY[0..3] OF WORD;
+    uRecv : ARRAY[0..3] OF WORD;
+    tPoll : TON;
+    wReplies : INT;
+END_VAR
+IF M8002 THEN
+    D8400 := 16#1C81;
+    D8409 := 5;
+    uSend[0] := 16#0601;
+    uSend[1] := 16#A001;
+    uSend[2] := 16#0000;
+    uSend[3] := 16#1488;
+END_IF;
+tPoll(IN := NOT tPoll.Q, PT := T#400ms);
+IF tPoll.Q AND NOT M8402 THEN
+    M8402 := TRUE;
+END_IF;
+IF M8403 THEN
+    wReplies := wReplies + 1;
+END_IF;
+RS2(TRUE, uSend[0], 8, 8, 1, uRecv[0]);
+END_PROGRAM
+"""
+
+
+def test_a_reception_never_rearmed_is_named_on_the_console_and_in_junit(tmp_path, monkeypatch):
+    # the program sends the stop every 400 ms and never resets M8403: every reply after the
+    # first is discarded. Only the JSON report said so, without a place; the console and
+    # the JUnit report, what a CI user reads, said nothing
+    (tmp_path / "MAIN.st").write_text(NEVER_REARMED, encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("MAIN.st", "--platform", "fx3u", "--duration", "3s", "--junit", "v.xml", "--json", "v.json")
+    lines = [line for line in result.output.splitlines() if line.startswith("    simulator ")]
+    assert len(lines) == 1, result.output  # one line for every discarded reply
+    assert re.fullmatch(
+        r"    simulator ×\d+, first at \d\.\d{3} s: RS2 fx3:1: \d received byte\(s\) discarded because M8403 was "
+        r"still ON: reset M8403 \(receive complete\) once the received data is read, or RS2 receives nothing "
+        r"more \(docs/instructions\.md §7\)  at MAIN\.st:23:1", lines[0]), lines[0]
+    out = ET.parse(tmp_path / "v.xml").getroot().find(".//system-out").text
+    assert lines[0].strip() in out.splitlines()
+    every = json.loads((tmp_path / "v.json").read_text())["scenarios"][0]["simulator_diagnostics"]
+    assert int(re.search(r"×(\d+)", lines[0]).group(1)) == len(every) > 1
+    # the JSON list names the file as the console does, not by its absolute path
+    assert all(entry.startswith("MAIN.st:23:1: t=") for entry in every), every[0]
+    # the HTML page: the console's line, not one item per discarded reply
+    invoke("MAIN.st", "--platform", "fx3u", "--duration", "3s", "--html", "v.html")
+    notes = re.findall(r'<li class="mono simulator-note">(.*?)</li>', (tmp_path / "v.html").read_text())
+    assert notes == [lines[0].strip().removeprefix("simulator ")]
+
+
+BACK_TO_BACK = """PROGRAM MAIN
+VAR
+    uSend : ARRAY[0..3] OF WORD;
+    uRecv : ARRAY[0..3] OF WORD;
+    wStep : INT;
+END_VAR
+IF M8002 THEN
+    D8400 := 16#1C81;
+    D8409 := 5;
+END_IF;
+(* scan 1: the stop; scan 2, as soon as the CPU has sent it: the point command *)
+IF wStep = 1 THEN
+    uSend[0] := 16#0601;
+    uSend[1] := 16#A001;
+    uSend[2] := 16#0000;
+    uSend[3] := 16#1488;
+    M8402 := TRUE;
+    wStep := 2;
+ELSIF wStep = 2 AND NOT M8402 THEN
+    uSend[0] := 16#0601;
+    uSend[1] := 16#0201;
+    uSend[2] := 16#0000;
+    uSend[3] := POINT2_CRC;
+    M8402 := TRUE;
+    wStep := 3;
+ELSIF wStep = 0 THEN
+    wStep := 1;
+END_IF;
+M8403 := FALSE;
+RS2(TRUE, uSend[0], 8, 8, 1, uRecv[0]);
+END_PROGRAM
+"""
+
+
+@pytest.mark.parametrize("crc, crc_finding", [
+    ("16#F629", None),  # 01 06 01 02 00 00 29 F6: both requests right, sent too close
+    ("16#F6D9", "UITAMR-CRC: 1 violation(s); first at 0.010 s: the second of two requests ran together: "
+                "01 06 01 02 00 00 D9 F6 followed 01 06 01 A0 00 00 88 14 after a silence of 1.667 ms, less than "
+                "t3.5 = 3.65 ms, so the robot takes them for one frame and discards it; its CRC bytes are D9 F6, "
+                "expected 29 F6 (CRC-16/MODBUS of the first 6 bytes, low byte first)"),
+])
+@pytest.mark.parametrize("path", [[], ["--every-scan"]])  # judged as it goes, and as a whole
+def test_two_requests_run_together_are_judged_one_by_one(tmp_path, monkeypatch, crc, crc_finding, path):
+    # the line makes one 16-byte frame of two requests 1.7 ms apart: UITAMR-CRC said
+    # 'expected 29 ED (CRC-16/MODBUS of the first 14 bytes)' of a frame no one built, and
+    # UITAMR-FORMAT only 'too long for an FC06 request: 16 bytes', not why
+    (tmp_path / "MAIN.st").write_text(BACK_TO_BACK.replace("POINT2_CRC", crc), encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("MAIN.st", "--platform", "fx3u", "--duration", "1s", "--junit", "v.xml", *path)
+    assert result.exit_code == 1, result.output
+    failures = {f.get("type"): f.get("message") for f in ET.parse(tmp_path / "v.xml").getroot().iter("failure")}
+    assert failures.get("UITAMR-CRC") == crc_finding
+    assert failures["UITAMR-FORMAT"] == (
+        "UITAMR-FORMAT: 1 violation(s); first at 0.010 s: two requests ran together: 01 06 01 02 00 00 "
+        + ("D9 F6" if crc_finding else "29 F6") + " followed 01 06 01 A0 00 00 88 14 after a silence of 1.667 ms, "
+        "less than t3.5 = 3.65 ms, so the robot takes them for one frame and discards it: leave at least t3.5 of "
+        "silence between two requests (and wait for the reply, or its time-out, before the next)")
+
+
+def test_a_program_the_sources_lack_is_reported_at_the_scenarios_program_line(tmp_path, monkeypatch):
+    # 'verify/healthy.toml: no PROGRAM ...' named the file only, though the line is known
+    (tmp_path / "MAIN.st").write_text(NEVER_REARMED, encoding="utf-8")
+    (tmp_path / "s.toml").write_text('name = "x"\nsources = ["MAIN.st"]\nprogram = "CELL_MAIN"\n', encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("--scenario", "s.toml")
+    assert result.exit_code == 2
+    assert "error: s.toml:3:11: program: no PROGRAM 'CELL_MAIN' in the sources; they define: MAIN" in result.output
+    # --program replaces the file's: then the file's line is not the place
+    result = invoke("--scenario", "s.toml", "--program", "OTHER")
+    assert result.exit_code == 2
+    assert "error: --program: no PROGRAM 'OTHER' in the sources; they define: MAIN" in result.output
+
+
+def test_matrix_with_two_programs_asks_for_program_without_naming_a_bundled_file(tmp_path, monkeypatch):
+    # the error named plc/scenarios/fx3u-address-out-of-range.toml and its 'program' key,
+    # a file the user did not write and cannot change
+    (tmp_path / "MAIN.st").write_text(NEVER_REARMED, encoding="utf-8")
+    (tmp_path / "OTHER.st").write_text(NEVER_REARMED.replace("PROGRAM MAIN", "PROGRAM OTHER"), encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("MAIN.st", "OTHER.st", "--platform", "fx3u", "--matrix")
+    assert result.exit_code == 2
+    assert ("error: --matrix runs one PROGRAM of your sources under the bundled fault sets: say which with "
+            "--program; the sources define: MAIN, OTHER") in result.output
+    assert "scenarios/" not in result.output
+
+
+def test_no_response_signal_names_the_error_outputs_the_program_has(tmp_path):
+    # 'set [response_handling] signal ... (e.g. "o_bErr")' for a program that has no
+    # o_bErr: the user had to find which of its FB outputs to name
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(
+        'name = "bad CRC for 8 s"\nprogram = "UITAMR_ExampleFx3"\nduration = "20s"\n'
+        '[[faults]]\nkind = "bad_crc"\nat_s = 5.0\nduration_s = 8.0\n', encoding="utf-8")
+    result = invoke(*FX3_SOURCES, "--scenario", scenario)
+    assert result.exit_code == 1, result.output
+    assert ("and the scenario names no output to show it: set [response_handling] signal in the scenario or "
+            "--response-signal (the program has no o_bErr; its FB instances have fbPort.o_bErr, fbEngine.o_bErr, "
+            "fbCycle.o_bErr)") in " ".join(result.output.split())
+
+
+def test_junit_error_of_a_stopped_cpu_says_where_and_why_in_its_message(tmp_path, monkeypatch):
+    # <error message="simulation stopped">: a CI server's list showed no place and no reason
+    (tmp_path / "Crash.st").write_text(
+        "PROGRAM Crash\nVAR\n    a : ARRAY[0..3] OF INT;\n    i : INT;\nEND_VAR\ni := i + 1;\na[i] := 1;\nEND_PROGRAM\n",
+        encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("Crash.st", "--platform", "fx3u", "--duration", "1s", "--junit", "v.xml")
+    assert result.exit_code == 1
+    (error,) = ET.parse(tmp_path / "v.xml").getroot().iter("error")
+    assert error.get("type") == "simulation"
+    assert re.fullmatch(r"simulation stopped: Crash\.st:7:3: index 4 is outside a\[0\.\.3\].*\(at t=0\.\d+ s\)",
+                        error.get("message")), error.get("message")
+
+
+def test_a_scenario_without_sources_says_the_file_can_list_them(tmp_path, monkeypatch):
+    # 'no ST sources: give them as arguments' left out the scenario's own 'sources' key
+    (tmp_path / "s.toml").write_text('program = "MAIN"\n', encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("--scenario", "s.toml")
+    assert result.exit_code == 2
+    assert ('error: s.toml: no ST sources: list them in the file (sources = ["plc/*.st"], relative to it) or give '
+            "them as arguments (uitamr verify FILE.st ...)") in " ".join(result.output.split())
+
+
+def test_a_response_signal_that_reads_no_label_is_refused():
+    # --response-signal TRUE made every failure 'noticed': the rule could not fail
+    result = invoke(*FX3_SOURCES, "--program", "UITAMR_ExampleFx3", "--duration", "1s", "--response-signal", "TRUE")
+    assert result.exit_code == 2
+    assert "--response-signal: 'TRUE' reads no label" in result.output

@@ -116,7 +116,8 @@ def test_the_documented_label_errors_are_what_verify_prints(tmp_path):
         'watch = ["fbEngine.o_wTxCount", "wBuf[40]"]\n',
         '[[inputs]]\nat = "0s"\nset = { X0 = 5 }\n',
         '[[inputs]]\nat = "0s"\nset = { X0 = true }\n[[inputs]]\nat = "0s"\nset = { D100 = 99999 }\n',
-        '[[expect]]\nthat = "TRUE"\n[[expect]]\nthat = "TRUE"\n[[expect]]\nthat = "fbEngine.o_wTask"\n',
+        '[[expect]]\nnever = "fbEngine.o_bErr"\n[[expect]]\nnever = "fbEngine.o_bErr"\n'
+        '[[expect]]\nthat = "fbEngine.o_wTask"\n',
     ]
     documented = _error_blocks()[1]
     assert len(documented) == len(bodies)

@@ -151,13 +151,17 @@ def _run_scenario(tmp_path, program, body: str):
 
 
 @pytest.mark.parametrize("body, line, key, message", [
-    ('\n[[expect]]\nthat = "nosuch.label"\n', "5:8", "expect[0].that", "the program Main has no label 'nosuch.label'"),
-    ('\n[[expect]]\nthat = "b"\n[[expect]]\nnever = "tmr.QQ"\n', "7:9", "expect[1].never",
+    # a label in a condition: at the label itself, inside the string
+    ('\n[[expect]]\nthat = "nosuch.label"\n', "5:9", "expect[0].that", "the program Main has no label 'nosuch.label'"),
+    ('\n[[expect]]\nthat = "b"\n[[expect]]\nnever = "tmr.QQ"\n', "7:10", "expect[1].never",
      "no label 'tmr.QQ' in the program Main: tmr has no member 'QQ'"),
+    # the one the program lacks, not the condition's first (was 5:8 for either)
+    ('\n[[expect]]\nthat = "b AND (w > 1 OR nosuch.label)"\n', "5:25", "expect[0].that",
+     "the program Main has no label 'nosuch.label'"),
     ('watch = ["w", "arr[7]"]\n', "3:15", "watch[1]", "no label 'arr[7]' in the program Main: arr has no element [7]"),
     # the label's own name in the table, not the table's brace (5:7)
     ('[[inputs]]\nat = "0s"\nset = { nosuch = true }\n', "5:9", "inputs[0].set", "the program Main has no label 'nosuch'"),
-    ('[response_handling]\nsignal = "bErr"\n', "4:10", "response_handling.signal", "the program Main has no label 'bErr'"),
+    ('[response_handling]\nsignal = "bErr"\n', "4:11", "response_handling.signal", "the program Main has no label 'bErr'"),
 ])
 def test_unknown_labels_name_file_line_and_key_once(tmp_path, program, body, line, key, message):
     result, scenario = _run_scenario(tmp_path, program, body)

@@ -406,3 +406,15 @@ def test_a_location_on_line_100_is_printed_as_it_is(tmp_path):
     assert done.returncode == 1, done.stdout + done.stderr
     assert "UITAMR-PACING" in done.stdout and "P.st:100:9" in done.stdout, done.stdout
     assert "\N{HUNDRED POINTS SYMBOL}" not in done.stdout
+
+
+def test_a_program_that_stops_the_cpu_names_its_st_file_as_the_frames_do(tmp_path, monkeypatch):
+    # the other reports name ST files relative to the working folder; the stop gave the
+    # absolute path (/tmp/.../Crash.st:7:3)
+    crash = tmp_path / "Crash.st"
+    crash.write_text("PROGRAM Crash\nVAR\n    a : ARRAY[0..3] OF INT;\n    i : INT;\nEND_VAR\ni := i + 1;\na[i] := 1;\n")
+    from verifier.verify.scenario import default_scenario
+
+    monkeypatch.chdir(tmp_path)
+    result = run_scenario(replace(default_scenario(duration_us=1_000_000), sources=(crash,), program="Crash"))
+    assert result.aborted.startswith("Crash.st:7:"), result.aborted

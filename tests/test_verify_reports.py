@@ -151,6 +151,20 @@ def test_console_summary_shows_verdict_counts_and_first_violations():
     assert text.rstrip().endswith("FAIL: 1 of 2 scenario(s) failed")
 
 
+def test_console_lists_five_kinds_of_simulator_note_and_counts_the_rest():
+    from verifier.sim.errors import SimDiagnostic, summarize_diagnostics
+
+    diagnostics = [SimDiagnostic(1000 * i, f"Main.st:{i % 7 + 1}:1", 0, f"note kind {chr(65 + i % 7)}: {i} byte(s)")
+                   for i in range(70)]
+    result = good_result()
+    result.diagnostic_summary = summarize_diagnostics(diagnostics)
+    assert result.diagnostic_summary[0] == "×10, first at 0.000 s: note kind A: 0 byte(s)  at Main.st:1:1"
+    out = io.StringIO()
+    report_console.render([result], Console(file=out, width=200, color_system=None))
+    lines = [line for line in out.getvalue().splitlines() if line.startswith("    simulator ")]
+    assert len(lines) == 6 and lines[-1] == "    simulator and 2 more kind(s) of note (see --json or --html)"
+
+
 def test_a_capture_with_no_traffic_neither_passes_nor_fails():
     """A monitored line or a capture with no bytes verified nothing: its verdict is
     "no-traffic" (any failure elsewhere still makes the whole run fail)."""
@@ -302,6 +316,28 @@ def test_html_diagram_zooms_in_the_browser(tmp_path):
     first = next(r for r in svg.iter("rect") if "frame" in (r.get("class") or "").split())
     assert float(first.get("width")) == round(8.333 * 8, 2)
     assert root.find(".//*[@id='s0-scale']").text == "8.0 px/ms"
+
+
+def test_html_violations_table_fits_the_window_with_a_long_frame(tmp_path):
+    """Two requests run together make a 16-byte frame with a long meaning: its cell, kept on
+    one line, pushed the ST location out of a 1400 px window and squeezed 'what' to one word
+    per line. Measured in Chromium: a script added to a copy of the page writes the cells'
+    boxes into the DOM that --dump-dom returns."""
+    merged = protocol.encode(READ, S) + bytes.fromhex("01 06 01 02 00 00 D9 F6")
+    trace = [TraceRecord(0, protocol.frame_time_us(16), "tx", merged, "plc/CELL_BUGGY.st:47:5")]
+    page = tmp_path / "report.html"
+    report_html.write([_result("merged", trace, 2_000_000)], page)
+    probe = tmp_path / "probe.html"
+    probe.write_text(page.read_text().replace("</body>", """<script>
+      const cells = document.querySelector('.violations-table tr.violation-row').querySelectorAll('td');
+      document.body.setAttribute('data-layout', JSON.stringify({
+        view: document.documentElement.clientWidth,
+        location: cells[4].getBoundingClientRect().right,
+        what: cells[2].getBoundingClientRect().width}));
+    </script></body>"""))
+    layout = json.loads(_rendered(probe.as_uri()).find(".//body").get("data-layout"))
+    assert layout["location"] <= layout["view"], layout  # the ST location is in sight
+    assert layout["what"] >= 200, layout  # the message reads as lines, not a column of words
 
 
 def test_html_screenshot_is_taken(tmp_path):

@@ -33,6 +33,20 @@ def test_bad_durations_are_refused_with_an_example(bad):
         parse_duration_us(bad)
 
 
+@pytest.mark.parametrize("text, hint", [
+    ("5sec", '; did you mean "5s"?'), ("250 msec", '; did you mean "250ms"?'), ("2 minutes", '; did you mean "2min"?'),
+    ("1hr", '; did you mean "1h"?'), ("3m", '; did you mean "3min"?'), ("1.5 Seconds", '; did you mean "1.5s"?'),
+    ("-1s", "; a duration counts forward (from power-on, or from the window's start): it cannot be negative"),
+    ("5 parsecs", ""), ("soon", ""),
+])
+def test_a_duration_with_a_unit_spelt_otherwise_names_the_one_meant(text, hint):
+    # '5sec' and '-1s' got only 'is not a duration: write a number and a unit'
+    with pytest.raises(ValueError) as info:
+        parse_duration_us(text)
+    assert str(info.value).startswith(f"{text!r} is not a duration: write a number and a unit")
+    assert str(info.value).endswith('e.g. "250ms" or "60s"' + hint)
+
+
 @pytest.mark.parametrize("text, us, message", [
     # Fraction() read none of these: 'Exceeds the limit (4300 digits) for integer string conversion'
     ("9" * 5000 + "s", None, "a duration of 5000 digits is longer than any run: check the number"),
@@ -261,6 +275,111 @@ def test_a_number_too_long_for_python_is_a_toml_error_at_its_place():
     assert str(error).startswith("x.toml:2:8: not valid TOML: a whole number of 5001 digits: too long to read")
 
 
+def test_a_duration_of_another_type_is_shown_as_the_file_writes_it():
+    # 'got True' (Python's spelling) for `within = true`; a bare number got no remedy
+    error = error_of('program = "M"\n[[expect]]\nthat = "a"\nwithin = true\n', Path("x.toml"))
+    assert str(error) == 'x.toml:4:10: expect[0].within: expected a duration such as "250ms" or "60s", got true'
+    error = error_of('program = "M"\n[[expect]]\nthat = "a"\nwithin = 5\n', Path("x.toml"))
+    assert str(error) == ('x.toml:4:10: expect[0].within: expected a duration such as "250ms" or "60s", got the '
+                          'bare number 5: write it in quotes with its unit, e.g. "5s" or "5ms"')
+
+
+@pytest.mark.parametrize("text, key, meant", [
+    ('scna = "10ms"\n', "scna", "scan"),
+    ('[[expect]]\ntaht = "a"\n', "expect[0].taht", "that"),
+    ('[robot]\nbattery_percent = 80\n', "robot.battery_percent", "battery_pct"),
+    ('[[faults]]\nkind = "no_reply"\nat = 3\n', "faults[0].at", "at_s"),
+    ('[[inputs]]\nat = "1s"\nset = { a = true }\npluse = "1s"\n', "inputs[0].pluse", "pulse"),
+])
+def test_a_misspelt_key_names_the_key_probably_meant(text, key, meant):
+    # the message listed every key there is (24 under [robot]) and left the search to the user
+    error = error_of('program = "M"\n' + text, Path("s.toml"))
+    assert f"{key}: unknown key; expected one of " in str(error)
+    assert str(error).endswith(f"; did you mean '{meant}'?")
+
+
+def test_an_unknown_key_like_none_there_is_gets_no_guess():
+    error = error_of('program = "M"\n[rules]\nbogus = 1\n', Path("s.toml"))
+    assert str(error).endswith("expected one of min_period, reply_timeout")
+
+
+def test_an_input_after_the_run_says_the_run_length_and_what_to_do():
+    # 'inputs[0].at: is at or after the end of the run' gave neither, unlike a late fault
+    error = error_of('program = "M"\nduration = "20s"\n[[inputs]]\nat = "30s"\nset = { X0 = true }\n',
+                     Path("x.toml"))
+    assert str(error) == ("x.toml:4:6: inputs[0].at: is at or after the end of the run (20s): the input would never "
+                          "be applied; make 'duration' longer")
+
+
+@pytest.mark.parametrize("text, place", [
+    # the ')' on the second line of a condition in three quotes: was 3:26, past the end of line 3
+    ('[[expect]]\nthat = """Y0 AND\n   (Y1 OR ) """\n', (4, 11)),
+    ('[[expect]]\nthat = """\nY0 AND\n   (Y1 OR ) """\n', (5, 11)),  # the newline after """ is not the value's
+    ("[[expect]]\nthat = \'\'\'Y0 AND\n   (Y1 OR ) \'\'\'\n", (4, 11)),
+    ('[[expect]]\nthat = "Y0 AND (Y1 OR )"\n', (3, 23)),
+    ("[[expect]]\nthat = 'Y0 AND (Y1 OR )'\n", (3, 23)),
+    ('[[expect]]\nthat = "Y0 AND\\t(Y1 OR )"\n', (3, 8)),  # an escape: the value's own place
+])
+def test_a_condition_that_does_not_parse_is_placed_where_it_fails_in_the_file(text, place):
+    error = error_of('program = "M"\n' + text, Path("x.toml"))
+    assert (error.line, error.col) == place, str(error)
+    assert "found ')'" in str(error)
+
+
+def test_reaching_a_point_the_robot_was_not_taught_is_an_impossible_expectation():
+    # the run failed with 'accepted ..., but the robot never reported the task running'
+    # and left the user to find the [robot] setting that made it so
+    error = error_of('program = "M"\n[robot]\ntaught_points = [1, 2, 3]\n[[expect]]\nreached_point = 5\n',
+                     Path("x.toml"))
+    assert str(error) == ("x.toml:5:17: expect[0].reached_point: point 5 is not among the robot's taught_points "
+                          "[1, 2, 3]: the robot accepts run-point 5 and does nothing, so it is never reached; add it "
+                          "to [robot] taught_points")
+    parse_scenario('program = "M"\n[robot]\ntaught_points = [1, 5]\n[[expect]]\nreached_point = 5\n')
+
+
+@pytest.mark.parametrize("text, expected", [
+    ('program = "M"\nduration = "20s"\nduration = "30s"\n',
+     "x.toml:3:1: not valid TOML: 'duration' is given twice (first on line 2): keep one"),
+    ('program = "M"\n[robot]\nbattery_pct = 50\n  battery_pct = 40\n',
+     "x.toml:4:3: not valid TOML: 'battery_pct' is given twice (first on line 3): keep one"),
+])
+def test_a_key_given_twice_is_named_with_its_first_line(text, expected):
+    # tomllib's 'Cannot overwrite a value' at the end of the second value's line named
+    # neither the key nor where it was given first
+    assert str(error_of(text, Path("x.toml"))) == expected
+
+
+@pytest.mark.parametrize("text, key, shown", [
+    ('[[expect]]\nalways = "TRUE"\n', "expect[0].always", "TRUE"),  # passed whatever the program did
+    ('[[expect]]\nnever = "FALSE"\n', "expect[0].never", "FALSE"),
+    ('[[expect]]\nthat = "1 < 2"\n', "expect[0].that", "1 < 2"),
+    ('[response_handling]\nsignal = "TRUE"\n', "response_handling.signal", "TRUE"),  # every failure 'noticed'
+])
+def test_a_condition_that_reads_no_label_is_an_error(text, key, shown):
+    error = error_of('program = "M"\n' + text, Path("x.toml"))
+    assert str(error).startswith(f"x.toml:3:")
+    assert str(error).endswith(f"{key}: '{shown}' reads no label: it is the same at every moment and says nothing "
+                               "about the program; name the program's labels (e.g. fbRobot.o_bErr) or devices (Y0)")
+
+
+def test_reaching_a_point_in_a_window_shorter_than_its_run_is_an_impossible_expectation():
+    # the run failed with 'run-point 1 was running ... but did not finish' however right the program
+    text = ('program = "M"\n[robot]\npoint_duration_s = 6.0\n[robot.point_durations_s]\n2 = 3.0\n'
+            '[[expect]]\nreached_point = 1\nwithin = "5s"\n')
+    error = error_of(text, Path("x.toml"))
+    assert str(error) == ("x.toml:8:10: expect[0].within: point 1 takes the robot 6s ([robot] point_duration_s / "
+                          "point_durations_s), longer than this window of 5s: it can never be reached in it; make "
+                          "'within' longer")
+    parse_scenario(text.replace("reached_point = 1", "reached_point = 2"))  # 3 s: may be reached in 5 s
+
+
+def test_an_empty_expectation_name_is_an_error_at_its_line():
+    # was accepted: the console then said "expected : 'Y0' became true at 0.570 s"
+    error = error_of('program = "M"\n[[expect]]\nname = " "\nnever = "Y0"\n', Path("x.toml"))
+    assert str(error) == ("x.toml:3:8: expect[0].name: is empty: name the expectation for the reports, "
+                          "or leave 'name' out to have it described ('never Y0')")
+
+
 def test_an_empty_program_name_is_an_error_at_its_line():
     # was "no PROGRAM '' in the sources" once the sources were loaded, naming no line
     error = error_of('name = "x"\nprogram = ""\n', Path("x.toml"))
@@ -305,14 +424,31 @@ def test_that_always_never():
     )
     assert [r.passed for r in results] == [True, False, True, False, True, False, True]
     assert results[0].t_us == 3_000_000
-    assert "never became true" in results[1].detail and "ok = False" in results[1].detail
-    assert "false at 6.000 s" in results[3].detail
+    # the values as ST writes them, as the condition does (was Python's 'ok = False')
+    assert results[1].detail == "'ok' never became true between 0.000 s and 2.000 s (at the end: ok = FALSE)"
+    assert results[3].detail == "'ok' was false at 6.000 s (ok = FALSE)"
     assert "became true at 5.000 s" in results[5].detail
 
 
 def test_a_window_past_the_end_of_the_run_fails_with_advice():
     (result,) = _judge('[[expect]]\nthat = "ok"\nafter = "8s"\nwithin = "5s"\n', _evidence({"ok": [(0, True)]}))
     assert not result.passed and "make the scenario's duration longer" in result.detail
+
+
+@pytest.mark.parametrize("kind, condition", [("that", "ok"), ("always", "ok"), ("never", "NOT ok")])
+def test_a_window_that_opens_after_the_run_fails_with_advice(kind, condition):
+    # `after` past the end with no `within` passed every kind: the window was empty
+    evidence = _evidence({"ok": [(0, True)]}, end_us=10_000_000)
+    (result,) = _judge(f'[[expect]]\n{kind} = "{condition}"\nafter = "12s"\n', evidence)
+    assert not result.passed
+    assert result.detail == ("the run ended at 10.000 s, before the window opened at 12.000 s: "
+                             "make the scenario's duration longer")
+
+
+def test_a_sent_or_reached_point_window_that_opens_after_the_run_fails():
+    for text in ('sent = "stop"', "reached_point = 1"):
+        (result,) = _judge(f'[[expect]]\n{text}\nafter = "10s"\n', _evidence({}))
+        assert not result.passed and "before the window opened at 10.000 s" in result.detail
 
 
 def _tx(t_ms, request):
@@ -343,6 +479,7 @@ POINT3 = protocol.ControlRequest(1, protocol.ControlCode.ROBOT, 3)
 def test_sent_and_reached_point():
     trace = _control(0, STOP) + _read(300, 0) + _control(600, POINT3) + _read(900, 1) + _read(1200, 1) + _read(1500, 0)
     results = _judge(
+        '[robot]\npoint_duration_s = 0.5\n'  # as fast as the trace's robot: 1 s can hold the run
         '[[expect]]\nsent = "stop"\nwithin = "1s"\n'
         '[[expect]]\nsent = "run-point 4"\n'
         '[[expect]]\nreached_point = 3\nwithin = "2s"\n'
@@ -354,6 +491,34 @@ def test_sent_and_reached_point():
     assert "running" in results[3].detail and "did not finish" in results[3].detail
 
 
+SPEED_STAGE_2 = protocol.ControlRequest(1, protocol.ControlCode.SPEED_TRACKLESS, 1)
+
+
+def test_a_control_command_not_sent_names_what_was_sent_instead():
+    # FB stage 2 (UITAMR_SetSpeed i_wStage) is 02/01 on the wire, 'speed trackless 1' in
+    # the words: the finding only said 'trackless speed stage 3 (02/02) ... was not sent'
+    trace = _control(0, STOP) + _read(300, 0) + _control(600, SPEED_STAGE_2) + _control(900, POINT3)
+    results = _judge('[[expect]]\nsent = "speed trackless 2"\n'
+                     '[[expect]]\nsent = "run-point 4"\n'
+                     '[[expect]]\nsent = "read battery"\n', _evidence({}, trace))
+    assert [r.passed for r in results] == [False, False, False]
+    assert results[0].detail == ("trackless speed stage 3 (02/02) (01 06 02 02 00 00 29 B2) was not sent between "
+                                 "0.000 s and 10.000 s; sent instead: trackless speed stage 2 (02/01) at 0.600 s")
+    assert results[1].detail.endswith("; sent instead: stop (01/A0) at 0.000 s, run point/script 3 (01/03) at 0.900 s")
+    assert "instead" not in results[2].detail  # the other reads would be noise
+
+
+def test_a_command_answered_with_an_exception_says_so():
+    # 'was sent at 0.600 s but never answered' for a command the robot refused with an
+    # exception: the user looked for a silent robot
+    frame = _tx(600, POINT3)
+    refused = protocol.encode(protocol.ExceptionReply(1, 0x06, 4), S)
+    rx = TraceRecord(frame.t_end_us + 5000, frame.t_end_us + 5000 + protocol.frame_time_us(len(refused)), "rx", refused)
+    (result,) = _judge('[[expect]]\nsent = "run-point 3"\n', _evidence({}, _control(0, STOP) + [frame, rx]))
+    assert result.detail == ("run point/script 3 (01/03) was sent at 0.600 s but never answered between 0.000 s and "
+                             "10.000 s (the first time: exception 04 (slave device failure) to function 06)")
+
+
 def test_reached_point_needs_the_task_to_run_and_end_without_error():
     never_runs = _control(0, STOP) + _read(300, 0) + _control(600, POINT3) + _read(900, 0)
     (result,) = _judge('[[expect]]\nreached_point = 3\n', _evidence({}, never_runs))
@@ -363,6 +528,31 @@ def test_reached_point_needs_the_task_to_run_and_end_without_error():
         request, _rx(request, protocol.StatusReply(1, 1, 0))]
     (result,) = _judge('[[expect]]\nreached_point = 3\n', _evidence({}, error_end))
     assert not result.passed and "error 01" in result.detail
+
+
+def _error_read(t_ms, error):
+    request = _tx(t_ms, protocol.StatusRequest(1, protocol.Query.TASK))
+    return [request, _rx(request, protocol.StatusReply(1, error, 0))]
+
+
+def test_reached_point_names_when_the_task_ended_not_the_last_status_read():
+    # the robot keeps reporting error 01 on every later poll: the finding named the last
+    # of them (8.900 s in a run where the obstacle stopped the task at 5.060 s)
+    trace = (_control(0, STOP) + _control(600, POINT3) + _read(900, 1) + _error_read(1500, 1)
+             + _error_read(1800, 1) + _error_read(2100, 1))
+    (result,) = _judge('[[expect]]\nreached_point = 3\n', _evidence({}, trace))
+    assert not result.passed
+    assert result.detail == "the task of run-point 3 ended with error 01 at 1.500 s"
+
+
+def test_a_task_stopped_by_an_error_is_not_reached_once_the_error_clears():
+    # after error 01 ended the task, the next poll with the error gone ("idle, error 00")
+    # counted as the point reached: the robot never got there
+    trace = (_control(0, STOP) + _control(600, POINT3) + _read(900, 1) + _error_read(1500, 1)
+             + _read(1800, 0))
+    (result,) = _judge('[[expect]]\nreached_point = 3\n', _evidence({}, trace))
+    assert not result.passed
+    assert result.detail == "the task of run-point 3 ended with error 01 at 1.500 s"
 
 
 # --- conditions: property test against Python's own evaluation ----------------------------------

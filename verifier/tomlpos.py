@@ -289,7 +289,34 @@ def decode_error_position(error: ValueError | RecursionError, source: str = "") 
             place = Place(source.count("\n") + 1, end - source.rfind("\n"))
             return _DECODE_AT_END.sub(" at the end of the file", text), place
         return text, None
-    return _DECODE_POSITION.sub("", text), Place(int(match.group(1)), int(match.group(2)))
+    place = Place(int(match.group(1)), int(match.group(2)))
+    if text.startswith("Cannot overwrite a value") and source:
+        return _given_twice(source, place)
+    return _DECODE_POSITION.sub("", text), place
+
+
+_KEY_AT_START = re.compile(r"""^(\s*)((?:[A-Za-z0-9_-]+|"[^"]*"|'[^']*')(?:\s*\.\s*(?:[A-Za-z0-9_-]+|"[^"]*"|'[^']*'))*)\s*=""")
+
+
+def _given_twice(source: str, place: Place) -> tuple[str, Place]:
+    """tomllib's 'Cannot overwrite a value', said by the key: which key is given twice, and
+    where first in the same table (`duration = ...` written twice: the second one is the
+    mistake, placed at its key)."""
+    lines = source.splitlines()
+    line = lines[place.line - 1] if place.line - 1 < len(lines) else ""
+    key = _KEY_AT_START.match(line)
+    if key is None:
+        return "Cannot overwrite a value: a key is given twice", place
+    name = key.group(2)
+    at = Place(place.line, len(key.group(1)) + 1)
+    for number in range(place.line - 1, 0, -1):
+        earlier = lines[number - 1]
+        if earlier.lstrip().startswith("["):
+            break  # the table's header: the key is not given before in this table
+        other = _KEY_AT_START.match(earlier)
+        if other is not None and other.group(2) == name:
+            return f"'{name}' is given twice (first on line {number}): keep one", at
+    return f"'{name}' is given twice in its table: keep one", at
 
 
 def _nested_too_deep(source: str) -> tuple[str, Place | None]:

@@ -101,9 +101,9 @@ class Fault:
         for key in data:
             if key not in allowed:
                 known = {f.name for f in fields(cls)}
-                why = f"not used by fault '{kind}'" if key in known else "unknown key"
-                raise schema.ConfigError(schema.join(path, str(key)),
-                                         f"{why}; expected one of {', '.join(allowed)}", at_name=True)
+                message = (f"not used by fault '{kind}'; expected one of {', '.join(allowed)}" if key in known
+                           else schema.unknown_key(key, allowed))
+                raise schema.ConfigError(schema.join(path, str(key)), message, at_name=True)
         at_s = data.get("at_s")
         on_request = data.get("on_request")
         if (at_s is None) == (on_request is None):

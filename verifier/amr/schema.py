@@ -37,13 +37,22 @@ def require_mapping(value: Any, path: str) -> Mapping[str, Any]:
     return value
 
 
+def unknown_key(key: str, allowed: Iterable[str]) -> str:
+    """The message for a key not in `allowed`: the keys there are, and the one probably
+    meant when one is spelt nearly so (`scna` -> 'scan', `battery_percent` -> 'battery_pct')."""
+    import difflib
+
+    allowed = list(allowed)
+    message = f"unknown key; expected one of {', '.join(allowed)}"
+    close = difflib.get_close_matches(str(key), allowed, n=1, cutoff=0.6)
+    return f"{message}; did you mean '{close[0]}'?" if close else message
+
+
 def reject_unknown_keys(data: Mapping[str, Any], allowed: Iterable[str], path: str) -> None:
     allowed = list(allowed)
     for key in data:
         if key not in allowed:
-            raise ConfigError(
-                join(path, str(key)), f"unknown key; expected one of {', '.join(allowed)}", at_name=True
-            )
+            raise ConfigError(join(path, str(key)), unknown_key(key, allowed), at_name=True)
 
 
 # no setting needs more: times are turned into microseconds (x 1e6) and must stay integers

@@ -153,30 +153,39 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
         scenarios = [_cut_short(s) for s in scenarios]
     if platform_given:
         scenarios = [replace(s, platform_from_option=True) for s in scenarios]
+    if program is not None:
+        scenarios = [replace(s, program_from_option=True) for s in scenarios]
     for scenario in scenarios:
         if scenario.scan_us > scenario.duration_us:
             raise UnusableInput(f"{scenario.name}: the scan time is longer than the whole run")
         if scenario.scan_jitter_us >= scenario.scan_us:
             raise UnusableInput(f"{scenario.path or scenario.name}: scan_jitter must be shorter than the scan time")
         if not scenario.sources:
-            where = scenario.path or "the default scenario"
-            raise UnusableInput(f"{where}: no ST sources: give them as arguments (uitamr verify FILE.st ...)")
+            if scenario.path is None:
+                raise UnusableInput("the default scenario: no ST sources: give them as arguments (uitamr verify FILE.st ...)")
+            raise UnusableInput(f"{scenario.path}: no ST sources: list them in the file (sources = [\"plc/*.st\"], "
+                                "relative to it) or give them as arguments (uitamr verify FILE.st ...)")
     return scenarios
 
 
 def _cut_short(scenario: Scenario) -> Scenario:
     """`scenario` with a note when --duration ends its run before some of its scripted faults
-    or converter drops: they were not tested, though the run may pass (with --matrix nothing
+    or converter drops, or before some of its operator inputs: they were not tested, though the run may pass (with --matrix nothing
     else says so: the scenario's own expectations are not applied)."""
     end = scenario.duration_us
     missed = [f.describe() for f in scenario.faults if f.at_s is not None and f.at_s * 1_000_000 >= end]
     if scenario.converter is not None:
         missed += [f"converter drop at {format_seconds(t)}" for t in scenario.converter.drops if t >= end]
-    if not missed:
-        return scenario
-    note = (f"--duration {format_duration(end)} ends the run before {len(missed)} of its scripted fault(s), "
-            f"not tested: {'; '.join(missed)}")
-    return replace(scenario, notes=scenario.notes + (note,))
+    notes = []
+    if missed:
+        notes.append(f"--duration {format_duration(end)} ends the run before {len(missed)} of its scripted fault(s), "
+                     f"not tested: {'; '.join(missed)}")
+    # operator inputs too: the run would go on as if no one pressed them
+    late = [f"{step.key} at {format_seconds(step.at_us)}" for step in scenario.inputs if step.at_us >= end]
+    if late:
+        notes.append(f"--duration {format_duration(end)} ends the run before {len(late)} of its operator input(s), "
+                     f"not applied: {'; '.join(late)}")
+    return replace(scenario, notes=scenario.notes + tuple(notes)) if notes else scenario
 
 
 def _with_signal(scenario: Scenario, text: str) -> Scenario:
@@ -186,6 +195,9 @@ def _with_signal(scenario: Scenario, text: str) -> Scenario:
         signal = parse_condition(text)
     except ConditionError as exc:
         raise UnusableInput(f"--response-signal: {exc.message} at column {exc.column} of {text!r}") from None
+    if not signal.names:
+        raise UnusableInput(f"--response-signal: '{signal}' reads no label: it is the same at every moment and says "
+                            "nothing about the program; name the program's output (e.g. fbRobot.o_bErr)")
     options = replace(scenario.options, response_signal=signal)
     return replace(scenario, options=options, response_signal_given=True, response_signal_key="--response-signal")
 

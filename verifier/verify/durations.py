@@ -25,14 +25,19 @@ _PATTERN = re.compile(r"^\s*([0-9]+(?:\.[0-9]+)?|\.[0-9]+)\s*(us|µs|ms|s|min|h)
 def parse_duration_us(text: object) -> int:
     """Return `text` ("250ms", "1.5s") in whole microseconds; ValueError on anything else."""
     if not isinstance(text, str):
-        raise ValueError(f"expected a duration such as \"250ms\" or \"60s\", got {text!r}")
+        from verifier.tomlpos import shown
+
+        if isinstance(text, (int, float)) and not isinstance(text, bool):
+            raise ValueError(f"expected a duration such as \"250ms\" or \"60s\", got the bare number {shown(text)}: "
+                             f"write it in quotes with its unit, e.g. \"{text}s\" or \"{text}ms\"")
+        raise ValueError(f"expected a duration such as \"250ms\" or \"60s\", got {shown(text)}")
     if problem := digit_problem(text):
         raise ValueError(f"{text!r}: {problem}")
     match = _PATTERN.match(text)
     if not match:
         raise ValueError(
             f"{text!r} is not a duration: write a number and a unit (us, ms, s, min, h), "
-            "e.g. \"250ms\" or \"60s\""
+            "e.g. \"250ms\" or \"60s\"" + _meant(text)
         )
     # Fraction() reads no number of more than 4300 digits: no duration needs 20 either side
     whole, _, fraction = match.group(1).partition(".")
@@ -46,6 +51,32 @@ def parse_duration_us(text: object) -> int:
     if value.denominator != 1:
         raise ValueError(f"{text!r} is finer than the virtual clock's microsecond")
     return int(value)
+
+
+#: units people write that are spelt otherwise here
+_OTHER_UNITS = {
+    "sec": "s", "secs": "s", "second": "s", "seconds": "s",
+    "msec": "ms", "msecs": "ms", "millisecond": "ms", "milliseconds": "ms",
+    "usec": "us", "microsecond": "us", "microseconds": "us",
+    "m": "min", "mins": "min", "minute": "min", "minutes": "min",
+    "hr": "h", "hrs": "h", "hour": "h", "hours": "h",
+}
+_OTHER = re.compile(r"^\s*(-?)\s*([0-9]+(?:\.[0-9]+)?|\.[0-9]+)\s*([A-Za-zµ]*)\s*$")
+
+
+def _meant(text: str) -> str:
+    """'; did you mean "5s"?' for "5sec", '; ... from power-on or a window's start: it cannot
+    be negative' for "-1s"; '' when nothing better can be said."""
+    match = _OTHER.match(text)
+    if not match:
+        return ""
+    sign, number, unit = match.groups()
+    unit = _OTHER_UNITS.get(unit.lower(), unit.lower() if unit.lower() in _UNITS_US else None)
+    if unit is None:
+        return ""
+    if sign:
+        return "; a duration counts forward (from power-on, or from the window's start): it cannot be negative"
+    return f"; did you mean \"{number}{unit}\"?"
 
 
 def format_seconds(t_us: int) -> str:

@@ -35,6 +35,8 @@ class RuleOptions:
     # RESPONSE-HANDLING: the output that shows the program noticed a failed exchange.
     response_signal: Condition | None = None
     response_within_us: int = DEFAULT_RESPONSE_WITHIN_US
+    # with no signal: the program's FB outputs that could be it ("fbEngine.o_bErr, ..."), for the message
+    response_signal_hint: str = ""
     # Captures (`uitamr monitor`, `uitamr replay`): how far host timestamps may be off, so
     # that timing rules do not fire on the adapter's latency; 0 for the simulator's exact times.
     timing_tolerance_us: int = 0

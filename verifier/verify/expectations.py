@@ -23,9 +23,10 @@ from verifier import protocol
 from .conditions import Condition
 from .durations import format_seconds
 from .evidence import FrameRef, RunEvidence
-from .traffic import Traffic
+from .traffic import ReplyStatus, Traffic
 
 KINDS = ("that", "always", "never", "sent", "reached_point")
+SENT_INSTEAD = 3  # other control commands a failed `sent` names
 #: Robot errors that stop a running task (a battery warning does not; docs/emulator.md).
 TASK_STOPPING_ERRORS = (protocol.RobotError.ANTI_COLLISION, protocol.RobotError.OFF_TAPE)
 
@@ -85,6 +86,15 @@ def verdict(expectation: Expectation, evidence: RunEvidence, watch: "ExchangeWat
     """The result of `expectation` once the run has ended: from `watch` (every exchange of
     the run given to it) for the kinds about exchanges, from the samples for the others."""
     start, end = expectation.window(evidence.end_us)
+    if expectation.after_us >= evidence.end_us:
+        # the window would be empty (or end before it begins): nothing could be judged
+        opens = format_seconds(expectation.after_us)
+        if evidence.stopped_early:
+            why = f"the simulation stopped at {format_seconds(evidence.end_us)}, before the window opened at {opens}"
+        else:
+            why = (f"the run ended at {format_seconds(evidence.end_us)}, before the window opened at {opens}: "
+                   "make the scenario's duration longer")
+        return ExpectationResult(expectation, False, why)
     short = expectation.within_us is not None and expectation.after_us + expectation.within_us > evidence.end_us
     if short:
         closes = format_seconds(expectation.after_us + expectation.within_us)
@@ -108,9 +118,16 @@ def _span(start: int, end: int) -> str:
     return f"between {format_seconds(start)} and {format_seconds(end)}"
 
 
+def _st_value(value) -> str:
+    """A label's value as the condition writes it: TRUE/FALSE, not Python's True/False."""
+    if isinstance(value, bool):
+        return "TRUE" if value else "FALSE"
+    return repr(value)
+
+
 def _values_at(evidence: RunEvidence, condition: Condition, t_us: int) -> str:
     return ", ".join(
-        f"{name} = {evidence.samples.value_at(name, t_us)!r}" for name in sorted(condition.names)
+        f"{name} = {_st_value(evidence.samples.value_at(name, t_us))}" for name in sorted(condition.names)
     )
 
 
@@ -190,9 +207,17 @@ class _Sent(ExchangeWatch):
         self.wanted = protocol.encode(expectation.request, settings)
         self.answered = None  # the first exchange of the request that was answered
         self.unanswered = None  # else the first one sent
+        # other control commands sent in the window, for a control command that was not:
+        # those with its control code first ("speed trackless 2" expected, stage 2 = 02/01
+        # sent), the first few distinct ones (meaning, time)
+        self.instead: dict[str, int] = {}
+        self.instead_other: dict[str, int] = {}
 
     def in_window(self, exchange, t: int) -> None:
-        if self.answered is not None or bytes(exchange.request.data) != self.wanted:
+        if self.answered is not None:
+            return
+        if bytes(exchange.request.data) != self.wanted:
+            self._other(exchange, t)
             return
         if exchange.answered:
             self.answered = exchange
@@ -209,15 +234,33 @@ class _Sent(ExchangeWatch):
         meaning = protocol.describe(expectation.request, self.settings)
         if self.unanswered is not None:
             t = self.unanswered.request.t_start_us
+            status, why = self.unanswered.reply_status
+            got = "" if status is ReplyStatus.NONE else f" (the first time: {why})"
             return ExpectationResult(
                 expectation, False,
-                f"{meaning} was sent at {format_seconds(t)} but never answered {_span(start, end)}",
+                f"{meaning} was sent at {format_seconds(t)} but never answered {_span(start, end)}{got}",
                 t, self.unanswered.refs(),
             )
+        instead = self.instead or self.instead_other
+        sent = ""
+        if instead:
+            sent = "; sent instead: " + ", ".join(
+                f"{other} at {format_seconds(t)}" for other, t in list(instead.items())[:SENT_INSTEAD])
+            if len(instead) > SENT_INSTEAD:
+                sent += ", ..."
         return ExpectationResult(
             expectation, False,
-            f"{meaning} ({protocol.hex_bytes(self.wanted)}) was not sent {_span(start, end)}",
+            f"{meaning} ({protocol.hex_bytes(self.wanted)}) was not sent {_span(start, end)}{sent}",
         )
+
+    def _other(self, exchange, t: int) -> None:
+        wanted = self.expectation.request
+        request = exchange.decoded_request
+        if not (isinstance(wanted, protocol.ControlRequest) and isinstance(request, protocol.ControlRequest)):
+            return  # a status read expected: the polls of every other query would only be noise
+        found = self.instead if request.code == wanted.code else self.instead_other
+        if len(found) <= SENT_INSTEAD:
+            found.setdefault(protocol.describe(request, self.settings), t)
 
 
 class _ReachedPoint(ExchangeWatch):
@@ -263,6 +306,8 @@ class _ReachedPoint(ExchangeWatch):
             error = int(reply.error)
             self.progress = lambda start, end: (
                 f"the task of run-point {point} ended with error {error:02d} at {format_seconds(t)}")
+            # the task is over: later polls that still show the error do not move its end
+            self.accepted_at, self.running_seen = None, False
 
     def result(self, start: int, end: int) -> ExpectationResult:
         point = self.expectation.point

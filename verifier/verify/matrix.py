@@ -71,6 +71,7 @@ def for_user_sources(scenario: Scenario, sources: tuple[Path, ...], program: str
         response_signal_given=False,
         key_lines={},
         notes=scenario.notes + (note,),
+        for_sources=True,
     )
 
 

@@ -13,6 +13,7 @@ from .result import NO_TRAFFIC, ScenarioResult, overall_verdict
 from .rules import RULES
 
 FIRST_VIOLATIONS = 3  # times listed per broken rule and scenario
+SIMULATOR_NOTES = 5  # kinds of simulator note listed per scenario (the JSON and HTML list every one)
 
 
 def render(results: list[ScenarioResult], console: Console, *, first: int = FIRST_VIOLATIONS) -> None:
@@ -50,6 +51,12 @@ def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
         console.print(f"    [dim]note: {escape(note)}[/]")
     if result.aborted:
         console.print(f"    [red]simulation stopped[/]: {escape(result.aborted)}")
+    shown = result.diagnostic_summary[:SIMULATOR_NOTES]
+    for line in shown:
+        console.print(f"    [yellow]simulator[/] {escape(line)}")
+    if len(result.diagnostic_summary) > len(shown):
+        console.print(f"    [yellow]simulator[/] and {len(result.diagnostic_summary) - len(shown)} more kind(s) of note "
+                      "(see --json or --html)")
     broken = sorted((found for found in result.violations.values() if found), key=lambda found: found[0].t_us)
     for found in broken:
         _rule_block(found, console, first)

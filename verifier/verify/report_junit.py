@@ -54,7 +54,9 @@ def to_element(results: list[ScenarioResult]) -> ET.Element:
             case.set("file", result.file)
         if result.aborted:
             errors += 1
-            element = ET.SubElement(case, "error", message="simulation stopped", type="simulation")
+            # the message is what a CI server lists: the ST place and the reason, as for a rule
+            first = result.aborted.splitlines()[0]
+            element = ET.SubElement(case, "error", message=f"simulation stopped: {first}", type="simulation")
             element.text = result.aborted
         if result.no_traffic:
             errors += 1  # nothing was verified: not a pass, and not a rule the PLC broke
@@ -80,6 +82,7 @@ def to_element(results: list[ScenarioResult]) -> ET.Element:
                 f"{format_seconds(result.ended_us)} of virtual time, scan {result.scan_us / 1000:g} ms, seed {result.seed}",
                 f"{tx} requests, {rx} replies",
                 *(f"note: {note}" for note in result.notes),
+                *(f"simulator {line}" for line in result.diagnostic_summary),
                 *(f"fault: {fault}" for fault in result.faults),
                 *([result.converter] if result.converter else []),
                 *(f"expectation met: {e.expectation.label}: {e.detail}" for e in result.expectations if e.passed),

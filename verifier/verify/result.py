@@ -92,6 +92,9 @@ class ScenarioResult:
     violations: dict[str, list[Violation]] = field(default_factory=dict)
     expectations: list[ExpectationResult] = field(default_factory=list)
     diagnostics: list[str] = field(default_factory=list)
+    # the same grouped by place and message, one line each (verifier.sim.errors.summarize_diagnostics):
+    # what the console and the JUnit report show
+    diagnostic_summary: list[str] = field(default_factory=list)
     watched: dict[str, list[tuple[int, Any]]] = field(default_factory=dict)
     aborted: str | None = None  # the program stopped the simulation (ST location inside)
     ended_us: int = 0

@@ -111,13 +111,22 @@ class _Plc:
         if scenario.program is None:
             if len(programs) == 1:
                 return programs[0]
+            if scenario.for_sources:  # the bundled file is not the user's to change
+                raise UnusableInput(f"--matrix runs one PROGRAM of your sources under the bundled fault sets: say which "
+                                    f"with --program; the sources define: {listing}")
             raise UnusableInput(
                 f"{_where(scenario)}: say which PROGRAM to run (--program or 'program'); the sources define: {listing}"
             )
         for name in programs:
             if name.upper() == scenario.program.upper():
                 return name
-        raise UnusableInput(f"{_where(scenario)}: no PROGRAM {scenario.program!r} in the sources; they define: {listing}")
+        if "program" in scenario.key_lines:
+            where = scenario.where("program", scenario.key_lines["program"])
+        elif scenario.program_from_option:
+            where = "--program"  # given on the command line: no file is where to look
+        else:
+            where = _where(scenario)
+        raise UnusableInput(f"{where}: no PROGRAM {scenario.program!r} in the sources; they define: {listing}")
 
     @property
     def now_us(self) -> int:
@@ -188,7 +197,18 @@ class _Plc:
             setattr(target, last, value)
 
     def diagnostics(self) -> list[str]:
-        return [str(d) for d in self.project.diagnostics]
+        """Each of the simulator's diagnostics, its ST file as the reports show ST files
+        (relative to the working folder when inside it, as the frames' origins)."""
+        import dataclasses
+
+        cwd = os.getcwd()
+        return [str(dataclasses.replace(d, location=_relative(d.location, cwd))) for d in self.project.diagnostics]
+
+    def diagnostic_summary(self) -> list[str]:
+        from verifier.sim.errors import summarize_diagnostics
+
+        cwd = os.getcwd()
+        return summarize_diagnostics(self.project.diagnostics, lambda location: _relative(location, cwd))
 
 
 def _did_you_mean(part: str, instance: Any) -> str:
@@ -312,12 +332,17 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
     missing default response signal is dropped. Errors name the file, line and key."""
     kinds: dict[str, str] = {}
     for use in scenario.label_uses():
-        missing = next((problem for problem in map(plc.problem, use.names) if problem), None)
+        missing, line = None, use.line
+        for name in use.names:
+            if (missing := plc.problem(name)) is not None:
+                line = scenario.key_lines.get(f"{use.key}:{name}", use.line)  # the label inside a condition
+                break
         if missing is not None and use.optional:
-            scenario = replace(scenario, options=replace(scenario.options, response_signal=None))
+            scenario = replace(scenario, options=replace(scenario.options, response_signal=None,
+                                                         response_signal_hint=_error_outputs(plc)))
             continue
         if missing is not None:
-            raise UnusableInput(f"{scenario.where(use.key, use.line)}: {missing}")
+            raise UnusableInput(f"{scenario.where(use.key, line)}: {missing}")
         for name in use.names:
             value = _plain(plc.read(name))
             kinds[name] = "bool" if isinstance(value, bool) else "STRING" if isinstance(value, str) else "number"
@@ -325,10 +350,26 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
         for name, value in (use.values or {}).items():
             problem = problem or _input_problem(plc, name, value)
         if problem and use.optional:  # the default signal: an o_bErr that is not a BOOL is not it
-            scenario = replace(scenario, options=replace(scenario.options, response_signal=None))
+            scenario = replace(scenario, options=replace(scenario.options, response_signal=None,
+                                                         response_signal_hint=_error_outputs(plc)))
         elif problem:
             raise UnusableInput(f"{scenario.where(use.key, use.line)}: {problem}")
     return scenario
+
+
+def _error_outputs(plc: _Plc) -> str:
+    """The BOOL `o_bErr` outputs of the program's FB instances ("fbEngine.o_bErr, ..."), at
+    most three, in declaration order: what a scenario may name as the response signal when the
+    program has no `o_bErr` of its own. "" when it has none."""
+    program = plc.program
+    if not isinstance(program, InstanceProxy):
+        return ""
+    found = []
+    for name in program._names():
+        label = f"{name}.o_bErr"
+        if plc.problem(label) is None and isinstance(_plain(plc.read(label)), bool):
+            found.append(label)
+    return ", ".join(found[:3]) + (", ..." if len(found) > 3 else "")
 
 
 def _input_problem(plc: _Plc, name: str, value: Any) -> str | None:
@@ -601,6 +642,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
             if progress is not None:
                 progress(plc.now_us, end)
     except SimulationError as exc:
+        exc.location = _relative(exc.location, os.getcwd())  # as the frames' origins name ST files
         aborted = str(exc)
         end = min(end, plc.now_us)
     if converter is not None:
@@ -644,6 +686,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         violations=violations,
         expectations=outcomes,
         diagnostics=plc.diagnostics(),
+        diagnostic_summary=plc.diagnostic_summary(),
         watched={name: list(samples.changes.get(name, [])) for name in scenario.watch} if keep.details and keep.watched else {},
         aborted=aborted,
         ended_us=end,

@@ -15,7 +15,7 @@ from typing import Any
 from verifier import protocol
 from verifier.amr.config import RobotConfig
 from verifier.amr.faults import Fault, check_fault_addresses
-from verifier.amr.schema import ConfigError
+from verifier.amr.schema import ConfigError, unknown_key
 from verifier.digits import digit_problem
 from verifier.textfile import UnreadableText, read_utf8, text_lines
 from verifier.tomlpos import Place, decode_error_position, place_of_key, shown
@@ -147,6 +147,8 @@ class Scenario:
     notes: tuple[str, ...] = ()  # for the reports: how this run differs from its file
     response_signal_key: str = "response_handling.signal"  # or "--response-signal" when given there
     platform_from_option: bool = False  # the platform is --platform's, not the file's (for messages)
+    for_sources: bool = False  # a bundled scenario run against the user's sources (--matrix)
+    program_from_option: bool = False  # the program is --program's, not the file's (for messages)
 
     @property
     def target(self) -> str:
@@ -202,7 +204,11 @@ class Scenario:
         return f"{text}: {key}" if key else text
 
     def with_overrides(self, **changes: Any) -> "Scenario":
-        return replace(self, **{k: v for k, v in changes.items() if v is not None})
+        changes = {k: v for k, v in changes.items() if v is not None}
+        if "program" in changes and "program" in self.key_lines:
+            # --program replaces the file's: its errors are no longer at the file's line
+            changes["key_lines"] = {k: v for k, v in self.key_lines.items() if k != "program"}
+        return replace(self, **changes)
 
 
 DEFAULT_STOP_WITHIN_US = 5_000_000
@@ -296,17 +302,48 @@ class _Reader:
         (a condition's own column, 1-based, past the quote)."""
         place = place_of_key(self.lines, at or key, at_name)
         if place is not None and offset:
-            place = Place(place.line, place.col + offset)
+            place = self._inside_string(place, offset)
         return ScenarioError(self.path, key, message, place)
+
+    def _inside_string(self, place: Place, offset: int) -> Place:
+        """The place of character `offset` (1-based) of the string value that starts at
+        `place`: past a one-line string's quote, or inside a multi-line string, line by line
+        (a condition written over several lines with three quotes). Where the text cannot be
+        followed back to the file (an escape in a basic string), the value's own place."""
+        line = self.lines[place.line - 1]
+        start = place.col - 1
+        quote = line[start:start + 3]
+        if quote not in ('"""', "\'\'\'"):
+            if line[start:start + 1] not in ("'", '"'):
+                return place
+            if line[start] == '"' and "\\" in line[start:]:
+                return place  # an escape: the value is shorter than its text in the file
+            return Place(place.line, place.col + offset)
+        row, col = place.line, place.col + 3  # the 1-based column of the value's first character
+        if col > len(line):  # a newline right after the opening quotes is not part of the value
+            row, col = row + 1, 1
+        if quote == '"""':
+            body, end = [], row
+            while end - 1 < len(self.lines):
+                text = self.lines[end - 1][(col - 1) if end == row else 0:]
+                body.append(text.split('"""')[0])
+                if '"""' in text:
+                    break
+                end += 1
+            if any("\\" in text for text in body):
+                return place
+        left = offset - 1  # characters to step over
+        while row - 1 < len(self.lines):
+            rest = len(self.lines[row - 1]) - (col - 1)
+            if left <= rest:
+                return Place(row, col + left)
+            left -= rest + 1  # the line's characters and its newline
+            row, col = row + 1, 1
+        return place
 
     def line_of(self, key: str) -> Place | None:
         """Best effort: line and column of what sets `key` (e.g. "expect[1].within", "robot.x")."""
         return place_of_key(self.lines, key)
-
-    def _quoted(self, key: str) -> bool:
-        """True when `key`'s value is a one-line string starting at its column."""
-        place = self.line_of(key)
-        return place is not None and self.lines[place.line - 1][place.col - 1:place.col] in ("'", '"')
 
     # --- helpers -------------------------------------------------------------------------
 
@@ -324,7 +361,7 @@ class _Reader:
         for name in data:
             if name not in allowed:
                 where = f"{key}.{name}" if key else name
-                raise self.fail(where, f"unknown key; expected one of {', '.join(allowed)}", at_name=True)
+                raise self.fail(where, unknown_key(name, allowed), at_name=True)
 
     def string(self, value: Any, key: str) -> str:
         if not isinstance(value, str):
@@ -346,7 +383,16 @@ class _Reader:
             return parse_condition(text)
         except ConditionError as exc:
             raise self.fail(key, f"{exc.message} at column {exc.column} of {text!r}",
-                            offset=exc.column if self._quoted(key) else 0) from None
+                            offset=exc.column) from None
+
+    def constant_refused(self, condition, key: str):
+        """`condition`, when it reads a label: one that reads none (`that = "TRUE"`) is the
+        same at every moment, so it tells nothing about the program - it always passes, or
+        can never pass."""
+        if not condition.names:
+            raise self.fail(key, f"'{condition}' reads no label: it is the same at every moment and says nothing "
+                                 "about the program; name the program's labels (e.g. fbRobot.o_bErr) or devices (Y0)")
+        return condition
 
     def label(self, value: Any, key: str, at: str = "") -> str:
         """A label path; `at` is the key that names it, when it is a key (an input's `set`)."""
@@ -415,6 +461,20 @@ class _Reader:
             self.expectation(item, f"expect[{i}]", settings)
             for i, item in enumerate(self.array_of_tables(data.get("expect", []), "expect"))
         )
+        for expectation in expectations:
+            if (expectation.kind == "reached_point" and expectation.within_us is not None and robot.is_taught(
+                    expectation.point) and expectation.within_us < robot.point_duration_us(expectation.point)):
+                takes = format_duration(robot.point_duration_us(expectation.point))
+                raise self.fail(f"{expectation.key}.within",
+                                f"point {expectation.point} takes the robot {takes} ([robot] point_duration_s / "
+                                f"point_durations_s), longer than this window of "
+                                f"{format_duration(expectation.within_us)}: it can never be reached in it; make "
+                                "'within' longer")
+            if expectation.kind == "reached_point" and not robot.is_taught(expectation.point):
+                raise self.fail(f"{expectation.key}.reached_point",
+                                f"point {expectation.point} is not among the robot's taught_points "
+                                f"{list(robot.taught_points)}: the robot accepts run-point {expectation.point} and "
+                                "does nothing, so it is never reached; add it to [robot] taught_points")
         options, signal_given = self.options(data.get("rules", {}), data.get("response_handling", None))
         initial = self.initial(data.get("initial", {}))
         c24 = tuple(
@@ -439,14 +499,33 @@ class _Reader:
         keys += [f"{step.key}.set" for step in inputs] + [f"watch[{i}]" for i in range(len(watch))]
         keys += ["response_handling.signal"] if signal_given else []
         keys += ["platform"] if "platform" in data else []
+        keys += ["program"] if program is not None else []
+        conditions = [(f"{e.key}.{e.kind}", e.condition) for e in expectations if e.condition is not None]
+        conditions += [("response_handling.signal", options.response_signal)] if signal_given else []
         return Scenario(
             name=name, path=self.path, description=description, sources=sources, program=program,
             platform=platform, channel=channel, duration_us=duration, scan_us=scan, scan_jitter_us=jitter, seed=seed,
             watch=watch, settings=settings, robot=robot, faults=faults, inputs=inputs,
             expectations=expectations, options=options, response_signal_given=signal_given,
-            key_lines={key: self.line_of(key) for key in keys} | self.set_names(inputs), initial=initial, c24=c24,
+            key_lines={key: self.line_of(key) for key in keys} | self.set_names(inputs)
+            | self.names_in_conditions(conditions), initial=initial, c24=c24,
             converter=converter,
         )
+
+    def names_in_conditions(self, conditions) -> dict[str, Place | None]:
+        """Where each label of a condition stands in the file (`expect[0].that:fbEngine.o_bErr`),
+        so that a label the program lacks is reported there, not at the condition's start."""
+        places: dict[str, Place | None] = {}
+        for key, condition in conditions:
+            start = place_of_key(self.lines, key)
+            if start is None:
+                continue
+            for name in condition.names:
+                found = re.search(r"(?<![A-Za-z0-9_.#\]])" + re.escape(name) + r"(?![A-Za-z0-9_\[.])",
+                                  condition.text, re.IGNORECASE)
+                if found is not None:
+                    places[f"{key}:{name}"] = self._inside_string(start, found.start() + 1)
+        return places
 
     def set_names(self, inputs: tuple[InputStep, ...]) -> dict[str, Place | None]:
         """Where each label an input sets is named (`inputs[0].set.X0`), for the errors about it."""
@@ -598,7 +677,8 @@ class _Reader:
             raise self.fail(key, "an input needs 'at' (when) and 'set' (labels and values)")
         at = self.duration(item["at"], f"{key}.at", positive=False)
         if at >= duration:
-            raise self.fail(f"{key}.at", "is at or after the end of the run")
+            raise self.fail(f"{key}.at", f"is at or after the end of the run ({format_duration(duration)}): "
+                                         "the input would never be applied; make 'duration' longer")
         values = self.table(item["set"], f"{key}.set")
         if not values:
             raise self.fail(f"{key}.set", "sets nothing")
@@ -625,7 +705,7 @@ class _Reader:
         value = item[kind]
         fields: dict[str, Any] = {}
         if kind in ("that", "always", "never"):
-            fields["condition"] = self.condition(value, f"{key}.{kind}")
+            fields["condition"] = self.constant_refused(self.condition(value, f"{key}.{kind}"), f"{key}.{kind}")
             what = {"that": "", "always": "always ", "never": "never "}[kind] + str(fields["condition"])
         elif kind == "sent":
             words = self.string(value, f"{key}.sent")
@@ -643,6 +723,9 @@ class _Reader:
         label = item.get("name")
         if label is None:
             label = f"{what} {describe_window(expectation)}".strip()
+        elif not self.string(label, f"{key}.name").strip():
+            raise self.fail(f"{key}.name", "is empty: name the expectation for the reports, or leave 'name' out "
+                                           f"to have it described ({what!r})")
         return replace(expectation, label=self.string(label, f"{key}.name"))
 
     def options(self, rules: Any, response: Any) -> tuple[RuleOptions, bool]:
@@ -658,7 +741,8 @@ class _Reader:
         response = self.table(response, "response_handling")
         self.only(response, RESPONSE_KEYS, "response_handling")
         if "signal" in response:
-            options = replace(options, response_signal=self.condition(response["signal"], "response_handling.signal"))
+            key = "response_handling.signal"
+            options = replace(options, response_signal=self.constant_refused(self.condition(response["signal"], key), key))
         if "within" in response:
             options = replace(
                 options, response_within_us=self.duration(response["within"], "response_handling.within")

@@ -61,6 +61,7 @@ class Rs2Port:
         self._eight_bit = dev.address(devices.eight_bit_mode) if devices.eight_bit_mode else None
         self._format = dev.address(devices.format_register) if devices.format_register else None
         self.last_call_scan = -2
+        self.call_location: str | None = None
         self.s_ref = self.d_ref = None
         self.m = self.n = 0
         self.sending_until: int | None = None
@@ -110,6 +111,7 @@ class Rs2Port:
             return False
         rt = self.rt
         self.last_call_scan = rt.scan_count
+        self.call_location = rt.locations[loc_id]  # where a reception's trouble is reported
         self.s_ref, self.m, self.n, self.d_ref = s_ref, m, n, d_ref
         if self.sending_until is None and self._send_req_cells[self._send_req_index]:
             location = rt.locations[loc_id]
@@ -195,10 +197,13 @@ class Rs2Port:
             self._complete(timed_out=True)
         self._set(self._recv_count, len(self.rx))
         if dropped:
+            flag = self.d.receive_complete
             why = ("RS2 was not executed" if not driven else
-                   f"{self.d.receive_complete} was still ON" if self.rx_done else "n = 0")
-            self.rt.warn(None, f"RS2 {self.channel.name}: {dropped} received byte(s) discarded "
-                               f"because {why}")
+                   f"{flag} was still ON: reset {flag} (receive complete) once the received data "
+                   "is read, or RS2 receives nothing more (docs/instructions.md §7)" if self.rx_done
+                   else "n = 0")
+            self.rt.warn(self.call_location, f"RS2 {self.channel.name}: {dropped} received byte(s) discarded "
+                                             f"because {why}")
 
     def _complete(self, timed_out: bool) -> None:
         data = bytes(self.rx[: self.n])

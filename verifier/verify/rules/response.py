@@ -129,7 +129,9 @@ class ResponseHandling(Judge):
             message = (
                 f"the robot's replies failed from {format_seconds(start)} {lasted} "
                 f"({episode.summary()}), and the scenario names no output to show it: set "
-                f"[response_handling] signal in the scenario or --response-signal (e.g. \"o_bErr\")"
+                f"[response_handling] signal in the scenario or --response-signal "
+                + (f"(the program has no o_bErr; its FB instances have {options.response_signal_hint})"
+                   if options.response_signal_hint else "(e.g. \"o_bErr\")")
             )
         else:
             began = self.signal.first_running_after(start)
