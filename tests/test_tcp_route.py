@@ -292,3 +292,57 @@ def test_whatever_the_converter_does_the_line_keeps_every_rule(platform, delay_m
     tx = [f for f in result.trace if f.direction == "tx"]
     assert tx and tx[0].data == STOP
     assert dict(result.watched)["fbPort.o_bConnected"][-1][1] is True
+
+
+# ---- speed without a changed byte (docs/performance.md, session 23) -----------------------------
+
+from dataclasses import asdict  # noqa: E402
+
+from verifier.sim import instructions  # noqa: E402
+
+ETHERNET = sorted(instructions.ETHERNET)
+TCP_SCENARIOS = sorted(SCENARIOS.glob("*-tcp-*.toml"))
+
+
+def _through_the_port(name: str):
+    """The InstructionSet entry as it was before the EN shortcut: always into the port."""
+    if name.startswith("SP_"):
+        return lambda self, *args: getattr(self.socket_port(), name.lower())(*args)
+    return lambda self, en, un, *args: getattr(self.e71(un), name.lower())(en, *args)
+
+
+def _comparable(result) -> dict:
+    data = asdict(result)
+    data.pop("wall_s")
+    return data
+
+
+@pytest.mark.parametrize("path", TCP_SCENARIOS, ids=lambda p: p.stem)
+def test_the_en_shortcut_of_the_ethernet_instructions_changes_nothing(path, monkeypatch):
+    """The SP_/ZP_ entries return at once on a scan with EN FALSE as on the scan before;
+    every bundled TCP scenario gives the same result, field for field, when every call goes
+    into the port as before."""
+    scenario = load_scenario(path)
+    shortcut = run_scenario(scenario)
+    for name in ETHERNET:
+        monkeypatch.setattr(instructions.InstructionSet, name, _through_the_port(name))
+    assert _comparable(shortcut) == _comparable(run_scenario(scenario))
+
+
+def test_control_an_entry_that_skips_a_rising_edge_is_seen(monkeypatch):
+    """Control for the comparison above: a ZP_BUFSND shortcut that also drops every second
+    rising edge changes the result."""
+    scenario = load_scenario(SCENARIOS / "q-tcp-healthy.toml")
+    scenario = replace(scenario, duration_us=10_000_000)
+    before = run_scenario(scenario)
+    seen = []
+
+    def lossy(self, en, un, *args):
+        if en and not self.e71(un)._last_en.get(args[-1]):
+            seen.append(1)
+            if len(seen) % 2 == 0:
+                return
+        self.e71(un).zp_bufsnd(en, *args)
+
+    monkeypatch.setattr(instructions.InstructionSet, "ZP_BUFSND", lossy)
+    assert _comparable(before) != _comparable(run_scenario(scenario))
