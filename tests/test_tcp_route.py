@@ -299,6 +299,8 @@ def test_whatever_the_converter_does_the_line_keeps_every_rule(platform, delay_m
 from dataclasses import asdict  # noqa: E402
 
 from verifier.sim import instructions  # noqa: E402
+from verifier.sim.instructions.tcp import TcpPort  # noqa: E402
+from verifier.sim.refs import operand_key, pulse_keys  # noqa: E402
 
 ETHERNET = sorted(instructions.ETHERNET)
 TCP_SCENARIOS = sorted(SCENARIOS.glob("*-tcp-*.toml"))
@@ -346,3 +348,37 @@ def test_control_an_entry_that_skips_a_rising_edge_is_seen(monkeypatch):
 
     monkeypatch.setattr(instructions.InstructionSet, "ZP_BUFSND", lossy)
     assert _comparable(before) != _comparable(run_scenario(scenario))
+
+
+def _idle_state_before(port: TcpPort) -> tuple:
+    """`TcpPort.idle_state` as it was before session 23 (a generator over the connections)."""
+    number = lambda c: None if c is None else c.number  # noqa: E731
+    conns = tuple(
+        (c.state, c.remote, c.open_done_us, c.open_ok, c.open_status,
+         None if c.open_refs is None else tuple(map(operand_key, c.open_refs)),
+         tuple(c.received), number(c.receiver), number(c.partner), number(c.pair))
+        for c in port.connections.values())
+    endpoint = port.endpoint
+    peer = endpoint.idle_state() if hasattr(endpoint, "idle_state") else None
+    return (conns, tuple(port._last_en.items()), pulse_keys(port.pulses), pulse_keys(port.pending),
+            port._active, tuple(getattr(port, "direction", {}).items()), peer)
+
+
+@pytest.mark.parametrize("path", TCP_SCENARIOS, ids=lambda p: p.stem)
+def test_idle_state_tells_scans_apart_exactly_as_before(path, monkeypatch):
+    """The idle check only compares a port's `idle_state` with the one of the scan before:
+    on every scan of every bundled TCP scenario (run scan by scan) the faster one is equal
+    to the one before exactly when the old one is."""
+    seen = []
+    original = TcpPort.poll
+
+    def poll_and_record(self, now):
+        seen.append((_idle_state_before(self), self.idle_state()))
+        original(self, now)
+
+    monkeypatch.setattr(TcpPort, "poll", poll_and_record)
+    run_scenario(load_scenario(path), plain=True)
+    assert len(seen) > 1000
+    changes = [(old != seen[k - 1][0], new != seen[k - 1][1]) for k, (old, new) in enumerate(seen) if k]
+    assert all(a == b for a, b in changes)
+    assert any(a for a, _ in changes) and not all(a for a, _ in changes)
