@@ -215,16 +215,19 @@ class TcpPort:
 
     # ---- between scans -----------------------------------------------------------------------------
     def poll(self, now: int) -> None:
-        for ref, bit in self.pulses:
-            ref.set(bit, False)
-        self.pulses, self.pending = self.pending, []
-        for ref, bit in self.pulses:
-            ref.set(bit, True)
+        if self.pulses or self.pending:  # (both empty on most scans: nothing to swap)
+            for ref, bit in self.pulses:
+                ref.set(bit, False)
+            self.pulses, self.pending = self.pending, []
+            for ref, bit in self.pulses:
+                ref.set(bit, True)
         if not self._active:
             return
-        endpoint = self.endpoint
+        endpoint = self.rt.tcp_endpoint
         active = False
         for conn in self.connections.values():
+            if conn.state == CLOSED:
+                continue
             if conn.state == OPENING:
                 active = True
                 if now >= conn.open_done_us:
