@@ -104,25 +104,6 @@ def test_the_first_quiet_state_is_left_out_on_the_tcp_route_only(idle_runs):
     assert skipper.first_states_skipped < skipper.jumps // 20
 
 
-# ---- jumps over the runner's one-second steps ----------------------------------------------
-
-@pytest.mark.parametrize("name", ["fx3u-healthy", "q-tcp-no-reply"])
-def test_an_idle_stretch_jumps_over_the_steps_of_the_run(name, idle_runs, monkeypatch):
-    """`uitamr verify` runs a virtual second at a time; a jump capped at each second's end
-    ran one scan there only to jump again. Now it jumps over it: fewer scans run, the same
-    result as the scan-by-scan run and as with the cap."""
-    scenario = load_scenario(PLC / "scenarios" / f"{name}.toml")
-    fast, plain, skipper = _fast_and_plain(scenario, idle_runs)
-    assert _comparable(fast) == _comparable(plain)
-    ran = skipper.rt.scan_count - skipper.skipped_scans
-    monkeypatch.setattr(idle_module.IdleScans, "jump_limit_us",
-                        property(lambda self: None, lambda self, value: None), raising=False)  # capped at every step
-    capped = run_scenario(scenario)
-    ran_capped = idle_runs[-1].rt.scan_count - idle_runs[-1].skipped_scans
-    assert _comparable(capped) == _comparable(fast)
-    assert ran < ran_capped - 20, (ran, ran_capped)
-
-
 # ---- random scenarios of the robot examples --------------------------------------------
 
 def _example(name: str) -> tuple[str, str, str, str, bool]:

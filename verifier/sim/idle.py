@@ -117,12 +117,6 @@ class IdleScans:
         self.rt = rt = project.rt
         self.next_input_us = next_input_us
         self.busy = False  # set by the caller for a scan it wrote inputs in, or sampled a change
-        # how far a jump may go past the stop of the run it is in (None: not past it): a
-        # caller that runs in steps (`uitamr verify` runs a virtual second at a time, for
-        # its progress and its stream) and itself does nothing to the program between them
-        # lets an idle stretch jump over a step's end, instead of running one scan there
-        # only to find it idle and jump again (verifier.verify.runner)
-        self.jump_limit_us: int | None = None
         self.skipped_scans = 0
         self.jumps = 0
         self._previous = None
@@ -291,8 +285,7 @@ class IdleScans:
             return
         deadline = min(deadline, self._timer_deadline_us(), self._clock_deadline_us(started_us))
         if stop_us is not None:
-            limit = self.jump_limit_us
-            deadline = min(deadline, stop_us if limit is None or limit < stop_us else limit)
+            deadline = min(deadline, stop_us)
         if now < deadline < INFINITY:
             self._jump(deadline)
 

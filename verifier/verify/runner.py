@@ -493,10 +493,6 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         [plc.name], read_devices=tuple(name for name in names if _DEVICE.match(name)),
         next_input_us=lambda: schedule[0][0] if schedule else float("inf"))
 
-    if idle is not None:
-        # between the steps below nothing touches the program (inputs are written in a
-        # scan, at their time): an idle stretch may jump over a step's end, to the run's end
-        idle.jump_limit_us = end
     rt = plc.project.rt
 
     def apply_inputs(_project=None) -> None:
