@@ -253,7 +253,9 @@ class IdleScans:
         changed = self._new_operand_cells() if rt.dirty_log else False
         busy, self.busy = self.busy, False
         if busy or changed or rt.scan_count < 2:
-            self._not_quiet()
+            self._previous, self._quiet = None, 0
+            if self._judging_first:
+                self._first_wasted()
             return
         now = rt.now_us
         deadline = self.next_input_us()
@@ -263,7 +265,9 @@ class IdleScans:
         for idle_deadline in self._deadlines:
             until = idle_deadline(now)
             if until is None or until <= now:
-                self._not_quiet()
+                self._previous, self._quiet = None, 0
+                if self._judging_first:
+                    self._first_wasted()
                 return
             if until < deadline:
                 deadline = until
@@ -289,14 +293,12 @@ class IdleScans:
         if now < deadline < INFINITY:
             self._jump(deadline)
 
-    def _not_quiet(self) -> None:
-        """A scan that is not quiet: no comparison with it (and a first quiet scan's state
-        taken just before was not worth taking)."""
-        self._previous = None
-        self._quiet = 0
-        if self._judging_first:
-            self._judging_first = False
-            self._first_score = min(FIRST_SKIP_SCORE + 2, self._first_score + 1)
+    def _first_wasted(self) -> None:
+        """The scan after a first quiet scan whose state was taken is not quiet: that state
+        was not worth taking (the caller has reset the comparison; inline, as it runs on
+        most scans)."""
+        self._judging_first = False
+        self._first_score = min(FIRST_SKIP_SCORE + 2, self._first_score + 1)
 
     def _new_operand_cells(self) -> bool:
         """Take in the cells instruction operands wrote since the last scan; True when one
