@@ -76,6 +76,34 @@ def test_the_serial_examples_skip_most_scans(idle_runs):
     assert _comparable(fast) == _comparable(plain)
 
 
+# ---- the first quiet scan's state (verifier.sim.idle, "The first quiet scan") ---------------
+
+@pytest.mark.parametrize("path", SCENARIOS, ids=lambda p: p.stem)
+def test_leaving_out_every_first_quiet_state_changes_no_result(path, idle_runs, monkeypatch):
+    """The policy at its extreme: every first quiet scan's state left out (never probed).
+    Each bundled scenario gives the plain run's result, byte for byte."""
+    monkeypatch.setattr(idle_module, "FIRST_SKIP_SCORE", 0)
+    monkeypatch.setattr(idle_module, "FIRST_PROBE_EVERY", 10**9)
+    fast, plain, skipper = _fast_and_plain(load_scenario(path), idle_runs)
+    assert _comparable(fast) == _comparable(plain)
+    fast.wall_s = plain.wall_s = 0.0
+    assert json.dumps(to_dict([fast]), sort_keys=True) == json.dumps(to_dict([plain]), sort_keys=True)
+    if skipper.reason is None and skipper.skipped_scans:
+        assert skipper.first_states_skipped > 0, "none left out: the comparison proves nothing"
+
+
+def test_the_first_quiet_state_is_left_out_on_the_tcp_route_only(idle_runs):
+    """On the TCP route the first quiet scan's state is of no use (the engine's re-arm
+    pulse follows it): most are left out, and the run jumps as often as it did. On the
+    FX3U example it is of use (the next scan is idle): almost all are taken."""
+    fast, plain, skipper = _fast_and_plain(load_scenario(PLC / "scenarios" / "q-tcp-healthy.toml"), idle_runs)
+    assert _comparable(fast) == _comparable(plain)
+    assert skipper.first_states_skipped > skipper.jumps // 2
+    fast, plain, skipper = _fast_and_plain(load_scenario(PLC / "scenarios" / "fx3u-healthy.toml"), idle_runs)
+    assert _comparable(fast) == _comparable(plain)
+    assert skipper.first_states_skipped < skipper.jumps // 20
+
+
 # ---- random scenarios of the robot examples --------------------------------------------
 
 def _example(name: str) -> tuple[str, str, str, str, bool]:

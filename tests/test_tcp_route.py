@@ -292,3 +292,146 @@ def test_whatever_the_converter_does_the_line_keeps_every_rule(platform, delay_m
     tx = [f for f in result.trace if f.direction == "tx"]
     assert tx and tx[0].data == STOP
     assert dict(result.watched)["fbPort.o_bConnected"][-1][1] is True
+
+
+# ---- speed without a changed byte (docs/performance.md, session 23) -----------------------------
+
+from dataclasses import asdict  # noqa: E402
+
+from verifier.sim import instructions  # noqa: E402
+from verifier.sim.instructions.tcp import TcpPort  # noqa: E402
+from verifier.sim.refs import operand_key, pulse_keys  # noqa: E402
+
+ETHERNET = sorted(instructions.ETHERNET)
+TCP_SCENARIOS = sorted(SCENARIOS.glob("*-tcp-*.toml"))
+
+
+def _through_the_port(name: str):
+    """The InstructionSet entry as it was before the EN shortcut: always into the port."""
+    if name.startswith("SP_"):
+        return lambda self, *args: getattr(self.socket_port(), name.lower())(*args)
+    return lambda self, en, un, *args: getattr(self.e71(un), name.lower())(en, *args)
+
+
+def _comparable(result) -> dict:
+    data = asdict(result)
+    data.pop("wall_s")
+    return data
+
+
+@pytest.mark.parametrize("path", TCP_SCENARIOS, ids=lambda p: p.stem)
+def test_the_en_shortcut_of_the_ethernet_instructions_changes_nothing(path, monkeypatch):
+    """The SP_/ZP_ entries return at once on a scan with EN FALSE as on the scan before;
+    every bundled TCP scenario gives the same result, field for field, when every call goes
+    into the port as before."""
+    scenario = load_scenario(path)
+    shortcut = run_scenario(scenario)
+    for name in ETHERNET:
+        monkeypatch.setattr(instructions.InstructionSet, name, _through_the_port(name))
+    assert _comparable(shortcut) == _comparable(run_scenario(scenario))
+
+
+def test_control_an_entry_that_skips_a_rising_edge_is_seen(monkeypatch):
+    """Control for the comparison above: a ZP_BUFSND shortcut that also drops every second
+    rising edge changes the result."""
+    scenario = load_scenario(SCENARIOS / "q-tcp-healthy.toml")
+    scenario = replace(scenario, duration_us=10_000_000)
+    before = run_scenario(scenario)
+    seen = []
+
+    def lossy(self, en, un, *args):
+        if en and not self.e71(un)._last_en.get(args[-1]):
+            seen.append(1)
+            if len(seen) % 2 == 0:
+                return
+        self.e71(un).zp_bufsnd(en, *args)
+
+    monkeypatch.setattr(instructions.InstructionSet, "ZP_BUFSND", lossy)
+    assert _comparable(before) != _comparable(run_scenario(scenario))
+
+
+def _idle_state_before(port: TcpPort) -> tuple:
+    """`TcpPort.idle_state` as it was before session 23 (a generator over the connections)."""
+    number = lambda c: None if c is None else c.number  # noqa: E731
+    conns = tuple(
+        (c.state, c.remote, c.open_done_us, c.open_ok, c.open_status,
+         None if c.open_refs is None else tuple(map(operand_key, c.open_refs)),
+         tuple(c.received), number(c.receiver), number(c.partner), number(c.pair))
+        for c in port.connections.values())
+    endpoint = port.endpoint
+    peer = endpoint.idle_state() if hasattr(endpoint, "idle_state") else None
+    return (conns, tuple(port._last_en.items()), pulse_keys(port.pulses), pulse_keys(port.pending),
+            port._active, tuple(getattr(port, "direction", {}).items()), peer)
+
+
+@pytest.mark.parametrize("path", TCP_SCENARIOS, ids=lambda p: p.stem)
+def test_idle_state_tells_scans_apart_exactly_as_before(path, monkeypatch):
+    """The idle check only compares a port's `idle_state` with the one of the scan before:
+    on every scan of every bundled TCP scenario (run scan by scan) the faster one is equal
+    to the one before exactly when the old one is."""
+    seen = []
+    original = TcpPort.poll
+
+    def poll_and_record(self, now):
+        seen.append((_idle_state_before(self), self.idle_state()))
+        original(self, now)
+
+    monkeypatch.setattr(TcpPort, "poll", poll_and_record)
+    run_scenario(load_scenario(path), plain=True)
+    assert len(seen) > 1000
+    changes = [(old != seen[k - 1][0], new != seen[k - 1][1]) for k, (old, new) in enumerate(seen) if k]
+    assert all(a == b for a, b in changes)
+    assert any(a for a, _ in changes) and not all(a for a, _ in changes)
+
+
+def _poll_before(self, now: int) -> None:
+    """`TcpPort.poll` as it was before session 23 (the pulse lists swapped on every scan,
+    every connection's state compared)."""
+    for ref, bit in self.pulses:
+        ref.set(bit, False)
+    self.pulses, self.pending = self.pending, []
+    for ref, bit in self.pulses:
+        ref.set(bit, True)
+    if not self._active:
+        return
+    endpoint = self.endpoint
+    active = False
+    for conn in self.connections.values():
+        if conn.state == tcp.OPENING:
+            active = True
+            if now >= conn.open_done_us:
+                control, done = conn.open_refs
+                conn.open_refs = None
+                conn.state = tcp.OPEN if conn.open_ok else tcp.CLOSED
+                control.set(1, conn.open_status)
+                done.set(0, True)
+                self.pulses.append((done, 0))
+                if not conn.open_ok:
+                    done.set(1, True)
+                    self.pulses.append((done, 1))
+                self.opened(conn)
+                self.show_status(conn)
+        elif conn.state == tcp.OPEN and endpoint is not None:
+            active = True
+            reader = conn.receiver or conn
+            for _, segment in endpoint.receive_until(now, conn.remote):
+                reader.received.append(segment)
+            if reader.received:
+                self.show_status(reader)
+            if endpoint.peer_closed(now, conn.remote):
+                conn.state = tcp.PEER_CLOSED
+                self.show_status(conn)
+        elif conn.state == tcp.PEER_CLOSED:
+            active = True
+    self._active = active
+
+
+@pytest.mark.parametrize("path", TCP_SCENARIOS, ids=lambda p: p.stem)
+def test_the_faster_poll_changes_nothing(path, monkeypatch):
+    """Every bundled TCP scenario gives the same result, field for field, with the port's
+    poll as it was (tests/test_idle_skip.py compares the skipping run with the scan-by-scan
+    one, which share the poll: this compares the poll itself)."""
+    scenario = load_scenario(path)
+    now = run_scenario(scenario)
+    monkeypatch.setattr(TcpPort, "poll", _poll_before)
+    assert _comparable(now) == _comparable(run_scenario(scenario))

@@ -34,6 +34,18 @@ scan by scan (safe by default).  RS2, C24, ADPRW and the Ethernet ports have the
   change (operands as the memory they name, `refs.operand_key`; scan numbers relative);
 - `skipped(scan_count, scans)`: fix what counts scans after a jump.
 
+The first quiet scan.  The state is taken after every quiet scan (no input written, no
+watched label changed, every I/O model quiet) and compared with the one before.  The state
+of the first quiet scan after a busy one can only be of use if the next scan leaves it
+unchanged; on the TCP route it never does (the port FB hands the reply to the engine, and
+the engine's one-scan re-arm pulse follows), so that state (about 13 µs of the 30 a scan
+costs there) was taken for nothing once per request.  A score kept per run says whether it
+was of use lately (one use counts as four wasted ones); when it was not, it is left out
+(`_previous` stays None, so the next quiet scan cannot jump: leaving a state out can only
+cost a scan, never make a wrong jump), and every eighth is still taken to see whether it
+has become of use.  Which states are taken changes which scans run at most, never what
+they do (tests/test_idle_skip.py).
+
 Not skippable (the run then goes scan by scan, as before): a program that reads a timer's
 ET, arrays of arrays, and labels of a type the walk does not know.  `IdleScans.reason`
 says which.
@@ -53,6 +65,11 @@ from .refs import Ref
 from .stdfbs import StdFB, TOF, TON, TP
 
 INFINITY = float("inf")
+# the first quiet scan's state is left out once it was of no use this many times more
+# than it was of use (FIRST_USEFUL counts a use); every FIRST_PROBE_EVERY-th is still taken
+FIRST_SKIP_SCORE = 4
+FIRST_USEFUL = 4
+FIRST_PROBE_EVERY = 8
 _CONST_CELL = re.compile(r"\b(_A_[A-Z]+|_U[0-9A-F]+)\[(\d+)\]")
 _ANY_USE = re.compile(r"\b(_A_[A-Z]+|_U[0-9A-F]+)\b(?!\[\d+\])")
 _OPERAND_CONSTRUCTORS = ("_Ref(", "_BitRef(", "_DwordRef(")
@@ -103,6 +120,14 @@ class IdleScans:
         self.skipped_scans = 0
         self.jumps = 0
         self._previous = None
+        # the first quiet scan's state (module docstring, "The first quiet scan"): how many
+        # quiet scans in a row so far, the score that decides whether to take it, the ones
+        # not taken, and whether the one taken is still to be judged
+        self._quiet = 0
+        self._first_score = 0
+        self._first_skipped = 0
+        self.first_states_skipped = 0
+        self._judging_first = False
         self._deadlines: list[Callable[[int], float | None]] = []  # each poller's idle_deadline
         # cells instruction operands have written: compared by value from then on, whoever
         # writes them later (cells list id -> (cells, indexes, getter of their values))
@@ -228,7 +253,9 @@ class IdleScans:
         changed = self._new_operand_cells() if rt.dirty_log else False
         busy, self.busy = self.busy, False
         if busy or changed or rt.scan_count < 2:
-            self._previous = None
+            self._previous, self._quiet = None, 0
+            if self._judging_first:
+                self._first_wasted()
             return
         now = rt.now_us
         deadline = self.next_input_us()
@@ -238,11 +265,25 @@ class IdleScans:
         for idle_deadline in self._deadlines:
             until = idle_deadline(now)
             if until is None or until <= now:
-                self._previous = None
+                self._previous, self._quiet = None, 0
+                if self._judging_first:
+                    self._first_wasted()
                 return
             if until < deadline:
                 deadline = until
+        self._quiet += 1
+        if self._quiet == 1 and self._first_score >= FIRST_SKIP_SCORE:
+            self._first_skipped += 1
+            if self._first_skipped % FIRST_PROBE_EVERY:
+                self.first_states_skipped += 1
+                return  # not taken: `_previous` stays None, the next quiet scan takes its state
         state = self._state()
+        if self._judging_first:  # the first quiet scan's state: was it worth taking?
+            self._judging_first = False
+            self._first_score = max(0, self._first_score - FIRST_USEFUL) if state == self._previous else \
+                min(FIRST_SKIP_SCORE + 2, self._first_score + 1)
+        elif self._quiet == 1:
+            self._judging_first = True
         if state != self._previous:
             self._previous = state
             return
@@ -251,6 +292,13 @@ class IdleScans:
             deadline = min(deadline, stop_us)
         if now < deadline < INFINITY:
             self._jump(deadline)
+
+    def _first_wasted(self) -> None:
+        """The scan after a first quiet scan whose state was taken is not quiet: that state
+        was not worth taking (the caller has reset the comparison; inline, as it runs on
+        most scans)."""
+        self._judging_first = False
+        self._first_score = min(FIRST_SKIP_SCORE + 2, self._first_score + 1)
 
     def _new_operand_cells(self) -> bool:
         """Take in the cells instruction operands wrote since the last scan; True when one

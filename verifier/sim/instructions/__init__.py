@@ -242,29 +242,49 @@ class InstructionSet:
             self._e71[un] = port
         return port
 
+    # Each of these runs on every scan and acts only on the rising edge of EN; a scan
+    # with EN FALSE, as on the scan before, changes nothing (`TcpPort.rising` would store
+    # FALSE again), so it returns here without a call into the port.
+
     def SP_SOCOPEN(self, en, u, s1, s2, d, loc_id):
-        self.socket_port().sp_socopen(en, u, s1, s2, d, loc_id)
+        port = self._socket or self.socket_port()
+        if en or port._last_en.get(loc_id) is not False:
+            port.sp_socopen(en, u, s1, s2, d, loc_id)
 
     def SP_SOCSND(self, en, u, s1, s2, s3, d, loc_id):
-        self.socket_port().sp_socsnd(en, u, s1, s2, s3, d, loc_id)
+        port = self._socket or self.socket_port()
+        if en or port._last_en.get(loc_id) is not False:
+            port.sp_socsnd(en, u, s1, s2, s3, d, loc_id)
 
     def SP_SOCRCV(self, en, u, s1, s2, d1, d2, loc_id):
-        self.socket_port().sp_socrcv(en, u, s1, s2, d1, d2, loc_id)
+        port = self._socket or self.socket_port()
+        if en or port._last_en.get(loc_id) is not False:
+            port.sp_socrcv(en, u, s1, s2, d1, d2, loc_id)
 
     def SP_SOCCLOSE(self, en, u, s1, s2, d, loc_id):
-        self.socket_port().sp_socclose(en, u, s1, s2, d, loc_id)
+        port = self._socket or self.socket_port()
+        if en or port._last_en.get(loc_id) is not False:
+            port.sp_socclose(en, u, s1, s2, d, loc_id)
 
     def ZP_OPEN(self, en, un, s1, s2, d, loc_id):
-        self.e71(un).zp_open(en, s1, s2, d, loc_id)
+        port = self._e71.get(un) or self.e71(un)
+        if en or port._last_en.get(loc_id) is not False:
+            port.zp_open(en, s1, s2, d, loc_id)
 
     def ZP_BUFSND(self, en, un, s1, s2, s3, d, loc_id):
-        self.e71(un).zp_bufsnd(en, s1, s2, s3, d, loc_id)
+        port = self._e71.get(un) or self.e71(un)
+        if en or port._last_en.get(loc_id) is not False:
+            port.zp_bufsnd(en, s1, s2, s3, d, loc_id)
 
     def ZP_BUFRCV(self, en, un, s1, s2, d1, d2, loc_id):
-        self.e71(un).zp_bufrcv(en, s1, s2, d1, d2, loc_id)
+        port = self._e71.get(un) or self.e71(un)
+        if en or port._last_en.get(loc_id) is not False:
+            port.zp_bufrcv(en, s1, s2, d1, d2, loc_id)
 
     def ZP_CLOSE(self, en, un, s1, s2, d, loc_id):
-        self.e71(un).zp_close(en, s1, s2, d, loc_id)
+        port = self._e71.get(un) or self.e71(un)
+        if en or port._last_en.get(loc_id) is not False:
+            port.zp_close(en, s1, s2, d, loc_id)
 
 
 def _module_number(un) -> int:

@@ -45,6 +45,9 @@ def _ip_text(low: int, high: int) -> str:
 
 
 class _Connection:
+    __slots__ = ("number", "state", "remote", "open_done_us", "open_ok", "open_status", "open_refs", "received",
+                 "receiver", "partner", "pair")
+
     def __init__(self, number: int):
         self.number = number
         self.state = CLOSED
@@ -216,16 +219,19 @@ class TcpPort:
 
     # ---- between scans -----------------------------------------------------------------------------
     def poll(self, now: int) -> None:
-        for ref, bit in self.pulses:
-            ref.set(bit, False)
-        self.pulses, self.pending = self.pending, []
-        for ref, bit in self.pulses:
-            ref.set(bit, True)
+        if self.pulses or self.pending:  # (both empty on most scans: nothing to swap)
+            for ref, bit in self.pulses:
+                ref.set(bit, False)
+            self.pulses, self.pending = self.pending, []
+            for ref, bit in self.pulses:
+                ref.set(bit, True)
         if not self._active:
             return
-        endpoint = self.endpoint
+        endpoint = self.rt.tcp_endpoint
         active = False
         for conn in self.connections.values():
+            if conn.state == CLOSED:
+                continue
             if conn.state == OPENING:
                 active = True
                 if now >= conn.open_done_us:
@@ -264,34 +270,42 @@ class TcpPort:
         if not self._active:
             return float("inf")  # poll returns at once
         deadline, active = float("inf"), False
-        endpoint = self.endpoint
+        endpoint = self.rt.tcp_endpoint
+        quiet = getattr(endpoint, "quiet_until", None)
         for conn in self.connections.values():
-            if conn.state == OPENING:
+            state = conn.state
+            if state == CLOSED:
+                continue
+            if state == OPENING:
                 active = True
                 deadline = min(deadline, conn.open_done_us)
-            elif conn.state == OPEN and endpoint is not None:
+            elif state == OPEN and endpoint is not None:
                 active = True
-                quiet = getattr(endpoint, "quiet_until", None)
                 until = quiet(conn.remote) if quiet is not None else None
                 if until is None or until <= now:
                     return None
                 deadline = min(deadline, until)
-            elif conn.state == PEER_CLOSED:
+            elif state == PEER_CLOSED:
                 active = True
         return deadline if active else None  # not active: poll clears `_active`
 
     def idle_state(self) -> tuple:
-        """Everything the instructions and `poll` change (nothing counts scans)."""
-        number = lambda c: None if c is None else c.number  # noqa: E731
-        conns = tuple(
-            (c.state, c.remote, c.open_done_us, c.open_ok, c.open_status,
-             None if c.open_refs is None else tuple(map(operand_key, c.open_refs)),
-             tuple(c.received), number(c.receiver), number(c.partner), number(c.pair))
-            for c in self.connections.values())
-        endpoint = self.endpoint
+        """Everything the instructions and `poll` change (nothing counts scans). Taken
+        about four times per request, so it is a plain loop over the connections."""
+        conns = []
+        for c in self.connections.values():
+            refs, receiver, partner, pair = c.open_refs, c.receiver, c.partner, c.pair
+            conns.append((c.state, c.remote, c.open_done_us, c.open_ok, c.open_status,
+                           None if refs is None else tuple(map(operand_key, refs)),
+                           tuple(c.received) if c.received else (),
+                           None if receiver is None else receiver.number,
+                           None if partner is None else partner.number,
+                           None if pair is None else pair.number))
+        endpoint = self.rt.tcp_endpoint
         peer = endpoint.idle_state() if hasattr(endpoint, "idle_state") else None
-        return (conns, tuple(self._last_en.items()), pulse_keys(self.pulses), pulse_keys(self.pending),
-                self._active, tuple(getattr(self, "direction", {}).items()), peer)
+        return (conns, tuple(self._last_en.items()), pulse_keys(self.pulses) if self.pulses else (),
+                pulse_keys(self.pending) if self.pending else (), self._active,
+                tuple(self.direction.items()) if hasattr(self, "direction") else (), peer)
 
     def skipped(self, scan_count: int, scans: int) -> None:
         """Nothing here depends on the scan count."""
