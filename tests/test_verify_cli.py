@@ -968,3 +968,17 @@ def test_a_response_signal_that_reads_no_label_is_refused():
     result = invoke(*FX3_SOURCES, "--program", "UITAMR_ExampleFx3", "--duration", "1s", "--response-signal", "TRUE")
     assert result.exit_code == 2
     assert "--response-signal: 'TRUE' reads no label" in result.output
+
+
+@pytest.mark.parametrize("report", [None, "--json"])
+def test_a_window_cut_off_by_the_duration_option_asks_for_a_longer_one(tmp_path, report):
+    """fx3u-healthy expects point 3 within 40 s; --duration 10s ends the run before: the
+    advice was "make the scenario's duration longer", though the file's 60 s was long
+    enough. Judged as it goes (no report) and as a whole (--json) alike."""
+    args = ["--scenario", PLC / "scenarios" / "fx3u-healthy.toml", "--duration", "10s"]
+    if report:
+        args += [report, tmp_path / "r.json"]
+    result = invoke(*args)
+    assert result.exit_code == 1, result.output
+    assert "before the window closed at 40.000 s: give a longer --duration" in result.output
+    assert "make the scenario's duration longer" not in result.output

@@ -185,7 +185,7 @@ def _cut_short(scenario: Scenario) -> Scenario:
     if late:
         notes.append(f"--duration {format_duration(end)} ends the run before {len(late)} of its operator input(s), "
                      f"not applied: {'; '.join(late)}")
-    return replace(scenario, notes=scenario.notes + tuple(notes)) if notes else scenario
+    return replace(scenario, notes=scenario.notes + tuple(notes), duration_from_option=True)
 
 
 def _with_signal(scenario: Scenario, text: str) -> Scenario:

@@ -188,3 +188,4 @@ class RunEvidence:
     samples: Samples = field(default_factory=Samples)
     options: RuleOptions = field(default_factory=RuleOptions)
     stopped_early: bool = False  # the program stopped the simulated CPU at end_us
+    duration_from_option: bool = False  # --duration set end_us, not the scenario file

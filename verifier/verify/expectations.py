@@ -93,7 +93,7 @@ def verdict(expectation: Expectation, evidence: RunEvidence, watch: "ExchangeWat
             why = f"the simulation stopped at {format_seconds(evidence.end_us)}, before the window opened at {opens}"
         else:
             why = (f"the run ended at {format_seconds(evidence.end_us)}, before the window opened at {opens}: "
-                   "make the scenario's duration longer")
+                   f"{_longer(evidence)}")
         return ExpectationResult(expectation, False, why)
     short = expectation.within_us is not None and expectation.after_us + expectation.within_us > evidence.end_us
     if short:
@@ -102,7 +102,7 @@ def verdict(expectation: Expectation, evidence: RunEvidence, watch: "ExchangeWat
             why = f"the simulation stopped at {format_seconds(evidence.end_us)}, before the window closed at {closes}"
         else:
             why = (f"the run ended at {format_seconds(evidence.end_us)}, before the window closed at {closes}: "
-                   "make the scenario's duration longer")
+                   f"{_longer(evidence)}")
         return ExpectationResult(expectation, False, why)
     if watch is not None:
         return watch.result(start, end)
@@ -112,6 +112,12 @@ def verdict(expectation: Expectation, evidence: RunEvidence, watch: "ExchangeWat
         "never": _judge_never,
     }[expectation.kind]
     return judge_kind(expectation, evidence, start, end)
+
+
+def _longer(evidence: RunEvidence) -> str:
+    """The remedy for a window the run ended too early for: the length is the file's, or
+    the --duration that cut it short."""
+    return "give a longer --duration" if evidence.duration_from_option else "make the scenario's duration longer"
 
 
 def _span(start: int, end: int) -> str:

@@ -550,7 +550,8 @@ def _silence_note(scenario: Scenario, plc: _Plc, converter: Converter | None) ->
 def _judge_whole(scenario: Scenario, trace: list[TraceRecord], end_us: int, events: list[LineEvent],
                  samples: Samples, stopped_early: bool):
     """Every rule's violations and every expectation's result, the run judged as a whole."""
-    evidence = RunEvidence(scenario.settings, trace, end_us, events, samples, scenario.options, stopped_early)
+    evidence = RunEvidence(scenario.settings, trace, end_us, events, samples, scenario.options, stopped_early,
+                           scenario.duration_from_option)
     traffic = analyse(trace, scenario.settings, scenario.options, converter_drops(events))
     return check_all(evidence, traffic), [judge(expectation, evidence, traffic) for expectation in scenario.expectations]
 
@@ -626,6 +627,8 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     streamed = not plain and (not keep.frames or keep.frames_to_file is not None)
     stream = Stream(scenario.settings, scenario.options, samples, scenario.expectations, _relative,
                     keep.frames_to_file if keep.frames else None, scenario.name) if streamed else None
+    if stream is not None:
+        stream.evidence.duration_from_option = scenario.duration_from_option
     rule_events = _NewRuleEvents(line, converter, drop_the_rest=not keep.details)
     taken_us = 0
     events_dropped = 0

@@ -149,6 +149,7 @@ class Scenario:
     platform_from_option: bool = False  # the platform is --platform's, not the file's (for messages)
     for_sources: bool = False  # a bundled scenario run against the user's sources (--matrix)
     program_from_option: bool = False  # the program is --program's, not the file's (for messages)
+    duration_from_option: bool = False  # the run's length is --duration's (for messages)
 
     @property
     def target(self) -> str:
