@@ -316,3 +316,22 @@ def test_one_stray_byte_breaks_the_link_for_good_without_timer_0(no_reception_ms
     run(project, 20000)
     assert robot.requests > 40                                  # polled all along, answered all along
     assert (prog.fbEngine.o_wCommErrCount == errors_before) == recovers
+
+
+def test_the_unread_note_dates_the_oldest_message_still_waiting():
+    """`c24_unread` (the note's "the oldest since ...") gave, after a G_INPUT had taken one
+    of several waiting messages, the time of that read instead of when the oldest message
+    still waiting arrived: a reply left unread for a second looked one scan old."""
+    main = USER_MAIN.replace("i_bReadReq := X2A", "i_bReadReq := bRead").replace(
+        "uPort : ARRAY[0..39] OF WORD;", "uPort : ARRAY[0..39] OF WORD;\n    bRead : BOOL;")
+    project = verifier.load(*LIBRARY, sources={"Main.st": main}, cpu="q")
+    project.attach_serial("q:2", Line(Robot(Settings(), RobotConfig(), [])))
+    project.run_programs(["Main"], ms=2000)
+    ((unit, channel, waiting, oldest),) = project.c24_unread()
+    assert (unit, channel) == (2, 2) and waiting >= 2 and oldest < 500_000
+    project.program("Main").bRead = True  # one G_INPUT, at 2 s: the first message is read
+    project.run_programs(["Main"], ms=10)
+    project.program("Main").bRead = False
+    project.run_programs(["Main"], ms=100)
+    ((_, _, _, since),) = project.c24_unread()
+    assert oldest < since < 1_900_000, since  # the second message's arrival, not the read at 2 s
