@@ -110,8 +110,14 @@ class C24Module:
         """The first G_OUTPUT / G_INPUT on this module: it is the program's, so it is on the
         line, and settings made for "the module the program drives" apply to it."""
         self.addressed = True
+        written = self.rt.c24_written
         for channel, settings in self.rt.c24_for_program.items():
-            self.configure(channel, **settings)
+            # a word the program wrote before this first call keeps the program's value: made
+            # in GX Works, the setting would have been in force from power-on, under the write
+            words = BUFFER[channel]
+            mine = {"byte_units": "unit", "receive_count": "recv_count", "end_code": "end_code"}
+            self.configure(channel, **{name: value for name, value in settings.items()
+                                       if name not in mine or (self.un, words[mine[name]]) not in written})
 
     # -- G_OUTPUT ----------------------------------------------------------------------------
     def output(self, s1, s2, d, loc_id) -> bool:
