@@ -316,3 +316,53 @@ def test_one_stray_byte_breaks_the_link_for_good_without_timer_0(no_reception_ms
     run(project, 20000)
     assert robot.requests > 40                                  # polled all along, answered all along
     assert (prog.fbEngine.o_wCommErrCount == errors_before) == recovers
+
+
+def test_the_unread_note_dates_the_oldest_message_still_waiting():
+    """`c24_unread` (the note's "the oldest since ...") gave, after a G_INPUT had taken one
+    of several waiting messages, the time of that read instead of when the oldest message
+    still waiting arrived: a reply left unread for a second looked one scan old."""
+    main = USER_MAIN.replace("i_bReadReq := X2A", "i_bReadReq := bRead").replace(
+        "uPort : ARRAY[0..39] OF WORD;", "uPort : ARRAY[0..39] OF WORD;\n    bRead : BOOL;")
+    project = verifier.load(*LIBRARY, sources={"Main.st": main}, cpu="q")
+    project.attach_serial("q:2", Line(Robot(Settings(), RobotConfig(), [])))
+    project.run_programs(["Main"], ms=2000)
+    ((unit, channel, waiting, oldest),) = project.c24_unread()
+    assert (unit, channel) == (2, 2) and waiting >= 2 and oldest < 500_000
+    project.program("Main").bRead = True  # one G_INPUT, at 2 s: the first message is read
+    project.run_programs(["Main"], ms=10)
+    project.program("Main").bRead = False
+    project.run_programs(["Main"], ms=100)
+    ((_, _, _, since),) = project.c24_unread()
+    assert oldest < since < 1_900_000, since  # the second message's arrival, not the read at 2 s
+
+
+@pytest.mark.parametrize("un", [2, None])
+def test_the_programs_own_c24_setting_stands_over_one_for_the_module_it_drives(un):
+    """A program that sets word units itself (U2\\G310 := 0, wrong for the library) fails
+    to link whether the scenario's byte-units setting names its module (un=2, made before
+    the first scan) or is for "the module the program drives" (un=None): the latter was
+    applied at the first G_OUTPUT, after the program's own write, and hid the mistake."""
+    main = USER_MAIN.replace("U2\\G310 := 1;", "U2\\G310 := 0;")
+    project = verifier.load(*LIBRARY, sources={"Main.st": main}, cpu="q")
+    project.attach_serial("q:2", Line(Robot(Settings(), RobotConfig(), [])))
+    project.configure_c24(un, 2, byte_units=True)
+    project.run_programs(["Main"], ms=3000)
+    assert not project.program("Main").fbEngine.o_bInitDone
+    # control: with the program's byte-units write, the same setting links
+    project = verifier.load(*LIBRARY, sources={"Main.st": USER_MAIN}, cpu="q")
+    project.attach_serial("q:2", Line(Robot(Settings(), RobotConfig(), [])))
+    project.configure_c24(un, 2, byte_units=True)
+    project.run_programs(["Main"], ms=3000)
+    assert project.program("Main").fbEngine.o_bInitDone
+
+
+def test_a_c24_setting_for_the_module_the_program_drives_fills_a_word_it_leaves_alone():
+    """The other half: a word the program does not write (here the receive count, G324)
+    takes the setting made for the module it drives."""
+    main = USER_MAIN.replace("    U2\\G324 := 8;\n", "")
+    project = verifier.load(*LIBRARY, sources={"Main.st": main}, cpu="q")
+    project.attach_serial("q:2", Line(Robot(Settings(), RobotConfig(), [])))
+    project.configure_c24(None, 2, receive_count=8)
+    project.run_programs(["Main"], ms=3000)
+    assert project.program("Main").fbEngine.o_bInitDone

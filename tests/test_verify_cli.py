@@ -982,3 +982,29 @@ def test_a_window_cut_off_by_the_duration_option_asks_for_a_longer_one(tmp_path,
     assert result.exit_code == 1, result.output
     assert "before the window closed at 40.000 s: give a longer --duration" in result.output
     assert "make the scenario's duration longer" not in result.output
+
+
+def test_a_fault_after_the_runs_end_is_not_said_to_have_met_no_request(tmp_path):
+    """A reply fault whose window opens after the run ended was noted as "no control
+    request reached the robot from 2 s for 1.5 s", as if the program had sent nothing then:
+    with --duration 1s the run simply ended first (--duration's own note says so, once), and
+    a CPU that stopped at 1 s is said as such."""
+    result = invoke("--scenario", PLC / "scenarios" / "fx3u-exception.toml", "--duration", "1s")
+    assert "ends the run before 1 of its scripted fault(s), not tested: exception (code 04) at 2 s" in result.output
+    assert "no control request reached the robot" not in result.output, result.output
+    assert result.output.count("not tested") == 1, result.output
+
+    program = tmp_path / "stop.st"
+    program.write_text("PROGRAM MAIN\nVAR\n    tWait : TON;\n    wZero : INT;\n    wOut : INT;\nEND_VAR\n"
+                       "tWait(IN := TRUE, PT := T#1s);\nIF tWait.Q THEN\n    wOut := 5 / wZero;\nEND_IF;\n"
+                       "END_PROGRAM\n", encoding="utf-8")
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(f'sources = ["{program.name}"]\nplatform = "q"\nduration = "5s"\n\n'
+                        '[[faults]]\nkind = "bad_crc"\nat_s = 2.0\nduration_s = 1.0\n', encoding="utf-8")
+    report = tmp_path / "r.json"
+    result = invoke("--scenario", scenario, "--json", report)
+    (run,) = json.loads(report.read_text())["scenarios"]
+    assert run["aborted"], result.output
+    (note,) = [note for note in run["notes"] if "faults[0]" in note]
+    assert "the simulation stopped at 1.0" in note and "before its window opened at 2 s" in note, note
+    assert "reached the robot" not in note

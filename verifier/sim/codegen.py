@@ -17,6 +17,7 @@ from . import datatypes
 from .calls import CallCompiler
 from .cpu import SEND_FLAGS
 from .devices import DeviceError, locate, locate_buffer
+from .instructions.c24 import BUFFER as _C24_BUFFER
 from .typesys import (ANYINT, ANYREAL, ArrayT, CompileError, FbT, PouInfo, StringT, StructT,
                       Symbol, concrete, is_int, is_real, is_string, norm_code, unify)
 
@@ -331,7 +332,12 @@ class BodyCompiler(CallCompiler):
             except DeviceError as e:
                 raise CompileError(d.span, str(e)) from None
             g = self.m.buffer_global(module)
-            return LValue("INT", f"{g}[{idx}]", f"{g}[{idx}] = {{v}}", label=label)
+            write = f"{g}[{idx}] = {{v}}"
+            if idx in C24_SETTING_WORDS:
+                # the program sets the QJ71C24N up itself: settings made for "the module the
+                # program drives" (configure_c24(None, ...)) do not replace this word
+                write += f"; _rt.c24_written.add(({module}, {idx}))"
+            return LValue("INT", f"{g}[{idx}]", write, label=label)
         try:
             area, index = locate(d, cpu)
         except DeviceError as e:
@@ -718,6 +724,8 @@ class BodyCompiler(CallCompiler):
         return "return _ret"
 
 
+#: buffer-memory words of the QJ71C24N settings Project.configure_c24 makes
+C24_SETTING_WORDS = frozenset(addr for words in _C24_BUFFER.values() for addr in words.values())
 LONG_CHAIN = 16  # operators in a left-deep chain compiled step by step (see chain())
 
 

@@ -425,8 +425,10 @@ class Project:
         no-reception monitoring time that ends a message on a silent line and its format
         (1: the message is read normally, X3/XA - the default here; 0: a reception error,
         X4/XB). `un=None` makes
-        them for the module the program drives, wherever it is: the first one its
-        G_OUTPUT / G_INPUT address. Only a module the program addresses is on the robot's
+        them for the module the program drives, wherever it is: each one its G_OUTPUT /
+        G_INPUT address, from the first call on; a settings word the program has assigned
+        by then (U2\\G310 := 1) keeps the program's value, as over a setting made in GX
+        Works. Only a module the program addresses is on the robot's
         line; settings for another one change nothing (`c24_addressed` tells which are)."""
         from .instructions.c24 import BUFFER
 

@@ -53,6 +53,9 @@ class Runtime:
         # QJ71C24N channel -> settings for whichever module the program's G_OUTPUT/G_INPUT
         # address first (Project.configure_c24 with un=None)
         self.c24_for_program: dict[int, dict] = {}
+        # (module, word) of those settings the program's own assignments wrote (U2\G310 := 1):
+        # the program's value stands, as it would over a setting made in GX Works
+        self.c24_written: set[tuple[int, int]] = set()
         self.origins: dict[str, str] = {}  # channel -> location of the last send-request flag write
         self.tcp_endpoint = None  # the Ethernet port's peer (verifier.link.converter.Converter)
         self.stop_on_operation_error = (cpu.stops_on_op_error if stop_on_operation_error is None

@@ -88,22 +88,11 @@ def verdict(expectation: Expectation, evidence: RunEvidence, watch: "ExchangeWat
     start, end = expectation.window(evidence.end_us)
     if expectation.after_us >= evidence.end_us:
         # the window would be empty (or end before it begins): nothing could be judged
-        opens = format_seconds(expectation.after_us)
-        if evidence.stopped_early:
-            why = f"the simulation stopped at {format_seconds(evidence.end_us)}, before the window opened at {opens}"
-        else:
-            why = (f"the run ended at {format_seconds(evidence.end_us)}, before the window opened at {opens}: "
-                   f"{_longer(evidence)}")
-        return ExpectationResult(expectation, False, why)
+        return ExpectationResult(expectation, False, _too_short(evidence, "opened", expectation.after_us))
     short = expectation.within_us is not None and expectation.after_us + expectation.within_us > evidence.end_us
     if short:
-        closes = format_seconds(expectation.after_us + expectation.within_us)
-        if evidence.stopped_early:
-            why = f"the simulation stopped at {format_seconds(evidence.end_us)}, before the window closed at {closes}"
-        else:
-            why = (f"the run ended at {format_seconds(evidence.end_us)}, before the window closed at {closes}: "
-                   f"{_longer(evidence)}")
-        return ExpectationResult(expectation, False, why)
+        return ExpectationResult(expectation, False,
+                                 _too_short(evidence, "closed", expectation.after_us + expectation.within_us))
     if watch is not None:
         return watch.result(start, end)
     judge_kind = {
@@ -112,6 +101,16 @@ def verdict(expectation: Expectation, evidence: RunEvidence, watch: "ExchangeWat
         "never": _judge_never,
     }[expectation.kind]
     return judge_kind(expectation, evidence, start, end)
+
+
+def _too_short(evidence: RunEvidence, moment: str, at_us: int) -> str:
+    """Why a window the run ended before it `moment` ("opened", "closed") at `at_us` was not
+    judged, with the remedy."""
+    if evidence.stopped_early:
+        return f"the simulation stopped at {format_seconds(evidence.end_us)}, before the window {moment} at " \
+               f"{format_seconds(at_us)}"
+    return (f"the run ended at {format_seconds(evidence.end_us)}, before the window {moment} at "
+            f"{format_seconds(at_us)}: {_longer(evidence)}")
 
 
 def _longer(evidence: RunEvidence) -> str:

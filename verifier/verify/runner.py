@@ -21,6 +21,7 @@ from verifier.link.converter import Converter
 from verifier.sim.values import InstanceProxy, read_together
 from verifier.textfile import shown_path
 
+from .durations import format_seconds
 from .events_shown import thin_line_events
 from .evidence import RunEvidence, Samples
 from .expectations import judge
@@ -466,15 +467,21 @@ def _c24_notes(scenario: Scenario, plc: _Plc) -> list[str]:
     return notes
 
 
-def _missed_fault_notes(scenario: Scenario, robot) -> list[str]:
+def _missed_fault_notes(scenario: Scenario, robot, end_us: int) -> list[str]:
     """A reply fault that met no request (a window in which the program sent nothing, a
     request number never reached, `requests = "control"` while only status reads went
-    out) tested nothing, though the run may pass: said, at the fault's line."""
+    out) tested nothing, though the run may pass: said, at the fault's line. A window that
+    opens only after the run's end (`end_us`: --duration, or a CPU that stopped) is not one
+    the program left empty: --duration's own note names those faults, a stop is said as such."""
     notes = []
     for index, fault in robot.reply_faults_missed():
         key = f"faults[{index}]"
         where = scenario.where(key, scenario.key_lines.get(key))
-        if fault.at_s is not None:
+        if fault.at_s is not None and round(fault.at_s * 1_000_000) >= end_us:
+            if scenario.duration_from_option and round(fault.at_s * 1_000_000) >= scenario.duration_us:
+                continue  # "--duration ... ends the run before ... scripted fault(s), not tested"
+            why = f"the simulation stopped at {format_seconds(end_us)}, before its window opened at {fault.at_s:g} s"
+        elif fault.at_s is not None:
             window = f"from {fault.at_s:g} s" + (f" for {fault.duration_s:g} s" if fault.duration_s else "")
             why = f"no {fault.requests + ' ' if fault.requests != 'any' else ''}request reached the robot {window}"
         else:
@@ -694,6 +701,6 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         aborted=aborted,
         ended_us=end,
         wall_s=time.perf_counter() - wall_start,
-        notes=list(scenario.notes) + plc.cpu_notes() + _c24_notes(scenario, plc) + _missed_fault_notes(scenario, robot)
+        notes=list(scenario.notes) + plc.cpu_notes() + _c24_notes(scenario, plc) + _missed_fault_notes(scenario, robot, end)
         + ([] if tx_count else [_silence_note(scenario, plc, converter)]),
     )

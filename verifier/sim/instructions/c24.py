@@ -36,13 +36,13 @@ class _Channel:
         self.out_done = None  # (s1 ref, d ref) awaiting completion
         self.rx = bytearray()
         self.rx_last_t = 0
-        # messages waiting for G_INPUT: (data, error code; 0 = a normal reception)
-        self.frames: list[tuple[bytes, int]] = []
+        # messages waiting for G_INPUT: (data, error code; 0 = a normal reception, when its
+        # last byte arrived in µs)
+        self.frames: list[tuple[bytes, int, int]] = []
         self.no_reception_us: int | None = None  # timer 0, off by default
         # what timer 0 running out does (C24 (Application) 6.1): format 1 ends the message
         # normally (X3/XA), format 0 reports a reception error (X4/XB, error code)
         self.no_reception_format = 1
-        self.unread_since: int | None = None  # when the oldest message still waiting arrived
 
 
 class C24Module:
@@ -110,8 +110,14 @@ class C24Module:
         """The first G_OUTPUT / G_INPUT on this module: it is the program's, so it is on the
         line, and settings made for "the module the program drives" apply to it."""
         self.addressed = True
+        written = self.rt.c24_written
         for channel, settings in self.rt.c24_for_program.items():
-            self.configure(channel, **settings)
+            # a word the program wrote before this first call keeps the program's value: made
+            # in GX Works, the setting would have been in force from power-on, under the write
+            words = BUFFER[channel]
+            mine = {"byte_units": "unit", "receive_count": "recv_count", "end_code": "end_code"}
+            self.configure(channel, **{name: value for name, value in settings.items()
+                                       if name not in mine or (self.un, words[mine[name]]) not in written})
 
     # -- G_OUTPUT ----------------------------------------------------------------------------
     def output(self, s1, s2, d, loc_id) -> bool:
@@ -143,8 +149,7 @@ class C24Module:
             return True
         if not chan.frames:
             return True  # nothing received: the instruction does nothing (ASSUMPTION)
-        data, error = chan.frames.pop(0)
-        chan.unread_since = self.rt.now_us if chan.frames else None
+        data, error, _ = chan.frames.pop(0)
         words = (len(data) + 1) // 2
         count = len(data) if self._word(chan.ch, "unit") == 1 else words
         if count > s.get(3):
@@ -162,13 +167,13 @@ class C24Module:
 
     def _signals(self, chan: _Channel) -> None:
         """X3/XA while a normal message waits, X4/XB while one ended by an error waits."""
-        self._set_x(READ_REQUEST[chan.ch], any(not error for _, error in chan.frames))
-        self._set_x(ABNORMAL[chan.ch], any(error for _, error in chan.frames))
+        self._set_x(READ_REQUEST[chan.ch], any(not frame[1] for frame in chan.frames))
+        self._set_x(ABNORMAL[chan.ch], any(frame[1] for frame in chan.frames))
 
     def unread(self) -> list[tuple[int, int, int]]:
         """(channel, messages waiting, since when in µs) for each channel whose received
         messages no G_INPUT has taken."""
-        return [(ch, len(c.frames), c.unread_since) for ch, c in self.channels.items() if c.frames]
+        return [(ch, len(c.frames), c.frames[0][2]) for ch, c in self.channels.items() if c.frames]
 
     # -- between scans ---------------------------------------------------------------------------
     def poll(self, now: int) -> None:
@@ -242,8 +247,6 @@ class C24Module:
         self._frame(chan, 0 if chan.no_reception_format == 1 else ERR_NO_RECEPTION)
 
     def _frame(self, chan: _Channel, error: int = 0) -> None:
-        if not chan.frames:
-            chan.unread_since = chan.rx_last_t
-        chan.frames.append((bytes(chan.rx), error))
+        chan.frames.append((bytes(chan.rx), error, chan.rx_last_t))
         chan.rx.clear()
         self._signals(chan)
