@@ -142,6 +142,40 @@ def test_bad_il_names_its_line():
         parse_il("LD X0\nOUT Y0\n", "x.il")
 
 
+@pytest.mark.parametrize("text, message", [
+    ("LD X0\nOUT\nEND\n", r"x.il:2:1: OUT takes 1 operand\(s\), got 0"),
+    ("LD X0\nOUT T200\nEND\n", r"x.il:2:1: OUT takes 2 operand\(s\), got 1"),
+    ("LD X0\n  MOVV D0 D1\nEND\n", r"x.il:2:3: 'MOVV' is not an instruction this converter knows"),
+    ("LD= D0\nEND\n", r"x.il:1:1: LD= takes 2 operand\(s\), got 1"),
+])
+def test_il_mistakes_are_named_with_line_and_column(text, message):
+    """A mistyped instruction used to become a CSV row GX Works2 would refuse (with a step
+    count of 1), and a missing operand a Python traceback."""
+    with pytest.raises(IlError, match=message):
+        parse_il(text, "x.il")
+
+
+def test_the_regeneration_command_reports_mistakes_without_a_traceback(tmp_path):
+    """`python -m verifier.export.ladder FILE.il` (docs/plc-library.md) on a missing file,
+    a file that is not UTF-8 or no argument: one message, exit status, no traceback."""
+    import subprocess
+    import sys
+    root = Path(__file__).resolve().parents[1]
+    bad = tmp_path / "bad.il"
+    bad.write_bytes(b"LD X0\nOUT Y0\xff\nEND\n")
+    cases = [([str(tmp_path / "missing.il")], 1, "missing.il: cannot read"),
+             ([str(bad)], 1, "bad.il: line 2, column 7 (byte 12): not UTF-8 text"),
+             ([], 2, "usage: python -m verifier.export.ladder FILE.il")]
+    for args, status, message in cases:
+        run = subprocess.run([sys.executable, "-m", "verifier.export.ladder", *args], cwd=root,
+                             capture_output=True, text=True, env={"PYTHONPATH": str(root), "PATH": ""})
+        assert run.returncode == status, run.stderr
+        assert message in run.stderr and "Traceback" not in run.stderr, run.stderr
+    ok = subprocess.run([sys.executable, "-m", "verifier.export.ladder", str(IL)], cwd=root,
+                        capture_output=True, env={"PYTHONPATH": str(root), "PATH": ""})
+    assert ok.returncode == 0 and ok.stdout == (LADDER / "UITAMR_LadderFx3.csv").read_bytes()
+
+
 def test_frame_constants_match_the_protocol(program):
     """The words the ladder writes are the protocol's frames, two bytes per word, low first."""
     words = lambda frame: [frame[i] | frame[i + 1] << 8 for i in range(0, 6, 2)]
