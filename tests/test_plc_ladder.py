@@ -260,3 +260,21 @@ def test_ladder_rejects_a_bad_crc_and_retries(tmp_path, program):
         table("faults", kind="bad_crc", on_request=6),
         table("expect", reached_point=2, within="30s"), table("expect", never="Y3"), duration="30s")
     assert result.passed, "\n".join(problems)
+
+
+def test_ladder_sends_the_stop_next_when_x1_comes_during_a_retry(tmp_path, program):
+    """X1 while the point command waits for a reply that never comes: the ladder used to
+    send the point command again after the stop button, so a robot that answered it drove
+    off. Now the retry becomes a task-status read and the stop follows it (R24, R19): no
+    control command after the button but the stop, and UITAMR-CYCLE's read in between."""
+    result, problems = run_ladder(
+        tmp_path, program, "ladder: stop during a retry",
+        table("faults", kind="no_reply", at_s=2.0, count=1, requests="control"),
+        press("X1", "2.3s"), table("expect", that="NOT Y1", after="2.3s", within="1s"), duration="8s")
+    assert result.passed, "\n".join(problems)
+    stop = encode(ControlRequest(1, 1, 0xA0))
+    after = [f.data for f in result.trace if f.direction == "tx" and f.t_start_us > 2_300_000]
+    read_task = encode(StatusRequest(1, 0))
+    assert after[:2] == [read_task, stop], [a.hex(" ") for a in after[:3]]
+    run_point = [f for f in result.trace if f.direction == "tx" and f.data[1] == 6 and f.data != stop]
+    assert len(run_point) == 1, [(f.t_start_us, f.data.hex(" ")) for f in run_point]
