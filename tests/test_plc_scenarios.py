@@ -114,3 +114,18 @@ def test_the_fx5_adprw_example_under_a_silent_robot_times_out_as_import_gxworks3
     silent = [f for f in result.trace if f.direction == "tx" and 4_000_000 <= f.t_start_us < 6_000_000]
     assert len(silent) == 3  # the engine's three attempts, each ended by the 400 ms time-out
     assert json.dumps(result.watched["fbEngine.o_uErrId"]).count("264") >= 1  # 16#0108
+
+
+def test_the_adprw_reply_window_is_the_slave_response_time_out_as_plc_library_says():
+    """docs/plc-library.md: on the ADPRW route a reply 400-500 ms late is lost to ADPRW
+    (D8409 = 400 ms) and the command is repeated; the default 500 ms rules see an answered
+    command sent twice (UITAMR-CYCLE), reply_timeout = 400 ms a retry. The bundled
+    fx3u-adprw-late-reply scenario runs both ways here."""
+    from dataclasses import replace
+    guide = " ".join((ROOT / "docs" / "plc-library.md").read_text(encoding="utf-8").split())
+    assert "`[rules] reply_timeout = \"400ms\"` when it has late replies" in guide
+    scenario = load_scenario(ROOT / "plc" / "scenarios" / "fx3u-adprw-late-reply.toml")
+    assert scenario.options.reply_timeout_us == 400_000
+    assert run_scenario(scenario).passed
+    default = run_scenario(replace(scenario, options=replace(scenario.options, reply_timeout_us=500_000)))
+    assert [v.rule for v in default.all_violations()] == ["UITAMR-CYCLE"]
