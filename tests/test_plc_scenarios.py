@@ -129,3 +129,20 @@ def test_the_adprw_reply_window_is_the_slave_response_time_out_as_plc_library_sa
     assert run_scenario(scenario).passed
     default = run_scenario(replace(scenario, options=replace(scenario.options, reply_timeout_us=500_000)))
     assert [v.rule for v in default.all_violations()] == ["UITAMR-CYCLE"]
+
+
+def test_the_rs232_choice_is_read_in_the_first_scan_only_as_wiring_rs232_says(tmp_path):
+    """docs/wiring-rs232.md said bUseRs232 could come 'from an input before the engine
+    starts'; the port reads it in its first scan only. Set at 1 s, D8400 keeps the RS-485
+    format H1C81 for the whole run, and the guide now says so."""
+    import json
+    guide = " ".join((ROOT / "docs" / "wiring-rs232.md").read_text(encoding="utf-8").split())
+    assert "It reads `i_bRs232` only in that first scan" in guide
+    plc = (ROOT / "plc").as_posix()
+    text = (ROOT / "plc" / "scenarios" / "fx3u-rs232-healthy.toml").read_text(encoding="utf-8")
+    text = text.split("[[expect]]")[0].replace('at = "0s"', 'at = "1s"').replace('"../', f'"{plc}/')
+    path = tmp_path / "rs232-late.toml"
+    path.write_text(text + '\n[[expect]]\nalways = "D8400 = 16#1C81"\nafter = "20ms"\nwithin = "59s"\n', encoding="utf-8")
+    result = run_scenario(load_scenario(path))
+    assert result.passed, [str(e) for e in result.failed_expectations]
+    assert json.dumps(result.watched["D8400"]).count(str(0x0081)) == 0
