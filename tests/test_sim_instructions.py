@@ -200,6 +200,18 @@ def test_rs2_warns_about_a_wrong_communication_format():
     project.program("P").bStart = True
     project.run_programs(["P"], scans=1)
     assert any("19200 8N1" in d.message for d in project.diagnostics)
+    # the RS-232 route's format is named too, not only the RS-485 ones
+    assert any("H0081 on its RS-232 route" in d.message for d in project.diagnostics)
+
+
+def test_rs2_takes_the_rs232_format_without_a_warning():
+    ep = FakeEndpoint()
+    project = load_st(RS2_PROG.replace("16#1C81", "16#0081"))  # 9600 8N1, RS-232C
+    project.attach_serial("fx3:1", ep)
+    project.run_programs(["P"], scans=2)
+    project.program("P").bStart = True
+    project.run_programs(["P"], scans=1)
+    assert ep.sent and not project.diagnostics
 
 
 def test_fx5_rs2_uses_its_own_devices():
