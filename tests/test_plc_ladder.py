@@ -278,3 +278,21 @@ def test_ladder_sends_the_stop_next_when_x1_comes_during_a_retry(tmp_path, progr
     assert after[:2] == [read_task, stop], [a.hex(" ") for a in after[:3]]
     run_point = [f for f in result.trace if f.direction == "tx" and f.data[1] == 6 and f.data != stop]
     assert len(run_point) == 1, [(f.t_start_us, f.data.hex(" ")) for f in run_point]
+
+
+def test_ladder_waits_for_the_reply_time_out_after_three_failed_power_on_stops(tmp_path, program):
+    """A robot silent for the first 3 s: after three unanswered stops the ladder starts the
+    stop again at once (M100 still owed). T201, the reply timer, stayed ON across that
+    back-to-back restart (its coil never saw step 30 left at R10), so the new stop timed out
+    in the same scan: the retry went out 300 ms later while its reply could still come
+    (UITAMR-ONE-AT-A-TIME), and an echo arriving then was flushed and the stop sent again
+    (UITAMR-CYCLE). R9 now resets T201 with every frame it sends."""
+    result, _ = run_ladder(
+        tmp_path, program, "ladder: silent at power-on",
+        table("faults", kind="no_reply", at_s=0.0, duration_s=3.0),
+        table("expect", that="M100 = FALSE", within="6s"), duration="8s")
+    assert [f"{v.rule} at {v.t_us / 1e6:.3f} s: {v.message}" for v in result.all_violations()] == []
+    sent = [f.t_start_us for f in result.trace if f.direction == "tx"]
+    answered = {f.t_start_us for f in result.trace if f.direction == "rx"}
+    assert all(b - a >= 500_000 for a, b in zip(sent, sent[1:]) if b < 3_000_000), sent
+    assert answered
