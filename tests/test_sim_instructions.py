@@ -358,6 +358,20 @@ def test_adprw_fx3_error_codes_are_those_of_the_modbus_manual(reply, code, detai
     assert project.devices["M8063"] is True and project.devices["D8063"] == 6321
 
 
+def test_adprw_fx3_a_good_transaction_keeps_the_last_error_code():
+    """FX-MB 6.1: D8402/D8403 are cleared at power-on and STOP->RUN only. The simulator
+    wrote 0 into D8402 after every good transaction, so a program showing the last error
+    lost it here and not on the PLC."""
+    project, ep, p = adprw_started(ADPRW_FX3_ERRORS)
+    project.run_programs(["P"], ms=3500)                   # no reply: 211
+    assert project.devices["D8402"] == 211
+    p.bRun = True
+    project.run_programs(["P"], scans=1)
+    ep.reply_at(ep.sent[-1][1] + 12_000, with_crc(bytes([1, 1, 3, 0, 0, 0])))
+    project.run_programs(["P"], scans=5)
+    assert p.nDone == 2 and project.devices["D8402"] == 211
+
+
 def test_adprw_fx5_fc01_unpacks_coils_and_reports_time_out():
     src = """
 PROGRAM P

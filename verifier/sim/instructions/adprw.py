@@ -213,8 +213,11 @@ class AdprwMaster:
         reports through M8029 at the next execution of ADPRW."""
         self.busy = False
         _, _, _, d2 = self.job
-        self._set(self._err_code, error)
         flags = []
+        if self.family != "fx3" or error:
+            # FX3: D8402/D8403 hold the last error until power-on or STOP->RUN (FX-MB 6.1,
+            # "Special clear conditions"): a transaction that succeeds does not clear them
+            self._set(self._err_code, error)
         if self.family == "fx3":
             self.completed = True
             if error:
