@@ -164,3 +164,14 @@ def test_the_fx3u_adprw_import_guide_names_the_modbus_setup_the_library_does_not
     # what the guide says the library leaves to the integrator, it indeed leaves
     assert "D8401" not in body(example) + body(port) and "D8400" not in body(example) + body(port)
     assert "D8409 := RESPONSE_TIMEOUT_MS" in port and "D8412 := RETRIES" in port
+
+
+def test_plc_readme_sends_the_485adp_mb_integrator_to_rs485_wiring_not_rs232():
+    """plc/README.md's ADPRW row said 'same' guide as the row above it, which is the RS-232
+    route's (import-gxworks2 + wiring-rs232): an FX3U-485ADP-MB integrator was sent to the
+    RS-232 cable page."""
+    rows = [line for line in (ROOT / "plc" / "README.md").read_text(encoding="utf-8").splitlines()
+            if line.startswith("| FX3U + FX3U-485ADP-MB (ADPRW)")]
+    assert len(rows) == 1
+    guides = rows[0].split("|")[4]
+    assert "wiring-rs485.md" in guides and "import-gxworks2.md" in guides and "wiring-rs232" not in guides
