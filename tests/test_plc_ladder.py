@@ -296,3 +296,18 @@ def test_ladder_waits_for_the_reply_time_out_after_three_failed_power_on_stops(t
     answered = {f.t_start_us for f in result.trace if f.direction == "rx"}
     assert all(b - a >= 500_000 for a, b in zip(sent, sent[1:]) if b < 3_000_000), sent
     assert answered
+
+
+def test_ladder_on_the_rs232_route_with_h0081(tmp_path, program):
+    """plc-library.md: on the RS-232 route change R1's H1C81 to H0081 and nothing else."""
+    guide = " ".join((Path(__file__).resolve().parents[1] / "docs" / "plc-library.md").read_text(encoding="utf-8").split())
+    assert "change R1's `MOV H1C81 D8400` to `MOV H0081 D8400`; nothing else changes" in guide
+    from dataclasses import replace
+    rs232 = [replace(i, operands=("H0081", "D8400")) if i.operands == ("H1C81", "D8400") else i for i in program]
+    assert rs232 != program
+    result, problems = run_ladder(
+        tmp_path, rs232, "ladder: RS-232 route",
+        table("expect", reached_point=3, within="40s"), table("expect", never="Y3"),
+        table("expect", that="D8400 = 16#0081", within="20ms"))
+    assert result.passed, "\n".join(problems)
+    assert result.diagnostics == []
