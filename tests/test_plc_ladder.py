@@ -142,6 +142,40 @@ def test_bad_il_names_its_line():
         parse_il("LD X0\nOUT Y0\n", "x.il")
 
 
+@pytest.mark.parametrize("text, message", [
+    ("LD X0\nOUT\nEND\n", r"x.il:2:1: OUT takes 1 operand\(s\), got 0"),
+    ("LD X0\nOUT T200\nEND\n", r"x.il:2:1: OUT takes 2 operand\(s\), got 1"),
+    ("LD X0\n  MOVV D0 D1\nEND\n", r"x.il:2:3: 'MOVV' is not an instruction this converter knows"),
+    ("LD= D0\nEND\n", r"x.il:1:1: LD= takes 2 operand\(s\), got 1"),
+])
+def test_il_mistakes_are_named_with_line_and_column(text, message):
+    """A mistyped instruction used to become a CSV row GX Works2 would refuse (with a step
+    count of 1), and a missing operand a Python traceback."""
+    with pytest.raises(IlError, match=message):
+        parse_il(text, "x.il")
+
+
+def test_the_regeneration_command_reports_mistakes_without_a_traceback(tmp_path):
+    """`python -m verifier.export.ladder FILE.il` (docs/plc-library.md) on a missing file,
+    a file that is not UTF-8 or no argument: one message, exit status, no traceback."""
+    import subprocess
+    import sys
+    root = Path(__file__).resolve().parents[1]
+    bad = tmp_path / "bad.il"
+    bad.write_bytes(b"LD X0\nOUT Y0\xff\nEND\n")
+    cases = [([str(tmp_path / "missing.il")], 1, "missing.il: cannot read"),
+             ([str(bad)], 1, "bad.il: line 2, column 7 (byte 12): not UTF-8 text"),
+             ([], 2, "usage: python -m verifier.export.ladder FILE.il")]
+    for args, status, message in cases:
+        run = subprocess.run([sys.executable, "-m", "verifier.export.ladder", *args], cwd=root,
+                             capture_output=True, text=True, env={"PYTHONPATH": str(root), "PATH": ""})
+        assert run.returncode == status, run.stderr
+        assert message in run.stderr and "Traceback" not in run.stderr, run.stderr
+    ok = subprocess.run([sys.executable, "-m", "verifier.export.ladder", str(IL)], cwd=root,
+                        capture_output=True, env={"PYTHONPATH": str(root), "PATH": ""})
+    assert ok.returncode == 0 and ok.stdout == (LADDER / "UITAMR_LadderFx3.csv").read_bytes()
+
+
 def test_frame_constants_match_the_protocol(program):
     """The words the ladder writes are the protocol's frames, two bytes per word, low first."""
     words = lambda frame: [frame[i] | frame[i + 1] << 8 for i in range(0, 6, 2)]
@@ -226,3 +260,54 @@ def test_ladder_rejects_a_bad_crc_and_retries(tmp_path, program):
         table("faults", kind="bad_crc", on_request=6),
         table("expect", reached_point=2, within="30s"), table("expect", never="Y3"), duration="30s")
     assert result.passed, "\n".join(problems)
+
+
+def test_ladder_sends_the_stop_next_when_x1_comes_during_a_retry(tmp_path, program):
+    """X1 while the point command waits for a reply that never comes: the ladder used to
+    send the point command again after the stop button, so a robot that answered it drove
+    off. Now the retry becomes a task-status read and the stop follows it (R24, R19): no
+    control command after the button but the stop, and UITAMR-CYCLE's read in between."""
+    result, problems = run_ladder(
+        tmp_path, program, "ladder: stop during a retry",
+        table("faults", kind="no_reply", at_s=2.0, count=1, requests="control"),
+        press("X1", "2.3s"), table("expect", that="NOT Y1", after="2.3s", within="1s"), duration="8s")
+    assert result.passed, "\n".join(problems)
+    stop = encode(ControlRequest(1, 1, 0xA0))
+    after = [f.data for f in result.trace if f.direction == "tx" and f.t_start_us > 2_300_000]
+    read_task = encode(StatusRequest(1, 0))
+    assert after[:2] == [read_task, stop], [a.hex(" ") for a in after[:3]]
+    run_point = [f for f in result.trace if f.direction == "tx" and f.data[1] == 6 and f.data != stop]
+    assert len(run_point) == 1, [(f.t_start_us, f.data.hex(" ")) for f in run_point]
+
+
+def test_ladder_waits_for_the_reply_time_out_after_three_failed_power_on_stops(tmp_path, program):
+    """A robot silent for the first 3 s: after three unanswered stops the ladder starts the
+    stop again at once (M100 still owed). T201, the reply timer, stayed ON across that
+    back-to-back restart (its coil never saw step 30 left at R10), so the new stop timed out
+    in the same scan: the retry went out 300 ms later while its reply could still come
+    (UITAMR-ONE-AT-A-TIME), and an echo arriving then was flushed and the stop sent again
+    (UITAMR-CYCLE). R9 now resets T201 with every frame it sends."""
+    result, _ = run_ladder(
+        tmp_path, program, "ladder: silent at power-on",
+        table("faults", kind="no_reply", at_s=0.0, duration_s=3.0),
+        table("expect", that="M100 = FALSE", within="6s"), duration="8s")
+    assert [f"{v.rule} at {v.t_us / 1e6:.3f} s: {v.message}" for v in result.all_violations()] == []
+    sent = [f.t_start_us for f in result.trace if f.direction == "tx"]
+    answered = {f.t_start_us for f in result.trace if f.direction == "rx"}
+    assert all(b - a >= 500_000 for a, b in zip(sent, sent[1:]) if b < 3_000_000), sent
+    assert answered
+
+
+def test_ladder_on_the_rs232_route_with_h0081(tmp_path, program):
+    """plc-library.md: on the RS-232 route change R1's H1C81 to H0081 and nothing else."""
+    guide = " ".join((Path(__file__).resolve().parents[1] / "docs" / "plc-library.md").read_text(encoding="utf-8").split())
+    assert "change R1's `MOV H1C81 D8400` to `MOV H0081 D8400`; nothing else changes" in guide
+    from dataclasses import replace
+    rs232 = [replace(i, operands=("H0081", "D8400")) if i.operands == ("H1C81", "D8400") else i for i in program]
+    assert rs232 != program
+    result, problems = run_ladder(
+        tmp_path, rs232, "ladder: RS-232 route",
+        table("expect", reached_point=3, within="40s"), table("expect", never="Y3"),
+        table("expect", that="D8400 = 16#0081", within="20ms"))
+    assert result.passed, "\n".join(problems)
+    assert result.diagnostics == []

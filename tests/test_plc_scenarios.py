@@ -114,3 +114,64 @@ def test_the_fx5_adprw_example_under_a_silent_robot_times_out_as_import_gxworks3
     silent = [f for f in result.trace if f.direction == "tx" and 4_000_000 <= f.t_start_us < 6_000_000]
     assert len(silent) == 3  # the engine's three attempts, each ended by the 400 ms time-out
     assert json.dumps(result.watched["fbEngine.o_uErrId"]).count("264") >= 1  # 16#0108
+
+
+def test_the_adprw_reply_window_is_the_slave_response_time_out_as_plc_library_says():
+    """docs/plc-library.md: on the ADPRW route a reply 400-500 ms late is lost to ADPRW
+    (D8409 = 400 ms) and the command is repeated; the default 500 ms rules see an answered
+    command sent twice (UITAMR-CYCLE), reply_timeout = 400 ms a retry. The bundled
+    fx3u-adprw-late-reply scenario runs both ways here."""
+    from dataclasses import replace
+    guide = " ".join((ROOT / "docs" / "plc-library.md").read_text(encoding="utf-8").split())
+    assert "`[rules] reply_timeout = \"400ms\"` when it has late replies" in guide
+    scenario = load_scenario(ROOT / "plc" / "scenarios" / "fx3u-adprw-late-reply.toml")
+    assert scenario.options.reply_timeout_us == 400_000
+    assert run_scenario(scenario).passed
+    default = run_scenario(replace(scenario, options=replace(scenario.options, reply_timeout_us=500_000)))
+    assert [v.rule for v in default.all_violations()] == ["UITAMR-CYCLE"]
+
+
+def test_the_rs232_choice_is_read_in_the_first_scan_only_as_wiring_rs232_says(tmp_path):
+    """docs/wiring-rs232.md said bUseRs232 could come 'from an input before the engine
+    starts'; the port reads it in its first scan only. Set at 1 s, D8400 keeps the RS-485
+    format H1C81 for the whole run, and the guide now says so."""
+    import json
+    guide = " ".join((ROOT / "docs" / "wiring-rs232.md").read_text(encoding="utf-8").split())
+    assert "It reads `i_bRs232` only in that first scan" in guide
+    plc = (ROOT / "plc").as_posix()
+    text = (ROOT / "plc" / "scenarios" / "fx3u-rs232-healthy.toml").read_text(encoding="utf-8")
+    text = text.split("[[expect]]")[0].replace('at = "0s"', 'at = "1s"').replace('"../', f'"{plc}/')
+    path = tmp_path / "rs232-late.toml"
+    path.write_text(text + '\n[[expect]]\nalways = "D8400 = 16#1C81"\nafter = "20ms"\nwithin = "59s"\n', encoding="utf-8")
+    result = run_scenario(load_scenario(path))
+    assert result.passed, [str(e) for e in result.failed_expectations]
+    assert json.dumps(result.watched["D8400"]).count(str(0x0081)) == 0
+
+
+def test_the_fx3u_adprw_import_guide_names_the_modbus_setup_the_library_does_not_write():
+    """An ADPRW integrator following import-gxworks2.md §5 found parameters for RS2 and the
+    QJ71C24N but nothing for the FX3U-485ADP-MB, whose master mode and line format neither
+    the port nor the example writes. The guide now names them; the protocol word it gives
+    follows the D8401 bit table it cites (b0 MODBUS, b4 0 = master, b8 0 = RTU)."""
+    guide = " ".join((ROOT / "docs" / "import-gxworks2.md").read_text(encoding="utf-8").split())
+    assert "**FX3U + FX3U-485ADP-MB (ADPRW, `UITAMR_PortAdpFx3`" in guide
+    assert "D8401 = H0001" in guide
+    modbus, master, rtu = 1 << 0, 0 << 4, 0 << 8
+    assert modbus | master | rtu == 0x0001
+    example = (ROOT / "plc" / "examples" / "fx3" / "UITAMR_ExampleAdpFx3.st").read_text(encoding="utf-8")
+    port = (ROOT / "plc" / "fx3" / "UITAMR_PortAdpFx3.st").read_text(encoding="utf-8")
+    body = lambda text: text.split("END_VAR")[-1]
+    # what the guide says the library leaves to the integrator, it indeed leaves
+    assert "D8401" not in body(example) + body(port) and "D8400" not in body(example) + body(port)
+    assert "D8409 := RESPONSE_TIMEOUT_MS" in port and "D8412 := RETRIES" in port
+
+
+def test_plc_readme_sends_the_485adp_mb_integrator_to_rs485_wiring_not_rs232():
+    """plc/README.md's ADPRW row said 'same' guide as the row above it, which is the RS-232
+    route's (import-gxworks2 + wiring-rs232): an FX3U-485ADP-MB integrator was sent to the
+    RS-232 cable page."""
+    rows = [line for line in (ROOT / "plc" / "README.md").read_text(encoding="utf-8").splitlines()
+            if line.startswith("| FX3U + FX3U-485ADP-MB (ADPRW)")]
+    assert len(rows) == 1
+    guides = rows[0].split("|")[4]
+    assert "wiring-rs485.md" in guides and "import-gxworks2.md" in guides and "wiring-rs232" not in guides

@@ -216,6 +216,18 @@ def test_rs2_warns_about_a_wrong_communication_format():
     project.program("P").bStart = True
     project.run_programs(["P"], scans=1)
     assert any("19200 8N1" in d.message for d in project.diagnostics)
+    # the RS-232 route's format is named too, not only the RS-485 ones
+    assert any("H0081 on its RS-232 route" in d.message for d in project.diagnostics)
+
+
+def test_rs2_takes_the_rs232_format_without_a_warning():
+    ep = FakeEndpoint()
+    project = load_st(RS2_PROG.replace("16#1C81", "16#0081"))  # 9600 8N1, RS-232C
+    project.attach_serial("fx3:1", ep)
+    project.run_programs(["P"], scans=2)
+    project.program("P").bStart = True
+    project.run_programs(["P"], scans=1)
+    assert ep.sent and not project.diagnostics
 
 
 def test_fx5_rs2_uses_its_own_devices():
@@ -328,6 +340,52 @@ END_PROGRAM
     p.bRun = True
     project.run_programs(["P"], scans=1)
     assert len(ep.sent) == 2 and ep.sent[1][0] == ep.sent[0][0]
+
+
+ADPRW_FX3_ERRORS = """
+PROGRAM P
+VAR uData : ARRAY[0..1] OF WORD; bRun : BOOL; nDone : INT; END_VAR
+ADPRW(bRun, 1, 1, 0, 22, uData[0]);
+IF bRun AND M8029 THEN nDone := nDone + 1; bRun := FALSE; END_IF;
+END_PROGRAM
+"""
+
+
+@pytest.mark.parametrize("reply, code, details", [
+    (None, 211, 0),                                              # communication time-out
+    (bytes.fromhex("0181040000"), 205, 0),                       # CRC/LRC error
+    (with_crc(bytes([1, 0x81, 4])), 212, 0x8104),                # exception: H abnormal fc, L code
+    (with_crc(bytes([2, 1, 3, 0, 0, 0])), 213, 0x0102),          # slave mismatch: H requested, L received
+    (with_crc(bytes([1, 6, 1, 0xA0, 0, 0])), 214, 0x0106),       # function mismatch
+    (with_crc(bytes([1, 1, 2, 0, 0])) + b"\0", 207, 2),          # byte count 2 for 22 coils
+])
+def test_adprw_fx3_error_codes_are_those_of_the_modbus_manual(reply, code, details):
+    """FX3U MODBUS Serial Communication Edition §12.6: D8402 holds the MODBUS error code
+    (211 time-out, 212 exception, 205 CRC, 207 length, 213/214 mismatch), D8403 its details,
+    M8063 ON and D8063 = 6321. The simulator used to write codes of its own (1, 2, 3, 104H),
+    so a program checked here reacted to codes a real FX3U never writes."""
+    project, ep, p = adprw_started(ADPRW_FX3_ERRORS)
+    if reply is not None:
+        ep.reply_at(ep.sent[0][1] + 12_000, reply)
+    project.run_programs(["P"], ms=3500)                   # D8409 = 0: 3 s
+    assert p.nDone == 1 and len(ep.sent) == 1
+    assert project.devices["D8402"] == code
+    assert project.devices["D8403"] == details
+    assert project.devices["M8063"] is True and project.devices["D8063"] == 6321
+
+
+def test_adprw_fx3_a_good_transaction_keeps_the_last_error_code():
+    """FX-MB 6.1: D8402/D8403 are cleared at power-on and STOP->RUN only. The simulator
+    wrote 0 into D8402 after every good transaction, so a program showing the last error
+    lost it here and not on the PLC."""
+    project, ep, p = adprw_started(ADPRW_FX3_ERRORS)
+    project.run_programs(["P"], ms=3500)                   # no reply: 211
+    assert project.devices["D8402"] == 211
+    p.bRun = True
+    project.run_programs(["P"], scans=1)
+    ep.reply_at(ep.sent[-1][1] + 12_000, with_crc(bytes([1, 1, 3, 0, 0, 0])))
+    project.run_programs(["P"], scans=5)
+    assert p.nDone == 2 and project.devices["D8402"] == 211
 
 
 def test_adprw_fx5_fc01_unpacks_coils_and_reports_time_out():

@@ -1008,3 +1008,23 @@ def test_a_fault_after_the_runs_end_is_not_said_to_have_met_no_request(tmp_path)
     (note,) = [note for note in run["notes"] if "faults[0]" in note]
     assert "the simulation stopped at 1.0" in note and "before its window opened at 2 s" in note, note
     assert "reached the robot" not in note
+
+
+@pytest.mark.parametrize("edit, options, message", [
+    (('duration = "60s"', 'duration = "60s"\nscan = "59s"'), ("--duration", "3s"),
+     r"fx3u-adprw-exception\.toml:9:8: scan: the scan time \(59s\) is longer than the whole run \(3s\) with --duration 3s"),
+    (("", ""), ("--scan", "2min"),
+     r"fx3u-adprw-exception\.toml:8:12: duration: the scan time \(2min\) is longer than the whole run \(1min\) with --scan 2min"),
+    (('duration = "60s"', 'duration = "60s"\nscan_jitter = "5ms"'), ("--scan", "2ms"),
+     r"fx3u-adprw-exception\.toml:9:15: scan_jitter: must be shorter than the scan time \(2ms\) with --scan 2ms"),
+])
+def test_an_option_that_clashes_with_a_scenario_file_is_named_with_the_files_line(tmp_path, edit, options, message):
+    """`--duration 3s` on a scenario with scan = "59s" (the CLI fuzz found it): the message
+    was 'NAME: the scan time is longer than the whole run', with no file, line or option."""
+    text = (PLC / "scenarios" / "fx3u-adprw-exception.toml").read_text(encoding="utf-8")
+    text = text.replace('scan = "10ms"\n', "").replace(*edit).replace('"../', f'"{PLC.as_posix()}/')
+    scenario = tmp_path / "fx3u-adprw-exception.toml"
+    scenario.write_text(text, encoding="utf-8")
+    result = CliRunner().invoke(command, ["--scenario", str(scenario), *options], catch_exceptions=False)
+    assert result.exit_code == 2, result.output
+    assert re.search(message, result.stderr), result.stderr

@@ -156,10 +156,21 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
     if program is not None:
         scenarios = [replace(s, program_from_option=True) for s in scenarios]
     for scenario in scenarios:
+        # each is fine in its file (checked there): an option on the command line clashes with it
         if scenario.scan_us > scenario.duration_us:
-            raise UnusableInput(f"{scenario.name}: the scan time is longer than the whole run")
+            key = "scan" if scan is None else "duration"  # the file's value the option met
+            option = f"--scan {format_duration(scan)}" if scan is not None else ""
+            if duration is not None:
+                option += (" and " if option else "") + f"--duration {format_duration(duration)}"
+            raise UnusableInput(
+                f"{scenario.where(key, scenario.key_lines.get(key))}: the scan time "
+                f"({format_duration(scenario.scan_us)}) is longer than the whole run "
+                f"({format_duration(scenario.duration_us)})" + (f" with {option}" if option else ""))
         if scenario.scan_jitter_us >= scenario.scan_us:
-            raise UnusableInput(f"{scenario.path or scenario.name}: scan_jitter must be shorter than the scan time")
+            raise UnusableInput(
+                f"{scenario.where('scan_jitter', scenario.key_lines.get('scan_jitter'))}: must be shorter than "
+                f"the scan time ({format_duration(scenario.scan_us)})"
+                + (f" with --scan {format_duration(scan)}" if scan is not None else ""))
         if not scenario.sources:
             if scenario.path is None:
                 raise UnusableInput("the default scenario: no ST sources: give them as arguments (uitamr verify FILE.st ...)")

@@ -14,7 +14,7 @@ from __future__ import annotations
 import sys
 from dataclasses import dataclass
 from pathlib import Path
-from verifier.textfile import text_lines
+from verifier.textfile import UnreadableText, read_utf8, text_lines
 
 HEADER = ("Step Number", "Line Statement", "Instruction", "I/O(Device)", "Blank", "PI Statement", "Note")
 PLC_TYPE = "FX3U/FX3UC"
@@ -26,6 +26,12 @@ STEPS = {"LD": 1, "LDI": 1, "AND": 1, "ANI": 1, "OR": 1, "ORI": 1, "ANB": 1, "OR
          "END": 1, "MOV": 5, "ADD": 7, "SUB": 7, "MUL": 7, "DIV": 7, "WAND": 7, "INC": 3,
          "CRC": 7, "RS2": 11}
 COMPARE_STEPS = 5
+#: operands each instruction takes (OUT of a timer or counter: the device and its preset)
+OPERANDS = {"LD": 1, "LDI": 1, "AND": 1, "ANI": 1, "OR": 1, "ORI": 1, "ANB": 0, "ORB": 0,
+            "MPS": 0, "MRD": 0, "MPP": 0, "LDP": 1, "LDF": 1, "OUT": 1, "SET": 1, "RST": 1,
+            "END": 0, "MOV": 2, "ADD": 3, "SUB": 3, "MUL": 3, "DIV": 3, "WAND": 3, "INC": 1,
+            "CRC": 3, "RS2": 5}
+COMPARES = ("=", "<>", ">", "<", ">=", "<=")
 
 
 class IlError(ValueError):
@@ -53,9 +59,24 @@ def parse_il(text: str, name: str = "<il>") -> list[Instruction]:
                 pending = comment
             continue
         op, *operands = line.split()
-        if not op.replace("=", "").replace("<", "").replace(">", "").isalnum():
-            raise IlError(f"{name}:{number}: '{op}' is not an instruction")
-        program.append(Instruction(number, op.upper(), tuple(operands), pending))
+        col = raw.index(op) + 1
+        upper = op.upper()
+        compare = next((upper[len(k):] for k in ("LD", "AND", "OR") if upper[len(k):] in COMPARES
+                        and upper.startswith(k)), None)
+        if compare is not None:
+            wanted = 2
+        elif upper in OPERANDS:
+            wanted = OPERANDS[upper]
+            if upper == "OUT" and operands and operands[0].upper().startswith(("T", "C")):
+                wanted = 2
+        else:
+            known = ", ".join(sorted(OPERANDS)) + ", LD=/AND=/OR= and the other comparisons"
+            raise IlError(f"{name}:{number}:{col}: '{op}' is not an instruction this converter "
+                          f"knows (it counts the steps of {known})")
+        if len(operands) != wanted:
+            raise IlError(f"{name}:{number}:{col}: {upper} takes {wanted} operand(s), "
+                          f"got {len(operands)}: '{line}'")
+        program.append(Instruction(number, upper, tuple(operands), pending))
         pending = ""
     if not program or program[-1].op != "END":
         raise IlError(f"{name}: the program must end with END")
@@ -89,10 +110,18 @@ def to_csv(program: list[Instruction], program_name: str) -> str:
     return "\r\n".join(rows) + "\r\n"
 
 
-def main(argv: list[str]) -> int:  # pragma: no cover - thin CLI
+def main(argv: list[str]) -> int:
+    if len(argv) != 1:
+        print("usage: python -m verifier.export.ladder FILE.il > FILE.csv", file=sys.stderr)
+        return 2
     path = Path(argv[0])
     try:
-        sys.stdout.write(to_csv(parse_il(path.read_text(), str(path)), path.stem))
+        text = read_utf8(path)
+    except UnreadableText as e:
+        print(f"{path}: {e}", file=sys.stderr)
+        return 1
+    try:
+        sys.stdout.write(to_csv(parse_il(text, str(path)), path.stem))
     except IlError as e:
         print(e, file=sys.stderr)
         return 1

@@ -494,7 +494,8 @@ class _Reader:
         if converter is not None and channel is not None:
             raise self.fail("channel", "a scenario with [converter] reaches the robot over TCP: "
                                        "it has no serial channel; remove 'channel'")
-        keys = [f"initial.{name}" for name, _ in initial] + [setting.key for setting in c24]
+        keys = [key for key in ("duration", "scan", "scan_jitter") if key in data]
+        keys += [f"initial.{name}" for name, _ in initial] + [setting.key for setting in c24]
         keys += [f"faults[{i}]" for i in range(len(faults))]
         keys += [f"{e.key}.{e.kind}" for e in expectations if e.condition is not None]
         keys += [f"{step.key}.set" for step in inputs] + [f"watch[{i}]" for i in range(len(watch))]

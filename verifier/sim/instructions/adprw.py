@@ -14,12 +14,23 @@ from verifier.protocol import crc_ok, with_crc
 
 from ..refs import operand_key, pulse_keys
 
-# simulator error codes (ASSUMPTION: the manuals' chapter-12 codes are not modelled)
+# FX5 (SD8500): simulator error codes (ASSUMPTION: the FX5 manual's codes are not modelled)
 ERR_TIMEOUT = 1
 ERR_CRC = 2
 ERR_FRAME = 3
 ERR_FUNCTION = 4
 ERR_EXCEPTION = 0x100  # + MODBUS exception code
+
+# FX3 (D8402/D8422 code, D8403/D8423 details): FX3U MODBUS Serial Communication Edition
+# §12.6 "MODBUS Error Code List" (manual pages 106-108); read as decimal, as the list's own
+# cross reference "Error Code 207" reads (docs/instructions.md, ADPRW)
+FX3_ERR_CRC = 205             # CRC/LRC error
+FX3_ERR_LENGTH = 207          # data length mismatch (byte count)
+FX3_ERR_TIMEOUT = 211         # communication time-out after the set retries
+FX3_ERR_EXCEPTION = 212       # exception response; details H: abnormal function code, L: exception code
+FX3_ERR_SLAVE = 213           # slave address mismatch; details H: requested, L: received
+FX3_ERR_FUNCTION = 214        # function code mismatch; details H: requested, L: received
+FX3_SERIAL_ERR_MODBUS = {1: 6321, 2: 3821}  # D8063 / D8438: "MODBUS error on ch1 / ch2"
 
 
 FX5_RESPONSE_TIMEOUT_US = 400_000  # "Slave Response Timeout 400 ms" (docs/import-gxworks3.md §4)
@@ -39,10 +50,14 @@ class AdprwMaster:
             self._retries = dev.address("D8412" if channel == 1 else "D8432")
             self._err_code = dev.address("D8402" if channel == 1 else "D8422")
             self._err_flag = dev.address("M8063" if channel == 1 else "M8438")
+            self._err_details = dev.address("D8403" if channel == 1 else "D8423")
+            self._serial_err = dev.address("D8063" if channel == 1 else "D8438")
+            self._serial_err_code = FX3_SERIAL_ERR_MODBUS[channel]
             self._done_flag = dev.address("M8029")
         else:
             self._timeout = self._retries = None
             self._err_code = dev.address("SD8500")
+            self._err_details = self._serial_err = None
             self._err_flag = None
             self._done_flag = None
         self.busy = False
@@ -142,7 +157,7 @@ class AdprwMaster:
             if self.attempts_left > 0:
                 self._send(None)
             else:
-                self._complete(ERR_TIMEOUT)
+                self._complete(FX3_ERR_TIMEOUT if self.family == "fx3" else ERR_TIMEOUT)
 
     # -- idle-scan skipping (verifier.sim.idle) -------------------------------------------
     def idle_deadline(self, now: int) -> float | None:
@@ -170,12 +185,20 @@ class AdprwMaster:
     def _reply(self) -> None:
         frame = bytes(self.rx)
         fc, count, data, _ = self.job
+        fx3 = self.family == "fx3"
         if not crc_ok(frame):
-            self._complete(ERR_CRC)
-        elif frame[0] != self.request[0] or frame[1] & 0x7F != fc:
-            self._complete(ERR_FRAME)
+            self._complete(FX3_ERR_CRC if fx3 else ERR_CRC)
+        elif frame[0] != self.request[0]:
+            self._complete(FX3_ERR_SLAVE if fx3 else ERR_FRAME, self.request[0] << 8 | frame[0])
+        elif frame[1] & 0x7F != fc:
+            self._complete(FX3_ERR_FUNCTION if fx3 else ERR_FRAME, fc << 8 | frame[1] & 0x7F)
         elif frame[1] & 0x80:
-            self._complete(ERR_EXCEPTION + frame[2])
+            if fx3:
+                self._complete(FX3_ERR_EXCEPTION, frame[1] << 8 | frame[2])
+            else:
+                self._complete(ERR_EXCEPTION + frame[2])
+        elif fc == 1 and frame[2] != (count + 7) // 8:
+            self._complete(FX3_ERR_LENGTH if fx3 else ERR_FRAME, frame[2])
         else:
             if fc == 1:
                 # coils packed 16 per word, the first coil in bit 0 (ASSUMPTION)
@@ -184,18 +207,23 @@ class AdprwMaster:
                     data.set(k, (bits >> (16 * k)) & 0xFFFF & ((1 << min(16, count - 16 * k)) - 1))
             self._complete(0)
 
-    def _complete(self, error: int, in_scan: bool = False) -> None:
+    def _complete(self, error: int, details: int = 0, in_scan: bool = False) -> None:
         """FX5 completion bits go ON for one scan: from this scan when the END processing
         between scans saw the reply, from the next one when the call itself failed.  FX3
         reports through M8029 at the next execution of ADPRW."""
         self.busy = False
         _, _, _, d2 = self.job
-        self._set(self._err_code, error)
         flags = []
+        if self.family != "fx3" or error:
+            # FX3: D8402/D8403 hold the last error until power-on or STOP->RUN (FX-MB 6.1,
+            # "Special clear conditions"): a transaction that succeeds does not clear them
+            self._set(self._err_code, error)
         if self.family == "fx3":
             self.completed = True
             if error:
                 self._set(self._err_flag, True)
+                self._set(self._err_details, details)
+                self._set(self._serial_err, self._serial_err_code)
         elif d2 is not None:
             flags.append((d2, 0))
             if error:

@@ -103,7 +103,8 @@ class Rs2Port:
             what = "; ".join(problems) if problems else f"it selects {fmt}"
             self.rt.warn(location, f"RS2 {self.channel.name}: communication format "
                                    f"{self.d.format_register}=H{word:04X}: {what} "
-                                   "(the robot's line is 9600 8N1, RS-485: H1C81 or H0C81)")
+                                   "(the robot's line is 9600 8N1: H1C81 or H0C81 on RS-485, "
+                                   "H0081 on its RS-232 route, docs/wiring-rs232.md)")
 
     # -- the instruction ---------------------------------------------------------------
     def call(self, en: bool, s_ref, m: int, n: int, d_ref, loc_id: int) -> bool:
