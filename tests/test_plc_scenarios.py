@@ -175,3 +175,23 @@ def test_plc_readme_sends_the_485adp_mb_integrator_to_rs485_wiring_not_rs232():
     assert len(rows) == 1
     guides = rows[0].split("|")[4]
     assert "wiring-rs485.md" in guides and "import-gxworks2.md" in guides and "wiring-rs232" not in guides
+
+
+@pytest.mark.parametrize("stop_at", ["2.5s", "2.55s"])
+def test_the_stop_button_right_after_a_point_command_breaks_no_rule(tmp_path, stop_at):
+    """The example sends the stop at once when X1 comes, even right after the run-point
+    command and before the status read that would follow it (the engine's priority slot):
+    UITAMR-CYCLE reported that as a violation, though holding the stop back would be the
+    worse program. The stop goes out first, the cycle ends, nothing else is sent for it."""
+    plc = Path(__file__).resolve().parents[1] / "plc"
+    text = (plc / "scenarios" / "fx3u-stop-during-run.toml").read_text(encoding="utf-8")
+    text = text.replace('"../', f'"{plc.as_posix()}/').replace('at = "11s"', f'at = "{stop_at}"')
+    text = text.replace('after = "11s"', f'after = "{stop_at}"').replace("reached_point = 1", "reached_point = 9")
+    text = text.replace('[[expect]]\nreached_point = 9\nwithin = "10s"\n', "")
+    (tmp_path / "s.toml").write_text(text, encoding="utf-8")
+    result = run_scenario(load_scenario(tmp_path / "s.toml"))
+    assert result.aborted is None, result.aborted
+    control = [f for f in result.trace if f.direction == "tx" and f.data[1] == 6]
+    assert [f.data[2:4].hex() for f in control[:3]] == ["01a0", "0101", "01a0"]  # stop, run 1, stop
+    assert control[2].t_start_us - control[1].t_start_us < 400_000  # no status read between them
+    assert result.passed, [v.message for v in result.all_violations()[:5]] + [str(e) for e in result.failed_expectations]

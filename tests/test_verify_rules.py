@@ -327,6 +327,18 @@ def test_cycle_allows_the_retry_of_an_unanswered_command_but_not_a_resend_of_an_
     assert len(check(resend)["UITAMR-CYCLE"]) == 1
 
 
+def test_cycle_lets_the_stop_overtake_a_command_without_a_read_in_between():
+    """The library sends the stop at once when the operator presses it, also right after a
+    run-point command (answered or not): that was a UITAMR-CYCLE violation. The command
+    after the stop still needs its read; a stop after a stop too (a resend)."""
+    answered = exchange(0, STOP) + exchange(300, READ_TASK) + exchange(600, POINT3) + exchange(900, STOP)
+    assert check(answered)["UITAMR-CYCLE"] == []
+    unanswered = exchange(0, STOP) + exchange(300, READ_TASK) + [tx(600, POINT3)] + exchange(1200, STOP)
+    assert check(unanswered)["UITAMR-CYCLE"] == []
+    (after_the_stop,) = check(answered + exchange(1200, POINT3))["UITAMR-CYCLE"]
+    assert "run point/script 3" in after_the_stop.message and "follows stop" in after_the_stop.message
+
+
 def test_cycle_needs_the_read_answered():
     unanswered_read = exchange(0, STOP) + [tx(300, READ_TASK)] + exchange(900, POINT3)
     assert len(check(unanswered_read)["UITAMR-CYCLE"]) == 1

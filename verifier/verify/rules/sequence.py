@@ -72,7 +72,15 @@ class Cycle(Judge):
             and not last_control.answered
             and bytes(last_control.request.data) == bytes(exchange.request.data)
         )
-        if last_control is not None and not self.status_read and not retry:
+        # the stop overtakes a command in flight (the library's priority slot): holding the
+        # robot's safety command back for a status read would be the worse program; a stop
+        # after a stop still needs the read in between, as any resend does
+        overtaking_stop = (
+            last_control is not None
+            and protocol.is_stop_command(exchange.decoded_request, settings)
+            and not protocol.is_stop_command(last_control.decoded_request, settings)
+        )
+        if last_control is not None and not self.status_read and not retry and not overtaking_stop:
             yield Violation(
                 "UITAMR-CYCLE",
                 exchange.request.t_start_us,
