@@ -311,3 +311,18 @@ def test_ladder_on_the_rs232_route_with_h0081(tmp_path, program):
         table("expect", that="D8400 = 16#0081", within="20ms"))
     assert result.passed, "\n".join(problems)
     assert result.diagnostics == []
+
+
+def test_ladder_reports_a_silent_robot_when_the_stop_was_pressed(tmp_path, program):
+    """The robot goes silent and the operator presses stop during the retries: R24 turned
+    every retry into a task-status read (step 15) and R8 set the attempt count back to 0
+    with each one, so the ladder polled for ever: no fault, no Y3, no 16#0101 (the ST engine
+    reports 16#0101 after three attempts). A failed status read is resent as before; only a
+    failed control command becomes the read."""
+    result, problems = run_ladder(
+        tmp_path, program, "ladder: silent robot, stop pressed",
+        table("faults", kind="no_reply", at_s=4.0, duration_s=30.0),
+        press("X1", "4.3s"),
+        table("expect", that="Y3 AND D225 = 16#0101", after="4s", within="5s"), duration="12s",
+        signal="Y3")
+    assert result.passed, "\n".join(problems)

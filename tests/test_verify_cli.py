@@ -1028,3 +1028,14 @@ def test_an_option_that_clashes_with_a_scenario_file_is_named_with_the_files_lin
     result = CliRunner().invoke(command, ["--scenario", str(scenario), *options], catch_exceptions=False)
     assert result.exit_code == 2, result.output
     assert re.search(message, result.stderr), result.stderr
+
+
+def test_scan_and_duration_options_that_clash_are_named_without_a_files_line():
+    """`--scan 2min --duration 1min` on a scenario file: both values are the options', yet the
+    message pointed at the file's `duration = "60s"` line as if the file were wrong."""
+    scenario = PLC / "scenarios" / "fx3u-adprw-exception.toml"
+    result = CliRunner().invoke(command, ["--scenario", str(scenario), "--scan", "2min", "--duration", "1min"],
+                                catch_exceptions=False)
+    assert result.exit_code == 2, result.output
+    assert "--scan 2min: the scan time is longer than the whole run (--duration 1min)" in result.stderr, result.stderr
+    assert ".toml" not in result.stderr, result.stderr

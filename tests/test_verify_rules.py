@@ -440,3 +440,13 @@ def test_pacing_flags_exactly_the_gaps_of_250_ms_or_less(gaps):
 
 def test_rules_by_id_matches_the_catalogue():
     assert set(RULES_BY_ID) == {rule.id for rule in RULES}
+
+
+def test_the_cycle_rules_explanation_names_the_stop_that_may_overtake():
+    """The explanation `verify --list-rules`, JUnit, HTML and JSON reports print said every
+    control command needs a read before the next, while the rule lets a stop overtake the
+    command before it (docs/verifier.md): a user reading a passing run's report could not
+    tell why point -> stop passed."""
+    explanation = RULES_BY_ID["UITAMR-CYCLE"].explanation
+    assert "stop" in explanation and "overtake" in explanation, explanation
+    assert "a stop after a stop" in explanation, explanation

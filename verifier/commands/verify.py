@@ -155,6 +155,10 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
         scenarios = [replace(s, platform_from_option=True) for s in scenarios]
     if program is not None:
         scenarios = [replace(s, program_from_option=True) for s in scenarios]
+    if scan is not None and duration is not None and scan > duration:
+        # both values are the options': no file's line is to blame
+        raise UnusableInput(f"--scan {format_duration(scan)}: the scan time is longer than the whole run "
+                            f"(--duration {format_duration(duration)})")
     for scenario in scenarios:
         # each is fine in its file (checked there): an option on the command line clashes with it
         if scenario.scan_us > scenario.duration_us:

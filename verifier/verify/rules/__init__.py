@@ -90,7 +90,9 @@ RULES: tuple[Rule, ...] = (
         "Control, then read status",
         f"After a control command the program reads the robot's status (function 01) before "
         f"the next control command; resending the same command after a failed exchange is a "
-        f"retry ({MANUAL}, 指令週期說明: 控制命令 -> 讀取 -> 讀取 -> ... -> 下一輪).",
+        f"retry, and the stop command may overtake the command before it without the read "
+        f"(a stop after a stop, and the command after the stop, still need it) "
+        f"({MANUAL}, 指令週期說明: 控制命令 -> 讀取 -> 讀取 -> ... -> 下一輪).",
         sequence.Cycle,
     ),
 )
