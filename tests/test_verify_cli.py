@@ -1039,3 +1039,23 @@ def test_scan_and_duration_options_that_clash_are_named_without_a_files_line():
     assert result.exit_code == 2, result.output
     assert "--scan 2min: the scan time is longer than the whole run (--duration 1min)" in result.stderr, result.stderr
     assert ".toml" not in result.stderr, result.stderr
+
+
+def test_matrix_on_the_bundled_example_keeps_its_response_signal(tmp_path):
+    """--matrix with the FX3U example's own sources and program: the persistent bad-CRC
+    scenario failed UITAMR-RESPONSE-HANDLING ("names no output to show it"), because the
+    scenario's signal, fbEngine.o_bErr, was dropped as "written for UITAMR_ExampleFx3" -
+    the very program run. Another program still gets the default signal."""
+    report = tmp_path / "r.json"
+    result = invoke(*FX3_SOURCES, "--program", "UITAMR_ExampleFx3", "--matrix", "--json", report)
+    assert result.exit_code == 0, result.output
+    runs = {s["name"]: s for s in json.loads(report.read_text())["scenarios"]}
+    persistent = runs["FX3U: every reply has a bad CRC for 5 s"]
+    assert persistent["verdict"] == "pass"
+    assert not any("its response signal" in note for note in persistent["notes"])
+    panel = tmp_path / "panel.json"  # the panel scenarios are written for UITAMR_PanelFx3
+    sources = FX3_SOURCES[:-1] + [PLC / "examples" / "fx3" / "UITAMR_PanelFx3.st"]
+    invoke(*sources, "--program", "UITAMR_PanelFx3", "--matrix", "--duration", "6s", "--json", panel)
+    notes = [n for s in json.loads(panel.read_text())["scenarios"] for n in s["notes"]]
+    assert any("being written for UITAMR_ExampleFx3" in n and "its response signal (fbEngine.o_bErr)" in n
+               for n in notes)
