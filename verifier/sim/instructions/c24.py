@@ -15,6 +15,12 @@ BUFFER = {
     2: {"recv_count": 0x144, "end_code": 0x145, "unit": 0x136},
 }
 DEFAULTS = {"recv_count": 511, "end_code": 0x0D0A, "unit": 0}
+# configure()'s settings that are buffer-memory words, by the word's name in BUFFER
+SETTING_NAMES = {"byte_units": "unit", "receive_count": "recv_count", "end_code": "end_code"}
+#: the buffer-memory words of those settings (any channel): a program's own assignment to
+#: one is recorded (codegen), so that a setting for "the module the program drives" does
+#: not replace it
+SETTING_WORDS = frozenset(addr for words in BUFFER.values() for addr in words.values())
 # input signals (offset from the module's start I/O): reception data read request and
 # reception abnormal detection per channel
 READ_REQUEST = {1: 0x3, 2: 0xA}
@@ -115,9 +121,9 @@ class C24Module:
             # a word the program wrote before this first call keeps the program's value: made
             # in GX Works, the setting would have been in force from power-on, under the write
             words = BUFFER[channel]
-            mine = {"byte_units": "unit", "receive_count": "recv_count", "end_code": "end_code"}
             self.configure(channel, **{name: value for name, value in settings.items()
-                                       if name not in mine or (self.un, words[mine[name]]) not in written})
+                                       if name not in SETTING_NAMES
+                                       or (self.un, words[SETTING_NAMES[name]]) not in written})
 
     # -- G_OUTPUT ----------------------------------------------------------------------------
     def output(self, s1, s2, d, loc_id) -> bool:
