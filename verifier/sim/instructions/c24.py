@@ -6,6 +6,7 @@ Behaviour, buffer addresses and what is an ASSUMPTION: docs/instructions.md ("QJ
 """
 from __future__ import annotations
 
+from ..datatypes import wrap16
 from ..refs import operand_key, pulse_keys
 
 # buffer memory (word addresses) per channel: receive data count, receive end code,
@@ -59,7 +60,7 @@ class C24Module:
         for addrs in BUFFER.values():
             for name, addr in addrs.items():
                 if self.buffer[addr] == 0:
-                    self.buffer[addr] = DEFAULTS[name] - (0x10000 if DEFAULTS[name] > 0x7FFF else 0)
+                    self.buffer[addr] = wrap16(DEFAULTS[name])
         self.channels = {ch: _Channel(self, ch) for ch in (1, 2)}
         # a module no G_OUTPUT / G_INPUT has addressed yet is not wired to the robot's line:
         # settings made for it (configure_c24) must not let it take the bytes the program's
@@ -106,7 +107,7 @@ class C24Module:
         if receive_count is not None:
             self.buffer[addr["recv_count"]] = receive_count
         if end_code is not None:
-            self.buffer[addr["end_code"]] = ((end_code & 0xFFFF) + 0x8000 & 0xFFFF) - 0x8000
+            self.buffer[addr["end_code"]] = wrap16(end_code)
         if no_reception_ms is not None:
             self.channels[channel].no_reception_us = round(no_reception_ms * 1000)
         if no_reception_format is not None:
