@@ -19,19 +19,21 @@ from verifier.textfile import UnreadableText, read_utf8, text_lines
 HEADER = ("Step Number", "Line Statement", "Instruction", "I/O(Device)", "Blank", "PI Statement", "Note")
 PLC_TYPE = "FX3U/FX3UC"
 
-#: program steps per instruction on FX3U (FX3 programming manual, instruction list tables);
-#: the numbers only fill the Step column, which GX Works2 recomputes (UNCONFIRMED)
-STEPS = {"LD": 1, "LDI": 1, "AND": 1, "ANI": 1, "OR": 1, "ORI": 1, "ANB": 1, "ORB": 1,
-         "MPS": 1, "MRD": 1, "MPP": 1, "LDP": 2, "LDF": 2, "OUT": 1, "SET": 1, "RST": 1,
-         "END": 1, "MOV": 5, "ADD": 7, "SUB": 7, "MUL": 7, "DIV": 7, "WAND": 7, "INC": 3,
-         "CRC": 7, "RS2": 11}
+#: instruction -> (program steps on FX3U, operands it takes). Steps: FX3 programming manual,
+#: instruction list tables; they only fill the Step column, which GX Works2 recomputes
+#: (UNCONFIRMED). Operands: OUT of a timer or counter takes the device and its preset.
+INSTRUCTIONS = {"LD": (1, 1), "LDI": (1, 1), "AND": (1, 1), "ANI": (1, 1), "OR": (1, 1), "ORI": (1, 1),
+                "ANB": (1, 0), "ORB": (1, 0), "MPS": (1, 0), "MRD": (1, 0), "MPP": (1, 0),
+                "LDP": (2, 1), "LDF": (2, 1), "OUT": (1, 1), "SET": (1, 1), "RST": (1, 1), "END": (1, 0),
+                "MOV": (5, 2), "ADD": (7, 3), "SUB": (7, 3), "MUL": (7, 3), "DIV": (7, 3), "WAND": (7, 3),
+                "INC": (3, 1), "CRC": (7, 3), "RS2": (11, 5)}
 COMPARE_STEPS = 5
-#: operands each instruction takes (OUT of a timer or counter: the device and its preset)
-OPERANDS = {"LD": 1, "LDI": 1, "AND": 1, "ANI": 1, "OR": 1, "ORI": 1, "ANB": 0, "ORB": 0,
-            "MPS": 0, "MRD": 0, "MPP": 0, "LDP": 1, "LDF": 1, "OUT": 1, "SET": 1, "RST": 1,
-            "END": 0, "MOV": 2, "ADD": 3, "SUB": 3, "MUL": 3, "DIV": 3, "WAND": 3, "INC": 1,
-            "CRC": 3, "RS2": 5}
 COMPARES = ("=", "<>", ">", "<", ">=", "<=")
+
+
+def _is_compare(op: str) -> bool:
+    """LD=, AND<>, OR>= ...: a comparison contact (two operands, COMPARE_STEPS steps)."""
+    return any(op.startswith(k) and op[len(k):] in COMPARES for k in ("LD", "AND", "OR"))
 
 
 class IlError(ValueError):
@@ -61,16 +63,14 @@ def parse_il(text: str, name: str = "<il>") -> list[Instruction]:
         op, *operands = line.split()
         col = raw.index(op) + 1
         upper = op.upper()
-        compare = next((upper[len(k):] for k in ("LD", "AND", "OR") if upper[len(k):] in COMPARES
-                        and upper.startswith(k)), None)
-        if compare is not None:
+        if _is_compare(upper):
             wanted = 2
-        elif upper in OPERANDS:
-            wanted = OPERANDS[upper]
+        elif upper in INSTRUCTIONS:
+            wanted = INSTRUCTIONS[upper][1]
             if upper == "OUT" and operands and operands[0].upper().startswith(("T", "C")):
                 wanted = 2
         else:
-            known = ", ".join(sorted(OPERANDS)) + ", LD=/AND=/OR= and the other comparisons"
+            known = ", ".join(sorted(INSTRUCTIONS)) + ", LD=/AND=/OR= and the other comparisons"
             raise IlError(f"{name}:{number}:{col}: '{op}' is not an instruction this converter "
                           f"knows (it counts the steps of {known})")
         if len(operands) != wanted:
@@ -84,7 +84,7 @@ def parse_il(text: str, name: str = "<il>") -> list[Instruction]:
 
 
 def steps(ins: Instruction) -> int:
-    if ins.op.startswith(("LD", "AND", "OR")) and any(c in ins.op for c in "=<>"):
+    if _is_compare(ins.op):
         return COMPARE_STEPS
     if ins.op == "OUT" and ins.operands[0].upper().startswith(("T", "C")):
         return 3
@@ -92,7 +92,7 @@ def steps(ins: Instruction) -> int:
         return 2 if ins.operands[0].upper().startswith(("T", "C")) else 3
     if ins.op in ("SET", "RST", "OUT") and ins.operands and ins.operands[0].upper()[:2] == "M8":
         return 2
-    return STEPS.get(ins.op, 1)
+    return INSTRUCTIONS[ins.op][0] if ins.op in INSTRUCTIONS else 1
 
 
 def _row(*cells: str) -> str:

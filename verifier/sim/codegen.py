@@ -17,7 +17,7 @@ from . import datatypes
 from .calls import CallCompiler
 from .cpu import SEND_FLAGS
 from .devices import DeviceError, locate, locate_buffer
-from .instructions.c24 import BUFFER as _C24_BUFFER
+from .instructions.c24 import SETTING_WORDS as C24_SETTING_WORDS
 from .typesys import (ANYINT, ANYREAL, ArrayT, CompileError, FbT, PouInfo, StringT, StructT,
                       Symbol, concrete, is_int, is_real, is_string, norm_code, unify)
 
@@ -724,8 +724,6 @@ class BodyCompiler(CallCompiler):
         return "return _ret"
 
 
-#: buffer-memory words of the QJ71C24N settings Project.configure_c24 makes
-C24_SETTING_WORDS = frozenset(addr for words in _C24_BUFFER.values() for addr in words.values())
 LONG_CHAIN = 16  # operators in a left-deep chain compiled step by step (see chain())
 
 

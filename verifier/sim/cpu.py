@@ -122,7 +122,6 @@ QCPU = CpuProfile(
 )
 
 
-
 def type_not_on_cpu(type_key: str, cpu: CpuProfile) -> str | None:
     """Why the elementary type `type_key` (upper case) has no place on `cpu`, or None.
     FLOAT [Double Precision] (LREAL) is "used for the Universal model QCPU only" among the
@@ -132,6 +131,7 @@ def type_not_on_cpu(type_key: str, cpu: CpuProfile) -> str | None:
         return (f"LREAL (FLOAT [Double Precision]) does not exist on the {cpu.name}: under "
                 f"GX Works2 only the Universal model QCPU has it; use REAL")
     return None
+
 
 PROFILES = {p.name: p for p in (FX3U, FX3G, FX5U, QCPU)}
 # Accepted spellings of a CPU, and the default CPU of each editor target.

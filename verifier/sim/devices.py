@@ -71,12 +71,9 @@ def device_warning(name: str, cpu: CpuProfile) -> str | None:
     if not m:
         return None
     digits, area_name, number, bit = m.groups()
-    if digits or bit is not None or not number.isdigit():
+    if digits or bit is not None:
         return None
-    from types import SimpleNamespace
-
-    return fx3_special_elsewhere(SimpleNamespace(index=None, digits=None, address=number, kind=area_name,
-                                                 text=name.strip(), key=name.strip().upper()), cpu)
+    return _fx3_special_warning(area_name, number, name.strip(), cpu)
 
 
 #: Buffer-memory words the simulator models per module (0..5FFFH). ASSUMPTION: enough for
@@ -191,15 +188,23 @@ def fx3_special_elsewhere(d, cpu: CpuProfile) -> str | None:
     """A warning for an FX3 special relay/register number (M8002, D8400) that exists on
     `cpu` as an ordinary device (a Q's M8002 is a plain internal relay, never set by the
     CPU): what the program most likely meant. None when `d` is not such a device."""
-    if d.index is not None or d.digits is not None or not d.address.isdigit():
+    if d.index is not None or d.digits is not None:
         return None
-    index = int(d.address, 10)
-    area = cpu.areas.get(d.kind)
-    if area is None or index >= area.size or not _is_fx3_special_elsewhere(d.kind, index, cpu):
+    return _fx3_special_warning(d.kind, d.address, d.text or d.key, cpu)
+
+
+def _fx3_special_warning(kind: str, address: str, label: str, cpu: CpuProfile) -> str | None:
+    """fx3_special_elsewhere's warning for the device `kind` `address` (decimal digits),
+    named `label`: shared by the ST check and the scenario check (device_warning)."""
+    if not address.isdigit():
         return None
-    plain = {"M": "internal relay", "D": "data register"}[d.kind]
-    return (f"{d.text or d.key} is an ordinary {plain} on the {cpu.name} (the CPU never sets it); "
-            + _fx3_phrase(d.kind, index, cpu))
+    index = int(address, 10)
+    area = cpu.areas.get(kind)
+    if area is None or index >= area.size or not _is_fx3_special_elsewhere(kind, index, cpu):
+        return None
+    plain = {"M": "internal relay", "D": "data register"}[kind]
+    return (f"{label} is an ordinary {plain} on the {cpu.name} (the CPU never sets it); "
+            + _fx3_phrase(kind, index, cpu))
 
 
 def _fmt(n: int, radix: int) -> str:

@@ -8,8 +8,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..rs2_devices import FX3_CHANNELS, FX5_CHANNELS
 from . import basic
-from .rs2 import FX3_CHANNELS, FX5_CHANNELS, Rs2Port
+from .rs2 import Rs2Port
 
 
 @dataclass(frozen=True)

@@ -6,6 +6,7 @@ Behaviour, buffer addresses and what is an ASSUMPTION: docs/instructions.md ("QJ
 """
 from __future__ import annotations
 
+from ..datatypes import wrap16
 from ..refs import operand_key, pulse_keys
 
 # buffer memory (word addresses) per channel: receive data count, receive end code,
@@ -15,6 +16,12 @@ BUFFER = {
     2: {"recv_count": 0x144, "end_code": 0x145, "unit": 0x136},
 }
 DEFAULTS = {"recv_count": 511, "end_code": 0x0D0A, "unit": 0}
+# configure()'s settings that are buffer-memory words, by the word's name in BUFFER
+SETTING_NAMES = {"byte_units": "unit", "receive_count": "recv_count", "end_code": "end_code"}
+#: the buffer-memory words of those settings (any channel): a program's own assignment to
+#: one is recorded (codegen), so that a setting for "the module the program drives" does
+#: not replace it
+SETTING_WORDS = frozenset(addr for words in BUFFER.values() for addr in words.values())
 # input signals (offset from the module's start I/O): reception data read request and
 # reception abnormal detection per channel
 READ_REQUEST = {1: 0x3, 2: 0xA}
@@ -53,7 +60,7 @@ class C24Module:
         for addrs in BUFFER.values():
             for name, addr in addrs.items():
                 if self.buffer[addr] == 0:
-                    self.buffer[addr] = DEFAULTS[name] - (0x10000 if DEFAULTS[name] > 0x7FFF else 0)
+                    self.buffer[addr] = wrap16(DEFAULTS[name])
         self.channels = {ch: _Channel(self, ch) for ch in (1, 2)}
         # a module no G_OUTPUT / G_INPUT has addressed yet is not wired to the robot's line:
         # settings made for it (configure_c24) must not let it take the bytes the program's
@@ -100,7 +107,7 @@ class C24Module:
         if receive_count is not None:
             self.buffer[addr["recv_count"]] = receive_count
         if end_code is not None:
-            self.buffer[addr["end_code"]] = ((end_code & 0xFFFF) + 0x8000 & 0xFFFF) - 0x8000
+            self.buffer[addr["end_code"]] = wrap16(end_code)
         if no_reception_ms is not None:
             self.channels[channel].no_reception_us = round(no_reception_ms * 1000)
         if no_reception_format is not None:
@@ -115,9 +122,9 @@ class C24Module:
             # a word the program wrote before this first call keeps the program's value: made
             # in GX Works, the setting would have been in force from power-on, under the write
             words = BUFFER[channel]
-            mine = {"byte_units": "unit", "receive_count": "recv_count", "end_code": "end_code"}
             self.configure(channel, **{name: value for name, value in settings.items()
-                                       if name not in mine or (self.un, words[mine[name]]) not in written})
+                                       if name not in SETTING_NAMES
+                                       or (self.un, words[SETTING_NAMES[name]]) not in written})
 
     # -- G_OUTPUT ----------------------------------------------------------------------------
     def output(self, s1, s2, d, loc_id) -> bool:

@@ -7,7 +7,7 @@ bytes to receive, n1 channel, d receive head.  Behaviour and devices: docs/instr
 from __future__ import annotations
 
 from ..refs import operand_key
-from ..rs2_devices import FX3_CHANNELS, FX5_CHANNELS, Rs2Devices  # noqa: F401  (the port's devices)
+from ..rs2_devices import Rs2Devices
 from ..serial import LineFormat, SerialChannel
 
 
