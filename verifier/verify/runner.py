@@ -443,6 +443,8 @@ def _c24_notes(scenario: Scenario, plc: _Plc) -> list[str]:
     module the program never drove, which changed nothing: the robot hangs on the module
     the program's G_OUTPUT / G_INPUT address, so its settings - the no-reception time a
     fault set may rely on - were not in force. Said, with the module the program did use."""
+    from verifier.sim.instructions.c24 import ABNORMAL, READ_REQUEST
+
     if scenario.platform != "q":
         return []
     used = plc.project.c24_addressed()
@@ -452,7 +454,7 @@ def _c24_notes(scenario: Scenario, plc: _Plc) -> list[str]:
     for un, channel, count, since_us in plc.project.c24_unread():
         if plc.now_us - since_us < UNREAD_NOTE_US:
             continue  # a reply that came in the last moments of the run
-        read, error = (0x3, 0x4) if channel == 1 else (0xA, 0xB)
+        read, error = READ_REQUEST[channel], ABNORMAL[channel]
         notes.append(f"QJ71C24N U{un:X} CH{channel}: {count} received message(s) never read by G_INPUT, the "
                      f"oldest since {since_us / 1e6:.3f} s; the module's reception data read request for "
                      f"CH{channel} is X{un * 16 + read:X} (reception abnormal detection X{un * 16 + error:X}): "
