@@ -635,9 +635,8 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     # page take the frames from files written as the run goes; else as a whole at the end
     streamed = not plain and (not keep.frames or keep.frames_to_file is not None)
     stream = Stream(scenario.settings, scenario.options, samples, scenario.expectations, _relative,
-                    keep.frames_to_file if keep.frames else None, scenario.name) if streamed else None
-    if stream is not None:
-        stream.evidence.duration_from_option = scenario.duration_from_option
+                    keep.frames_to_file if keep.frames else None, scenario.name,
+                    scenario.duration_from_option) if streamed else None
     rule_events = _NewRuleEvents(line, converter, drop_the_rest=not keep.details)
     taken_us = 0
     events_dropped = 0
