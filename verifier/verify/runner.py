@@ -541,7 +541,8 @@ def _silence_note(scenario: Scenario, plc: _Plc, converter: Converter | None) ->
                 note += (f"; the {port.name} opened the connection ({port.open_count} open(s)) and the "
                          f"program closed it again each time without sending: the port learns of the open "
                          f"from i_uOpenSignal, the module's open completion signal - does the program pass "
-                         f"U{port.un:X}\\G20480 (and U{port.un:X}\\G20485 as i_uRecvSignal)?")
+                         f"U{port.un:X}\\G{port.OPEN_SIGNAL} (and U{port.un:X}\\G{port.RECEIVE_SIGNAL} as "
+                         f"i_uRecvSignal)?")
         if sent:
             note += f"; {sent}: a serial port, not the TCP route: drop [converter] from the scenario"
         return note
