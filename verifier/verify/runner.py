@@ -339,8 +339,7 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
                 line = scenario.key_lines.get(f"{use.key}:{name}", use.line)  # the label inside a condition
                 break
         if missing is not None and use.optional:
-            scenario = replace(scenario, options=replace(scenario.options, response_signal=None,
-                                                         response_signal_hint=_error_outputs(plc)))
+            scenario = _without_default_signal(plc, scenario)
             continue
         if missing is not None:
             raise UnusableInput(f"{scenario.where(use.key, line)}: {missing}")
@@ -351,11 +350,17 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
         for name, value in (use.values or {}).items():
             problem = problem or _input_problem(plc, name, value)
         if problem and use.optional:  # the default signal: an o_bErr that is not a BOOL is not it
-            scenario = replace(scenario, options=replace(scenario.options, response_signal=None,
-                                                         response_signal_hint=_error_outputs(plc)))
+            scenario = _without_default_signal(plc, scenario)
         elif problem:
             raise UnusableInput(f"{scenario.where(use.key, use.line)}: {problem}")
     return scenario
+
+
+def _without_default_signal(plc: _Plc, scenario: Scenario) -> Scenario:
+    """`scenario` without the default response signal the program does not have (or not as
+    a BOOL), with the FB outputs its message may offer instead."""
+    return replace(scenario, options=replace(scenario.options, response_signal=None,
+                                             response_signal_hint=_error_outputs(plc)))
 
 
 def _error_outputs(plc: _Plc) -> str:
