@@ -187,7 +187,8 @@ def _cut_short(scenario: Scenario) -> Scenario:
     or converter drops, or before some of its operator inputs: they were not tested, though the run may pass (with --matrix nothing
     else says so: the scenario's own expectations are not applied)."""
     end = scenario.duration_us
-    missed = [f.describe() for f in scenario.faults if f.at_s is not None and f.at_s * 1_000_000 >= end]
+    # the time the robot strikes at (Fault.at_us, rounded to the µs), as _missed_fault_notes reads it
+    missed = [f.describe() for f in scenario.faults if f.at_us is not None and f.at_us >= end]
     if scenario.converter is not None:
         missed += [f"converter drop at {format_seconds(t)}" for t in scenario.converter.drops if t >= end]
     notes = []

@@ -484,8 +484,8 @@ def _missed_fault_notes(scenario: Scenario, robot, end_us: int) -> list[str]:
     for index, fault in robot.reply_faults_missed():
         key = f"faults[{index}]"
         where = scenario.where(key, scenario.key_lines.get(key))
-        if fault.at_s is not None and round(fault.at_s * 1_000_000) >= end_us:
-            if scenario.duration_from_option and round(fault.at_s * 1_000_000) >= scenario.duration_us:
+        if fault.at_us is not None and fault.at_us >= end_us:
+            if scenario.duration_from_option and fault.at_us >= scenario.duration_us:
                 continue  # "--duration ... ends the run before ... scripted fault(s), not tested"
             why = f"the simulation stopped at {format_seconds(end_us)}, before its window opened at {fault.at_s:g} s"
         elif fault.at_s is not None:
