@@ -333,6 +333,20 @@ def test_a_duration_that_ends_the_run_before_a_fault_says_the_fault_was_not_test
     assert "not tested" not in result.output
 
 
+def test_a_fault_due_at_the_microsecond_the_duration_ends_is_said_not_tested(tmp_path):
+    """The robot times a fault by its at_s rounded to the µs (Fault.at_us): at_s = 2.9999995
+    is due at 3 s, which --duration 3s never reaches. --duration's note compared the unrounded
+    time (2999999.5 µs, before the end: no note) while the missed-fault note left it to
+    --duration's: the fault went untested without a word."""
+    sources = [str(p) for p in FX3_SOURCES]
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(f'sources = {json.dumps(sources)}\nprogram = "UITAMR_ExampleFx3"\nduration = "10s"\n'
+                        '[[faults]]\nkind = "no_reply"\nat_s = 2.9999995\nduration_s = 0.5\n')
+    result = invoke("--scenario", scenario, "--duration", "3s")
+    assert result.exit_code in (0, 1), result.output
+    assert "--duration 3s ends the run before 1 of its scripted fault(s), not tested: " in result.output
+
+
 def test_a_duration_that_ends_the_run_before_an_input_says_it_was_not_applied(tmp_path):
     # --duration 15s on a scenario that presses X4 at 20 s: the run went on as if no one
     # pressed it, and only the expectations on its outcome hinted at why

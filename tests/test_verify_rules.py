@@ -406,6 +406,22 @@ def test_response_handling_counts_exceptions_wrong_addresses_and_garbage_as_fail
         assert len(found["UITAMR-RESPONSE-HANDLING"]) == 1, reply.hex()
 
 
+def test_response_handling_on_a_capture_says_what_to_check_on_site_for_each_failure():
+    """A capture shows no outputs: the message names what to look at on site, per kind of
+    failure on the line (no reply: the slave the requests go to; the rest from the table)."""
+    options = RuleOptions(outputs_visible=False, response_within_us=1_000_000)
+    (silent,) = check(_silent_robot_trace(12), end_us=12_000_000, options=options)["UITAMR-RESPONSE-HANDLING"]
+    assert "on site, check why the robot does not answer: its power, its address (the requests go to slave 1)" \
+        in silent.message
+    exception = protocol.encode(protocol.ExceptionReply(1, 6, 4), S)
+    trace = []
+    for i in range(10):
+        trace += exchange(700 * i, STOP, reply=exception)
+    (refused,) = check(trace, end_us=8_000_000, options=options)["UITAMR-RESPONSE-HANDLING"]
+    assert refused.message.endswith(
+        "on site, check why the robot refused the requests: the exception code in the replies")
+
+
 def test_response_handling_asks_for_a_signal_when_none_is_known():
     (violation,) = check(_silent_robot_trace(12), end_us=12_000_000)["UITAMR-RESPONSE-HANDLING"]
     assert "[response_handling] signal" in violation.message

@@ -151,10 +151,9 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
         scenarios += [s.with_overrides(**{**overrides, "platform": None}) for s in bundled]
     if duration is not None:
         scenarios = [_cut_short(s) for s in scenarios]
-    if platform_given:
-        scenarios = [replace(s, platform_from_option=True) for s in scenarios]
-    if program is not None:
-        scenarios = [replace(s, program_from_option=True) for s in scenarios]
+    # what the command line set, for the messages that blame an option rather than a file's line
+    scenarios = [replace(s, platform_from_option=platform_given, program_from_option=program is not None,
+                         duration_from_option=duration is not None) for s in scenarios]
     if scan is not None and duration is not None and scan > duration:
         # both values are the options': no file's line is to blame
         raise UnusableInput(f"--scan {format_duration(scan)}: the scan time is longer than the whole run "
@@ -188,7 +187,8 @@ def _cut_short(scenario: Scenario) -> Scenario:
     or converter drops, or before some of its operator inputs: they were not tested, though the run may pass (with --matrix nothing
     else says so: the scenario's own expectations are not applied)."""
     end = scenario.duration_us
-    missed = [f.describe() for f in scenario.faults if f.at_s is not None and f.at_s * 1_000_000 >= end]
+    # the time the robot strikes at (Fault.at_us, rounded to the µs), as _missed_fault_notes reads it
+    missed = [f.describe() for f in scenario.faults if f.at_us is not None and f.at_us >= end]
     if scenario.converter is not None:
         missed += [f"converter drop at {format_seconds(t)}" for t in scenario.converter.drops if t >= end]
     notes = []
@@ -200,7 +200,7 @@ def _cut_short(scenario: Scenario) -> Scenario:
     if late:
         notes.append(f"--duration {format_duration(end)} ends the run before {len(late)} of its operator input(s), "
                      f"not applied: {'; '.join(late)}")
-    return replace(scenario, notes=scenario.notes + tuple(notes), duration_from_option=True)
+    return replace(scenario, notes=scenario.notes + tuple(notes))
 
 
 def _with_signal(scenario: Scenario, text: str) -> Scenario:

@@ -289,6 +289,15 @@ class Condition:
     def names(self) -> frozenset[str]:
         return frozenset(_names(self.tree))
 
+    def name_columns(self) -> dict[str, int]:
+        """The 1-based column in `text` where each label first stands, as the tokenizer
+        read it (for pointing at a label in the scenario file)."""
+        columns: dict[str, int] = {}
+        for token in _tokenize(self.text):
+            if token.kind == "name":
+                columns.setdefault(token.text, token.column)
+        return columns
+
     def holds(self, values: Mapping[str, Value]) -> bool:
         return bool(_evaluate(self.tree, values))
 

@@ -339,8 +339,7 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
                 line = scenario.key_lines.get(f"{use.key}:{name}", use.line)  # the label inside a condition
                 break
         if missing is not None and use.optional:
-            scenario = replace(scenario, options=replace(scenario.options, response_signal=None,
-                                                         response_signal_hint=_error_outputs(plc)))
+            scenario = _without_default_signal(plc, scenario)
             continue
         if missing is not None:
             raise UnusableInput(f"{scenario.where(use.key, line)}: {missing}")
@@ -351,11 +350,17 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
         for name, value in (use.values or {}).items():
             problem = problem or _input_problem(plc, name, value)
         if problem and use.optional:  # the default signal: an o_bErr that is not a BOOL is not it
-            scenario = replace(scenario, options=replace(scenario.options, response_signal=None,
-                                                         response_signal_hint=_error_outputs(plc)))
+            scenario = _without_default_signal(plc, scenario)
         elif problem:
             raise UnusableInput(f"{scenario.where(use.key, use.line)}: {problem}")
     return scenario
+
+
+def _without_default_signal(plc: _Plc, scenario: Scenario) -> Scenario:
+    """`scenario` without the default response signal the program does not have (or not as
+    a BOOL), with the FB outputs its message may offer instead."""
+    return replace(scenario, options=replace(scenario.options, response_signal=None,
+                                             response_signal_hint=_error_outputs(plc)))
 
 
 def _error_outputs(plc: _Plc) -> str:
@@ -443,6 +448,8 @@ def _c24_notes(scenario: Scenario, plc: _Plc) -> list[str]:
     module the program never drove, which changed nothing: the robot hangs on the module
     the program's G_OUTPUT / G_INPUT address, so its settings - the no-reception time a
     fault set may rely on - were not in force. Said, with the module the program did use."""
+    from verifier.sim.instructions.c24 import ABNORMAL, READ_REQUEST
+
     if scenario.platform != "q":
         return []
     used = plc.project.c24_addressed()
@@ -452,7 +459,7 @@ def _c24_notes(scenario: Scenario, plc: _Plc) -> list[str]:
     for un, channel, count, since_us in plc.project.c24_unread():
         if plc.now_us - since_us < UNREAD_NOTE_US:
             continue  # a reply that came in the last moments of the run
-        read, error = (0x3, 0x4) if channel == 1 else (0xA, 0xB)
+        read, error = READ_REQUEST[channel], ABNORMAL[channel]
         notes.append(f"QJ71C24N U{un:X} CH{channel}: {count} received message(s) never read by G_INPUT, the "
                      f"oldest since {since_us / 1e6:.3f} s; the module's reception data read request for "
                      f"CH{channel} is X{un * 16 + read:X} (reception abnormal detection X{un * 16 + error:X}): "
@@ -477,8 +484,8 @@ def _missed_fault_notes(scenario: Scenario, robot, end_us: int) -> list[str]:
     for index, fault in robot.reply_faults_missed():
         key = f"faults[{index}]"
         where = scenario.where(key, scenario.key_lines.get(key))
-        if fault.at_s is not None and round(fault.at_s * 1_000_000) >= end_us:
-            if scenario.duration_from_option and round(fault.at_s * 1_000_000) >= scenario.duration_us:
+        if fault.at_us is not None and fault.at_us >= end_us:
+            if scenario.duration_from_option and fault.at_us >= scenario.duration_us:
                 continue  # "--duration ... ends the run before ... scripted fault(s), not tested"
             why = f"the simulation stopped at {format_seconds(end_us)}, before its window opened at {fault.at_s:g} s"
         elif fault.at_s is not None:
@@ -539,7 +546,8 @@ def _silence_note(scenario: Scenario, plc: _Plc, converter: Converter | None) ->
                 note += (f"; the {port.name} opened the connection ({port.open_count} open(s)) and the "
                          f"program closed it again each time without sending: the port learns of the open "
                          f"from i_uOpenSignal, the module's open completion signal - does the program pass "
-                         f"U{port.un:X}\\G20480 (and U{port.un:X}\\G20485 as i_uRecvSignal)?")
+                         f"U{port.un:X}\\G{port.OPEN_SIGNAL} (and U{port.un:X}\\G{port.RECEIVE_SIGNAL} as "
+                         f"i_uRecvSignal)?")
         if sent:
             note += f"; {sent}: a serial port, not the TCP route: drop [converter] from the scenario"
         return note
@@ -633,9 +641,8 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     # page take the frames from files written as the run goes; else as a whole at the end
     streamed = not plain and (not keep.frames or keep.frames_to_file is not None)
     stream = Stream(scenario.settings, scenario.options, samples, scenario.expectations, _relative,
-                    keep.frames_to_file if keep.frames else None, scenario.name) if streamed else None
-    if stream is not None:
-        stream.evidence.duration_from_option = scenario.duration_from_option
+                    keep.frames_to_file if keep.frames else None, scenario.name,
+                    scenario.duration_from_option) if streamed else None
     rule_events = _NewRuleEvents(line, converter, drop_the_rest=not keep.details)
     taken_us = 0
     events_dropped = 0

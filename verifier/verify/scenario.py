@@ -522,11 +522,8 @@ class _Reader:
             start = place_of_key(self.lines, key)
             if start is None:
                 continue
-            for name in condition.names:
-                found = re.search(r"(?<![A-Za-z0-9_.#\]])" + re.escape(name) + r"(?![A-Za-z0-9_\[.])",
-                                  condition.text, re.IGNORECASE)
-                if found is not None:
-                    places[f"{key}:{name}"] = self._inside_string(start, found.start() + 1)
+            for name, column in condition.name_columns().items():
+                places[f"{key}:{name}"] = self._inside_string(start, column)
         return places
 
     def set_names(self, inputs: tuple[InputStep, ...]) -> dict[str, Place | None]:

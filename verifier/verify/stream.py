@@ -40,10 +40,11 @@ SHARED_FRAMES = 4096  # distinct frames whose bytes equal frames share (garbage 
 class Stream:
     def __init__(self, settings: protocol.Settings, options: RuleOptions, samples: Samples,
                  expectations: Sequence[Expectation], relative_origin, spool_folder: str | None = None,
-                 name: str = ""):
+                 name: str = "", duration_from_option: bool = False):
         """`spool_folder` (Keep.frames_to_file): the frames' trace lines go to a file there
         as they are given (`trace_file`, complete after `finish`); the folder's owner
-        removes it. `name`: the scenario's, for the trace lines."""
+        removes it. `name`: the scenario's, for the trace lines. `duration_from_option`:
+        --duration set the run's end (RunEvidence's, for the expectations' messages)."""
         self.settings = settings
         self.name = name
         self._spool_folder = spool_folder
@@ -54,7 +55,8 @@ class Stream:
                 handle, self.trace_file = tempfile.mkstemp(prefix=spool.PREFIX, suffix=".part", dir=spool_folder)
                 self.spool = os.fdopen(handle, "w", encoding="utf-8", errors=UNENCODABLE)
         self.pairing = Pairing(settings, options)
-        self.evidence = RunEvidence(settings, (), _OPEN_END_US, [], samples, options)
+        self.evidence = RunEvidence(settings, (), _OPEN_END_US, [], samples, options,
+                                    duration_from_option=duration_from_option)
         self.judgement = Judgement(self.evidence, self.pairing.traffic)
         self.expectations = list(expectations)
         self.watches = [watch_exchanges(expectation, settings) for expectation in self.expectations]

@@ -18,6 +18,17 @@ from ..evidence import RunEvidence, Violation
 from ..traffic import Exchange, ReplyStatus, Traffic
 from .judge import Judge
 
+#: an overdue exchange's kind while a late reply may still come (Episode.counts)
+NO_REPLY_SO_FAR = "no reply so far"
+#: what to look at on site for each kind of failure (docs/commissioning.md §5); no reply: _on_site
+_ON_SITE = {
+    ReplyStatus.BAD_CRC.value: "the line for noise: the shield, a termination at both ends, GND joined",
+    ReplyStatus.GARBLED.value: "the line for noise: the shield, a termination at both ends, GND joined",
+    ReplyStatus.LATE.value: "the robot's or a converter's delay against the PLC's reply time-out",
+    ReplyStatus.WRONG_ADDRESS.value: "the robot's address setting against the PLC's requests",
+    ReplyStatus.EXCEPTION.value: "why the robot refused the requests: the exception code in the replies",
+}
+
 
 @dataclass
 class Episode:
@@ -78,7 +89,7 @@ class ResponseHandling(Judge):
         episode = self.current
         if episode is None and overdue is not None:
             episode = Episode(overdue)
-            episode.counts["no reply so far"] += 1
+            episode.counts[NO_REPLY_SO_FAR] += 1
         if episode is not None and episode.first.index != self._told:
             for violation in self._judge(episode, end_us):
                 self._told = episode.first.index
@@ -88,20 +99,12 @@ class ResponseHandling(Judge):
         """What to look at on site for the failures a line shows (docs/commissioning.md §5)."""
         hints = []
         for kind in episode.counts:
-            if kind in ("no reply", "no reply so far"):
+            if kind in (ReplyStatus.NONE.value, NO_REPLY_SO_FAR):
                 hint = (f"why the robot does not answer: its power, its address (the requests go to "
                         f"slave {self.evidence.settings.address}), the pair's wiring and polarity (A, B, GND) "
                         f"and its line settings")
-            elif kind in ("bad CRC", "garbled"):
-                hint = "the line for noise: the shield, a termination at both ends, GND joined"
-            elif kind == "late":
-                hint = "the robot's or a converter's delay against the PLC's reply time-out"
-            elif kind == "wrong address":
-                hint = "the robot's address setting against the PLC's requests"
-            elif kind == "exception":
-                hint = "why the robot refused the requests: the exception code in the replies"
             else:
-                hint = "the route between the PLC and the robot"
+                hint = _ON_SITE.get(kind, "the route between the PLC and the robot")
             if hint not in hints:
                 hints.append(hint)
         return "; ".join(hints)
