@@ -152,7 +152,8 @@ def test_console_summary_shows_verdict_counts_and_first_violations():
 
 
 def test_console_lists_five_kinds_of_simulator_note_and_counts_the_rest():
-    from verifier.sim.errors import SimDiagnostic, summarize_diagnostics
+    from verifier.sim.errors import SimDiagnostic
+    from verifier.verify.result import summarize_diagnostics
 
     diagnostics = [SimDiagnostic(1000 * i, f"Main.st:{i % 7 + 1}:1", 0, f"note kind {chr(65 + i % 7)}: {i} byte(s)")
                    for i in range(70)]

@@ -75,26 +75,3 @@ class SimDiagnostic:
     def __str__(self) -> str:
         where = f"{self.location}: " if self.location else ""
         return f"{where}t={self.t_us / 1e6:.6f} s: {self.message} (error code {self.code})"
-
-
-def summarize_diagnostics(diagnostics, shown=lambda location: location) -> list[str]:
-    """`diagnostics` (SimDiagnostic) grouped by place and by message, numbers aside: one
-    line each, in the order they first happened, e.g. "×160, first at 0.250 s: RS2 fx3:1:
-    6 received byte(s) discarded because ...  at plc/MAIN.st:58:1". A program that gets
-    one wrong on every reply gets one line, not thousands. `shown` turns a location into
-    the text the line gives (the reports make files relative to the working folder)."""
-    import re
-
-    groups: dict[tuple, list] = {}
-    for d in diagnostics:
-        key = (d.location, d.code, re.sub(r"\d+", "#", d.message))
-        if key in groups:
-            groups[key][1] += 1
-        else:
-            groups[key] = [d, 1]
-    lines = []
-    for first, count in groups.values():
-        times = f"×{count}, first at {first.t_us / 1e6:.3f} s" if count > 1 else f"at {first.t_us / 1e6:.3f} s"
-        where = f"  at {shown(first.location)}" if first.location else ""
-        lines.append(f"{times}: {first.message}{where}")
-    return lines

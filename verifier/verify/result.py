@@ -5,12 +5,14 @@ report reads the same thing.
 """
 from __future__ import annotations
 
+import re
 from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any
 
 from verifier import protocol
 
+from .durations import format_seconds
 from .evidence import Violation
 from .expectations import ExpectationResult
 
@@ -92,7 +94,7 @@ class ScenarioResult:
     violations: dict[str, list[Violation]] = field(default_factory=dict)
     expectations: list[ExpectationResult] = field(default_factory=list)
     diagnostics: list[str] = field(default_factory=list)
-    # the same grouped by place and message, one line each (verifier.sim.errors.summarize_diagnostics):
+    # the same grouped by place and message, one line each (summarize_diagnostics below):
     # what the console and the JUnit report show
     diagnostic_summary: list[str] = field(default_factory=list)
     watched: dict[str, list[tuple[int, Any]]] = field(default_factory=dict)
@@ -182,3 +184,25 @@ def overall_verdict(results: list[ScenarioResult]) -> str:
     if not results or "fail" in verdicts:
         return "fail"
     return NO_TRAFFIC if NO_TRAFFIC in verdicts else "pass"
+
+
+def summarize_diagnostics(diagnostics, shown=lambda location: location) -> list[str]:
+    """`diagnostics` (SimDiagnostic) grouped by place and by message, numbers aside: one
+    line each, in the order they first happened, e.g. "×160, first at 0.250 s: RS2 fx3:1:
+    6 received byte(s) discarded because ...  at plc/MAIN.st:58:1". A program that gets
+    one wrong on every reply gets one line, not thousands. `shown` turns a location into
+    the text the line gives (the reports make files relative to the working folder)."""
+    groups: dict[tuple, list] = {}
+    for d in diagnostics:
+        key = (d.location, d.code, re.sub(r"\d+", "#", d.message))
+        if key in groups:
+            groups[key][1] += 1
+        else:
+            groups[key] = [d, 1]
+    lines = []
+    for first, count in groups.values():
+        at = format_seconds(first.t_us)
+        times = f"×{count}, first at {at}" if count > 1 else f"at {at}"
+        where = f"  at {shown(first.location)}" if first.location else ""
+        lines.append(f"{times}: {first.message}{where}")
+    return lines

@@ -25,7 +25,7 @@ from .durations import format_seconds
 from .events_shown import thin_line_events
 from .evidence import RunEvidence, Samples
 from .expectations import judge
-from .result import KEEP_ALL, Keep, LineEvent, ScenarioResult, TraceRecord, UnusableInput
+from .result import KEEP_ALL, Keep, LineEvent, ScenarioResult, TraceRecord, UnusableInput, summarize_diagnostics
 from .rules import check_all
 from .scenario import BUFFER_MEMORY, DEVICE_NAME, Scenario, scenario_power_on_stop
 from .stream import Stream
@@ -206,8 +206,6 @@ class _Plc:
         return [str(dataclasses.replace(d, location=_relative(d.location, cwd))) for d in self.project.diagnostics]
 
     def diagnostic_summary(self) -> list[str]:
-        from verifier.sim.errors import summarize_diagnostics
-
         cwd = os.getcwd()
         return summarize_diagnostics(self.project.diagnostics, lambda location: _relative(location, cwd))
 
