@@ -233,7 +233,7 @@ def _decode_and_print(data: bytes, settings: Settings, direction, request, show_
         click.echo(f"invalid frame: {exc}")
         hint = modbus_tcp_hint(data, settings)
         if hint:
-            click.echo(hint[2:])
+            click.echo(hint)
         guessed = direction or ("reply" if request is not None or looks_like_reply(data) else "request")
         if guessed == "request":
             click.echo("the robot would " + _robot_answer(exc, settings))

@@ -43,12 +43,13 @@ def describe(
         try:
             frame_or_bytes = decode_frame(bytes(frame_or_bytes), settings, direction)
         except FrameError as exc:
-            return f"invalid frame: {exc}" + modbus_tcp_hint(bytes(frame_or_bytes), settings)
+            hint = modbus_tcp_hint(bytes(frame_or_bytes), settings)
+            return f"invalid frame: {exc}" + (f"; {hint}" if hint else "")
     return _describe_frame(frame_or_bytes, settings)
 
 
 def modbus_tcp_hint(data: bytes, settings: Settings = DEFAULT_SETTINGS) -> str:
-    """'; this is a Modbus TCP frame ...' when `data` is a whole MBAP frame (protocol id 0,
+    """'this is a Modbus TCP frame ...' when `data` is a whole MBAP frame (protocol id 0,
     its length field matching): a master, PLC or converter set to Modbus TCP where the
     robot's route carries Modbus RTU inside TCP (docs/tcp-converter.md). '' otherwise. At
     least 9 bytes (an exception reply: unit, function, code): an 8-byte "MBAP frame" would
@@ -62,7 +63,7 @@ def modbus_tcp_hint(data: bytes, settings: Settings = DEFAULT_SETTINGS) -> str:
         meaning = f"; as RTU: {_describe_frame(decode_frame(rtu, settings), settings)}"
     except FrameError:
         meaning = ""
-    return (f"; this is a Modbus TCP frame (MBAP header {data[:6].hex(' ').upper()}, unit {data[6]}{meaning}): "
+    return (f"this is a Modbus TCP frame (MBAP header {data[:6].hex(' ').upper()}, unit {data[6]}{meaning}): "
             "the robot's route carries Modbus RTU frames with their CRC inside TCP: set the master or the "
             "converter to RTU over TCP (transparent mode), not Modbus TCP (docs/tcp-converter.md)")
 
