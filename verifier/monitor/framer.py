@@ -22,12 +22,11 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 from verifier.protocol import timing as line_timing
+from verifier.protocol.codec import MAX_FRAME
 from verifier.protocol.stream import frame_length_either_side
 
 from .capture import Chunk
 
-#: the longest frame a Modbus RTU line carries (Modbus over Serial Line V1.02 §2.5.1)
-MAX_FRAME = 256
 #: default host timing tolerance: above an FTDI adapter's default 16 ms latency timer
 DEFAULT_TOLERANCE_US = 20_000
 

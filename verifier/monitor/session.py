@@ -14,6 +14,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 from verifier import protocol
+from verifier.protocol.codec import MAX_FRAME
+from verifier.protocol.stream import frame_length_either_side
 from verifier.verify.evidence import RuleOptions, RunEvidence, Violation
 from verifier.verify.result import ScenarioResult, TraceRecord
 from verifier.verify.rules import Judgement, check_all
@@ -21,7 +23,7 @@ from verifier.verify.traffic import Exchange, Pairing, analyse
 
 from .capture import Chunk
 from .classify import Classifier
-from .framer import MAX_FRAME, Framer, LineTiming, frame_length_either_side
+from .framer import Framer, LineTiming
 
 POWER_ON_RULE = "UITAMR-POWERON-STOP"
 PROVISIONAL_RULE = "UITAMR-RESPONSE-HANDLING"  # the one rule with early word (Judgement.provisional)
