@@ -19,7 +19,6 @@ timing): frames end by the t3.5 silence alone, exactly as Modbus RTU defines the
 from __future__ import annotations
 
 from dataclasses import dataclass
-from fractions import Fraction
 
 from verifier.protocol import timing as line_timing
 from verifier.protocol.codec import MAX_FRAME
@@ -41,19 +40,12 @@ class LineTiming:
     tolerance_us: int = DEFAULT_TOLERANCE_US
 
     @property
-    def char_us(self) -> Fraction:
-        return Fraction(1_000_000 * self.bits_per_char, self.baud)
-
-    @property
     def silence_us(self) -> int:
         """t3.5 (for baud rates above 19200 the standard fixes it at 1.75 ms)."""
         return line_timing.silence_us(self.baud, self.bits_per_char)
 
     def frame_us(self, length: int) -> int:
-        """`round(self.char_us * length)` (halves to even) in whole numbers: it is asked once
-        per byte, and a Fraction per byte cost more than all the rest of a replay."""
-        whole, part = divmod(1_000_000 * self.bits_per_char * length, self.baud)
-        return whole + (2 * part > self.baud or (2 * part == self.baud and whole % 2 == 1))
+        return line_timing.frame_time_us(length, self.baud, self.bits_per_char)
 
 
 @dataclass(frozen=True)
