@@ -99,9 +99,9 @@ def _places(text: str) -> dict[KeyPath, tuple[Place, Place]]:
     walk = _Walk(text)
     try:
         walk.document()
-    except ValueError:  # not TOML after all (every loader reads it with tomllib first): what was found
-        pass
-    except RecursionError:  # arrays nested deeper than the walk can follow (tomllib reads a little deeper)
+    except (ValueError, RecursionError):
+        # not TOML after all (every loader reads it with tomllib first), or arrays nested
+        # deeper than the walk can follow (tomllib reads a little deeper): what was found
         pass
     return walk.places
 
