@@ -106,9 +106,16 @@ class Framer:
         self._drop(len(self._buffer))
         return [frame]
 
-    def discard(self) -> None:
-        """Forget the pending bytes (the end of a capture cut them)."""
-        self._drop(len(self._buffer))
+    def finish(self) -> tuple[list[Frame], bytes]:
+        """At the end of the capture: (the pending bytes as a frame, b""), or ([], the
+        pending bytes) when they begin a frame of known length but stop short of it: the
+        end of the capture cut that frame, the PLC did not send it short."""
+        pending = self.pending
+        length = frame_length_either_side(pending)
+        if length is not None and len(pending) < length:
+            self._drop(len(pending))
+            return [], pending
+        return self.flush(), b""
 
     def _frame(self, at: int, length: int) -> Frame:
         """`length` buffered bytes from `at` on as a frame: it ends when its last byte arrived

@@ -15,7 +15,6 @@ from dataclasses import dataclass, field, replace
 
 from verifier import protocol
 from verifier.protocol.codec import MAX_FRAME
-from verifier.protocol.stream import frame_length_either_side
 from verifier.verify.evidence import RuleOptions, RunEvidence, Violation
 from verifier.verify.result import ScenarioResult, TraceRecord
 from verifier.verify.rules import Judgement, check_all
@@ -99,14 +98,8 @@ class MonitorSession:
         that begin a frame of known length but stop short of it were cut by the end of the
         capture (Ctrl-C, --duration, a converter that dropped the connection, the end of
         the file), not sent short by the PLC: they are noted (`cut_off`), not judged."""
-        pending = self.framer.pending
-        length = frame_length_either_side(pending)
-        if length is not None and len(pending) < length:
-            self.cut_off = pending
-            self.framer.discard()
-            frames = []
-        else:
-            frames = self._take(self.framer.flush())
+        frames, self.cut_off = self.framer.finish()
+        frames = self._take(frames)
         self._closed = True
         return frames
 
