@@ -8,18 +8,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from click.testing import CliRunner
 
-from verifier.cli import main
+from test_cli_robustness import invoke
 from verifier.digits import digit_problem
 from verifier.verify.scenario import ScenarioError, parse_scenario
 
 FULL_TWO = "２"  # U+FF12 FULLWIDTH DIGIT TWO
 ARABIC_FIVE = "٥"  # U+0665 ARABIC-INDIC DIGIT FIVE
-
-
-def invoke(*args):
-    return CliRunner().invoke(main, [str(a) for a in args], catch_exceptions=False)
 
 
 def test_the_message_names_the_character_and_the_digit_to_write():

@@ -19,11 +19,10 @@ import tempfile
 import tomllib
 from pathlib import Path
 
-from click.testing import CliRunner
 from hypothesis import HealthCheck, given, settings, strategies as st
 
-from test_cli_robustness import VALUES, toml_value
-from verifier.cli import main
+from test_cli_robustness import VALUES, invoke, toml_value
+from verifier.textfile import BOM
 from verifier.verify.scenario import ScenarioError, parse_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -31,11 +30,6 @@ CAPTURE = (ROOT / "tests" / "captures" / "bad-master.txt").read_bytes()
 SCENARIOS = sorted((ROOT / "plc" / "scenarios").glob("*.toml"))
 ST_FILES = [p for p in sorted((ROOT / "plc").rglob("*.st")) if p.stat().st_size < 8000]
 FUZZ = settings(deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
-BOM = b"\xef\xbb\xbf"
-
-
-def invoke(*args):
-    return CliRunner().invoke(main, [str(a) for a in args], catch_exceptions=False)
 
 
 def trace_of_the_capture() -> bytes:

@@ -4,21 +4,14 @@ from __future__ import annotations
 
 import textwrap
 
+from sim_helpers import FB_DELAY
+
 pytest_plugins = ["pytester"]
 
-FB = """
-FUNCTION_BLOCK FB_DELAY
-VAR_INPUT i_bExecute : BOOL; END_VAR
-VAR_OUTPUT o_bDone : BOOL; END_VAR
-VAR fbTimer : TON; END_VAR
-fbTimer(IN := i_bExecute, PT := T#3s);
-o_bDone := fbTimer.Q;
-END_FUNCTION_BLOCK
-"""
 
 
 def test_fixtures_run_st_and_failures_show_st_state(pytester):
-    pytester.makefile(".st", FB_DELAY=FB)
+    pytester.makefile(".st", FB_DELAY=FB_DELAY)
     pytester.makepyfile(test_delay=textwrap.dedent("""
         import pytest
 

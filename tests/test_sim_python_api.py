@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import verifier
 
+from sim_helpers import FB_DELAY
+
 GLOBALS_AND_FB = """
 TYPE ST_Station :
 STRUCT
@@ -70,15 +72,7 @@ def test_a_var_external_structure_taken_before_a_restart_is_the_cpus_after_it():
     assert project.globals.g_stHome.iX == 7
 
 
-DELAY = """
-FUNCTION_BLOCK FB_Delay
-VAR_INPUT i_bExecute : BOOL; END_VAR
-VAR_OUTPUT o_bDone : BOOL; END_VAR
-VAR fbTimer : TON; END_VAR
-fbTimer(IN := i_bExecute, PT := T#3s);
-o_bDone := fbTimer.Q;
-END_FUNCTION_BLOCK
-PROGRAM MAIN
+DELAY = FB_DELAY + """PROGRAM MAIN
 VAR fb : FB_Delay; END_VAR
 fb(i_bExecute := TRUE);
 END_PROGRAM

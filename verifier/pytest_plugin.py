@@ -65,8 +65,7 @@ def describe_project(project) -> str:
             if hasattr(value, "_symbols") and not hasattr(value, "__len__"):
                 # a TON's IN/PT/Q/ET and a structure's members in one line; an instance
                 # of a user FB (maybe large) by name: the test can create or read it
-                standard = getattr(sym.type, "standard", True)
-                if not standard:
+                if not getattr(sym.type, "standard", True):
                     value = "<instance>"
             elif hasattr(value, "__iter__") and not isinstance(value, str):
                 value = list(value)

@@ -85,7 +85,13 @@ def place_of_byte(data: bytes, offset: int) -> tuple[int, int]:
     text before it read as UTF-8 (a leading byte order mark is not a column)."""
     start = len(BOM) if data.startswith(BOM) else 0
     before = data[start:offset].decode("utf-8", errors="replace")
-    return before.count("\n") + 1, len(before) - (before.rfind("\n") + 1) + 1
+    return place_of_char(before, len(before))
+
+
+def place_of_char(text: str, offset: int) -> tuple[int, int]:
+    """The line and column (1-based) at which character `offset` of `text` stands (lines
+    end at line feeds, as tomllib and `text_lines` count them)."""
+    return text.count("\n", 0, offset) + 1, offset - text.rfind("\n", 0, offset)
 
 
 def lone_cr_as_line_feed(text: str) -> str:

@@ -19,7 +19,7 @@ import re
 import tomllib
 from dataclasses import dataclass
 
-from verifier.textfile import has_lone_cr
+from verifier.textfile import has_lone_cr, place_of_char
 
 
 @dataclass(frozen=True)
@@ -99,9 +99,9 @@ def _places(text: str) -> dict[KeyPath, tuple[Place, Place]]:
     walk = _Walk(text)
     try:
         walk.document()
-    except ValueError:  # not TOML after all (every loader reads it with tomllib first): what was found
-        pass
-    except RecursionError:  # arrays nested deeper than the walk can follow (tomllib reads a little deeper)
+    except (ValueError, RecursionError):
+        # not TOML after all (every loader reads it with tomllib first), or arrays nested
+        # deeper than the walk can follow (tomllib reads a little deeper): what was found
         pass
     return walk.places
 
@@ -260,6 +260,7 @@ class _Walk:
             self.places[path] = (self.place(name_at), self.place(value_at))
 
     def place(self, offset: int) -> Place:
+        """`textfile.place_of_char`, by bisection of the line starts: asked for every key"""
         line = bisect.bisect_right(self.line_starts, offset)
         return Place(line, offset - self.line_starts[line - 1] + 1)
 
@@ -285,8 +286,7 @@ def decode_error_position(error: ValueError | RecursionError, source: str = "") 
         if source and _DECODE_AT_END.search(text):
             # a file that ends inside a string, a key, a table header: tomllib names no line
             # (Python < 3.14); the place is just past the last character, as tomllib counts
-            end = len(source)
-            place = Place(source.count("\n") + 1, end - source.rfind("\n"))
+            place = Place(*place_of_char(source, len(source)))
             return _DECODE_AT_END.sub(" at the end of the file", text), place
         return text, None
     place = Place(int(match.group(1)), int(match.group(2)))
@@ -336,8 +336,7 @@ def _too_many_digits(source: str) -> tuple[str, Place | None]:
     match = _LONG_NUMBER.search(source)
     if match is None:
         return "a number too long to read", None
-    before = source[:match.start()]
-    place = Place(before.count("\n") + 1, match.start() - (before.rfind("\n") + 1) + 1)
+    place = Place(*place_of_char(source, match.start()))
     digits = sum(ch.isdigit() for ch in match.group())
     return f"a whole number of {digits} digits: too long to read (at most 4300), and no setting takes it", place
 

@@ -32,11 +32,11 @@ from dataclasses import dataclass
 
 from pymodbus.pdu import DecodePDU
 
+from verifier.protocol.codec import MAX_FRAME
 from verifier.protocol.crc import crc_ok
 from verifier.protocol.stream import frame_length
 from verifier.protocol.timing import T3_5_US
 
-MAX_FRAME = 256  # Modbus over Serial Line V1.02 §2.5.1: RTU ADU at most 256 bytes
 DEFAULT_SILENCE_US = 20_000
 _MODBUS_REQUESTS = DecodePDU(is_server=True)
 

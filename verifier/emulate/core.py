@@ -114,14 +114,14 @@ class Emulator:
         when some were not: a client gone, or the stop, before they fell due)."""
         s = self.stats
         unsent = s["not sent"]
-        not_sent = f", {_count(unsent, 'reply', 'replies')} not sent" if unsent else ""
+        not_sent = f", {counted(unsent, 'reply', 'replies')} not sent" if unsent else ""
         return (f"uitamr emulate: stopped after {self.now_us() / 1e6:.1f} s: "
-                f"{_count(s['frames in'], 'frame', 'frames')} in, {_count(s['replies out'], 'reply', 'replies')} out, "
-                f"{s['no reply']} unanswered{not_sent}, {_count(s['faults'], 'fault event', 'fault events')}, "
-                f"{_count(s['dropped bytes'], 'flood byte', 'flood bytes')} dropped; robot {self.robot.mode}, "
+                f"{counted(s['frames in'], 'frame', 'frames')} in, {counted(s['replies out'], 'reply', 'replies')} out, "
+                f"{s['no reply']} unanswered{not_sent}, {counted(s['faults'], 'fault event', 'fault events')}, "
+                f"{counted(s['dropped bytes'], 'flood byte', 'flood bytes')} dropped; robot {self.robot.mode}, "
                 f"error {int(self.robot.error):02d}")
 
 
-def _count(n: int, one: str, many: str) -> str:
-    """'1 frame', '2 frames', '0 frames'."""
+def counted(n: int, one: str, many: str) -> str:
+    """'1 frame', '2 frames', '0 frames': the counts of the emulator's log lines."""
     return f"{n} {one if n == 1 else many}"

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import serial
 
 from verifier.emulate.assembler import RequestAssembler
-from verifier.emulate.core import Emulator, Outgoing
+from verifier.emulate.core import Emulator, Outgoing, counted
 from verifier.link.line import LineConfig
 from verifier.protocol.codec import hex_bytes
 
@@ -82,11 +82,10 @@ class _Channel:
         unread = self.unread_at_end + self.assembler.discard()
         lost = []
         if unread:
-            lost.append(f"{len(unread)} received byte{'s' if len(unread) != 1 else ''} that were not yet "
+            lost.append(f"{counted(len(unread), 'received byte', 'received bytes')} that were not yet "
                         f"a whole request dropped ({hex_bytes(unread)})")
         if self.outgoing:
-            count = len(self.outgoing)
-            lost.append(f"{count} repl{'ies' if count != 1 else 'y'} not sent")
+            lost.append(f"{counted(len(self.outgoing), 'reply', 'replies')} not sent")
             self.outgoing = []
         return "; " + ", ".join(lost) if lost else ""
 

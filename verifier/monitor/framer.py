@@ -19,15 +19,13 @@ timing): frames end by the t3.5 silence alone, exactly as Modbus RTU defines the
 from __future__ import annotations
 
 from dataclasses import dataclass
-from fractions import Fraction
 
 from verifier.protocol import timing as line_timing
+from verifier.protocol.codec import MAX_FRAME
 from verifier.protocol.stream import frame_length_either_side
 
 from .capture import Chunk
 
-#: the longest frame a Modbus RTU line carries (Modbus over Serial Line V1.02 §2.5.1)
-MAX_FRAME = 256
 #: default host timing tolerance: above an FTDI adapter's default 16 ms latency timer
 DEFAULT_TOLERANCE_US = 20_000
 
@@ -42,19 +40,12 @@ class LineTiming:
     tolerance_us: int = DEFAULT_TOLERANCE_US
 
     @property
-    def char_us(self) -> Fraction:
-        return Fraction(1_000_000 * self.bits_per_char, self.baud)
-
-    @property
     def silence_us(self) -> int:
         """t3.5 (for baud rates above 19200 the standard fixes it at 1.75 ms)."""
         return line_timing.silence_us(self.baud, self.bits_per_char)
 
     def frame_us(self, length: int) -> int:
-        """`round(self.char_us * length)` (halves to even) in whole numbers: it is asked once
-        per byte, and a Fraction per byte cost more than all the rest of a replay."""
-        whole, part = divmod(1_000_000 * self.bits_per_char * length, self.baud)
-        return whole + (2 * part > self.baud or (2 * part == self.baud and whole % 2 == 1))
+        return line_timing.frame_time_us(length, self.baud, self.bits_per_char)
 
 
 @dataclass(frozen=True)
@@ -115,9 +106,16 @@ class Framer:
         self._drop(len(self._buffer))
         return [frame]
 
-    def discard(self) -> None:
-        """Forget the pending bytes (the end of a capture cut them)."""
-        self._drop(len(self._buffer))
+    def finish(self) -> tuple[list[Frame], bytes]:
+        """At the end of the capture: (the pending bytes as a frame, b""), or ([], the
+        pending bytes) when they begin a frame of known length but stop short of it: the
+        end of the capture cut that frame, the PLC did not send it short."""
+        pending = self.pending
+        length = frame_length_either_side(pending)
+        if length is not None and len(pending) < length:
+            self._drop(len(pending))
+            return [], pending
+        return self.flush(), b""
 
     def _frame(self, at: int, length: int) -> Frame:
         """`length` buffered bytes from `at` on as a frame: it ends when its last byte arrived

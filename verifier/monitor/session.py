@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 from verifier import protocol
+from verifier.protocol.codec import MAX_FRAME
 from verifier.verify.evidence import RuleOptions, RunEvidence, Violation
 from verifier.verify.result import ScenarioResult, TraceRecord
 from verifier.verify.rules import Judgement, check_all
@@ -21,7 +22,7 @@ from verifier.verify.traffic import Exchange, Pairing, analyse
 
 from .capture import Chunk
 from .classify import Classifier
-from .framer import MAX_FRAME, Framer, LineTiming, frame_length_either_side
+from .framer import Framer, LineTiming
 
 POWER_ON_RULE = "UITAMR-POWERON-STOP"
 PROVISIONAL_RULE = "UITAMR-RESPONSE-HANDLING"  # the one rule with early word (Judgement.provisional)
@@ -97,14 +98,8 @@ class MonitorSession:
         that begin a frame of known length but stop short of it were cut by the end of the
         capture (Ctrl-C, --duration, a converter that dropped the connection, the end of
         the file), not sent short by the PLC: they are noted (`cut_off`), not judged."""
-        pending = self.framer.pending
-        length = frame_length_either_side(pending)
-        if length is not None and len(pending) < length:
-            self.cut_off = pending
-            self.framer.discard()
-            frames = []
-        else:
-            frames = self._take(self.framer.flush())
+        frames, self.cut_off = self.framer.finish()
+        frames = self._take(frames)
         self._closed = True
         return frames
 

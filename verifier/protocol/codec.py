@@ -47,6 +47,9 @@ CONTROL_REPLY_LENGTH = 8  # FC06 echo
 STATUS_REPLY_LENGTH = 8  # FC01: addr 01 03 00 ERR VAL CRC CRC
 EXCEPTION_REPLY_LENGTH = 5
 REPLY_LENGTHS = {FC_WRITE_SINGLE_REGISTER: CONTROL_REPLY_LENGTH, FC_READ_COILS: STATUS_REPLY_LENGTH}
+#: the longest frame any Modbus RTU line carries (Modbus over Serial Line V1.02 §2.5.1: an
+#: RTU ADU is at most 256 bytes): a longer run of bytes without a silence is noise
+MAX_FRAME = 256
 
 FUNCTION_NAMES = {FC_READ_COILS: "FC01 (read coils)", FC_WRITE_SINGLE_REGISTER: "FC06 (write single register)"}
 

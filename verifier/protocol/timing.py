@@ -44,6 +44,9 @@ def gap_limit_us(baud: int = BAUD, bits_per_char: int = BITS_PER_CHAR) -> int:
     return 750 if baud > 19200 else round(1.5 * bits_per_char * 1_000_000 / baud)
 
 
-def frame_time_us(length: int) -> int:
-    """Time to send ``length`` characters back to back, rounded to whole µs."""
-    return round(BYTE_TIME_EXACT_US * length)
+def frame_time_us(length: int, baud: int = BAUD, bits_per_char: int = BITS_PER_CHAR) -> int:
+    """Time to send ``length`` characters back to back, rounded to whole µs (halves to
+    even, as `round` of the exact Fraction) in whole numbers: the monitor asks it once per
+    byte, and a Fraction per byte cost more than all the rest of a replay."""
+    whole, part = divmod(1_000_000 * bits_per_char * length, baud)
+    return whole + (2 * part > baud or (2 * part == baud and whole % 2 == 1))
