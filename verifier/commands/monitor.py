@@ -25,7 +25,7 @@ from verifier.commands.protocol_options import protocol_settings
 from verifier.commands.report_files import ReportError, check_folders, report_options, text_console, write_reports
 from verifier.commands.verify import _Duration
 from verifier.emulate.ports import serial_url_problem
-from verifier.monitor.capture import format_plain
+from verifier.monitor.capture import format_plain, tolerance_hides_pacing
 from verifier.monitor.framer import DEFAULT_TOLERANCE_US, LineTiming
 from verifier.monitor.session import CaptureInfo, MonitorSession
 from verifier.monitor.sources import SerialSource, SourceError, TcpSource, now_us
@@ -45,7 +45,7 @@ class _Tolerance(_Duration):
 
     def convert(self, value, param, ctx):
         us = super().convert(value, param, ctx)
-        if us >= protocol.MIN_PERIOD_US:
+        if tolerance_hides_pacing(us):
             self.fail(f"{value!r} is not below the pacing period of {protocol.MIN_PERIOD_US // 1000} ms: with it no "
                       "UITAMR-PACING violation could be found. A USB adapter needs its latency timer "
                       f"(16 ms by default: the default {DEFAULT_TOLERANCE_US // 1000}ms covers it); was the unit "

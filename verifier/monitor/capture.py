@@ -40,6 +40,13 @@ class Chunk:
     tolerance_us: int | None = None  # a trace of host times (monitor --trace): their tolerance
 
 
+def tolerance_hides_pacing(tolerance_us: int) -> bool:
+    """A host-timing tolerance with which no UITAMR-PACING violation could be found (a
+    period plus the tolerance must be under the pacing period): refused from --tolerance
+    and from a trace's recorded tolerance alike."""
+    return tolerance_us >= protocol.MIN_PERIOD_US
+
+
 class CaptureError(Exception):
     """A capture file that cannot be read; the message is `file:line:col: what`."""
 
@@ -142,9 +149,9 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
                                f"{scenario!r} ({chunks[-1].t_start_us / 1_000_000:g} s); a trace is in time "
                                "order, and two runs in one trace need names of their own")
         tolerance = _seconds(record["tolerance"], "tolerance", where) if record.get("tolerance") is not None else None
-        if tolerance is not None and round(tolerance * 1_000_000) >= protocol.MIN_PERIOD_US:
-            # what `--tolerance` refuses: with it no UITAMR-PACING violation could be found, and
-            # a digit lost in a hand edit (20 for 0.020) would pass a PLC pacing at 100 ms
+        if tolerance is not None and tolerance_hides_pacing(round(tolerance * 1_000_000)):
+            # what `--tolerance` refuses: a digit lost in a hand edit (20 for 0.020) would pass
+            # a PLC pacing at 100 ms
             raise CaptureError(f"{where}: 'tolerance' is {json.dumps(record['tolerance'])} s; a monitor records its "
                                f"--tolerance, which is below the pacing period of "
                                f"{protocol.MIN_PERIOD_US / 1_000_000:g} s")
