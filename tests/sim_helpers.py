@@ -1,10 +1,7 @@
 """Helpers for the simulator tests: load ST from text, a fake serial endpoint."""
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    import verifier.sim
+import verifier.sim
 
 
 #: a function block with a TON (done 3 s after i_bExecute rises), as an integrator's first
@@ -21,11 +18,6 @@ END_FUNCTION_BLOCK
 
 
 def load_st(text: str, name: str = "t.st", **options) -> verifier.sim.Project:
-    # imported here, not with this module: test_sim_pytest_plugin.py takes FB_DELAY from
-    # here, and its in-process pytester runs drop the modules they imported, which must
-    # then be all of the simulator's or none ("cannot simulate type NamedType")
-    import verifier.sim
-
     return verifier.sim.load(sources={name: text}, **options)
 
 

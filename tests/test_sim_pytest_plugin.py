@@ -30,7 +30,7 @@ def test_fixtures_run_st_and_failures_show_st_state(pytester):
             fb.run(ms=1000)
             assert fb.o_bDone
     """))
-    result = pytester.runpytest("-p", "no:cacheprovider")
+    result = pytester.runpytest_subprocess("-p", "no:cacheprovider")
     result.assert_outcomes(passed=1, failed=1)
     out = result.stdout.str()
     assert "ST state 1" in out
@@ -50,6 +50,6 @@ def test_simulation_error_location_is_reported(pytester):
         def test_oob(st_load):
             st_load("FB_OOB.st").instance("FB_OOB").scan(3)
     """))
-    result = pytester.runpytest("-p", "no:cacheprovider")
+    result = pytester.runpytest_subprocess("-p", "no:cacheprovider")
     result.assert_outcomes(failed=1)
     assert "FB_OOB.st:4:3: index 2 is outside a[0..1]" in result.stdout.str()
