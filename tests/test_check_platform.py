@@ -63,7 +63,9 @@ def test_sm400_on_an_fx3u_is_an_error_at_its_place(tmp_path):
                                         "its switch settings (UITAMR_PortQC24, docs/import-gxworks2.md)")
     assert errors(run("--platform", "fx5u", bad).output) == [  # the FX5U has SM400 but D0..D7999
         f"{bad}:5:6: error: device D8403 does not exist on the fx5u: D runs D0..D7999; "
-        "the FX3's D8403 (RS2 ch1 received byte count) is SD8561 on the fx5u (docs/instructions.md §8)"]
+        "the FX3's D8403 (RS2 ch1 received byte count) is SD8561 on the fx5u (docs/instructions.md §8); as the "
+        "FX3U-485ADP-MB's ADPRW ch1 MODBUS error details it has no device known on the fx5u: the register of the "
+        "FX5 ADPRW's error code was not found (docs/instructions.md §10)"]
 
 
 @pytest.mark.parametrize("platform, body, col, message", [
@@ -86,7 +88,9 @@ def test_sm400_on_an_fx3u_is_an_error_at_its_place(tmp_path):
                                "the line settings from the module parameters (GX Works3: Module Parameter > 485 "
                                "Serial Port, docs/import-gxworks3.md §4)"),
     ("fx5u", "x := D8429;", 6, "device D8429 does not exist on the fx5u: D runs D0..D7999; the FX3's D8429 "
-                               "(RS2 ch2 receive time-out) is SD8631 on the fx5u, in ms (docs/instructions.md §8)"),
+                               "(RS2 ch2 receive time-out) is SD8631 on the fx5u, in ms (docs/instructions.md §8); "
+                               "as the FX3U-485ADP-MB's ADPRW ch2 slave response time-out it is a module parameter "
+                               "on the fx5u (GX Works3: Module Parameter > 485 Serial Port, docs/import-gxworks3.md §4)"),
     ("q", "x := W2000;", 6, "device W2000 does not exist on the q: W runs W0..W1FFF"),  # hexadecimal
     ("fx3u", "x := SD0;", 6, "device SD0: the fx3u has no SD devices; its special registers are "
                              "D8000..D8511: use D8067 (operation error code)"),
@@ -106,6 +110,30 @@ def test_device_out_of_range_or_unknown_to_the_cpu(tmp_path, platform, body, col
     done = run("--platform", platform, path)
     assert done.exit_code == 1, done.output
     assert errors(done.output) == [f"{path}:5:{col}: error: {message}"]
+
+
+FX5_MODBUS_PARAMETER = ("a module parameter on the fx5u (GX Works3: Module Parameter > 485 Serial Port, "
+                        "docs/import-gxworks3.md §4)")
+
+
+@pytest.mark.parametrize("body, message", [
+    # an FX3U ADPRW program moved to an FX5U: D8409 was only named as RS2's receive time-out,
+    # sending the integrator to SD8621 for the MODBUS slave response time-out
+    ("D8409 := 400;", "device D8409 does not exist on the fx5u: D runs D0..D7999; the FX3's D8409 (RS2 ch1 "
+                      "receive time-out) is SD8621 on the fx5u, in ms (docs/instructions.md §8); as the "
+                      "FX3U-485ADP-MB's ADPRW ch1 slave response time-out it is " + FX5_MODBUS_PARAMETER),
+    ("D8412 := 0;", "device D8412 does not exist on the fx5u: D runs D0..D7999; the FX3's D8412 (the "
+                    "FX3U-485ADP-MB's ADPRW ch1 retries) is " + FX5_MODBUS_PARAMETER),
+    ("x := D8422;", "device D8422 does not exist on the fx5u: D runs D0..D7999; the FX3's D8422 (RS2 ch2 bytes "
+                    "left to send) is SD8570 on the fx5u (docs/instructions.md §8); as the FX3U-485ADP-MB's ADPRW "
+                    "ch2 MODBUS error code it has no device known on the fx5u: the register of the FX5 ADPRW's "
+                    "error code was not found (docs/instructions.md §10)"),
+])
+def test_an_fx3_modbus_register_on_the_fx5u_names_its_modbus_meaning_too(tmp_path, body, message):
+    path = write(tmp_path, program(body, "x : INT;"))
+    done = run("--platform", "fx5u", path)
+    assert done.exit_code == 1, done.output
+    assert errors(done.output) == [f"{path}:5:{1 if body.startswith('D') else 6}: error: {message}"]
 
 
 @pytest.mark.parametrize("platform, body, message", [
