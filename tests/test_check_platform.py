@@ -328,9 +328,30 @@ def test_an_instruction_of_the_other_editor_is_one_error_too(tmp_path, platform,
         "instruction: check " + HOW[platform]]
 
 
-HOME = {"fx5u": "GX Works2 (FX3U/FX3G, Q)", "q": "GX Works3 (FX5U)"}  # the editor the call is from
-HOW = {"fx5u": "FX3 and Q sources with --platform fx3u, fx3g or q (or --target gxworks2)",
+HOME = {"fx5u": "GX Works2 (Q)", "q": "GX Works3 (FX5U)"}  # the editor the call is from (ZP_OPEN: a Q's)
+HOW = {"fx5u": "Q sources with --platform q (or --target gxworks2)",
        "q": "FX5U sources with --platform fx5u (or --target gxworks3)"}
+
+
+def test_the_fx3_adprw_in_an_fx5u_file_sends_to_the_fx3_platforms_not_to_the_q(tmp_path):
+    """The FX3U's six-operand ADPRW copied into an FX5U program: the hint said to check it
+    with '--platform fx3u, fx3g or q', and a Q has no ADPRW at all."""
+    path = write(tmp_path, program("ADPRW(TRUE, 1, 6, 16#0100, 1, w[0]);", "w : ARRAY[0..1] OF WORD;"))
+    assert errors(run("--platform", "fx5u", path).output) == [
+        f"{path}:5:1: error: ADPRW takes 7 argument(s) (EN, s, s1, s2, s3, s4d1, d2), 6 given; with 6 arguments it "
+        "is the GX Works2 (FX3U/FX3G) ADPRW: check FX3 sources with --platform fx3u or fx3g (or --target gxworks2)"]
+
+
+def test_the_one_family_gx_works2_instructions_are_the_simulators():
+    from verifier.sim.instructions import SPECS
+    from verifier.st.check import _GX2_ONE_FAMILY
+    from verifier.st.library import INSTRUCTIONS
+
+    gx2_only = {n for n, sig in INSTRUCTIONS.items() if sig.targets == ("gxworks2",)}
+    assert set(_GX2_ONE_FAMILY) == gx2_only
+    for name, (_, _, platforms) in _GX2_ONE_FAMILY.items():
+        families = {"fx3u": "fx3", "fx3g": "fx3", "q": "q"}
+        assert {families[p] for p in platforms.split(" or ")} == set(SPECS[name].families), name
 
 
 def test_check_refuses_the_scenario_devices_verify_refuses_for_its_platform(tmp_path):

@@ -1089,6 +1089,13 @@ _CHECK_FOR = {"gxworks3": ("GX Works3 (FX5U)", "check FX5U sources with --platfo
                                                        "or q (or --target gxworks2)")}
 
 
+#: GX Works2 instructions of one CPU family: (its CPUs, the sources, the --platform choices);
+#: FX3's ADPRW sent to '--platform fx3u, fx3g or q' where a Q has none. Kept beside the
+#: simulator's instruction families (verifier.sim.instructions) by tests/test_check_platform.py.
+_GX2_ONE_FAMILY = {"ADPRW": ("FX3U/FX3G", "FX3", "fx3u or fx3g")} | {
+    name: ("Q", "Q", "q") for name in ("ZP_OPEN", "ZP_BUFSND", "ZP_BUFRCV", "ZP_CLOSE")}
+
+
 def _other_editor_hint(name: str, target: str, given: int) -> str:
     """When instruction `name`, refused or mis-called on `target`, is the other editor's
     with `given` arguments: a hint that the file was written for that editor (a whole
@@ -1096,6 +1103,10 @@ def _other_editor_hint(name: str, target: str, given: int) -> str:
     for other, (editor, how) in _CHECK_FOR.items():
         if other == target:
             continue
+        if other == "gxworks2" and name in _GX2_ONE_FAMILY:
+            cpus, sources, platforms = _GX2_ONE_FAMILY[name]
+            editor = f"GX Works2 ({cpus})"
+            how = f"check {sources} sources with --platform {platforms} (or --target gxworks2)"
         sig = library.instruction(name, other)
         if sig is None or other not in sig.targets:
             continue
