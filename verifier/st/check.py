@@ -979,6 +979,25 @@ class Checker:
             self.rep.warning(c, f"the result of {sig.name} is discarded")
         return result
 
+    @staticmethod
+    def _two_bits(t: T.Type, node: ast.Expr) -> str | None:
+        """A completion-bits operand (ADPRW's d2, the SP_/ZP_ and G_ instructions' d) is the
+        head of two bits, done and error: a single BOOL label, an array of one, or the last
+        element of an array leaves the error bit nowhere (the simulator stopped the run
+        there, on the first error completion only, after check had passed the program)."""
+        need = "needs 2 bits (done, error) from its head: "
+        if isinstance(t, T.ArrayOf):
+            return None if t.size >= 2 else f"{need}{_text(node)} is an array of {t.size} BOOL"
+        if isinstance(node, (ast.Name, ast.Member)):
+            return (f"{need}{_text(node)} is a single BOOL label; declare it ARRAY[0..1] OF BOOL, "
+                    "or use a bit device")
+        if isinstance(node, ast.Index) and len(node.indices) == 1 and isinstance(node.indices[0], ast.IntLiteral):
+            base = getattr(node.base, "type", None)
+            if isinstance(base, T.ArrayOf) and len(base.dims) == 1 and node.indices[0].value == base.dims[0][1]:
+                lo, hi = base.dims[0]
+                return f"{need}{_text(node)} is the last element of {_text(node.base)} (ARRAY[{lo}..{hi}])"
+        return None
+
     def _accepts(self, p: T.Param, t: T.Type, node: ast.Expr) -> str | None:
         a = p.accepts
         if t is T.ANY:
@@ -1010,10 +1029,13 @@ class Checker:
             if T.width(t) == 16 and not T.is_group(t, "real"):
                 return None
             return f"needs the head of a block of words (an INT/WORD array or its element, or a word device), not {t}"
-        if a == "BITS":
+        if a in ("BITS", "BITS2"):
+            whole = t
             if isinstance(t, T.ArrayOf):
                 t = t.element
-            return None if T.is_bool(t) else f"needs a bit (BOOL label, bit device or BOOL array), not {t}"
+            if not T.is_bool(t):
+                return f"needs a bit (BOOL label, bit device or BOOL array), not {t}"
+            return self._two_bits(whole, node) if a == "BITS2" else None
         if a == "ANY_NUM":
             return None if T.is_any_num(t) and not T.is_group(t, "bits") else f"needs INT, DINT or REAL, not {t}"
         if a == "ANY_INT":
