@@ -537,3 +537,19 @@ def test_lreal_passes_on_q_and_fx5(tmp_path):
     path = write(tmp_path, program("l := 1.5;", "l : LREAL;"))
     assert run("--platform", "q", path).exit_code == 0
     assert run("--target", "gxworks3", "--platform", "fx5u", path).exit_code == 0
+
+
+def test_scenario_files_alone_are_not_said_to_be_checked_for_gx_works2(tmp_path):
+    """`uitamr check fx5u-healthy.toml` printed '1 file(s) checked for gxworks2', as if an
+    FX5U scenario had been read in the FX3's dialect; each scenario is read for its own
+    platform, so a run of scenario files alone names no dialect (one asked for still shows)."""
+    fx5 = ROOT / "plc" / "scenarios" / "fx5u-healthy.toml"
+    done = run(fx5)
+    assert done.exit_code == 0, done.output
+    assert done.output.splitlines()[-1] == "1 file(s) checked: 0 error(s), 0 warning(s)"
+    assert run("--platform", "fx5u", fx5).output.splitlines()[-1] == \
+        "1 file(s) checked for gxworks3 on the fx5u CPU: 0 error(s), 0 warning(s)"
+    assert run("--target", "gxworks3", fx5).output.splitlines()[-1] == \
+        "1 file(s) checked for gxworks3: 0 error(s), 0 warning(s)"
+    st_file = write(tmp_path, program("x := 1;"))
+    assert run(fx5, st_file).output.splitlines()[-1].startswith("2 file(s) checked for gxworks2:")
