@@ -299,6 +299,9 @@ class Checker:
         if key in T.MISSING_TYPES:
             self.rep.error(ref, library_missing(key, self.target))
             return T.ANY
+        if key in _UNMODELLED_FBS:
+            self.rep.error(ref, f"unknown type '{ref.name}'; {_UNMODELLED_FBS[key]}")
+            return T.ANY
         self.rep.error(ref, f"unknown type '{ref.name}'; "
                        + (_in_library(ref.name, self.plc_shown) or "declare the structure or function block, or use a GX Works type"))
         return T.ANY
@@ -1104,6 +1107,13 @@ def _plc_as_given(filenames: list[str]) -> Path | None:
 def _target_name(target: str) -> str:
     return {"gxworks2": "GX Works2", "gxworks3": "GX Works3"}.get(target, target)
 
+
+#: GX Works function blocks an integrator's program may use that the toolkit does not model,
+#: and what to write instead
+_UNMODELLED_FBS = {
+    "TON_10": ("TON_10 is the FX5's 10 ms on-delay timer FB (a secondary source, docs/instructions.md section 4), "
+               "which the toolkit does not model: declare a TON (the simulator times it in ms of virtual time)"),
+}
 
 #: the editor a file was written for, and how to check it (README, docs/ci.md)
 _CHECK_FOR = {"gxworks3": ("GX Works3 (FX5U)", "check FX5U sources with --platform fx5u (or --target gxworks3)"),
