@@ -221,3 +221,7 @@ def test_an_exception_on_the_fx5_adprw_route_is_repeated_as_the_docs_say():
         points[platform] = [f for f in result.trace if f.direction == "tx" and 2_000_000 <= f.t_start_us < 3_500_000
                             and f.data[:4] == bytes([0x01, 0x06, 0x01, 0x01])]  # run point 1
     assert len(points["fx3u"]) == 1 and len(points["fx5u"]) == 3
+    # the fault outlasts the three attempts at a slow scan too (it ended before the third at 120 ms)
+    from dataclasses import replace
+    slow = replace(load_scenario(ROOT / "plc" / "scenarios" / "fx5u-adprw-exception.toml"), scan_us=120_000)
+    assert run_scenario(slow).passed
