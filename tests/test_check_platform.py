@@ -63,7 +63,9 @@ def test_sm400_on_an_fx3u_is_an_error_at_its_place(tmp_path):
                                         "its switch settings (UITAMR_PortQC24, docs/import-gxworks2.md)")
     assert errors(run("--platform", "fx5u", bad).output) == [  # the FX5U has SM400 but D0..D7999
         f"{bad}:5:6: error: device D8403 does not exist on the fx5u: D runs D0..D7999; "
-        "the FX3's D8403 (RS2 ch1 received byte count) is SD8561 on the fx5u (docs/instructions.md §8)"]
+        "the FX3's D8403 (RS2 ch1 received byte count) is SD8561 on the fx5u (docs/instructions.md §8); as the "
+        "FX3U-485ADP-MB's ADPRW ch1 MODBUS error details it has no device known on the fx5u: the register of the "
+        "FX5 ADPRW's error code was not found (docs/instructions.md §10)"]
 
 
 @pytest.mark.parametrize("platform, body, col, message", [
@@ -86,7 +88,9 @@ def test_sm400_on_an_fx3u_is_an_error_at_its_place(tmp_path):
                                "the line settings from the module parameters (GX Works3: Module Parameter > 485 "
                                "Serial Port, docs/import-gxworks3.md §4)"),
     ("fx5u", "x := D8429;", 6, "device D8429 does not exist on the fx5u: D runs D0..D7999; the FX3's D8429 "
-                               "(RS2 ch2 receive time-out) is SD8631 on the fx5u, in ms (docs/instructions.md §8)"),
+                               "(RS2 ch2 receive time-out) is SD8631 on the fx5u, in ms (docs/instructions.md §8); "
+                               "as the FX3U-485ADP-MB's ADPRW ch2 slave response time-out it is a module parameter "
+                               "on the fx5u (GX Works3: Module Parameter > 485 Serial Port, docs/import-gxworks3.md §4)"),
     ("q", "x := W2000;", 6, "device W2000 does not exist on the q: W runs W0..W1FFF"),  # hexadecimal
     ("fx3u", "x := SD0;", 6, "device SD0: the fx3u has no SD devices; its special registers are "
                              "D8000..D8511: use D8067 (operation error code)"),
@@ -106,6 +110,30 @@ def test_device_out_of_range_or_unknown_to_the_cpu(tmp_path, platform, body, col
     done = run("--platform", platform, path)
     assert done.exit_code == 1, done.output
     assert errors(done.output) == [f"{path}:5:{col}: error: {message}"]
+
+
+FX5_MODBUS_PARAMETER = ("a module parameter on the fx5u (GX Works3: Module Parameter > 485 Serial Port, "
+                        "docs/import-gxworks3.md §4)")
+
+
+@pytest.mark.parametrize("body, message", [
+    # an FX3U ADPRW program moved to an FX5U: D8409 was only named as RS2's receive time-out,
+    # sending the integrator to SD8621 for the MODBUS slave response time-out
+    ("D8409 := 400;", "device D8409 does not exist on the fx5u: D runs D0..D7999; the FX3's D8409 (RS2 ch1 "
+                      "receive time-out) is SD8621 on the fx5u, in ms (docs/instructions.md §8); as the "
+                      "FX3U-485ADP-MB's ADPRW ch1 slave response time-out it is " + FX5_MODBUS_PARAMETER),
+    ("D8412 := 0;", "device D8412 does not exist on the fx5u: D runs D0..D7999; the FX3's D8412 (the "
+                    "FX3U-485ADP-MB's ADPRW ch1 retries) is " + FX5_MODBUS_PARAMETER),
+    ("x := D8422;", "device D8422 does not exist on the fx5u: D runs D0..D7999; the FX3's D8422 (RS2 ch2 bytes "
+                    "left to send) is SD8570 on the fx5u (docs/instructions.md §8); as the FX3U-485ADP-MB's ADPRW "
+                    "ch2 MODBUS error code it has no device known on the fx5u: the register of the FX5 ADPRW's "
+                    "error code was not found (docs/instructions.md §10)"),
+])
+def test_an_fx3_modbus_register_on_the_fx5u_names_its_modbus_meaning_too(tmp_path, body, message):
+    path = write(tmp_path, program(body, "x : INT;"))
+    done = run("--platform", "fx5u", path)
+    assert done.exit_code == 1, done.output
+    assert errors(done.output) == [f"{path}:5:{1 if body.startswith('D') else 6}: error: {message}"]
 
 
 @pytest.mark.parametrize("platform, body, message", [
@@ -300,9 +328,30 @@ def test_an_instruction_of_the_other_editor_is_one_error_too(tmp_path, platform,
         "instruction: check " + HOW[platform]]
 
 
-HOME = {"fx5u": "GX Works2 (FX3U/FX3G, Q)", "q": "GX Works3 (FX5U)"}  # the editor the call is from
-HOW = {"fx5u": "FX3 and Q sources with --platform fx3u, fx3g or q (or --target gxworks2)",
+HOME = {"fx5u": "GX Works2 (Q)", "q": "GX Works3 (FX5U)"}  # the editor the call is from (ZP_OPEN: a Q's)
+HOW = {"fx5u": "Q sources with --platform q (or --target gxworks2)",
        "q": "FX5U sources with --platform fx5u (or --target gxworks3)"}
+
+
+def test_the_fx3_adprw_in_an_fx5u_file_sends_to_the_fx3_platforms_not_to_the_q(tmp_path):
+    """The FX3U's six-operand ADPRW copied into an FX5U program: the hint said to check it
+    with '--platform fx3u, fx3g or q', and a Q has no ADPRW at all."""
+    path = write(tmp_path, program("ADPRW(TRUE, 1, 6, 16#0100, 1, w[0]);", "w : ARRAY[0..1] OF WORD;"))
+    assert errors(run("--platform", "fx5u", path).output) == [
+        f"{path}:5:1: error: ADPRW takes 7 argument(s) (EN, s, s1, s2, s3, s4d1, d2), 6 given; with 6 arguments it "
+        "is the GX Works2 (FX3U/FX3G) ADPRW: check FX3 sources with --platform fx3u or fx3g (or --target gxworks2)"]
+
+
+def test_the_one_family_gx_works2_instructions_are_the_simulators():
+    from verifier.sim.instructions import SPECS
+    from verifier.st.check import _GX2_ONE_FAMILY
+    from verifier.st.library import INSTRUCTIONS
+
+    gx2_only = {n for n, sig in INSTRUCTIONS.items() if sig.targets == ("gxworks2",)}
+    assert set(_GX2_ONE_FAMILY) == gx2_only
+    for name, (_, _, platforms) in _GX2_ONE_FAMILY.items():
+        families = {"fx3u": "fx3", "fx3g": "fx3", "q": "q"}
+        assert {families[p] for p in platforms.split(" or ")} == set(SPECS[name].families), name
 
 
 def test_check_refuses_the_scenario_devices_verify_refuses_for_its_platform(tmp_path):
@@ -488,3 +537,19 @@ def test_lreal_passes_on_q_and_fx5(tmp_path):
     path = write(tmp_path, program("l := 1.5;", "l : LREAL;"))
     assert run("--platform", "q", path).exit_code == 0
     assert run("--target", "gxworks3", "--platform", "fx5u", path).exit_code == 0
+
+
+def test_scenario_files_alone_are_not_said_to_be_checked_for_gx_works2(tmp_path):
+    """`uitamr check fx5u-healthy.toml` printed '1 file(s) checked for gxworks2', as if an
+    FX5U scenario had been read in the FX3's dialect; each scenario is read for its own
+    platform, so a run of scenario files alone names no dialect (one asked for still shows)."""
+    fx5 = ROOT / "plc" / "scenarios" / "fx5u-healthy.toml"
+    done = run(fx5)
+    assert done.exit_code == 0, done.output
+    assert done.output.splitlines()[-1] == "1 file(s) checked: 0 error(s), 0 warning(s)"
+    assert run("--platform", "fx5u", fx5).output.splitlines()[-1] == \
+        "1 file(s) checked for gxworks3 on the fx5u CPU: 0 error(s), 0 warning(s)"
+    assert run("--target", "gxworks3", fx5).output.splitlines()[-1] == \
+        "1 file(s) checked for gxworks3: 0 error(s), 0 warning(s)"
+    st_file = write(tmp_path, program("x := 1;"))
+    assert run(fx5, st_file).output.splitlines()[-1].startswith("2 file(s) checked for gxworks2:")

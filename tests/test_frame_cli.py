@@ -25,6 +25,10 @@ def run(*args: str):
     (["move", "rear", "+1"], "01 06 08 0A 00 00 AB A8"),
     (["rotate", "-0.5"], "01 06 0D 32 00 00 2A A9"),
     (["--field-order", "code-low", "stop"], "01 06 A0 01 00 00 FA 0A"),
+    # the words in one quoted argument, as a scenario's `sent = "run-point 1"` writes them:
+    # was "unknown command 'run-point 1'; one of: ... run-point N"
+    (["run-point 1"], "01 06 01 01 00 00 D9 F6"),
+    (["speed trackless", "2"], "01 06 02 02 00 00 29 B2"),
 ])
 def test_prints_exact_bytes(args, expected):
     result = run(*args)

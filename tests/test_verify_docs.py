@@ -205,7 +205,7 @@ def test_sent_by_names_the_statement_of_every_fx5u_and_tcp_route(tmp_path):
 def test_the_troubleshooting_rows_that_name_an_fx3_serial_device_name_the_fx5s_too():
     """An FX5U integrator reading the bench-test and commissioning tables finds the device of
     its own CPU next to the FX3's (the equivalents `uitamr check --platform fx5u` names)."""
-    from verifier.sim.cpu import FX3_SERIAL
+    from verifier.sim.cpu import FX3_MODBUS, FX3_SERIAL
 
     rows = [line for doc in ("emulator.md", "commissioning.md")
             for line in (DOCS / doc).read_text(encoding="utf-8").splitlines() if line.startswith("|")]
@@ -218,6 +218,10 @@ def test_the_troubleshooting_rows_that_name_an_fx3_serial_device_name_the_fx5s_t
             wanted = re.match(r"S[MD]\d+", fx5)
             assert (wanted.group(0) if wanted else "module parameters") in row, (device, row)
             checked += 1
+            if device in FX3_MODBUS and "time-out" in row:
+                # D8409 is the FX3U-485ADP-MB's slave response time-out too: on the FX5 ADPRW
+                # route that is a module parameter, not SD8621
+                assert "slave response time-out" in row and "module parameter" in row, (device, row)
     assert checked >= 4
 
 

@@ -180,6 +180,7 @@ def command(sources: tuple[str, ...], target: str | None, platform: str | None, 
     """Parse and type-check GX Works structured text (files or directories of .st), and
     scenario files (.toml) as `uitamr verify` reads them. With --platform, also check the
     devices and instructions against that CPU."""
+    target_given = target is not None
     target = platform_target(platform, target) if platform else target or "gxworks2"
     paths = expand_sources(sources)
     unusable = [(p, _not_a_source(p)) for p in paths]
@@ -201,7 +202,7 @@ def command(sources: tuple[str, ...], target: str | None, platform: str | None, 
         annotations = to_github(findings)
         if annotations:
             click.echo(annotations)
-        click.echo(f"{len(paths)} file(s) checked for {_checked_for(target, platform)}: {errors} error(s), "
+        click.echo(f"{_summary(paths, target, target_given, platform)}: {errors} error(s), "
                    f"{warnings} warning(s)")
     elif fmt == "sarif":
         from verifier import __version__
@@ -214,7 +215,7 @@ def command(sources: tuple[str, ...], target: str | None, platform: str | None, 
                 texts[str(p)] = _lines_of(p)
         for d in diagnostics:
             click.echo(render(d, texts.get(d.file)))
-        click.echo(f"{len(paths)} file(s) checked for {_checked_for(target, platform)}: {errors} error(s), "
+        click.echo(f"{_summary(paths, target, target_given, platform)}: {errors} error(s), "
                    f"{warnings} warning(s)")
     sys.exit(EXIT_ERRORS if errors else EXIT_OK)
 
@@ -228,3 +229,12 @@ def _lines_of(path: Path) -> list[str] | None:
 
 def _checked_for(target: str, platform: str | None) -> str:
     return f"{target} on the {platform} CPU" if platform else target
+
+
+def _summary(paths: list[Path], target: str, target_given: bool, platform: str | None) -> str:
+    """'N file(s) checked for <dialect>': a run of scenario files only, with no dialect asked
+    for, names none (each file is read for its own platform: an FX5U scenario said 'checked
+    for gxworks2')."""
+    if not platform and not target_given and all(p.suffix.lower() == ".toml" for p in paths):
+        return f"{len(paths)} file(s) checked"
+    return f"{len(paths)} file(s) checked for {_checked_for(target, platform)}"

@@ -87,8 +87,9 @@ def command_from_words(words: list[str] | str, address: int = 1) -> ControlReque
     ``words`` is a list (``["move", "x", "-2.5"]``) or one string (``"move x -2.5"``).
     """
     if isinstance(words, str):
-        words = words.split()
-    words = [w.strip() for w in words if w.strip()]
+        words = [words]
+    # "run-point 3" given as one argument (quoted, as a scenario's `sent` writes it) is two words
+    words = [part for w in words for part in w.split()]
     if not words:
         raise CommandError("no command given; one of: " + _forms())
     name, args = words[0].lower(), words[1:]

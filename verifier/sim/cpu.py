@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from .rs2_devices import FX3_CHANNELS, FX5_CHANNELS
+from .rs2_devices import FX3_CHANNELS, FX3_MODBUS_CHANNELS, FX5_CHANNELS
 
 
 @dataclass(frozen=True)
@@ -253,14 +253,34 @@ def _fx3_serial() -> dict[str, tuple[str, dict[str, str]]]:
 
 FX3_SERIAL = _fx3_serial()
 
+# The FX3U-485ADP-MB MODBUS master's registers (docs/instructions.md §10), several of them
+# RS2's numbers in the other mode: a program moved from an FX3U ADPRW route was sent to
+# SD8621 for the slave response time-out, which on the FX5 is a module parameter.
+_FX5_MODBUS_PARAMETER = ("a module parameter on the fx5u (GX Works3: Module Parameter > 485 Serial Port, "
+                         "docs/import-gxworks3.md §4)")
+_FX5_MODBUS_UNKNOWN = ("no device known on the fx5u: the register of the FX5 ADPRW's error code was not found "
+                       "(docs/instructions.md §10)")
+_MODBUS_ROLES = (("response_timeout", "slave response time-out", _FX5_MODBUS_PARAMETER),
+                 ("retries", "retries", _FX5_MODBUS_PARAMETER),
+                 ("error_code", "MODBUS error code", _FX5_MODBUS_UNKNOWN),
+                 ("error_details", "MODBUS error details", _FX5_MODBUS_UNKNOWN))
+FX3_MODBUS = {getattr(devices, field_name): (f"the FX3U-485ADP-MB's ADPRW ch{channel} {role}",
+                                             {"fx5": fx5})  # a Q has no ADPRW: RS2's hint says enough
+              for channel, devices in FX3_MODBUS_CHANNELS.items() for field_name, role, fx5 in _MODBUS_ROLES}
+
 
 def fx3_serial_equivalent(device: str, cpu: CpuProfile) -> str | None:
     """'the FX3's M8402 (RS2 ch1 send request) is SM8561 on the fx5u (...)' for an FX3
-    serial-communication device named on another CPU family; None for other devices."""
-    entry = FX3_SERIAL.get(device.upper())
-    if entry is None or cpu.family not in entry[1]:
-        return None
-    role, texts = entry
-    text = texts[cpu.family]
-    verb = "has" if text.startswith("no device") else "is"
-    return f"the FX3's {device.upper()} ({role}) {verb} {text}"
+    serial-communication device named on another CPU family, with its meaning for the
+    FX3U-485ADP-MB MODBUS master too where it has one; None for other devices."""
+    key = device.upper()
+    parts = []
+    for table in (FX3_SERIAL, FX3_MODBUS):
+        entry = table.get(key)
+        if entry is None or cpu.family not in entry[1]:
+            continue
+        role, texts = entry
+        text = texts[cpu.family]
+        verb = "has" if text.startswith("no device") else "is"
+        parts.append(f"as {role} it {verb} {text}" if parts else f"the FX3's {key} ({role}) {verb} {text}")
+    return "; ".join(parts) or None

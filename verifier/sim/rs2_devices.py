@@ -1,6 +1,7 @@
-"""The special devices of the RS2 channels, per CPU family (docs/instructions.md §7, §8):
-data the RS2 port model drives (`instructions.rs2`) and the CPU check names when a program
-moved to another family uses the FX3's (`cpu.FX3_SERIAL`)."""
+"""The special devices of the RS2 channels, per CPU family (docs/instructions.md §7, §8),
+and of the FX3U-485ADP-MB MODBUS master (§10): data the RS2 and ADPRW models drive
+(`instructions.rs2`, `instructions.adprw`) and the CPU check names when a program moved
+to another family uses the FX3's (`cpu.FX3_SERIAL`)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -28,4 +29,24 @@ FX3_CHANNELS = {
 FX5_CHANNELS = {
     1: Rs2Devices("SM8561", "SM8562", "SM8565", "SD8560", "SD8561", "SD8621", 1, None, "SD8622"),
     2: Rs2Devices("SM8571", "SM8572", "SM8575", "SD8570", "SD8571", "SD8631", 1, None, "SD8632"),
+}
+
+
+@dataclass(frozen=True)
+class Fx3ModbusDevices:
+    """The special devices of one FX3U-485ADP-MB MODBUS master channel (FX3U MODBUS Serial
+    Communication Edition 6.1 and 12.6, docs/instructions.md §10). Some share their number
+    with an RS2 device of the same channel: the two modes do not run on one channel."""
+
+    response_timeout: str  # slave response time-out, ms (0 = 3 s)
+    retries: str
+    error_code: str
+    error_details: str
+    error_flag: str
+    serial_error: str  # serial communication error code (6321 / 3821: MODBUS error)
+
+
+FX3_MODBUS_CHANNELS = {
+    1: Fx3ModbusDevices("D8409", "D8412", "D8402", "D8403", "M8063", "D8063"),
+    2: Fx3ModbusDevices("D8429", "D8432", "D8422", "D8423", "M8438", "D8438"),
 }

@@ -299,6 +299,9 @@ class Checker:
         if key in T.MISSING_TYPES:
             self.rep.error(ref, library_missing(key, self.target))
             return T.ANY
+        if key in _UNMODELLED_FBS:
+            self.rep.error(ref, f"unknown type '{ref.name}'; {_UNMODELLED_FBS[key]}")
+            return T.ANY
         self.rep.error(ref, f"unknown type '{ref.name}'; "
                        + (_in_library(ref.name, self.plc_shown) or "declare the structure or function block, or use a GX Works type"))
         return T.ANY
@@ -979,6 +982,25 @@ class Checker:
             self.rep.warning(c, f"the result of {sig.name} is discarded")
         return result
 
+    @staticmethod
+    def _two_bits(t: T.Type, node: ast.Expr) -> str | None:
+        """A completion-bits operand (ADPRW's d2, the SP_/ZP_ and G_ instructions' d) is the
+        head of two bits, done and error: a single BOOL label, an array of one, or the last
+        element of an array leaves the error bit nowhere (the simulator stopped the run
+        there, on the first error completion only, after check had passed the program)."""
+        need = "needs 2 bits (done, error) from its head: "
+        if isinstance(t, T.ArrayOf):
+            return None if t.size >= 2 else f"{need}{_text(node)} is an array of {t.size} BOOL"
+        if isinstance(node, (ast.Name, ast.Member)):
+            return (f"{need}{_text(node)} is a single BOOL label; declare it ARRAY[0..1] OF BOOL, "
+                    "or use a bit device")
+        if isinstance(node, ast.Index) and len(node.indices) == 1 and isinstance(node.indices[0], ast.IntLiteral):
+            base = getattr(node.base, "type", None)
+            if isinstance(base, T.ArrayOf) and len(base.dims) == 1 and node.indices[0].value == base.dims[0][1]:
+                lo, hi = base.dims[0]
+                return f"{need}{_text(node)} is the last element of {_text(node.base)} (ARRAY[{lo}..{hi}])"
+        return None
+
     def _accepts(self, p: T.Param, t: T.Type, node: ast.Expr) -> str | None:
         a = p.accepts
         if t is T.ANY:
@@ -1010,10 +1032,13 @@ class Checker:
             if T.width(t) == 16 and not T.is_group(t, "real"):
                 return None
             return f"needs the head of a block of words (an INT/WORD array or its element, or a word device), not {t}"
-        if a == "BITS":
+        if a in ("BITS", "BITS2"):
+            whole = t
             if isinstance(t, T.ArrayOf):
                 t = t.element
-            return None if T.is_bool(t) else f"needs a bit (BOOL label, bit device or BOOL array), not {t}"
+            if not T.is_bool(t):
+                return f"needs a bit (BOOL label, bit device or BOOL array), not {t}"
+            return self._two_bits(whole, node) if a == "BITS2" else None
         if a == "ANY_NUM":
             return None if T.is_any_num(t) and not T.is_group(t, "bits") else f"needs INT, DINT or REAL, not {t}"
         if a == "ANY_INT":
@@ -1083,10 +1108,24 @@ def _target_name(target: str) -> str:
     return {"gxworks2": "GX Works2", "gxworks3": "GX Works3"}.get(target, target)
 
 
+#: GX Works function blocks an integrator's program may use that the toolkit does not model,
+#: and what to write instead
+_UNMODELLED_FBS = {
+    "TON_10": ("TON_10 is the FX5's 10 ms on-delay timer FB (a secondary source, docs/instructions.md section 4), "
+               "which the toolkit does not model: declare a TON (the simulator times it in ms of virtual time)"),
+}
+
 #: the editor a file was written for, and how to check it (README, docs/ci.md)
 _CHECK_FOR = {"gxworks3": ("GX Works3 (FX5U)", "check FX5U sources with --platform fx5u (or --target gxworks3)"),
               "gxworks2": ("GX Works2 (FX3U/FX3G, Q)", "check FX3 and Q sources with --platform fx3u, fx3g "
                                                        "or q (or --target gxworks2)")}
+
+
+#: GX Works2 instructions of one CPU family: (its CPUs, the sources, the --platform choices);
+#: FX3's ADPRW sent to '--platform fx3u, fx3g or q' where a Q has none. Kept beside the
+#: simulator's instruction families (verifier.sim.instructions) by tests/test_check_platform.py.
+_GX2_ONE_FAMILY = {"ADPRW": ("FX3U/FX3G", "FX3", "fx3u or fx3g")} | {
+    name: ("Q", "Q", "q") for name in ("ZP_OPEN", "ZP_BUFSND", "ZP_BUFRCV", "ZP_CLOSE")}
 
 
 def _other_editor_hint(name: str, target: str, given: int) -> str:
@@ -1096,6 +1135,10 @@ def _other_editor_hint(name: str, target: str, given: int) -> str:
     for other, (editor, how) in _CHECK_FOR.items():
         if other == target:
             continue
+        if other == "gxworks2" and name in _GX2_ONE_FAMILY:
+            cpus, sources, platforms = _GX2_ONE_FAMILY[name]
+            editor = f"GX Works2 ({cpus})"
+            how = f"check {sources} sources with --platform {platforms} (or --target gxworks2)"
         sig = library.instruction(name, other)
         if sig is None or other not in sig.targets:
             continue

@@ -134,40 +134,40 @@ _ins("ADPRW", [("s", "ANY16", "in"), ("s1", "ANY16", "in"), ("s2", "ANY16", "in"
 INSTRUCTIONS["ADPRW_FX5"] = Signature(
     "ADPRW", "instruction",
     (Param("EN", "BOOL"), Param("s", "ANY16"), Param("s1", "ANY16"), Param("s2", "ANY16"),
-     Param("s3", "ANY16"), Param("s4d1", "BLOCK16", "inout"), Param("d2", "BITS", "out")),
+     Param("s3", "ANY16"), Param("s4d1", "BLOCK16", "inout"), Param("d2", "BITS2", "out")),
     None, False, ("gxworks3",), "FX5 MODBUS master: slave, function, address, count, data head, completion bits")
 _ins("G_OUTPUT", [("Un", "ANY16", "in"), ("s1", "BLOCK16", "inout"), ("s2", "BLOCK16", "in"),
-                  ("d", "BITS", "out")], pulse=False,
+                  ("d", "BITS2", "out")], pulse=False,
      note="QJ71C24N non-procedural send: Un start I/O, s1 control data, s2 send data, d completion bits")
 _ins("G_INPUT", [("Un", "ANY16", "in"), ("s", "BLOCK16", "inout"), ("d1", "BLOCK16", "out"),
-                 ("d2", "BITS", "out")], pulse=False,
+                 ("d2", "BITS2", "out")], pulse=False,
      note="QJ71C24N non-procedural receive: Un start I/O, s control data, d1 receive data, d2 completion bits")
 
 # Ethernet (docs/instructions.md "Ethernet"): the ladder forms SP.SOCOPEN ... and ZP.OPEN ...
 # run once on the rising edge of EN; U / Un is the module as a string ('U0')
 _ins("SP_SOCOPEN", [("U", "STRING", "in"), ("s1", "ANY16", "in"), ("s2", "BLOCK16", "inout"),
-                    ("d", "BITS", "out")], targets=("gxworks3",), pulse=False,
+                    ("d", "BITS2", "out")], targets=("gxworks3",), pulse=False,
      note="FX5 socket open: U 'U0', s1 connection, s2 control data, d completion bits")
 _ins("SP_SOCSND", [("U", "STRING", "in"), ("s1", "ANY16", "in"), ("s2", "BLOCK16", "inout"),
-                   ("s3", "BLOCK16", "in"), ("d", "BITS", "out")], targets=("gxworks3",), pulse=False,
+                   ("s3", "BLOCK16", "in"), ("d", "BITS2", "out")], targets=("gxworks3",), pulse=False,
      note="FX5 socket send: U 'U0', s1 connection, s2 control data, s3 byte count + data, d completion bits")
 _ins("SP_SOCRCV", [("U", "STRING", "in"), ("s1", "ANY16", "in"), ("s2", "BLOCK16", "inout"),
-                   ("d1", "BLOCK16", "out"), ("d2", "BITS", "out")], targets=("gxworks3",), pulse=False,
+                   ("d1", "BLOCK16", "out"), ("d2", "BITS2", "out")], targets=("gxworks3",), pulse=False,
      note="FX5 socket receive: U 'U0', s1 connection, s2 control data, d1 byte count + data, d2 completion bits")
 _ins("SP_SOCCLOSE", [("U", "STRING", "in"), ("s1", "ANY16", "in"), ("s2", "BLOCK16", "inout"),
-                     ("d", "BITS", "out")], targets=("gxworks3",), pulse=False,
+                     ("d", "BITS2", "out")], targets=("gxworks3",), pulse=False,
      note="FX5 socket close: U 'U0', s1 connection, s2 control data, d completion bits")
 _ins("ZP_OPEN", [("Un", "STRING", "in"), ("s1", "ANY16", "in"), ("s2", "BLOCK16", "inout"),
-                 ("d", "BITS", "out")], targets=("gxworks2",), pulse=False,
+                 ("d", "BITS2", "out")], targets=("gxworks2",), pulse=False,
      note="QJ71E71 open: Un module ('U0'), s1 connection, s2 control data, d completion bits")
 _ins("ZP_BUFSND", [("Un", "STRING", "in"), ("s1", "ANY16", "in"), ("s2", "BLOCK16", "inout"),
-                   ("s3", "BLOCK16", "in"), ("d", "BITS", "out")], targets=("gxworks2",), pulse=False,
+                   ("s3", "BLOCK16", "in"), ("d", "BITS2", "out")], targets=("gxworks2",), pulse=False,
      note="QJ71E71 fixed buffer send: Un, s1 connection, s2 control data, s3 length + data, d completion bits")
 _ins("ZP_BUFRCV", [("Un", "STRING", "in"), ("s1", "ANY16", "in"), ("s2", "BLOCK16", "inout"),
-                   ("d1", "BLOCK16", "out"), ("d2", "BITS", "out")], targets=("gxworks2",), pulse=False,
+                   ("d1", "BLOCK16", "out"), ("d2", "BITS2", "out")], targets=("gxworks2",), pulse=False,
      note="QJ71E71 fixed buffer receive: Un, s1 connection, s2 control data, d1 length + data, d2 completion bits")
 _ins("ZP_CLOSE", [("Un", "STRING", "in"), ("s1", "ANY16", "in"), ("s2", "BLOCK16", "inout"),
-                  ("d", "BITS", "out")], targets=("gxworks2",), pulse=False,
+                  ("d", "BITS2", "out")], targets=("gxworks2",), pulse=False,
      note="QJ71E71 close: Un, s1 connection, s2 control data, d completion bits")
 
 

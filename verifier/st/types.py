@@ -290,7 +290,7 @@ def concrete(t: Type) -> Type:
 class Param:
     """One parameter of a function or instruction. `accepts` is a class name checked by
     `accepts()`: "BOOL", "ANY16", "ANY32", "ANY_NUM", "ANY_INT", "ANY_BIT", "ANY_REAL",
-    "ANY_SIMPLE", "ANY", "BLOCK16" (head of a block of words), "BITS" (head of bits),
+    "ANY_SIMPLE", "ANY", "BLOCK16" (head of a block of words), "BITS" (a bit, or the head of bits), "BITS2" (the head of two completion bits),
     "TIME", "STRING", or an elementary type name. `direction` "in", "out" or "inout"."""
 
     name: str

@@ -36,6 +36,13 @@ PLATFORMS = {
     "q": ("gxworks2", "q:1"),
 }
 CHANNELS = ("fx3:1", "fx3:2", "fx5:1", "fx5:2", "q:1", "q:2", "adp:1")
+#: the channels each platform's simulated CPU has (`Project.serial_channels`; ADPRW's adp:1
+#: on the FX CPUs only), so that a channel of another CPU is an error at its line
+PLATFORM_CHANNELS = {
+    "fx3u": ("fx3:1", "fx3:2", "adp:1"),
+    "fx5u": ("fx5:1", "fx5:2", "adp:1"),
+    "q": ("q:1", "q:2"),
+}
 DEFAULT_DURATION_US = 60_000_000
 #: The longest run accepted (virtual time). A day of 10 ms scans takes the simulator about
 #: an hour; anything longer is almost always a typo ("1000h") and would look like a hang.
@@ -426,6 +433,14 @@ class _Reader:
             channel = self.string(data["channel"], "channel")
             if channel not in CHANNELS:
                 raise self.fail("channel", f"unknown channel {channel!r}; expected one of {', '.join(CHANNELS)}")
+            if channel not in PLATFORM_CHANNELS[platform]:
+                told = ""
+                if "platform" not in data:  # the platform is the default (or --platform's)
+                    owner = next(p for p, have in PLATFORM_CHANNELS.items() if channel in have)
+                    given = "--platform's" if self.platform_option else "the default platform"
+                    told = f" ({platform} is {given}: set platform = \"{owner}\", the CPU that has {channel})"
+                raise self.fail("channel", f"channel {channel} does not exist on the {platform} CPU; it has "
+                                           f"{', '.join(PLATFORM_CHANNELS[platform])}{told}")
         duration = self.duration(data.get("duration", "60s"), "duration")
         if duration > MAX_DURATION_US:
             raise self.fail("duration", f"longer than the limit of {format_duration(MAX_DURATION_US)} of virtual time; "

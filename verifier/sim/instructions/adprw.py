@@ -13,6 +13,7 @@ from __future__ import annotations
 from verifier.protocol import crc_ok, with_crc
 
 from ..refs import operand_key, pulse_keys
+from ..rs2_devices import FX3_MODBUS_CHANNELS
 
 # FX5 (SD8500): simulator error codes (ASSUMPTION: the FX5 manual's codes are not modelled)
 ERR_TIMEOUT = 1
@@ -46,12 +47,13 @@ class AdprwMaster:
         dev = rt.dev
         if self.family == "fx3":
             # D8409 slave response time-out ms (0 = 3 s), D8412 retries (MODBUS manual p.33/34)
-            self._timeout = dev.address("D8409" if channel == 1 else "D8429")
-            self._retries = dev.address("D8412" if channel == 1 else "D8432")
-            self._err_code = dev.address("D8402" if channel == 1 else "D8422")
-            self._err_flag = dev.address("M8063" if channel == 1 else "M8438")
-            self._err_details = dev.address("D8403" if channel == 1 else "D8423")
-            self._serial_err = dev.address("D8063" if channel == 1 else "D8438")
+            devices = FX3_MODBUS_CHANNELS[channel]
+            self._timeout = dev.address(devices.response_timeout)
+            self._retries = dev.address(devices.retries)
+            self._err_code = dev.address(devices.error_code)
+            self._err_flag = dev.address(devices.error_flag)
+            self._err_details = dev.address(devices.error_details)
+            self._serial_err = dev.address(devices.serial_error)
             self._serial_err_code = FX3_SERIAL_ERR_MODBUS[channel]
             self._done_flag = dev.address("M8029")
         else:
