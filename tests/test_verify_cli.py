@@ -754,6 +754,11 @@ def test_a_misspelt_label_in_a_scenario_offers_the_label_meant(tmp_path):
             ("fbEngine.o_bErrr", "no label 'fbEngine.o_bErrr' in the program UITAMR_ExampleFx5: fbEngine has no "
                                  "member 'o_bErrr'; did you mean 'o_bErr'?"),
             ("zzz", "the program UITAMR_ExampleFx5 has no label 'zzz'"),
+            # an abbreviated instance: the label guess asked for 80 % alike (the key guess 60 %) and made none
+            ("fbEng.o_bErr", "the program UITAMR_ExampleFx5 has no label 'fbEng.o_bErr'; did you mean 'fbEngine'?"),
+            # fbCycle's input asked of fbEngine: at 60 % alike the guess would be its constant KIND_STATUS
+            ("fbEngine.i_bStart", "no label 'fbEngine.i_bStart' in the program UITAMR_ExampleFx5: fbEngine has no "
+                                  "member 'i_bStart'"),
             # a standard FB's member too (its inputs and outputs are its labels)
             ("fbEngine.tmrPace.PTT", "no label 'fbEngine.tmrPace.PTT' in the program UITAMR_ExampleFx5: "
                                      "fbEngine.tmrPace has no member 'PTT'; did you mean 'PT'?")):

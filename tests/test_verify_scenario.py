@@ -290,6 +290,8 @@ def test_a_duration_of_another_type_is_shown_as_the_file_writes_it():
     ('[robot]\nbattery_percent = 80\n', "robot.battery_percent", "battery_pct"),
     ('[[faults]]\nkind = "no_reply"\nat = 3\n', "faults[0].at", "at_s"),
     ('[[inputs]]\nat = "1s"\nset = { a = true }\npluse = "1s"\n', "inputs[0].pluse", "pulse"),
+    # a TOML key is case-sensitive, so 'SCAN' is unknown; the guess compared cases too and made none
+    ('SCAN = "10ms"\n', "SCAN", "scan"),
 ])
 def test_a_misspelt_key_names_the_key_probably_meant(text, key, meant):
     # the message listed every key there is (24 under [robot]) and left the search to the user
