@@ -26,6 +26,7 @@ from .durations import format_seconds
 from .events_shown import thin_line_events
 from .evidence import RunEvidence, Samples
 from .expectations import judge
+from .overwritten import overwritten_input_notes
 from .result import KEEP_ALL, Keep, LineEvent, ScenarioResult, TraceRecord, UnusableInput, summarize_diagnostics
 from .rules import check_all
 from .scenario import BUFFER_MEMORY, DEVICE_NAME, Scenario, scenario_power_on_stop
@@ -704,5 +705,6 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         ended_us=end,
         wall_s=time.perf_counter() - wall_start,
         notes=list(scenario.notes) + plc.cpu_notes() + _c24_notes(scenario, plc) + _missed_fault_notes(scenario, robot, end)
+        + overwritten_input_notes(scenario, plc.project.files, plc.name, _relative)
         + ([] if tx_count else [_silence_note(scenario, plc, converter)]),
     )
