@@ -82,9 +82,10 @@ def splits_at_pauses(t_start_us: int, t_end_us: int, length: int,
     for i, end in enumerate(pauses_us):
         begin = pauses_us[i - 1] if i else t_start_us  # where this run of characters began
         longer: list[tuple[tuple[int, int], ...]] = []
+        lowest = max(1, int((end - begin - T3_5_US) / BYTE_TIME_EXACT_US) - 1)  # no pause is longer
         for way in ways:
             sent = way[-1][0] if way else 0
-            for count in range(1, length - sent):
+            for count in range(lowest, length - sent):
                 silence = end - (begin + frame_time_us(count))
                 if silence < T1_5_US:
                     break

@@ -70,7 +70,7 @@ def _parts(data: bytes, split: tuple[tuple[int, int], ...]) -> list[bytes]:
 
 def _together_text(data: bytes, split: tuple[tuple[int, int], ...]) -> str:
     parts = _parts(data, split)
-    (first_k, first_silence), later = split[0], split[1:]
+    first_silence, later = split[0][1], split[1:]
     text = (f"{_count(len(parts), _COUNTS, 2)} requests ran together: {protocol.hex_bytes(parts[1])} followed "
             f"{protocol.hex_bytes(parts[0])} after a silence of {first_silence / 1000:.3f} ms")
     for part, (_, silence) in zip(parts[2:], later):
