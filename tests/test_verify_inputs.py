@@ -495,6 +495,8 @@ def test_the_documented_note_on_the_fx3u_example_is_what_verify_prints(tmp_path,
     ("n := arr[2] + 1;\narr[2] := 0;", "arr[2]", None),
     ("BMOV(TRUE, arr[0], 3, buf[0]);\nbuf[2] := 0;", "buf[2]", None),  # an operand reaches a block
     ("tmr(IN := y, PT := T#1s);", "tmr.Q", None),  # a standard FB: no ST body to follow
+    ("tmr(IN := y, PT := T#1s);", "tmr.PT", 8),  # ... but the call assigns its inputs
+    ("tmr(IN := y, PT := T#1s);", "tmr.ET", None),
     ("g := TRUE;", "g", None),  # a global label: any POU may read it
     ("n := 1;\nY3 := y;", "Y3", 9),  # a device, before any call
     ("y := NOT y;\nY3 := y;", "Y3", 9),

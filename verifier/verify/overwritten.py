@@ -181,19 +181,20 @@ def _call(call: ast.Call, target: list, context: _Context) -> Overwrite | None:
                 raise _Touched
     if not member_of_it:
         return written  # the body reaches only its own members and what the arguments name
-    if pou is None:
-        raise _Touched  # a standard FB (TON) or an array of instances: no ST body here
     rest = target[len(callee):]
-    if not isinstance(rest[0], str):
-        raise _Touched
-    member = {v.name.upper(): v for v in pou.variables}.get(rest[0])
-    if member is None or member.section not in ("VAR", "VAR_INPUT", "VAR_OUTPUT") or member.constant:
+    if declared is None or not isinstance(declared.type, ast.NamedType) or not isinstance(rest[0], str):
+        raise _Touched  # an array of instances, or an element of the instance
+    member = {v.name.upper(): v for v in pou.variables}.get(rest[0]) if pou is not None else None
+    if pou is not None and (member is None or member.section not in ("VAR", "VAR_INPUT", "VAR_OUTPUT")
+                            or member.constant):
         raise _Touched  # VAR_IN_OUT, VAR_EXTERNAL: another name for something outside
     for arg in inputs:
         if arg.name is not None and arg.name.upper() == rest[0]:  # the call assigns the input
-            if len(rest) == 1:
+            if len(rest) == 1:  # (a standard FB's too: TON's PT)
                 return Overwrite(arg.span, arg.value, context.pou)
             raise _Touched
+    if pou is None:
+        raise _Touched  # a standard FB (TON): no ST body here to follow
     inner = _first(pou.body, rest, context.inside(pou))
     if inner is not None:
         return inner
