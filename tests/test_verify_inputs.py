@@ -473,7 +473,9 @@ def test_the_documented_note_on_the_fx3u_example_is_what_verify_prints(tmp_path,
     plc = Path(__file__).parent.parent / "plc"
     text = (plc / "scenarios" / "fx3u-healthy.toml").read_text(encoding="utf-8")
     assert text.splitlines()[15] == "set = { X0 = true }"  # line 16, as the documented note says
-    text = text.replace("set = { X0 = true }", 'set = { "fbCycle.i_bStart" = true }').replace('"../', f'"{plc.as_posix()}/')
+    # Y0 too: assigned after the example's FB calls, which the search does not see through (no note)
+    text = text.replace("set = { X0 = true }", 'set = { "fbCycle.i_bStart" = true, Y0 = true }')
+    text = text.replace('"../', f'"{plc.as_posix()}/')
     (tmp_path / "s.toml").write_text(text, encoding="utf-8")
     monkeypatch.chdir(plc.parent)  # the ST files as the reports show them, relative to the working folder
     result = invoke("--scenario", tmp_path / "s.toml", "--duration", "3s", "--json", tmp_path / "r.json")

@@ -2,9 +2,9 @@
 that the program overwrites in every scan before it reads it.
 
 Inputs are applied before a scan (docs/scenarios.md). When the first thing every scan does
-with the label is to assign it - `Y0 := fbEngine.o_bInitDone;` at the top level of the
-PROGRAM, or an FB call that binds it, `fbCycle(i_bStart := X0, ...)` for
-`fbCycle.i_bStart` - the value set is gone before anything reads it: the scenario's button
+with the label is to assign it - `bLamp := nStarts > 0;` at the top level of the PROGRAM,
+an FB call that binds it, `fbCycle(i_bStart := X0, ...)` for `fbCycle.i_bStart`, or an
+assignment in the body of the FB the PROGRAM calls - the value set is gone before anything reads it: the scenario's button
 press did nothing. A label the program resets only sometimes (`IF bStartPb THEN ...
 bStartPb := FALSE; END_IF`), or after reading it (`IF bStart THEN ... END_IF; bStart :=
 FALSE;`, a one-scan pulse), is seen, and is not reported.
@@ -13,9 +13,9 @@ The search is conservative: it follows the PROGRAM's statements in order, and th
 an FB instance it calls, and stops without a finding at the first statement that might
 read or partly write the label - one that names it, or a part or a whole of it (`wBuf[i]`
 for `wBuf[2]`, `fbCycle` passed on), inside a condition, a loop, a call's arguments (an
-instruction's operand stands for the block it reaches), or a RETURN. A device, or a label
-that is not the PROGRAM's own (a global one), might be reached by any call: for those it
-stops at the first call too.
+instruction's operand stands for the block it reaches), or a RETURN. A device might be
+reached by any call: for one it stops at the first call too. A label that is not the
+PROGRAM's own (a global one, which any POU may read) is not followed at all.
 """
 from __future__ import annotations
 
