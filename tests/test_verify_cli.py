@@ -756,6 +756,8 @@ def test_a_misspelt_label_in_a_scenario_offers_the_label_meant(tmp_path):
             ("zzz", "the program UITAMR_ExampleFx5 has no label 'zzz'"),
             # an abbreviated instance: the label guess asked for 80 % alike (the key guess 60 %) and made none
             ("fbEng.o_bErr", "the program UITAMR_ExampleFx5 has no label 'fbEng.o_bErr'; did you mean 'fbEngine'?"),
+            # written in one case: compared case aside, as the 80 % guess did (upper-cased)
+            ("FBENGIN.o_bErr", "the program UITAMR_ExampleFx5 has no label 'FBENGIN.o_bErr'; did you mean 'fbEngine'?"),
             # fbCycle's input asked of fbEngine: at 60 % alike the guess would be its constant KIND_STATUS
             ("fbEngine.i_bStart", "no label 'fbEngine.i_bStart' in the program UITAMR_ExampleFx5: fbEngine has no "
                                   "member 'i_bStart'"),

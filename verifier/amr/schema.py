@@ -44,22 +44,26 @@ def did_you_mean(word: str, candidates: Iterable[str]) -> str:
     `at` -> 'at_s') and a label or member (`fbEngin` -> 'fbEngine', `PTT` -> 'PT'). A name
     that differs in case only is the guess (`SCAN` -> 'scan': a TOML key is case-sensitive,
     an ST label is not; either way the user meant the name there is). Otherwise at least two
-    thirds of the characters, capitals as written, must match (difflib's ratio), and two of
-    them at least: enough for a short key's missing suffix, not for names of a large FB that
-    share only their prefix (`o_bNope` is not 'o_bENO', `i_bStart` not 'KIND_STATUS': the
-    capitals mark where the words of a label start), nor for one letter in common (`QQ` is
-    not 'Q')."""
+    thirds of the characters must match (difflib's ratio), and two of them at least: enough
+    for a short key's missing suffix, not for one letter in common (`QQ` is not 'Q'). The
+    capitals count where the user wrote some: they mark where the words of a label start,
+    so names of a large FB that share only their prefix are not alike (`o_bNope` is not
+    'o_bENO', `i_bStart` not 'KIND_STATUS'); a name written in one case (`FBENGIN`,
+    `fbengin`) is compared case aside."""
     import difflib
 
+    word = str(word)
     candidates = list(candidates)
-    same = [name for name in candidates if name.casefold() == str(word).casefold()]
+    same = [name for name in candidates if name.casefold() == word.casefold()]
     if same:
         return f"; did you mean '{same[0]}'?"
+    one_case = word == word.upper() or word == word.lower()
+    shown = (lambda name: name.casefold()) if one_case else (lambda name: name)
     matcher = difflib.SequenceMatcher()
-    matcher.set_seq2(str(word))
+    matcher.set_seq2(shown(word))
     best: tuple[float, str] | None = None
     for name in candidates:
-        matcher.set_seq1(name)
+        matcher.set_seq1(shown(name))
         if matcher.real_quick_ratio() < 2 / 3 or matcher.quick_ratio() < 2 / 3:
             continue
         score = matcher.ratio()
