@@ -754,6 +754,13 @@ def test_a_misspelt_label_in_a_scenario_offers_the_label_meant(tmp_path):
             ("fbEngine.o_bErrr", "no label 'fbEngine.o_bErrr' in the program UITAMR_ExampleFx5: fbEngine has no "
                                  "member 'o_bErrr'; did you mean 'o_bErr'?"),
             ("zzz", "the program UITAMR_ExampleFx5 has no label 'zzz'"),
+            # an abbreviated instance: the label guess asked for 80 % alike (the key guess 60 %) and made none
+            ("fbEng.o_bErr", "the program UITAMR_ExampleFx5 has no label 'fbEng.o_bErr'; did you mean 'fbEngine'?"),
+            # written in one case: compared case aside, as the 80 % guess did (upper-cased)
+            ("FBENGIN.o_bErr", "the program UITAMR_ExampleFx5 has no label 'FBENGIN.o_bErr'; did you mean 'fbEngine'?"),
+            # fbCycle's input asked of fbEngine: at 60 % alike the guess would be its constant KIND_STATUS
+            ("fbEngine.i_bStart", "no label 'fbEngine.i_bStart' in the program UITAMR_ExampleFx5: fbEngine has no "
+                                  "member 'i_bStart'"),
             # a standard FB's member too (its inputs and outputs are its labels)
             ("fbEngine.tmrPace.PTT", "no label 'fbEngine.tmrPace.PTT' in the program UITAMR_ExampleFx5: "
                                      "fbEngine.tmrPace has no member 'PTT'; did you mean 'PT'?")):
@@ -910,6 +917,47 @@ def test_two_requests_run_together_are_judged_one_by_one(tmp_path, monkeypatch, 
         + ("D9 F6" if crc_finding else "29 F6") + " followed 01 06 01 A0 00 00 88 14 after a silence of 1.667 ms, "
         "less than t3.5 = 3.65 ms, so the robot takes them for one frame and discards it: leave at least t3.5 of "
         "silence between two requests (and wait for the reply, or its time-out, before the next)")
+
+
+# a third request, as soon as the CPU has sent the second: one 24-byte frame with two pauses
+THREE_BACK_TO_BACK = BACK_TO_BACK.replace("POINT2_CRC", "16#F629").replace("""    wStep := 3;
+ELSIF""", """    wStep := 3;
+ELSIF wStep = 3 AND NOT M8402 THEN
+    uSend[0] := 16#0601;
+    uSend[1] := 16#0301;
+    uSend[2] := 16#0000;
+    uSend[3] := POINT3_CRC;
+    M8402 := TRUE;
+    wStep := 4;
+ELSIF""")
+
+THREE_TOGETHER = ("three requests ran together: 01 06 01 02 00 00 29 F6 followed 01 06 01 A0 00 00 88 14 after a "
+                  "silence of 1.667 ms, 01 06 01 03 00 00 {crc} followed that after 1.667 ms, each less than t3.5 = "
+                  "3.65 ms, so the robot takes them for one frame and discards it")
+
+
+@pytest.mark.parametrize("crc, crc_finding", [
+    ("16#3678", None),  # 01 06 01 03 00 00 78 36: all three right, sent too close
+    ("16#F6D9", "UITAMR-CRC: 1 violation(s); first at 0.010 s: the third of " + THREE_TOGETHER.format(crc="D9 F6")
+                + "; its CRC bytes are D9 F6, expected 78 36 (CRC-16/MODBUS of the first 6 bytes, low byte first)"),
+])
+@pytest.mark.parametrize("path", [[], ["--every-scan"]])  # judged as it goes, and as a whole
+def test_three_requests_run_together_are_split_at_both_pauses(tmp_path, monkeypatch, crc, crc_finding, path):
+    # the line recorded the first pause only, and the bytes before it were worked out from
+    # the frame's whole silence (both pauses): no split, and UITAMR-CRC said 'expected D3 2C
+    # (CRC-16/MODBUS of the first 22 bytes)', UITAMR-FORMAT 'too long for an FC06 request: 24 bytes'
+    (tmp_path / "MAIN.st").write_text(THREE_BACK_TO_BACK.replace("POINT3_CRC", crc), encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("MAIN.st", "--platform", "fx3u", "--duration", "1s", "--junit", "v.xml", "--json", "v.json", *path)
+    assert result.exit_code == 1, result.output
+    failures = {f.get("type"): f.get("message") for f in ET.parse(tmp_path / "v.xml").getroot().iter("failure")}
+    assert failures.get("UITAMR-CRC") == crc_finding
+    assert failures["UITAMR-FORMAT"] == (
+        "UITAMR-FORMAT: 1 violation(s); first at 0.010 s: " + THREE_TOGETHER.format(crc="D9 F6" if crc_finding else "78 36")
+        + ": leave at least t3.5 of silence between two requests (and wait for the reply, or its time-out, before "
+        "the next)")
+    (run,) = json.loads((tmp_path / "v.json").read_text())["scenarios"]
+    assert [e["t"] for e in run["line_events"] if e["kind"] == "gap"] == [0.02, 0.03]  # each pause on the line
 
 
 def test_a_program_the_sources_lack_is_reported_at_the_scenarios_program_line(tmp_path, monkeypatch):

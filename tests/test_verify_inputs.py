@@ -360,3 +360,162 @@ def test_an_o_bErr_that_is_not_a_bool_is_not_taken_as_the_default_signal(tmp_pat
     assert result.exit_code == 1 and "error:" not in result.output  # runs; fails only on the power-on stop
     result = invoke(odd, "--duration", "1s", "--response-signal", "o_bErr")
     assert result.exit_code == 2 and "--response-signal: o_bErr is a number, not a condition" in result.output
+
+
+# --- inputs the program never sees -------------------------------------------------------------
+
+PUSHBUTTONS = """\
+PROGRAM Main
+VAR
+    bStartPb : BOOL;
+    bPulse : BOOL;
+    bLamp : BOOL;
+    bMode : BOOL;
+    nStarts : INT;
+    nPulses : INT;
+    fbLatch : Latch;
+END_VAR
+bLamp := nStarts > 0;
+Y2 := bLamp;
+(* a pushbutton label reset after the program acted on it *)
+IF bStartPb THEN
+    nStarts := nStarts + 1;
+    bStartPb := FALSE;
+END_IF;
+(* read, then reset in every scan: a one-scan pulse *)
+IF bPulse THEN
+    nPulses := nPulses + 1;
+END_IF;
+bPulse := FALSE;
+fbLatch(i_bSet := bMode, i_bReset := X1);
+Y0 := fbLatch.o_bOn;
+IF bMode THEN
+    Y1 := TRUE;
+END_IF;
+END_PROGRAM
+"""
+
+LATCH = """\
+FUNCTION_BLOCK Latch
+VAR_INPUT
+    i_bSet : BOOL;
+    i_bReset : BOOL;
+END_VAR
+VAR_OUTPUT
+    o_bOn : BOOL;
+END_VAR
+VAR
+    bState : BOOL;
+END_VAR
+IF i_bSet THEN
+    bState := TRUE;
+END_IF;
+IF i_bReset THEN
+    bState := FALSE;
+END_IF;
+o_bOn := bState;
+END_FUNCTION_BLOCK
+"""
+
+
+def test_an_input_the_program_overwrites_before_reading_it_is_noted_at_both_places(tmp_path, monkeypatch):
+    """An [[inputs]] entry on a label the program assigns in every scan before it reads it
+    did nothing, and the run said nothing: the user thought the button was pressed. A note
+    names the input's place and the ST that overwrites it. Labels the program reads, resets
+    only sometimes (a pushbutton reset after acting on it) or resets after reading (a
+    one-scan pulse) are not noted, nor is a device a call might reach (Y0 after fbLatch)."""
+    (tmp_path / "Main.st").write_text(PUSHBUTTONS, encoding="utf-8")
+    (tmp_path / "Latch.st").write_text(LATCH, encoding="utf-8")
+    (tmp_path / "s.toml").write_text(
+        'sources = ["Main.st", "Latch.st"]\nprogram = "Main"\nduration = "1s"\n'
+        '[[inputs]]\nat = "100ms"\n'
+        'set = { bLamp = true, "fbLatch.i_bSet" = true, "fbLatch.o_bOn" = true, Y2 = true }\n'
+        '[[inputs]]\nat = "200ms"\n'
+        'set = { bStartPb = true, bPulse = true, bMode = true, X1 = true, Y0 = true, Y1 = true, '
+        '"fbLatch.bState" = true }\n'
+        '[[expect]]\nthat = "nStarts = 1 AND nPulses = 1"\n', encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("--scenario", "s.toml", "--json", "r.json")
+    assert result.exit_code == 0, result.output
+    (run,) = json.loads((tmp_path / "r.json").read_text())["scenarios"]
+    assert [note for note in run["notes"] if "does nothing" in note] == [
+        "s.toml:6:9: inputs[0].set: bLamp = true does nothing: the program overwrites bLamp in every scan before "
+        "reading it, at Main.st:11:1 (bLamp := nStarts > 0;)",
+        "s.toml:6:23: inputs[0].set: fbLatch.i_bSet = true does nothing: the program overwrites fbLatch.i_bSet in "
+        "every scan before reading it, at Main.st:23:9 (i_bSet := bMode); set bMode instead",
+        "s.toml:6:48: inputs[0].set: fbLatch.o_bOn = true does nothing: the program overwrites fbLatch.o_bOn in "
+        "every scan before reading it, at Latch.st:18:1 (o_bOn := bState;)",
+        "s.toml:6:72: inputs[0].set: Y2 = true does nothing: the program overwrites Y2 in every scan before "
+        "reading it, at Main.st:12:1 (Y2 := bLamp;)",  # not 'set bLamp instead': it is overwritten too
+    ]
+    assert "note: s.toml:6:9: inputs[0].set: bLamp = true does nothing" in result.output
+
+
+def test_no_bundled_scenario_has_an_input_its_program_never_sees():
+    """The bundled examples' inputs: buttons (X0, X20...) read through FB calls, an address
+    register (D202), a setting label (bUseRs232): none is noted."""
+    import verifier
+    from verifier.verify.overwritten import overwritten_input_notes
+
+    projects = {}
+    scenarios = [load_scenario(path) for path in sorted((Path(__file__).parent.parent / "plc" / "scenarios").glob("*.toml"))]
+    assert sum(len(s.inputs) for s in scenarios) > 60
+    for scenario in scenarios:
+        key = (scenario.sources, scenario.platform, scenario.program)
+        if key not in projects:
+            projects[key] = verifier.load(*[str(p) for p in scenario.sources], target=scenario.target,
+                                          cpu=scenario.platform, programs=[scenario.program])
+        assert overwritten_input_notes(scenario, projects[key].files, scenario.program, lambda o, c: o) == [], scenario.path
+
+
+def test_the_documented_note_on_the_fx3u_example_is_what_verify_prints(tmp_path, monkeypatch):
+    """docs/scenarios.md: pressing fbCycle.i_bStart instead of X0 in the FX3U example."""
+    plc = Path(__file__).parent.parent / "plc"
+    text = (plc / "scenarios" / "fx3u-healthy.toml").read_text(encoding="utf-8")
+    assert text.splitlines()[15] == "set = { X0 = true }"  # line 16, as the documented note says
+    # Y0 too: assigned after the example's FB calls, which the search does not see through (no note)
+    text = text.replace("set = { X0 = true }", 'set = { "fbCycle.i_bStart" = true, Y0 = true }')
+    text = text.replace('"../', f'"{plc.as_posix()}/')
+    (tmp_path / "s.toml").write_text(text, encoding="utf-8")
+    monkeypatch.chdir(plc.parent)  # the ST files as the reports show them, relative to the working folder
+    result = invoke("--scenario", tmp_path / "s.toml", "--duration", "3s", "--json", tmp_path / "r.json")
+    (note,) = [n for n in json.loads((tmp_path / "r.json").read_text())["scenarios"][0]["notes"] if "does nothing" in n]
+    assert note.startswith(f"{tmp_path / 's.toml'}:16:9: ")
+    documented = " ".join((plc.parent / "docs" / "scenarios.md").read_text(encoding="utf-8").split())
+    assert f"`s.toml:16:9: {note.split(':16:9: ', 1)[1]}`" in documented, note
+    assert "note: " + note in result.output
+
+
+@pytest.mark.parametrize("body, name, line", [
+    ("x := FALSE;\nIF x THEN n := 1; END_IF;", "x", 8),  # assigned first: the input is gone
+    ("X_UP := TRUE;", "x_up", 8),  # ST labels: x_up is X_UP
+    ("arr[2] := 0;", "arr[2]", 8),
+    ("x := x OR y;", "x", None),  # reads itself first
+    ("IF y THEN RETURN; END_IF;\nx := TRUE;", "x", None),  # the assignment may not run
+    ("arr[n] := 0;\narr[2] := 1;", "arr[2]", None),  # any element, then: it may be read before
+    ("w.3 := TRUE;\nw := 0;", "w", None),  # a bit of it first: the search gives up (a miss, no false alarm)
+    ("n := arr[2] + 1;\narr[2] := 0;", "arr[2]", None),
+    ("BMOV(TRUE, arr[0], 3, buf[0]);\nbuf[2] := 0;", "buf[2]", None),  # an operand reaches a block
+    ("tmr(IN := y, PT := T#1s);", "tmr.Q", None),  # a standard FB: no ST body to follow
+    ("tmr(IN := y, PT := T#1s);", "tmr.PT", 8),  # ... but the call assigns its inputs
+    ("tmr(IN := y, PT := T#1s);", "tmr.ET", None),
+    ("g := TRUE;", "g", None),  # a global label: any POU may read it
+    ("n := 1;\nY3 := y;", "Y3", 9),  # a device, before any call
+    ("y := NOT y;\nY3 := y;", "Y3", 9),
+    ("BMOV(TRUE, arr[0], 3, buf[0]);\nY3 := y;", "Y3", None),  # any call may reach a device
+    ("IF y THEN x := TRUE; END_IF;\nx := FALSE;", "x", None),  # an IF that names it: given up (a miss)
+    ("x := FALSE;", "X0", None),  # a label is not the device of the same name
+    ("Y10 := y;", "Y8", None),  # on the FX3U Y10 is octal: compared as written, never confused
+    ("Y010 := y;", "Y10", 8),
+])
+def test_what_counts_as_overwritten_before_read(tmp_path, body, name, line):
+    import verifier
+    from verifier.verify.overwritten import first_overwrite
+
+    (tmp_path / "Main.st").write_text(
+        "PROGRAM Main\nVAR\n    x, y, X_UP : BOOL;\n    n, w : INT;\n    arr, buf : ARRAY[0..3] OF INT;\n"
+        "    tmr : TON;\nEND_VAR\n" + body + "\nEND_PROGRAM\n", encoding="utf-8")  # the body from line 8
+    (tmp_path / "Globals.st").write_text("VAR_GLOBAL\n    g : BOOL;\nEND_VAR\n", encoding="utf-8")
+    project = verifier.load(str(tmp_path / "Main.st"), str(tmp_path / "Globals.st"), target="gxworks2", cpu="fx3u")
+    found = first_overwrite(project.files, "Main", name)
+    assert (found.span.line if found is not None else None) == line, found

@@ -176,6 +176,28 @@ def test_format_flags_a_pause_inside_a_frame():
     assert check_all(RunEvidence(S, [request], 1_000_000, [outside]))["UITAMR-FORMAT"] == []
 
 
+def test_requests_run_together_are_split_where_the_crcs_tell_the_times_apart():
+    """Three requests with pauses of 1.6 and 2.7 ms: the times allow 8 + 8 + 8 bytes and
+    7 + 9 + 8 (a pause of 1.5 to 3.5 characters leaves one either way); only the first split
+    gives whole requests with good CRCs, and it is the one reported."""
+    from verifier.verify.result import LineEvent
+
+    first, second = protocol.with_crc(bytes.fromhex("010601A00000")), protocol.with_crc(bytes.fromhex("010601020000"))
+    third = protocol.with_crc(bytes.fromhex("010601030000"))
+    start = 10 * MS
+    pauses = [start + protocol.frame_time_us(8) + 1_600]
+    pauses.append(pauses[0] + protocol.frame_time_us(8) + 2_700)
+    assert len(protocol.splits_at_pauses(start, pauses[1] + protocol.frame_time_us(8), 24, pauses)) == 2
+    frame = TraceRecord(start, pauses[1] + protocol.frame_time_us(8), "tx", first + second + third)
+    gaps = [LineEvent(t, "gap", "silence between bytes of one frame") for t in pauses]
+    found = check_all(RunEvidence(S, [frame], 1_000_000, gaps))
+    assert found["UITAMR-CRC"] == []
+    (violation,) = found["UITAMR-FORMAT"]
+    assert violation.message.startswith(
+        f"three requests ran together: {protocol.hex_bytes(second)} followed {protocol.hex_bytes(first)} after a "
+        f"silence of 1.600 ms, {protocol.hex_bytes(third)} followed that after 2.700 ms, each less than t3.5")
+
+
 def test_format_follows_the_field_order_setting():
     code_low = protocol.Settings(field_order="code-low")
     frame = protocol.encode(STOP, code_low)

@@ -295,6 +295,8 @@ def test_a_duration_of_another_type_is_shown_as_the_file_writes_it():
     ('[robot]\nbattery_percent = 80\n', "robot.battery_percent", "battery_pct"),
     ('[[faults]]\nkind = "no_reply"\nat = 3\n', "faults[0].at", "at_s"),
     ('[[inputs]]\nat = "1s"\nset = { a = true }\npluse = "1s"\n', "inputs[0].pluse", "pulse"),
+    # a TOML key is case-sensitive, so 'SCAN' is unknown; the guess compared cases too and made none
+    ('SCAN = "10ms"\n', "SCAN", "scan"),
 ])
 def test_a_misspelt_key_names_the_key_probably_meant(text, key, meant):
     # the message listed every key there is (24 under [robot]) and left the search to the user
@@ -365,6 +367,40 @@ def test_a_condition_that_reads_no_label_is_an_error(text, key, shown):
     assert str(error).startswith(f"x.toml:3:")
     assert str(error).endswith(f"{key}: '{shown}' reads no label: it is the same at every moment and says nothing "
                                "about the program; name the program's labels (e.g. fbRobot.o_bErr) or devices (Y0)")
+
+
+@pytest.mark.parametrize("text, place, message", [
+    # each passed the check as reading a label, and then passed (or failed) whatever the program did
+    ('[[expect]]\nthat = "Y7 AND NOT Y7"\n', "3:8: expect[0].that", "'Y7 AND NOT Y7' is FALSE whichever value Y7 takes"),
+    ('[[expect]]\nnever = "X0 OR NOT X0"\n', "3:9: expect[0].never", "'X0 OR NOT X0' is TRUE whichever value X0 takes"),
+    ('[[expect]]\nalways = "x1 = TRUE OR NOT X1"\n', "3:10: expect[0].always",
+     "'x1 = TRUE OR NOT X1' is TRUE whichever value x1 takes"),  # ST labels: x1 is X1
+    ('[[expect]]\nthat = """(a AND b)\n  XOR (b AND a)"""\n', "3:8: expect[0].that",
+     "'(a AND b)\n  XOR (b AND a)' is FALSE whichever values a, b take"),
+    ('[response_handling]\nsignal = "o_bErr OR NOT o_bErr"\n', "3:10: response_handling.signal",
+     "'o_bErr OR NOT o_bErr' is TRUE whichever value o_bErr takes"),  # every failure 'noticed'
+])
+def test_a_condition_that_cannot_change_whatever_its_labels_is_an_error(text, place, message):
+    error = error_of('program = "M"\n' + text, Path("x.toml"))
+    assert str(error) == (f"x.toml:{place}: {message}: it is the same at every moment and says nothing about the "
+                          "program; write what the program's labels must show")
+
+
+@pytest.mark.parametrize("condition", [
+    "X0 AND NOT X1", "a XOR b", "Y0 = Y1",  # can change
+    "n = n", "n > 3 OR n <= 3", "n = 1 AND n = 2",  # numbers, or labels that may be: not decided, not guessed
+    " AND ".join(f"(b{i} OR NOT b{i})" for i in range(11)),  # more labels than MAX_LABELS_DECIDED: not tried
+])
+def test_a_condition_that_can_change_or_is_not_decided_is_accepted(condition):
+    parse_scenario(f'program = "M"\n[[expect]]\nthat = "{condition}"\n', Path("x.toml"))
+
+
+def test_a_response_signal_option_that_cannot_change_is_refused():
+    from verifier.commands.verify import _with_signal
+    from verifier.verify.result import UnusableInput
+
+    with pytest.raises(UnusableInput, match=r"^--response-signal: 'Y4 AND NOT Y4' is FALSE whichever value Y4 takes"):
+        _with_signal(parse_scenario('program = "M"\n'), "Y4 AND NOT Y4")
 
 
 def test_reaching_a_point_in_a_window_shorter_than_its_run_is_an_impossible_expectation():

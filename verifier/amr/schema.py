@@ -37,15 +37,47 @@ def require_mapping(value: Any, path: str) -> Mapping[str, Any]:
     return value
 
 
+def did_you_mean(word: str, candidates: Iterable[str]) -> str:
+    """'; did you mean 'scan'?' when one of `candidates` is spelt nearly as `word`, else ''.
+
+    The one guess for every misspelt name a scenario can hold: a key (`scna` -> 'scan',
+    `at` -> 'at_s') and a label or member (`fbEngin` -> 'fbEngine', `PTT` -> 'PT'). A name
+    that differs in case only is the guess (`SCAN` -> 'scan': a TOML key is case-sensitive,
+    an ST label is not; either way the user meant the name there is). Otherwise at least two
+    thirds of the characters must match (difflib's ratio), and two of them at least: enough
+    for a short key's missing suffix, not for one letter in common (`QQ` is not 'Q'). The
+    capitals count where the user wrote some: they mark where the words of a label start,
+    so names of a large FB that share only their prefix are not alike (`o_bNope` is not
+    'o_bENO', `i_bStart` not 'KIND_STATUS'); a name written in one case (`FBENGIN`,
+    `fbengin`) is compared case aside."""
+    import difflib
+
+    word = str(word)
+    candidates = list(candidates)
+    same = [name for name in candidates if name.casefold() == word.casefold()]
+    if same:
+        return f"; did you mean '{same[0]}'?"
+    one_case = word == word.upper() or word == word.lower()
+    shown = (lambda name: name.casefold()) if one_case else (lambda name: name)
+    matcher = difflib.SequenceMatcher()
+    matcher.set_seq2(shown(word))
+    best: tuple[float, str] | None = None
+    for name in candidates:
+        matcher.set_seq1(shown(name))
+        if matcher.real_quick_ratio() < 2 / 3 or matcher.quick_ratio() < 2 / 3:
+            continue
+        score = matcher.ratio()
+        common = sum(block.size for block in matcher.get_matching_blocks())
+        if score >= 2 / 3 and common >= 2 and (best is None or (score, name) > best):
+            best = (score, name)
+    return f"; did you mean '{best[1]}'?" if best else ""
+
+
 def unknown_key(key: str, allowed: Iterable[str]) -> str:
     """The message for a key not in `allowed`: the keys there are, and the one probably
     meant when one is spelt nearly so (`scna` -> 'scan', `battery_percent` -> 'battery_pct')."""
-    import difflib
-
     allowed = list(allowed)
-    message = f"unknown key; expected one of {', '.join(allowed)}"
-    close = difflib.get_close_matches(str(key), allowed, n=1, cutoff=0.6)
-    return f"{message}; did you mean '{close[0]}'?" if close else message
+    return f"unknown key; expected one of {', '.join(allowed)}{did_you_mean(key, allowed)}"
 
 
 def reject_unknown_keys(data: Mapping[str, Any], allowed: Iterable[str], path: str) -> None:

@@ -204,7 +204,7 @@ def _cut_short(scenario: Scenario) -> Scenario:
 
 
 def _with_signal(scenario: Scenario, text: str) -> Scenario:
-    from verifier.verify.conditions import ConditionError, parse_condition
+    from verifier.verify.conditions import ConditionError, parse_condition, unchanging
 
     try:
         signal = parse_condition(text)
@@ -213,6 +213,9 @@ def _with_signal(scenario: Scenario, text: str) -> Scenario:
     if not signal.names:
         raise UnusableInput(f"--response-signal: '{signal}' reads no label: it is the same at every moment and says "
                             "nothing about the program; name the program's output (e.g. fbRobot.o_bErr)")
+    problem = unchanging(signal)
+    if problem is not None:
+        raise UnusableInput(f"--response-signal: {problem}")
     options = replace(scenario.options, response_signal=signal)
     return replace(scenario, options=options, response_signal_given=True, response_signal_key="--response-signal")
 

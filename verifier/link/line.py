@@ -143,6 +143,7 @@ class Line:
         self._to_plc: deque[_Byte] = deque()
         self._frame: list[_Byte] = []
         self._frame_broken: str | None = None
+        self._frame_paused = False  # the frame was broken by a pause (not by a collision)
         self._tx_frames: list[_OpenFrame] = []
         self._rx_frames: list[TraceFrame] = []
         self._events: list[LineEvent] = []
@@ -292,18 +293,25 @@ class Line:
                 self._frame_broken = "bytes sent while the robot was transmitting were lost"
         elif self._frame and byte.start - self._frame[-1].end > self._t15:
             gap = byte.start - self._frame[-1].end
-            if self._frame_broken is None:
+            first = self._frame_broken is None
+            if first:
                 self._frame_broken = (f"a gap of {gap / 1000:.3f} ms inside the frame "
                                       f"(more than t1.5 = {self._t15 / 1000:.3f} ms)")
+                self._frame_paused = True
+            # every pause, not the first only (the format rule splits requests run together at
+            # each); none in a frame that lost bytes to a collision first, as before. The bytes
+            # before it with the first only: a program pausing after every byte of a long
+            # frame would otherwise copy the frame once a byte
+            if self._frame_paused:
                 self._event(byte.start, "gap",
                             f"silence of {gap / 1000:.3f} ms between bytes of one frame "
                             f"(more than t1.5 = {self._t15 / 1000:.3f} ms): the robot will discard it",
-                            (bytes(b.value for b in self._frame),))
+                            (bytes(b.value for b in self._frame),) if first else ())
         self._frame.append(byte)
 
     def _complete_frame(self) -> None:
         frame, broken = self._frame, self._frame_broken
-        self._frame, self._frame_broken = [], None
+        self._frame, self._frame_broken, self._frame_paused = [], None, False
         data = bytes([b.value for b in frame])
         end = frame[-1].end
         if broken is not None:

@@ -62,6 +62,7 @@ from verifier.protocol.timing import (
     T1_5_US,
     T3_5_US,
     frame_time_us,
+    splits_at_pauses,
 )
 
 __all__ = [name for name in dir() if not name.startswith("_")]

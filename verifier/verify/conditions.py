@@ -227,6 +227,29 @@ def _evaluate(node, values: Mapping[str, Value]) -> Value:
     return {"and": left and right, "or": left or right, "xor": left != right}[kind]
 
 
+#: A condition of BOOLs over at most this many labels is tried on every combination of their
+#: values (2**10 = 1024 evaluations); over more, whether it can change is not decided.
+MAX_LABELS_DECIDED = 10
+
+
+def _bools_only(node) -> bool:
+    """Whether `node` is BOOL-valued by its shape alone, each label in it a BOOL: a label,
+    TRUE/FALSE, NOT/AND/OR/XOR of such, or = / <> of two such of which one at least is not
+    a bare label (`a = b` may compare two numbers; `a = TRUE`, `(a AND b) <> c` cannot)."""
+    tag = node[0]
+    if tag == "lit":
+        return isinstance(node[1], bool)
+    if tag == "var":
+        return True
+    if tag in ("not", "and", "or", "xor"):
+        return all(_bools_only(child) for child in node[1:])
+    if tag == "cmp":
+        op, left, right = node[1:]
+        return (op in ("=", "<>") and _bools_only(left) and _bools_only(right)
+                and not (left[0] == "var" and right[0] == "var"))
+    return False  # a number or a minus sign: the labels may be numbers
+
+
 class _TypeProblem(Exception):
     pass
 
@@ -301,6 +324,22 @@ class Condition:
     def holds(self, values: Mapping[str, Value]) -> bool:
         return bool(_evaluate(self.tree, values))
 
+    def constant_value(self) -> bool | None:
+        """TRUE or FALSE when the condition has that value whatever the values of the labels
+        it reads (`Y7 AND NOT Y7`, `X0 OR NOT X0`), else None. Decided exactly, by trying
+        every combination, for a condition of BOOLs only over at most MAX_LABELS_DECIDED
+        labels; for any other (numbers, or more labels) None: not decided, not guessed."""
+        labels = sorted({name.upper() for name in self.names})  # ST: y7 is Y7
+        if not labels or len(labels) > MAX_LABELS_DECIDED or not _bools_only(self.tree):
+            return None
+        seen: set[bool] = set()
+        for k in range(2 ** len(labels)):
+            value = {label: bool(k >> i & 1) for i, label in enumerate(labels)}
+            seen.add(bool(_evaluate(self.tree, {name: value[name.upper()] for name in self.names})))
+            if len(seen) == 2:
+                return None
+        return seen.pop()
+
     def type_error(self, kinds: Mapping[str, str]) -> str | None:
         """Why the condition does not type-check, given each label's kind ("bool",
         "number", or the name of a type a condition cannot read, e.g. "STRING"), or None.
@@ -316,6 +355,20 @@ class Condition:
 
     def __str__(self) -> str:
         return self.text
+
+
+def unchanging(condition: Condition) -> str | None:
+    """Why `condition` is refused although it reads labels: it has one value whatever theirs
+    (Condition.constant_value), so, as one that reads none, it always passes or can never
+    pass. None when it can change (or when that is not decided)."""
+    value = condition.constant_value()
+    if value is None:
+        return None
+    names = sorted({name.upper(): name for name in sorted(condition.names)}.values())
+    which = (f"whichever value {names[0]} takes" if len(names) == 1
+             else f"whichever values {', '.join(names)} take")
+    return (f"'{condition}' is {'TRUE' if value else 'FALSE'} {which}: it is the same at every moment and says "
+            "nothing about the program; write what the program's labels must show")
 
 
 def parse_condition(text: str) -> Condition:

@@ -16,6 +16,7 @@ from dataclasses import replace
 from typing import Any, Callable
 
 from verifier.amr.robot import Robot
+from verifier.amr.schema import did_you_mean
 from verifier.link import Line
 from verifier.link.converter import Converter
 from verifier.sim.values import InstanceProxy, read_together
@@ -25,6 +26,7 @@ from .durations import format_seconds
 from .events_shown import thin_line_events
 from .evidence import RunEvidence, Samples
 from .expectations import judge
+from .overwritten import overwritten_input_notes
 from .result import KEEP_ALL, Keep, LineEvent, ScenarioResult, TraceRecord, UnusableInput, summarize_diagnostics
 from .rules import check_all
 from .scenario import BUFFER_MEMORY, DEVICE_NAME, Scenario, scenario_power_on_stop
@@ -213,13 +215,9 @@ class _Plc:
 def _did_you_mean(part: str, instance: Any) -> str:
     """'; did you mean 'fbBatt'?' when `instance` (a program or FB) has a label spelt
     nearly as `part` (a scenario's typo of an instance or member name), else ''."""
-    import difflib
-
     if not isinstance(instance, InstanceProxy):
         return ""  # a value or an array: no labels to offer
-    by_key = {n.upper(): n for n in instance._names()}  # a standard FB's (TON) too
-    close = difflib.get_close_matches(part.upper(), list(by_key), n=1, cutoff=0.8)
-    return f"; did you mean {by_key[close[0]]!r}?" if close else ""
+    return did_you_mean(part, instance._names())  # a standard FB's (TON) too
 
 
 def _path_parts(name: str) -> list[str]:
@@ -707,5 +705,6 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         ended_us=end,
         wall_s=time.perf_counter() - wall_start,
         notes=list(scenario.notes) + plc.cpu_notes() + _c24_notes(scenario, plc) + _missed_fault_notes(scenario, robot, end)
+        + overwritten_input_notes(scenario, plc.project.files, plc.name, _relative)
         + ([] if tx_count else [_silence_note(scenario, plc, converter)]),
     )

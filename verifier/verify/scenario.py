@@ -23,7 +23,7 @@ from verifier.sim.devices import BUFFER_WORDS  # buffer-memory words modelled pe
 
 from verifier.link.converter import ConverterConfig
 
-from .conditions import Condition, ConditionError, parse_condition
+from .conditions import Condition, ConditionError, parse_condition, unchanging
 from .durations import format_duration, parse_duration_us
 from .evidence import RuleOptions
 from .expectations import KINDS, Expectation, describe_window
@@ -400,6 +400,9 @@ class _Reader:
         if not condition.names:
             raise self.fail(key, f"'{condition}' reads no label: it is the same at every moment and says nothing "
                                  "about the program; name the program's labels (e.g. fbRobot.o_bErr) or devices (Y0)")
+        problem = unchanging(condition)
+        if problem is not None:
+            raise self.fail(key, problem)
         return condition
 
     def label(self, value: Any, key: str, at: str = "") -> str:

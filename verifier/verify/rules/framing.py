@@ -1,7 +1,7 @@
 """UITAMR-CRC and UITAMR-FORMAT: every frame the PLC sends, byte by byte."""
 from __future__ import annotations
 
-from bisect import bisect_right
+from bisect import bisect_left, bisect_right
 from functools import lru_cache
 from typing import Iterator
 
@@ -21,7 +21,7 @@ class _GapReader(Judge):
         self.gaps: tuple[list[int], list] = ([], [])  # the "gap" events read so far, and their times
         self._read = 0  # events read (a run judged as it goes appends them as they happen)
 
-    def gap_inside(self, frame):
+    def gaps_inside(self, frame) -> list:
         events = self.evidence.events
         if len(events) > self._read:
             times, found = self.gaps
@@ -30,30 +30,54 @@ class _GapReader(Judge):
                     times.append(event.t_us)
                     found.append(event)
             self._read = len(events)
-        return _gap_inside(frame, self.gaps)
+        return _gaps_inside(frame, self.gaps)
 
 
-def _run_together(frame, gap) -> tuple[int, int] | None:
-    """(k, silence in µs) when `frame` is two requests sent with less than t3.5 between
-    them, so that the line made one frame of them: its first k bytes, up to the pause, are a
-    whole request with a good CRC, and more bytes follow. None otherwise."""
-    if gap is None:
+def _run_together(frame, gaps: list) -> tuple[tuple[int, int], ...] | None:
+    """((k, silence in µs), ...) a pause, when `frame` is requests sent with less than t3.5
+    between them, so that the line made one frame of them: up to each pause (its first k
+    bytes), a whole request with a good CRC, and more bytes follow the last. None otherwise,
+    and when the frame's times allow more than one such split."""
+    if not gaps:
         return None
     data = bytes(frame.data)
     # from the frame's times, as every report keeps them (a run judged as a whole has the
-    # events without the bytes before the pause): the silence is what the frame took beyond
-    # its bytes, and the bytes before it are those sent before the pause began
-    silence = frame.t_end_us - frame.t_start_us - protocol.frame_time_us(len(data))
-    k = round((gap.t_us - frame.t_start_us - silence) / protocol.BYTE_TIME_EXACT_US)
-    if not 4 <= k < len(data) or not protocol.crc_ok(data[:k]):
-        return None
-    return k, gap.t_us - (frame.t_start_us + protocol.frame_time_us(k))
+    # events without the bytes before each pause): protocol.splits_at_pauses
+    found = [way for way in protocol.splits_at_pauses(frame.t_start_us, frame.t_end_us, len(data),
+                                                      [gap.t_us for gap in gaps])
+             if all(_request_ends(data, way[i - 1][0] if i else 0, k) for i, (k, _) in enumerate(way))]
+    return found[0] if len(found) == 1 else None
 
 
-def _together_text(data: bytes, k: int, silence_us: int) -> str:
-    return (f"two requests ran together: {protocol.hex_bytes(data[k:])} followed {protocol.hex_bytes(data[:k])} "
-            f"after a silence of {silence_us / 1000:.3f} ms, less than t3.5 = {protocol.T3_5_US / 1000:.2f} ms, so "
-            "the robot takes them for one frame and discards it")
+def _request_ends(data: bytes, start: int, end: int) -> bool:
+    """Whether data[start:end] is a whole frame with a good CRC (an address, a function
+    code and the CRC at least)."""
+    return end - start >= 4 and protocol.crc_ok(data[start:end])
+
+
+_COUNTS = ("two", "three", "four", "five", "six", "seven", "eight", "nine", "ten")
+_ORDINALS = ("first", "second", "third", "fourth", "fifth", "sixth", "seventh", "eighth", "ninth", "tenth")
+
+
+def _count(n: int, words: tuple[str, ...], first: int) -> str:
+    return words[n - first] if n - first < len(words) else str(n)
+
+
+def _parts(data: bytes, split: tuple[tuple[int, int], ...]) -> list[bytes]:
+    bounds = [0] + [k for k, _ in split] + [len(data)]
+    return [data[a:b] for a, b in zip(bounds, bounds[1:])]
+
+
+def _together_text(data: bytes, split: tuple[tuple[int, int], ...]) -> str:
+    parts = _parts(data, split)
+    first_silence, later = split[0][1], split[1:]
+    text = (f"{_count(len(parts), _COUNTS, 2)} requests ran together: {protocol.hex_bytes(parts[1])} followed "
+            f"{protocol.hex_bytes(parts[0])} after a silence of {first_silence / 1000:.3f} ms")
+    for part, (_, silence) in zip(parts[2:], later):
+        text += f", {protocol.hex_bytes(part)} followed that after {silence / 1000:.3f} ms"
+    each = "each " if later else ""
+    return (f"{text}, {each}less than t3.5 = {protocol.T3_5_US / 1000:.2f} ms, so the robot takes them for one "
+            "frame and discards it")
 
 
 class Crc(_GapReader):
@@ -62,14 +86,15 @@ class Crc(_GapReader):
         data = bytes(frame.data)
         message = _crc_problem(data)
         if message is not None:
-            together = _run_together(frame, self.gap_inside(frame))
+            together = _run_together(frame, self.gaps_inside(frame))
             if together is not None:
-                # judge each request on its own: the CRC "of the first 14 bytes" is no one's
-                k, silence = together
-                second = _crc_problem(data[k:])
-                if second is None:
-                    return  # both CRCs are right: UITAMR-FORMAT reports the two run together
-                message = f"the second of {_together_text(data, k, silence)}; its {second}"
+                # judge each request on its own: the CRC "of the first 14 bytes" is no one's;
+                # those before the last pause have good ones (else no split)
+                last = _crc_problem(_parts(data, together)[-1])
+                if last is None:
+                    return  # every CRC is right: UITAMR-FORMAT reports the requests run together
+                which = _count(len(together) + 1, _ORDINALS, 1)
+                message = f"the {which} of {_together_text(data, together)}; its {last}"
             ref = frame_ref(frame, self.evidence.settings)
             yield Violation("UITAMR-CRC", frame.t_start_us, message, (ref,), frame.origin)
 
@@ -99,15 +124,14 @@ class Format(_GapReader):
     def request(self, index: int) -> Iterator[Violation]:
         frame = self.traffic.tx[index]
         problem = _layout_problem(bytes(frame.data), self.evidence.settings)
-        gap = self.gap_inside(frame)
-        together = _run_together(frame, gap) if problem is not None else None
+        gaps = self.gaps_inside(frame)
+        together = _run_together(frame, gaps) if problem is not None else None
         if together is not None:
-            k, silence = together
-            problem = (f"{_together_text(bytes(frame.data), k, silence)}: leave at least t3.5 of silence "
+            problem = (f"{_together_text(bytes(frame.data), together)}: leave at least t3.5 of silence "
                        "between two requests (and wait for the reply, or its time-out, before the next)")
-        elif gap is not None and problem is None:
+        elif gaps and problem is None:
             problem = (
-                f"{gap.message}; a Modbus RTU frame must be sent as one continuous stream "
+                f"{gaps[0].message}; a Modbus RTU frame must be sent as one continuous stream "
                 f"(at most t1.5 = {protocol.T1_5_US / 1000:.2f} ms between bytes)"
             )
         if problem:
@@ -130,11 +154,10 @@ def _layout_problem(data: bytes, settings: protocol.Settings) -> str | None:
     return None
 
 
-def _gap_inside(frame, gaps: tuple[list[int], list]):
-    """The line's "gap" event inside this PLC frame, if the PLC paused in mid-frame (the
-    first one after the frame's start: a bisection, so a long run stays linear)."""
+def _gaps_inside(frame, gaps: tuple[list[int], list]) -> list:
+    """The line's "gap" events inside this PLC frame, one a pause the PLC made in mid-frame
+    (found by bisection, so a long run stays linear)."""
     times, found = gaps
-    index = bisect_right(times, frame.t_start_us)
-    if index < len(times) and times[index] < frame.t_end_us:
-        return found[index]
-    return None
+    first = bisect_right(times, frame.t_start_us)
+    last = bisect_left(times, frame.t_end_us, lo=first)
+    return found[first:last]
