@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import random
 import re
+import select
 import signal
 import socket
 import os
@@ -377,7 +378,12 @@ def test_a_bad_master_on_a_real_line_gets_exactly_its_findings(line, tmp_path):
     out, err = monitor.communicate(timeout=WAIT_S)
     assert monitor.returncode == 1, out + err
     assert findings(tmp_path / "m.json") == Counter(BAD_MASTER_FINDINGS)
-    assert "UITAMR-POWERON-STOP" in out and "run point/script 1" in out  # the live line names it
+    live, summary = out.split("\nFAIL monitor ", 1)
+    # each finding was printed live (its time, rule, message and frames), before the summary
+    assert re.search(r"^0\.000 s  UITAMR-POWERON-STOP: the first control command after power-on is run "
+                     r"point/script 1 \(01/01\)", live, re.M), out
+    assert re.search(r"^ +0\.000 s  PLC → robot  01 06 01 01 00 00 D9 F6  run point/script 1", live, re.M), out
+    assert Counter(re.findall(r"^\d+\.\d{3} s  (UITAMR-[A-Z-]+): ", live, re.M)) == Counter(BAD_MASTER_FINDINGS)
     assert "<testcase" in (tmp_path / "m.xml").read_text() and "<svg" in (tmp_path / "m.html").read_text()
     done = subprocess.run(uitamr("replay", tmp_path / "c.txt", "--json", tmp_path / "r.json"),
                           capture_output=True, text=True, timeout=WAIT_S)
@@ -539,6 +545,64 @@ def test_monitor_on_a_tcp_stream(tmp_path):
     assert "the server closed the connection" in done.stdout  # ended by the stream, reports still written
     assert f"reading, connected to tcp 127.0.0.1:{port}" in done.stdout  # a client, not a listener
     assert findings(tmp_path / "m.json") == Counter(BAD_MASTER_FINDINGS)
+
+
+def test_on_a_terminal_a_rich_panel_counts_frames_and_findings_under_the_lines(tmp_path):
+    """The live console view: the monitor's output is a terminal (a pty), so a rich panel
+    under the frame lines counts requests, replies and findings per rule while it runs;
+    the frames and findings are still printed as lines above it."""
+    import pty
+
+    (chunks,) = read_capture(CAPTURES / "bad-master.txt").values()
+    server = socket.create_server(("127.0.0.1", 0))
+    port = server.getsockname()[1]
+
+    def stream():
+        connection, _ = server.accept()
+        with connection:
+            t0, first = time.monotonic(), chunks[0].t_us
+            for chunk in chunks:
+                delay = t0 + (chunk.t_us - first) / 1_000_000 - time.monotonic()
+                if delay > 0:
+                    time.sleep(delay)
+                connection.sendall(chunk.data)
+            time.sleep(1.0)  # the panel refreshes 4 times a second: let it show the last counts
+
+    thread = threading.Thread(target=stream, daemon=True)
+    thread.start()
+    terminal, end = pty.openpty()
+    monitor = subprocess.Popen(uitamr("monitor", "--tcp", f"127.0.0.1:{port}", "--duration", "10s"),
+                               stdin=end, stdout=end, stderr=end,
+                               env={**os.environ, "COLUMNS": "160", "LINES": "40", "TERM": "xterm"})
+    os.close(end)
+    out = b""
+    deadline = time.monotonic() + WAIT_S
+    while time.monotonic() < deadline:
+        ready, _, _ = select.select([terminal], [], [], 0.2)
+        if ready:
+            try:
+                data = os.read(terminal, 65536)
+            except OSError:  # the monitor closed its end
+                break
+            if not data:
+                break
+            out += data
+        elif monitor.poll() is not None:
+            break
+    os.close(terminal)
+    monitor.wait(timeout=WAIT_S)
+    thread.join(timeout=5)
+    server.close()
+    text = re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", out.decode("utf-8", errors="replace"))
+    assert monitor.returncode == 1, text
+    assert f"uitamr monitor — tcp 127.0.0.1:{port} (Ctrl-C stops and writes the reports)" in text
+    rows = re.findall(r"│ (\d+) +│ (\d+) +│ ([^│]*?) +│", text)
+    assert ("0", "0", "none") in rows  # the panel is there from the start ...
+    # ... and counts (the PACING count depends on the host keeping the stream's 100 ms gaps)
+    assert any(row[:2] == ("6", "5") and "UITAMR-CRC ×1" in row[2] and "UITAMR-POWERON-STOP ×1" in row[2]
+               for row in rows), rows
+    assert "01 06 01 01 00 00 D9 F6    run point/script 1 (01/01)" in text  # the frame lines above it
+    assert "0.000 s  UITAMR-POWERON-STOP: the first control command" in text  # a finding line above it
 
 
 def test_a_converter_that_drops_the_connection_inside_a_frame_is_not_the_plcs_short_frame(tmp_path):
