@@ -516,34 +516,59 @@ def test_ctrl_c_stops_the_monitor_and_the_reports_are_written(line, tmp_path):
 
 
 # --------------------------------------------------------------------- the converter route (TCP)
-def test_monitor_on_a_tcp_stream(tmp_path):
-    """A TCP server on 127.0.0.1 streams the bad master's line, chunk by chunk at its times
-    (what a serial-to-Ethernet converter on a second tap does); the monitor connects."""
-    (chunks,) = read_capture(CAPTURES / "bad-master.txt").values()
-    server = socket.create_server(("127.0.0.1", 0))
-    port = server.getsockname()[1]
+class BadMasterStream:
+    """A TCP server on 127.0.0.1 that streams the bad master's line to the one client that
+    connects, chunk by chunk at its times (what a serial-to-Ethernet converter on a second
+    tap does) from `lead_s` after the connection, stays `linger_s` and closes."""
 
-    def stream():
-        connection, _ = server.accept()
+    def __init__(self, linger_s: float = 0.3, lead_s: float = 0.0):
+        (self.chunks,) = read_capture(CAPTURES / "bad-master.txt").values()
+        self.server = socket.create_server(("127.0.0.1", 0))
+        self.port = self.server.getsockname()[1]
+        self.linger_s, self.lead_s = linger_s, lead_s
+        self.thread = threading.Thread(target=self._stream, daemon=True)
+        self.thread.start()
+
+    def _stream(self):
+        connection, _ = self.server.accept()
         with connection:
-            t0 = time.monotonic()
-            first = chunks[0].t_us
-            for chunk in chunks:
+            time.sleep(self.lead_s)
+            t0, first = time.monotonic(), self.chunks[0].t_us
+            for chunk in self.chunks:
                 delay = t0 + (chunk.t_us - first) / 1_000_000 - time.monotonic()
                 if delay > 0:
                     time.sleep(delay)
                 connection.sendall(chunk.data)
-            time.sleep(0.3)
+            time.sleep(self.linger_s)
 
-    thread = threading.Thread(target=stream, daemon=True)
-    thread.start()
-    done = subprocess.run(uitamr("monitor", "--tcp", f"127.0.0.1:{port}", "--duration", "10s",
+    def close(self):
+        self.thread.join(timeout=5)
+        self.server.close()
+
+
+def test_monitor_on_a_tcp_stream(tmp_path):
+    """The monitor connects to a converter's TCP stream of the bad master's line."""
+    stream = BadMasterStream()
+    done = subprocess.run(uitamr("monitor", "--tcp", f"127.0.0.1:{stream.port}", "--duration", "10s",
                                  "--json", tmp_path / "m.json"), capture_output=True, text=True, timeout=60)
-    thread.join(timeout=5)
-    server.close()
+    stream.close()
     assert done.returncode == 1, done.stdout + done.stderr
     assert "the server closed the connection" in done.stdout  # ended by the stream, reports still written
-    assert f"reading, connected to tcp 127.0.0.1:{port}" in done.stdout  # a client, not a listener
+    assert f"reading, connected to tcp 127.0.0.1:{stream.port}" in done.stdout  # a client, not a listener
+    assert findings(tmp_path / "m.json") == Counter(BAD_MASTER_FINDINGS)
+
+
+def test_monitor_serial_takes_a_pyserial_url(tmp_path):
+    """--serial takes pyserial URLs as well as device names: socket:// reads the same
+    stream through pyserial's own URL handler, and finds the bad master's findings. (The
+    stream starts 0.3 s after the connection: pyserial's socket:// open empties the
+    socket, and would drop bytes already sent, as a monitor started mid-frame would.)"""
+    stream = BadMasterStream(linger_s=1.0, lead_s=0.3)
+    done = subprocess.run(uitamr("monitor", "--serial", f"socket://127.0.0.1:{stream.port}", "--duration", "3s",
+                                 "--json", tmp_path / "m.json"), capture_output=True, text=True, timeout=60)
+    stream.close()
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert f"listening on socket://127.0.0.1:{stream.port} (9600 8N1" in done.stdout
     assert findings(tmp_path / "m.json") == Counter(BAD_MASTER_FINDINGS)
 
 
@@ -553,25 +578,9 @@ def test_on_a_terminal_a_rich_panel_counts_frames_and_findings_under_the_lines(t
     the frames and findings are still printed as lines above it."""
     import pty
 
-    (chunks,) = read_capture(CAPTURES / "bad-master.txt").values()
-    server = socket.create_server(("127.0.0.1", 0))
-    port = server.getsockname()[1]
-
-    def stream():
-        connection, _ = server.accept()
-        with connection:
-            t0, first = time.monotonic(), chunks[0].t_us
-            for chunk in chunks:
-                delay = t0 + (chunk.t_us - first) / 1_000_000 - time.monotonic()
-                if delay > 0:
-                    time.sleep(delay)
-                connection.sendall(chunk.data)
-            time.sleep(1.0)  # the panel refreshes 4 times a second: let it show the last counts
-
-    thread = threading.Thread(target=stream, daemon=True)
-    thread.start()
+    stream = BadMasterStream(linger_s=1.0)  # the panel refreshes 4 times a second: let it show the last counts
     terminal, end = pty.openpty()
-    monitor = subprocess.Popen(uitamr("monitor", "--tcp", f"127.0.0.1:{port}", "--duration", "10s"),
+    monitor = subprocess.Popen(uitamr("monitor", "--tcp", f"127.0.0.1:{stream.port}", "--duration", "10s"),
                                stdin=end, stdout=end, stderr=end,
                                env={**os.environ, "COLUMNS": "160", "LINES": "40", "TERM": "xterm"})
     os.close(end)
@@ -591,11 +600,10 @@ def test_on_a_terminal_a_rich_panel_counts_frames_and_findings_under_the_lines(t
             break
     os.close(terminal)
     monitor.wait(timeout=WAIT_S)
-    thread.join(timeout=5)
-    server.close()
+    stream.close()
     text = re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", out.decode("utf-8", errors="replace"))
     assert monitor.returncode == 1, text
-    assert f"uitamr monitor — tcp 127.0.0.1:{port} (Ctrl-C stops and writes the reports)" in text
+    assert f"uitamr monitor — tcp 127.0.0.1:{stream.port} (Ctrl-C stops and writes the reports)" in text
     rows = re.findall(r"│ (\d+) +│ (\d+) +│ ([^│]*?) +│", text)
     assert ("0", "0", "none") in rows  # the panel is there from the start ...
     # ... and counts (the PACING count depends on the host keeping the stream's 100 ms gaps)
