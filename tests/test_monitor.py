@@ -311,6 +311,12 @@ def test_a_verify_trace_as_raw_bytes_gets_the_same_frames_and_verdicts(name):
     a chunk): the monitor finds the same frames, sides and rule results as `verify`
     (RESPONSE-HANDLING aside: a capture cannot see the PLC's outputs)."""
     result = run_scenario(load_scenario(ROOT / "plc" / "scenarios" / f"{name}.toml"))
+    assert_the_monitor_judges_as_verify(result)
+
+
+def assert_the_monitor_judges_as_verify(result) -> None:
+    """`result`'s trace as raw bytes, each frame a chunk: the monitor finds the same frames
+    and sides, and the same violations per rule at the same times, as `verify` did."""
     chunks = [Chunk(f.t_end_us, f.data) for f in sorted(result.trace, key=lambda f: f.t_start_us)]
     session = session_of(chunks, tolerance_us=0)
     expected = [(f.t_start_us, f.direction, f.data) for f in sorted(result.trace, key=lambda f: f.t_start_us)]
@@ -321,6 +327,41 @@ def test_a_verify_trace_as_raw_bytes_gets_the_same_frames_and_verdicts(name):
     judged.pop("UITAMR-RESPONSE-HANDLING")
     wanted.pop("UITAMR-RESPONSE-HANDLING")
     assert judged == wanted
+
+
+def _bad_crc(request) -> bytes:
+    data = bytearray(protocol.encode(request, protocol.DEFAULT_SETTINGS))
+    data[6] ^= 0x10
+    return bytes(data)
+
+
+_SEQ_STOP = protocol.command_from_words("stop")
+_SEQ_READ = protocol.command_from_words("read task")
+_SEQ_POINT = protocol.command_from_words("run-point 3")
+#: programs that break rules (tests/test_verify_pipeline.py's sequencer): what verify finds
+_BREAKING = {
+    "cycle": ({"UITAMR-CYCLE"}, dict(frames=[_SEQ_STOP, _SEQ_POINT, _SEQ_READ])),
+    "poweron-stop": ({"UITAMR-POWERON-STOP"}, dict(frames=[_SEQ_READ, _SEQ_POINT, _SEQ_READ, _SEQ_STOP])),
+    "pacing": ({"UITAMR-PACING"}, dict(frames=[_SEQ_STOP, _SEQ_READ, _SEQ_READ], period="T#200ms")),
+    "format": ({"UITAMR-FORMAT"}, dict(frames=[_SEQ_STOP, protocol.with_crc(bytes.fromhex("010100000008")),
+                                               _SEQ_READ])),
+    "crc": ({"UITAMR-CRC"}, dict(frames=[_SEQ_STOP, _bad_crc(_SEQ_READ)])),
+    "one-at-a-time": ({"UITAMR-ONE-AT-A-TIME", "UITAMR-HALF-DUPLEX"},
+                      dict(frames=[_SEQ_STOP, _SEQ_READ, _SEQ_READ, _SEQ_READ],
+                           faults=[{"kind": "no_reply", "at_s": 0.5, "duration_s": 0.5}])),
+}
+
+
+@pytest.mark.parametrize("name", sorted(_BREAKING))
+def test_a_program_that_breaks_a_rule_is_judged_by_the_monitor_as_by_verify(name, tmp_path):
+    """The comparison above on programs that break the rules: the bundled scenarios break
+    none, so there it shows only that the monitor blames nothing verify does not."""
+    from test_verify_pipeline import run_sequence
+
+    broken, sequence = _BREAKING[name]
+    result = run_sequence(tmp_path, **sequence)
+    assert {rule for rule, found in result.violations.items() if found} == broken
+    assert_the_monitor_judges_as_verify(result)
 
 
 def test_replay_of_a_verify_trace_file(tmp_path):
