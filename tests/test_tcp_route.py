@@ -435,3 +435,24 @@ def test_the_faster_poll_changes_nothing(path, monkeypatch):
     now = run_scenario(scenario)
     monkeypatch.setattr(TcpPort, "poll", _poll_before)
     assert _comparable(now) == _comparable(run_scenario(scenario))
+
+
+@pytest.mark.parametrize("platform", ["fx5u", "q"])
+def test_the_port_opens_again_after_the_documented_back_off(platform):
+    """docs/tcp-converter.md and the error table: after a failed open the port tries again
+    after 0.5 s, 1 s, 2 s, 4 s, then every 8 s; the drop of a connection that was open is a
+    first failure again, so the next open follows 0.5 s later. Measured on the converter's events (each open it saw),
+    allowing each wait a few scans (close, open, the converter's connect time)."""
+    scenario = load_scenario(SCENARIOS / f"{platform}-tcp-refused.toml")
+    result = run_scenario(replace(scenario, duration_us=40_000_000, expectations=(),
+                                  converter=replace(scenario.converter, refuse_until_us=30_000_000)))
+    opens = [(e.t_us, e.kind) for e in result.events if e.kind in ("converter.refused", "converter.accepted")]
+    assert [kind for _, kind in opens] == ["converter.refused"] * 7 + ["converter.accepted"]
+    waits = [later - earlier for (earlier, _), (later, _) in zip(opens, opens[1:])]
+    for wait, back_off in zip(waits, [500_000, 1_000_000, 2_000_000, 4_000_000, 8_000_000, 8_000_000, 8_000_000]):
+        assert back_off <= wait <= back_off + 60_000, waits
+    scenario = load_scenario(SCENARIOS / f"{platform}-tcp-dropped.toml")
+    result = run_scenario(replace(scenario, duration_us=25_000_000, expectations=()))
+    events = [(e.t_us, e.kind) for e in result.events if e.kind in ("converter.dropped", "converter.accepted")]
+    assert [kind for _, kind in events] == ["converter.accepted", "converter.dropped", "converter.accepted"]
+    assert 500_000 <= events[2][0] - events[1][0] <= 600_000
