@@ -456,3 +456,21 @@ def test_the_port_opens_again_after_the_documented_back_off(platform):
     events = [(e.t_us, e.kind) for e in result.events if e.kind in ("converter.dropped", "converter.accepted")]
     assert [kind for _, kind in events] == ["converter.accepted", "converter.dropped", "converter.accepted"]
     assert 500_000 <= events[2][0] - events[1][0] <= 600_000
+
+
+@pytest.mark.parametrize("platform", ["fx5u", "q"])
+def test_a_frame_sent_with_no_connection_fails_the_attempt_with_0314(platform):
+    """docs/tcp-converter.md: a frame the engine sends while there is no connection is not
+    sent (16#0314) and the engine repeats it; after three failed attempts it ends with
+    16#0108, detail 16#0314. Here the converter refuses every open: the port holds
+    16#0310 (the open), the engine 16#0108/16#0314, and nothing reaches the robot."""
+    scenario = load_scenario(SCENARIOS / f"{platform}-tcp-refused.toml")
+    result = run_scenario(replace(scenario, duration_us=5_000_000, expectations=(),
+                                  watch=scenario.watch + ("fbEngine.o_uErrDetail", "fbEngine.o_wRetryCount"),
+                                  converter=replace(scenario.converter, refuse_until_us=30_000_000)))
+    watched = dict(result.watched)
+    assert not result.trace
+    assert watched["fbPort.o_uErrId"][-1][1] == 0x0310
+    assert (watched["fbEngine.o_uErrId"][-1][1], watched["fbEngine.o_uErrDetail"][-1][1]) == (0x0108, 0x0314)
+    retries = [v for _, v in watched["fbEngine.o_wRetryCount"]]
+    assert retries[:4] == [0, 1, 2, 3]  # repeated, not sent
