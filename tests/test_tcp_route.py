@@ -474,3 +474,69 @@ def test_a_frame_sent_with_no_connection_fails_the_attempt_with_0314(platform):
     assert (watched["fbEngine.o_uErrId"][-1][1], watched["fbEngine.o_uErrDetail"][-1][1]) == (0x0108, 0x0314)
     retries = [v for _, v in watched["fbEngine.o_wRetryCount"]]
     assert retries[:4] == [0, 1, 2, 3]  # repeated, not sent
+
+
+TCP_LINK_HARNESS = """
+PROGRAM T_Tcp
+VAR
+    fbLink : UITAMR_TcpLink;
+    uPort : ARRAY[0..39] OF WORD;
+    uSockSend : ARRAY[0..8] OF WORD;
+    uSockRecv : ARRAY[0..8] OF WORD;
+    bEN : BOOL; bConnected : BOOL; bOpenDone : BOOL; bOpenErr : BOOL; uOpenStatus : WORD;
+    bSendDone : BOOL; bSendErr : BOOL; uSendStatus : WORD;
+    bRecvReady : BOOL; bRecvDone : BOOL; bRecvErr : BOOL; uRecvStatus : WORD; bCloseDone : BOOL;
+END_VAR
+fbLink(i_bEN := bEN, i_bConnected := bConnected, i_bOpenDone := bOpenDone, i_bOpenErr := bOpenErr,
+       i_uOpenStatus := uOpenStatus, i_bSendDone := bSendDone, i_bSendErr := bSendErr,
+       i_uSendStatus := uSendStatus, i_bRecvReady := bRecvReady, i_bRecvDone := bRecvDone,
+       i_bRecvErr := bRecvErr, i_uRecvStatus := uRecvStatus, i_bCloseDone := bCloseDone,
+       io_uPort := uPort, io_uSockSend := uSockSend, io_uSockRecv := uSockRecv);
+END_PROGRAM
+"""
+
+
+def test_tcp_link_send_and_receive_errors_are_0312_and_0313_as_the_error_table_says():
+    """UITAMR_TcpLink driven by hand (no instruction model can fail a send or a receive on
+    an open connection): the engine's frame goes to the send instruction as raw RTU bytes,
+    CRC included, low byte first; a failed send is 16#0312 with its completion status and
+    fails the engine's attempt at once (port word 4 = 16#0312, as the engine's 16#0108
+    detail); a failed receive is 16#0313 and fails nothing (docs/plc-library.md)."""
+    import verifier
+
+    guide = (Path(__file__).resolve().parents[1] / "docs" / "plc-library.md").read_text(encoding="utf-8")
+    assert "port code (16#0306/0307/0309, 16#0311/0312/0314)" in guide
+    assert "| 16#0313 | TCP port: the receive instruction completed with an error | completion status | " \
+           "the bytes of that receive are dropped; the attempt is not failed at once" in guide
+    h = verifier.load(Path(__file__).resolve().parents[1] / "plc" / "core",
+                      sources={"T_Tcp.st": TCP_LINK_HARNESS}).program("T_Tcp")
+    h.bEN = True
+    h.scan()
+    assert h.fbLink.o_bOpen
+    h.bOpenDone = h.bConnected = True
+    h.scan()
+    h.bOpenDone = False
+    h.scan()
+    assert h.fbLink.o_bConnected and h.fbLink.o_uErrId == 0
+    for k, byte in enumerate(STOP):  # the engine's request on the port interface
+        h.uPort[8 + k] = byte
+    h.uPort[1], h.uPort[0] = len(STOP), 1
+    h.scan()
+    assert h.fbLink.o_bSend
+    assert [h.uSockSend[k] for k in range(5)] == [8, 0x0601, 0xA001, 0x0000, 0x1488]
+    h.bSendDone, h.bSendErr, h.uSendStatus = True, True, 0xC0A1
+    h.scan()
+    h.bSendDone = h.bSendErr = False
+    assert (h.fbLink.o_bErr, h.fbLink.o_uErrId, h.fbLink.o_uErrDetail) == (True, 0x0312, 0xC0A1)
+    h.scan(2)
+    assert (h.uPort[2], h.uPort[3], h.uPort[4]) == (1, 0, 0x0312)  # the attempt failed, no bytes
+    h.uPort[2] = 0  # the engine took it
+    h.bRecvReady = True
+    h.scan()
+    assert h.fbLink.o_bRecv
+    h.bRecvReady, h.bRecvDone, h.bRecvErr, h.uRecvStatus = False, True, True, 0x1234
+    h.scan()
+    h.bRecvDone = h.bRecvErr = False
+    assert (h.fbLink.o_bErr, h.fbLink.o_uErrId, h.fbLink.o_uErrDetail) == (True, 0x0313, 0x1234)
+    h.scan(3)
+    assert h.uPort[2] == 0  # no reply handed to the engine: its reply time-out decides
