@@ -149,6 +149,7 @@ class Scenario:
     platform_from_option: bool = False  # the platform is --platform's, not the file's (for messages)
     for_sources: bool = False  # a bundled scenario run against the user's sources (--matrix)
     program_from_option: bool = False  # the program is --program's, not the file's (for messages)
+    channel_from_option: bool = False  # the channel is --channel's, not the file's (for messages)
     duration_from_option: bool = False  # the run's length is --duration's (for messages)
 
     @property
@@ -206,9 +207,10 @@ class Scenario:
 
     def with_overrides(self, **changes: Any) -> "Scenario":
         changes = {k: v for k, v in changes.items() if v is not None}
-        if "program" in changes and "program" in self.key_lines:
-            # --program replaces the file's: its errors are no longer at the file's line
-            changes["key_lines"] = {k: v for k, v in self.key_lines.items() if k != "program"}
+        replaced = [key for key in ("program", "channel") if key in changes and key in self.key_lines]
+        if replaced:
+            # --program/--channel replace the file's: their errors are no longer at the file's line
+            changes["key_lines"] = {k: v for k, v in self.key_lines.items() if k not in replaced}
         return replace(self, **changes)
 
 
@@ -502,6 +504,7 @@ class _Reader:
         keys += ["response_handling.signal"] if signal_given else []
         keys += ["platform"] if "platform" in data else []
         keys += ["program"] if program is not None else []
+        keys += ["channel"] if channel is not None else []
         conditions = [(f"{e.key}.{e.kind}", e.condition) for e in expectations if e.condition is not None]
         conditions += [("response_handling.signal", options.response_signal)] if signal_given else []
         return Scenario(
