@@ -169,3 +169,20 @@ def test_sarif_uris_are_percent_encoded_and_resolve_to_the_files(tmp_path):
             uri = urljoin(base, uri)
         places.append(Path(unquote(urlparse(uri).path)))
     assert places == [inside.resolve(), other.resolve()]
+
+
+def test_a_channel_the_scenarios_cpu_lacks_is_a_check_error_at_its_line(tmp_path):
+    # `uitamr check` reads scenario files "as uitamr verify reads them": [[c24]] and
+    # [converter] on the wrong CPU were errors at their line, but channel = "q:1" in an
+    # FX3U scenario passed the check and failed only when verify loaded the program
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('platform = "fx3u"\nchannel = "q:1"\n', encoding="utf-8")
+    done = run("s.toml", cwd=tmp_path)
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert done.stdout.startswith("s.toml:2:11: error: channel: channel q:1 does not exist on the fx3u CPU; "
+                                  "the fx3u CPU has fx3:1, fx3:2, adp:1")
+    for platform, channel in (("fx5u", "adp:1"), ("q", "q:2"), ("fx3u", "fx3:2")):
+        scenario.write_text(f'platform = "{platform}"\nchannel = "{channel}"\n', encoding="utf-8")
+        assert run("s.toml", cwd=tmp_path).returncode == 0
+    scenario.write_text('platform = "q"\nchannel = "adp:1"\n', encoding="utf-8")
+    assert "channel adp:1 does not exist on the q CPU; the q CPU has q:1, q:2" in run("s.toml", cwd=tmp_path).stdout

@@ -948,7 +948,8 @@ def test_a_function_block_as_program_and_a_channel_the_cpu_lacks_are_reported_at
     # given on the command line, the option is the place, not the file's line
     result = invoke("--scenario", "fb.toml", "--program", "FB_X")
     assert result.exit_code == 2 and "error: --program: FB_X is a FUNCTION_BLOCK" in result.output
-    result = invoke("--scenario", "ch.toml", "--channel", "q:2")
+    (tmp_path / "fx3u.toml").write_text('name = "x"\nsources = ["MAIN.st"]\nplatform = "fx3u"\n', encoding="utf-8")
+    result = invoke("--scenario", "fx3u.toml", "--channel", "q:2")
     assert result.exit_code == 2 and "error: --channel: channel q:2 does not exist on the fx3u CPU" in result.output
 
 

@@ -428,6 +428,12 @@ class _Reader:
             channel = self.string(data["channel"], "channel")
             if channel not in CHANNELS:
                 raise self.fail("channel", f"unknown channel {channel!r}; expected one of {', '.join(CHANNELS)}")
+            from verifier.sim.cpu import PROFILES
+            from verifier.sim.project import channel_problem
+
+            problem = channel_problem(channel, PROFILES[platform])  # as verify's load would refuse it
+            if problem is not None:
+                raise self.fail("channel", problem)
         duration = self.duration(data.get("duration", "60s"), "duration")
         if duration > MAX_DURATION_US:
             raise self.fail("duration", f"longer than the limit of {format_duration(MAX_DURATION_US)} of virtual time; "
