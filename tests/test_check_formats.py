@@ -142,3 +142,47 @@ def test_a_scenario_file_is_checked_with_line_and_column(tmp_path, fmt):
 def test_the_bundled_scenarios_check_clean():
     done = run(*sorted((ROOT / "plc" / "scenarios").glob("*.toml")))
     assert done.returncode == 0, done.stdout
+
+
+def test_sarif_uris_are_percent_encoded_and_resolve_to_the_files(tmp_path):
+    # SARIF 2.1.0 §3.10.2: artifactLocation.uri is a URI reference (RFC 3986), so a space,
+    # a '%' or a non-ASCII letter in a file name is percent-encoded; a file outside the
+    # working directory gets an absolute file: URI and no uriBaseId (§3.4.4)
+    from urllib.parse import unquote, urljoin, urlparse
+    repo, outside = tmp_path / "repo", tmp_path / "else where"
+    repo.mkdir()
+    outside.mkdir()
+    inside = repo / "Main Program 100% ü.st"
+    other = outside / "b.st"
+    for path in (inside, other):
+        path.write_bytes(BROKEN.read_bytes())
+    run_ = _sarif(inside.name, other, cwd=repo)["runs"][0]
+    base = run_["originalUriBaseIds"]["%SRCROOT%"]["uri"]
+    places = []
+    for result in run_["results"]:
+        artifact = result["locations"][0]["physicalLocation"]["artifactLocation"]
+        uri = artifact["uri"]
+        assert re.fullmatch(r"[A-Za-z0-9\-._~!$&'()*+,;=:@/%]+", uri), uri
+        assert not re.search(r"%(?![0-9A-F]{2})", uri), uri
+        if "uriBaseId" in artifact:
+            assert artifact["uriBaseId"] == "%SRCROOT%" and not urlparse(uri).scheme
+            uri = urljoin(base, uri)
+        places.append(Path(unquote(urlparse(uri).path)))
+    assert places == [inside.resolve(), other.resolve()]
+
+
+def test_a_channel_the_scenarios_cpu_lacks_is_a_check_error_at_its_line(tmp_path):
+    # `uitamr check` reads scenario files "as uitamr verify reads them": [[c24]] and
+    # [converter] on the wrong CPU were errors at their line, but channel = "q:1" in an
+    # FX3U scenario passed the check and failed only when verify loaded the program
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('platform = "fx3u"\nchannel = "q:1"\n', encoding="utf-8")
+    done = run("s.toml", cwd=tmp_path)
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert done.stdout.startswith("s.toml:2:11: error: channel: channel q:1 does not exist on the fx3u CPU; "
+                                  "the fx3u CPU has fx3:1, fx3:2, adp:1")
+    for platform, channel in (("fx5u", "adp:1"), ("q", "q:2"), ("fx3u", "fx3:2")):
+        scenario.write_text(f'platform = "{platform}"\nchannel = "{channel}"\n', encoding="utf-8")
+        assert run("s.toml", cwd=tmp_path).returncode == 0
+    scenario.write_text('platform = "q"\nchannel = "adp:1"\n', encoding="utf-8")
+    assert "channel adp:1 does not exist on the q CPU; the q CPU has q:1, q:2" in run("s.toml", cwd=tmp_path).stdout

@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import random
 import re
+import select
 import signal
 import socket
 import os
@@ -91,6 +92,55 @@ def test_a_frame_in_two_chunks_with_a_usb_pause_is_one_frame():
     assert framer.feed(Chunk(10_000, STOP[:3])) == []
     (whole,) = framer.feed(Chunk(26_000, STOP[3:]))  # 16 ms later: the adapter's latency timer
     assert whole.data == STOP
+
+
+def test_a_frame_whose_first_byte_came_alone_is_one_frame():
+    """The latency timer ran out one byte into a request: that byte alone, the rest 16 ms
+    later. One byte does not tell its frame's length, so it waits as an incomplete frame
+    does (t3.5 plus the tolerance), not only t3.5: it was cut off as a 1-byte frame, and
+    the rest judged as a frame of its own (CRC and FORMAT findings against a good PLC)."""
+    session = session_of([Chunk(10_000, STOP[:1]), Chunk(26_000, STOP[1:]), Chunk(40_000, STOP)])
+    assert [(f.direction, f.data) for f in session.frames] == [("tx", STOP), ("rx", STOP)]
+    assert not rules_of(session)
+
+
+def ftdi_chunks(trace, latency_us: int, phase_us: int) -> list[Chunk]:
+    """The bytes of a wire trace as an FTDI adapter hands them to the host (AN232B-04):
+    each byte is in its buffer once its 10 bits are on the wire; the buffer goes to the
+    host when the latency timer runs out (every `latency_us`, from `phase_us`) or at 62
+    bytes, so a chunk may end anywhere in a frame."""
+    chunks, buffer, deliver_at = [], bytearray(), 0
+    for frame in sorted(trace, key=lambda f: f.t_start_us):
+        byte_us = (frame.t_end_us - frame.t_start_us) / len(frame.data)
+        for k, byte in enumerate(frame.data):
+            arrived = round(frame.t_start_us + (k + 1) * byte_us)
+            if buffer and arrived > deliver_at:
+                chunks.append(Chunk(deliver_at, bytes(buffer)))
+                buffer.clear()
+            if not buffer:
+                deliver_at = phase_us + ((arrived - phase_us) // latency_us + 1) * latency_us
+            buffer.append(byte)
+            if len(buffer) == 62:
+                chunks.append(Chunk(arrived, bytes(buffer)))
+                buffer.clear()
+    if buffer:
+        chunks.append(Chunk(deliver_at, bytes(buffer)))
+    return chunks
+
+
+@pytest.mark.parametrize("phase_us", [0, 3_000, 7_500, 11_000, 15_500])
+def test_a_compliant_plc_behind_an_ftdi_adapter_at_its_default_latency_timer_has_no_finding(phase_us):
+    """commissioning.md: the default tolerance (20 ms) covers an FTDI adapter at its default
+    16 ms latency timer. The simulated PLC's traffic (fx3u-healthy, no rule broken), handed
+    over as such an adapter hands it: the same frames as on the wire, and no finding. (A
+    first byte delivered alone broke about one frame in ten into CRC and FORMAT findings.)"""
+    result = run_scenario(load_scenario(ROOT / "plc" / "scenarios" / "fx3u-healthy.toml"))
+    chunks = ftdi_chunks(result.trace, 16_000, phase_us)
+    assert any(len(c.data) == 1 for c in chunks)  # the case that broke frames is in the stream
+    session = session_of(chunks)
+    wire = [(f.direction, f.data) for f in sorted(result.trace, key=lambda f: f.t_start_us)]
+    assert [(f.direction, f.data) for f in session.frames] == wire
+    assert not rules_of(session)
 
 
 def test_a_chunk_that_ends_one_byte_into_the_reply_does_not_break_it():
@@ -310,6 +360,12 @@ def test_a_verify_trace_as_raw_bytes_gets_the_same_frames_and_verdicts(name):
     a chunk): the monitor finds the same frames, sides and rule results as `verify`
     (RESPONSE-HANDLING aside: a capture cannot see the PLC's outputs)."""
     result = run_scenario(load_scenario(ROOT / "plc" / "scenarios" / f"{name}.toml"))
+    assert_the_monitor_judges_as_verify(result)
+
+
+def assert_the_monitor_judges_as_verify(result) -> None:
+    """`result`'s trace as raw bytes, each frame a chunk: the monitor finds the same frames
+    and sides, and the same violations per rule at the same times, as `verify` did."""
     chunks = [Chunk(f.t_end_us, f.data) for f in sorted(result.trace, key=lambda f: f.t_start_us)]
     session = session_of(chunks, tolerance_us=0)
     expected = [(f.t_start_us, f.direction, f.data) for f in sorted(result.trace, key=lambda f: f.t_start_us)]
@@ -320,6 +376,41 @@ def test_a_verify_trace_as_raw_bytes_gets_the_same_frames_and_verdicts(name):
     judged.pop("UITAMR-RESPONSE-HANDLING")
     wanted.pop("UITAMR-RESPONSE-HANDLING")
     assert judged == wanted
+
+
+def _bad_crc(request) -> bytes:
+    data = bytearray(protocol.encode(request, protocol.DEFAULT_SETTINGS))
+    data[6] ^= 0x10
+    return bytes(data)
+
+
+_SEQ_STOP = protocol.command_from_words("stop")
+_SEQ_READ = protocol.command_from_words("read task")
+_SEQ_POINT = protocol.command_from_words("run-point 3")
+#: programs that break rules (tests/test_verify_pipeline.py's sequencer): what verify finds
+_BREAKING = {
+    "cycle": ({"UITAMR-CYCLE"}, dict(frames=[_SEQ_STOP, _SEQ_POINT, _SEQ_READ])),
+    "poweron-stop": ({"UITAMR-POWERON-STOP"}, dict(frames=[_SEQ_READ, _SEQ_POINT, _SEQ_READ, _SEQ_STOP])),
+    "pacing": ({"UITAMR-PACING"}, dict(frames=[_SEQ_STOP, _SEQ_READ, _SEQ_READ], period="T#200ms")),
+    "format": ({"UITAMR-FORMAT"}, dict(frames=[_SEQ_STOP, protocol.with_crc(bytes.fromhex("010100000008")),
+                                               _SEQ_READ])),
+    "crc": ({"UITAMR-CRC"}, dict(frames=[_SEQ_STOP, _bad_crc(_SEQ_READ)])),
+    "one-at-a-time": ({"UITAMR-ONE-AT-A-TIME", "UITAMR-HALF-DUPLEX"},
+                      dict(frames=[_SEQ_STOP, _SEQ_READ, _SEQ_READ, _SEQ_READ],
+                           faults=[{"kind": "no_reply", "at_s": 0.5, "duration_s": 0.5}])),
+}
+
+
+@pytest.mark.parametrize("name", sorted(_BREAKING))
+def test_a_program_that_breaks_a_rule_is_judged_by_the_monitor_as_by_verify(name, tmp_path):
+    """The comparison above on programs that break the rules: the bundled scenarios break
+    none, so there it shows only that the monitor blames nothing verify does not."""
+    from test_verify_pipeline import run_sequence
+
+    broken, sequence = _BREAKING[name]
+    result = run_sequence(tmp_path, **sequence)
+    assert {rule for rule, found in result.violations.items() if found} == broken
+    assert_the_monitor_judges_as_verify(result)
 
 
 def test_replay_of_a_verify_trace_file(tmp_path):
@@ -377,7 +468,12 @@ def test_a_bad_master_on_a_real_line_gets_exactly_its_findings(line, tmp_path):
     out, err = monitor.communicate(timeout=WAIT_S)
     assert monitor.returncode == 1, out + err
     assert findings(tmp_path / "m.json") == Counter(BAD_MASTER_FINDINGS)
-    assert "UITAMR-POWERON-STOP" in out and "run point/script 1" in out  # the live line names it
+    live, summary = out.split("\nFAIL monitor ", 1)
+    # each finding was printed live (its time, rule, message and frames), before the summary
+    assert re.search(r"^0\.000 s  UITAMR-POWERON-STOP: the first control command after power-on is run "
+                     r"point/script 1 \(01/01\)", live, re.M), out
+    assert re.search(r"^ +0\.000 s  PLC → robot  01 06 01 01 00 00 D9 F6  run point/script 1", live, re.M), out
+    assert Counter(re.findall(r"^\d+\.\d{3} s  (UITAMR-[A-Z-]+): ", live, re.M)) == Counter(BAD_MASTER_FINDINGS)
     assert "<testcase" in (tmp_path / "m.xml").read_text() and "<svg" in (tmp_path / "m.html").read_text()
     done = subprocess.run(uitamr("replay", tmp_path / "c.txt", "--json", tmp_path / "r.json"),
                           capture_output=True, text=True, timeout=WAIT_S)
@@ -510,35 +606,101 @@ def test_ctrl_c_stops_the_monitor_and_the_reports_are_written(line, tmp_path):
 
 
 # --------------------------------------------------------------------- the converter route (TCP)
-def test_monitor_on_a_tcp_stream(tmp_path):
-    """A TCP server on 127.0.0.1 streams the bad master's line, chunk by chunk at its times
-    (what a serial-to-Ethernet converter on a second tap does); the monitor connects."""
-    (chunks,) = read_capture(CAPTURES / "bad-master.txt").values()
-    server = socket.create_server(("127.0.0.1", 0))
-    port = server.getsockname()[1]
+class BadMasterStream:
+    """A TCP server on 127.0.0.1 that streams the bad master's line to the one client that
+    connects, chunk by chunk at its times (what a serial-to-Ethernet converter on a second
+    tap does) from `lead_s` after the connection, stays `linger_s` and closes."""
 
-    def stream():
-        connection, _ = server.accept()
+    def __init__(self, linger_s: float = 0.3, lead_s: float = 0.0):
+        (self.chunks,) = read_capture(CAPTURES / "bad-master.txt").values()
+        self.server = socket.create_server(("127.0.0.1", 0))
+        self.port = self.server.getsockname()[1]
+        self.linger_s, self.lead_s = linger_s, lead_s
+        self.thread = threading.Thread(target=self._stream, daemon=True)
+        self.thread.start()
+
+    def _stream(self):
+        connection, _ = self.server.accept()
         with connection:
-            t0 = time.monotonic()
-            first = chunks[0].t_us
-            for chunk in chunks:
+            time.sleep(self.lead_s)
+            t0, first = time.monotonic(), self.chunks[0].t_us
+            for chunk in self.chunks:
                 delay = t0 + (chunk.t_us - first) / 1_000_000 - time.monotonic()
                 if delay > 0:
                     time.sleep(delay)
                 connection.sendall(chunk.data)
-            time.sleep(0.3)
+            time.sleep(self.linger_s)
 
-    thread = threading.Thread(target=stream, daemon=True)
-    thread.start()
-    done = subprocess.run(uitamr("monitor", "--tcp", f"127.0.0.1:{port}", "--duration", "10s",
+    def close(self):
+        self.thread.join(timeout=5)
+        self.server.close()
+
+
+def test_monitor_on_a_tcp_stream(tmp_path):
+    """The monitor connects to a converter's TCP stream of the bad master's line."""
+    stream = BadMasterStream()
+    done = subprocess.run(uitamr("monitor", "--tcp", f"127.0.0.1:{stream.port}", "--duration", "10s",
                                  "--json", tmp_path / "m.json"), capture_output=True, text=True, timeout=60)
-    thread.join(timeout=5)
-    server.close()
+    stream.close()
     assert done.returncode == 1, done.stdout + done.stderr
     assert "the server closed the connection" in done.stdout  # ended by the stream, reports still written
-    assert f"reading, connected to tcp 127.0.0.1:{port}" in done.stdout  # a client, not a listener
+    assert f"reading, connected to tcp 127.0.0.1:{stream.port}" in done.stdout  # a client, not a listener
     assert findings(tmp_path / "m.json") == Counter(BAD_MASTER_FINDINGS)
+
+
+def test_monitor_serial_takes_a_pyserial_url(tmp_path):
+    """--serial takes pyserial URLs as well as device names: socket:// reads the same
+    stream through pyserial's own URL handler, and finds the bad master's findings. (The
+    stream starts 0.3 s after the connection: pyserial's socket:// open empties the
+    socket, and would drop bytes already sent, as a monitor started mid-frame would.)"""
+    stream = BadMasterStream(linger_s=1.0, lead_s=0.3)
+    done = subprocess.run(uitamr("monitor", "--serial", f"socket://127.0.0.1:{stream.port}", "--duration", "3s",
+                                 "--json", tmp_path / "m.json"), capture_output=True, text=True, timeout=60)
+    stream.close()
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert f"listening on socket://127.0.0.1:{stream.port} (9600 8N1" in done.stdout
+    assert findings(tmp_path / "m.json") == Counter(BAD_MASTER_FINDINGS)
+
+
+def test_on_a_terminal_a_rich_panel_counts_frames_and_findings_under_the_lines(tmp_path):
+    """The live console view: the monitor's output is a terminal (a pty), so a rich panel
+    under the frame lines counts requests, replies and findings per rule while it runs;
+    the frames and findings are still printed as lines above it."""
+    import pty
+
+    stream = BadMasterStream(linger_s=1.0)  # the panel refreshes 4 times a second: let it show the last counts
+    terminal, end = pty.openpty()
+    monitor = subprocess.Popen(uitamr("monitor", "--tcp", f"127.0.0.1:{stream.port}", "--duration", "10s"),
+                               stdin=end, stdout=end, stderr=end,
+                               env={**os.environ, "COLUMNS": "160", "LINES": "40", "TERM": "xterm"})
+    os.close(end)
+    out = b""
+    deadline = time.monotonic() + WAIT_S
+    while time.monotonic() < deadline:
+        ready, _, _ = select.select([terminal], [], [], 0.2)
+        if ready:
+            try:
+                data = os.read(terminal, 65536)
+            except OSError:  # the monitor closed its end
+                break
+            if not data:
+                break
+            out += data
+        elif monitor.poll() is not None:
+            break
+    os.close(terminal)
+    monitor.wait(timeout=WAIT_S)
+    stream.close()
+    text = re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", out.decode("utf-8", errors="replace"))
+    assert monitor.returncode == 1, text
+    assert f"uitamr monitor — tcp 127.0.0.1:{stream.port} (Ctrl-C stops and writes the reports)" in text
+    rows = re.findall(r"│ (\d+) +│ (\d+) +│ ([^│]*?) +│", text)
+    assert ("0", "0", "none") in rows  # the panel is there from the start ...
+    # ... and counts (the PACING count depends on the host keeping the stream's 100 ms gaps)
+    assert any(row[:2] == ("6", "5") and "UITAMR-CRC ×1" in row[2] and "UITAMR-POWERON-STOP ×1" in row[2]
+               for row in rows), rows
+    assert "01 06 01 01 00 00 D9 F6    run point/script 1 (01/01)" in text  # the frame lines above it
+    assert "0.000 s  UITAMR-POWERON-STOP: the first control command" in text  # a finding line above it
 
 
 def test_a_converter_that_drops_the_connection_inside_a_frame_is_not_the_plcs_short_frame(tmp_path):

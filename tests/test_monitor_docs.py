@@ -30,6 +30,12 @@ def test_the_default_tolerance_is_the_codes():
     assert f"**{DEFAULT_TOLERANCE_US // 1000} ms**" in DOC and f"`{DEFAULT_TOLERANCE_US // 1000}ms`" in DOC
 
 
+def test_how_soon_a_finding_shows_is_the_codes():
+    from verifier.commands.monitor import CHECK_EVERY_S
+
+    assert f"at the next of the monitor's checks (every {CHECK_EVERY_S:g} s)" in " ".join(DOC.split())
+
+
 def test_the_example_capture_reads():
     block = DOC.split("# uitamr monitor capture of /dev/ttyUSB0, 9600 8N1\n", 1)[1].split("```", 1)[0]
     session = MonitorSession(CaptureInfo("doc", "doc"))

@@ -20,6 +20,26 @@ def test_there_are_bundled_scenarios_for_every_platform():
         assert any(n.startswith(prefix) for n in names), prefix
 
 
+#: the routes of issue 9, each a bundled scenario that `uitamr verify` runs by default:
+#: the two Ethernet ports through a healthy, refusing, dropping, splitting and silent
+#: converter, and the FX3U's RS-232 adapter
+ROUTE_SCENARIOS = {
+    **{f"{platform}-tcp-{case}": (platform, True) for platform in ("fx5u", "q")
+       for case in ("healthy", "refused", "dropped", "split", "no-reply")},
+    "fx3u-rs232-healthy": ("fx3u", False),
+}
+
+
+@pytest.mark.parametrize("name", sorted(ROUTE_SCENARIOS))
+def test_every_route_case_is_a_bundled_scenario_of_the_default_run(name):
+    from verifier.commands.verify import bundled_scenarios
+
+    assert ROOT / "plc" / "scenarios" / f"{name}.toml" in bundled_scenarios()
+    platform, over_tcp = ROUTE_SCENARIOS[name]
+    scenario = load_scenario(ROOT / "plc" / "scenarios" / f"{name}.toml")
+    assert scenario.platform == platform and (scenario.converter is not None) == over_tcp
+
+
 @pytest.mark.parametrize("path", SCENARIOS, ids=[p.stem for p in SCENARIOS])
 def test_bundled_scenario_passes(path):
     result = run_scenario(load_scenario(path))

@@ -435,3 +435,108 @@ def test_the_faster_poll_changes_nothing(path, monkeypatch):
     now = run_scenario(scenario)
     monkeypatch.setattr(TcpPort, "poll", _poll_before)
     assert _comparable(now) == _comparable(run_scenario(scenario))
+
+
+@pytest.mark.parametrize("platform", ["fx5u", "q"])
+def test_the_port_opens_again_after_the_documented_back_off(platform):
+    """docs/tcp-converter.md and the error table: after a failed open the port tries again
+    after 0.5 s, 1 s, 2 s, 4 s, then every 8 s; the drop of a connection that was open is a
+    first failure again, so the next open follows 0.5 s later. Measured on the converter's events (each open it saw),
+    allowing each wait a few scans (close, open, the converter's connect time)."""
+    scenario = load_scenario(SCENARIOS / f"{platform}-tcp-refused.toml")
+    result = run_scenario(replace(scenario, duration_us=40_000_000, expectations=(),
+                                  converter=replace(scenario.converter, refuse_until_us=30_000_000)))
+    opens = [(e.t_us, e.kind) for e in result.events if e.kind in ("converter.refused", "converter.accepted")]
+    assert [kind for _, kind in opens] == ["converter.refused"] * 7 + ["converter.accepted"]
+    waits = [later - earlier for (earlier, _), (later, _) in zip(opens, opens[1:])]
+    for wait, back_off in zip(waits, [500_000, 1_000_000, 2_000_000, 4_000_000, 8_000_000, 8_000_000, 8_000_000]):
+        assert back_off <= wait <= back_off + 60_000, waits
+    scenario = load_scenario(SCENARIOS / f"{platform}-tcp-dropped.toml")
+    result = run_scenario(replace(scenario, duration_us=25_000_000, expectations=()))
+    events = [(e.t_us, e.kind) for e in result.events if e.kind in ("converter.dropped", "converter.accepted")]
+    assert [kind for _, kind in events] == ["converter.accepted", "converter.dropped", "converter.accepted"]
+    assert 500_000 <= events[2][0] - events[1][0] <= 600_000
+
+
+@pytest.mark.parametrize("platform", ["fx5u", "q"])
+def test_a_frame_sent_with_no_connection_fails_the_attempt_with_0314(platform):
+    """docs/tcp-converter.md: a frame the engine sends while there is no connection is not
+    sent (16#0314) and the engine repeats it; after three failed attempts it ends with
+    16#0108, detail 16#0314. Here the converter refuses every open: the port holds
+    16#0310 (the open), the engine 16#0108/16#0314, and nothing reaches the robot."""
+    scenario = load_scenario(SCENARIOS / f"{platform}-tcp-refused.toml")
+    result = run_scenario(replace(scenario, duration_us=5_000_000, expectations=(),
+                                  watch=scenario.watch + ("fbEngine.o_uErrDetail", "fbEngine.o_wRetryCount"),
+                                  converter=replace(scenario.converter, refuse_until_us=30_000_000)))
+    watched = dict(result.watched)
+    assert not result.trace
+    assert watched["fbPort.o_uErrId"][-1][1] == 0x0310
+    assert (watched["fbEngine.o_uErrId"][-1][1], watched["fbEngine.o_uErrDetail"][-1][1]) == (0x0108, 0x0314)
+    retries = [v for _, v in watched["fbEngine.o_wRetryCount"]]
+    assert retries[:4] == [0, 1, 2, 3]  # repeated, not sent
+
+
+TCP_LINK_HARNESS = """
+PROGRAM T_Tcp
+VAR
+    fbLink : UITAMR_TcpLink;
+    uPort : ARRAY[0..39] OF WORD;
+    uSockSend : ARRAY[0..8] OF WORD;
+    uSockRecv : ARRAY[0..8] OF WORD;
+    bEN : BOOL; bConnected : BOOL; bOpenDone : BOOL; bOpenErr : BOOL; uOpenStatus : WORD;
+    bSendDone : BOOL; bSendErr : BOOL; uSendStatus : WORD;
+    bRecvReady : BOOL; bRecvDone : BOOL; bRecvErr : BOOL; uRecvStatus : WORD; bCloseDone : BOOL;
+END_VAR
+fbLink(i_bEN := bEN, i_bConnected := bConnected, i_bOpenDone := bOpenDone, i_bOpenErr := bOpenErr,
+       i_uOpenStatus := uOpenStatus, i_bSendDone := bSendDone, i_bSendErr := bSendErr,
+       i_uSendStatus := uSendStatus, i_bRecvReady := bRecvReady, i_bRecvDone := bRecvDone,
+       i_bRecvErr := bRecvErr, i_uRecvStatus := uRecvStatus, i_bCloseDone := bCloseDone,
+       io_uPort := uPort, io_uSockSend := uSockSend, io_uSockRecv := uSockRecv);
+END_PROGRAM
+"""
+
+
+def test_tcp_link_send_and_receive_errors_are_0312_and_0313_as_the_error_table_says():
+    """UITAMR_TcpLink driven by hand (no instruction model can fail a send or a receive on
+    an open connection): the engine's frame goes to the send instruction as raw RTU bytes,
+    CRC included, low byte first; a failed send is 16#0312 with its completion status and
+    fails the engine's attempt at once (port word 4 = 16#0312, as the engine's 16#0108
+    detail); a failed receive is 16#0313 and fails nothing (docs/plc-library.md)."""
+    import verifier
+
+    guide = (Path(__file__).resolve().parents[1] / "docs" / "plc-library.md").read_text(encoding="utf-8")
+    assert "port code (16#0306/0307/0309, 16#0311/0312/0314)" in guide
+    assert "| 16#0313 | TCP port: the receive instruction completed with an error | completion status | " \
+           "the bytes of that receive are dropped; the attempt is not failed at once" in guide
+    h = verifier.load(Path(__file__).resolve().parents[1] / "plc" / "core",
+                      sources={"T_Tcp.st": TCP_LINK_HARNESS}).program("T_Tcp")
+    h.bEN = True
+    h.scan()
+    assert h.fbLink.o_bOpen
+    h.bOpenDone = h.bConnected = True
+    h.scan()
+    h.bOpenDone = False
+    h.scan()
+    assert h.fbLink.o_bConnected and h.fbLink.o_uErrId == 0
+    for k, byte in enumerate(STOP):  # the engine's request on the port interface
+        h.uPort[8 + k] = byte
+    h.uPort[1], h.uPort[0] = len(STOP), 1
+    h.scan()
+    assert h.fbLink.o_bSend
+    assert [h.uSockSend[k] for k in range(5)] == [8, 0x0601, 0xA001, 0x0000, 0x1488]
+    h.bSendDone, h.bSendErr, h.uSendStatus = True, True, 0xC0A1
+    h.scan()
+    h.bSendDone = h.bSendErr = False
+    assert (h.fbLink.o_bErr, h.fbLink.o_uErrId, h.fbLink.o_uErrDetail) == (True, 0x0312, 0xC0A1)
+    h.scan(2)
+    assert (h.uPort[2], h.uPort[3], h.uPort[4]) == (1, 0, 0x0312)  # the attempt failed, no bytes
+    h.uPort[2] = 0  # the engine took it
+    h.bRecvReady = True
+    h.scan()
+    assert h.fbLink.o_bRecv
+    h.bRecvReady, h.bRecvDone, h.bRecvErr, h.uRecvStatus = False, True, True, 0x1234
+    h.scan()
+    h.bRecvDone = h.bRecvErr = False
+    assert (h.fbLink.o_bErr, h.fbLink.o_uErrId, h.fbLink.o_uErrDetail) == (True, 0x0313, 0x1234)
+    h.scan(3)
+    assert h.uPort[2] == 0  # no reply handed to the engine: its reply time-out decides

@@ -974,6 +974,33 @@ def test_a_program_the_sources_lack_is_reported_at_the_scenarios_program_line(tm
     assert "error: --program: no PROGRAM 'OTHER' in the sources; they define: MAIN" in result.output
 
 
+def test_a_function_block_as_program_and_a_channel_the_cpu_lacks_are_reported_at_their_lines(tmp_path, monkeypatch):
+    # issue 11: every scenario error has file:line:column; these two named the file only
+    # ('s.toml: FB_X is a FUNCTION_BLOCK, not a PROGRAM', 's.toml: channel q:1 does not exist
+    # on the fx3u CPU'), though the key that says so is in the file
+    (tmp_path / "MAIN.st").write_text(NEVER_REARMED, encoding="utf-8")
+    (tmp_path / "FB_X.st").write_text("FUNCTION_BLOCK FB_X\nVAR_INPUT i_b : BOOL; END_VAR\nEND_FUNCTION_BLOCK\n",
+                                      encoding="utf-8")
+    (tmp_path / "fb.toml").write_text('name = "x"\nsources = ["MAIN.st", "FB_X.st"]\nprogram = "FB_X"\n',
+                                      encoding="utf-8")
+    (tmp_path / "ch.toml").write_text('name = "x"\nsources = ["MAIN.st"]\nplatform = "fx3u"\nchannel = "q:1"\n',
+                                      encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("--scenario", "fb.toml")
+    assert result.exit_code == 2
+    assert "error: fb.toml:3:11: program: FB_X is a FUNCTION_BLOCK, not a PROGRAM: name the PROGRAM" in result.output
+    result = invoke("--scenario", "ch.toml")
+    assert result.exit_code == 2
+    assert ("error: ch.toml:4:11: channel: channel q:1 does not exist on the fx3u CPU; the fx3u CPU has "
+            "fx3:1, fx3:2, adp:1") in result.output
+    # given on the command line, the option is the place, not the file's line
+    result = invoke("--scenario", "fb.toml", "--program", "FB_X")
+    assert result.exit_code == 2 and "error: --program: FB_X is a FUNCTION_BLOCK" in result.output
+    (tmp_path / "fx3u.toml").write_text('name = "x"\nsources = ["MAIN.st"]\nplatform = "fx3u"\n', encoding="utf-8")
+    result = invoke("--scenario", "fx3u.toml", "--channel", "q:2")
+    assert result.exit_code == 2 and "error: --channel: channel q:2 does not exist on the fx3u CPU" in result.output
+
+
 def test_matrix_with_two_programs_asks_for_program_without_naming_a_bundled_file(tmp_path, monkeypatch):
     # the error named plc/scenarios/fx3u-address-out-of-range.toml and its 'program' key,
     # a file the user did not write and cannot change

@@ -19,6 +19,7 @@ import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from urllib.parse import quote
 
 from verifier.st.ast import Diagnostic
 from verifier.textfile import shown_path
@@ -104,6 +105,16 @@ def to_github(findings: list[Finding]) -> str:
     return "\n".join(out)
 
 
+def _artifact(file: str) -> dict:
+    """A SARIF artifactLocation: a URI reference (percent-encoded: spaces, '%', non-ASCII
+    letters, ':'), relative to %SRCROOT% below the working directory, else an absolute
+    file: URI without a base (SARIF 2.1.0 §3.4.4)."""
+    path = relative(file)
+    if Path(path).is_absolute():
+        return {"uri": Path(path).as_uri()}
+    return {"uri": quote(path, safe="/"), "uriBaseId": "%SRCROOT%"}
+
+
 def to_sarif(findings: list[Finding], version: str, rules: dict[str, str] = RULES) -> str:
     """SARIF 2.1.0, one run, for GitHub code scanning (upload-sarif) and SARIF viewers;
     `rules` are those the run lists (RULES, and PLATFORM_RULES with --platform)."""
@@ -112,7 +123,7 @@ def to_sarif(findings: list[Finding], version: str, rules: dict[str, str] = RULE
     results = []
     for f in findings:
         d = f.diagnostic
-        location: dict = {"artifactLocation": {"uri": relative(d.file), "uriBaseId": "%SRCROOT%"}}
+        location: dict = {"artifactLocation": _artifact(d.file)}
         if d.line >= 1:
             region = {"startLine": d.line, "startColumn": max(d.col, 1)}
             if d.end_line and d.end_line >= d.line and d.end_col:

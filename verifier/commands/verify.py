@@ -153,7 +153,8 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
         scenarios = [_cut_short(s) for s in scenarios]
     # what the command line set, for the messages that blame an option rather than a file's line
     scenarios = [replace(s, platform_from_option=platform_given, program_from_option=program is not None,
-                         duration_from_option=duration is not None) for s in scenarios]
+                         channel_from_option=channel is not None, duration_from_option=duration is not None)
+                 for s in scenarios]
     if scan is not None and duration is not None and scan > duration:
         # both values are the options': no file's line is to blame
         raise UnusableInput(f"--scan {format_duration(scan)}: the scan time is longer than the whole run "

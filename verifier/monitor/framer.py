@@ -7,7 +7,9 @@ between them and a request and its reply may come in one chunk. The framer there
 cuts by content first — every frame of this protocol is 8 bytes, an exception reply 5,
 known from the function code — and by silence only where content cannot tell: a gap ends
 a frame of unknown length when it exceeds t3.5, and a frame of known length that is still
-incomplete only when it exceeds t3.5 plus the host's timing tolerance.
+incomplete only when it exceeds t3.5 plus the host's timing tolerance; so does a lone
+byte, whose length its function code, the next byte, will tell (the latency timer may run
+out one byte into a frame).
 
 Times: a chunk's bytes are taken to have arrived back to back, the last one when the read
 returned, so a frame starts one frame-time before the chunk that completes it (or at its
@@ -140,7 +142,8 @@ class Framer:
     def _silence_ends_frame(self, t_us: int) -> bool:
         gap = t_us - (self._last_us if self._last_us is not None else t_us)
         length = frame_length_either_side(self._buffer)
-        undecided = length is not None and (len(self._buffer) < length or len(self._buffer) == length + 1)
+        undecided = len(self._buffer) < 2 or (  # one byte: its frame's length is not known yet
+            length is not None and (len(self._buffer) < length or len(self._buffer) == length + 1))
         if undecided:  # a frame, or the next frame's first byte, still incomplete
             return gap >= self.timing.silence_us + self.timing.tolerance_us
         return gap >= self.timing.silence_us

@@ -72,6 +72,31 @@ def _empty_folder(path: Path) -> ast.Diagnostic:
                           f"*.st files, not its subfolders){hint}")
 
 
+def serial_channels_of(cpu) -> list[str]:
+    """The serial channels a CPU (a cpu.CpuProfile) has: its own ports ("fx3:1", "fx3:2" /
+    "fx5:1", "fx5:2" / "q:1", "q:2") and, where it has ADPRW, the MODBUS master's ("adp:1")."""
+    from .instructions import lookup
+
+    adprw, _ = lookup("ADPRW", cpu.family)
+    families = {cpu.family, "adp"} if cpu.family in adprw.families else {cpu.family}
+    return [c for c in CHANNELS if c.split(":")[0] in families]
+
+
+def channel_problem(channel: str, cpu) -> str | None:
+    """Why `channel` cannot be attached on `cpu`, naming the channels it has; None if it can
+    (also for the scenario reader: a channel its platform lacks is an error at its line)."""
+    have = serial_channels_of(cpu)
+    if channel in have:
+        return None
+    if channel in CHANNELS:
+        problem = f"channel {channel} does not exist on the {cpu.name} CPU"
+    elif channel in NOT_SIMULATED:
+        problem = f"channel {channel} is not simulated: {NOT_SIMULATED[channel]}"
+    else:
+        problem = f"unknown serial channel {channel!r}"
+    return f"{problem}; the {cpu.name} CPU has {', '.join(have)}"
+
+
 class Project:
     """One simulated CPU running the loaded ST."""
 
@@ -362,25 +387,14 @@ class Project:
 
     # ------------------------------------------------------------------ serial
     def serial_channels(self) -> list[str]:
-        """The serial channels this CPU has: its own ports ("fx3:1", "fx3:2" / "fx5:1",
-        "fx5:2" / "q:1", "q:2") and, where it has ADPRW, the MODBUS master's ("adp:1")."""
-        from .instructions import lookup
-
-        adprw, _ = lookup("ADPRW", self.cpu.family)
-        families = {self.cpu.family, "adp"} if self.cpu.family in adprw.families else {self.cpu.family}
-        return [c for c in CHANNELS if c.split(":")[0] in families]
+        """The serial channels this CPU has (`serial_channels_of`)."""
+        return serial_channels_of(self.cpu)
 
     def _serial_channel(self, channel: str):
         """The channel by name; ValueError naming the channels this CPU has otherwise."""
-        have = self.serial_channels()
-        if channel not in have:
-            if channel in CHANNELS:
-                problem = f"channel {channel} does not exist on the {self.cpu.name} CPU"
-            elif channel in NOT_SIMULATED:
-                problem = f"channel {channel} is not simulated: {NOT_SIMULATED[channel]}"
-            else:
-                problem = f"unknown serial channel {channel!r}"
-            raise ValueError(f"{problem}; the {self.cpu.name} CPU has {', '.join(have)}")
+        problem = channel_problem(channel, self.cpu)
+        if problem is not None:
+            raise ValueError(problem)
         return self.rt.channel(channel)
 
     def attach_serial(self, channel: str, endpoint) -> None:

@@ -75,7 +75,7 @@ class _Plc:
             else:
                 self.project.attach_serial(scenario.serial_channel, line)
         except ValueError as exc:
-            raise UnusableInput(f"{_where(scenario)}: {exc}") from None
+            raise UnusableInput(f"{_key_where(scenario, 'channel')}: {exc}") from None
         self.name = self._program_name(scenario)
         self.program = self.project.program(self.name)
 
@@ -106,7 +106,8 @@ class _Plc:
         wanted = (scenario.program or "").upper()
         other = next((pou for f in self.project.files for pou in f.pous if pou.key == wanted), None)
         if other is not None and other.kind != "PROGRAM":  # the FB under test named instead of its caller
-            raise UnusableInput(f"{_where(scenario)}: {other.name} is a {other.kind}, not a PROGRAM: name the PROGRAM "
+            raise UnusableInput(f"{_key_where(scenario, 'program')}: {other.name} is a {other.kind}, not a PROGRAM: "
+                                f"name the PROGRAM "
                                 f"that calls it (the sources define: {listing})")
         if not programs:
             raise UnusableInput(f"{_where(scenario)}: the sources define no PROGRAM, only function blocks and "
@@ -123,13 +124,8 @@ class _Plc:
         for name in programs:
             if name.upper() == scenario.program.upper():
                 return name
-        if "program" in scenario.key_lines:
-            where = scenario.where("program", scenario.key_lines["program"])
-        elif scenario.program_from_option:
-            where = "--program"  # given on the command line: no file is where to look
-        else:
-            where = _where(scenario)
-        raise UnusableInput(f"{where}: no PROGRAM {scenario.program!r} in the sources; they define: {listing}")
+        raise UnusableInput(f"{_key_where(scenario, 'program')}: no PROGRAM {scenario.program!r} in the sources; "
+                            f"they define: {listing}")
 
     @property
     def now_us(self) -> int:
@@ -245,6 +241,16 @@ def _platform_hint(scenario: Scenario) -> str:
 
 def _where(scenario: Scenario) -> str:
     return str(scenario.path) if scenario.path else f"scenario {scenario.name!r}"
+
+
+def _key_where(scenario: Scenario, key: str) -> str:
+    """Where the scenario's `key` ('program', 'channel') was given: `file:line:col: key`,
+    `--key` when the command line's option replaced the file's, else the file."""
+    if key in scenario.key_lines:
+        return scenario.where(key, scenario.key_lines[key])
+    if getattr(scenario, f"{key}_from_option"):
+        return f"--{key}"  # given on the command line: no file is where to look
+    return _where(scenario)
 
 
 def _display_path(path: Path | None) -> str | None:

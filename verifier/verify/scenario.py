@@ -36,13 +36,6 @@ PLATFORMS = {
     "q": ("gxworks2", "q:1"),
 }
 CHANNELS = ("fx3:1", "fx3:2", "fx5:1", "fx5:2", "q:1", "q:2", "adp:1")
-#: the channels each platform's simulated CPU has (`Project.serial_channels`; ADPRW's adp:1
-#: on the FX CPUs only), so that a channel of another CPU is an error at its line
-PLATFORM_CHANNELS = {
-    "fx3u": ("fx3:1", "fx3:2", "adp:1"),
-    "fx5u": ("fx5:1", "fx5:2", "adp:1"),
-    "q": ("q:1", "q:2"),
-}
 DEFAULT_DURATION_US = 60_000_000
 #: The longest run accepted (virtual time). A day of 10 ms scans takes the simulator about
 #: an hour; anything longer is almost always a typo ("1000h") and would look like a hang.
@@ -156,6 +149,7 @@ class Scenario:
     platform_from_option: bool = False  # the platform is --platform's, not the file's (for messages)
     for_sources: bool = False  # a bundled scenario run against the user's sources (--matrix)
     program_from_option: bool = False  # the program is --program's, not the file's (for messages)
+    channel_from_option: bool = False  # the channel is --channel's, not the file's (for messages)
     duration_from_option: bool = False  # the run's length is --duration's (for messages)
 
     @property
@@ -213,9 +207,10 @@ class Scenario:
 
     def with_overrides(self, **changes: Any) -> "Scenario":
         changes = {k: v for k, v in changes.items() if v is not None}
-        if "program" in changes and "program" in self.key_lines:
-            # --program replaces the file's: its errors are no longer at the file's line
-            changes["key_lines"] = {k: v for k, v in self.key_lines.items() if k != "program"}
+        replaced = [key for key in ("program", "channel") if key in changes and key in self.key_lines]
+        if replaced:
+            # --program/--channel replace the file's: their errors are no longer at the file's line
+            changes["key_lines"] = {k: v for k, v in self.key_lines.items() if k not in replaced}
         return replace(self, **changes)
 
 
@@ -436,14 +431,16 @@ class _Reader:
             channel = self.string(data["channel"], "channel")
             if channel not in CHANNELS:
                 raise self.fail("channel", f"unknown channel {channel!r}; expected one of {', '.join(CHANNELS)}")
-            if channel not in PLATFORM_CHANNELS[platform]:
-                told = ""
-                if "platform" not in data:  # the platform is the default (or --platform's)
-                    owner = next(p for p, have in PLATFORM_CHANNELS.items() if channel in have)
+            from verifier.sim.cpu import PROFILES
+            from verifier.sim.project import channel_problem, serial_channels_of
+
+            problem = channel_problem(channel, PROFILES[platform])  # as verify's load would refuse it
+            if problem is not None:
+                owner = next((p for p in PLATFORMS if channel in serial_channels_of(PROFILES[p])), None)
+                if "platform" not in data and owner is not None:  # the platform is the default (or --platform's)
                     given = "--platform's" if self.platform_option else "the default platform"
-                    told = f" ({platform} is {given}: set platform = \"{owner}\", the CPU that has {channel})"
-                raise self.fail("channel", f"channel {channel} does not exist on the {platform} CPU; it has "
-                                           f"{', '.join(PLATFORM_CHANNELS[platform])}{told}")
+                    problem += f" ({platform} is {given}: set platform = \"{owner}\", the CPU that has {channel})"
+                raise self.fail("channel", problem)
         duration = self.duration(data.get("duration", "60s"), "duration")
         if duration > MAX_DURATION_US:
             raise self.fail("duration", f"longer than the limit of {format_duration(MAX_DURATION_US)} of virtual time; "
@@ -520,6 +517,7 @@ class _Reader:
         keys += ["response_handling.signal"] if signal_given else []
         keys += ["platform"] if "platform" in data else []
         keys += ["program"] if program is not None else []
+        keys += ["channel"] if channel is not None else []
         conditions = [(f"{e.key}.{e.kind}", e.condition) for e in expectations if e.condition is not None]
         conditions += [("response_handling.signal", options.response_signal)] if signal_given else []
         return Scenario(
