@@ -352,3 +352,17 @@ def test_frames_taken_as_they_settle_are_the_trace_in_order(script, faults):
     # no frame handed over later starts before the frontier said at the time
     for handed, frontier in frontiers:
         assert all(f.t_start_us >= frontier for f in taken[handed:])
+
+
+def test_a_frame_the_robot_cannot_read_is_on_the_line_but_discarded():
+    """send(..., unreadable=why): the PLC's port runs at another line format; the bytes are
+    traced as sent, the robot discards the frame with that reason and stays silent."""
+    line = make_line()
+    line.send(STOP_FRAME, 0, origin="Main.st:3:1", unreadable="sent at 19200 8N1")
+    assert line.receive_until(300_000) == []
+    assert [(f.direction, f.data) for f in line.trace] == [("tx", STOP_FRAME)]
+    discarded = next(e for e in line.events if e.kind == "discarded")
+    assert discarded.message.endswith("discarded by the robot: sent at 19200 8N1")
+    assert not line.robot.stop_seen
+    line.send(STOP_FRAME, 400_000)                      # the same bytes readable: answered
+    assert bytes(b for b, _ in line.receive_until(800_000)) == STOP_FRAME

@@ -108,3 +108,15 @@ def test_the_wiring_checklist_catches_a_port_that_reads_its_own_frame():
     wiring = (ROOT / "docs" / "wiring-rs485.md").read_text()
     step = wiring.split("6. Once, with the pair unplugged at the robot", 1)[1]
     assert "16#0101" in step and "**UNCONFIRMED**" in step and "echo" in step
+
+
+def test_the_library_page_leads_to_the_wiring_of_every_port():
+    """Issue 6 asked docs/plc-library.md for the wiring of the FX3U-485-BD, the FX5U built-in
+    port and the QJ71C24N-R4; it moved to wiring-rs485.md (and wiring-rs232.md), which the
+    library page must still lead to, and which must still hold a section for each."""
+    text = DOC.read_text(encoding="utf-8")
+    for page, boards in {"wiring-rs485.md": ("FX3U-485-BD", "FX5U", "QJ71C24N-R4"),
+                         "wiring-rs232.md": ("FX3U",)}.items():
+        assert f"]({page})" in text.split("\n## ", 1)[0], f"plc-library.md's introduction does not link {page}"
+        headings = [h for h in (ROOT / "docs" / page).read_text(encoding="utf-8").splitlines() if h.startswith("#")]
+        assert all(any(board in h for h in headings) for board in boards), (page, headings)

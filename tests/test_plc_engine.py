@@ -447,6 +447,27 @@ def test_a_new_value_needs_a_new_edge(rig):
     assert encode(ControlRequest(1, 1, 6), SETTINGS) in port.kinds()
 
 
+
+def test_a_rising_edge_while_busy_is_ignored_as_the_library_page_says(rig):
+    """A second rising edge on the same FB while o_bBusy sends nothing: the running command
+    goes on and its o_bOK follows. plc-library.md said only "send the new value with a new
+    rising edge", which an integrator reads as "re-trigger at once"; it now says the edge
+    must come after the command has ended, as UITAMR_Command's header does."""
+    h, port = rig
+    port.running_polls = 8
+    start_point(h, port, point=1)
+    port.run(500)
+    assert h.fbRun.o_bBusy
+    h.bRun = False
+    port.run(50)
+    h.wPoint, h.bRun = 2, True                        # re-triggered while busy
+    port.run(8000, until=lambda x: x.fbRun.o_bOK or x.fbRun.o_bErr)
+    assert h.fbRun.o_bOK
+    assert encode(ControlRequest(1, 1, 2), SETTINGS) not in port.kinds()
+    page = " ".join((ROOT / "docs" / "plc-library.md").read_text(encoding="utf-8").split())
+    assert ("a new rising edge once the command has ended (`o_bOK` or `o_bErr`): a rising edge "
+            "while `o_bBusy` is ignored") in page
+
 # ---------------------------------------------------------------------------- i_bEN / o_bENO
 def test_eno_mirrors_en_on_command_fbs_and_engine(rig):
     h, port = rig

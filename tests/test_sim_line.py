@@ -93,3 +93,29 @@ def test_restart_sends_the_power_on_stop_again():
     after = [f for f in line.trace if f.direction == "tx" and f.t_start_us >= 2_500_000]
     assert after[0].data == STOP_FRAME
     assert after[0].t_start_us > 2_500_000
+
+
+@pytest.mark.parametrize("cpu, target, port, program, channel", PLATFORMS, ids=[p[3] for p in PLATFORMS])
+def test_stop_to_run_with_the_labels_kept_sends_the_stop_first(cpu, target, port, program, channel):
+    """Issue 6: the stop command goes first after power-on *or STOP->RUN*. A CPU that keeps
+    its labels over STOP->RUN (a Q keeps device memory; latched labels on any CPU) leaves
+    the engine initialised, so only the example's `i_bEN := NOT M8002` / `NOT SM402` makes
+    it send the stop again. Project.restart clears the labels (a power cycle), so the
+    restart test above passes without that line; here the CPU only stops for 0.5 s and its
+    next scan is a first scan again with every label as it was (the simulator has no STOP
+    mode of its own: virtual time passes unscanned, then the first-scan flag is set)."""
+    project = verifier.load(*CORE, st_file(port), st_file(program), target=target, cpu=cpu, scan_ms=10)
+    line = Line(Robot())
+    project.attach_serial(channel, line)
+    if cpu == "q":
+        project.configure_c24(0, 1, byte_units=True, receive_count=8, end_code=0xFFFF, no_reception_ms=20)
+    project.run_programs([program], ms=3000)
+    assert project.get(f"{program}.fbEngine.o_bInitDone") is True
+    polled = [f.data[1] for f in line.trace if f.direction == "tx" and f.t_start_us > 600_000]
+    assert polled and set(polled) == {0x01}              # idle: the engine polls the status
+    project.advance(500)                                  # STOP for 0.5 s ...
+    project.rt.scan_count = 0                             # ... then RUN: a first scan, labels kept
+    back = project.now_us
+    project.run_programs([program], ms=2000)
+    after = [f for f in line.trace if f.direction == "tx" and f.t_start_us >= back]
+    assert after and after[0].data == STOP_FRAME

@@ -1148,3 +1148,30 @@ def test_matrix_on_the_bundled_example_keeps_its_response_signal(tmp_path):
     notes = [n for s in json.loads(panel.read_text())["scenarios"] for n in s["notes"]]
     assert any("being written for UITAMR_ExampleFx3" in n and "its response signal (fbEngine.o_bErr)" in n
                for n in notes)
+
+
+def test_the_response_signal_ci_md_names_judges_a_fault_that_strikes_between_commands(tmp_path):
+    """docs/ci.md's --matrix job names the program's error output for
+    UITAMR-RESPONSE-HANDLING. The example's MAIN, built on the library as the bundled
+    examples are, failed the bundled persistent bad-CRC scenario under --matrix with the
+    signal ci.md showed (the cycle's o_bErr, 'fbRobot.o_bErr'): the matrix applies no
+    operator input, so that fault strikes while no command runs, when only the engine,
+    which polls the robot between commands, sees it. ci.md now names the engine's o_bErr
+    and says why; the cycle's still fails, as it should. (The scenario is re-aimed as
+    --matrix re-aims it, without running the whole matrix.)"""
+    from verifier.commands.verify import _with_signal
+    from verifier.verify.matrix import for_user_sources
+    from verifier.verify.runner import run_scenario
+    from verifier.verify.scenario import load_scenario
+
+    guide = (REPO / "docs" / "ci.md").read_text(encoding="utf-8")
+    signal = re.search(r'--matrix\n\s+--response-signal "([^"]+)"', guide).group(1)
+    main = tmp_path / "MAIN.st"
+    main.write_text((PLC / "examples" / "fx3" / "UITAMR_ExampleFx3.st").read_text(encoding="utf-8")
+                    .replace("PROGRAM UITAMR_ExampleFx3", "PROGRAM MAIN"), encoding="utf-8")
+    persistent = load_scenario(PLC / "scenarios" / "fx3u-bad-crc-persistent.toml")
+    mine = for_user_sources(persistent, (*FX3_SOURCES[:-1], main), "MAIN", None)
+    assert mine.inputs == ()
+    assert run_scenario(_with_signal(mine, signal)).passed
+    cycle = run_scenario(_with_signal(mine, "fbCycle.o_bErr"))
+    assert [rule for rule, found in cycle.violations.items() if found] == ["UITAMR-RESPONSE-HANDLING"]

@@ -291,6 +291,27 @@ def test_the_verifier_catches_a_broken_library(tmp_path, variant):
     assert expected <= broken_rules(result), f"{variant}: broke {broken_rules(result)}"
 
 
+
+@pytest.mark.parametrize("word, passes", [("16#1C91", False), ("16#1C87", False), ("16#1C80", False),
+                                          ("16#0C81", True)])
+def test_a_port_at_another_line_format_than_the_robots_fails(tmp_path, word, passes):
+    """D8400 = H1C81 (9600 8N1) is what the robot reads. A port set to 19200 8N1, 9600 8E1
+    or 9600 7N1 puts its frames on the line in a form the robot's UART cannot read, so it
+    never answers. The simulator used to note the format and let the robot answer anyway:
+    the run PASSed. H0C81 is 9600 8N1 too (without the RS-485 control bit) and passes."""
+    edit = {"fx3/UITAMR_PortFx3.st": [("COMM_FORMAT : WORD := 16#1C81;", f"COMM_FORMAT : WORD := {word};")]}
+    result = run_library(tmp_path, edit)
+    assert result.passed is passes
+    sent = [f for f in result.trace if f.direction == "tx"]
+    assert sent and sent[0].data == protocol.encode(STOP, S)          # sent as the program wrote it
+    answered = [f for f in result.trace if f.direction == "rx"]
+    if passes:
+        assert answered
+        return
+    assert answered == []
+    assert any(e.kind == "discarded" and "its receiver cannot read it" in e.message for e in result.events)
+    assert any(f"communication format D8400=H{word[3:]}" in d for d in result.diagnostics)
+
 @pytest.mark.parametrize("scan, jitter", [("10ms", "4ms"), ("25ms", "10ms"), ("2ms", "1ms")])
 def test_the_library_keeps_every_rule_whatever_the_scan_time(tmp_path, scan, jitter):
     copy = library_copy(tmp_path, {})

@@ -101,6 +101,7 @@ class _Byte:
     end: int
     value: int
     lost: bool = False  # never reaches the other side (collision)
+    unreadable: str | None = None  # why the robot's receiver cannot read it (another line format)
 
 
 @dataclass(slots=True)
@@ -157,9 +158,15 @@ class Line:
 
     # ---- the PLC's endpoint ----------------------------------------------------------------
 
-    def send(self, data: bytes, t_us: int, origin: str | None = None) -> int:
+    #: `send` takes ``unreadable``: the simulated PLC's serial port tells a frame sent at
+    #: another line format than the robot's (verifier.sim.serial.SerialChannel)
+    accepts_unreadable = True
+
+    def send(self, data: bytes, t_us: int, origin: str | None = None, unreadable: str | None = None) -> int:
         """The PLC starts transmitting ``data`` at ``t_us`` (after anything it is still
-        sending). Returns when the last byte's stop bit ends."""
+        sending). Returns when the last byte's stop bit ends. ``unreadable`` says why the
+        robot's receiver cannot read these bytes (the PLC's port runs at another speed or
+        character format): they are on the line as sent, but the robot discards the frame."""
         data = bytes(data)
         self._check_time(t_us, "send")
         self._work_until(t_us)
@@ -167,6 +174,9 @@ class Line:
             return max(t_us, self._plc_free_us)
         start = max(t_us, self._plc_free_us)
         send = _Transmission(start, 0, data, origin, self._on_line(start, data))
+        if unreadable is not None:
+            for byte in send.bytes_:
+                byte.unreadable = unreadable
         self._plc_queue.extend(send.bytes_)
         send.end = send.bytes_[-1].end
         self._plc_free_us = send.end
@@ -307,6 +317,8 @@ class Line:
                             f"silence of {gap / 1000:.3f} ms between bytes of one frame "
                             f"(more than t1.5 = {self._t15 / 1000:.3f} ms): the robot will discard it",
                             (bytes(b.value for b in self._frame),) if first else ())
+        if byte.unreadable is not None and self._frame_broken is None:
+            self._frame_broken = byte.unreadable
         self._frame.append(byte)
 
     def _complete_frame(self) -> None:

@@ -4,7 +4,9 @@ A `SerialChannel` is one physical port of the simulated PLC ("fx3:1", "q:2", ...
 the PLC sends go to the attached endpoint (the ROBOT engineer's `verifier.link.Line`, or
 any object with the same master interface: `send(data, t_us, origin)` and
 `receive_until(t_us) -> [(byte, arrival_t_us), ...]`; optionally `now_us` and
-`quiet_until_us`, see `SerialChannel.attach`) and are logged with their times.
+`quiet_until_us`, see `SerialChannel.attach`) and are logged with their times. An
+endpoint with `accepts_unreadable` (the Line) is told when the port sends at another line
+format than the robot's 9600 8N1 (`send(..., unreadable=why)`): the robot cannot read it.
 With no endpoint attached the line is silent: what is sent is only logged.
 """
 from __future__ import annotations
@@ -49,6 +51,7 @@ class LineFormat:
 
 
 NINE_SIX_8N1 = LineFormat()
+ROBOT_LINE = NINE_SIX_8N1  # the robot's port (its manual: 9600 8N1)
 
 
 class SerialChannel:
@@ -84,7 +87,12 @@ class SerialChannel:
         data = bytes(data)
         end = t_us + self.format.duration_us(len(data))
         if self.endpoint is not None and data:
-            self.endpoint.send(data, t_us, origin)
+            if self.format != ROBOT_LINE and getattr(self.endpoint, "accepts_unreadable", False):
+                # the robot's UART reads framing errors or other bytes: it discards the frame
+                self.endpoint.send(data, t_us, origin, unreadable=f"sent at {self.format}, the robot's line runs "
+                                                                  f"at {ROBOT_LINE}: its receiver cannot read it")
+            else:
+                self.endpoint.send(data, t_us, origin)
         if self.keep_sent:
             self.sent.append(SentFrame(t_us, end, data, origin))
         self.sent_count += 1

@@ -414,8 +414,8 @@ class Checker:
                                   f"{MAX_BRANCHES} in one statement; split it into several CASE statements")
             st = self.expr(s.selector)
             if not (T.is_group(st, "int", "int-literal", "any16", "any32", "any")):
-                self.rep.error(s.selector, f"CASE needs an integer selector (INT or DINT), not {st}; "
-                                           f"convert it, e.g. {st}_TO_INT(...)")
+                self.rep.error(s.selector, f"CASE needs an integer selector (INT or DINT), not {st}"
+                                           + self._convert(st, T.INT, "; convert it, e.g. {}(...)"))
             seen: dict[int, ast.Node] = {}
             for clause in s.clauses:
                 for label in clause.labels:
@@ -677,6 +677,12 @@ class Checker:
         self.rep.error(e, f"'.{e.member}' needs a structure or FB instance; this is {bt}")
         return T.ANY
 
+    def _convert(self, source: T.Type, target: T.Type, advice: str) -> str:
+        """`advice` with the editor's conversion from `source` to `target` in its {}, or ""
+        where the editor has no such function (so no message names one it would refuse)."""
+        conv = library.conversion(T.concrete(source), target, self.target)
+        return advice.format(conv) if conv else ""
+
     def _binary(self, e: ast.BinaryOp) -> T.Type:
         lt = self.expr(e.left)
         rt = self.expr(e.right)
@@ -684,19 +690,25 @@ class Checker:
         if lt is T.ANY or rt is T.ANY:
             return T.BOOL if op in ("=", "<>", "<", ">", "<=", ">=") else (rt if lt is T.ANY else lt)
         if op == "**":
-            if not T.is_group(lt, "real", "real-literal"):
-                self.rep.error(e.left, f"'**' needs a REAL base, not {lt}; convert it, e.g. {T.concrete(lt)}_TO_REAL(...)")
+            base_ok = T.is_group(lt, "real", "real-literal")
+            if not base_ok:
+                self.rep.error(e.left, f"'**' needs a REAL base, not {lt}"
+                                       + self._convert(lt, T.REAL, "; convert it, e.g. {}(...)"))
             if not T.is_any_num(rt):
                 self.rep.error(e.right, f"'**' needs a numeric exponent, not {rt}")
+            if not base_ok:  # reported once: no second error where the result is used
+                return T.ANY
             return T.REAL if T.is_group(lt, "real-literal") else lt
         common = T.unify(lt, rt)
         if common is None:
-            self.rep.error(e, f"'{op}' mixes {lt} and {rt}; convert one side (e.g. {_conv_hint(lt, rt)})")
+            self.rep.error(e, f"'{op}' mixes {lt} and {rt}"
+                              + (self._convert(rt, lt, "; convert one side (e.g. {}(...))")
+                                 or self._convert(lt, rt, "; convert one side (e.g. {}(...))")))
             return T.BOOL if op in ("=", "<>", "<", ">", "<=", ">=") else lt
         if op in ("+", "-", "*", "/"):
             if not T.is_any_num(common) or T.is_group(common, "bits"):
                 self.rep.error(e, f"'{op}' needs INT, DINT or REAL operands, not {common}; "
-                                  f"arithmetic on bit strings is not allowed (convert with {common}_TO_INT)")
+                                  + _no_arithmetic(common, self.target))
             if op == "/" and _const_int(e.right) == 0:
                 self.rep.error(e.right, "division by zero")
             return self._fold(e, common)
@@ -708,8 +720,8 @@ class Checker:
             return self._fold(e, common)
         if op in ("AND", "OR", "XOR"):
             if not T.is_any_bit(common):
-                self.rep.error(e, f"{op} needs BOOL, WORD or DWORD operands, not {common}; "
-                                  f"for bit operations on integers convert with {common}_TO_WORD")
+                self.rep.error(e, f"{op} needs BOOL, WORD or DWORD operands, not {common}"
+                                  + self._convert(common, T.WORD, "; for bit operations convert with {}"))
             return self._fold(e, common)
         # comparisons
         if isinstance(common, (T.ArrayOf, T.StructOf, T.FbType)):
@@ -1044,9 +1056,11 @@ class Checker:
         if a == "ANY_INT":
             return None if T.is_any_int(t) else f"needs INT or DINT, not {t}"
         if a == "ANY_REAL":
-            return None if T.is_group(t, "real", "real-literal") else f"needs REAL, not {t}; convert it with {T.concrete(t)}_TO_REAL"
+            return None if T.is_group(t, "real", "real-literal") else \
+                f"needs REAL, not {t}" + self._convert(t, T.REAL, "; convert it with {}")
         if a == "ANY_BIT":
-            return None if T.is_any_bit(t) else f"needs BOOL, WORD or DWORD, not {t}; convert it with {T.concrete(t)}_TO_WORD"
+            return None if T.is_any_bit(t) else \
+                f"needs BOOL, WORD or DWORD, not {t}" + self._convert(t, T.WORD, "; convert it with {}")
         if a == "ANY_SIMPLE":
             return None if isinstance(t, (T.Elementary, T.Generic)) else f"needs a simple value, not {t}"
         # an elementary type name
@@ -1213,9 +1227,15 @@ def _is_constant(e) -> bool:
     return False
 
 
-def _conv_hint(a: T.Type, b: T.Type) -> str:
-    a, b = T.concrete(a), T.concrete(b)
-    return f"{b.name}_TO_{a.name}(...)"
+def _no_arithmetic(t: T.Type, editor: str) -> str:
+    """Why `t` takes no arithmetic, and the conversion that makes a number of it."""
+    if T.is_group(t, "time"):
+        return "arithmetic on TIME is not allowed (convert with TIME_TO_DINT, and back with DINT_TO_TIME)"
+    if T.is_group(t, "string"):
+        return "arithmetic on strings is not allowed (join them with CONCAT)"
+    number = T.DINT if T.width(t) == 32 else T.INT
+    conv = library.conversion(T.concrete(t), number, editor)
+    return "arithmetic on bit strings is not allowed" + (f" (convert with {conv})" if conv else "")
 
 
 def check_project(files: list[ast.SourceFile], target: str = "gxworks2") -> tuple[list[ast.Diagnostic], SymbolTable]:

@@ -83,6 +83,17 @@ for _src, _st in _CONV_TYPES.items():
             continue
         _targets = ("gxworks3",) if _src in _GX3_ONLY or _dst in _GX3_ONLY else ("gxworks2", "gxworks3")
         _fn(f"{_src}_TO_{_dst}", [("IN", _st.name)], _dt, targets=_targets)
+_CONV_SPELLING = {t.name: name for name, t in _CONV_TYPES.items()}
+
+
+def conversion(source, target, editor: str) -> str | None:
+    """The function converting type `source` to `target` as `editor` spells it
+    (STRING is STR: STR_TO_INT), or None where the editor has none (TIME and REAL)."""
+    name = f"{_CONV_SPELLING.get(getattr(source, 'name', None))}_TO_{_CONV_SPELLING.get(getattr(target, 'name', None))}"
+    sig = STANDARD_FUNCTIONS.get(name)
+    return name if sig is not None and editor in sig.targets else None
+
+
 for _t in ("INT", "DINT", "WORD", "DWORD"):
     _fn(f"{_t}_TO_BCD", [("IN", _t)], WORD if _t in ("INT", "WORD") else DWORD)
     _fn(f"BCD_TO_{_t}", [("IN", "WORD" if _t in ("INT", "WORD") else "DWORD")], INT if _t == "INT" else (DINT if _t == "DINT" else (WORD if _t == "WORD" else DWORD)))

@@ -227,7 +227,11 @@ def assignable(target: Type, source: Type, target_name: str = "gxworks2") -> str
     if isinstance(target, Elementary) and isinstance(source, Elementary):
         if target_name == "gxworks3" and _widening(source, target):
             return None
-        conv = f"{source.name}_TO_{target.name}"
+        from verifier.st.library import conversion  # the library is built on these types
+
+        conv = conversion(source, target, target_name)
+        if conv is None:
+            return f"{source} cannot be stored in {target}: GX Works has no function converting one to the other"
         return f"{source} cannot be stored in {target} without conversion; use {conv}(...)"
     return f"{source} cannot be stored in {target}"
 

@@ -1,0 +1,56 @@
+"""The checker's advice names only conversions GX Works has: every `X_TO_Y` a message
+tells the user to write is a function the same checker accepts for that editor (STRING
+conversions are spelt STR: INT_TO_STR, STR_TO_INT; TIME has none to or from REAL)."""
+from __future__ import annotations
+
+import re
+
+import pytest
+
+from verifier import st
+from verifier.st import library
+
+TYPES = {
+    "gxworks2": ["BOOL", "INT", "DINT", "WORD", "DWORD", "REAL", "TIME", "STRING"],
+    "gxworks3": ["BOOL", "INT", "DINT", "UINT", "UDINT", "WORD", "DWORD", "REAL", "LREAL", "TIME",
+                 "STRING", "WSTRING"],
+}
+OTHERS = ["ARRAY[0..1] OF INT", "TON"]      # no conversion at all: the advice must not invent one
+
+
+def program(target: str) -> str:
+    """Every mistake whose message offers a conversion, with every type of the editor."""
+    names = {t: f"lbl{i}" for i, t in enumerate(TYPES[target] + OTHERS)}
+    decls = "\n".join(f"    {v} : {t};" for t, v in names.items())
+    i, r, w, b = names["INT"], names["REAL"], names["WORD"], names["BOOL"]
+    body = []
+    for a, va in names.items():
+        body += [f"{va} := {vb};" for vb in names.values() if vb != va]      # assignment
+        body += [f"{i} := {va} + {i};", f"{va} := {va} + {va};", f"{r} := {va} ** 2.0;",
+                 f"{w} := {va} AND {w};", f"{r} := SQRT({va});", f"{w} := SHL({va}, 1);",
+                 f"CASE {va} OF 1: {b} := TRUE; END_CASE;"]
+    return f"PROGRAM Hints\nVAR\n{decls}\nEND_VAR\n" + "\n".join(body) + "\nEND_PROGRAM\n"
+
+
+@pytest.mark.parametrize("target", sorted(TYPES))
+def test_every_conversion_a_message_names_exists(target):
+    source = st.parse(program(target), "t.st", target)
+    assert source.diagnostics == []
+    messages = [d.message for d in st.check([source], target)]
+    named = {m for text in messages for m in re.findall(r"\b([A-Z]+_TO_[A-Z]+)\b", text)}
+    assert len(named) > 20                        # the program does reach the hints
+    missing = sorted(n for n in named if n not in library.STANDARD_FUNCTIONS
+                     or target not in library.STANDARD_FUNCTIONS[n].targets)
+    assert missing == [], [m for m in messages if any(n in m for n in missing)][:8]
+
+
+def test_a_string_is_converted_with_str_and_time_is_not_called_a_bit_string():
+    text = ("PROGRAM Hints\nVAR\n    i : INT;\n    s : STRING;\n    t : TIME;\nEND_VAR\n"
+            "i := s;\nt := t + t;\nEND_PROGRAM\n")
+    source = st.parse(text, "t.st", "gxworks2")
+    messages = [str(d) for d in st.check([source], "gxworks2")]
+    assert messages == [
+        "t.st:7:6: error: assignment: STRING cannot be stored in INT without conversion; use STR_TO_INT(...)",
+        "t.st:8:6: error: '+' needs INT, DINT or REAL operands, not TIME; arithmetic on TIME is not allowed "
+        "(convert with TIME_TO_DINT, and back with DINT_TO_TIME)",
+    ]
