@@ -33,6 +33,20 @@ def test_neither_encoding_is_an_error_not_a_guess(tmp_path):
     assert "byte 0xFF at offset 10 is neither UTF-8 nor Shift-JIS" in problem.message
 
 
+@pytest.mark.parametrize("encoding, order", [("utf-16", None), ("utf-16-le", "little"), ("utf-16-be", "big")])
+def test_a_utf16_file_is_named_as_utf16(tmp_path, encoding, order):
+    """Windows editors save "Unicode" as UTF-16 with a byte order mark: said so, with what
+    to do, instead of "byte 0xFF at offset 0 is neither UTF-8 nor Shift-JIS"."""
+    bom = {"little": b"\xff\xfe", "big": b"\xfe\xff"}
+    data = PROGRAM.encode(encoding) if order is None else bom[order] + PROGRAM.encode(encoding)
+    order = order or ("little" if data.startswith(b"\xff\xfe") else "big")
+    path = tmp_path / "p.st"
+    path.write_bytes(data)
+    text, (problem,) = st.read_source(path)
+    assert text == "" and (problem.line, problem.col) == (1, 1)
+    assert f"the file is UTF-16 ({order}-endian" in problem.message and "save it as UTF-8" in problem.message
+
+
 @pytest.mark.parametrize("make, message", [
     (lambda tmp: tmp / "missing.st", "cannot read: no such file"),
     (lambda tmp: tmp, "is a folder"),

@@ -18,6 +18,7 @@ ENCODINGS = ("utf-8-sig", "cp932")
 #: Python's cp932 decodes these single bytes to control or private-use characters that
 #: no editor writes; a file holding them is not Shift-JIS text.
 _NOT_SHIFT_JIS = frozenset("\x80\uf8f0\uf8f1\uf8f2\uf8f3")
+_UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")
 
 
 def read_source(path: str | Path) -> tuple[str, list[Diagnostic]]:
@@ -57,6 +58,12 @@ def decode_source(data: bytes, name: str = "<bytes>") -> tuple[str, list[Diagnos
         text = None
     if text is not None and not _NOT_SHIFT_JIS.intersection(text):
         return text, []
+    if data.startswith(_UTF16_BOMS):
+        # what Windows editors call "Unicode": named, not read (the policy above)
+        order = "little" if data.startswith(b"\xff\xfe") else "big"
+        return "", [_error(name, 1, 1, f"the file is UTF-16 ({order}-endian: it starts with the bytes "
+                                       f"{data[0]:02X} {data[1]:02X}, UTF-16's byte order mark), not UTF-8 or "
+                                       "Shift-JIS text; save it as UTF-8 (an editor's \"Unicode\" is UTF-16)")]
     line, col = place_of_byte(data, bad)
     return "", [_error(name, line, col,
                        f"byte 0x{data[bad]:02X} at offset {bad} is neither UTF-8 nor Shift-JIS text; "
