@@ -73,18 +73,24 @@ def _inline_commands(text: str) -> list[str]:
     return found
 
 
-def _argv(command: str) -> list[str]:
-    """The arguments after `uitamr`, up to a shell comment, redirection, pipe or `&`."""
-    lexer = shlex.shlex(command, posix=True, punctuation_chars="|&;<>")
+def _words(line: str) -> list[str]:
+    """A shell line's words, up to a comment, redirection, pipe or `&`."""
+    lexer = shlex.shlex(line, posix=True, punctuation_chars="|&;<>")
     lexer.whitespace_split = True
     lexer.commenters = "#"
-    argv = []
+    words = []
     for token in lexer:
         if token in SHELL_ENDS:
             break
-        argv.append(token)
-    assert argv[0] == "uitamr", command
-    return argv[1:]
+        words.append(token)
+    return words
+
+
+def _argv(command: str) -> list[str]:
+    """The arguments after `uitamr`."""
+    words = _words(command)
+    assert words[0] == "uitamr", command
+    return words[1:]
 
 
 def _quoted_commands() -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
@@ -168,3 +174,47 @@ def test_every_option_of_a_command_is_in_its_page(name):
         options -= PROTOCOL_OPTIONS
     missing = sorted(opt for opt in options if not re.search(rf"(?<![\w-]){re.escape(opt)}(?![\w-])", text))
     assert not missing, f"uitamr {name} has options that {', '.join(OPTION_PAGES[name])} do not name: {missing}"
+
+
+@pytest.mark.serial
+def test_emulator_bench_recipe(tmp_path):
+    """emulator.md, "Testing without hardware", run as the page gives it (its /tmp links
+    moved into the test's folder): socat's pty pair, the emulator on one end, the three
+    mbpoll commands on the other; the stop and the point command are written, and the
+    status read shows coil 17 = 1 (running), as the page says."""
+    import os
+    import subprocess
+    import sys
+    import time
+
+    text = (ROOT / "docs" / "emulator.md").read_text(encoding="utf-8")
+    block = text.split("## Testing without hardware", 1)[1].split("```sh\n", 1)[1].split("```", 1)[0]
+    lines = [line.replace("/tmp/robot", str(tmp_path / "robot")).replace("/tmp/plc", str(tmp_path / "plc"))
+             for line in block.splitlines() if line.strip()]
+    socat_line, emulate_line, *mbpoll_lines = lines
+    assert socat_line.startswith("socat -d -d pty,raw,echo=0,") and emulate_line.startswith("uitamr emulate --serial")
+    assert len(mbpoll_lines) == 3 and all(line.startswith("mbpoll ") for line in mbpoll_lines)
+    socat = subprocess.Popen(_words(socat_line), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    emulator = None
+    try:
+        deadline = time.monotonic() + 15
+        while not ((tmp_path / "robot").exists() and (tmp_path / "plc").exists()):
+            assert socat.poll() is None and time.monotonic() < deadline, "socat made no pty pair"
+            time.sleep(0.02)
+        emulator = subprocess.Popen([sys.executable, "-m", "verifier.cli", *_argv(emulate_line)],
+                                    stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                    env={**os.environ, "PYTHONUNBUFFERED": "1"})
+        assert "listening on serial" in emulator.stdout.readline()
+        outputs = []
+        for line in mbpoll_lines:
+            done = subprocess.run(_words(line), capture_output=True, text=True, timeout=30)
+            assert done.returncode == 0, (line, done.stdout, done.stderr)
+            outputs.append(done.stdout)
+        assert "Written 1 references." in outputs[0] and "Written 1 references." in outputs[1]
+        coils = dict(re.findall(r"^\[(\d+)\]:\s+(\d)", outputs[2], flags=re.M))
+        assert len(coils) == 22 and coils["17"] == "1", outputs[2]  # running: point 3 was started
+    finally:
+        for process in (emulator, socat):
+            if process is not None and process.poll() is None:
+                process.terminate()
+                process.wait(timeout=15)
