@@ -768,6 +768,12 @@ def test_the_reports_of_a_capture_do_not_describe_a_simulated_run(tmp_path):
     for wrong in ("program <code>?</code>", "virtual time", "scan 0 ms", "seed 0"):
         assert wrong not in page, wrong
     assert "the PLC on the line (capture) · 1.306 s of traffic ·" in " ".join(page.split())
+    # a line at another speed: the page said "bytes at 9600 8N1" whatever --baud was
+    fast = subprocess.run(uitamr("replay", CAPTURES / "bad-master.txt", "--baud", "19200", "--junit", junit,
+                                 "--html", html), capture_output=True, text=True, timeout=WAIT_S)
+    assert fast.returncode == 1, fast.stdout + fast.stderr
+    page = " ".join(html.read_text(encoding="utf-8").split())
+    assert "9600" not in page and "traffic captured on " in page and " at 19200 8N1" in page
     healthy = ROOT / "plc" / "scenarios" / "fx3u-healthy.toml"
     verified = subprocess.run(uitamr("verify", "--scenario", healthy, "--duration", "2s", "--junit", junit,
                                      "--html", html), capture_output=True, text=True, timeout=120)

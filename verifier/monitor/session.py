@@ -237,7 +237,7 @@ class MonitorSession:
         return ScenarioResult(
             name=self.info.name,
             file=self.info.source,
-            description=f"traffic captured on {self.info.source}",
+            description=f"traffic captured on {self.info.source} at {self.info.line}",
             program=None,
             platform=LINE,
             channel=self.info.channel,
