@@ -218,3 +218,54 @@ def test_emulator_bench_recipe(tmp_path):
             if process is not None and process.poll() is None:
                 process.terminate()
                 process.wait(timeout=15)
+
+
+def _python_blocks(page: str) -> list[str]:
+    return re.findall(r"```python\n(.*?)```", (ROOT / "docs" / page).read_text(encoding="utf-8"), flags=re.S)
+
+
+def test_the_python_examples_of_verifier_md_run(monkeypatch):
+    """verifier.md, "Using it from Python": the example runs (its own assert is the check),
+    and a trace from elsewhere is judged with the classes and fields the page names."""
+    from types import SimpleNamespace
+
+    monkeypatch.chdir(ROOT)
+    (block,) = _python_blocks("verifier.md")
+    exec(compile(block, "verifier.md", "exec"), {})
+    text = " ".join((ROOT / "docs" / "verifier.md").read_text(encoding="utf-8").split())
+    said = re.search(r"build `([\w.]+)\.RunEvidence\(settings, frames, end_us\)`.* from objects with "
+                     r"`t_start_us`, `t_end_us`, `direction` \(`\"tx\"` or `\"rx\"`\), `data` \(bytes\), `origin`\.",
+                     text)
+    assert said, "verifier.md no longer says how to build the evidence"
+    import importlib
+
+    from verifier.protocol import Settings
+    from verifier.verify.rules import check_all
+
+    evidence_class = importlib.import_module(said.group(1)).RunEvidence
+    run_point = bytes.fromhex("01 06 01 01 00 00 D9 F6")
+    frames = [SimpleNamespace(t_start_us=0, t_end_us=8_333, direction="tx", data=run_point, origin=None),
+              SimpleNamespace(t_start_us=13_000, t_end_us=21_333, direction="rx", data=run_point, origin=None)]
+    found = check_all(evidence_class(Settings(), frames, 1_000_000))
+    assert [rule for rule, violations in found.items() if violations] == ["UITAMR-POWERON-STOP"]
+
+
+def test_the_python_example_of_protocol_md_gives_what_its_comments_say():
+    (block,) = [b for b in _python_blocks("protocol.md") if "from verifier.protocol import" in b]
+    imports, lines = block.split("\n\n", 1)
+    names: dict = {}
+    exec(imports, names)
+    results = []
+    for line in lines.splitlines():
+        code, _, comment = line.partition("#")
+        if "=" in code.split("(")[0]:
+            exec(code, names)
+        else:
+            results.append((eval(code, names), comment.strip()))
+    assert [comment for _, comment in results] == [
+        r"b'\x01\x06\x01\xa0\x00\x00\x88\x14'", "StatusRequest(1, Query.TASK)", "'stop (01/A0)'",
+        "ControlRequest(1, MOVE_FRONT_NEG, 25)"]
+    encoded, status, described, move = (value for value, _ in results)
+    assert repr(encoded) == results[0][1] and repr(described) == results[2][1]
+    assert (status.address, status.query.name) == (1, "TASK")
+    assert (move.address, move.code.name, move.command) == (1, "MOVE_FRONT_NEG", 25)
