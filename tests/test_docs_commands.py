@@ -269,3 +269,16 @@ def test_the_python_example_of_protocol_md_gives_what_its_comments_say():
     assert repr(encoded) == results[0][1] and repr(described) == results[2][1]
     assert (status.address, status.query.name) == (1, "TASK")
     assert (move.address, move.code.name, move.command) == (1, "MOVE_FRONT_NEG", 25)
+
+
+def test_the_fault_defaults_emulator_md_gives_are_the_codes():
+    """emulator.md's fault table gave the exception's default code but not the garbage
+    bytes `--garbage-on N` sends (A5 5A FF, as its `-- scripted fault:` line shows)."""
+    from verifier.amr.faults import Fault
+
+    rows = {row.split("|")[1].strip(): row for row in (ROOT / "docs" / "emulator.md").read_text(encoding="utf-8")
+            .splitlines() if row.startswith("| `")}
+    garbage = Fault("garbage", on_request=1)
+    assert f"`data` bytes (default `{garbage.data.hex(' ').upper()}`)" in rows["`garbage`"]
+    assert f'`"{garbage.position}"`, the default' in rows["`garbage`"]
+    assert f"`code` (default {Fault('exception', on_request=1).code:02d})" in rows["`exception`"]
