@@ -199,8 +199,9 @@ def render(diag: Diagnostic, lines: list[str] | None) -> str:
               help="text: file:line:col: error: message (editors); json; github: GitHub Actions "
                    "annotations; sarif: SARIF 2.1.0 for code scanning (docs/ci.md).")
 def command(sources: tuple[str, ...], target: str | None, platform: str | None, fmt: str) -> None:
-    """Parse and type-check GX Works structured text (files or directories of .st), and
-    scenario files (.toml) as `uitamr verify` reads them. With --platform, also check the
+    """Parse and type-check GX Works structured text (files, directories of .st, or glob
+    patterns, which check expands itself as verify does), and scenario files (.toml) as
+    `uitamr verify` reads them. With --platform, also check the
     devices and instructions against that CPU."""
     target = platform_target(platform, target) if platform else target or "gxworks2"
     paths = expand_sources(sources)
