@@ -383,8 +383,11 @@ def test_a_scenario_without_platform_is_judged_for_the_platform_given(tmp_path):
     done = run("--platform", "fx5u", scenario)
     assert done.exit_code == 0, done.output
     assert done.output.splitlines()[-1] == "1 file(s) checked for gxworks3 on the fx5u CPU: 0 error(s), 0 warning(s)"
-    alone = run(scenario)  # no --platform: the file's own default, fx3u
+    alone = run(scenario)  # no --platform: the file's own default, fx3u, as ci.md says
     assert alone.exit_code == 1
+    ci_md = " ".join((ROOT / "docs" / "ci.md").read_text(encoding="utf-8").split())
+    assert ("a file that names none is judged for `--platform`, the CPU `uitamr verify --platform` runs it on, "
+            "and without `--platform` for the fx3u") in ci_md
     assert errors(alone.output)[0] == (
         f"{scenario}:8:1: error: converter: the TCP route needs a PLC with an Ethernet port the library drives "
         "(fx5u or q); this scenario names no platform, so it is 'fx3u' (the default): add platform = \"fx5u\" "

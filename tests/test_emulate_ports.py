@@ -194,6 +194,30 @@ def test_a_second_emulator_on_the_same_port_is_refused(pty_pair, start_emulator)
     assert first.stop()[0] == 0
 
 
+def test_a_port_a_monitor_holds_is_refused_naming_the_monitor(pty_pair):
+    """On the bench a `uitamr monitor` left on the adapter holds the port as a second
+    emulator would; the refusal used to ask only "another uitamr emulate?", sending the
+    user to look for an emulator that was not running."""
+    robot_end, _ = pty_pair
+    monitor = subprocess.Popen([sys.executable, "-m", "verifier.cli", "monitor", "--serial", robot_end,
+                                "--duration", "60s", "--quiet"],
+                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                               env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    try:
+        assert "listening on" in monitor.stdout.readline()
+        refused = run_cli("--serial", robot_end, "--exit-after", "5")
+        assert refused.returncode == 1
+        assert (f"cannot open serial port {robot_end}: another program has it locked (another uitamr "
+                "emulate, or a uitamr monitor?)") in refused.stderr, refused.stderr
+    finally:
+        monitor.send_signal(signal.SIGINT)
+        try:
+            monitor.wait(timeout=WAIT_S)
+        except subprocess.TimeoutExpired:
+            monitor.kill()
+            monitor.wait(timeout=WAIT_S)
+
+
 def test_mbpoll_sees_a_task_run_and_an_anti_collision_stop(pty_pair, start_emulator):
     robot_end, master_end = pty_pair
     emulator = start_emulator("--serial", robot_end, "--point-duration-s", "600")

@@ -912,6 +912,39 @@ def test_replay_refuses_to_write_a_report_over_its_own_capture(tmp_path):
     assert path.read_text(encoding="utf-8") == text
 
 
+def test_the_reports_of_a_capture_do_not_describe_a_simulated_run(tmp_path):
+    """commissioning.md: the monitor and replay write "the same reports as verify". A
+    replay's JUnit said "program None on line (capture), 1.306 s of virtual time, scan 0
+    ms, seed 0" and its page "program ? ... virtual time · scan 0 ms · seed 0": a ticket
+    with a site capture read as a simulation with no program. They now say what was
+    judged: the PLC on the line, and how long the capture is."""
+    import xml.etree.ElementTree as ET
+
+    junit, html = tmp_path / "site.xml", tmp_path / "site.html"
+    done = subprocess.run(uitamr("replay", CAPTURES / "bad-master.txt", "--junit", junit, "--html", html),
+                          capture_output=True, text=True, timeout=WAIT_S)
+    assert done.returncode == 1, done.stdout + done.stderr
+    (out,) = [element.text for element in ET.parse(junit).iter("system-out")]
+    assert out.splitlines()[1] == "the PLC on the line (capture), 1.306 s of traffic"
+    page = html.read_text(encoding="utf-8")
+    for wrong in ("program <code>?</code>", "virtual time", "scan 0 ms", "seed 0"):
+        assert wrong not in page, wrong
+    assert "the PLC on the line (capture) · 1.306 s of traffic ·" in " ".join(page.split())
+    # a line at another speed: the page said "bytes at 9600 8N1" whatever --baud was
+    fast = subprocess.run(uitamr("replay", CAPTURES / "bad-master.txt", "--baud", "19200", "--junit", junit,
+                                 "--html", html), capture_output=True, text=True, timeout=WAIT_S)
+    assert fast.returncode == 1, fast.stdout + fast.stderr
+    page = " ".join(html.read_text(encoding="utf-8").split())
+    assert "9600" not in page and "traffic captured on " in page and " at 19200 8N1" in page
+    healthy = ROOT / "plc" / "scenarios" / "fx3u-healthy.toml"
+    verified = subprocess.run(uitamr("verify", "--scenario", healthy, "--duration", "2s", "--junit", junit,
+                                     "--html", html), capture_output=True, text=True, timeout=120)
+    assert verified.returncode == 1, verified.stdout + verified.stderr  # expectations past 2 s fail
+    (out,) = [element.text for element in ET.parse(junit).iter("system-out")]
+    assert "program UITAMR_ExampleFx3 on fx3u (fx3:1), 2.000 s of virtual time, scan 10 ms, seed 0" in out
+    assert "virtual time" in html.read_text(encoding="utf-8")
+
+
 def test_a_capture_named_with_control_characters_does_not_restyle_the_terminal(tmp_path):
     """The run's name was shown escaped, but its file path beside it was printed raw: a
     file name holding ESC [31m turned the console red, a newline split the verdict line."""

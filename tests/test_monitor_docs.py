@@ -142,3 +142,15 @@ def test_the_time_of_a_capture_line_is_when_its_last_byte_arrived():
     session.close()
     (frame,) = session.frames
     assert frame.t_end_us - frame.t_start_us == 8333  # 8 bytes at 9600 8N1, ending at the line's time
+
+
+def test_how_soon_a_finding_is_printed_is_how_often_the_monitor_looks():
+    """§3 said a one-frame finding is printed "as soon as" its request is on the line; the
+    monitor judges what the line settled every CHECK_EVERY_S, so frames that came before a
+    look are printed before the findings the look makes (as in the example view)."""
+    from verifier.commands.monitor import CHECK_EVERY_S
+
+    text = " ".join(DOC.split())
+    assert CHECK_EVERY_S == 0.5
+    assert "The monitor looks for findings twice a second" in text
+    assert "a finding shows up to half a second after its frames" in text

@@ -7,6 +7,7 @@ our replies (FC06 echo, FC01 22-coil status) and read back the coil bits we mean
 from __future__ import annotations
 
 import os
+import re
 import select
 import subprocess
 import time
@@ -107,3 +108,33 @@ def test_mbpoll_reads_our_status_reply_as_22_coils(pty_pair, query, error, value
     assert bits[0:8] == [0] * 8
     assert sum(bit << i for i, bit in enumerate(bits[8:16])) == error
     assert sum(bit << i for i, bit in enumerate(bits[16:22])) == value
+
+
+def _set_labels(output: str) -> set[int]:
+    """The coil numbers mbpoll shows as 1."""
+    return {int(ref.strip("[ ")) for ref, bit in (line.split("]:") for line in output.splitlines()
+                                                    if line.startswith("[") and "]:" in line) if bit.strip() == "1"}
+
+
+@pytest.mark.parametrize("query, page, sentence", [
+    ("task", "protocol.md", r"for `read task` coils (\d+)–(\d+) and (\d+)–(\d+)"),
+    ("battery", "protocol.md", r"for `read battery` \(`-r 3`\) (\d+)–(\d+) and (\d+)–(\d+)"),
+    ("task", "emulator.md", r"coils (\d+)–(\d+) carry the error byte and (\d+)–(\d+) the value"),
+    ("battery", "emulator.md", r"\(`-r 4`, battery: the error byte in coils (\d+)–(\d+), the value in (\d+)–(\d+)\)"),
+])
+def test_the_coil_numbers_the_pages_give_are_the_ones_mbpoll_shows(pty_pair, query, page, sentence):
+    """mbpoll numbers the coils it shows from its start reference, the query parameter: the
+    pages gave the error code as coils 8-15 and the value as 16-21 for every query, so a
+    battery read (-r 3) was read three coils off. Error 03 and value 1 show where they are."""
+    device, fd = pty_pair
+    text = " ".join((Path(__file__).resolve().parents[1] / "docs" / page).read_text(encoding="utf-8").split())
+    error_first, error_last, value_first, value_last = map(int, re.search(sentence, text).groups())
+    request = command_from_words(["read", query])
+    argv = mbpoll_command(request, Settings(), device)
+    if page == "emulator.md":  # its recipe counts from 1: -r P+1 without -0
+        assert "-t 0 -r 1 -c 22 -1 /tmp/plc" in text.split("## Testing without hardware", 1)[1]
+        argv = [word for word in argv if word != "-0"]
+        argv[argv.index("-r") + 1] = str(int(request.query) + 1)
+    output = exchange(fd, argv, encode(request), encode(StatusReply(1, RobotError.BATTERY_LOW, 1, request.query)))
+    assert _set_labels(output) == {error_first, error_first + 1, value_first}
+    assert (error_last - error_first, value_last - value_first) == (7, 5)

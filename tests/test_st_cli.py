@@ -72,6 +72,30 @@ def test_a_folder_is_read_as_verify_reads_it(tmp_path):
     assert expand_sources((str(src),)) == expand(str(src), tmp_path)
 
 
+def test_a_pattern_is_expanded_as_verify_expands_it(tmp_path, monkeypatch):
+    """ci.md's commands (`uitamr check --platform fx3u plc/ verify/*.toml`, the VS Code task)
+    rely on the shell to expand `*.toml`; cmd and PowerShell do not, and check took the
+    pattern for a file name ("verify/*.toml: no such file") where `uitamr verify 'plc/*.st'`
+    expands it itself. check and export now read a pattern as verify does."""
+    (tmp_path / "plc").mkdir()
+    (tmp_path / "verify").mkdir()
+    (tmp_path / "plc" / "MAIN.st").write_text(GOOD.read_text(encoding="utf-8"), encoding="utf-8")
+    (tmp_path / "verify" / "healthy.toml").write_text('[[expect]]\nsent = "stop"\nwithin = "1s"\n', encoding="utf-8")
+    (tmp_path / "verify" / "broken.toml").write_text("name = 3\n", encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = run("plc/*.st", "verify/*.toml")
+    assert result.exit_code == 1, result.output
+    assert "verify/broken.toml:1:8: error: name: expected a string, got 3" in result.output
+    assert result.output.splitlines()[-1].startswith("3 file(s) checked")
+    none = run("plc/*.st", "verify/*.tmol")
+    assert none.exit_code == 2 and "uitamr check: verify/*.tmol: matches no file" in none.output, none.output
+    exported = CliRunner().invoke(main, ["export", "--target", "gxworks2", "--out", "gx2", "plc/*.st"])
+    assert exported.exit_code == 0, exported.output
+    assert (tmp_path / "gx2" / "IMPORT_ORDER.txt").exists()
+    missing = CliRunner().invoke(main, ["export", "--target", "gxworks2", "--out", "gx2", "src/*.st"])
+    assert missing.exit_code == 2 and "src/*.st" in missing.output, missing.output
+
+
 def test_json_format():
     result = run("--format", "json", BAD, WARN)
     assert result.exit_code == 1

@@ -772,6 +772,24 @@ def test_a_misspelt_label_in_a_scenario_offers_the_label_meant(tmp_path):
         assert result.output.strip().endswith(f"expect[2].never: {message}"), result.output
 
 
+def test_a_renamed_instance_gets_no_guess_that_lacks_the_member(tmp_path):
+    """ci.md: a renamed instance makes the job exit 2 with "no label ...". The FX3U example
+    with its engine renamed fbRobot and `--response-signal fbEngine.o_bErr` was told "did
+    you mean 'bEngineOn'?": a BOOL, which has no o_bErr. A guess for a part of a path must
+    have the rest of the path."""
+    main = tmp_path / "MAIN.st"
+    main.write_text((PLC / "examples" / "fx3" / "UITAMR_ExampleFx3.st").read_text(encoding="utf-8")
+                    .replace("fbEngine", "fbRobot").replace("PROGRAM UITAMR_ExampleFx3", "PROGRAM MAIN"),
+                    encoding="utf-8")
+    sources = [PLC / "core", PLC / "fx3", PLC / "examples" / "common", main]
+    result = invoke(*sources, "--program", "MAIN", "--platform", "fx3u", "--response-signal", "fbEngine.o_bErr")
+    assert result.exit_code == 2
+    assert result.output.strip().endswith("--response-signal: the program MAIN has no label 'fbEngine.o_bErr'"), \
+        result.output
+    result = invoke(*sources, "--program", "MAIN", "--platform", "fx3u", "--response-signal", "fbRobott.o_bErr")
+    assert result.output.strip().endswith("has no label 'fbRobott.o_bErr'; did you mean 'fbRobot'?"), result.output
+
+
 def test_the_converter_drop_a_scenario_scripts_is_marked_as_its_fault_on_the_page(tmp_path):
     """verifier.md: the scenario's faults are large orange marks, also on the overview strip.
     The TCP route's scripted drop (converter.dropped) is one - a healthy converter run has none."""

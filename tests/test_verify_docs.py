@@ -296,3 +296,53 @@ def test_the_json_example_shows_the_schema_the_reports_carry():
     example = page.split("### `--json FILE`", 1)[1].split("```", 2)[1]
     assert f'"schema": {SCHEMA_VERSION},' in example
     assert f"**{SCHEMA_VERSION}**: " in page  # and what that number means
+
+
+def test_the_share_of_idle_scans_jumped_over_is_the_bundled_scenarios(monkeypatch):
+    """verifier.md, "Idle scans are jumped over": the range of the share of scans each
+    bundled scenario jumps over, and the FX3U example's "three scans in four". The range
+    said 60-89 % after a bundled scenario (fx3u-address-out-of-range) had come to jump over
+    92.5 %."""
+    import math
+
+    from verifier.sim import project as project_module
+    from verifier.verify.runner import run_scenario
+    from verifier.verify.scenario import load_scenario
+
+    text = " ".join(VERIFIER_MD.split())
+    low, high = map(int, re.search(r"between (\d+) % and (\d+) % of the scans are jumped over", text).groups())
+    assert "In the FX3U example, about three scans in four are jumped over." in text
+    made = []
+    original = project_module.Project.skip_idle_scans
+
+    def recording(self, *args, **kwargs):
+        made.append(original(self, *args, **kwargs))
+        return made[-1]
+
+    monkeypatch.setattr(project_module.Project, "skip_idle_scans", recording)
+    shares = {}
+    for path in sorted((DOCS.parent / "plc" / "scenarios").glob("*.toml")):
+        made.clear()
+        run_scenario(load_scenario(path))
+        (idle,) = made
+        shares[path.stem] = 100 * idle.skipped_scans / idle.rt.scan_count
+    assert (math.floor(min(shares.values())), math.ceil(max(shares.values()))) == (low, high), shares
+    assert 70 <= shares["fx3u-healthy"] < 80  # about three in four
+
+
+def test_the_trace_of_an_hour_of_fx3u_healthy_is_the_size_verifier_md_says(tmp_path, monkeypatch):
+    """verifier.md, "Long runs": the disk a trace takes an hour (it said 5.5 MiB; the trace
+    of an hour of fx3u-healthy, run from the repository's root, is 5.36 MiB)."""
+    from click.testing import CliRunner
+
+    from verifier.cli import main
+
+    said = {float(size) for size in re.findall(r"(\d+\.\d) MiB an hour of fx3u-healthy", VERIFIER_MD)
+            + re.findall(r"the trace of an hour of fx3u-healthy is (\d+\.\d) MiB", VERIFIER_MD)}
+    assert len(said) == 1, said
+    monkeypatch.chdir(DOCS.parent)  # the frames' origins are relative to the working folder
+    trace = tmp_path / "hour.jsonl"
+    done = CliRunner().invoke(main, ["verify", "--scenario", "plc/scenarios/fx3u-healthy.toml", "--duration", "1h",
+                                     "--trace", str(trace)])
+    assert done.exit_code == 0, done.output
+    assert round(trace.stat().st_size / 2**20, 1) == said.pop()

@@ -6,7 +6,7 @@ problem matchers read it). `--format json`, `github` (GitHub Actions annotations
 `sarif` (SARIF 2.1.0 for code scanning) are for CI (docs/ci.md). Scenario files
 (`.toml`) given among the sources are checked as `uitamr verify` would read them.
 Exit status: 1 if any error, 0 otherwise (warnings allowed), 2 for usage errors
-(missing file, not a regular file, bad option). Every file is read and checked even when
+(missing file, a pattern that matches none, not a regular file, bad option). Every file is read and checked even when
 another one is broken; POUs may use POUs from the other files given.
 
 `--platform fx3u|fx3g|fx5u|q` also checks every device and instruction against that CPU,
@@ -30,17 +30,37 @@ from verifier.textfile import real_path, text_lines
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
 
 
-def expand_sources(sources: tuple[str, ...]) -> list[Path]:
-    """Files named on the command line; directories give their .st files (recursive, as
-    `uitamr verify` reads them). A file named twice (itself and through its folder) is read
-    once, where first named."""
+def is_pattern(name: str) -> bool:
+    """A name with glob characters that is no existing path: a pattern to expand, as
+    `uitamr verify` expands one (cmd and PowerShell hand `verify/*.toml` over as it is)."""
+    from verifier.verify.sources import GLOB_CHARACTERS
+
+    return any(ch in name for ch in GLOB_CHARACTERS) and not Path(name).exists()
+
+
+def _named(name: str) -> list[Path]:
+    """The files one name on the command line stands for: a folder its .st files
+    (recursive, as `uitamr verify` reads it), a pattern its matches (folders among them
+    their .st files; a pattern that matches nothing stays as named, for the caller to
+    report), anything else itself."""
+    import glob
+
     from verifier.verify.sources import st_files_in
 
+    path = Path(name)
+    if is_pattern(name):
+        matches = sorted(Path(match) for match in glob.glob(name, recursive=True))
+        return [f for match in matches for f in (st_files_in(match) if match.is_dir() else [match])] or [path]
+    return st_files_in(path) if path.is_dir() else [path]
+
+
+def expand_sources(sources: tuple[str, ...]) -> list[Path]:
+    """Files named on the command line (`_named`). A file named twice (itself and through
+    its folder or a pattern) is read once, where first named."""
     paths: list[Path] = []
     seen: set[Path] = set()
     for s in sources:
-        p = Path(s)
-        for path in st_files_in(p) if p.is_dir() else [p]:
+        for path in _named(s):
             key = real_path(path)
             if key not in seen:
                 seen.add(key)
@@ -55,6 +75,8 @@ def _not_a_source(path: Path) -> str | None:
 
     if path.is_file():
         return None
+    if is_pattern(str(path)):
+        return "matches no file"
     if not path.exists() and not path.is_symlink():
         return "no such file"
     problems = read_source(path)[1]
@@ -177,8 +199,9 @@ def render(diag: Diagnostic, lines: list[str] | None) -> str:
               help="text: file:line:col: error: message (editors); json; github: GitHub Actions "
                    "annotations; sarif: SARIF 2.1.0 for code scanning (docs/ci.md).")
 def command(sources: tuple[str, ...], target: str | None, platform: str | None, fmt: str) -> None:
-    """Parse and type-check GX Works structured text (files or directories of .st), and
-    scenario files (.toml) as `uitamr verify` reads them. With --platform, also check the
+    """Parse and type-check GX Works structured text (files, directories of .st, or glob
+    patterns, which check expands itself as verify does), and scenario files (.toml) as
+    `uitamr verify` reads them. With --platform, also check the
     devices and instructions against that CPU."""
     target_given = target is not None
     target = platform_target(platform, target) if platform else target or "gxworks2"

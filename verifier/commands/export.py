@@ -19,13 +19,14 @@ With no SOURCES, the bundled library of that platform is exported.
 """
 from __future__ import annotations
 
+import glob
 import sys
 from pathlib import Path
 
 import click
 
 from verifier.bundled import PLC_DIR
-from verifier.commands.check import expand_sources, platform_target
+from verifier.commands.check import expand_sources, is_pattern, platform_target
 from verifier.sim.cpu import PROFILES
 from verifier.textfile import real_path
 
@@ -79,7 +80,9 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
         ctx = click.get_current_context()
         raise click.MissingParameter(ctx=ctx, param=next(p for p in ctx.command.params if p.name == "target"))
     if sources:
-        missing = [s for s in sources if not Path(s).exists()]
+        # a pattern is expanded as `uitamr verify` expands it (cmd and PowerShell do not)
+        missing = [s for s in sources
+                   if not Path(s).exists() and not (is_pattern(s) and glob.glob(s, recursive=True))]
         if missing:
             click.echo(f"uitamr export: no such file or folder: {', '.join(missing)}", err=True)
             sys.exit(EXIT_USAGE)

@@ -112,15 +112,15 @@ def serve_serial(url: str, emulator: Emulator, stop: threading.Event, silence_us
                  baudrate: int = 9600) -> None:
     """Run until ``stop`` is set: read requests from ``url``, write replies when due."""
     try:
-        # exclusive: a second emulator (or another locking program) on the same port would
-        # take every other request, and each would answer what it read
+        # exclusive: a second emulator (or a monitor, or another locking program) on the same
+        # port would take every other request, and each would answer what it read
         port = serial.serial_for_url(url, baudrate=baudrate, bytesize=serial.EIGHTBITS,
                                      parity=serial.PARITY_NONE, stopbits=serial.STOPBITS_ONE,
                                      timeout=POLL_S, exclusive=True)
     except (serial.SerialException, ValueError, OSError) as err:
         if getattr(err, "errno", None) in (errno.EAGAIN, errno.EWOULDBLOCK):
             raise PortError(f"cannot open serial port {url}: another program has it locked (another "
-                            "uitamr emulate?); stop that one first") from None
+                            "uitamr emulate, or a uitamr monitor?); stop that one first") from None
         raise PortError(f"cannot open serial port {url}: {err}") from None
     channel = _Channel(serial_assembler(baudrate, silence_us))
     gap_us = channel.assembler.silence_us

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field, replace
 from verifier import protocol
 from verifier.protocol.codec import MAX_FRAME
 from verifier.verify.evidence import RuleOptions, RunEvidence, Violation
-from verifier.verify.result import ScenarioResult, TraceRecord
+from verifier.verify.result import LINE, ScenarioResult, TraceRecord
 from verifier.verify.rules import Judgement, check_all
 from verifier.verify.traffic import Exchange, Pairing, analyse
 
@@ -237,9 +237,9 @@ class MonitorSession:
         return ScenarioResult(
             name=self.info.name,
             file=self.info.source,
-            description=f"traffic captured on {self.info.source}",
+            description=f"traffic captured on {self.info.source} at {self.info.line}",
             program=None,
-            platform="line",
+            platform=LINE,
             channel=self.info.channel,
             sources=[],
             duration_us=end,

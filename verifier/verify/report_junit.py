@@ -78,8 +78,7 @@ def to_element(results: list[ScenarioResult]) -> ET.Element:
         out.text = "\n".join(
             [
                 result.description,
-                f"program {result.program} on {result.platform} ({result.channel}), "
-                f"{format_seconds(result.ended_us)} of virtual time, scan {result.scan_us / 1000:g} ms, seed {result.seed}",
+                result.run_line,
                 f"{tx} requests, {rx} replies",
                 *(f"note: {note}" for note in result.notes),
                 *(f"simulator {line}" for line in result.diagnostic_summary),

@@ -47,6 +47,10 @@ KEEP_ALL = Keep()
 #: the verdict of a capture that saw no bytes (`uitamr monitor`, `uitamr replay`)
 NO_TRAFFIC = "no-traffic"
 
+#: the `platform` of a capture's result (`uitamr monitor`, `uitamr replay`): a real line,
+#: no simulated CPU, program, scan or seed
+LINE = "line"
+
 
 class UnusableInput(Exception):
     """Input the verifier cannot run (bad scenario, ST that does not load, unknown program).
@@ -140,6 +144,20 @@ class ScenarioResult:
     def passed(self) -> bool:
         return (self.no_traffic is None and self.aborted is None and self.violation_count == 0
                 and not self.failed_expectations)
+
+    @property
+    def captured(self) -> bool:
+        """A real line's traffic (`uitamr monitor`, `uitamr replay`), not a simulated run."""
+        return self.platform == LINE
+
+    @property
+    def run_line(self) -> str:
+        """What ran, for people: the program on its CPU and the run's virtual time, scan and
+        seed; for a capture the line and how long its traffic is."""
+        if self.captured:
+            return f"the PLC on the line ({self.channel}), {format_seconds(self.ended_us)} of traffic"
+        return (f"program {self.program} on {self.platform} ({self.channel}), {format_seconds(self.ended_us)} of "
+                f"virtual time, scan {self.scan_us / 1000:g} ms, seed {self.seed}")
 
     @property
     def verdict(self) -> str:

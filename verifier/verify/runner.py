@@ -149,12 +149,13 @@ class _Plc:
                 return str(exc)
             return None
         target, shown = self.program, ""
-        for part in _path_parts(name):
+        parts = _path_parts(name)
+        for index, part in enumerate(parts):
             try:
                 inside = target
-                target = target[int(part[1:-1])] if part.startswith("[") else getattr(target, part)
-            except (AttributeError, KeyError, IndexError, TypeError, ValueError, LookupError):
-                hint = "" if part.startswith("[") else _did_you_mean(part, inside)
+                target = _step(target, part)
+            except _MISSING:
+                hint = "" if part.startswith("[") else _did_you_mean(part, inside, parts[index + 1:])
                 if not shown:
                     return f"the program {self.name} has no label {name!r}{hint}"
                 what = f"element {part}" if part.startswith("[") else f"member {part!r}"
@@ -208,12 +209,31 @@ class _Plc:
         return summarize_diagnostics(self.project.diagnostics, lambda location: _relative(location, cwd))
 
 
-def _did_you_mean(part: str, instance: Any) -> str:
+_MISSING = (AttributeError, KeyError, IndexError, TypeError, ValueError, LookupError)
+
+
+def _step(target: Any, part: str) -> Any:
+    """`target`'s member or element `part` (a name, or "[3]")."""
+    return target[int(part[1:-1])] if part.startswith("[") else getattr(target, part)
+
+
+def _has_path(target: Any, parts: list[str]) -> bool:
+    try:
+        for part in parts:
+            target = _step(target, part)
+    except _MISSING:
+        return False
+    return True
+
+
+def _did_you_mean(part: str, instance: Any, rest: list[str] = ()) -> str:
     """'; did you mean 'fbBatt'?' when `instance` (a program or FB) has a label spelt
-    nearly as `part` (a scenario's typo of an instance or member name), else ''."""
+    nearly as `part` (a scenario's typo of an instance or member name) that also has the
+    `rest` of the path (fbEngine.o_bErr does not offer the BOOL bEngineOn), else ''."""
     if not isinstance(instance, InstanceProxy):
         return ""  # a value or an array: no labels to offer
-    return did_you_mean(part, instance._names())  # a standard FB's (TON) too
+    names = [n for n in instance._names() if _has_path(instance, [n, *rest])]  # a standard FB's (TON) too
+    return did_you_mean(part, names)
 
 
 def _path_parts(name: str) -> list[str]:

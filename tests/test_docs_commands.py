@@ -1,0 +1,284 @@
+"""The `uitamr` commands the user-facing pages show are commands the tool takes, and every
+option of a command is in the page about it.
+
+Each command line in a code block of these pages (a shell line, a `$ ` session, a GitHub
+Actions or GitLab step, a Jenkins `sh`, a VS Code task) and each concrete one in inline
+code is parsed by the command itself, as the shell would hand it over: an option that was
+renamed or dropped, a choice that is no longer one, a missing value fails here rather than
+in an integrator's CI. Running them needs hardware or the integrator's files; the pages'
+`uitamr frame` sessions are run by test_protocol_docs.py, the emulator's bench recipe by
+test_emulator_bench_recipe below.
+"""
+from __future__ import annotations
+
+import re
+import shlex
+from pathlib import Path
+
+import click
+import pytest
+
+from verifier.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+PAGES = ["README.md", "README.zh-TW.md", "docs/commissioning.md", "docs/emulator.md", "docs/wiring-rs485.md",
+         "docs/wiring-rs232.md", "docs/ci.md", "docs/verifier.md", "docs/protocol.md"]
+SHELL_ENDS = {">", ">>", "|", "&", "&&", ";"}
+
+
+def _command(name: str) -> click.Command | None:
+    return main.get_command(click.Context(main), name)
+
+
+def _block_commands(block: str) -> list[str]:
+    """The `uitamr ...` command lines of one code block, continuation lines joined."""
+    lines = block.splitlines()
+    found, index = [], 0
+    while index < len(lines):
+        line = lines[index]
+        folded = re.match(r"(\s*)(?:- |run: )>\s*$", line)  # a YAML folded scalar
+        if folded:
+            parts = []
+            index += 1
+            while index < len(lines) and (not lines[index].strip()
+                                          or len(lines[index]) - len(lines[index].lstrip()) > len(folded.group(1))):
+                parts.append(lines[index].strip())
+                index += 1
+            text = " ".join(part for part in parts if part)
+            if text.startswith("uitamr "):
+                found.append(text)
+            continue
+        quoted = re.search(r"""(?:sh '|"command": ")(uitamr [^'"]*)""", line)
+        plain = re.match(r"\s*(?:\$ |- |run: )?(uitamr .*)", line)
+        if quoted or plain:
+            text = (quoted or plain).group(1)
+            while text.endswith("\\") and index + 1 < len(lines):
+                index += 1
+                text = text[:-1] + " " + lines[index].strip()
+            found.append(text)
+        index += 1
+    return found
+
+
+def _inline_commands(text: str) -> list[str]:
+    """Inline `uitamr ...` code that is a whole command: no placeholders (SOURCES, PORT),
+    no elisions, not a quoted message (`uitamr replay: site.txt:...`)."""
+    found = []
+    for span in re.findall(r"`(uitamr [^`]+)`", text):
+        words = span.split()
+        if (words[1].endswith(":") or "..." in span or "…" in span or re.search(r"[^\x00-\x7f]", span)
+                or any(re.fullmatch(r"\[?[A-Z][A-Z_:.]+\]?(\.\.\.)?", word) for word in words[1:])):
+            continue
+        found.append(span)
+    return found
+
+
+def _words(line: str) -> list[str]:
+    """A shell line's words, up to a comment, redirection, pipe or `&`."""
+    lexer = shlex.shlex(line, posix=True, punctuation_chars="|&;<>")
+    lexer.whitespace_split = True
+    lexer.commenters = "#"
+    words = []
+    for token in lexer:
+        if token in SHELL_ENDS:
+            break
+        words.append(token)
+    return words
+
+
+def _argv(command: str) -> list[str]:
+    """The arguments after `uitamr`."""
+    words = _words(command)
+    assert words[0] == "uitamr", command
+    return words[1:]
+
+
+def _quoted_commands() -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
+    """(page, command) of the code blocks' command lines, and of inline code."""
+    blocks, inline = [], []
+    for page in PAGES:
+        text = (ROOT / page).read_text(encoding="utf-8")
+        for block in re.findall(r"```[\w]*\n(.*?)```", text, flags=re.S):
+            blocks += [(page, command) for command in _block_commands(block)]
+        inline += [(page, command) for command in _inline_commands(text)]
+    return blocks, inline
+
+
+QUOTED, INLINE = _quoted_commands()
+
+
+def test_the_pages_quote_commands():
+    """The extraction finds what it must: a failure here is the parser's, not the pages'."""
+    pages = {page for page, _ in QUOTED + INLINE}
+    assert {"docs/ci.md", "docs/emulator.md", "docs/commissioning.md", "docs/verifier.md", "docs/protocol.md",
+            "docs/wiring-rs485.md"} <= pages
+    commands = [command for _, command in QUOTED]
+    assert any(c.startswith("uitamr verify plc/*.st --program MAIN --platform fx3u --scenario verify/healthy.toml "
+                            "--scenario verify/no-reply.toml --jobs 2") for c in commands)  # the folded YAML step
+    assert any("--response-signal" in c for c in commands)
+    assert "uitamr check --platform fx3u plc verify/*.toml" in commands  # the VS Code task
+    assert len(QUOTED) >= 30 and len(INLINE) >= 30
+
+
+@pytest.mark.parametrize("page, command", QUOTED, ids=[f"{p}: {c}" for p, c in QUOTED])
+def test_a_command_line_of_a_page_is_one_the_tool_takes(page, command):
+    """A whole command line: its options, their values and its arguments, as click reads them."""
+    argv = _argv(command)
+    sub = _command(argv[0])
+    assert sub is not None, f"{page}: `{command}`: uitamr has no command {argv[0]!r}"
+    try:
+        sub.make_context(f"uitamr {argv[0]}", argv[1:])
+    except click.UsageError as err:
+        pytest.fail(f"{page}: `{command}`: {err.format_message()}")
+
+
+@pytest.mark.parametrize("page, command", INLINE, ids=[f"{p}: {c}" for p, c in INLINE])
+def test_a_command_named_in_the_text_has_the_options_it_is_named_with(page, command):
+    """Inline code names a command, often not a whole one (`uitamr replay`, `uitamr emulate
+    --tcp`): its command and options must exist, and a choice given must be one."""
+    argv = _argv(command)
+    sub = _command(argv[0])
+    assert sub is not None, f"{page}: `{command}`: uitamr has no command {argv[0]!r}"
+    options = {opt: param for param in sub.params if isinstance(param, click.Option) for opt in param.opts}
+    for index, word in enumerate(argv[1:], start=1):
+        if not word.startswith("--"):
+            continue
+        assert word in options, f"{page}: `{command}`: uitamr {argv[0]} has no option {word}"
+        param = options[word]
+        if isinstance(param.type, click.Choice) and index + 1 < len(argv):
+            assert argv[index + 1] in param.type.choices, f"{page}: `{command}`: {argv[index + 1]!r} is not a choice"
+
+
+# The page that documents each command's options. `monitor` and `replay` refer to the
+# protocol options as "`--address`, `--field-order`, ... as `uitamr frame`".
+OPTION_PAGES = {
+    "verify": ["docs/verifier.md"],
+    "check": ["docs/ci.md", "docs/st-dialect.md"],
+    "frame": ["docs/protocol.md"],
+    "monitor": ["docs/commissioning.md"],
+    "replay": ["docs/commissioning.md"],
+    "emulate": ["docs/emulator.md"],
+    "export": ["docs/import-gxworks2.md", "docs/import-gxworks3.md", "README.md"],
+}
+PROTOCOL_OPTIONS = {"--address", "--field-order", "--codes-10-13", "--status-order", "--manual-stop-counts-as-stop"}
+
+
+@pytest.mark.parametrize("name", sorted(OPTION_PAGES))
+def test_every_option_of_a_command_is_in_its_page(name):
+    command = _command(name)
+    text = "\n".join((ROOT / page).read_text(encoding="utf-8") for page in OPTION_PAGES[name])
+    options = {opt for param in command.params if isinstance(param, click.Option)
+               for opt in param.opts if opt.startswith("--")} - {"--help"}
+    if name in ("monitor", "replay"):
+        assert "| `--address`, `--field-order`, ... | as `uitamr frame` |" in text
+        options -= PROTOCOL_OPTIONS
+    missing = sorted(opt for opt in options if not re.search(rf"(?<![\w-]){re.escape(opt)}(?![\w-])", text))
+    assert not missing, f"uitamr {name} has options that {', '.join(OPTION_PAGES[name])} do not name: {missing}"
+
+
+@pytest.mark.serial
+def test_emulator_bench_recipe(tmp_path):
+    """emulator.md, "Testing without hardware", run as the page gives it (its /tmp links
+    moved into the test's folder): socat's pty pair, the emulator on one end, the three
+    mbpoll commands on the other; the stop and the point command are written, and the
+    status read shows coil 17 = 1 (running), as the page says."""
+    import os
+    import subprocess
+    import sys
+    import time
+
+    text = (ROOT / "docs" / "emulator.md").read_text(encoding="utf-8")
+    block = text.split("## Testing without hardware", 1)[1].split("```sh\n", 1)[1].split("```", 1)[0]
+    lines = [line.replace("/tmp/robot", str(tmp_path / "robot")).replace("/tmp/plc", str(tmp_path / "plc"))
+             for line in block.splitlines() if line.strip()]
+    socat_line, emulate_line, *mbpoll_lines = lines
+    assert socat_line.startswith("socat -d -d pty,raw,echo=0,") and emulate_line.startswith("uitamr emulate --serial")
+    assert len(mbpoll_lines) == 3 and all(line.startswith("mbpoll ") for line in mbpoll_lines)
+    socat = subprocess.Popen(_words(socat_line), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    emulator = None
+    try:
+        deadline = time.monotonic() + 15
+        while not ((tmp_path / "robot").exists() and (tmp_path / "plc").exists()):
+            assert socat.poll() is None and time.monotonic() < deadline, "socat made no pty pair"
+            time.sleep(0.02)
+        emulator = subprocess.Popen([sys.executable, "-m", "verifier.cli", *_argv(emulate_line)],
+                                    stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                    env={**os.environ, "PYTHONUNBUFFERED": "1"})
+        assert "listening on serial" in emulator.stdout.readline()
+        outputs = []
+        for line in mbpoll_lines:
+            done = subprocess.run(_words(line), capture_output=True, text=True, timeout=30)
+            assert done.returncode == 0, (line, done.stdout, done.stderr)
+            outputs.append(done.stdout)
+        assert "Written 1 references." in outputs[0] and "Written 1 references." in outputs[1]
+        coils = dict(re.findall(r"^\[(\d+)\]:\s+(\d)", outputs[2], flags=re.M))
+        assert len(coils) == 22 and coils["17"] == "1", outputs[2]  # running: point 3 was started
+    finally:
+        for process in (emulator, socat):
+            if process is not None and process.poll() is None:
+                process.terminate()
+                process.wait(timeout=15)
+
+
+def _python_blocks(page: str) -> list[str]:
+    return re.findall(r"```python\n(.*?)```", (ROOT / "docs" / page).read_text(encoding="utf-8"), flags=re.S)
+
+
+def test_the_python_examples_of_verifier_md_run(monkeypatch):
+    """verifier.md, "Using it from Python": the example runs (its own assert is the check),
+    and a trace from elsewhere is judged with the classes and fields the page names."""
+    from types import SimpleNamespace
+
+    monkeypatch.chdir(ROOT)
+    (block,) = _python_blocks("verifier.md")
+    exec(compile(block, "verifier.md", "exec"), {})
+    text = " ".join((ROOT / "docs" / "verifier.md").read_text(encoding="utf-8").split())
+    said = re.search(r"build `([\w.]+)\.RunEvidence\(settings, frames, end_us\)`.* from objects with "
+                     r"`t_start_us`, `t_end_us`, `direction` \(`\"tx\"` or `\"rx\"`\), `data` \(bytes\), `origin`\.",
+                     text)
+    assert said, "verifier.md no longer says how to build the evidence"
+    import importlib
+
+    from verifier.protocol import Settings
+    from verifier.verify.rules import check_all
+
+    evidence_class = importlib.import_module(said.group(1)).RunEvidence
+    run_point = bytes.fromhex("01 06 01 01 00 00 D9 F6")
+    frames = [SimpleNamespace(t_start_us=0, t_end_us=8_333, direction="tx", data=run_point, origin=None),
+              SimpleNamespace(t_start_us=13_000, t_end_us=21_333, direction="rx", data=run_point, origin=None)]
+    found = check_all(evidence_class(Settings(), frames, 1_000_000))
+    assert [rule for rule, violations in found.items() if violations] == ["UITAMR-POWERON-STOP"]
+
+
+def test_the_python_example_of_protocol_md_gives_what_its_comments_say():
+    (block,) = [b for b in _python_blocks("protocol.md") if "from verifier.protocol import" in b]
+    imports, lines = block.split("\n\n", 1)
+    names: dict = {}
+    exec(imports, names)
+    results = []
+    for line in lines.splitlines():
+        code, _, comment = line.partition("#")
+        if "=" in code.split("(")[0]:
+            exec(code, names)
+        else:
+            results.append((eval(code, names), comment.strip()))
+    assert [comment for _, comment in results] == [
+        r"b'\x01\x06\x01\xa0\x00\x00\x88\x14'", "StatusRequest(1, Query.TASK)", "'stop (01/A0)'",
+        "ControlRequest(1, MOVE_FRONT_NEG, 25)"]
+    encoded, status, described, move = (value for value, _ in results)
+    assert repr(encoded) == results[0][1] and repr(described) == results[2][1]
+    assert (status.address, status.query.name) == (1, "TASK")
+    assert (move.address, move.code.name, move.command) == (1, "MOVE_FRONT_NEG", 25)
+
+
+def test_the_fault_defaults_emulator_md_gives_are_the_codes():
+    """emulator.md's fault table gave the exception's default code but not the garbage
+    bytes `--garbage-on N` sends (A5 5A FF, as its `-- scripted fault:` line shows)."""
+    from verifier.amr.faults import Fault
+
+    rows = {row.split("|")[1].strip(): row for row in (ROOT / "docs" / "emulator.md").read_text(encoding="utf-8")
+            .splitlines() if row.startswith("| `")}
+    garbage = Fault("garbage", on_request=1)
+    assert f"`data` bytes (default `{garbage.data.hex(' ').upper()}`)" in rows["`garbage`"]
+    assert f'`"{garbage.position}"`, the default' in rows["`garbage`"]
+    assert f"`code` (default {Fault('exception', on_request=1).code:02d})" in rows["`exception`"]
