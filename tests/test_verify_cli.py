@@ -429,6 +429,20 @@ def test_a_function_block_or_no_program_at_all_is_named_as_such():
     assert "the sources define no PROGRAM, only function blocks and functions" in result.output
 
 
+def test_sources_with_no_program_are_placed_at_the_scenarios_sources_key(tmp_path, monkeypatch):
+    """A scenario whose `sources` hold only function blocks named the file alone; now its
+    `sources` key, and the file alone when SOURCES on the command line replaced them."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "fb.st").write_text("FUNCTION_BLOCK F\nVAR x : INT; END_VAR\nx := 1;\nEND_FUNCTION_BLOCK\n")
+    (tmp_path / "s.toml").write_text('name = "x"\nsources = ["fb.st"]\n')
+    result = invoke("--scenario", "s.toml")
+    assert result.exit_code == 2
+    assert "error: s.toml:2:11: sources: the sources define no PROGRAM" in result.output
+    result = invoke("--scenario", "s.toml", "fb.st")
+    assert result.exit_code == 2
+    assert "error: s.toml: the sources define no PROGRAM" in result.output
+
+
 def test_text_in_square_brackets_is_shown_as_written_not_read_as_markup(tmp_path):
     """The console library reads "[...]" as styling: user text in an error must be escaped,
     or "[/]" crashes and "uMbx[i]" loses its index (found by a robustness sweep)."""

@@ -112,7 +112,7 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
     overrides = {"program": program, "platform": platform, "channel": channel,
                  "duration_us": duration, "scan_us": scan, "seed": seed}
     if resolved:
-        own = [replace(s, sources=resolved) for s in own]
+        own = [s.with_overrides(sources=resolved) for s in own]
     if platform is None and channel is not None and resolved and not own:
         platform = _CHANNEL_PLATFORMS.get(channel.split(":")[0])  # --channel q:1: a Q CPU's port
         overrides["platform"] = platform

@@ -62,8 +62,7 @@ def for_user_sources(scenario: Scenario, sources: tuple[Path, ...], program: str
         f"{', '.join(left_out) or 'nothing'}"
     )
     return replace(
-        scenario,
-        sources=sources,
+        scenario.with_overrides(sources=sources),
         program=program,
         channel=None if scenario.converter is not None else channel,
         converter=converter,

@@ -110,7 +110,9 @@ class _Plc:
                                 f"name the PROGRAM "
                                 f"that calls it (the sources define: {listing})")
         if not programs:
-            raise UnusableInput(f"{_where(scenario)}: the sources define no PROGRAM, only function blocks and "
+            where = (scenario.where("sources", scenario.key_lines["sources"]) if "sources" in scenario.key_lines
+                     else _where(scenario))  # SOURCES given on the command line: the file is all there is
+            raise UnusableInput(f"{where}: the sources define no PROGRAM, only function blocks and "
                                 "functions: give also the .st file of the PROGRAM to run")
         if scenario.program is None:
             if len(programs) == 1:

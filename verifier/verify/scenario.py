@@ -207,9 +207,9 @@ class Scenario:
 
     def with_overrides(self, **changes: Any) -> "Scenario":
         changes = {k: v for k, v in changes.items() if v is not None}
-        replaced = [key for key in ("program", "channel") if key in changes and key in self.key_lines]
+        replaced = [key for key in ("program", "channel", "sources") if key in changes and key in self.key_lines]
         if replaced:
-            # --program/--channel replace the file's: their errors are no longer at the file's line
+            # --program/--channel/SOURCES replace the file's: their errors are no longer at the file's line
             changes["key_lines"] = {k: v for k, v in self.key_lines.items() if k not in replaced}
         return replace(self, **changes)
 
@@ -518,6 +518,7 @@ class _Reader:
         keys += ["platform"] if "platform" in data else []
         keys += ["program"] if program is not None else []
         keys += ["channel"] if channel is not None else []
+        keys += ["sources"] if "sources" in data else []
         conditions = [(f"{e.key}.{e.kind}", e.condition) for e in expectations if e.condition is not None]
         conditions += [("response_handling.signal", options.response_signal)] if signal_given else []
         return Scenario(
