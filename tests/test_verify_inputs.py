@@ -507,6 +507,10 @@ def test_the_documented_note_on_the_fx3u_example_is_what_verify_prints(tmp_path,
     ("x := FALSE;", "X0", None),  # a label is not the device of the same name
     ("Y10 := y;", "Y8", None),  # on the FX3U Y10 is octal: compared as written, never confused
     ("Y010 := y;", "Y10", 8),
+    # an output's destination is written after the call: its index is read (the input seen)
+    ("tmr(IN := y, PT := T#1s, Q => bits[n]);\nn := 0;", "n", None),
+    ("tmr(IN := y, PT := T#1s, Q => bits[n]);\nbits[2] := FALSE;", "bits[2]", None),
+    ("tmr(IN := y, PT := T#1s, Q => bits[2]);\nn := 0;", "n", 9),
 ])
 def test_what_counts_as_overwritten_before_read(tmp_path, body, name, line):
     import verifier
@@ -514,7 +518,7 @@ def test_what_counts_as_overwritten_before_read(tmp_path, body, name, line):
 
     (tmp_path / "Main.st").write_text(
         "PROGRAM Main\nVAR\n    x, y, X_UP : BOOL;\n    n, w : INT;\n    arr, buf : ARRAY[0..3] OF INT;\n"
-        "    tmr : TON;\nEND_VAR\n" + body + "\nEND_PROGRAM\n", encoding="utf-8")  # the body from line 8
+        "    tmr : TON; bits : ARRAY[0..3] OF BOOL;\nEND_VAR\n" + body + "\nEND_PROGRAM\n", encoding="utf-8")  # the body from line 8
     (tmp_path / "Globals.st").write_text("VAR_GLOBAL\n    g : BOOL;\nEND_VAR\n", encoding="utf-8")
     project = verifier.load(str(tmp_path / "Main.st"), str(tmp_path / "Globals.st"), target="gxworks2", cpu="fx3u")
     found = first_overwrite(project.files, "Main", name)

@@ -175,6 +175,8 @@ def _call(call: ast.Call, target: list, context: _Context) -> Overwrite | None:
             path = _path(arg.value)
             if path is None:
                 raise _Touched
+            for index in _index_expressions(arg.value):  # `Q => bits[n]` reads n
+                _reads(index, target, context)
             if path == target:
                 written = Overwrite(arg.span, None, context.pou)
             elif _overlap(path, target):
