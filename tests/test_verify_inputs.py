@@ -511,6 +511,12 @@ def test_the_documented_note_on_the_fx3u_example_is_what_verify_prints(tmp_path,
     ("tmr(IN := y, PT := T#1s, Q => bits[n]);\nn := 0;", "n", None),
     ("tmr(IN := y, PT := T#1s, Q => bits[n]);\nbits[2] := FALSE;", "bits[2]", None),
     ("tmr(IN := y, PT := T#1s, Q => bits[2]);\nn := 0;", "n", 9),
+    # an index register is read by the device it modifies
+    ("n := D100Z0;\nZ0 := 0;", "Z0", None),
+    ("D100Z0 := n;\nZ0 := 0;", "Z0", None),
+    # a module number is compared as a number, as the simulator reads it (U00 is U0)
+    ("n := U00\\G10;\nU0\\G10 := 1;", "U0\\G10", None),
+    ("U00\\G10 := n;", "U0\\G10", 8),
 ])
 def test_what_counts_as_overwritten_before_read(tmp_path, body, name, line):
     import verifier

@@ -67,7 +67,7 @@ def first_overwrite(files: list[ast.SourceFile], program: str, name: str) -> Ove
         if any(v.at is not None for f in files for block in f.globals for v in block.variables) or \
                 any(v.at is not None for p in pous.values() for v in p.variables):
             return None  # a label bound to a device is another name for it
-        target: list = [("dev", device["kind"], _address(device["address"]), device["module"])]
+        target: list = [("dev", device["kind"], _address(device["address"]), _module(device["module"]))]
         context = _Context(pous, pou, calls_touch=True)
     else:
         target = _label_path(name)
@@ -243,7 +243,7 @@ def _path(expr: ast.Expr) -> list | None:
         return None if base is None else base + [("bit", expr.bit)]
     if isinstance(expr, ast.Device):
         exact = expr.bit is None and expr.digits is None and expr.index is None
-        return [("dev", expr.kind.upper(), _address(expr.address) if exact else _ANY, expr.module)]
+        return [("dev", expr.kind.upper(), _address(expr.address) if exact else _ANY, _module(expr.module))]
     return None
 
 
@@ -251,6 +251,11 @@ def _address(written: str) -> str:
     """A device address as written, compared as written (X10 is octal on an FX, hex on a
     Q: the same reading on both sides either way), leading zeros aside."""
     return written.upper().lstrip("0") or "0"
+
+
+def _module(written: str | None) -> str | None:
+    """A module number (U00\\G10's) as the simulator reads it: hexadecimal, U00 is U0."""
+    return None if written is None else format(int(written, 16), "X")
 
 
 def _root(expr: ast.Expr) -> list | None:
@@ -269,6 +274,8 @@ def _index_expressions(expr: ast.Expr) -> list[ast.Expr]:
         if isinstance(expr, ast.Index):
             found += expr.indices
         expr = expr.base
+    if isinstance(expr, ast.Device) and expr.index is not None:  # D100Z0 reads the index register Z0
+        found.append(ast.Device(kind="Z", address=str(expr.index), number=expr.index))
     return found
 
 
