@@ -333,10 +333,23 @@ def _source(found: Overwrite, files: list[ast.SourceFile], program: str, texts: 
     path = _path(found.value)
     if path is None or _ANY in path or any(isinstance(part, tuple) and part[0] == "bit" for part in path):
         return None
+    if isinstance(path[0], str) and not _kept(path[0], found.pou, files):
+        return None
     text = _snippet(texts.get(found.value.span.file, ""), found.value.span)
     if not text or first_overwrite(files, program, text) is not None:
         return None
     return text
+
+
+def _kept(name: str, program: ast.Pou, files: list[ast.SourceFile]) -> bool:
+    """Whether an input could set the label `name` (the PROGRAM's own, or else a global
+    one) and the program keep it: not a constant (refused), nor a VAR_TEMP (set afresh at
+    the start of every scan)."""
+    declared = next((v for v in program.variables if v.name.upper() == name), None)
+    if declared is None:
+        declared = next((v for f in files for block in f.globals for v in block.variables
+                         if v.name.upper() == name), None)
+    return declared is None or not (declared.constant or declared.section == "VAR_TEMP")
 
 
 def _snippet(text: str, span: ast.Span) -> str:
