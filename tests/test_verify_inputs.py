@@ -451,6 +451,26 @@ def test_an_input_the_program_overwrites_before_reading_it_is_noted_at_both_plac
     assert "note: s.toml:6:9: inputs[0].set: bLamp = true does nothing" in result.output
 
 
+def test_the_note_never_says_set_a_label_no_input_can_keep(tmp_path, monkeypatch):
+    """'set X instead' names what the program copies into the input's label; a constant
+    (which an input may not set) or a VAR_TEMP (set afresh at the start of every scan, so
+    an input on it does nothing either) is no way to reach the program: not offered."""
+    (tmp_path / "Main.st").write_text(
+        "PROGRAM Main\nVAR\n    n, m, k : INT;\nEND_VAR\nVAR CONSTANT\n    cMax : INT := 5;\nEND_VAR\n"
+        "VAR_TEMP\n    nTemp : INT;\nEND_VAR\n"
+        "n := cMax;\nm := nTemp;\nk := D10;\nY0 := n > m + k;\nEND_PROGRAM\n", encoding="utf-8")
+    (tmp_path / "s.toml").write_text(
+        'sources = ["Main.st"]\nprogram = "Main"\nduration = "1s"\n'
+        '[[inputs]]\nat = "100ms"\nset = { n = 1, m = 2, k = 3 }\n[[expect]]\nthat = "Y0"\n', encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("--scenario", "s.toml", "--json", "r.json")
+    (run,) = json.loads((tmp_path / "r.json").read_text())["scenarios"]
+    notes = [note for note in run["notes"] if "does nothing" in note]
+    assert [note.split(": ")[2].split(" =")[0] for note in notes] == ["n", "m", "k"], result.output
+    assert notes[0].endswith("(n := cMax;)") and notes[1].endswith("(m := nTemp;)"), notes
+    assert notes[2].endswith("(k := D10;); set D10 instead"), notes  # a device an input can set
+
+
 def test_no_bundled_scenario_has_an_input_its_program_never_sees():
     """The bundled examples' inputs: buttons (X0, X20...) read through FB calls, an address
     register (D202), a setting label (bUseRs232): none is noted."""
@@ -507,6 +527,16 @@ def test_the_documented_note_on_the_fx3u_example_is_what_verify_prints(tmp_path,
     ("x := FALSE;", "X0", None),  # a label is not the device of the same name
     ("Y10 := y;", "Y8", None),  # on the FX3U Y10 is octal: compared as written, never confused
     ("Y010 := y;", "Y10", 8),
+    # an output's destination is written after the call: its index is read (the input seen)
+    ("tmr(IN := y, PT := T#1s, Q => bits[n]);\nn := 0;", "n", None),
+    ("tmr(IN := y, PT := T#1s, Q => bits[n]);\nbits[2] := FALSE;", "bits[2]", None),
+    ("tmr(IN := y, PT := T#1s, Q => bits[2]);\nn := 0;", "n", 9),
+    # an index register is read by the device it modifies
+    ("n := D100Z0;\nZ0 := 0;", "Z0", None),
+    ("D100Z0 := n;\nZ0 := 0;", "Z0", None),
+    # a module number is compared as a number, as the simulator reads it (U00 is U0)
+    ("n := U00\\G10;\nU0\\G10 := 1;", "U0\\G10", None),
+    ("U00\\G10 := n;", "U0\\G10", 8),
 ])
 def test_what_counts_as_overwritten_before_read(tmp_path, body, name, line):
     import verifier
@@ -514,7 +544,7 @@ def test_what_counts_as_overwritten_before_read(tmp_path, body, name, line):
 
     (tmp_path / "Main.st").write_text(
         "PROGRAM Main\nVAR\n    x, y, X_UP : BOOL;\n    n, w : INT;\n    arr, buf : ARRAY[0..3] OF INT;\n"
-        "    tmr : TON;\nEND_VAR\n" + body + "\nEND_PROGRAM\n", encoding="utf-8")  # the body from line 8
+        "    tmr : TON; bits : ARRAY[0..3] OF BOOL;\nEND_VAR\n" + body + "\nEND_PROGRAM\n", encoding="utf-8")  # the body from line 8
     (tmp_path / "Globals.st").write_text("VAR_GLOBAL\n    g : BOOL;\nEND_VAR\n", encoding="utf-8")
     project = verifier.load(str(tmp_path / "Main.st"), str(tmp_path / "Globals.st"), target="gxworks2", cpu="fx3u")
     found = first_overwrite(project.files, "Main", name)

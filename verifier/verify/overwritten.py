@@ -67,7 +67,7 @@ def first_overwrite(files: list[ast.SourceFile], program: str, name: str) -> Ove
         if any(v.at is not None for f in files for block in f.globals for v in block.variables) or \
                 any(v.at is not None for p in pous.values() for v in p.variables):
             return None  # a label bound to a device is another name for it
-        target: list = [("dev", device["kind"], _address(device["address"]), device["module"])]
+        target: list = [("dev", device["kind"], _address(device["address"]), _module(device["module"]))]
         context = _Context(pous, pou, calls_touch=True)
     else:
         target = _label_path(name)
@@ -175,6 +175,8 @@ def _call(call: ast.Call, target: list, context: _Context) -> Overwrite | None:
             path = _path(arg.value)
             if path is None:
                 raise _Touched
+            for index in _index_expressions(arg.value):  # `Q => bits[n]` reads n
+                _reads(index, target, context)
             if path == target:
                 written = Overwrite(arg.span, None, context.pou)
             elif _overlap(path, target):
@@ -241,7 +243,7 @@ def _path(expr: ast.Expr) -> list | None:
         return None if base is None else base + [("bit", expr.bit)]
     if isinstance(expr, ast.Device):
         exact = expr.bit is None and expr.digits is None and expr.index is None
-        return [("dev", expr.kind.upper(), _address(expr.address) if exact else _ANY, expr.module)]
+        return [("dev", expr.kind.upper(), _address(expr.address) if exact else _ANY, _module(expr.module))]
     return None
 
 
@@ -249,6 +251,11 @@ def _address(written: str) -> str:
     """A device address as written, compared as written (X10 is octal on an FX, hex on a
     Q: the same reading on both sides either way), leading zeros aside."""
     return written.upper().lstrip("0") or "0"
+
+
+def _module(written: str | None) -> str | None:
+    """A module number (U00\\G10's) as the simulator reads it: hexadecimal, U00 is U0."""
+    return None if written is None else format(int(written, 16), "X")
 
 
 def _root(expr: ast.Expr) -> list | None:
@@ -267,6 +274,8 @@ def _index_expressions(expr: ast.Expr) -> list[ast.Expr]:
         if isinstance(expr, ast.Index):
             found += expr.indices
         expr = expr.base
+    if isinstance(expr, ast.Device) and expr.index is not None:  # D100Z0 reads the index register Z0
+        found.append(ast.Device(kind="Z", address=str(expr.index), number=expr.index))
     return found
 
 
@@ -324,10 +333,23 @@ def _source(found: Overwrite, files: list[ast.SourceFile], program: str, texts: 
     path = _path(found.value)
     if path is None or _ANY in path or any(isinstance(part, tuple) and part[0] == "bit" for part in path):
         return None
+    if isinstance(path[0], str) and not _kept(path[0], found.pou, files):
+        return None
     text = _snippet(texts.get(found.value.span.file, ""), found.value.span)
     if not text or first_overwrite(files, program, text) is not None:
         return None
     return text
+
+
+def _kept(name: str, program: ast.Pou, files: list[ast.SourceFile]) -> bool:
+    """Whether an input could set the label `name` (the PROGRAM's own, or else a global
+    one) and the program keep it: not a constant (refused), nor a VAR_TEMP (set afresh at
+    the start of every scan)."""
+    declared = next((v for v in program.variables if v.name.upper() == name), None)
+    if declared is None:
+        declared = next((v for f in files for block in f.globals for v in block.variables
+                         if v.name.upper() == name), None)
+    return declared is None or not (declared.constant or declared.section == "VAR_TEMP")
 
 
 def _snippet(text: str, span: ast.Span) -> str:
