@@ -161,6 +161,26 @@ def test_exporting_a_folder_into_a_folder_inside_it_runs_twice(tmp_path):
     assert third.exit_code == 1 and "outside a POU" in third.output
 
 
+def test_a_pattern_is_read_as_the_folders_and_files_it_matches(tmp_path, monkeypatch):
+    """export expands a pattern itself (cmd and PowerShell do not). A pattern matching the
+    folder that holds --out ran once and then failed on the first run's bodies ('outside a
+    POU'), where the same folder named, or expanded by bash, runs again; a pattern matching
+    only a folder without .st files was read as a file of that name ('cannot read: no such
+    file', '1 unreadable file(s)', exit 1) instead of refused as matching no source (exit 2)."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "src").mkdir()
+    (tmp_path / "empty").mkdir()
+    (tmp_path / "src" / "Main.st").write_text("PROGRAM Main\nVAR\n    wX : INT;\nEND_VAR\nwX := wX + 1;\nEND_PROGRAM\n")
+    args = ["--target", "gxworks2", "--out", "src/gx2", "sr[c]"]
+    first = CliRunner().invoke(command, args)
+    assert first.exit_code == 0, first.output
+    second = CliRunner().invoke(command, args)
+    assert second.exit_code == 0, second.output
+    assert "1 file(s) in the --out folder src/gx2 left out of the sources (an earlier export)" in second.output
+    empty = CliRunner().invoke(command, ["--target", "gxworks2", "--out", "o", "emp*"])
+    assert empty.exit_code == 2 and "emp*" in empty.output and "unreadable" not in empty.output, empty.output
+
+
 def test_missing_source_is_a_usage_error(tmp_path):
     result = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(tmp_path), "nope.st"])
     assert result.exit_code == 2 and "nope.st" in result.output

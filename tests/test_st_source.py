@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 
 import pytest
-from hypothesis import given, strategies as st_
+from hypothesis import example, given, strategies as st_
 
 import verifier.sim
 from verifier import st
@@ -111,10 +111,17 @@ def test_after_a_byte_order_mark_the_byte_named_is_the_one_that_is_not_utf8(tmp_
 
 
 @given(st_.sampled_from([b"", b"\xef\xbb\xbf"]), st_.binary(max_size=200))
+@example(b"", b"\xff\xfe\x00")  # UTF-16's byte order mark: the bytes named are the first two
 def test_the_byte_an_error_names_is_at_the_offset_it_names(bom, body):
     data = bom + body
     _, problems = decode_source(data, "x.st")
     for problem in problems:
+        utf16 = re.match(r"the file is UTF-16 \((little|big)-endian: it starts with the bytes ([0-9A-F]{2}) ([0-9A-F]{2}),",
+                         problem.message)
+        if utf16:
+            assert data[:2] == bytes(int(b, 16) for b in utf16.group(2, 3))
+            assert data[:2] == {"little": b"\xff\xfe", "big": b"\xfe\xff"}[utf16.group(1)]
+            continue
         named, offset = re.match(r"byte 0x([0-9A-F]{2}) at offset (\d+)", problem.message).groups()
         assert data[int(offset)] == int(named, 16)
         data[len(bom):int(offset)].decode("utf-8")  # what comes before it is UTF-8 text

@@ -293,12 +293,14 @@ def test_the_verifier_catches_a_broken_library(tmp_path, variant):
 
 
 @pytest.mark.parametrize("word, passes", [("16#1C91", False), ("16#1C87", False), ("16#1C80", False),
-                                          ("16#0C81", True)])
+                                          ("16#0C81", True), ("16#1C89", True)])
 def test_a_port_at_another_line_format_than_the_robots_fails(tmp_path, word, passes):
     """D8400 = H1C81 (9600 8N1) is what the robot reads. A port set to 19200 8N1, 9600 8E1
     or 9600 7N1 puts its frames on the line in a form the robot's UART cannot read, so it
     never answers. The simulator used to note the format and let the robot answer anyway:
-    the run PASSed. H0C81 is 9600 8N1 too (without the RS-485 control bit) and passes."""
+    the run PASSed. H0C81 is 9600 8N1 too (without the RS-485 control bit) and passes.
+    H1C89 (9600 8N2) is reported too, but its frames are read: a second stop bit is only a
+    longer idle before the next start bit to an 8N1 receiver (it failed the run as if not)."""
     edit = {"fx3/UITAMR_PortFx3.st": [("COMM_FORMAT : WORD := 16#1C81;", f"COMM_FORMAT : WORD := {word};")]}
     result = run_library(tmp_path, edit)
     assert result.passed is passes

@@ -30,27 +30,16 @@ from verifier.textfile import real_path, text_lines
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
 
 
-def is_pattern(name: str) -> bool:
-    """A name with glob characters that is no existing path: a pattern to expand, as
-    `uitamr verify` expands one (cmd and PowerShell hand `verify/*.toml` over as it is)."""
-    from verifier.verify.sources import GLOB_CHARACTERS
-
-    return any(ch in name for ch in GLOB_CHARACTERS) and not Path(name).exists()
-
-
 def _named(name: str) -> list[Path]:
     """The files one name on the command line stands for: a folder its .st files
-    (recursive, as `uitamr verify` reads it), a pattern its matches (folders among them
-    their .st files; a pattern that matches nothing stays as named, for the caller to
-    report), anything else itself."""
-    import glob
-
-    from verifier.verify.sources import st_files_in
+    (recursive, as `uitamr verify` reads it), a pattern what it stands for as `uitamr
+    verify` expands one (cmd and PowerShell hand `verify/*.toml` over as it is; a pattern
+    that stands for no file stays as named, for the caller to report), anything else itself."""
+    from verifier.verify.sources import is_pattern, pattern_files, st_files_in
 
     path = Path(name)
     if is_pattern(name):
-        matches = sorted(Path(match) for match in glob.glob(name, recursive=True))
-        return [f for match in matches for f in (st_files_in(match) if match.is_dir() else [match])] or [path]
+        return pattern_files(name) or [path]
     return st_files_in(path) if path.is_dir() else [path]
 
 
@@ -72,6 +61,7 @@ def _not_a_source(path: Path) -> str | None:
     """Why `path` cannot be checked at all (missing, a device, a pipe ...), or None.
     Files that exist but hold no text are diagnosed with file:line:col instead."""
     from verifier.st import read_source
+    from verifier.verify.sources import is_pattern
 
     if path.is_file():
         return None

@@ -19,14 +19,13 @@ With no SOURCES, the bundled library of that platform is exported.
 """
 from __future__ import annotations
 
-import glob
 import sys
 from pathlib import Path
 
 import click
 
 from verifier.bundled import PLC_DIR
-from verifier.commands.check import expand_sources, is_pattern, platform_target
+from verifier.commands.check import expand_sources, platform_target
 from verifier.sim.cpu import PROFILES
 from verifier.textfile import real_path
 
@@ -80,9 +79,10 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
         ctx = click.get_current_context()
         raise click.MissingParameter(ctx=ctx, param=next(p for p in ctx.command.params if p.name == "target"))
     if sources:
+        from verifier.verify.sources import is_pattern, pattern_files, pattern_matches
+
         # a pattern is expanded as `uitamr verify` expands it (cmd and PowerShell do not)
-        missing = [s for s in sources
-                   if not Path(s).exists() and not (is_pattern(s) and glob.glob(s, recursive=True))]
+        missing = [s for s in sources if not Path(s).exists() and not (is_pattern(s) and pattern_files(s))]
         if missing:
             click.echo(f"uitamr export: no such file or folder: {', '.join(missing)}", err=True)
             sys.exit(EXIT_USAGE)
@@ -90,7 +90,8 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
         # a folder that holds --out: the files of an earlier export there are not sources (bodies
         # without declarations: the second run of the same command failed on them)
         out = real_path(out_dir)
-        folders = [real_path(s) for s in sources if Path(s).is_dir()]
+        folders = [real_path(f) for s in sources for f in (pattern_matches(s) if is_pattern(s) else [Path(s)])
+                   if f.is_dir()]
         earlier = [p for p in paths if real_path(p).is_relative_to(out)] \
             if any(out != f and out.is_relative_to(f) for f in folders) else []
         if earlier:

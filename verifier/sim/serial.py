@@ -5,8 +5,8 @@ the PLC sends go to the attached endpoint (the ROBOT engineer's `verifier.link.L
 any object with the same master interface: `send(data, t_us, origin)` and
 `receive_until(t_us) -> [(byte, arrival_t_us), ...]`; optionally `now_us` and
 `quiet_until_us`, see `SerialChannel.attach`) and are logged with their times. An
-endpoint with `accepts_unreadable` (the Line) is told when the port sends at another line
-format than the robot's 9600 8N1 (`send(..., unreadable=why)`): the robot cannot read it.
+endpoint with `accepts_unreadable` (the Line) is told when the port sends at a line format
+the robot's 9600 8N1 receiver cannot read (`send(..., unreadable=why)`, `LineFormat.read_at`).
 With no endpoint attached the line is silent: what is sent is only logged.
 """
 from __future__ import annotations
@@ -45,6 +45,13 @@ class LineFormat:
     def duration_us(self, n_bytes: int) -> int:
         """Time n back-to-back characters take, rounded to the nearest µs (no drift)."""
         return (n_bytes * self.bits_per_byte * 1_000_000 + self.baud // 2) // self.baud
+
+    def read_at(self, receiver: "LineFormat") -> bool:
+        """Whether a UART set to `receiver` reads what is sent at this format: the same
+        speed, data bits and parity. A receiver checks one stop bit, so more stop bits than
+        it expects are only a longer idle before the next start bit (8N2 reads as 8N1)."""
+        return ((self.baud, self.data_bits, self.parity) == (receiver.baud, receiver.data_bits, receiver.parity)
+                and self.stop_bits >= receiver.stop_bits)
 
     def __str__(self) -> str:
         return f"{self.baud} {self.data_bits}{self.parity}{self.stop_bits}"
@@ -87,7 +94,7 @@ class SerialChannel:
         data = bytes(data)
         end = t_us + self.format.duration_us(len(data))
         if self.endpoint is not None and data:
-            if self.format != ROBOT_LINE and getattr(self.endpoint, "accepts_unreadable", False):
+            if not self.format.read_at(ROBOT_LINE) and getattr(self.endpoint, "accepts_unreadable", False):
                 # the robot's UART reads framing errors or other bytes: it discards the frame
                 self.endpoint.send(data, t_us, origin, unreadable=f"sent at {self.format}, the robot's line runs "
                                                                   f"at {ROBOT_LINE}: its receiver cannot read it")

@@ -25,14 +25,27 @@ def expand(name: str, base: Path) -> list[Path]:
         raise SourceError(f"{exc.filename or name}: {exc.strerror or exc}") from None
 
 
+def is_pattern(name: str, literal: Path | None = None) -> bool:
+    """`name` has glob characters and is no existing path (`literal`, the path it names
+    where that is not `name` itself): "[A]/x.st" that exists is that file, not a pattern."""
+    return any(ch in name for ch in GLOB_CHARACTERS) and not (Path(name) if literal is None else literal).exists()
+
+
+def pattern_matches(pattern: str) -> list[Path]:
+    """The files and folders a glob pattern matches, sorted (`**` at any depth)."""
+    return sorted(Path(p) for p in glob.glob(pattern, recursive=True))
+
+
+def pattern_files(pattern: str) -> list[Path]:
+    """The files a glob pattern stands for: the files it matches, and the .st files of
+    the folders it matches (`st_files_in`)."""
+    return [f for match in pattern_matches(pattern) for f in (st_files_in(match) if match.is_dir() else [match])]
+
+
 def _expand(name: str, base: Path) -> list[Path]:
     literal = Path(name) if Path(name).is_absolute() else base / name
-    if any(ch in name for ch in GLOB_CHARACTERS) and not literal.exists():
-        pattern = name if Path(name).is_absolute() else str(base / name)
-        matches = sorted(Path(p) for p in glob.glob(pattern, recursive=True))
-        files: list[Path] = []
-        for match in matches:
-            files += st_files_in(match) if match.is_dir() else [match]
+    if is_pattern(name, literal):
+        files = pattern_files(name if Path(name).is_absolute() else str(base / name))
         if not files:
             where = "" if Path(name).is_absolute() else f" (relative to {base})"
             raise SourceError(f"{name!r} matches no file{where}")
