@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from ..refs import operand_key
 from ..rs2_devices import Rs2Devices
-from ..serial import LineFormat, SerialChannel
+from ..serial import ROBOT_LINE, LineFormat, SerialChannel
 
 
 _FX3_BAUD = {0b0011: 300, 0b0100: 600, 0b0101: 1200, 0b0110: 2400, 0b0111: 4800,
@@ -99,7 +99,7 @@ class Rs2Port:
         fmt, problems = decode_fx3_format(word)
         if fmt is not None:
             self.channel.format = fmt
-        if fmt is None or problems or str(fmt) != "9600 8N1":
+        if fmt is None or problems or fmt != ROBOT_LINE:
             what = "; ".join(problems) if problems else f"it selects {fmt}"
             self.rt.warn(location, f"RS2 {self.channel.name}: communication format "
                                    f"{self.d.format_register}=H{word:04X}: {what} "
