@@ -82,9 +82,12 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
         from verifier.verify.sources import is_pattern, pattern_files, pattern_matches
 
         # a pattern is expanded as `uitamr verify` expands it (cmd and PowerShell do not)
-        missing = [s for s in sources if not Path(s).exists() and not (is_pattern(s) and pattern_files(s))]
-        if missing:
-            click.echo(f"uitamr export: no such file or folder: {', '.join(missing)}", err=True)
+        unmatched = [s for s in sources if is_pattern(s) and not pattern_files(s)]
+        missing = [s for s in sources if not Path(s).exists() and not is_pattern(s)]
+        if unmatched or missing:
+            said = [f"{s!r} matches no file" for s in unmatched]  # as check and verify say it
+            said += [f"no such file or folder: {', '.join(missing)}"] if missing else []
+            click.echo(f"uitamr export: {'; '.join(said)}", err=True)
             sys.exit(EXIT_USAGE)
         paths = expand_sources(sources)
         # a folder that holds --out: the files of an earlier export there are not sources (bodies
