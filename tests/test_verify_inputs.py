@@ -456,19 +456,22 @@ def test_the_note_never_says_set_a_label_no_input_can_keep(tmp_path, monkeypatch
     (which an input may not set) or a VAR_TEMP (set afresh at the start of every scan, so
     an input on it does nothing either) is no way to reach the program: not offered."""
     (tmp_path / "Main.st").write_text(
-        "PROGRAM Main\nVAR\n    n, m, k : INT;\nEND_VAR\nVAR CONSTANT\n    cMax : INT := 5;\nEND_VAR\n"
+        "PROGRAM Main\nVAR\n    n, m, k : INT;\n    b : BOOL;\n    tmr : TON;\nEND_VAR\nVAR CONSTANT\n    cMax : INT := 5;\nEND_VAR\n"
         "VAR_TEMP\n    nTemp : INT;\nEND_VAR\n"
-        "n := cMax;\nm := nTemp;\nk := D10;\nY0 := n > m + k;\nEND_PROGRAM\n", encoding="utf-8")
+        "n := cMax;\nm := nTemp;\nk := D10;\nb := tmr.Q;\ntmr(IN := X1, PT := T#1s);\nY0 := n > m + k OR b;\n"
+        "END_PROGRAM\n", encoding="utf-8")
     (tmp_path / "s.toml").write_text(
         'sources = ["Main.st"]\nprogram = "Main"\nduration = "1s"\n'
-        '[[inputs]]\nat = "100ms"\nset = { n = 1, m = 2, k = 3 }\n[[expect]]\nthat = "Y0"\n', encoding="utf-8")
+        '[[inputs]]\nat = "100ms"\nset = { n = 1, m = 2, k = 3, b = true }\n[[expect]]\nthat = "Y0"\n',
+        encoding="utf-8")
     monkeypatch.chdir(tmp_path)
     result = invoke("--scenario", "s.toml", "--json", "r.json")
     (run,) = json.loads((tmp_path / "r.json").read_text())["scenarios"]
     notes = [note for note in run["notes"] if "does nothing" in note]
-    assert [note.split(": ")[2].split(" =")[0] for note in notes] == ["n", "m", "k"], result.output
+    assert [note.split(": ")[2].split(" =")[0] for note in notes] == ["n", "m", "k", "b"], result.output
     assert notes[0].endswith("(n := cMax;)") and notes[1].endswith("(m := nTemp;)"), notes
     assert notes[2].endswith("(k := D10;); set D10 instead"), notes  # a device an input can set
+    assert notes[3].endswith("(b := tmr.Q;)"), notes  # an FB's output: its next call writes it again
 
 
 def test_no_bundled_scenario_has_an_input_its_program_never_sees():

@@ -333,6 +333,8 @@ def _source(found: Overwrite, files: list[ast.SourceFile], program: str, texts: 
     path = _path(found.value)
     if path is None or _ANY in path or any(isinstance(part, tuple) and part[0] == "bit" for part in path):
         return None
+    if any(isinstance(part, str) for part in path[1:]):
+        return None  # a member of an FB instance or structure (tmr.Q): the FB's next call may write it again
     if isinstance(path[0], str) and not _kept(path[0], found.pou, files):
         return None
     text = _snippet(texts.get(found.value.span.file, ""), found.value.span)
