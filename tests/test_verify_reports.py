@@ -411,3 +411,12 @@ def test_console_counts_one_request_in_the_singular():
     report_console.render([one, good_result()], Console(file=out, width=200, color_system=None))
     text = out.getvalue()
     assert "on fx3u, 1 request in 1.000 s" in text and "on fx3u, 20 requests in 6.000 s" in text
+
+
+def test_a_page_of_no_run_does_not_say_its_times_came_from_a_line():
+    """The header said 'times from the line' (a monitor capture) for an empty list of runs:
+    all() of nothing is True."""
+    from verifier.verify import report_html
+
+    page = report_html.render([])
+    assert "virtual time · bytes at 9600 8N1" in page and "times from the line" not in page

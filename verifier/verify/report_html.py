@@ -208,7 +208,7 @@ def _pieces(results: list[ScenarioResult]) -> Iterator[str]:
         px_per_ms=DEFAULT_PX_PER_MS,
         failed=sum(not r.passed for r in results),
         total=len(results),
-        captured=all(r.captured for r in results),
+        captured=bool(results) and all(r.captured for r in results),  # a page of no run is not a capture
     )
 
 
