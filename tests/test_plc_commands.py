@@ -19,25 +19,28 @@ VAR
     fbPort : UITAMR_PortFx3;
     fbEngine : UITAMR_Engine;
     fbRun : UITAMR_RunPoint;
+    fbSpeed : UITAMR_SetSpeed;
     uMbx : ARRAY[0..15] OF WORD;
     uPort : ARRAY[0..39] OF WORD;
     bCallEngine : BOOL;
     bCmdOff : BOOL;
     bRun : BOOL;
     wPoint : INT;
+    bSpeed : BOOL;
 END_VAR
 fbPort(i_bEN := TRUE, i_wChannel := 1, i_bRs232 := FALSE, io_uPort := uPort);
 IF bCallEngine THEN
     fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := FALSE, io_uMbx := uMbx, io_uPort := uPort);
 END_IF;
 fbRun(i_bEN := NOT bCmdOff, i_bExecute := bRun, i_wPoint := wPoint, io_uMbx := uMbx);
+fbSpeed(i_bEN := TRUE, i_bExecute := bSpeed, i_bMagnetic := FALSE, i_wStage := 2, io_uMbx := uMbx);
 END_PROGRAM
 """
 
 
-def rig():
+def rig(point_duration_s=1.0):
     project = verifier.load(PLC / "core", PLC / "fx3", sources={"T_Commands.st": HARNESS})
-    line = Line(Robot(config=RobotConfig(point_duration_s=1.0)))
+    line = Line(Robot(config=RobotConfig(point_duration_s=point_duration_s)))
     project.attach_serial("fx3:1", line)
     h = project.program("T_Commands")
     h.bCallEngine = True
@@ -106,3 +109,22 @@ def test_an_edge_when_en_returns_is_served_after_the_discarded_command():
     assert frames.index(encode(ControlRequest(1, 1, 3), SETTINGS)) > frames.index(
         encode(ControlRequest(1, 1, 2), SETTINGS))
     assert h.uMbx[0] == 0 and h.uMbx[8] == 0
+
+
+def test_a_command_queued_behind_a_long_task_waits_for_it_and_is_sent():
+    """Found writing a station program: the speed button pressed during a 45 s run to a
+    point ended after 30 s with 16#0303 ('is the engine called every scan?') and was never
+    sent, though the page says requests of several FBs are served one after the other and
+    none is lost. A task may run up to TASK_TIMEOUT (10 min): the time a command ahead
+    runs (the engine serving it) does not count against QUEUE_TIMEOUT."""
+    project, h, line = rig(point_duration_s=40.0)
+    run(project, 1500, until=lambda x: x.fbEngine.o_bInitDone)
+    h.wPoint, h.bRun = 2, True
+    run(project, 1000)
+    h.bSpeed = True
+    run(project, 500)
+    assert h.fbRun.o_bBusy and h.fbSpeed.o_bBusy
+    run(project, 45_000, until=lambda x: x.fbSpeed.o_bOK or x.fbSpeed.o_bErr)
+    assert h.fbSpeed.o_bOK and not h.fbSpeed.o_bErr, hex(h.fbSpeed.o_uErrId)
+    assert h.fbRun.o_bOK
+    assert encode(ControlRequest(1, 2, 1), SETTINGS) in sent(line)
