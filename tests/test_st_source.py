@@ -115,6 +115,10 @@ def test_the_byte_an_error_names_is_at_the_offset_it_names(bom, body):
     data = bom + body
     _, problems = decode_source(data, "x.st")
     for problem in problems:
+        if problem.message.startswith("the file is UTF-16"):
+            # a UTF-16 byte order mark is named as such (commit 1891cae), not as its byte
+            assert data[:2] in (b"\xff\xfe", b"\xfe\xff") and (problem.line, problem.col) == (1, 1)
+            continue
         named, offset = re.match(r"byte 0x([0-9A-F]{2}) at offset (\d+)", problem.message).groups()
         assert data[int(offset)] == int(named, 16)
         data[len(bom):int(offset)].decode("utf-8")  # what comes before it is UTF-8 text
