@@ -125,3 +125,31 @@ def test_the_file_to_add_is_named_where_the_integrator_vendored_the_library(tmp_
     lines = [line for line in result.output.splitlines() if ": error: " in line]
     assert lines == ["src/Main.st:3:14: error: unknown type 'UITAMR_PortFx3'; the UITAMR library declares it: "
                      "add vendor/uitamr/plc/fx3/UITAMR_PortFx3.st (or its folder) to the sources"]
+
+
+def test_a_call_with_the_old_run_input_i_benable_is_told_its_new_name(tmp_path):
+    """docs/plc-library.md: the engine's and the ports' run input i_bEnable is now i_bEN,
+    and 'uitamr check names every call that still uses i_bEnable'. It named the call but
+    said only "UITAMR_Engine has no parameter 'i_bEnable'": not what to write instead."""
+    main = tmp_path / "Main.st"
+    main.write_text("PROGRAM Main\nVAR\n    fbPort : UITAMR_PortFx3;\n    fbEngine : UITAMR_Engine;\n"
+                    "    uMbx : ARRAY[0..15] OF WORD;\n    uPort : ARRAY[0..39] OF WORD;\nEND_VAR\n"
+                    "fbPort(i_bEnable := TRUE, i_wChannel := 1, io_uPort := uPort);\n"
+                    "fbEngine(i_bEnable := NOT M8002, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, "
+                    "io_uPort := uPort);\nEND_PROGRAM\n")
+    result = CliRunner().invoke(check_command, ["--platform", "fx3u", str(PLC / "core"),
+                                                str(PLC / "fx3" / "UITAMR_PortFx3.st"), str(main)])
+    assert result.exit_code == 1
+    for line, fb in ((8, "UITAMR_PortFx3"), (9, "UITAMR_Engine")):
+        assert (f"{main}:{line}:"in result.output and f"{fb} has no parameter 'i_bEnable'; its run input "
+                "is i_bEN (renamed from i_bEnable, docs/plc-library.md): write 'i_bEN := ...'") in result.output
+
+
+def test_a_misspelt_fb_parameter_gets_the_name_probably_meant(tmp_path):
+    main = tmp_path / "Main.st"
+    main.write_text("PROGRAM Main\nVAR\n    fbRun : UITAMR_RunPoint;\n    uMbx : ARRAY[0..15] OF WORD;\n"
+                    "END_VAR\nfbRun(i_bEN := TRUE, i_bExecute := TRUE, i_wPiont := 4, io_uMbx := uMbx);\n"
+                    "END_PROGRAM\n")
+    result = CliRunner().invoke(check_command, ["--target", "gxworks2", str(PLC / "core"), str(main)])
+    assert result.exit_code == 1
+    assert "UITAMR_RunPoint has no parameter 'i_wPiont'; did you mean 'i_wPoint'?" in result.output

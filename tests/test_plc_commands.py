@@ -19,25 +19,35 @@ VAR
     fbPort : UITAMR_PortFx3;
     fbEngine : UITAMR_Engine;
     fbRun : UITAMR_RunPoint;
+    fbSpeed : UITAMR_SetSpeed;
+    fbJog : UITAMR_Jog;
+    fbJogStop : UITAMR_Jog;
     uMbx : ARRAY[0..15] OF WORD;
     uPort : ARRAY[0..39] OF WORD;
     bCallEngine : BOOL;
     bCmdOff : BOOL;
     bRun : BOOL;
     wPoint : INT;
+    bSpeed : BOOL;
+    bJog : BOOL;
+    wJogDir : INT;
+    bJogStop : BOOL;
 END_VAR
 fbPort(i_bEN := TRUE, i_wChannel := 1, i_bRs232 := FALSE, io_uPort := uPort);
 IF bCallEngine THEN
     fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := FALSE, io_uMbx := uMbx, io_uPort := uPort);
 END_IF;
 fbRun(i_bEN := NOT bCmdOff, i_bExecute := bRun, i_wPoint := wPoint, io_uMbx := uMbx);
+fbSpeed(i_bEN := TRUE, i_bExecute := bSpeed, i_bMagnetic := FALSE, i_wStage := 2, io_uMbx := uMbx);
+fbJog(i_bEN := TRUE, i_bExecute := bJog, i_wDirection := wJogDir, io_uMbx := uMbx);
+fbJogStop(i_bEN := TRUE, i_bExecute := bJogStop, i_wDirection := 0, io_uMbx := uMbx);
 END_PROGRAM
 """
 
 
-def rig():
+def rig(point_duration_s=1.0):
     project = verifier.load(PLC / "core", PLC / "fx3", sources={"T_Commands.st": HARNESS})
-    line = Line(Robot(config=RobotConfig(point_duration_s=1.0)))
+    line = Line(Robot(config=RobotConfig(point_duration_s=point_duration_s)))
     project.attach_serial("fx3:1", line)
     h = project.program("T_Commands")
     h.bCallEngine = True
@@ -106,3 +116,57 @@ def test_an_edge_when_en_returns_is_served_after_the_discarded_command():
     assert frames.index(encode(ControlRequest(1, 1, 3), SETTINGS)) > frames.index(
         encode(ControlRequest(1, 1, 2), SETTINGS))
     assert h.uMbx[0] == 0 and h.uMbx[8] == 0
+
+
+def test_a_command_queued_behind_a_long_task_waits_for_it_and_is_sent():
+    """Found writing a station program: the speed button pressed during a 45 s run to a
+    point ended after 30 s with 16#0303 ('is the engine called every scan?') and was never
+    sent, though the page says requests of several FBs are served one after the other and
+    none is lost. A task may run up to TASK_TIMEOUT (10 min): the time a command ahead
+    runs (the engine serving it) does not count against QUEUE_TIMEOUT."""
+    project, h, line = rig(point_duration_s=40.0)
+    run(project, 1500, until=lambda x: x.fbEngine.o_bInitDone)
+    h.wPoint, h.bRun = 2, True
+    run(project, 1000)
+    h.bSpeed = True
+    run(project, 500)
+    assert h.fbRun.o_bBusy and h.fbSpeed.o_bBusy
+    run(project, 45_000, until=lambda x: x.fbSpeed.o_bOK or x.fbSpeed.o_bErr)
+    assert h.fbSpeed.o_bOK and not h.fbSpeed.o_bErr, hex(h.fbSpeed.o_uErrId)
+    assert h.fbRun.o_bOK
+    assert encode(ControlRequest(1, 2, 1), SETTINGS) in sent(line)
+
+
+JOG_FORWARD = encode(ControlRequest(1, 5, 1), SETTINGS)
+JOG_STOP = encode(ControlRequest(1, 5, 0), SETTINGS)
+
+
+def test_hold_to_jog_needs_a_second_instance_for_the_stop():
+    """Found writing a station's hold-to-jog buttons: with ONE UITAMR_Jog, direction 1 on
+    the press and 0 on the release, a short tap released while the move command was still
+    busy (its status read, ~0.3 s) gave an edge the FB ignored - the stop never went out
+    and the robot kept moving. Pinned here as the page now says it, with the pattern it
+    gives (a second instance for direction 0, as UITAMR_PanelFx3 has), which loses nothing."""
+    project, h, line = rig()
+    run(project, 1500, until=lambda x: x.fbEngine.o_bInitDone)
+    h.wJogDir, h.bJog = 1, True                       # press
+    run(project, 100)
+    h.bJog = False
+    run(project, 20)
+    h.wJogDir, h.bJog = 0, True                       # release: a new edge while busy
+    run(project, 3000)
+    assert JOG_FORWARD in sent(line) and JOG_STOP not in sent(line)
+    h.bJog = False
+    run(project, 50)
+    h.wJogDir, h.bJogStop = 1, False
+    h.bJog = True                                     # press again
+    run(project, 100)
+    h.bJog, h.bJogStop = False, True                  # release: the second instance
+    run(project, 3000, until=lambda x: x.fbJogStop.o_bOK or x.fbJogStop.o_bErr)
+    assert h.fbJogStop.o_bOK
+    frames = sent(line)
+    assert frames.count(JOG_FORWARD) == 2 and frames[::-1].index(JOG_STOP) < frames[::-1].index(JOG_FORWARD)
+    header = (PLC / "core" / "UITAMR_Jog.st").read_text()
+    page = (PLC.parent / "docs" / "plc-library.md").read_text()
+    for text in (header, page):
+        assert "second instance" in text and "UITAMR_PanelFx3" in text

@@ -263,6 +263,68 @@ def test_stop_overtakes_a_running_point(rig):
     assert port.kinds()[count] == STOP            # the very next frame
 
 
+def test_a_stop_also_ends_a_command_still_waiting_in_the_mailbox(rig):
+    """Found writing a station program: start pressed while the robot was silent (the
+    monitor's status read being retried), then the emergency stop. The run-point request
+    waited in the mailbox, the engine had not taken it yet; the stop was sent, and then
+    the run point: the robot drove off after the emergency stop."""
+    h, port = rig
+    h.bMonitor = True
+    port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)
+    port.run(400)
+    port.silent = True                     # the monitor's next poll gets no reply
+    port.run(350)
+    h.wPoint, h.bRun = 4, True             # start: the request waits behind the poll
+    port.run(100)
+    assert h.uMbx[0] == 1                  # requested, not taken by the engine
+    h.bStop = True                         # emergency stop
+    port.run(100)
+    port.silent = False
+    count = len(port.requests)
+    port.run(4000)
+    run4 = encode(ControlRequest(1, 1, 4), SETTINGS)
+    assert run4 not in port.kinds()[count - 1:], "run point 4 was sent after the stop"
+    assert h.fbStop.o_bOK
+    assert h.fbRun.o_bErr and h.fbRun.o_uErrId == 0x0305 and not h.fbRun.o_bBusy
+
+
+def test_a_stop_also_ends_the_commands_queued_behind_the_running_one(rig):
+    """A speed command queued (o_bBusy) behind a running point, then the stop: the point
+    ends with 16#0305, and the speed command, which would have been posted as the point's
+    slot came free, must not go out after the stop either."""
+    h, port = rig
+    port.running_polls = 50
+    start_point(h, port)
+    port.run(1000)
+    h.wStage, h.bSpeed = 2, True
+    port.run(100)
+    assert h.fbRun.o_bBusy and h.fbSpeed.o_bBusy
+    count = len(port.requests)
+    h.bStop = True
+    port.run(3000, until=lambda x: x.fbStop.o_bOK)
+    port.run(1000)
+    assert port.kinds()[count] == STOP
+    assert not [d for d in port.kinds()[count:] if d[1] == 6 and d != STOP]
+    assert h.fbRun.o_uErrId == 0x0305
+    assert h.fbSpeed.o_bErr and h.fbSpeed.o_uErrId == 0x0305 and not h.fbSpeed.o_bBusy
+
+
+def test_a_command_started_after_the_stop_ended_is_sent(rig):
+    h, port = rig
+    port.running_polls = 50
+    start_point(h, port)
+    port.run(1000)
+    h.bStop = True
+    port.run(3000, until=lambda x: x.fbStop.o_bOK)
+    h.bRun = False
+    port.run(50)
+    port.running_polls = 1
+    h.wPoint, h.bRun = 6, True
+    port.run(3000, until=lambda x: x.fbRun.o_bOK or x.fbRun.o_bErr)
+    assert h.fbRun.o_bOK
+    assert encode(ControlRequest(1, 1, 6), SETTINGS) in port.kinds()
+
+
 def test_out_of_range_parameters_send_nothing(rig):
     h, port = rig
     port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)

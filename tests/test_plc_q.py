@@ -366,3 +366,82 @@ def test_a_c24_setting_for_the_module_the_program_drives_fills_a_word_it_leaves_
     project.configure_c24(None, 2, receive_count=8)
     project.run_programs(["Main"], ms=3000)
     assert project.program("Main").fbEngine.o_bInitDone
+
+
+def test_a_c24_left_in_word_units_is_named_with_the_setting_to_make(tmp_path):
+    """Found writing a Q program of one's own: the receive settings left to "the module
+    parameters" (no U0\\G writes) and none made, the module kept its default word units,
+    G_OUTPUT sent the 8-byte stop as 16 bytes, and the report said only 'byte 8: too long
+    for an FC06 request: 16 bytes' - nothing about the word/byte units. The note names the
+    buffer-memory word, its value and the three places to set byte units."""
+    from click.testing import CliRunner
+
+    from verifier.commands.verify import command
+
+    text = USER_MAIN.replace("    U2\\G310 := 1;\n", "")
+    assert "G310" not in text
+    (tmp_path / "Main.st").write_text(text)
+    result = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--channel", "q:2",
+                                          "--duration", "3s"], catch_exceptions=False)
+    assert result.exit_code == 1
+    assert "UITAMR-FORMAT" in result.output
+    assert ("note: QJ71C24N U2 CH2 is in word units (buffer memory 136H = 0, the module's default): G_OUTPUT "
+            "sent a count of 8 as 16 bytes. UITAMR_PortQC24 counts bytes: set byte units (136H = 1) in the "
+            "module's parameters, or in the first scan (U2\\G310 := 1, as UITAMR_ExampleQ does); in a "
+            "scenario, [[c24]] byte_units = true") in " ".join(result.output.split())
+    (tmp_path / "Main.st").write_text(USER_MAIN)
+    fixed = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--channel", "q:2",
+                                         "--duration", "3s"], catch_exceptions=False)
+    assert fixed.exit_code == 0 and "word units" not in fixed.output
+
+
+def test_replies_waiting_for_a_count_they_never_reach_are_named_with_the_settings(tmp_path):
+    """The next step of the same newcomer: byte units set, but the received data count
+    (511) and the end code (0D0AH) left at the module's defaults. Every reply stayed in
+    the module as an unfinished message, and the report said only UITAMR-CYCLE (stop
+    after stop). The note names the bytes waiting and the two settings."""
+    from click.testing import CliRunner
+
+    from verifier.commands.verify import command
+
+    text = USER_MAIN.replace("    U2\\G324 := 8;\n    U2\\G325 := 16#FFFF;\n", "")
+    assert "G324" not in text and "G325" not in text
+    (tmp_path / "Main.st").write_text(text)
+    result = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--channel", "q:2",
+                                          "--duration", "5s"], catch_exceptions=False)
+    assert result.exit_code == 1
+    out = " ".join(result.output.split())
+    assert ("note: QJ71C24N U2 CH2: 40 received byte(s) wait in the module as an unfinished message since "
+            "0.244 s:") in out
+    assert ("it ends at the received data count (144H = 511) or the receive end code (145H = 0D0AH). "
+            "UITAMR_PortQC24 needs a count of 8 bytes and no end code: set 144H = 8 and 145H = FFFFH in the "
+            "module's parameters, or in the first scan (U2\\G324 := 8; U2\\G325 := 16#FFFF, as UITAMR_ExampleQ "
+            "does); in a scenario, [[c24]] receive_count = 8, end_code = \"none\"") in out
+    (tmp_path / "Main.st").write_text(USER_MAIN)
+    fixed = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--channel", "q:2",
+                                         "--duration", "5s"], catch_exceptions=False)
+    assert fixed.exit_code == 0 and "unfinished message" not in fixed.output
+
+
+def test_matrix_runs_a_program_that_leaves_the_receive_settings_to_the_module_parameters(tmp_path):
+    """docs/import-gxworks2.md §5 says to prefer the module's parameters for byte units,
+    the received data count and the end code over the example's first-scan U0\\G writes. A
+    program that followed it failed every bundled Q scenario under --matrix (UITAMR-FORMAT,
+    16-byte frames): the bundled scenarios did not make those settings, only the example's
+    writes did. They are now the bundled scenarios' [[c24]], as an installation makes them."""
+    import json
+
+    from click.testing import CliRunner
+
+    from verifier.commands.verify import command
+
+    text = USER_MAIN.replace("    U2\\G310 := 1;\n    U2\\G324 := 8;\n    U2\\G325 := 16#FFFF;\n", "")
+    assert "\\G" not in text
+    (tmp_path / "Main.st").write_text(text)
+    report = tmp_path / "m.json"
+    result = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--matrix",
+                                          "--channel", "q:2", "--duration", "8s", "--json", str(report)],
+                                catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    runs = json.loads(report.read_text())["scenarios"]
+    assert runs and all(s["verdict"] == "pass" and not s["violations"] for s in runs)

@@ -195,6 +195,31 @@ def test_bytes_discarded_for_a_reception_never_rearmed_name_the_rs2_call_and_the
                             "(docs/instructions.md §7)")
 
 
+def test_bytes_after_a_reply_of_a_program_that_rearms_are_not_called_a_missing_reset():
+    """Found running an own station program under the bundled garbage and late-reply fault
+    sets: the library's port resets M8403 after every reply, yet the one stray burst after
+    a reply was reported as "discarded because M8403 was still ON: reset M8403 ... or RS2
+    receives nothing more", pointing at the library's RS2 call as if it never re-armed.
+    Once the program has reset M8403, the message says what happened instead."""
+    ep = FakeEndpoint()
+    project, p = rs2_project(ep)
+    ep.reply_at(25_000, bytes.fromhex("0101030000003c4e"))
+    project.run_programs(["P"], scans=3)
+    project.devices["M8403"] = False         # the program reads the reply and re-arms
+    project.run_programs(["P"], scans=1)
+    ep.reply_at(55_000, bytes.fromhex("0101030000003c4e"))   # last byte at 63.3 ms
+    project.run_programs(["P"], scans=2)
+    assert project.devices["M8403"] is True
+    ep.reply_at(75_000, b"\x99\x98")        # noise right after the reply, before the reset
+    project.run_programs(["P"], scans=2)
+    last = project.diagnostics[-1]
+    assert last.location == "t.st:16:1"
+    assert last.message == ("RS2 fx3:1: 2 received byte(s) discarded because they came while M8403 was ON after a "
+                            "complete reception, before the program reset it: bytes right after a complete reply "
+                            "(a late reply, noise) are lost so, as on the CPU; the program does reset M8403, so "
+                            "the receptions after them go on (docs/instructions.md §7)")
+
+
 def test_rs2_receive_ends_on_the_d8409_time_out():
     ep = FakeEndpoint()
     project, p = rs2_project(ep)

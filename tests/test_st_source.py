@@ -121,6 +121,7 @@ def test_the_byte_an_error_names_is_at_the_offset_it_names(bom, body):
         if utf16:
             assert data[:2] == bytes(int(b, 16) for b in utf16.group(2, 3))
             assert data[:2] == {"little": b"\xff\xfe", "big": b"\xfe\xff"}[utf16.group(1)]
+            assert (problem.line, problem.col) == (1, 1)
             continue
         named, offset = re.match(r"byte 0x([0-9A-F]{2}) at offset (\d+)", problem.message).groups()
         assert data[int(offset)] == int(named, 16)

@@ -94,6 +94,23 @@ def test_condition_errors_name_the_column(text, column):
     assert info.value.column == column
 
 
+@pytest.mark.parametrize("text, column, hint", [
+    ("Y4 AND D20 = 0x0201", 14, "write 16#0201"),
+    ("w = 0b1010", 5, "write 2#1010"),
+    ("a == 1", 3, "write '='"),
+    ("a != 1", 3, "write '<>'"),
+    ("a && b", 3, "write 'AND'"),
+    ("a || b", 3, "write 'OR'"),
+    ("!a", 1, "write 'NOT'"),
+])
+def test_c_notation_in_a_condition_is_told_the_st_spelling(text, column, hint):
+    """Writing a station's scenario, 'D20 = 0x0201' got "unexpected 'x0201' at column 15":
+    neither the place of the number nor how ST writes hex."""
+    with pytest.raises(ConditionError) as info:
+        parse_condition(text)
+    assert info.value.column == column and hint in info.value.message, info.value.message
+
+
 @pytest.mark.parametrize("number", ["9" * 5000, "16#" + "F" * 5000, "1." + "9" * 5000])
 def test_a_number_of_thousands_of_digits_in_a_condition_says_so(number):
     # was "'99...9' is not a number" (int()'s 4300-digit limit), or read and judged as it was

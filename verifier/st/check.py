@@ -835,7 +835,7 @@ class Checker:
             p = fb.param(a.name)
             if p is None:
                 self.expr(a.value)
-                self.rep.error(a, f"{fb} has no parameter '{a.name}'")
+                self.rep.error(a, f"{fb} has no parameter '{a.name}'" + _parameter_hint(fb, a.name))
                 continue
             kind, pt = p
             if a.output:
@@ -1271,3 +1271,15 @@ def _ladder_spelling(callee: ast.Expr, table, pou) -> tuple[str, str] | None:
     if joined.upper() not in library.INSTRUCTIONS:
         return None
     return f"{callee.base.name}.{callee.member}", joined
+
+
+def _parameter_hint(fb: T.FbType, name: str) -> str:
+    """What to write instead of a parameter `fb` does not have: the library's old run
+    input `i_bEnable` by its new name `i_bEN` (docs/plc-library.md), else the parameter
+    spelt nearly so."""
+    from verifier.amr.schema import did_you_mean
+
+    if name.upper() == "I_BENABLE" and fb.param("i_bEN") is not None:
+        return "; its run input is i_bEN (renamed from i_bEnable, docs/plc-library.md): write 'i_bEN := ...'"
+    names = [n for group in (fb.inputs, fb.outputs, fb.in_outs) for n, _t in group]
+    return did_you_mean(name, names)

@@ -48,12 +48,30 @@ class _Token:
     column: int
 
 
+_C_NUMBER = re.compile(r"0([xXbB])([0-9A-Fa-f_]+)")
+_C_OPERATORS = {"==": "=", "!=": "<>", "&&": "AND", "||": "OR", "!": "NOT"}
+
+
+def _c_notation(text: str, position: int) -> None:
+    """C's spelling of a number or an operator at `position`: said with the ST one."""
+    number = _C_NUMBER.match(text, position)
+    if number and (position == 0 or not (text[position - 1].isalnum() or text[position - 1] in "_#")):
+        base = "16" if number.group(1) in "xX" else "2"
+        raise ConditionError(f"{number.group()!r} is C notation: write {base}#{number.group(2)}", position + 1)
+    for c_op, st_op in _C_OPERATORS.items():
+        if text.startswith(c_op, position):
+            raise ConditionError(f"{c_op!r} is C notation: write {st_op!r}", position + 1)
+
+
 def _tokenize(text: str) -> list[_Token]:
     tokens: list[_Token] = []
     position = 0
     foreign = foreign_digit(text)  # '٣' in a number or an index: the message says what it is
     if foreign is not None:
         raise ConditionError(describe(text[foreign]), foreign + 1)
+    for position in range(len(text)):
+        _c_notation(text, position)
+    position = 0
     while position < len(text):
         match = _TOKEN.match(text, position)
         if not match:

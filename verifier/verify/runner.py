@@ -466,13 +466,15 @@ def _apply_plc_settings(plc: _Plc, scenario: Scenario) -> None:
 UNREAD_NOTE_US = 1_000_000  # a message unread this long at the end of the run is not being read
 
 
-def _c24_notes(scenario: Scenario, plc: _Plc) -> list[str]:
+def _c24_notes(scenario: Scenario, plc: _Plc, violations: dict | None = None) -> list[str]:
     """Replies left in the program's QJ71C24N (the port reads on another input signal than
     the module's read request: the run shows only repeated attempts), and a [[c24]] for a
     module the program never drove, which changed nothing: the robot hangs on the module
     the program's G_OUTPUT / G_INPUT address, so its settings - the no-reception time a
-    fault set may rely on - were not in force. Said, with the module the program did use."""
-    from verifier.sim.instructions.c24 import ABNORMAL, READ_REQUEST
+    fault set may rely on - were not in force. Said, with the module the program did use.
+    And, when the line saw frames of the wrong length (UITAMR-FORMAT in `violations`), a
+    channel the program sent on in word units: the library's port counts bytes."""
+    from verifier.sim.instructions.c24 import ABNORMAL, BUFFER, READ_REQUEST
 
     if scenario.platform != "q":
         return []
@@ -488,6 +490,27 @@ def _c24_notes(scenario: Scenario, plc: _Plc) -> list[str]:
                      f"oldest since {since_us / 1e6:.3f} s; the module's reception data read request for "
                      f"CH{channel} is X{un * 16 + read:X} (reception abnormal detection X{un * 16 + error:X}): "
                      f"is that what the program passes to the port (i_bReadReq, i_bRecvErr)?")
+    for un, channel, count, since_us, recv_count, end_code in plc.project.c24_unfinished():
+        if plc.now_us - since_us < UNREAD_NOTE_US:
+            continue  # a reply still coming in
+        words = BUFFER[channel]
+        notes.append(f"QJ71C24N U{un:X} CH{channel}: {count} received byte(s) wait in the module as an unfinished "
+                     f"message since {since_us / 1e6:.3f} s: it ends at the received data count "
+                     f"({words['recv_count']:X}H = {recv_count}) or the receive end code ({words['end_code']:X}H = "
+                     + ("none" if end_code == 0xFFFF else f"{end_code:04X}H") + "). UITAMR_PortQC24 needs a count "
+                     f"of 8 bytes and no end code: set {words['recv_count']:X}H = 8 and {words['end_code']:X}H = "
+                     f"FFFFH in the module's parameters, or in the first scan (U{un:X}\\G{words['recv_count']} := 8; "
+                     f"U{un:X}\\G{words['end_code']} := 16#FFFF, as UITAMR_ExampleQ does); in a scenario, [[c24]] "
+                     f"receive_count = 8, end_code = \"none\"")
+    if (violations or {}).get("UITAMR-FORMAT"):
+        # frames of the wrong length from a channel in word units: the port counted bytes
+        for un, channel, count, nbytes in plc.project.c24_word_unit_sends():
+            word = BUFFER[channel]["unit"]
+            notes.append(f"QJ71C24N U{un:X} CH{channel} is in word units (buffer memory {word:X}H = 0, the "
+                         f"module's default): G_OUTPUT sent a count of {count} as {nbytes} bytes. UITAMR_PortQC24 "
+                         f"counts bytes: set byte units ({word:X}H = 1) in the module's parameters, or in the "
+                         f"first scan (U{un:X}\\G{word} := 1, as UITAMR_ExampleQ does); in a scenario, [[c24]] "
+                         f"byte_units = true")
     for setting in scenario.c24:
         if setting.unit is None or setting.unit in used:
             continue
@@ -732,7 +755,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         aborted=aborted,
         ended_us=end,
         wall_s=time.perf_counter() - wall_start,
-        notes=list(scenario.notes) + plc.cpu_notes() + _c24_notes(scenario, plc) + _missed_fault_notes(scenario, robot, end)
+        notes=list(scenario.notes) + plc.cpu_notes() + _c24_notes(scenario, plc, violations) + _missed_fault_notes(scenario, robot, end)
         + overwritten_input_notes(scenario, plc.project.files, plc.name, _relative)
         + ([] if tx_count else [_silence_note(scenario, plc, converter)]),
     )

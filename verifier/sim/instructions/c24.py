@@ -43,6 +43,7 @@ class _Channel:
         self.out_done = None  # (s1 ref, d ref) awaiting completion
         self.rx = bytearray()
         self.rx_last_t = 0
+        self.rx_first_t = 0  # when the first byte of the unfinished message arrived
         # messages waiting for G_INPUT: (data, error code; 0 = a normal reception, when its
         # last byte arrived in µs)
         self.frames: list[tuple[bytes, int, int]] = []
@@ -50,6 +51,9 @@ class _Channel:
         # what timer 0 running out does (C24 (Application) 6.1): format 1 ends the message
         # normally (X3/XA), format 0 reports a reception error (X4/XB, error code)
         self.no_reception_format = 1
+        # the first G_OUTPUT sent in word units: (count, bytes sent), for the report's note
+        # when the frames it sent were not the robot's (a port that counts bytes)
+        self.word_send: tuple[int, int] | None = None
 
 
 class C24Module:
@@ -139,6 +143,8 @@ class C24Module:
             return True  # already sending: the running G_OUTPUT finishes first (ASSUMPTION)
         count = s1.get(2)
         nbytes = count if self._word(chan.ch, "unit") == 1 else 2 * count
+        if nbytes != count and chan.word_send is None:
+            chan.word_send = (count, nbytes)
         data = s2.get_bytes(nbytes)
         origin = self.rt.locations[loc_id]
         chan.sending_until = chan.port.transmit(data, self.rt.now_us, origin)
@@ -181,6 +187,16 @@ class C24Module:
         """(channel, messages waiting, since when in µs) for each channel whose received
         messages no G_INPUT has taken."""
         return [(ch, len(c.frames), c.frames[0][2]) for ch, c in self.channels.items() if c.frames]
+
+    def unfinished(self) -> list[tuple[int, int, int, int, int]]:
+        """(channel, bytes, since µs, received data count, end code) of the bytes each
+        channel holds that no message end (count, end code, timer 0) has closed."""
+        return [(ch, len(c.rx), c.rx_first_t, self._word(ch, "recv_count"), self._word(ch, "end_code"))
+                for ch, c in self.channels.items() if c.rx]
+
+    def word_unit_sends(self) -> list[tuple[int, int, int]]:
+        """(channel, count, bytes sent) of the first G_OUTPUT each channel sent in word units."""
+        return [(ch, *c.word_send) for ch, c in self.channels.items() if c.word_send is not None]
 
     # -- between scans ---------------------------------------------------------------------------
     def poll(self, now: int) -> None:
@@ -240,6 +256,8 @@ class C24Module:
         for value, t in chan.port.receive_until(now):
             if chan.rx and chan.no_reception_us is not None and t - chan.rx_last_t > chan.no_reception_us:
                 self._timed_out(chan)
+            if not chan.rx:
+                chan.rx_first_t = t
             chan.rx.append(value)
             chan.rx_last_t = t
             if (end_code != 0xFFFF and len(chan.rx) >= 2

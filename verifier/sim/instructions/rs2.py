@@ -70,6 +70,9 @@ class Rs2Port:
         self.rx = bytearray()
         self.rx_last_t = 0
         self.rx_done = False
+        # the program has reset the receive-complete flag after a reception at least once:
+        # bytes dropped while it is ON are then ones right after a reply, not a missing reset
+        self.rearmed = False
         self.reported_format: int | None = None
         rt.pollers.append(self)
 
@@ -136,6 +139,7 @@ class Rs2Port:
         if self.rx_done and not self._get(self._recv_done):
             # the program reset the receive-complete flag: the count is cleared with it
             self.rx_done = False
+            self.rearmed = True
             self.rx.clear()
             self._set(self._recv_count, 0)
         got = self.channel.receive_until(now)
@@ -162,7 +166,7 @@ class Rs2Port:
         """Everything `call` and `poll` change, the scan of the last call relative to now."""
         return (self.last_call_scan - self.rt.scan_count, operand_key(self.s_ref), operand_key(self.d_ref),
                 self.m, self.n, self.sending_until,
-                self.send_started, self.send_len, bytes(self.rx), self.rx_last_t, self.rx_done,
+                self.send_started, self.send_len, bytes(self.rx), self.rx_last_t, self.rx_done, self.rearmed,
                 self.reported_format, self.channel.sent_count)
 
     def skipped(self, scan_count: int, scans: int) -> None:
@@ -199,10 +203,17 @@ class Rs2Port:
         self._set(self._recv_count, len(self.rx))
         if dropped:
             flag = self.d.receive_complete
-            why = ("RS2 was not executed" if not driven else
-                   f"{flag} was still ON: reset {flag} (receive complete) once the received data "
-                   "is read, or RS2 receives nothing more (docs/instructions.md §7)" if self.rx_done
-                   else "n = 0")
+            if not driven:
+                why = "RS2 was not executed"
+            elif self.rx_done and self.rearmed:
+                why = (f"they came while {flag} was ON after a complete reception, before the program reset it: "
+                       "bytes right after a complete reply (a late reply, noise) are lost so, as on the CPU; "
+                       f"the program does reset {flag}, so the receptions after them go on (docs/instructions.md §7)")
+            elif self.rx_done:
+                why = (f"{flag} was still ON: reset {flag} (receive complete) once the received data "
+                       "is read, or RS2 receives nothing more (docs/instructions.md §7)")
+            else:
+                why = "n = 0"
             self.rt.warn(self.call_location, f"RS2 {self.channel.name}: {dropped} received byte(s) discarded "
                                              f"because {why}")
 
