@@ -309,6 +309,30 @@ def test_a_stop_also_ends_the_commands_queued_behind_the_running_one(rig):
     assert h.fbSpeed.o_bErr and h.fbSpeed.o_uErrId == 0x0305 and not h.fbSpeed.o_bBusy
 
 
+def test_a_command_a_stop_ends_shows_no_value_of_an_earlier_command(rig):
+    """A status read the stop ended while it waited for a retry showed o_wRobotErr 3 - the
+    battery warning of the read before it, left in the slot - while one the stop ended
+    still unsent in the mailbox showed 0: the stop's 16#0305 carries no status value."""
+    h, port = rig
+    port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)
+    port.robot_error = 3                              # battery warning: the read ends ok
+    h.wQuery, h.bRead = 3, True
+    port.run(2000, until=lambda x: x.fbRead.o_bOK)
+    assert h.fbRead.o_wRobotErr == 3
+    h.bRead = False
+    port.run(50)
+    port.robot_error, port.silent = 0, True           # the next read waits for a retry
+    h.wQuery, h.bRead = 0, True
+    port.run(600)
+    assert h.uMbx[0] == 2 and h.fbRead.o_bBusy
+    h.bStop = True
+    port.run(20)
+    port.silent = False
+    port.run(3000, until=lambda x: x.fbStop.o_bOK)
+    assert h.fbRead.o_bErr and h.fbRead.o_uErrId == 0x0305
+    assert h.fbRead.o_wValue == 0 and h.fbRead.o_wRobotErr == 0
+
+
 def test_a_command_started_after_the_stop_ended_is_sent(rig):
     h, port = rig
     port.running_polls = 50

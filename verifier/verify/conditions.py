@@ -65,12 +65,11 @@ def _c_notation(text: str, position: int) -> None:
 
 def _tokenize(text: str) -> list[_Token]:
     tokens: list[_Token] = []
-    position = 0
     foreign = foreign_digit(text)  # '٣' in a number or an index: the message says what it is
     if foreign is not None:
         raise ConditionError(describe(text[foreign]), foreign + 1)
-    for position in range(len(text)):
-        _c_notation(text, position)
+    for index in range(len(text)):
+        _c_notation(text, index)
     position = 0
     while position < len(text):
         match = _TOKEN.match(text, position)
