@@ -17,7 +17,6 @@ import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
-import verifier.sim.project as project_module
 from verifier.sim import idle as idle_module
 from verifier.verify.report_json import to_dict
 from verifier.verify.runner import run_scenario
@@ -26,20 +25,6 @@ from verifier.verify.scenario import load_scenario, parse_scenario
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIOS = sorted((ROOT / "plc" / "scenarios").glob("*.toml"))
 PLC = ROOT / "plc"
-
-
-@pytest.fixture
-def idle_runs(monkeypatch):
-    """The IdleScans of every run started in the test, to see how much each skipped."""
-    made = []
-    original = project_module.Project.skip_idle_scans
-
-    def recording(self, *args, **kwargs):
-        made.append(original(self, *args, **kwargs))
-        return made[-1]
-
-    monkeypatch.setattr(project_module.Project, "skip_idle_scans", recording)
-    return made
 
 
 def _comparable(result) -> dict:

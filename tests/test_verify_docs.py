@@ -298,33 +298,24 @@ def test_the_json_example_shows_the_schema_the_reports_carry():
     assert f"**{SCHEMA_VERSION}**: " in page  # and what that number means
 
 
-def test_the_share_of_idle_scans_jumped_over_is_the_bundled_scenarios(monkeypatch):
+def test_the_share_of_idle_scans_jumped_over_is_the_bundled_scenarios(idle_runs):
     """verifier.md, "Idle scans are jumped over": the range of the share of scans each
     bundled scenario jumps over, and the FX3U example's "three scans in four". The range
     said 60-89 % after a bundled scenario (fx3u-address-out-of-range) had come to jump over
     92.5 %."""
     import math
 
-    from verifier.sim import project as project_module
     from verifier.verify.runner import run_scenario
     from verifier.verify.scenario import load_scenario
 
     text = " ".join(VERIFIER_MD.split())
     low, high = map(int, re.search(r"between (\d+) % and (\d+) % of the scans are jumped over", text).groups())
     assert "In the FX3U example, about three scans in four are jumped over." in text
-    made = []
-    original = project_module.Project.skip_idle_scans
-
-    def recording(self, *args, **kwargs):
-        made.append(original(self, *args, **kwargs))
-        return made[-1]
-
-    monkeypatch.setattr(project_module.Project, "skip_idle_scans", recording)
     shares = {}
     for path in sorted((DOCS.parent / "plc" / "scenarios").glob("*.toml")):
-        made.clear()
+        idle_runs.clear()
         run_scenario(load_scenario(path))
-        (idle,) = made
+        (idle,) = idle_runs
         shares[path.stem] = 100 * idle.skipped_scans / idle.rt.scan_count
     assert (math.floor(min(shares.values())), math.ceil(max(shares.values()))) == (low, high), shares
     assert 70 <= shares["fx3u-healthy"] < 80  # about three in four
