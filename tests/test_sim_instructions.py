@@ -216,8 +216,30 @@ def test_bytes_after_a_reply_of_a_program_that_rearms_are_not_called_a_missing_r
     assert last.location == "t.st:16:1"
     assert last.message == ("RS2 fx3:1: 2 received byte(s) discarded because they came while M8403 was ON after a "
                             "complete reception, before the program reset it: bytes right after a complete reply "
-                            "(a late reply, noise) are lost so, as on the CPU; the program does reset M8403, so "
-                            "the receptions after them go on (docs/instructions.md §7)")
+                            "(a late reply, noise) are lost so, as on the CPU; the program last reset M8403 at "
+                            "0.050 s: if it resets it after every reception, the receptions after them go on; if "
+                            "not, reset it once the received data is read (docs/instructions.md §7)")
+
+
+def test_bytes_dropped_long_after_the_last_reset_say_when_that_was():
+    """Seen by the final read: a program that reset M8403 once and then stopped was told
+    "the program does reset M8403, so the receptions after them go on" of a reply 2 s
+    later. The message now gives the time of the last reset, which shows the program has
+    stopped, and the advice to reset it."""
+    ep = FakeEndpoint()
+    project, p = rs2_project(ep)
+    ep.reply_at(25_000, bytes.fromhex("0101030000003c4e"))
+    project.run_programs(["P"], scans=3)
+    project.devices["M8403"] = False         # re-armed once...
+    project.run_programs(["P"], scans=1)
+    ep.reply_at(55_000, bytes.fromhex("0101030000003c4e"))
+    project.run_programs(["P"], scans=2)     # ...and never again
+    ep.reply_at(2_000_000, bytes.fromhex("0101030000003c4e"))
+    project.run_programs(["P"], ms=2100)
+    last = project.diagnostics[-1]
+    assert "8 received byte(s) discarded" in last.message
+    assert "the program last reset M8403 at 0.050 s" in last.message
+    assert "if not, reset it once the received data is read" in last.message
 
 
 def test_rs2_receive_ends_on_the_d8409_time_out():

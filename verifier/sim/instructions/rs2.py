@@ -70,9 +70,9 @@ class Rs2Port:
         self.rx = bytearray()
         self.rx_last_t = 0
         self.rx_done = False
-        # the program has reset the receive-complete flag after a reception at least once:
-        # bytes dropped while it is ON are then ones right after a reply, not a missing reset
-        self.rearmed = False
+        # when the program last reset the receive-complete flag after a reception (None: never):
+        # bytes dropped while it is ON may then be ones right after a reply, not a missing reset
+        self.rearmed_at: int | None = None
         self.reported_format: int | None = None
         rt.pollers.append(self)
 
@@ -139,7 +139,7 @@ class Rs2Port:
         if self.rx_done and not self._get(self._recv_done):
             # the program reset the receive-complete flag: the count is cleared with it
             self.rx_done = False
-            self.rearmed = True
+            self.rearmed_at = now
             self.rx.clear()
             self._set(self._recv_count, 0)
         got = self.channel.receive_until(now)
@@ -166,7 +166,7 @@ class Rs2Port:
         """Everything `call` and `poll` change, the scan of the last call relative to now."""
         return (self.last_call_scan - self.rt.scan_count, operand_key(self.s_ref), operand_key(self.d_ref),
                 self.m, self.n, self.sending_until,
-                self.send_started, self.send_len, bytes(self.rx), self.rx_last_t, self.rx_done, self.rearmed,
+                self.send_started, self.send_len, bytes(self.rx), self.rx_last_t, self.rx_done, self.rearmed_at,
                 self.reported_format, self.channel.sent_count)
 
     def skipped(self, scan_count: int, scans: int) -> None:
@@ -205,10 +205,14 @@ class Rs2Port:
             flag = self.d.receive_complete
             if not driven:
                 why = "RS2 was not executed"
-            elif self.rx_done and self.rearmed:
+            elif self.rx_done and self.rearmed_at is not None:
+                # when the program last reset the flag, not a guess whether it still does: a
+                # program that re-armed once and then stopped reads the old time here
                 why = (f"they came while {flag} was ON after a complete reception, before the program reset it: "
                        "bytes right after a complete reply (a late reply, noise) are lost so, as on the CPU; "
-                       f"the program does reset {flag}, so the receptions after them go on (docs/instructions.md §7)")
+                       f"the program last reset {flag} at {self.rearmed_at / 1e6:.3f} s: if it resets it after "
+                       "every reception, the receptions after them go on; if not, reset it once the received "
+                       "data is read (docs/instructions.md §7)")
             elif self.rx_done:
                 why = (f"{flag} was still ON: reset {flag} (receive complete) once the received data "
                        "is read, or RS2 receives nothing more (docs/instructions.md §7)")
