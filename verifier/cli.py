@@ -62,7 +62,7 @@ class LazyGroup(click.Group):
 @click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="uitamr")
 def main() -> None:
-    """UITAMR PLC toolkit: verify, emulate and export."""
+    """UITAMR PLC toolkit: verify, check, frame, emulate, monitor, replay and export."""
     # A file name that is not UTF-8 (b"\xfe.st" from a Shift-JIS or Big5 share) holds lone
     # surrogates, which a UTF-8 stdout with strict errors (a UTF-8 locale other than C, a
     # pipe, PYTHONIOENCODING) cannot print: `uitamr check` ended in a traceback. Such
