@@ -392,10 +392,7 @@ class _Reader:
         """`condition`, when it reads a label: one that reads none (`that = "TRUE"`) is the
         same at every moment, so it tells nothing about the program - it always passes, or
         can never pass."""
-        if not condition.names:
-            raise self.fail(key, f"'{condition}' reads no label: it is the same at every moment and says nothing "
-                                 "about the program; name the program's labels (e.g. fbRobot.o_bErr) or devices (Y0)")
-        problem = unchanging(condition)
+        problem = unchanging(condition, "name the program's labels (e.g. fbRobot.o_bErr) or devices (Y0)")
         if problem is not None:
             raise self.fail(key, problem)
         return condition
