@@ -19,7 +19,6 @@ from verifier.amr.schema import ConfigError, unknown_key
 from verifier.digits import digit_problem
 from verifier.textfile import UnreadableText, read_utf8, text_lines
 from verifier.tomlpos import Place, decode_error_position, place_of_key, shown
-from verifier.sim.devices import BUFFER_WORDS  # buffer-memory words modelled per module (0..5FFFH)
 
 from verifier.link.converter import ConverterConfig
 
@@ -604,6 +603,9 @@ class _Reader:
             if problem := digit_problem(name):  # 'U0\G１６４'
                 raise self.fail(key, problem, at_name=True)
             match = BUFFER_MEMORY.match(name)
+            # the simulator's size, imported only here: reading a scenario does not load the simulator
+            from verifier.sim.devices import BUFFER_WORDS  # words modelled per module (0..5FFFH)
+
             if match and int(match.group(2)) >= BUFFER_WORDS:
                 raise self.fail(key, f"buffer memory ends at G{BUFFER_WORDS - 1} in the simulator")
             if not match and not DEVICE_NAME.match(name):
