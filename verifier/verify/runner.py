@@ -110,10 +110,9 @@ class _Plc:
                                 f"name the PROGRAM "
                                 f"that calls it (the sources define: {listing})")
         if not programs:
-            where = (scenario.where("sources", scenario.key_lines["sources"]) if "sources" in scenario.key_lines
-                     else _where(scenario))  # SOURCES given on the command line: the file is all there is
-            raise UnusableInput(f"{where}: the sources define no PROGRAM, only function blocks and "
-                                "functions: give also the .st file of the PROGRAM to run")
+            # SOURCES given on the command line: the file is all there is
+            raise UnusableInput(f"{_key_where(scenario, 'sources')}: the sources define no PROGRAM, only function "
+                                "blocks and functions: give also the .st file of the PROGRAM to run")
         if scenario.program is None:
             if len(programs) == 1:
                 return programs[0]
@@ -266,11 +265,11 @@ def _where(scenario: Scenario) -> str:
 
 
 def _key_where(scenario: Scenario, key: str) -> str:
-    """Where the scenario's `key` ('program', 'channel') was given: `file:line:col: key`,
-    `--key` when the command line's option replaced the file's, else the file."""
+    """Where the scenario's `key` ('program', 'channel', 'sources') was given: `file:line:col:
+    key`, `--key` when the command line's option replaced the file's, else the file."""
     if key in scenario.key_lines:
         return scenario.where(key, scenario.key_lines[key])
-    if getattr(scenario, f"{key}_from_option"):
+    if key != "sources" and getattr(scenario, f"{key}_from_option"):  # SOURCES are arguments, no option
         return f"--{key}"  # given on the command line: no file is where to look
     return _where(scenario)
 
