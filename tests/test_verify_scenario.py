@@ -655,6 +655,19 @@ def test_the_scenario_channels_are_the_simulators():
     assert sorted(CHANNELS) == sorted(SIMULATED)
 
 
+def test_reading_a_scenario_does_not_import_the_simulator():
+    """The reason the channel lists above are kept apart: `uitamr check` of a scenario file
+    and the scenario reader stay clear of the simulator until a run needs it (a module-level
+    import of its buffer-memory size once loaded it)."""
+    import subprocess
+    import sys
+
+    code = ("import sys, verifier.verify.scenario; "
+            "print(sorted(m for m in sys.modules if m.startswith('verifier.sim')))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
+
+
 def test_each_platforms_channels_are_its_simulated_cpus():
     """The channels a scenario accepts for a platform are those its simulated CPU has
     (`Project.serial_channels`), so a scenario the parser lets through attaches."""

@@ -211,10 +211,7 @@ def _with_signal(scenario: Scenario, text: str) -> Scenario:
         signal = parse_condition(text)
     except ConditionError as exc:
         raise UnusableInput(f"--response-signal: {exc.message} at column {exc.column} of {text!r}") from None
-    if not signal.names:
-        raise UnusableInput(f"--response-signal: '{signal}' reads no label: it is the same at every moment and says "
-                            "nothing about the program; name the program's output (e.g. fbRobot.o_bErr)")
-    problem = unchanging(signal)
+    problem = unchanging(signal, "name the program's output (e.g. fbRobot.o_bErr)")
     if problem is not None:
         raise UnusableInput(f"--response-signal: {problem}")
     options = replace(scenario.options, response_signal=signal)

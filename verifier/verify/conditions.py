@@ -374,10 +374,14 @@ class Condition:
         return self.text
 
 
-def unchanging(condition: Condition) -> str | None:
-    """Why `condition` is refused although it reads labels: it has one value whatever theirs
-    (Condition.constant_value), so, as one that reads none, it always passes or can never
-    pass. None when it can change (or when that is not decided)."""
+def unchanging(condition: Condition, name_labels: str) -> str | None:
+    """Why `condition` is refused: it reads no label (`that = "TRUE"`; `name_labels` says
+    what to name instead), or it has one value whatever theirs (Condition.constant_value).
+    Either way it is the same at every moment, so it always passes or can never pass. None
+    when it can change (or when that is not decided)."""
+    if not condition.names:
+        return (f"'{condition}' reads no label: it is the same at every moment and says nothing about the "
+                f"program; {name_labels}")
     value = condition.constant_value()
     if value is None:
         return None

@@ -110,10 +110,9 @@ class _Plc:
                                 f"name the PROGRAM "
                                 f"that calls it (the sources define: {listing})")
         if not programs:
-            where = (scenario.where("sources", scenario.key_lines["sources"]) if "sources" in scenario.key_lines
-                     else _where(scenario))  # SOURCES given on the command line: the file is all there is
-            raise UnusableInput(f"{where}: the sources define no PROGRAM, only function blocks and "
-                                "functions: give also the .st file of the PROGRAM to run")
+            # SOURCES given on the command line: the file is all there is
+            raise UnusableInput(f"{_key_where(scenario, 'sources')}: the sources define no PROGRAM, only function "
+                                "blocks and functions: give also the .st file of the PROGRAM to run")
         if scenario.program is None:
             if len(programs) == 1:
                 return programs[0]
@@ -266,11 +265,11 @@ def _where(scenario: Scenario) -> str:
 
 
 def _key_where(scenario: Scenario, key: str) -> str:
-    """Where the scenario's `key` ('program', 'channel') was given: `file:line:col: key`,
-    `--key` when the command line's option replaced the file's, else the file."""
+    """Where the scenario's `key` ('program', 'channel', 'sources') was given: `file:line:col:
+    key`, `--key` when the command line's option replaced the file's, else the file."""
     if key in scenario.key_lines:
         return scenario.where(key, scenario.key_lines[key])
-    if getattr(scenario, f"{key}_from_option"):
+    if key != "sources" and getattr(scenario, f"{key}_from_option"):  # SOURCES are arguments, no option
         return f"--{key}"  # given on the command line: no file is where to look
     return _where(scenario)
 
@@ -487,7 +486,7 @@ def _c24_notes(scenario: Scenario, plc: _Plc, violations: dict | None = None) ->
             continue  # a reply that came in the last moments of the run
         read, error = READ_REQUEST[channel], ABNORMAL[channel]
         notes.append(f"QJ71C24N U{un:X} CH{channel}: {count} received message(s) never read by G_INPUT, the "
-                     f"oldest since {since_us / 1e6:.3f} s; the module's reception data read request for "
+                     f"oldest since {format_seconds(since_us)}; the module's reception data read request for "
                      f"CH{channel} is X{un * 16 + read:X} (reception abnormal detection X{un * 16 + error:X}): "
                      f"is that what the program passes to the port (i_bReadReq, i_bRecvErr)?")
     for un, channel, count, since_us, recv_count, end_code in plc.project.c24_unfinished():
@@ -495,7 +494,7 @@ def _c24_notes(scenario: Scenario, plc: _Plc, violations: dict | None = None) ->
             continue  # a reply still coming in
         words = BUFFER[channel]
         notes.append(f"QJ71C24N U{un:X} CH{channel}: {count} received byte(s) wait in the module as an unfinished "
-                     f"message since {since_us / 1e6:.3f} s: it ends at the received data count "
+                     f"message since {format_seconds(since_us)}: it ends at the received data count "
                      f"({words['recv_count']:X}H = {recv_count}) or the receive end code ({words['end_code']:X}H = "
                      + ("none" if end_code == 0xFFFF else f"{end_code:04X}H") + "). UITAMR_PortQC24 needs a count "
                      f"of 8 bytes and no end code: set {words['recv_count']:X}H = 8 and {words['end_code']:X}H = "

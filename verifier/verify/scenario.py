@@ -19,7 +19,6 @@ from verifier.amr.schema import ConfigError, unknown_key
 from verifier.digits import digit_problem
 from verifier.textfile import UnreadableText, read_utf8, text_lines
 from verifier.tomlpos import Place, decode_error_position, place_of_key, shown
-from verifier.sim.devices import BUFFER_WORDS  # buffer-memory words modelled per module (0..5FFFH)
 
 from verifier.link.converter import ConverterConfig
 
@@ -392,10 +391,7 @@ class _Reader:
         """`condition`, when it reads a label: one that reads none (`that = "TRUE"`) is the
         same at every moment, so it tells nothing about the program - it always passes, or
         can never pass."""
-        if not condition.names:
-            raise self.fail(key, f"'{condition}' reads no label: it is the same at every moment and says nothing "
-                                 "about the program; name the program's labels (e.g. fbRobot.o_bErr) or devices (Y0)")
-        problem = unchanging(condition)
+        problem = unchanging(condition, "name the program's labels (e.g. fbRobot.o_bErr) or devices (Y0)")
         if problem is not None:
             raise self.fail(key, problem)
         return condition
@@ -607,6 +603,9 @@ class _Reader:
             if problem := digit_problem(name):  # 'U0\G１６４'
                 raise self.fail(key, problem, at_name=True)
             match = BUFFER_MEMORY.match(name)
+            # the simulator's size, imported only here: reading a scenario does not load the simulator
+            from verifier.sim.devices import BUFFER_WORDS  # words modelled per module (0..5FFFH)
+
             if match and int(match.group(2)) >= BUFFER_WORDS:
                 raise self.fail(key, f"buffer memory ends at G{BUFFER_WORDS - 1} in the simulator")
             if not match and not DEVICE_NAME.match(name):
