@@ -158,6 +158,13 @@ fbEngine(i_bEN := NOT SM402, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMb
 LIBRARY = [PLC / "core", PLC / "q" / "UITAMR_PortQC24.st"]
 
 
+def load_main(main, faults=()):
+    """LIBRARY and a program Main (text main) on a Q CPU, its C24 CH2 at U2 on a line to a robot."""
+    project = verifier.load(*LIBRARY, sources={"Main.st": main}, cpu="q")
+    project.attach_serial("q:2", Line(Robot(Settings(), RobotConfig(), list(faults))))
+    return project
+
+
 def invoke_verify(*args):
     """`uitamr verify` with args (paths given as Path or str)."""
     from click.testing import CliRunner
@@ -194,10 +201,7 @@ def test_c24_settings_for_the_module_the_program_drives():
     5-byte exception to a status read at U2/CH2 is reported as such, and the replies after
     it stay aligned."""
     fault = Fault(kind="exception", at_s=2.0, count=1, code=3, requests="status")
-    robot = Robot(Settings(), RobotConfig(), [fault])
-    line = Line(robot)
-    project = verifier.load(*LIBRARY, sources={"Main.st": USER_MAIN}, cpu="q")
-    project.attach_serial("q:2", line)
+    project = load_main(USER_MAIN, [fault])
     project.configure_c24(None, 2, no_reception_ms=5)
     errors = set()
     project.run_programs(["Main"], ms=6000,
@@ -315,8 +319,7 @@ def test_the_unread_note_dates_the_oldest_message_still_waiting():
     still waiting arrived: a reply left unread for a second looked one scan old."""
     main = USER_MAIN.replace("i_bReadReq := X2A", "i_bReadReq := bRead").replace(
         "uPort : ARRAY[0..39] OF WORD;", "uPort : ARRAY[0..39] OF WORD;\n    bRead : BOOL;")
-    project = verifier.load(*LIBRARY, sources={"Main.st": main}, cpu="q")
-    project.attach_serial("q:2", Line(Robot(Settings(), RobotConfig(), [])))
+    project = load_main(main)
     project.run_programs(["Main"], ms=2000)
     ((unit, channel, waiting, oldest),) = project.c24_unread()
     assert (unit, channel) == (2, 2) and waiting >= 2 and oldest < 500_000
@@ -335,14 +338,12 @@ def test_the_programs_own_c24_setting_stands_over_one_for_the_module_it_drives(u
     the first scan) or is for "the module the program drives" (un=None): the latter was
     applied at the first G_OUTPUT, after the program's own write, and hid the mistake."""
     main = USER_MAIN.replace("U2\\G310 := 1;", "U2\\G310 := 0;")
-    project = verifier.load(*LIBRARY, sources={"Main.st": main}, cpu="q")
-    project.attach_serial("q:2", Line(Robot(Settings(), RobotConfig(), [])))
+    project = load_main(main)
     project.configure_c24(un, 2, byte_units=True)
     project.run_programs(["Main"], ms=3000)
     assert not project.program("Main").fbEngine.o_bInitDone
     # control: with the program's byte-units write, the same setting links
-    project = verifier.load(*LIBRARY, sources={"Main.st": USER_MAIN}, cpu="q")
-    project.attach_serial("q:2", Line(Robot(Settings(), RobotConfig(), [])))
+    project = load_main(USER_MAIN)
     project.configure_c24(un, 2, byte_units=True)
     project.run_programs(["Main"], ms=3000)
     assert project.program("Main").fbEngine.o_bInitDone
@@ -352,8 +353,7 @@ def test_a_c24_setting_for_the_module_the_program_drives_fills_a_word_it_leaves_
     """The other half: a word the program does not write (here the receive count, G324)
     takes the setting made for the module it drives."""
     main = USER_MAIN.replace("    U2\\G324 := 8;\n", "")
-    project = verifier.load(*LIBRARY, sources={"Main.st": main}, cpu="q")
-    project.attach_serial("q:2", Line(Robot(Settings(), RobotConfig(), [])))
+    project = load_main(main)
     project.configure_c24(None, 2, receive_count=8)
     project.run_programs(["Main"], ms=3000)
     assert project.program("Main").fbEngine.o_bInitDone
