@@ -1,5 +1,8 @@
-"""Helpers for the simulator tests: load ST from text, a fake serial endpoint."""
+"""Helpers for the simulator tests: load ST from text, a fake serial endpoint, a scenario
+result to compare with another run's."""
 from __future__ import annotations
+
+from dataclasses import asdict
 
 import verifier.sim
 
@@ -61,3 +64,11 @@ class FakeEndpoint:
         out = [x for x in self._incoming if x[1] <= t_us]
         self._incoming = [x for x in self._incoming if x[1] > t_us]
         return out
+
+
+def comparable(result) -> dict:
+    """A scenario result as a dict without its wall-clock time: two runs meant to give the
+    same result compare equal field for field."""
+    data = asdict(result)
+    data.pop("wall_s")
+    return data

@@ -10,13 +10,13 @@ from __future__ import annotations
 
 import json
 import re
-from dataclasses import asdict
 from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
+from sim_helpers import comparable
 from verifier.sim import idle as idle_module
 from verifier.verify.report_json import to_dict
 from verifier.verify.runner import run_scenario
@@ -25,12 +25,6 @@ from verifier.verify.scenario import load_scenario, parse_scenario
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIOS = sorted((ROOT / "plc" / "scenarios").glob("*.toml"))
 PLC = ROOT / "plc"
-
-
-def _comparable(result) -> dict:
-    data = asdict(result)
-    data.pop("wall_s")
-    return data
 
 
 def _fast_and_plain(scenario, idle_runs):
@@ -46,7 +40,7 @@ def _fast_and_plain(scenario, idle_runs):
 @pytest.mark.parametrize("path", SCENARIOS, ids=lambda p: p.stem)
 def test_bundled_scenario_same_result_and_report_bytes(path, idle_runs):
     fast, plain, skipper = _fast_and_plain(load_scenario(path), idle_runs)
-    assert _comparable(fast) == _comparable(plain)
+    assert comparable(fast) == comparable(plain)
     fast.wall_s = plain.wall_s = 0.0
     assert json.dumps(to_dict([fast]), sort_keys=True) == json.dumps(to_dict([plain]), sort_keys=True)
     if skipper.reason is None and all(hasattr(p, "idle_deadline") for p in skipper.rt.pollers):
@@ -58,7 +52,7 @@ def test_the_serial_examples_skip_most_scans(idle_runs):
     fast, plain, skipper = _fast_and_plain(load_scenario(PLC / "scenarios" / "fx3u-healthy.toml"), idle_runs)
     assert skipper.reason is None
     assert skipper.skipped_scans > skipper.rt.scan_count // 2
-    assert _comparable(fast) == _comparable(plain)
+    assert comparable(fast) == comparable(plain)
 
 
 # ---- the first quiet scan's state (verifier.sim.idle, "The first quiet scan") ---------------
@@ -70,7 +64,7 @@ def test_leaving_out_every_first_quiet_state_changes_no_result(path, idle_runs, 
     monkeypatch.setattr(idle_module, "FIRST_SKIP_SCORE", 0)
     monkeypatch.setattr(idle_module, "FIRST_PROBE_EVERY", 10**9)
     fast, plain, skipper = _fast_and_plain(load_scenario(path), idle_runs)
-    assert _comparable(fast) == _comparable(plain)
+    assert comparable(fast) == comparable(plain)
     fast.wall_s = plain.wall_s = 0.0
     assert json.dumps(to_dict([fast]), sort_keys=True) == json.dumps(to_dict([plain]), sort_keys=True)
     if skipper.reason is None and skipper.skipped_scans:
@@ -82,10 +76,10 @@ def test_the_first_quiet_state_is_left_out_on_the_tcp_route_only(idle_runs):
     pulse follows it): most are left out, and the run jumps as often as it did. On the
     FX3U example it is of use (the next scan is idle): almost all are taken."""
     fast, plain, skipper = _fast_and_plain(load_scenario(PLC / "scenarios" / "q-tcp-healthy.toml"), idle_runs)
-    assert _comparable(fast) == _comparable(plain)
+    assert comparable(fast) == comparable(plain)
     assert skipper.first_states_skipped > skipper.jumps // 2
     fast, plain, skipper = _fast_and_plain(load_scenario(PLC / "scenarios" / "fx3u-healthy.toml"), idle_runs)
-    assert _comparable(fast) == _comparable(plain)
+    assert comparable(fast) == comparable(plain)
     assert skipper.first_states_skipped < skipper.jumps // 20
 
 
@@ -166,7 +160,7 @@ def robot_scenarios(draw):
 def test_random_robot_scenarios_same_result(text, idle_runs):
     scenario = parse_scenario(text, PLC / "scenarios" / "random.toml")
     fast, plain, skipper = _fast_and_plain(scenario, idle_runs)
-    assert _comparable(fast) == _comparable(plain)
+    assert comparable(fast) == comparable(plain)
     assert skipper.reason is None and skipper.skipped_scans > 0
 
 
@@ -230,7 +224,7 @@ def test_random_timer_programs_same_result(tmp_path_factory, idle_runs, pts, sca
     scenario = _timer_scenario(tmp_path_factory.mktemp("t"), source, scan_ms, scan_ms * jitter // 101, seed,
                                platform, watch_clock=clock if watch_clock else None)
     fast, plain, skipper = _fast_and_plain(scenario, idle_runs)
-    assert _comparable(fast) == _comparable(plain)
+    assert comparable(fast) == comparable(plain)
     assert skipper.reason is None  # (whether a given draw leaves two quiet scans in a row varies)
 
 
@@ -238,7 +232,7 @@ def test_random_timer_programs_same_result(tmp_path_factory, idle_runs, pts, sca
 def test_timer_programs_do_skip(tmp_path, idle_runs, clock):
     scenario = _timer_scenario(tmp_path, _timer_program([370, 55, 125], clock, read_et=False), 10, 0, 0, "fx3u")
     fast, plain, skipper = _fast_and_plain(scenario, idle_runs)
-    assert _comparable(fast) == _comparable(plain)
+    assert comparable(fast) == comparable(plain)
     assert skipper.skipped_scans > skipper.rt.scan_count // 4
     assert fast.watched["nOn"][-1][1] > 40
 
@@ -248,7 +242,7 @@ def test_a_program_reading_et_runs_scan_by_scan(tmp_path, idle_runs):
     fast, plain, skipper = _fast_and_plain(scenario, idle_runs)
     assert skipper.reason == "the program reads a timer's ET"
     assert skipper.skipped_scans == 0
-    assert _comparable(fast) == _comparable(plain)
+    assert comparable(fast) == comparable(plain)
     assert fast.watched["wLate"][-1][1] > 0
 
 
@@ -258,4 +252,4 @@ def test_a_skip_that_ends_late_is_caught(tmp_path, idle_runs, monkeypatch):
     monkeypatch.setattr(idle_module.IdleScans, "_timer_deadline_us", lambda self: late(self) + 10_000)
     scenario = _timer_scenario(tmp_path, _timer_program([370, 55, 125], "FALSE", read_et=False), 10, 0, 0, "fx3u")
     fast, plain, _ = _fast_and_plain(scenario, idle_runs)
-    assert _comparable(fast) != _comparable(plain)
+    assert comparable(fast) != comparable(plain)

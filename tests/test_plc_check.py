@@ -141,7 +141,8 @@ def test_a_call_with_the_old_run_input_i_benable_is_told_its_new_name(tmp_path):
                                                 str(PLC / "fx3" / "UITAMR_PortFx3.st"), str(main)])
     assert result.exit_code == 1
     for line, fb in ((8, "UITAMR_PortFx3"), (9, "UITAMR_Engine")):
-        assert (f"{main}:{line}:"in result.output and f"{fb} has no parameter 'i_bEnable'; its run input "
+        assert f"{main}:{line}:" in result.output
+        assert (f"{fb} has no parameter 'i_bEnable'; its run input "
                 "is i_bEN (renamed from i_bEnable, docs/plc-library.md): write 'i_bEN := ...'") in result.output
 
 

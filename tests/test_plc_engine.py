@@ -159,6 +159,13 @@ def start_point(h, port, point=3):
     h.wPoint, h.bRun = point, True
 
 
+def start_long_point(h, port):
+    """Point 3 run, 1 s on: its task answers 'running' to 50 polls, so it is still running and polled."""
+    port.running_polls = 50
+    start_point(h, port)
+    port.run(1000)
+
+
 def test_the_stop_command_goes_first_and_is_followed_by_a_task_poll(rig):
     h, port = rig
     port.run(1500)
@@ -293,9 +300,7 @@ def test_a_stop_also_ends_the_commands_queued_behind_the_running_one(rig):
     ends with 16#0305, and the speed command, which would have been posted as the point's
     slot came free, must not go out after the stop either."""
     h, port = rig
-    port.running_polls = 50
-    start_point(h, port)
-    port.run(1000)
+    start_long_point(h, port)
     h.wStage, h.bSpeed = 2, True
     port.run(100)
     assert h.fbRun.o_bBusy and h.fbSpeed.o_bBusy
@@ -335,9 +340,7 @@ def test_a_command_a_stop_ends_shows_no_value_of_an_earlier_command(rig):
 
 def test_a_command_started_after_the_stop_ended_is_sent(rig):
     h, port = rig
-    port.running_polls = 50
-    start_point(h, port)
-    port.run(1000)
+    start_long_point(h, port)
     h.bStop = True
     port.run(3000, until=lambda x: x.fbStop.o_bOK)
     h.bRun = False
@@ -386,9 +389,7 @@ def test_collision_range_steps(rig, metres, step):
 
 def test_disabling_the_engine_fails_pending_commands_and_reenabling_stops_first(rig):
     h, port = rig
-    port.running_polls = 50
-    start_point(h, port)
-    port.run(1000)
+    start_long_point(h, port)
     h.bEnable = False
     port.run(100)
     assert h.fbRun.o_bErr and h.fbRun.o_uErrId == 0x0302
@@ -533,7 +534,6 @@ def test_a_new_value_needs_a_new_edge(rig):
     assert encode(ControlRequest(1, 1, 6), SETTINGS) in port.kinds()
 
 
-
 def test_a_rising_edge_while_busy_is_ignored_as_the_library_page_says(rig):
     """A second rising edge on the same FB while o_bBusy sends nothing: the running command
     goes on and its o_bOK follows. plc-library.md said only "send the new value with a new
@@ -553,6 +553,7 @@ def test_a_rising_edge_while_busy_is_ignored_as_the_library_page_says(rig):
     page = " ".join((ROOT / "docs" / "plc-library.md").read_text(encoding="utf-8").split())
     assert ("a new rising edge once the command has ended (`o_bOK` or `o_bErr`): a rising edge "
             "while `o_bBusy` is ignored") in page
+
 
 # ---------------------------------------------------------------------------- i_bEN / o_bENO
 def test_eno_mirrors_en_on_command_fbs_and_engine(rig):
@@ -696,9 +697,7 @@ def test_fixing_the_address_recovers_with_the_stop_first(rig):
 
 def test_an_address_going_out_of_range_ends_the_running_command_and_needs_the_stop_again(rig):
     h, port = rig
-    port.running_polls = 50
-    start_point(h, port)
-    port.run(1000)                                          # the point runs, its task is polled
+    start_long_point(h, port)
     h.wAddress = 0x1000
     port.run(600)                                           # a reply still due is discarded
     count = len(port.requests)
@@ -741,9 +740,7 @@ def test_another_valid_address_is_another_robot_the_stop_goes_first_to_it(rig):
     stop before anything else (it may have just been powered on), the command asked of the
     robot at address 1 ends with 16#0305, and commands are served at address 2 after."""
     h, port = rig
-    port.running_polls = 50
-    start_point(h, port)
-    port.run(1000)                                          # the point runs, its task is polled
+    start_long_point(h, port)
     count = len(port.requests)
     h.wAddress = 2
     port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)

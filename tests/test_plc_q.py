@@ -158,6 +158,28 @@ fbEngine(i_bEN := NOT SM402, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMb
 LIBRARY = [PLC / "core", PLC / "q" / "UITAMR_PortQC24.st"]
 
 
+def load_main(main, faults=()):
+    """LIBRARY and a program Main (text main) on a Q CPU, its C24 CH2 at U2 on a line to a robot."""
+    project = verifier.load(*LIBRARY, sources={"Main.st": main}, cpu="q")
+    project.attach_serial("q:2", Line(Robot(Settings(), RobotConfig(), list(faults))))
+    return project
+
+
+def invoke_verify(*args):
+    """`uitamr verify` with args (paths given as Path or str)."""
+    from click.testing import CliRunner
+
+    from verifier.commands.verify import command
+
+    return CliRunner().invoke(command, [*map(str, args)], catch_exceptions=False)
+
+
+def verify_main(tmp_path, main, *args):
+    """`uitamr verify` of LIBRARY and a Main.st in tmp_path holding main."""
+    (tmp_path / "Main.st").write_text(main)
+    return invoke_verify(*LIBRARY, tmp_path / "Main.st", *args)
+
+
 def test_matrix_runs_a_program_whose_c24_sits_in_another_slot_on_ch2(tmp_path):
     """The bundled q-exception.toml sets timer 0 for the example's module (U0, CH1). Under
     --matrix those settings once made a module at U0 that took the robot's replies off the
@@ -165,15 +187,8 @@ def test_matrix_runs_a_program_whose_c24_sits_in_another_slot_on_ch2(tmp_path):
     (UITAMR-CYCLE: stop after stop). The settings now go to the module the program drives."""
     import json
 
-    from click.testing import CliRunner
-
-    from verifier.commands.verify import command
-
-    (tmp_path / "Main.st").write_text(USER_MAIN)
     report = tmp_path / "m.json"
-    result = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--matrix",
-                                          "--channel", "q:2", "--duration", "8s", "--json", str(report)],
-                                catch_exceptions=False)
+    result = verify_main(tmp_path, USER_MAIN, "--matrix", "--channel", "q:2", "--duration", "8s", "--json", str(report))
     assert result.exit_code == 0, result.output
     runs = {s["name"]: s for s in json.loads(report.read_text())["scenarios"]}
     exception = next(s for name, s in runs.items() if "exception" in name)
@@ -186,10 +201,7 @@ def test_c24_settings_for_the_module_the_program_drives():
     5-byte exception to a status read at U2/CH2 is reported as such, and the replies after
     it stay aligned."""
     fault = Fault(kind="exception", at_s=2.0, count=1, code=3, requests="status")
-    robot = Robot(Settings(), RobotConfig(), [fault])
-    line = Line(robot)
-    project = verifier.load(*LIBRARY, sources={"Main.st": USER_MAIN}, cpu="q")
-    project.attach_serial("q:2", line)
+    project = load_main(USER_MAIN, [fault])
     project.configure_c24(None, 2, no_reception_ms=5)
     errors = set()
     project.run_programs(["Main"], ms=6000,
@@ -204,16 +216,10 @@ def test_a_c24_setting_for_a_slot_the_program_does_not_drive_is_noted(tmp_path):
     made a phantom module that swallowed the replies (the run failed with no hint why);
     now the run goes on, and a note at the [[c24]]'s line says the settings were not in
     force and which unit to give."""
-    from click.testing import CliRunner
-
-    from verifier.commands.verify import command
-
-    (tmp_path / "Main.st").write_text(USER_MAIN)
     scenario = tmp_path / "s.toml"
     scenario.write_text('program = "Main"\nplatform = "q"\nchannel = "q:2"\nduration = "3s"\n\n'
                         '[[c24]]\nunit = 0\nchannel = 2\nno_reception = "5ms"\n')
-    result = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--scenario", str(scenario)],
-                                catch_exceptions=False)
+    result = verify_main(tmp_path, USER_MAIN, "--scenario", str(scenario))
     assert result.exit_code == 0, result.output
     assert f"{scenario}:6:1: c24[0]: unit = 0 (U0) is not the QJ71C24N the program drives" in result.output
     assert "give unit = 2" in result.output
@@ -223,19 +229,12 @@ def test_replies_left_in_the_module_are_noted_with_the_signal_to_read_on(tmp_pat
     """Moving the C24 to U2/CH2 but leaving i_bReadReq at X3: every reply stayed in the
     module and the report only said UITAMR-CYCLE (stop after stop), far from the cause.
     Now a note names the unread messages and the module's own read request, X2A."""
-    from click.testing import CliRunner
-
-    from verifier.commands.verify import command
-
-    (tmp_path / "Main.st").write_text(USER_MAIN.replace("i_bReadReq := X2A", "i_bReadReq := X3"))
-    result = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--channel", "q:2",
-                                          "--duration", "5s"], catch_exceptions=False)
+    result = verify_main(tmp_path, USER_MAIN.replace("i_bReadReq := X2A", "i_bReadReq := X3"),
+                         "--channel", "q:2", "--duration", "5s")
     assert result.exit_code == 1
     assert ("note: QJ71C24N U2 CH2: 5 received message(s) never read by G_INPUT, the oldest since 0.252 s; "
             "the module's reception data read request for CH2 is X2A (reception abnormal detection X2B)") in result.output
-    (tmp_path / "Main.st").write_text(USER_MAIN)
-    fixed = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--channel", "q:2",
-                                         "--duration", "5s"], catch_exceptions=False)
+    fixed = verify_main(tmp_path, USER_MAIN, "--channel", "q:2", "--duration", "5s")
     assert fixed.exit_code == 0 and "never read" not in fixed.output
 
 
@@ -258,19 +257,15 @@ def test_an_e71_program_reading_another_modules_open_signal_is_told_which_words_
     the module opened, the port never saw it open and closed it again, over and over, and
     the report said only that nothing reached the robot. The note now says the program
     closed every open connection unused and names the module's words to pass."""
-    from click.testing import CliRunner
-
-    from verifier.commands.verify import command
-
     (tmp_path / "TcpMain.st").write_text(TCP_MAIN.replace("U2\\G2048", "U0\\G2048"))
     sources = [PLC / "core", PLC / "q" / "UITAMR_PortE71.st", tmp_path / "TcpMain.st"]
-    result = CliRunner().invoke(command, [*map(str, sources), "--duration", "5s"], catch_exceptions=False)
+    result = invoke_verify(*sources, "--duration", "5s")
     assert result.exit_code == 1
     assert ("the QJ71E71 at U2 opened the connection (10 open(s)) and the program closed it again each time "
             "without sending") in result.output
     assert "does the program pass U2\\G20480 (and U2\\G20485 as i_uRecvSignal)?" in result.output
     (tmp_path / "TcpMain.st").write_text(TCP_MAIN)
-    fixed = CliRunner().invoke(command, [*map(str, sources), "--duration", "5s"], catch_exceptions=False)
+    fixed = invoke_verify(*sources, "--duration", "5s")
     assert fixed.exit_code == 0, fixed.output
 
 
@@ -324,8 +319,7 @@ def test_the_unread_note_dates_the_oldest_message_still_waiting():
     still waiting arrived: a reply left unread for a second looked one scan old."""
     main = USER_MAIN.replace("i_bReadReq := X2A", "i_bReadReq := bRead").replace(
         "uPort : ARRAY[0..39] OF WORD;", "uPort : ARRAY[0..39] OF WORD;\n    bRead : BOOL;")
-    project = verifier.load(*LIBRARY, sources={"Main.st": main}, cpu="q")
-    project.attach_serial("q:2", Line(Robot(Settings(), RobotConfig(), [])))
+    project = load_main(main)
     project.run_programs(["Main"], ms=2000)
     ((unit, channel, waiting, oldest),) = project.c24_unread()
     assert (unit, channel) == (2, 2) and waiting >= 2 and oldest < 500_000
@@ -344,14 +338,12 @@ def test_the_programs_own_c24_setting_stands_over_one_for_the_module_it_drives(u
     the first scan) or is for "the module the program drives" (un=None): the latter was
     applied at the first G_OUTPUT, after the program's own write, and hid the mistake."""
     main = USER_MAIN.replace("U2\\G310 := 1;", "U2\\G310 := 0;")
-    project = verifier.load(*LIBRARY, sources={"Main.st": main}, cpu="q")
-    project.attach_serial("q:2", Line(Robot(Settings(), RobotConfig(), [])))
+    project = load_main(main)
     project.configure_c24(un, 2, byte_units=True)
     project.run_programs(["Main"], ms=3000)
     assert not project.program("Main").fbEngine.o_bInitDone
     # control: with the program's byte-units write, the same setting links
-    project = verifier.load(*LIBRARY, sources={"Main.st": USER_MAIN}, cpu="q")
-    project.attach_serial("q:2", Line(Robot(Settings(), RobotConfig(), [])))
+    project = load_main(USER_MAIN)
     project.configure_c24(un, 2, byte_units=True)
     project.run_programs(["Main"], ms=3000)
     assert project.program("Main").fbEngine.o_bInitDone
@@ -361,8 +353,7 @@ def test_a_c24_setting_for_the_module_the_program_drives_fills_a_word_it_leaves_
     """The other half: a word the program does not write (here the receive count, G324)
     takes the setting made for the module it drives."""
     main = USER_MAIN.replace("    U2\\G324 := 8;\n", "")
-    project = verifier.load(*LIBRARY, sources={"Main.st": main}, cpu="q")
-    project.attach_serial("q:2", Line(Robot(Settings(), RobotConfig(), [])))
+    project = load_main(main)
     project.configure_c24(None, 2, receive_count=8)
     project.run_programs(["Main"], ms=3000)
     assert project.program("Main").fbEngine.o_bInitDone
@@ -374,24 +365,16 @@ def test_a_c24_left_in_word_units_is_named_with_the_setting_to_make(tmp_path):
     G_OUTPUT sent the 8-byte stop as 16 bytes, and the report said only 'byte 8: too long
     for an FC06 request: 16 bytes' - nothing about the word/byte units. The note names the
     buffer-memory word, its value and the three places to set byte units."""
-    from click.testing import CliRunner
-
-    from verifier.commands.verify import command
-
     text = USER_MAIN.replace("    U2\\G310 := 1;\n", "")
     assert "G310" not in text
-    (tmp_path / "Main.st").write_text(text)
-    result = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--channel", "q:2",
-                                          "--duration", "3s"], catch_exceptions=False)
+    result = verify_main(tmp_path, text, "--channel", "q:2", "--duration", "3s")
     assert result.exit_code == 1
     assert "UITAMR-FORMAT" in result.output
     assert ("note: QJ71C24N U2 CH2 is in word units (buffer memory 136H = 0, the module's default): G_OUTPUT "
             "sent a count of 8 as 16 bytes. UITAMR_PortQC24 counts bytes: set byte units (136H = 1) in the "
             "module's parameters, or in the first scan (U2\\G310 := 1, as UITAMR_ExampleQ does); in a "
             "scenario, [[c24]] byte_units = true") in " ".join(result.output.split())
-    (tmp_path / "Main.st").write_text(USER_MAIN)
-    fixed = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--channel", "q:2",
-                                         "--duration", "3s"], catch_exceptions=False)
+    fixed = verify_main(tmp_path, USER_MAIN, "--channel", "q:2", "--duration", "3s")
     assert fixed.exit_code == 0 and "word units" not in fixed.output
 
 
@@ -400,15 +383,9 @@ def test_replies_waiting_for_a_count_they_never_reach_are_named_with_the_setting
     (511) and the end code (0D0AH) left at the module's defaults. Every reply stayed in
     the module as an unfinished message, and the report said only UITAMR-CYCLE (stop
     after stop). The note names the bytes waiting and the two settings."""
-    from click.testing import CliRunner
-
-    from verifier.commands.verify import command
-
     text = USER_MAIN.replace("    U2\\G324 := 8;\n    U2\\G325 := 16#FFFF;\n", "")
     assert "G324" not in text and "G325" not in text
-    (tmp_path / "Main.st").write_text(text)
-    result = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--channel", "q:2",
-                                          "--duration", "5s"], catch_exceptions=False)
+    result = verify_main(tmp_path, text, "--channel", "q:2", "--duration", "5s")
     assert result.exit_code == 1
     out = " ".join(result.output.split())
     assert ("note: QJ71C24N U2 CH2: 40 received byte(s) wait in the module as an unfinished message since "
@@ -417,9 +394,7 @@ def test_replies_waiting_for_a_count_they_never_reach_are_named_with_the_setting
             "UITAMR_PortQC24 needs a count of 8 bytes and no end code: set 144H = 8 and 145H = FFFFH in the "
             "module's parameters, or in the first scan (U2\\G324 := 8; U2\\G325 := 16#FFFF, as UITAMR_ExampleQ "
             "does); in a scenario, [[c24]] receive_count = 8, end_code = \"none\"") in out
-    (tmp_path / "Main.st").write_text(USER_MAIN)
-    fixed = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--channel", "q:2",
-                                         "--duration", "5s"], catch_exceptions=False)
+    fixed = verify_main(tmp_path, USER_MAIN, "--channel", "q:2", "--duration", "5s")
     assert fixed.exit_code == 0 and "unfinished message" not in fixed.output
 
 
@@ -431,17 +406,10 @@ def test_matrix_runs_a_program_that_leaves_the_receive_settings_to_the_module_pa
     writes did. They are now the bundled scenarios' [[c24]], as an installation makes them."""
     import json
 
-    from click.testing import CliRunner
-
-    from verifier.commands.verify import command
-
     text = USER_MAIN.replace("    U2\\G310 := 1;\n    U2\\G324 := 8;\n    U2\\G325 := 16#FFFF;\n", "")
     assert "\\G" not in text
-    (tmp_path / "Main.st").write_text(text)
     report = tmp_path / "m.json"
-    result = CliRunner().invoke(command, [*map(str, LIBRARY), str(tmp_path / "Main.st"), "--matrix",
-                                          "--channel", "q:2", "--duration", "8s", "--json", str(report)],
-                                catch_exceptions=False)
+    result = verify_main(tmp_path, text, "--matrix", "--channel", "q:2", "--duration", "8s", "--json", str(report))
     assert result.exit_code == 0, result.output
     runs = json.loads(report.read_text())["scenarios"]
     assert runs and all(s["verdict"] == "pass" and not s["violations"] for s in runs)

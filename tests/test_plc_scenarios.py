@@ -20,6 +20,11 @@ def test_there_are_bundled_scenarios_for_every_platform():
         assert any(n.startswith(prefix) for n in names), prefix
 
 
+def squeezed(name):
+    """The text of ROOT / name with every run of white space one blank (docs wrap sentences)."""
+    return " ".join((ROOT / name).read_text(encoding="utf-8").split())
+
+
 #: the routes of issue 9, each a bundled scenario that `uitamr verify` runs by default:
 #: the two Ethernet ports through a healthy, refusing, dropping, splitting and silent
 #: converter, and the FX3U's RS-232 adapter
@@ -73,7 +78,7 @@ def test_an_example_with_its_address_out_of_range_sends_nothing_and_reports_0315
     same on every platform) reports 16#0315 with the address as detail from the start and
     holds it, the line stays silent, and the cycle started on its button ends with 16#0315
     (it used to end with 16#0107 while the engine retried the stop, refused, every 2 s)."""
-    plc = Path(__file__).resolve().parents[1] / "plc"
+    plc = ROOT / "plc"
     ports, example, button = ADDRESS_EXAMPLES[platform]
     source = (plc / "examples" / f"{example}.st").read_text(encoding="utf-8")
     assert "ROBOT_ADDRESS : INT := 1;" in source
@@ -120,7 +125,7 @@ def test_the_fx5_adprw_example_under_a_silent_robot_times_out_as_import_gxworks3
     simulator took before, one frame went out and the engine's own time-outs said 16#0101."""
     import json
 
-    guide = " ".join((ROOT / "docs" / "import-gxworks3.md").read_text(encoding="utf-8").split())
+    guide = squeezed("docs/import-gxworks3.md")
     assert "**Slave Response Timeout 400 ms** (less than the engine's 500 ms)" in guide
     plc = (ROOT / "plc").as_posix()
     text = (ROOT / "plc" / "scenarios" / "fx3u-adprw-no-reply.toml").read_text(encoding="utf-8")
@@ -142,7 +147,7 @@ def test_the_adprw_reply_window_is_the_slave_response_time_out_as_plc_library_sa
     command sent twice (UITAMR-CYCLE), reply_timeout = 400 ms a retry. The bundled
     fx3u-adprw-late-reply scenario runs both ways here."""
     from dataclasses import replace
-    guide = " ".join((ROOT / "docs" / "plc-library.md").read_text(encoding="utf-8").split())
+    guide = squeezed("docs/plc-library.md")
     assert "`[rules] reply_timeout = \"400ms\"` when it has late replies" in guide
     scenario = load_scenario(ROOT / "plc" / "scenarios" / "fx3u-adprw-late-reply.toml")
     assert scenario.options.reply_timeout_us == 400_000
@@ -156,7 +161,7 @@ def test_the_rs232_choice_is_read_in_the_first_scan_only_as_wiring_rs232_says(tm
     starts'; the port reads it in its first scan only. Set at 1 s, D8400 keeps the RS-485
     format H1C81 for the whole run, and the guide now says so."""
     import json
-    guide = " ".join((ROOT / "docs" / "wiring-rs232.md").read_text(encoding="utf-8").split())
+    guide = squeezed("docs/wiring-rs232.md")
     assert "It reads `i_bRs232` only in that first scan" in guide
     plc = (ROOT / "plc").as_posix()
     text = (ROOT / "plc" / "scenarios" / "fx3u-rs232-healthy.toml").read_text(encoding="utf-8")
@@ -173,7 +178,7 @@ def test_the_fx3u_adprw_import_guide_names_the_modbus_setup_the_library_does_not
     QJ71C24N but nothing for the FX3U-485ADP-MB, whose master mode and line format neither
     the port nor the example writes. The guide now names them; the protocol word it gives
     follows the D8401 bit table it cites (b0 MODBUS, b4 0 = master, b8 0 = RTU)."""
-    guide = " ".join((ROOT / "docs" / "import-gxworks2.md").read_text(encoding="utf-8").split())
+    guide = squeezed("docs/import-gxworks2.md")
     assert "**FX3U + FX3U-485ADP-MB (ADPRW, `UITAMR_PortAdpFx3`" in guide
     assert "D8401 = H0001" in guide
     modbus, master, rtu = 1 << 0, 0 << 4, 0 << 8
@@ -203,7 +208,7 @@ def test_the_stop_button_right_after_a_point_command_breaks_no_rule(tmp_path, st
     command and before the status read that would follow it (the engine's priority slot):
     UITAMR-CYCLE reported that as a violation, though holding the stop back would be the
     worse program. The stop goes out first, the cycle ends, nothing else is sent for it."""
-    plc = Path(__file__).resolve().parents[1] / "plc"
+    plc = ROOT / "plc"
     text = (plc / "scenarios" / "fx3u-stop-during-run.toml").read_text(encoding="utf-8")
     text = text.replace('"../', f'"{plc.as_posix()}/').replace('at = "11s"', f'at = "{stop_at}"')
     text = text.replace('after = "11s"', f'after = "{stop_at}"').replace("reached_point = 1", "reached_point = 9")
@@ -225,9 +230,6 @@ def test_an_exception_on_the_fx5_adprw_route_is_repeated_as_the_docs_say():
     port's header even said SD8500 held the code 'per the FX5 manual'); instructions.md
     now marks it an ASSUMPTION, plc-library.md says what the integrator sees, and the two
     bundled exception scenarios show both routes."""
-    def squeezed(name):
-        return " ".join((ROOT / name).read_text(encoding="utf-8").split())
-
     assert "the FX5 MODBUS manual's code for an exception response and the register holding it were not " \
            "found (**ASSUMPTION**" in squeezed("docs/plc-library.md")
     assert "**ASSUMPTION**: SD8500 as the error-code register of CH1 and every FX5 code above are the " \

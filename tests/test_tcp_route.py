@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from sim_helpers import load_st
+from sim_helpers import comparable, load_st
 from verifier.amr import Robot
 from verifier.link import Line
 from verifier.link.converter import Converter, ConverterConfig
@@ -296,7 +296,6 @@ def test_whatever_the_converter_does_the_line_keeps_every_rule(platform, delay_m
 
 # ---- speed without a changed byte (docs/performance.md, session 23) -----------------------------
 
-from dataclasses import asdict  # noqa: E402
 
 from verifier.sim import instructions  # noqa: E402
 from verifier.sim.instructions.tcp import TcpPort  # noqa: E402
@@ -313,12 +312,6 @@ def _through_the_port(name: str):
     return lambda self, en, un, *args: getattr(self.e71(un), name.lower())(en, *args)
 
 
-def _comparable(result) -> dict:
-    data = asdict(result)
-    data.pop("wall_s")
-    return data
-
-
 @pytest.mark.parametrize("path", TCP_SCENARIOS, ids=lambda p: p.stem)
 def test_the_en_shortcut_of_the_ethernet_instructions_changes_nothing(path, monkeypatch):
     """The SP_/ZP_ entries return at once on a scan with EN FALSE as on the scan before;
@@ -328,7 +321,7 @@ def test_the_en_shortcut_of_the_ethernet_instructions_changes_nothing(path, monk
     shortcut = run_scenario(scenario)
     for name in ETHERNET:
         monkeypatch.setattr(instructions.InstructionSet, name, _through_the_port(name))
-    assert _comparable(shortcut) == _comparable(run_scenario(scenario))
+    assert comparable(shortcut) == comparable(run_scenario(scenario))
 
 
 def test_control_an_entry_that_skips_a_rising_edge_is_seen(monkeypatch):
@@ -347,7 +340,7 @@ def test_control_an_entry_that_skips_a_rising_edge_is_seen(monkeypatch):
         self.e71(un).zp_bufsnd(en, *args)
 
     monkeypatch.setattr(instructions.InstructionSet, "ZP_BUFSND", lossy)
-    assert _comparable(before) != _comparable(run_scenario(scenario))
+    assert comparable(before) != comparable(run_scenario(scenario))
 
 
 def _idle_state_before(port: TcpPort) -> tuple:
@@ -434,7 +427,7 @@ def test_the_faster_poll_changes_nothing(path, monkeypatch):
     scenario = load_scenario(path)
     now = run_scenario(scenario)
     monkeypatch.setattr(TcpPort, "poll", _poll_before)
-    assert _comparable(now) == _comparable(run_scenario(scenario))
+    assert comparable(now) == comparable(run_scenario(scenario))
 
 
 @pytest.mark.parametrize("platform", ["fx5u", "q"])

@@ -313,6 +313,16 @@ def test_an_array_nested_deeper_than_the_walk_can_follow_is_no_crash():
     assert error.value.line == 1 and "name" in str(error.value)
 
 
+def check_scenario(path, text):
+    """`uitamr check` of a scenario file written at path with text."""
+    from click.testing import CliRunner
+
+    from verifier.cli import main
+
+    path.write_text(text, encoding="utf-8")
+    return CliRunner().invoke(main, ["check", str(path)], catch_exceptions=False)
+
+
 @pytest.mark.parametrize("text, place, words", [
     ('name = "x"\nprogram = "P', (2, 13), "Unterminated string at the end of the file"),
     ('name = "x"\nprogram', (2, 8), "Expected '=' after a key in a key/value pair at the end of the file"),
@@ -326,10 +336,7 @@ def test_a_file_that_ends_inside_a_value_is_placed_at_its_end(text, place, words
     message, found = decode_error_position(caught.value, text)
     assert (found.line, found.col) == place and message == words
     path = tmp_path / "cut.toml"
-    path.write_text(text, encoding="utf-8")
-    from click.testing import CliRunner
-    from verifier.cli import main
-    result = CliRunner().invoke(main, ["check", str(path)], catch_exceptions=False)
+    result = check_scenario(path, text)
     assert result.output.startswith(f"{path}:{place[0]}:{place[1]}: error: not valid TOML: {words}\n")
 
 
@@ -348,10 +355,7 @@ def test_an_empty_key_is_found_where_it_is_written(text, key, place):
 
 def test_a_scenario_with_an_empty_key_names_its_line(tmp_path):
     path = tmp_path / "empty-key.toml"
-    path.write_text('name = "x"\n"" = 1\n', encoding="utf-8")
-    from click.testing import CliRunner
-    from verifier.cli import main
-    result = CliRunner().invoke(main, ["check", str(path)], catch_exceptions=False)
+    result = check_scenario(path, 'name = "x"\n"" = 1\n')
     assert result.output.startswith(f"{path}:2:1: error: unknown key; expected one of name,")
 
 
@@ -362,8 +366,6 @@ def test_a_scenario_with_an_empty_key_names_its_line(tmp_path):
 def test_values_nested_too_deep_for_tomllib_are_an_error_at_their_key(text, place, tmp_path):
     # tomllib raised RecursionError (not a TOMLDecodeError) some 400 levels deep: check,
     # verify --scenario and emulate --faults ended in a traceback
-    from click.testing import CliRunner
-    from verifier.cli import main
     from verifier.emulate.faultfile import FaultFileError, load_fault_file
     from verifier.verify.scenario import ScenarioError, parse_scenario
 
@@ -373,8 +375,7 @@ def test_values_nested_too_deep_for_tomllib_are_an_error_at_their_key(text, plac
     assert error.value.message == ("not valid TOML: arrays or inline tables nested hundreds deep: too deep to "
                                    "read, and no setting takes them")
     path = tmp_path / "deep.toml"
-    path.write_text(text, encoding="utf-8")
-    result = CliRunner().invoke(main, ["check", str(path)], catch_exceptions=False)
+    result = check_scenario(path, text)
     assert result.output.startswith(f"{path}:{place[0]}:{place[1]}: error: not valid TOML: arrays")
     with pytest.raises(FaultFileError, match=rf"^{path}:{place[0]}:{place[1]}: not valid TOML: arrays or inline tables"):
         load_fault_file(path)
