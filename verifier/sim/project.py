@@ -459,9 +459,8 @@ class Project:
                         no_reception_ms=no_reception_ms, no_reception_format=no_reception_format)
         if un is None:
             self.rt.c24_for_program[channel] = settings
-            for module in self._instructions()._c24.values():
-                if module.addressed:
-                    module.configure(channel, **settings)
+            for _un, module in self._program_c24():
+                module.configure_for_program(channel, settings)
             return
         last_un = self.cpu.areas["X"].size // 16 - 1  # the start I/O's upper digits: U0 = X/Y000
         if type(un) is not int or not 0 <= un <= last_un:
