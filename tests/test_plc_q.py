@@ -349,6 +349,20 @@ def test_the_programs_own_c24_setting_stands_over_one_for_the_module_it_drives(u
     assert project.program("Main").fbEngine.o_bInitDone
 
 
+def test_a_c24_setting_for_the_module_the_program_drives_made_mid_run_leaves_the_programs_word():
+    """configure_c24(None, ...) made after the program's first G_OUTPUT: the program's own
+    U2\\G310 := 0 stands there too, as at the first call (it was written over, and the
+    word-units mistake linked)."""
+    main = USER_MAIN.replace("U2\\G310 := 1;", "U2\\G310 := 0;")
+    project = verifier.load(*LIBRARY, sources={"Main.st": main}, cpu="q")
+    project.attach_serial("q:2", Line(Robot(Settings(), RobotConfig(), [])))
+    project.run_programs(["Main"], ms=1000)
+    assert project.c24_addressed() == [2]
+    project.configure_c24(None, 2, byte_units=True)
+    project.run_programs(["Main"], ms=3000)
+    assert not project.program("Main").fbEngine.o_bInitDone
+
+
 def test_a_c24_setting_for_the_module_the_program_drives_fills_a_word_it_leaves_alone():
     """The other half: a word the program does not write (here the receive count, G324)
     takes the setting made for the module it drives."""

@@ -279,9 +279,11 @@ class IdleScans:
                 return  # not taken: `_previous` stays None, the next quiet scan takes its state
         state = self._state()
         if self._judging_first:  # the first quiet scan's state: was it worth taking?
-            self._judging_first = False
-            self._first_score = max(0, self._first_score - FIRST_USEFUL) if state == self._previous else \
-                min(FIRST_SKIP_SCORE + 2, self._first_score + 1)
+            if state == self._previous:
+                self._judging_first = False
+                self._first_score = max(0, self._first_score - FIRST_USEFUL)
+            else:
+                self._first_wasted()
         elif self._quiet == 1:
             self._judging_first = True
         if state != self._previous:
@@ -294,9 +296,8 @@ class IdleScans:
             self._jump(deadline)
 
     def _first_wasted(self) -> None:
-        """The scan after a first quiet scan whose state was taken is not quiet: that state
-        was not worth taking (the caller has reset the comparison; inline, as it runs on
-        most scans)."""
+        """The scan after a first quiet scan whose state was taken is not quiet, or its
+        state differs: that state was not worth taking."""
         self._judging_first = False
         self._first_score = min(FIRST_SKIP_SCORE + 2, self._first_score + 1)
 

@@ -459,9 +459,8 @@ class Project:
                         no_reception_ms=no_reception_ms, no_reception_format=no_reception_format)
         if un is None:
             self.rt.c24_for_program[channel] = settings
-            for module in self._instructions()._c24.values():
-                if module.addressed:
-                    module.configure(channel, **settings)
+            for _un, module in self._program_c24():
+                module.configure_for_program(channel, settings)
             return
         last_un = self.cpu.areas["X"].size // 16 - 1  # the start I/O's upper digits: U0 = X/Y000
         if type(un) is not int or not 0 <= un <= last_un:
@@ -473,25 +472,27 @@ class Project:
         """(start I/O, channel, messages, since µs) for the received messages that wait in
         a QJ71C24N the program drives, not read by G_INPUT: a program that reads on the
         wrong input signal leaves every reply there."""
-        return [(un, *waiting) for un, module in sorted(self._instructions()._c24.items())
-                if module.addressed for waiting in module.unread()]
+        return [(un, *waiting) for un, module in self._program_c24() for waiting in module.unread()]
 
     def c24_unfinished(self) -> list[tuple[int, int, int, int, int, int]]:
         """(start I/O, channel, bytes, since µs, received data count, end code) of the bytes a
         QJ71C24N channel the program drives holds as a message not yet ended."""
-        return [(un, *waiting) for un, module in sorted(self._instructions()._c24.items())
-                if module.addressed for waiting in module.unfinished()]
+        return [(un, *waiting) for un, module in self._program_c24() for waiting in module.unfinished()]
 
     def c24_word_unit_sends(self) -> list[tuple[int, int, int, int]]:
         """(start I/O, channel, count, bytes sent) of the first G_OUTPUT a QJ71C24N channel
         the program drives sent in word units (buffer memory 96H / 136H = 0, the default)."""
-        return [(un, *sent) for un, module in sorted(self._instructions()._c24.items())
-                if module.addressed for sent in module.word_unit_sends()]
+        return [(un, *sent) for un, module in self._program_c24() for sent in module.word_unit_sends()]
 
     def c24_addressed(self) -> list[int]:
         """Start I/O numbers (U0 -> 0) of the QJ71C24N modules the program's G_OUTPUT /
         G_INPUT have addressed so far."""
-        return sorted(un for un, module in self._instructions()._c24.items() if module.addressed)
+        return [un for un, _module in self._program_c24()]
+
+    def _program_c24(self) -> list:
+        """(start I/O, module) of the QJ71C24N modules the program's G_OUTPUT / G_INPUT have
+        addressed so far, by start I/O: the ones on the robot's line."""
+        return [(un, module) for un, module in sorted(self._instructions()._c24.items()) if module.addressed]
 
     def _instructions(self):
         return self.module.namespace["_I"]

@@ -43,10 +43,11 @@ class Fx3ModbusDevices:
     error_code: str
     error_details: str
     error_flag: str
-    serial_error: str  # serial communication error code (6321 / 3821: MODBUS error)
+    serial_error: str  # serial communication error code register
+    serial_error_code: int  # the code ADPRW stores there: "MODBUS error on ch1 / ch2"
 
 
 FX3_MODBUS_CHANNELS = {
-    1: Fx3ModbusDevices("D8409", "D8412", "D8402", "D8403", "M8063", "D8063"),
-    2: Fx3ModbusDevices("D8429", "D8432", "D8422", "D8423", "M8438", "D8438"),
+    1: Fx3ModbusDevices("D8409", "D8412", "D8402", "D8403", "M8063", "D8063", 6321),
+    2: Fx3ModbusDevices("D8429", "D8432", "D8422", "D8423", "M8438", "D8438", 3821),
 }

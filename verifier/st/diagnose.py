@@ -21,6 +21,8 @@ from dataclasses import dataclass
 from lark import Lark, Token
 from lark.exceptions import UnexpectedInput, UnexpectedToken
 
+from verifier.textfile import place_of_char
+
 #: block keyword -> the keyword that closes it
 BLOCK_CLOSER = {
     "IF": "END_IF", "CASE": "END_CASE", "FOR": "END_FOR", "WHILE": "END_WHILE",
@@ -400,5 +402,4 @@ def _at(tok: Token | None, text: str, message: str,
         return tok.line, tok.column, message
     if before:
         return before[-1].end_line, before[-1].end_column, message
-    line = text.count("\n") + 1
-    return line, len(text) - (text.rfind("\n") + 1) + 1, message
+    return *place_of_char(text, len(text)), message

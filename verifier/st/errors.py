@@ -13,6 +13,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 from lark.lexer import PatternStr
 
 from verifier.st import diagnose
+from verifier.textfile import place_of_char
 
 #: how terminals that are not plain strings are named in messages
 _TERMINAL_WORDS = {
@@ -98,10 +99,6 @@ def _semicolon_fixes(exc: UnexpectedToken) -> bool:
 _BLOCK_COMMENT_RE = re.compile(r"\(\*[\s\S]*?\*\)")
 
 
-def _line_col(text: str, pos: int) -> tuple[int, int]:
-    return text.count("\n", 0, pos) + 1, pos - (text.rfind("\n", 0, pos) + 1) + 1
-
-
 def _error_pos(exc: UnexpectedInput, text: str) -> int:
     if isinstance(exc, UnexpectedCharacters):
         return exc.pos_in_stream
@@ -122,8 +119,8 @@ def _nested_comment(text: str, pos: int) -> tuple[int, int, str] | None:
             continue
         tail_end = text.find("*)", m.end())
         if tail_end != -1 and pos <= tail_end + 1:
-            line, col = _line_col(text, inner)
-            outer_line, outer_col = _line_col(text, m.start())
+            line, col = place_of_char(text, inner)
+            outer_line, outer_col = place_of_char(text, m.start())
             return (line, col, f"nested comments are not supported: this '(*' is inside the comment opened at "
                                f"{outer_line}:{outer_col}, which the first '*)' closes; remove the inner '(*' "
                                "and '*)'")
@@ -157,7 +154,7 @@ def describe_syntax_error(exc: UnexpectedInput, text: str, parser: Lark) -> tupl
     error_pos = _error_pos(exc, text)
     if text[error_pos:error_pos + 2] in ("(*", "/*"):
         closer = "*)" if text[error_pos] == "(" else "*/"
-        line, col = _line_col(text, error_pos)
+        line, col = place_of_char(text, error_pos)
         return line, col, f"comment '{text[error_pos:error_pos + 2]}' is never closed; add '{closer}'"
     accepted = (_accepted(exc) if isinstance(exc, UnexpectedToken) else set()) or set(exc.expected or ())
     explained = diagnose.explain(parser, text, error_pos, accepted)
@@ -166,17 +163,15 @@ def describe_syntax_error(exc: UnexpectedInput, text: str, parser: Lark) -> tupl
 
     if isinstance(exc, UnexpectedEOF):
         expected = _expected_list(parser, exc.expected)
-        line = text.count("\n") + 1
-        col = len(text) - (text.rfind("\n") + 1) + 1
+        line, col = place_of_char(text, len(text))
         return line, col, f"unexpected end of file; expected {expected}"
 
     assert isinstance(exc, UnexpectedToken)
     tok = exc.token
     expected = set(exc.expected)
     if tok.type == "$END":
-        line = text.count("\n") + 1
-        col = len(text) - (text.rfind("\n") + 1) + 1
         pos = len(text)
+        line, col = place_of_char(text, pos)
     else:
         line, col, pos = tok.line, tok.column, tok.start_pos
     if tok.type in ("LPAR", "SLASH") and text[pos:pos + 2] in ("(*", "/*"):

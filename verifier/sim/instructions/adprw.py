@@ -31,7 +31,6 @@ FX3_ERR_TIMEOUT = 211         # communication time-out after the set retries
 FX3_ERR_EXCEPTION = 212       # exception response; details H: abnormal function code, L: exception code
 FX3_ERR_SLAVE = 213           # slave address mismatch; details H: requested, L: received
 FX3_ERR_FUNCTION = 214        # function code mismatch; details H: requested, L: received
-FX3_SERIAL_ERR_MODBUS = {1: 6321, 2: 3821}  # D8063 / D8438: "MODBUS error on ch1 / ch2"
 
 
 FX5_RESPONSE_TIMEOUT_US = 400_000  # "Slave Response Timeout 400 ms" (docs/import-gxworks3.md §4)
@@ -54,7 +53,7 @@ class AdprwMaster:
             self._err_flag = dev.address(devices.error_flag)
             self._err_details = dev.address(devices.error_details)
             self._serial_err = dev.address(devices.serial_error)
-            self._serial_err_code = FX3_SERIAL_ERR_MODBUS[channel]
+            self._serial_err_code = devices.serial_error_code
             self._done_flag = dev.address("M8029")
         else:
             self._timeout = self._retries = None

@@ -121,14 +121,18 @@ class C24Module:
         """The first G_OUTPUT / G_INPUT on this module: it is the program's, so it is on the
         line, and settings made for "the module the program drives" apply to it."""
         self.addressed = True
-        written = self.rt.c24_written
         for channel, settings in self.rt.c24_for_program.items():
-            # a word the program wrote before this first call keeps the program's value: made
-            # in GX Works, the setting would have been in force from power-on, under the write
-            words = BUFFER[channel]
-            self.configure(channel, **{name: value for name, value in settings.items()
-                                       if name not in SETTING_NAMES
-                                       or (self.un, words[SETTING_NAMES[name]]) not in written})
+            self.configure_for_program(channel, settings)
+
+    def configure_for_program(self, channel: int, settings: dict) -> None:
+        """`configure` with settings made for "the module the program drives": a word the
+        program has written keeps the program's value (made in GX Works, the setting would
+        have been in force from power-on, under the write)."""
+        written = self.rt.c24_written
+        words = BUFFER[channel]
+        self.configure(channel, **{name: value for name, value in settings.items()
+                                   if name not in SETTING_NAMES
+                                   or (self.un, words[SETTING_NAMES[name]]) not in written})
 
     # -- G_OUTPUT ----------------------------------------------------------------------------
     def output(self, s1, s2, d, loc_id) -> bool:

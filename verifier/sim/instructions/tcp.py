@@ -95,7 +95,9 @@ class TcpPort:
     # ---- helpers -----------------------------------------------------------------------------
     @property
     def endpoint(self):
-        return getattr(self.rt, "tcp_endpoint", None)
+        """The Ethernet port's peer (`Runtime.tcp_endpoint`, None until one is attached);
+        `poll`, `idle_deadline` and `idle_state` read it there directly (once per scan)."""
+        return self.rt.tcp_endpoint
 
     def rising(self, en: bool, loc_id: int) -> bool:
         """SP./ZP. instructions run once on the rising edge of their execution command."""
