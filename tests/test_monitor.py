@@ -69,11 +69,73 @@ def test_plain_capture_reads_chunks_and_frames_with_directions():
     ("0.1   # nothing\n", "c.txt:1:4: the line has a time but no bytes"),
     ("0.1 01\n 1" + "0" * 400 + " 02\n", "c.txt:2:2: time 1000"),  # was an OverflowError traceback
     ("1000000001 01\n", "c.txt:1:1: time 1000000001 s is beyond 1e+09 s; expected a time in seconds"),
+    ("0.1 01\n0.2 end 02\n", "c.txt:2:9: an `end` line holds no bytes"),
+    ("0.1 01\n0.2 end\n# after\n 0.3 02\n", "c.txt:4:2: the capture ended at its `end` line (c.txt:2)"),
+    ("0.2 01\n0.1 end\n", "c.txt:2:1: time 0.1 s is earlier than the line before"),
 ])
 def test_a_bad_capture_is_named_with_file_line_and_column(text, where):
     with pytest.raises(CaptureError) as caught:
         parse_plain(text, "c.txt")
     assert str(caught.value).startswith(where)
+
+
+def test_an_end_line_says_until_when_the_line_was_listened_to():
+    chunks = parse_plain("0.5 01 06 01 A0 00 00 88 14\n2.25 END  # the monitor stopped\n")
+    assert chunks == [Chunk(500_000, STOP), Chunk(2_250_000, b"")]
+    assert format_plain(chunks[:1], end_us=2_250_000).endswith("0.500000 01 06 01 A0 00 00 88 14\n2.250000 end\n")
+    assert parse_plain(format_plain(chunks[:1], end_us=2_250_000)) == chunks
+
+
+def _live(chunks: list[Chunk], end_us: int, tolerance_us: int) -> MonitorSession:
+    """A session fed as `uitamr monitor` feeds it: each chunk as it came, a poll when a read
+    returned nothing (here: at the end of listening), then the close."""
+    session = MonitorSession(CaptureInfo("site", "site"), timing=LineTiming(tolerance_us=tolerance_us))
+    for chunk in chunks:
+        session.feed(chunk)
+    session.poll(end_us)
+    session.close()
+    return session
+
+
+def _judged(session: MonitorSession) -> tuple:
+    result = session.result()
+    return ([(f.t_start_us, f.t_end_us, f.direction, f.data) for f in result.trace], result.duration_us,
+            {rule: [(v.t_us, v.message) for v in found] for rule, found in result.violations.items()},
+            result.notes)
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(st.tuples(st.integers(0, 400_000), st.binary(min_size=1, max_size=12)), min_size=1, max_size=12),
+       st.integers(0, 3_000_000), st.integers(0, 30_000))
+def test_a_replay_of_the_monitors_capture_judges_as_the_live_session_did(pieces, listened_after_us, tolerance_us):
+    """The capture is the line's only record: its replay must give the live session's
+    frames, findings, duration and notes. A replay used to stop at the last byte: a frame
+    left short by the line's silence was "cut by the end of the capture", a reply still
+    due was never judged overdue, and the run was seconds shorter."""
+    t, chunks = 0, []
+    for gap, data in pieces:
+        t += gap
+        chunks.append(Chunk(t, data))
+    live = _live(chunks, t + listened_after_us, tolerance_us)
+    text = format_plain(live.chunks, "site", end_us=live.last_us)
+    replayed = session_of(parse_plain(text), tolerance_us)
+    assert _judged(replayed) == _judged(live)
+
+
+def test_a_capture_with_its_end_line_replays_the_silence_after_the_last_bytes(tmp_path):
+    """The live session saw three bytes of a reply, then 2 s of silence: a short frame,
+    judged. Without the `end` line the replay took them for a frame the end cut."""
+    chunks = [Chunk(10_000, STOP), Chunk(21_000, STOP), Chunk(500_000, READ), Chunk(520_000, b"\x01\x01\x00")]
+    live = _live(chunks, 2_520_000, 20_000)
+    assert live.frames[-1].data == b"\x01\x01\x00" and live.cut_off == b""
+    capture = tmp_path / "site.txt"
+    capture.write_text(format_plain(live.chunks, end_us=live.last_us), encoding="utf-8")
+    done = subprocess.run(uitamr("replay", capture, "--json", tmp_path / "r.json"), capture_output=True, text=True,
+                          timeout=WAIT_S)
+    assert "were not judged" not in done.stdout, done.stdout + done.stderr
+    replayed = json.loads((tmp_path / "r.json").read_text())["scenarios"][0]
+    assert replayed["duration"] == pytest.approx(live.last_us / 1_000_000) == pytest.approx(2.518333)
+    assert _judged(session_of(parse_plain(capture.read_text(encoding="utf-8")))) == _judged(live)
 
 
 def test_a_bad_trace_record_is_named_with_its_line(tmp_path):
@@ -478,6 +540,11 @@ def test_a_bad_master_on_a_real_line_gets_exactly_its_findings(line, tmp_path):
     done = subprocess.run(uitamr("replay", tmp_path / "c.txt", "--json", tmp_path / "r.json"),
                           capture_output=True, text=True, timeout=WAIT_S)
     assert done.returncode == 1 and findings(tmp_path / "r.json") == Counter(BAD_MASTER_FINDINGS)
+    # the replay of the capture is the live session's judgement: frames, findings, notes and
+    # how long the line was listened to (the capture's `end` line); only the names differ
+    live_run, replayed = (json.loads((tmp_path / name).read_text())["scenarios"][0] for name in ("m.json", "r.json"))
+    differing = {key for key in live_run if live_run[key] != replayed[key]}
+    assert differing == {"name", "file", "description", "channel"}, differing
 
 
 @pytest.mark.serial

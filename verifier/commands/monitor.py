@@ -161,7 +161,10 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
         # the capture is the line's only record (the reports can be made again from it by
         # `uitamr replay`): it is written even when a report cannot be
         if capture_path:
-            text = format_plain(session.chunks, f"uitamr monitor capture of {source.description}, {baud} {line_format}")
+            comment = f"uitamr monitor capture of {source.description}, {baud} {line_format}"
+            if lost:
+                comment += f"\nthe capture ended early: {lost}"
+            text = format_plain(session.chunks, comment, end_us=session.last_us if session.chunks else None)
             try:
                 Path(capture_path).write_text(text, encoding="utf-8")
             except OSError as exc:

@@ -10,8 +10,12 @@ The plain capture format (docs/commissioning.md) is one chunk or one frame per l
 a time in seconds (from any origin; only differences count), optionally `tx` (PLC to
 robot) or `rx` (robot to PLC), then the bytes in hex (spaces optional between bytes). A
 line without a direction is a chunk of the line's stream: the monitor splits chunks into
-frames by silence and content as it does live. A capture that cannot be read is an error
-naming file, line and column; nothing in it is skipped silently.
+frames by silence and content as it does live. A last line `<time> end` says the line was
+listened to, silent, until then (`uitamr monitor --capture` writes it): a replay judges
+the capture as the live session did, up to its end - a reply still due, the bytes of a
+frame left short by the silence - rather than as if listening stopped at the last byte.
+A capture that cannot be read is an error naming file, line and column; nothing in it is
+skipped silently.
 """
 from __future__ import annotations
 
@@ -31,7 +35,8 @@ from verifier.textfile import UnreadableText, lone_cr_as_line_feed, read_utf8, t
 class Chunk:
     """Bytes as the host received them; `t_us` is when the read returned (the last byte's
     arrival, give or take the adapter's latency). `direction` is known only for captures
-    that say it (our own traces, `tx`/`rx` lines)."""
+    that say it (our own traces, `tx`/`rx` lines). No bytes: nothing came until `t_us`
+    (a live read that returned empty; a plain capture's `end` line)."""
 
     t_us: int
     data: bytes
@@ -60,10 +65,15 @@ def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
     file with lone CRs too)."""
     chunks: list[Chunk] = []
     last_t: int | None = None
+    end_line: int | None = None  # the line number of the `end` line
     for number, raw in enumerate(text_lines(text), start=1):
         line = raw.split("#", 1)[0].rstrip()
         if not line.strip():
             continue
+        if end_line is not None:
+            col = len(line) - len(line.lstrip()) + 1
+            raise CaptureError(f"{name}:{number}:{col}: the capture ended at its `end` line ({name}:{end_line}); "
+                               "move this line before it, or remove the `end` line")
         foreign = foreign_digit(line)  # float() reads '٠.٥' as 0.5
         if foreign is not None:
             raise CaptureError(f"{name}:{number}:{foreign + 1}: {describe(line[foreign])}")
@@ -82,6 +92,16 @@ def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
                                f"earlier than the line before ({last_t / 1_000_000:.6f} s); a capture "
                                "is in time order")
         pos = time_match.end()
+        end = re.match(r"\s+end\b", line[pos:], re.IGNORECASE)
+        if end is not None:
+            rest = line[pos + end.end():]
+            if rest.strip():
+                col = pos + end.end() + len(rest) - len(rest.lstrip()) + 1
+                raise CaptureError(f"{name}:{number}:{col}: an `end` line holds no bytes (it says until when the "
+                                   "line was listened to); put the bytes on a line of their own before it")
+            chunks.append(Chunk(t_us, b""))
+            last_t, end_line = t_us, number
+            continue
         direction = None
         word = re.match(r"\s+(tx|rx|TX|RX)\b", line[pos:])
         if word is not None:
@@ -187,10 +207,15 @@ def read_capture(path: Path) -> dict[str, list[Chunk]]:
     return {path.stem: parse_plain(text, str(path))}
 
 
-def format_plain(chunks: list[Chunk], comment: str = "") -> str:
-    """The plain format of `chunks` (what `uitamr monitor --capture FILE` writes)."""
+def format_plain(chunks: list[Chunk], comment: str = "", end_us: int | None = None) -> str:
+    """The plain format of `chunks` (what `uitamr monitor --capture FILE` writes), with an
+    `end` line at `end_us` when given (until when the line was listened to)."""
     lines = [f"# {line}" for line in comment.splitlines()]
     for chunk in chunks:
+        if not chunk.data:
+            continue  # nothing came: only the `end` line says so
         direction = f" {chunk.direction}" if chunk.direction else ""
         lines.append(f"{chunk.t_us / 1_000_000:.6f}{direction} {protocol.hex_bytes(chunk.data)}")
+    if end_us is not None:
+        lines.append(f"{end_us / 1_000_000:.6f} end")
     return "\n".join(lines) + "\n"

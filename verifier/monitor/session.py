@@ -69,7 +69,10 @@ class MonitorSession:
 
     # --- input ---------------------------------------------------------------------------
     def feed(self, chunk: Chunk) -> list[TraceRecord]:
-        """Take the next chunk (host times in µs, any origin); the frames it completed."""
+        """Take the next chunk (host times in µs, any origin); the frames it completed. A
+        chunk with no bytes says nothing came until its time (`poll`)."""
+        if not chunk.data:
+            return self.poll(chunk.t_us)
         self._open()
         if self._origin_us is None:
             self._origin_us = (chunk.t_start_us if chunk.t_start_us is not None
