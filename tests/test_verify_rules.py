@@ -323,6 +323,29 @@ def test_a_late_reply_colliding_with_a_retry_after_the_time_out_is_the_robots_fa
     assert found["UITAMR-HALF-DUPLEX"] == [] and found["UITAMR-ONE-AT-A-TIME"] == []
 
 
+def test_a_request_the_robot_talked_over_is_not_answered_and_the_pairing_does_not_slip():
+    """A late reply began while the PLC's retry was still going out: the robot could not
+    read that retry, so it answers nothing of it. Its next frame answers the PLC's next
+    request; pairing it with the talked-over retry (still within its time-out) made every
+    later exchange one off - each request "sent while its predecessor's reply was due"
+    until the end of the run (UITAMR-HALF-DUPLEX and ONE-AT-A-TIME at every poll)."""
+    first = tx(0, READ_TASK)
+    retry = tx(700, READ_TASK)
+    late = rx(retry.t_start_us + 3 * MS, protocol.encode(protocol.StatusReply(1, 0, 1), S))
+    trace = [first, retry, late]
+    for start_ms in range(1070, 4000, 370):  # the polls after it, each answered at once
+        trace += exchange(start_ms, READ_TASK)
+    found = check(trace)
+    assert found["UITAMR-HALF-DUPLEX"] == []
+    # the PLC took the late frame for its reply and polled again 370 ms after the retry: that
+    # one poll is early (the frame began before the retry ended, so it is no reply to it)
+    assert [v.t_us for v in found["UITAMR-ONE-AT-A-TIME"]] == [1_070_000]
+    # the same retry when the robot began after it had ended: awaited as before
+    heard = check([first, retry, rx(retry.t_end_us + 3 * MS, protocol.encode(protocol.StatusReply(1, 0, 1), S)),
+                   *exchange(1300, READ_TASK)])
+    assert heard["UITAMR-HALF-DUPLEX"] == [] and heard["UITAMR-ONE-AT-A-TIME"] == []
+
+
 def test_one_at_a_time_waits_for_the_time_out_when_no_reply_comes():
     impatient = [tx(0, STOP)] + exchange(300, READ_TASK)
     (violation,) = check(impatient)["UITAMR-ONE-AT-A-TIME"]

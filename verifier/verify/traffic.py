@@ -114,6 +114,9 @@ class Exchange:
     settings: protocol.Settings
     reply_timeout_us: int
     lost_at_converter: bool = False  # the converter dropped the connection after forwarding it
+    # a robot frame overlapped the request on the half-duplex line: the robot cannot have
+    # read it, so no later frame is its reply (`Pairing`)
+    talked_over: bool = False
     _decoded: object = field(default=_NOT_YET, init=False, repr=False, compare=False)
     _status: object = field(default=_NOT_YET, init=False, repr=False, compare=False)
 
@@ -215,7 +218,10 @@ class Pairing:
 
     A robot frame goes to the oldest request that has ended, has no reply yet and whose
     time-out has not run out — preferring one it is a valid reply to, then one with a good
-    CRC (a slave never answers a request with a bad one). When no request is
+    CRC (a slave never answers a request with a bad one). A request a robot frame
+    overlapped on the line (the robot was talking while it went out: `talked_over`) waits
+    for nothing: the robot cannot have read it, so the robot's next frame answers a later
+    request rather than making every pairing after it one off. When no request is
     waiting, it joins the latest request that ended before it (a late reply, garbage).
 
     Frames are given in `analyse`'s order (by start; a request before a robot frame that
@@ -233,10 +239,12 @@ class Pairing:
         self._oldest = 0  # exchanges before this one are answered or timed out for good
         self._settled = 0
         self._given = 0  # requests given, those let go of (`forget`) included
+        self._robot_end_us = -1  # when the latest robot frame given ended
 
     def request(self, frame: TraceFrameLike) -> None:
         traffic = self.traffic
-        traffic.exchanges.append(Exchange(self._given, frame, [], self.settings, self.reply_timeout_us))
+        traffic.exchanges.append(Exchange(self._given, frame, [], self.settings, self.reply_timeout_us,
+                                          talked_over=frame.t_start_us < self._robot_end_us))
         self._given += 1
         traffic.tx.append(frame)
         self._ends.append(frame.t_end_us)
@@ -246,13 +254,21 @@ class Pairing:
         traffic, exchanges = self.traffic, self.traffic.exchanges
         traffic.rx.append(frame)
         t = frame.t_start_us
+        self._robot_end_us = max(self._robot_end_us, frame.t_end_us)
         count = bisect_right(self._ends, t)  # requests that ended before this frame began
+        # requests given so far that overlap this frame (a live line gives the one still going
+        # out when the robot began; `analyse`, which gives every request first, also those
+        # that began while it was talking: `request` marks those on a live line)
+        k = count
+        while k < len(exchanges) and exchanges[k].request.t_start_us < frame.t_end_us:
+            exchanges[k].talked_over = True
+            k += 1
         if count == 0:
             traffic.rx_before_first_request.append(frame)
             return
         while self._oldest < count and (exchanges[self._oldest].rx or exchanges[self._oldest].deadline_us < t):
             self._oldest += 1
-        waiting = [e for e in exchanges[self._oldest:count] if not e.rx and t <= e.deadline_us]
+        waiting = [e for e in exchanges[self._oldest:count] if not e.rx and not e.talked_over and t <= e.deadline_us]
         if waiting:
             # a slave never answers a request whose CRC is wrong (MODBUS over Serial Line
             # V1.02 §2.4.1): a frame that is no valid reply to any waiting request goes to
