@@ -219,7 +219,7 @@ VAR_OUTPUT
 END_VAR
 VAR
     wCount : INT := 5;
-    bOn : BOOL := TRUE;
+    bRun : BOOL := TRUE;
     tDelay : TIME := T#2s;
 END_VAR
 VAR CONSTANT
@@ -277,7 +277,7 @@ def test_dropped_initial_values_are_listed_with_their_place(tmp_path):
     dropped = dropped_initial_values(files, "gxworks2")
     assert [(d.owner, d.label, d.value) for d in dropped] == [
         ("FB_Init", "i_wIn", "3"), ("FB_Init", "o_wOut", "4"), ("FB_Init", "wCount", "5"),
-        ("FB_Init", "bOn", "TRUE"), ("FB_Init", "tDelay", "T#2s"), ("global", "gwStart", "9"),
+        ("FB_Init", "bRun", "TRUE"), ("FB_Init", "tDelay", "T#2s"), ("global", "gwStart", "9"),
         ("S_Pos", "wX", "11")]
     assert str(dropped[2]).startswith(f"{paths[0]}:9:21: note: VAR 'FB_Init.wCount' := 5 not exported")
     files3 = [st.parse(p.read_text(), str(p), "gxworks3") for p in paths]

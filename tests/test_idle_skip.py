@@ -173,12 +173,12 @@ def _timer_program(pts: list[int], clock: str, read_et: bool) -> str:
 VAR
     tmrOn : TON; tmrOff : TOF; tmrPulse : TP;
     nOn : INT; nOff : INT; nPulse : INT; nClock : INT;
-    bOn : BOOL; bOff : BOOL; bPulse : BOOL; bClock : BOOL;
+    bOnQ : BOOL; bOff : BOOL; bPulse : BOOL; bClock : BOOL;
     wLate : INT;
 END_VAR
 tmrOn(IN := NOT tmrOn.Q, PT := T#{pts[0]}ms);
-IF tmrOn.Q AND NOT bOn THEN nOn := nOn + 1; END_IF;
-bOn := tmrOn.Q;
+IF tmrOn.Q AND NOT bOnQ THEN nOn := nOn + 1; END_IF;
+bOnQ := tmrOn.Q;
 tmrOff(IN := tmrOn.Q, PT := T#{pts[1]}ms);
 IF bOff AND NOT tmrOff.Q THEN nOff := nOff + 1; END_IF;
 bOff := tmrOff.Q;
@@ -197,7 +197,7 @@ def _timer_scenario(tmp_path: Path, source: str, scan_ms: int, jitter_ms: int, s
                     watch_clock: str | None = None) -> object:
     st_file = tmp_path / "timers.st"
     st_file.write_text(source, encoding="utf-8")
-    watch = ["nOn", "nOff", "nPulse", "nClock", "wLate", "bOn", "bOff", "bPulse"]
+    watch = ["nOn", "nOff", "nPulse", "nClock", "wLate", "bOnQ", "bOff", "bPulse"]
     if watch_clock:
         watch.append(watch_clock)
     text = "\n".join([

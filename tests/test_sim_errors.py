@@ -179,7 +179,7 @@ def test_a_function_call_without_an_input_does_not_load(call, message):
 def test_the_simulator_never_runs_a_function_call_without_an_input(monkeypatch):
     import verifier.sim.project
 
-    monkeypatch.setattr(verifier.sim.project, "_run_checker", lambda files, target: [])  # the checker would stop it
+    monkeypatch.setattr(verifier.sim.project, "_run_checker", lambda files, target, platform=None: [])  # the checker would stop it
     with pytest.raises(LoadError) as err:
         load_st(ADD3.format(call="Add3(a := 1, c := 3)"))
     assert "t.st:7:6: error: Add3 is called without input b; GX Works needs every input of a function" \

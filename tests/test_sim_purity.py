@@ -8,15 +8,15 @@ from verifier.sim.purity import pure_functions
 
 SOURCES = """
 VAR_GLOBAL gOffset : INT; END_VAR
-FUNCTION Sum : WORD
+FUNCTION XorSum : WORD
 VAR_INPUT a : ARRAY[0..3] OF WORD; n : INT; END_VAR
 VAR i : INT; END_VAR
-Sum := 0;
-FOR i := 0 TO n - 1 DO Sum := Sum XOR SHL(a[i], 1); END_FOR;
+XorSum := 0;
+FOR i := 0 TO n - 1 DO XorSum := XorSum XOR SHL(a[i], 1); END_FOR;
 END_FUNCTION
 FUNCTION Twice : WORD
 VAR_INPUT a : ARRAY[0..3] OF WORD; END_VAR
-Twice := Sum(a, 4) XOR Sum(a, 3);
+Twice := XorSum(a, 4) XOR XorSum(a, 3);
 END_FUNCTION
 FUNCTION Half : INT
 VAR_INPUT x : INT; END_VAR
@@ -37,7 +37,7 @@ ViaImpure := Half(x);
 END_FUNCTION
 PROGRAM P
 VAR a : ARRAY[0..3] OF WORD; w : WORD; r : INT; z : INT; END_VAR
-w := Sum(a, 4) XOR Twice(a);
+w := XorSum(a, 4) XOR Twice(a);
 r := Half(r) + FromDevice(1) + FromGlobal(1) + ViaImpure(2);
 r := Half(z) + 0;
 END_PROGRAM
@@ -47,17 +47,17 @@ END_PROGRAM
 def test_only_input_only_functions_are_remembered():
     project = load_st(SOURCES)
     functions = {k: v for k, v in project.module.pous.items() if v.kind == "FUNCTION"}
-    assert pure_functions(functions) == {"SUM", "TWICE"}
+    assert pure_functions(functions) == {"XORSUM", "TWICE"}
     namespace = project.module.namespace
-    assert hasattr(namespace["FN_SUM"], "__wrapped__") and not hasattr(namespace["FN_HALF"], "__wrapped__")
+    assert hasattr(namespace["FN_XORSUM"], "__wrapped__") and not hasattr(namespace["FN_HALF"], "__wrapped__")
 
 
 def test_remembered_results_follow_the_array_contents_and_the_rest_runs_every_call():
     project = load_st(SOURCES)
-    assert project.call("Sum", [1, 2, 3, 4], 4) == 8
-    assert project.call("Sum", [1, 2, 3, 5], 4) == 10      # another array: computed again
-    assert project.call("Sum", [1, 2, 3, 4], 4) == 8
-    assert project.call("Sum", [1, 2, 3, 4], 3) == 0        # another count
+    assert project.call("XorSum", [1, 2, 3, 4], 4) == 8
+    assert project.call("XorSum", [1, 2, 3, 5], 4) == 10      # another array: computed again
+    assert project.call("XorSum", [1, 2, 3, 4], 4) == 8
+    assert project.call("XorSum", [1, 2, 3, 4], 3) == 0        # another count
     assert project.call("Twice", [1, 1, 1, 1]) == 2
     project.devices["D100"] = 5
     assert project.call("FromDevice", 1) == 6
@@ -70,10 +70,10 @@ def test_remembered_results_follow_the_array_contents_and_the_rest_runs_every_ca
     project.run_programs(["P"], scans=1)
     assert project.devices["M8067"] is False               # no division by zero yet
     # a FUNCTION that divides is never remembered: a division by zero flags every time
-    src = "FUNCTION Inv : INT\nVAR_INPUT x : INT; END_VAR\nInv := 100 / x;\nEND_FUNCTION\n"
+    src = "FUNCTION Hundredth : INT\nVAR_INPUT x : INT; END_VAR\nHundredth := 100 / x;\nEND_FUNCTION\n"
     inv = load_st(src)
     for _ in range(2):
         inv.devices["M8067"] = False
-        inv.call("Inv", 0)
+        inv.call("Hundredth", 0)
         assert inv.devices["M8067"] is True
     assert len([d for d in inv.diagnostics if "division by zero" in d.message]) == 2

@@ -14,7 +14,7 @@ from verifier.sim.storage import INSTANCE_LIMIT, LABEL_LIMIT
 
 @pytest.fixture(autouse=True)
 def no_checker(monkeypatch):
-    monkeypatch.setattr(verifier.sim.project, "_run_checker", lambda files, target: [])
+    monkeypatch.setattr(verifier.sim.project, "_run_checker", lambda files, target, platform=None: [])
 
 
 def refused(src: str) -> str:

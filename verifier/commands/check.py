@@ -92,7 +92,7 @@ def check_findings(paths: list[Path], target: str,
             files.append(parse(text, str(p), target))
     findings += [Finding(d, "UITAMR-ST-SYNTAX") for f in files for d in f.diagnostics]
     findings += [Finding(d, "UITAMR-ST-CHECK" if d.is_error else "UITAMR-ST-WARNING")
-                 for d in check(files, target)]
+                 for d in check(files, target, platform)]
     if platform is not None:
         from verifier.sim.cpucheck import on_cpu
 

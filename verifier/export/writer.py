@@ -268,7 +268,7 @@ def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, 
     texts = texts or {}
     files = [st.parse(texts.get(p) or p.read_text(encoding="utf-8-sig"), str(p), target) for p in paths]
     problems = [d for f in files for d in f.diagnostics if d.is_error]
-    problems += [d for d in st.check(files, target) if d.is_error]
+    problems += [d for d in st.check(files, target, cpu.name if cpu is not None else None) if d.is_error]
     if cpu is not None:
         problems = _on_cpu(files, cpu, problems, programs, warnings)
     if problems:

@@ -110,7 +110,7 @@ class Project:
             raise option_error(str(e), **({"target": target} if cpu is None else {"target": target, "cpu": cpu})) from None
         editor = target.split(":", 1)[0].lower()  # as profile_for reads it
         self.target = editor
-        files, warnings = _parsed_and_checked(texts, editor)
+        files, warnings = _parsed_and_checked(texts, editor, self.cpu.name)
         self.warnings = list(warnings)
         self.files = files
         for name, value in (("scan_ms", scan_ms), ("jitter_ms", jitter_ms)):
@@ -591,17 +591,18 @@ def _stop_time(now: int, ms, until_us, scans=None, what: str = "ms"):
     return until_us
 
 
-#: parsed and checked sources by (editor, file names and texts): `uitamr verify` loads
+#: parsed and checked sources by (editor, CPU, file names and texts): `uitamr verify` loads
 #: the same library for scenario after scenario; the trees are only read after the check
 _CHECKED: dict[tuple, tuple[list, list]] = {}
 _CHECKED_MAX = 8
 
 
-def _parsed_and_checked(texts: dict[str, str], editor: str) -> tuple[list, list]:
-    """The parsed files and the warnings of parsing and checking them (LoadError for errors)."""
+def _parsed_and_checked(texts: dict[str, str], editor: str, cpu: str | None = None) -> tuple[list, list]:
+    """The parsed files and the warnings of parsing and checking them (LoadError for errors);
+    `cpu` (a CPU profile name): the CPU whose instruction names no label may take."""
     from verifier import st
 
-    key = (editor, tuple(texts.items()))
+    key = (editor, cpu, tuple(texts.items()))
     found = _CHECKED.get(key)
     if found is not None:
         return found
@@ -610,7 +611,7 @@ def _parsed_and_checked(texts: dict[str, str], editor: str) -> tuple[list, list]
     if errors:
         raise LoadError(errors)
     warnings = [d for f in files for d in f.diagnostics if not d.is_error]
-    checked = _run_checker(files, editor)
+    checked = _run_checker(files, editor, cpu)
     errors = [d for d in checked if d.is_error]
     if errors:
         raise LoadError(errors)
@@ -634,11 +635,11 @@ def _only_programs(files, programs: Iterable[str] | None) -> frozenset[str] | No
     return wanted if wanted and wanted <= defined else None
 
 
-def _run_checker(files, target):
+def _run_checker(files, target, platform=None):
     # import the function itself: `verifier.st.check` becomes the submodule once imported
     from verifier.st.check import check
 
-    return check(files, target)
+    return check(files, target, platform)
 
 
 _LIVE: list = []

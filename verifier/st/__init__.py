@@ -28,12 +28,14 @@ def parse(text: str, filename: str = "<string>", target: str = "gxworks2") -> So
     return _parse(text, filename, target)
 
 
-def check(files: list[SourceFile], target: str = "gxworks2") -> list[Diagnostic]:
+def check(files: list[SourceFile], target: str = "gxworks2", platform: str | None = None) -> list[Diagnostic]:
     """Semantic check of parsed files together (a POU may use POUs of other files).
-    Annotates the trees in place (expression types, resolved names and calls)."""
+    Annotates the trees in place (expression types, resolved names and calls).
+    `platform` (fx3u, fx3g, fx5u, q): also refuse labels named like an instruction of that
+    CPU; None: like one of any CPU the target's editor programs (docs/st-dialect.md §4)."""
     from verifier.st.check import check as _check
 
-    return _check(files, target)
+    return _check(files, target, platform)
 
 
 def format_source(source: SourceFile) -> str:

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 from verifier.bundled import PLC_DIR, library_file
 from verifier.textfile import real_path
-from verifier.st import ast, library, structure
+from verifier.st import ast, library, melsec, structure
 from verifier.st import types as T
 from verifier.st.devices import looks_like_device
 
@@ -85,9 +85,11 @@ _CONSTANT_RE = re.compile(r"[Kk][0-9]+|[Hh][0-9A-Fa-f]+")
 
 
 @functools.lru_cache(maxsize=8192)
-def label_name_problem(name: str) -> str | None:
+def label_name_problem(name: str, families: tuple[str, ...] = ()) -> str | None:
     """Why GX Works refuses `name` as a label, or None. Rules: docs/st-dialect.md §4.
-    (A function of the name alone: remembered, as the same labels recur across POUs.)"""
+    `families`: the CPU families whose instruction names are refused too
+    (`melsec.families_for`). (A function of its arguments alone: remembered, as the same
+    labels recur across POUs.)"""
     if name.startswith("_") or name.endswith("_"):
         return "must not start or end with '_'"
     if "__" in name:
@@ -98,7 +100,7 @@ def label_name_problem(name: str) -> str | None:
         return "must not start with K1..K8 (read as a digit-specified device)"
     if looks_like_device(name) or _CONSTANT_RE.fullmatch(name) or _OTHER_DEVICE_RE.fullmatch(name):
         return "looks like a device or constant"
-    reason = library.reserved_reason(name)
+    reason = library.reserved_reason(name, families)
     if reason:
         return reason
     if len(name) > _MAX_NAME:
@@ -108,9 +110,11 @@ def label_name_problem(name: str) -> str | None:
 
 # ----------------------------------------------------------------------------- the checker
 class Checker:
-    def __init__(self, files: list[ast.SourceFile], target: str) -> None:
+    def __init__(self, files: list[ast.SourceFile], target: str, platform: str | None = None) -> None:
         self.files = [f for f in files if f.ok]
         self.target = target
+        #: the CPU families whose instruction names no label may take (docs/st-dialect.md §4)
+        self.families = melsec.families_for(target, platform)
         self.table = SymbolTable(target)
         self.rep = _Reporter()
         self.pou: PouInfo | None = None
@@ -234,7 +238,7 @@ class Checker:
             self.rep.error(block, f"{kw} exists only in GX Works3; use VAR_OUTPUT/VAR (or --target gxworks3)")
 
     def _check_name(self, node, name: str, what: str) -> None:
-        problem = label_name_problem(name)
+        problem = label_name_problem(name, self.families)
         if problem:
             self.rep.error(node, f"{what} name '{name}' {problem}; rename it")
 
@@ -1238,9 +1242,12 @@ def _no_arithmetic(t: T.Type, editor: str) -> str:
     return "arithmetic on bit strings is not allowed" + (f" (convert with {conv})" if conv else "")
 
 
-def check_project(files: list[ast.SourceFile], target: str = "gxworks2") -> tuple[list[ast.Diagnostic], SymbolTable]:
-    """Check `files` together; return the diagnostics and the symbol table."""
-    checker = Checker(files, target)
+def check_project(files: list[ast.SourceFile], target: str = "gxworks2",
+                  platform: str | None = None) -> tuple[list[ast.Diagnostic], SymbolTable]:
+    """Check `files` together; return the diagnostics and the symbol table. `platform` (a
+    CPU profile name: fx3u, fx3g, fx5u, q): refuse the labels named like an instruction of
+    that CPU; None: like an instruction of any CPU the target's editor programs."""
+    checker = Checker(files, target, platform)
     try:
         checker.collect()
         checker.check_bodies()
@@ -1254,9 +1261,10 @@ def check_project(files: list[ast.SourceFile], target: str = "gxworks2") -> tupl
     return diags, checker.table
 
 
-def check(files: list[ast.SourceFile], target: str = "gxworks2") -> list[ast.Diagnostic]:
-    """Diagnostics for `files` checked together (parse diagnostics not included)."""
-    return check_project(files, target)[0]
+def check(files: list[ast.SourceFile], target: str = "gxworks2", platform: str | None = None) -> list[ast.Diagnostic]:
+    """Diagnostics for `files` checked together (parse diagnostics not included);
+    `platform` as check_project takes it."""
+    return check_project(files, target, platform)[0]
 
 
 def _ladder_spelling(callee: ast.Expr, table, pou) -> tuple[str, str] | None:

@@ -3,6 +3,7 @@ blocks, and the MELSEC instructions this project calls (with their ST operand or
 docs/st-dialect.md section 1)."""
 from __future__ import annotations
 
+from verifier.st import melsec
 from verifier.st.types import (
     BOOL, DINT, DWORD, INT, LREAL, REAL, STRING, TIME, UDINT, UINT, WORD, WSTRING,
     FbType, Param, Signature,
@@ -210,8 +211,10 @@ RESERVED_DEVICE_WORDS = frozenset(
     + ["AUX", "CON", "PRN", "NUL"])
 
 
-def reserved_reason(name: str) -> str | None:
-    """Why GX Works would refuse `name` as a reserved word, or None."""
+def reserved_reason(name: str, families: tuple[str, ...] = ()) -> str | None:
+    """Why GX Works would refuse `name` as a reserved word, or None. `families`: the CPU
+    families (verifier.st.melsec: fx3, fx5, q) whose instruction names are refused too,
+    as `melsec.families_for` picks them for the target and platform checked."""
     key = name.upper()
     if key in KEYWORDS:
         return "is an ST keyword or type name"
@@ -221,6 +224,11 @@ def reserved_reason(name: str) -> str | None:
         return "is a standard function name"
     if key in STANDARD_FBS:
         return "is a standard function block name"
+    family = melsec.instruction_family(key, families)
+    if family is not None:
+        cpus, editor = melsec.FAMILIES[family]
+        return (f"is the name of a MELSEC instruction of the {cpus} CPU ({editor} refuses every "
+                f"instruction name of the CPU as a label, docs/st-dialect.md section 4)")
     if key in RESERVED_DEVICE_WORDS:
         return "is a reserved device name of the operating system"
     return None
