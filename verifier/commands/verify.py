@@ -166,19 +166,20 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
             option = f"--scan {format_duration(scan)}" if scan is not None else ""
             if duration is not None:
                 option += (" and " if option else "") + f"--duration {format_duration(duration)}"
+            default = "" if key in scenario.key_lines or key != "scan" else ", the default"
             raise UnusableInput(
-                f"{scenario.where(key, scenario.key_lines.get(key))}: the scan time "
-                f"({format_duration(scenario.scan_us)}) is longer than the whole run "
+                f"{scenario.key_where(key)}: the scan time "
+                f"({format_duration(scenario.scan_us)}{default}) is longer than the whole run "
                 f"({format_duration(scenario.duration_us)})" + (f" with {option}" if option else ""))
         if scenario.scan_jitter_us >= scenario.scan_us:
             raise UnusableInput(
-                f"{scenario.where('scan_jitter', scenario.key_lines.get('scan_jitter'))}: must be shorter than "
+                f"{scenario.key_where('scan_jitter')}: must be shorter than "
                 f"the scan time ({format_duration(scenario.scan_us)})"
                 + (f" with --scan {format_duration(scan)}" if scan is not None else ""))
         if not scenario.sources:
             if scenario.path is None:
                 raise UnusableInput("the default scenario: no ST sources: give them as arguments (uitamr verify FILE.st ...)")
-            raise UnusableInput(f"{scenario.path}: no ST sources: list them in the file (sources = [\"plc/*.st\"], "
+            raise UnusableInput(f"{scenario.key_where('sources')}: no ST sources: list them in the file (sources = [\"plc/*.st\"], "
                                 "relative to it) or give them as arguments (uitamr verify FILE.st ...)")
     return scenarios
 
