@@ -648,6 +648,43 @@ def test_monitor_on_a_tcp_stream(tmp_path):
     assert findings(tmp_path / "m.json") == Counter(BAD_MASTER_FINDINGS)
 
 
+def _makers(folder: Path) -> tuple:
+    """What the reports in `folder` say made them: the page's title and heading, the JUnit
+    suites' names and first test case's class, the JSON's tool."""
+    import xml.etree.ElementTree as ET
+
+    page = (folder / "r.html").read_text(encoding="utf-8")
+    suites = ET.parse(folder / "r.xml").getroot()
+    return (re.search(r"<title>([^:<]*):", page).group(1), re.search(r"<h1>([^<]*)</h1>", page).group(1),
+            suites.get("name"), suites.find("testsuite").get("name"), suites.find("testsuite/testcase").get("classname"),
+            json.loads((folder / "r.json").read_text())["tool"]["name"])
+
+
+def test_the_reports_name_the_command_that_made_them(tmp_path):
+    """A capture's reports (`uitamr monitor`, `uitamr replay`) said "uitamr verify" in the
+    page's heading, the JUnit suite and the JSON's tool, as if a simulated run made them."""
+    reports = lambda folder: ("--html", folder / "r.html", "--junit", folder / "r.xml", "--json", folder / "r.json")
+    (tmp_path / "monitor").mkdir()
+    stream = BadMasterStream()
+    done = subprocess.run(uitamr("monitor", "--tcp", f"127.0.0.1:{stream.port}", "--duration", "10s",
+                                 "--capture", tmp_path / "c.txt", *reports(tmp_path / "monitor")),
+                          capture_output=True, text=True, timeout=60)
+    stream.close()
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert _makers(tmp_path / "monitor") == ("uitamr monitor",) * 4 + ("uitamr.monitor.line", "uitamr monitor")
+    (tmp_path / "replay").mkdir()
+    done = subprocess.run(uitamr("replay", tmp_path / "c.txt", *reports(tmp_path / "replay")),
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert _makers(tmp_path / "replay") == ("uitamr replay",) * 4 + ("uitamr.replay.line", "uitamr replay")
+    (tmp_path / "verify").mkdir()  # a simulated run's stay as they were
+    done = subprocess.run(uitamr("verify", "--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml",
+                                 "--duration", "2s", *reports(tmp_path / "verify")),
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode in (0, 1), done.stdout + done.stderr
+    assert _makers(tmp_path / "verify") == ("uitamr verify",) * 4 + ("uitamr.verify.fx3u", "uitamr verify")
+
+
 def test_monitor_serial_takes_a_pyserial_url(tmp_path):
     """--serial takes pyserial URLs as well as device names: socket:// reads the same
     stream through pyserial's own URL handler, and finds the bad master's findings. (The
