@@ -854,7 +854,7 @@ def test_replay_of_a_capture_with_no_bytes_is_no_traffic_and_findings_come_first
     done = subprocess.run(uitamr("replay", empty, CAPTURES / "bad-master.txt", "--json", tmp_path / "r.json"),
                           capture_output=True, text=True, timeout=WAIT_S)
     assert done.returncode == 1, done.stdout + done.stderr  # a rule broken outranks a capture with nothing
-    assert "FAIL: 1 of 2 scenario(s) failed, 1 saw no traffic" in done.stdout
+    assert "FAIL: 1 of 2 capture(s) failed, 1 saw no traffic" in done.stdout
     report = json.loads((tmp_path / "r.json").read_text())
     assert report["verdict"] == "fail" and [s["verdict"] for s in report["scenarios"]] == ["no-traffic", "fail"]
     # counted as the console counts them: passed + failed + no_traffic = scenarios
