@@ -1112,6 +1112,32 @@ def test_a_key_the_scenario_leaves_out_is_placed_at_the_start_of_the_file(tmp_pa
             "with --duration 5ms") in " ".join(result.output.split())
 
 
+def test_the_progress_bar_first_shows_how_far_the_work_is():
+    """On a terminal the bar's first frame said 0 % though it appeared (after half a second)
+    with the run well on - or with the run over: rich drew the task as it was added, before
+    its first update. It shows the work done; a run over before the bar would appear shows
+    none (it would be drawn, then erased at once)."""
+    import io
+    import time
+
+    from rich.console import Console
+
+    from verifier.commands.verify import SHOW_PROGRESS_AFTER_S, _LazyProgress
+
+    def frames(*updates: int) -> list[str]:
+        out = io.StringIO()
+        progress = _LazyProgress(Console(file=out, force_terminal=True, width=100), 1000, True)
+        progress.started = time.perf_counter() - SHOW_PROGRESS_AFTER_S - 1  # a long run
+        for done in updates:
+            progress.update(done, "[1/1] soak")
+        progress.stop()
+        return re.findall(r"(\d+)% ", out.getvalue())
+
+    shown = frames(400, 1000)
+    assert shown and shown[0] == "40" and "0" not in shown, shown
+    assert frames(1000) == []
+
+
 def test_a_response_signal_that_reads_no_label_is_refused():
     # --response-signal TRUE made every failure 'noticed': the rule could not fail
     result = invoke(*FX3_SOURCES, "--program", "UITAMR_ExampleFx3", "--duration", "1s", "--response-signal", "TRUE")

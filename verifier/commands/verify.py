@@ -296,14 +296,18 @@ class _LazyProgress:
             self._plain(now, done_us, label)
             return
         if self.bar is None:
-            if now - self.started < SHOW_PROGRESS_AFTER_S:
-                return
+            if now - self.started < SHOW_PROGRESS_AFTER_S or done_us >= self.total:
+                return  # a moment's work, or the work done: no bar to show (it would be erased at once)
             self.bar = Progress(
                 TextColumn("{task.description}"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"),
                 TimeElapsedColumn(), console=self.console, transient=True,
             )
+            # the task as far as the work is, before the bar is drawn: started first, its first
+            # frame said 0 % (add_task draws at once) though the run was well on, or even done
+            self.task = self.bar.add_task(label, total=self.total, completed=done_us)
             self.bar.start()
-            self.task = self.bar.add_task(label, total=self.total)
+            self.last_update = now
+            return
         if now - self.last_update < 0.1 and done_us < self.total:
             return
         self.last_update = now
