@@ -32,7 +32,7 @@ from verifier.textfile import real_path
 from verifier.verify.scenario import (
     CHANNELS, DEFAULT_DURATION_US, MAX_DURATION_US, PLATFORMS, Scenario, ScenarioError, default_scenario, load_scenario,
 )
-from verifier.verify.sources import SourceError, expand, unique
+from verifier.verify.sources import SourceError, expand, st_files_in, unique
 
 EXIT_PASS, EXIT_FAIL, EXIT_UNUSABLE = 0, 1, 2
 SHOW_PROGRESS_AFTER_S = 0.5
@@ -227,7 +227,10 @@ def _scenario_files(names) -> list[Path]:
         if path.is_dir():
             found = sorted(path.glob("*.toml"))
             if not found:
-                raise UnusableInput(f"the folder {path} holds no scenario (.toml) file")
+                sources = st_files_in(path)  # a folder of ST sources given as the scenario
+                hint = (f" but {len(sources)} .st file(s): give it without --scenario, as SOURCES (uitamr verify "
+                        f"{name} ...)") if sources else ""
+                raise UnusableInput(f"the folder {path} holds no scenario (.toml) file{hint}")
             files += found
         elif path.suffix.lower() == ".st":  # as a .toml among the SOURCES is sent to --scenario
             raise UnusableInput(f"{name} is ST source, not a scenario: give it without --scenario "
@@ -243,6 +246,11 @@ def _source_files(sources) -> tuple[Path, ...]:
     for name in sources:
         if Path(name).suffix.lower() == ".toml":
             raise UnusableInput(f"{name} is a scenario, not ST source: give it as --scenario {name}")
+        if Path(name).is_dir() and not st_files_in(Path(name)) and any(Path(name).glob("*.toml")):
+            # a folder of scenarios given as SOURCES (uitamr verify plc/scenarios)
+            count = len(list(Path(name).glob("*.toml")))
+            raise UnusableInput(f"the folder {name} holds no .st file but {count} scenario (.toml) file(s): give it "
+                                f"as --scenario {name} (with the .st files, if the scenarios name none, as SOURCES)")
         try:
             found += expand(name, Path.cwd())
         except SourceError as exc:
