@@ -202,13 +202,7 @@ def command(sources: tuple[str, ...], target: str | None, platform: str | None, 
         for p, why in unusable:
             click.echo(f"uitamr check: {p}: {why}", err=True)
         sys.exit(EXIT_USAGE)
-    # a folder named for its .st files that has none (plc/scenarios): said, not passed over
-    # in silence ("20 file(s) checked" read as if its scenarios were among them)
-    from verifier.verify.sources import is_pattern, st_files_in
-
-    for folder in dict.fromkeys(s for s in sources if not is_pattern(s) and Path(s).is_dir()):
-        if not st_files_in(Path(folder)):
-            click.echo(f"uitamr check: {'warning: ' if paths else ''}{folder}: {_no_st_in(Path(folder))}", err=True)
+    say_folders_without_st("uitamr check", sources, fatal=not paths)
     if not paths:
         sys.exit(EXIT_USAGE)
     files, findings = check_findings(paths, target, platform)
@@ -237,6 +231,17 @@ def command(sources: tuple[str, ...], target: str | None, platform: str | None, 
         click.echo(f"{_summary(paths, target, target_given, platform)}: {errors} error(s), "
                    f"{warnings} warning(s)")
     sys.exit(EXIT_ERRORS if errors else EXIT_OK)
+
+
+def say_folders_without_st(command: str, sources, fatal: bool) -> None:
+    """Each folder of `sources` that holds no .st file (plc/scenarios), on stderr with what it
+    holds: said, not passed over in silence ("20 file(s) checked" read as if its scenarios
+    were among them); a warning unless nothing at all was found (`fatal`)."""
+    from verifier.verify.sources import is_pattern, st_files_in
+
+    for folder in dict.fromkeys(s for s in sources if not is_pattern(s) and Path(s).is_dir()):
+        if not st_files_in(Path(folder)):
+            click.echo(f"{command}: {'' if fatal else 'warning: '}{folder}: {_no_st_in(Path(folder))}", err=True)
 
 
 def _no_st_in(folder: Path) -> str:
