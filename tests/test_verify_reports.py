@@ -190,7 +190,8 @@ def test_a_capture_with_no_traffic_neither_passes_nor_fails():
 def test_captures_are_counted_as_captures_without_expectations():
     """`uitamr replay` of a capture said "PASS: 1 scenario(s) compliant, every expectation met"
     and "0 expectation(s) met" for a run that was no scenario and could have no expectation;
-    the page said "scenario(s)" too. Simulated runs keep their words."""
+    the page said "scenario(s)" too, with a column of "0 / 0 met" in its index. Simulated runs
+    keep their words."""
     from dataclasses import replace
 
     from verifier.verify.result import LINE
@@ -206,12 +207,16 @@ def test_captures_are_counted_as_captures_without_expectations():
     report_console.render([captured[0], replace(bad_result(), platform=LINE, expectations=[])],
                           Console(file=out, width=200, color_system=None))
     assert out.getvalue().rstrip().endswith("FAIL: 1 of 2 capture(s) failed")
-    assert "1 of 2 capture(s) compliant" in report_html.render([captured[0], replace(bad_result(), platform=LINE)])
+    page = report_html.render([captured[0], replace(bad_result(), platform=LINE, expectations=[])])
+    assert "1 of 2 capture(s) compliant" in page and "<h2>Captures</h2>" in page
+    assert "<th>capture</th>" in page and "<th>expectations</th>" not in page and " met</td>" not in page
     out = io.StringIO()
     report_console.render([good_result()], Console(file=out, width=200, color_system=None))
     assert "1 expectation(s) met" in out.getvalue()
     assert out.getvalue().rstrip().endswith("PASS: 1 scenario(s) compliant, every expectation met")
-    assert "1 of 2 scenario(s) compliant" in report_html.render([good_result(), bad_result()])
+    page = report_html.render([good_result(), bad_result()])
+    assert "1 of 2 scenario(s) compliant" in page and "<h2>Scenarios</h2>" in page
+    assert "<th>scenario</th>" in page and "<th>expectations</th>" in page and "1 / 1 met</td>" in page
 
 
 def test_console_lists_as_many_times_per_rule_as_asked():
