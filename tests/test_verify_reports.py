@@ -201,7 +201,7 @@ def test_captures_are_counted_as_captures_without_expectations():
     out = io.StringIO()
     report_console.render(captured, Console(file=out, width=200, color_system=None))
     lines = out.getvalue().splitlines()
-    assert lines[0] == "PASS site1.txt (plc/scenarios/healthy.toml): the PLC on line, 20 requests in 6.000 s, 0 violation(s)"
+    assert lines[0] == "PASS site1.txt (plc/scenarios/healthy.toml): the PLC on the line, 20 requests in 6.000 s, 0 violation(s)"
     assert lines[-1] == "PASS: 2 capture(s) compliant"
     out = io.StringIO()
     report_console.render([captured[0], replace(bad_result(), platform=LINE, expectations=[])],

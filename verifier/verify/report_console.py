@@ -47,8 +47,10 @@ def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
         else "" if result.captured and not result.expectations  # a capture has none to meet
         else f", {len(result.expectations)} expectation(s) met"
     )
+    # a capture's PLC is on the line ("the PLC on line" read as "online")
+    ran = "the PLC on the line" if result.captured else f"{escape(result.program or 'the PLC')} on {result.platform}"
     console.print(
-        f"{mark} [bold]{escape(escape_chars(result.name, str.isprintable))}[/]{where}: {escape(result.program or 'the PLC')} on {result.platform}, {tx} request{'' if tx == 1 else 's'} in "
+        f"{mark} [bold]{escape(escape_chars(result.name, str.isprintable))}[/]{where}: {ran}, {tx} request{'' if tx == 1 else 's'} in "
         f"{format_seconds(result.ended_us)}, {result.violation_count} violation(s){expectations}"
     )
     for note in result.notes:
