@@ -685,6 +685,36 @@ def test_the_reports_name_the_command_that_made_them(tmp_path):
     assert _makers(tmp_path / "verify") == ("uitamr verify",) * 4 + ("uitamr.verify.fx3u", "uitamr verify")
 
 
+def test_replay_of_another_of_the_toolkits_files_says_what_it_is(tmp_path):
+    """`uitamr replay` given a scenario, ST source or a report said only "expected a time in
+    seconds at the start of the line": it says what the file is, and what to give instead."""
+    from click.testing import CliRunner
+
+    from verifier.cli import main
+
+    report = tmp_path / "r"
+    made = CliRunner().invoke(main, ["replay", str(CAPTURES / "bad-master.txt"), "--json", f"{report}.json",
+                                     "--html", f"{report}.html", "--junit", f"{report}.xml"])
+    assert made.exit_code == 1, made.output
+    scenario = ROOT / "plc" / "scenarios" / "fx3u-healthy.toml"
+    source = ROOT / "plc" / "core" / "UITAMR_Engine.st"
+    instead = "replay reads a --trace file (JSON Lines) or a plain capture (docs/commissioning.md)"
+    cases = [(scenario, f"{scenario}:1:1: ", f"this is a scenario file: run it with uitamr verify --scenario {scenario}"),
+             (source, f"{source}:1:1: ", f"this is ST source: run it with uitamr verify {source}"),
+             (f"{report}.json", f"{report}.json:1:2: ", "this is a --json report"),
+             (f"{report}.html", f"{report}.html:1:1: ", "this is a --html report"),
+             (f"{report}.xml", f"{report}.xml:1:1: ", "this is a --junit report")]
+    for path, place, what in cases:
+        done = CliRunner().invoke(main, ["replay", str(path)])
+        assert done.exit_code == 2, done.output
+        assert done.stderr.startswith(f"uitamr replay: {place}") and done.stderr.endswith(f"; {what}; {instead}\n"), \
+            done.stderr
+    (tmp_path / "notes.txt").write_text("hello\n", encoding="utf-8")  # anything else: the place alone
+    done = CliRunner().invoke(main, ["replay", str(tmp_path / "notes.txt")])
+    assert done.stderr == (f"uitamr replay: {tmp_path / 'notes.txt'}:1:1: expected a time in seconds (e.g. 0.250) at "
+                           "the start of the line\n")
+
+
 def test_monitor_serial_takes_a_pyserial_url(tmp_path):
     """--serial takes pyserial URLs as well as device names: socket:// reads the same
     stream through pyserial's own URL handler, and finds the bad master's findings. (The
