@@ -93,8 +93,8 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
         scenarios = [str(p) for p in paths if p.suffix.lower() == ".toml"]
         if scenarios:  # read as ST, a scenario's first key was "unexpected 'name'"
             more = f" and {len(scenarios) - 3} more" if len(scenarios) > 3 else ""
-            click.echo(f"uitamr export: {', '.join(scenarios[:3])}{more}: a scenario (.toml), not ST source: export writes "
-                       f"the POUs of .st files; run scenarios with uitamr verify --scenario", err=True)
+            click.echo(f"uitamr export: {', '.join(scenarios[:3])}{more}: a scenario (.toml), not ST source: "
+                       "export writes the POUs of .st files; run scenarios with uitamr verify --scenario", err=True)
             sys.exit(EXIT_USAGE)
         say_folders_without_st("uitamr export", sources, fatal=not paths)
         if not paths:

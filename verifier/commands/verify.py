@@ -179,8 +179,9 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
         if not scenario.sources:
             if scenario.path is None:
                 raise UnusableInput("the default scenario: no ST sources: give them as arguments (uitamr verify FILE.st ...)")
-            raise UnusableInput(f"{scenario.key_where('sources')}: no ST sources: list them in the file (sources = [\"plc/*.st\"], "
-                                "relative to it) or give them as arguments (uitamr verify FILE.st ...)")
+            raise UnusableInput(f"{scenario.key_where('sources')}: no ST sources: list them in the file "
+                                "(sources = [\"plc/*.st\"], relative to it) or give them as arguments "
+                                "(uitamr verify FILE.st ...)")
     return scenarios
 
 
@@ -246,14 +247,14 @@ def _source_files(sources) -> tuple[Path, ...]:
     for name in sources:
         if Path(name).suffix.lower() == ".toml":
             raise UnusableInput(f"{name} is a scenario, not ST source: give it as --scenario {name}")
-        if Path(name).is_dir() and not st_files_in(Path(name)) and any(Path(name).glob("*.toml")):
-            # a folder of scenarios given as SOURCES (uitamr verify plc/scenarios)
-            count = len(list(Path(name).glob("*.toml")))
-            raise UnusableInput(f"the folder {name} holds no .st file but {count} scenario (.toml) file(s): give it "
-                                f"as --scenario {name} (with the .st files, if the scenarios name none, as SOURCES)")
         try:
             found += expand(name, Path.cwd())
         except SourceError as exc:
+            scenarios = list(Path(name).glob("*.toml")) if Path(name).is_dir() else []
+            if scenarios:  # a folder of scenarios given as SOURCES (uitamr verify plc/scenarios)
+                raise UnusableInput(f"the folder {name} holds no .st file but {len(scenarios)} scenario (.toml) "
+                                    f"file(s): give it as --scenario {name} (with the .st files, if the scenarios "
+                                    "name none, as SOURCES)") from None
             raise UnusableInput(str(exc)) from None
     return unique(found)
 
