@@ -235,7 +235,7 @@ def test_a_report_that_cannot_be_written_to_its_end_is_not_left_half_written(opt
     result = run_with_file_size_limit(1000, "replay", ROOT / "tests" / "captures" / "bad-master.txt", option, name,
                                       cwd=tmp_path)
     assert result.returncode == 2, result.stderr
-    assert result.stderr.endswith(f"uitamr: cannot write {name}: File too large\n")
+    assert result.stderr.endswith(f"uitamr replay: cannot write {name}: File too large\n")
     assert not (tmp_path / name).exists()
 
 

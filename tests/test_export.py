@@ -191,6 +191,29 @@ def test_missing_source_is_a_usage_error(tmp_path):
     assert result.exit_code == 2 and "nope.st" in result.output
 
 
+def test_a_scenario_or_a_folder_without_st_is_named_as_such(tmp_path, monkeypatch):
+    """`uitamr export ... s.toml` read the scenario as ST ("1:1: error: unexpected 'name'"),
+    and a folder of scenarios gave "no .st files to export" without naming it; beside a
+    folder that has .st files, it was passed over in silence."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "scenarios").mkdir()
+    (tmp_path / "scenarios" / "s.toml").write_text('name = "s"\n', encoding="utf-8")
+    (tmp_path / "src").mkdir()
+    (tmp_path / "src" / "Main.st").write_text("PROGRAM Main\nVAR x : INT; END_VAR\nx := 1;\nEND_PROGRAM\n")
+    result = run("--target", "gxworks2", "--out", "out", "scenarios/s.toml")
+    assert result.exit_code == 2 and not (tmp_path / "out").exists()
+    assert result.stderr == ("uitamr export: scenarios/s.toml: a scenario (.toml), not ST source: export writes the "
+                             "POUs of .st files; run scenarios with uitamr verify --scenario\n")
+    result = run("--target", "gxworks2", "--out", "out", "scenarios")
+    assert result.exit_code == 2 and not (tmp_path / "out").exists()
+    assert result.stderr.startswith("uitamr export: scenarios: no .st file in it or below it: it holds 1 .toml "
+                                    "file(s); its 1 .toml file(s) are scenarios: run them with `uitamr verify "
+                                    '--scenario "scenarios"`')
+    result = run("--target", "gxworks2", "--out", "out", "src", "scenarios")
+    assert result.exit_code == 0 and (tmp_path / "out" / "Main.st").is_file()
+    assert result.stderr.startswith("uitamr export: warning: scenarios: no .st file in it or below it")
+
+
 def test_global_labels_get_their_own_table(tmp_path):
     src = tmp_path / "Main.st"
     src.write_text(

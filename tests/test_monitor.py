@@ -715,6 +715,73 @@ def test_monitor_on_a_tcp_stream(tmp_path):
     assert findings(tmp_path / "m.json") == Counter(BAD_MASTER_FINDINGS)
 
 
+def _makers(folder: Path) -> tuple:
+    """What the reports in `folder` say made them: the page's title and heading, the JUnit
+    suites' names and first test case's class, the JSON's tool."""
+    import xml.etree.ElementTree as ET
+
+    page = (folder / "r.html").read_text(encoding="utf-8")
+    suites = ET.parse(folder / "r.xml").getroot()
+    return (re.search(r"<title>([^:<]*):", page).group(1), re.search(r"<h1>([^<]*)</h1>", page).group(1),
+            suites.get("name"), suites.find("testsuite").get("name"), suites.find("testsuite/testcase").get("classname"),
+            json.loads((folder / "r.json").read_text())["tool"]["name"])
+
+
+def test_the_reports_name_the_command_that_made_them(tmp_path):
+    """A capture's reports (`uitamr monitor`, `uitamr replay`) said "uitamr verify" in the
+    page's heading, the JUnit suite and the JSON's tool, as if a simulated run made them."""
+    reports = lambda folder: ("--html", folder / "r.html", "--junit", folder / "r.xml", "--json", folder / "r.json")
+    (tmp_path / "monitor").mkdir()
+    stream = BadMasterStream()
+    done = subprocess.run(uitamr("monitor", "--tcp", f"127.0.0.1:{stream.port}", "--duration", "10s",
+                                 "--capture", tmp_path / "c.txt", *reports(tmp_path / "monitor")),
+                          capture_output=True, text=True, timeout=60)
+    stream.close()
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert _makers(tmp_path / "monitor") == ("uitamr monitor",) * 4 + ("uitamr.monitor.line", "uitamr monitor")
+    (tmp_path / "replay").mkdir()
+    done = subprocess.run(uitamr("replay", tmp_path / "c.txt", *reports(tmp_path / "replay")),
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert _makers(tmp_path / "replay") == ("uitamr replay",) * 4 + ("uitamr.replay.line", "uitamr replay")
+    (tmp_path / "verify").mkdir()  # a simulated run's stay as they were
+    done = subprocess.run(uitamr("verify", "--scenario", ROOT / "plc" / "scenarios" / "fx3u-healthy.toml",
+                                 "--duration", "2s", *reports(tmp_path / "verify")),
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode in (0, 1), done.stdout + done.stderr
+    assert _makers(tmp_path / "verify") == ("uitamr verify",) * 4 + ("uitamr.verify.fx3u", "uitamr verify")
+
+
+def test_replay_of_another_of_the_toolkits_files_says_what_it_is(tmp_path):
+    """`uitamr replay` given a scenario, ST source or a report said only "expected a time in
+    seconds at the start of the line": it says what the file is, and what to give instead."""
+    from click.testing import CliRunner
+
+    from verifier.cli import main
+
+    report = tmp_path / "r"
+    made = CliRunner().invoke(main, ["replay", str(CAPTURES / "bad-master.txt"), "--json", f"{report}.json",
+                                     "--html", f"{report}.html", "--junit", f"{report}.xml"])
+    assert made.exit_code == 1, made.output
+    scenario = ROOT / "plc" / "scenarios" / "fx3u-healthy.toml"
+    source = ROOT / "plc" / "core" / "UITAMR_Engine.st"
+    instead = "replay reads a --trace file (JSON Lines) or a plain capture (docs/commissioning.md)"
+    cases = [(scenario, f"{scenario}:1:1: ", f"this is a scenario file: run it with uitamr verify --scenario {scenario}"),
+             (source, f"{source}:1:1: ", f"this is ST source: run it with uitamr verify {source}"),
+             (f"{report}.json", f"{report}.json:1:2: ", "this is a --json report"),
+             (f"{report}.html", f"{report}.html:1:1: ", "this is a --html report"),
+             (f"{report}.xml", f"{report}.xml:1:1: ", "this is a --junit report")]
+    for path, place, what in cases:
+        done = CliRunner().invoke(main, ["replay", str(path)])
+        assert done.exit_code == 2, done.output
+        assert done.stderr.startswith(f"uitamr replay: {place}") and done.stderr.endswith(f"; {what}; {instead}\n"), \
+            done.stderr
+    (tmp_path / "notes.txt").write_text("hello\n", encoding="utf-8")  # anything else: the place alone
+    done = CliRunner().invoke(main, ["replay", str(tmp_path / "notes.txt")])
+    assert done.stderr == (f"uitamr replay: {tmp_path / 'notes.txt'}:1:1: expected a time in seconds (e.g. 0.250) at "
+                           "the start of the line\n")
+
+
 def test_monitor_serial_takes_a_pyserial_url(tmp_path):
     """--serial takes pyserial URLs as well as device names: socket:// reads the same
     stream through pyserial's own URL handler, and finds the bad master's findings. (The
@@ -884,7 +951,7 @@ def test_replay_of_a_capture_with_no_bytes_is_no_traffic_and_findings_come_first
     done = subprocess.run(uitamr("replay", empty, CAPTURES / "bad-master.txt", "--json", tmp_path / "r.json"),
                           capture_output=True, text=True, timeout=WAIT_S)
     assert done.returncode == 1, done.stdout + done.stderr  # a rule broken outranks a capture with nothing
-    assert "FAIL: 1 of 2 scenario(s) failed, 1 saw no traffic" in done.stdout
+    assert "FAIL: 1 of 2 capture(s) failed, 1 saw no traffic" in done.stdout
     report = json.loads((tmp_path / "r.json").read_text())
     assert report["verdict"] == "fail" and [s["verdict"] for s in report["scenarios"]] == ["no-traffic", "fail"]
     # counted as the console counts them: passed + failed + no_traffic = scenarios

@@ -72,6 +72,30 @@ def test_a_folder_is_read_as_verify_reads_it(tmp_path):
     assert expand_sources((str(src),)) == expand(str(src), tmp_path)
 
 
+def test_a_folder_of_scenarios_says_what_it_holds_and_what_to_run(tmp_path, monkeypatch):
+    """`uitamr check plc/scenarios` said only "no .st files found in the given directories";
+    it names the folder, what it holds, and the commands for its scenarios - which run as
+    told. A folder without .st among others is said too, not passed over in silence."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "scenarios").mkdir()
+    (tmp_path / "scenarios" / "a.toml").write_text('name = "a"\n', encoding="utf-8")
+    (tmp_path / "scenarios" / "README.md").write_text("notes\n", encoding="utf-8")
+    (tmp_path / "empty").mkdir()
+    result = run("scenarios")
+    assert result.exit_code == 2
+    assert result.stderr == (
+        'uitamr check: scenarios: no .st file in it or below it: it holds 1 .toml and 1 .md file(s); its 1 .toml '
+        'file(s) are scenarios: run them with `uitamr verify --scenario "scenarios"` (on the sources they name, or '
+        'on .st files given as arguments), or check them by name with `uitamr check "scenarios/*.toml"`\n')
+    told = run("scenarios/*.toml")  # the command it gives
+    assert told.exit_code == 0 and "1 file(s) checked: 0 error(s)" in told.output, told.output
+    result = run("empty")
+    assert result.exit_code == 2 and result.stderr == "uitamr check: empty: no .st file in it: the folder is empty\n"
+    result = run(GOOD, "scenarios")
+    assert result.exit_code == 0 and "1 file(s) checked" in result.output
+    assert result.stderr.startswith("uitamr check: warning: scenarios: no .st file in it or below it: ")
+
+
 def test_a_pattern_is_expanded_as_verify_expands_it(tmp_path, monkeypatch):
     """ci.md's commands (`uitamr check --platform fx3u plc/ verify/*.toml`, the VS Code task)
     rely on the shell to expand `*.toml`; cmd and PowerShell do not, and check took the

@@ -256,7 +256,7 @@ def test_a_scenario_on_the_wrong_platform_says_which_platform_to_set(tmp_path):
     result = invoke("--scenario", unset)
     assert result.exit_code == 2
     assert str(PLC / "fx5" / "UITAMR_Port") in result.output  # the load errors stay
-    assert (f"{unset}: platform: the sources load on fx5u, not on fx3u (the default): set "
+    assert (f"{unset}:1:1: platform: the sources load on fx5u, not on fx3u (the default): set "
             'platform = "fx5u" in the scenario, or give --platform fx5u') in result.output
     wrong = tmp_path / "wrong.toml"
     wrong.write_text(text + 'platform = "q"\n', encoding="utf-8")
@@ -277,12 +277,11 @@ def test_a_wrong_platform_option_is_not_blamed_on_a_scenario_file(tmp_path):
     fx5 = [PLC / "core", PLC / "fx5", PLC / "examples" / "common", PLC / "examples" / "fx5" / "UITAMR_ExampleFx5.st"]
     result = invoke(*fx5, "--platform", "fx3u", "--duration", "2s")
     assert result.exit_code == 2
-    assert ("scenario 'healthy robot': the sources load on fx5u, not on fx3u (--platform fx3u): give --platform fx5u"
-            in result.output)
+    assert "--platform fx3u: the sources load on fx5u, not on fx3u: give --platform fx5u" in result.output
     assert "(the default)" not in result.output and "in the scenario" not in result.output
     result = invoke("--scenario", PLC / "scenarios" / "fx5u-healthy.toml", "--platform", "q")
     assert result.exit_code == 2
-    assert "fx5u-healthy.toml: the sources load on fx5u, not on q (--platform q): give --platform fx5u" in result.output
+    assert "--platform q: the sources load on fx5u, not on q: give --platform fx5u" in result.output
 
 
 def test_platform_without_sources_picks_the_bundled_scenarios_of_that_platform(tmp_path):
@@ -431,7 +430,8 @@ def test_a_function_block_or_no_program_at_all_is_named_as_such():
 
 def test_sources_with_no_program_are_placed_at_the_scenarios_sources_key(tmp_path, monkeypatch):
     """A scenario whose `sources` hold only function blocks named the file alone; now its
-    `sources` key, and the file alone when SOURCES on the command line replaced them."""
+    `sources` key, and the SOURCES on the command line when they replaced them (they are to
+    blame, not the file: it said 's.toml:' with no line)."""
     monkeypatch.chdir(tmp_path)
     (tmp_path / "fb.st").write_text("FUNCTION_BLOCK F\nVAR x : INT; END_VAR\nx := 1;\nEND_FUNCTION_BLOCK\n")
     (tmp_path / "s.toml").write_text('name = "x"\nsources = ["fb.st"]\n')
@@ -440,7 +440,7 @@ def test_sources_with_no_program_are_placed_at_the_scenarios_sources_key(tmp_pat
     assert "error: s.toml:2:11: sources: the sources define no PROGRAM" in result.output
     result = invoke("--scenario", "s.toml", "fb.st")
     assert result.exit_code == 2
-    assert "error: s.toml: the sources define no PROGRAM" in result.output
+    assert "error: SOURCES (fb.st): the sources define no PROGRAM" in result.output
 
 
 def test_text_in_square_brackets_is_shown_as_written_not_read_as_markup(tmp_path):
@@ -1080,8 +1080,62 @@ def test_a_scenario_without_sources_says_the_file_can_list_them(tmp_path, monkey
     monkeypatch.chdir(tmp_path)
     result = invoke("--scenario", "s.toml")
     assert result.exit_code == 2
-    assert ('error: s.toml: no ST sources: list them in the file (sources = ["plc/*.st"], relative to it) or give '
+    assert ('error: s.toml:1:1: sources: no ST sources: list them in the file (sources = ["plc/*.st"], relative to it) or give '
             "them as arguments (uitamr verify FILE.st ...)") in " ".join(result.output.split())
+
+
+def test_a_key_the_scenario_leaves_out_is_placed_at_the_start_of_the_file(tmp_path, monkeypatch):
+    """An error about a top-level key the scenario does not hold ('sources', 'program', the
+    default 'scan') named the file without a line ("s.toml: no ST sources", "s.toml: say which
+    PROGRAM"); like a key missing from an [[inputs]] table (placed at its header), it is placed
+    at the table it belongs in: the file, 1:1. A scenario without a file names no place."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "two.st").write_text("PROGRAM MainA\nVAR x : INT; END_VAR\nx := 1;\nEND_PROGRAM\n"
+                                     "PROGRAM MainB\nVAR x : INT; END_VAR\nx := 2;\nEND_PROGRAM\n")
+    (tmp_path / "none.toml").write_text('name = "x"\nduration = "1s"\n')
+    (tmp_path / "two.toml").write_text('name = "x"\nduration = "1s"\nsources = ["two.st"]\n')
+    result = invoke("--scenario", "none.toml")
+    assert result.exit_code == 2
+    assert "error: none.toml:1:1: sources: no ST sources: list them in the file" in result.output
+    result = invoke("--scenario", "two.toml")
+    assert result.exit_code == 2
+    assert ('error: two.toml:1:1: program: say which PROGRAM to run (program = "MainA" in the file, or --program); '
+            "the sources define: MainA, MainB") in " ".join(result.output.split())
+    result = invoke("two.st", "--scenario", "none.toml")  # the program is still the file's to name
+    assert result.exit_code == 2 and "error: none.toml:1:1: program: say which PROGRAM" in result.output
+    result = invoke("two.st")  # no file: the option alone
+    assert result.exit_code == 2
+    assert "error: say which PROGRAM to run with --program; the sources define: MainA, MainB" in result.output
+    result = invoke("--scenario", "two.toml", "--program", "MainA", "--duration", "5ms")
+    assert result.exit_code == 2
+    assert ("error: two.toml:1:1: scan: the scan time (10ms, the default) is longer than the whole run (5ms) "
+            "with --duration 5ms") in " ".join(result.output.split())
+
+
+def test_the_progress_bar_first_shows_how_far_the_work_is():
+    """On a terminal the bar's first frame said 0 % though it appeared (after half a second)
+    with the run well on - or with the run over: rich drew the task as it was added, before
+    its first update. It shows the work done; a run over before the bar would appear shows
+    none (it would be drawn, then erased at once)."""
+    import io
+    import time
+
+    from rich.console import Console
+
+    from verifier.commands.verify import SHOW_PROGRESS_AFTER_S, _LazyProgress
+
+    def frames(*updates: int) -> list[str]:
+        out = io.StringIO()
+        progress = _LazyProgress(Console(file=out, force_terminal=True, width=100), 1000, True)
+        progress.started = time.perf_counter() - SHOW_PROGRESS_AFTER_S - 1  # a long run
+        for done in updates:
+            progress.update(done, "[1/1] soak")
+        progress.stop()
+        return re.findall(r"(\d+)% ", out.getvalue())
+
+    shown = frames(400, 1000)
+    assert shown and shown[0] == "40" and "0" not in shown, shown
+    assert frames(1000) == []
 
 
 def test_a_response_signal_that_reads_no_label_is_refused():

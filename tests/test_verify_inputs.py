@@ -133,6 +133,25 @@ def test_the_command_line_takes_folders(tmp_path, program):
     assert result.exit_code == 2 and "holds no scenario (.toml) file" in result.output
 
 
+def test_a_folder_given_in_the_wrong_place_says_where_it_goes(tmp_path, program):
+    """`uitamr verify plc/scenarios` said "holds no .st file" and `--scenario plc/core` "holds no
+    scenario (.toml) file", with nothing on what the folder does hold: they say it, and where
+    to give the folder instead - which then runs."""
+    folder = tmp_path / "scenarios"
+    folder.mkdir()
+    (folder / "a.toml").write_text('name = "a"\nduration = "1s"\n', encoding="utf-8")
+    result = invoke(folder)
+    assert result.exit_code == 2
+    assert (f"error: the folder {folder} holds no .st file but 1 scenario (.toml) file(s): give it as --scenario "
+            f"{folder} (with the .st files, if the scenarios name none, as SOURCES)") in " ".join(result.output.split())
+    result = invoke("--scenario", tmp_path / "src")
+    assert result.exit_code == 2
+    assert (f"error: the folder {tmp_path / 'src'} holds no scenario (.toml) file but 1 .st file(s): give it without "
+            f"--scenario, as SOURCES (uitamr verify {tmp_path / 'src'} ...)") in " ".join(result.output.split())
+    ran = invoke(tmp_path / "src", "--scenario", folder, "--json", tmp_path / "r.json")  # as told: it runs
+    assert [s["name"] for s in json.loads((tmp_path / "r.json").read_text())["scenarios"]] == ["a"], ran.output
+
+
 def test_the_reports_name_the_program_chosen_for_the_user(tmp_path, program):
     """No --program and no 'program': the only PROGRAM runs, and every report says which."""
     json_path, html = tmp_path / "r.json", tmp_path / "r.html"

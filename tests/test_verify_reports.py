@@ -187,6 +187,38 @@ def test_a_capture_with_no_traffic_neither_passes_nor_fails():
     assert [s["no_traffic"] for s in data["scenarios"]] == [None, silent.no_traffic]
 
 
+def test_captures_are_counted_as_captures_without_expectations():
+    """`uitamr replay` of a capture said "PASS: 1 scenario(s) compliant, every expectation met"
+    and "0 expectation(s) met" for a run that was no scenario and could have no expectation;
+    the page said "scenario(s)" too, with a column of "0 / 0 met" in its index. Simulated runs
+    keep their words."""
+    from dataclasses import replace
+
+    from verifier.verify.result import LINE
+
+    captured = [replace(good_result(), platform=LINE, program=None, expectations=[], name=f"site{i}.txt")
+                for i in (1, 2)]
+    out = io.StringIO()
+    report_console.render(captured, Console(file=out, width=200, color_system=None))
+    lines = out.getvalue().splitlines()
+    assert lines[0] == "PASS site1.txt (plc/scenarios/healthy.toml): the PLC on the line, 20 requests in 6.000 s, 0 violation(s)"
+    assert lines[-1] == "PASS: 2 capture(s) compliant"
+    out = io.StringIO()
+    report_console.render([captured[0], replace(bad_result(), platform=LINE, expectations=[])],
+                          Console(file=out, width=200, color_system=None))
+    assert out.getvalue().rstrip().endswith("FAIL: 1 of 2 capture(s) failed")
+    page = report_html.render([captured[0], replace(bad_result(), platform=LINE, expectations=[])])
+    assert "1 of 2 capture(s) compliant" in page and "<h2>Captures</h2>" in page
+    assert "<th>capture</th>" in page and "<th>expectations</th>" not in page and " met</td>" not in page
+    out = io.StringIO()
+    report_console.render([good_result()], Console(file=out, width=200, color_system=None))
+    assert "1 expectation(s) met" in out.getvalue()
+    assert out.getvalue().rstrip().endswith("PASS: 1 scenario(s) compliant, every expectation met")
+    page = report_html.render([good_result(), bad_result()])
+    assert "1 of 2 scenario(s) compliant" in page and "<h2>Scenarios</h2>" in page
+    assert "<th>scenario</th>" in page and "<th>expectations</th>" in page and "1 / 1 met</td>" in page
+
+
 def test_console_lists_as_many_times_per_rule_as_asked():
     out = io.StringIO()
     report_console.render([bad_result()], Console(file=out, width=200, color_system=None), first=1)

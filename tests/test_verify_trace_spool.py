@@ -265,4 +265,4 @@ def test_runs_that_share_a_name_are_apart_in_the_trace_and_replay_reads_them(tmp
     assert runs[f"{name} [{first} #1]"] == runs[f"{name} [{copy}]"] == runs[f"{name} [{first} #2]"]
     replayed = CliRunner().invoke(main, ["replay", str(trace)])
     assert replayed.exit_code == 0, replayed.output
-    assert "PASS: 3 scenario(s) compliant" in replayed.output
+    assert "PASS: 3 capture(s) compliant" in replayed.output

@@ -202,8 +202,8 @@ def command(sources: tuple[str, ...], target: str | None, platform: str | None, 
         for p, why in unusable:
             click.echo(f"uitamr check: {p}: {why}", err=True)
         sys.exit(EXIT_USAGE)
+    say_folders_without_st("uitamr check", sources, fatal=not paths)
     if not paths:
-        click.echo("uitamr check: no .st files found in the given directories", err=True)
         sys.exit(EXIT_USAGE)
     files, findings = check_findings(paths, target, platform)
     diagnostics = [f.diagnostic for f in findings]
@@ -231,6 +231,39 @@ def command(sources: tuple[str, ...], target: str | None, platform: str | None, 
         click.echo(f"{_summary(paths, target, target_given, platform)}: {errors} error(s), "
                    f"{warnings} warning(s)")
     sys.exit(EXIT_ERRORS if errors else EXIT_OK)
+
+
+def say_folders_without_st(command: str, sources, fatal: bool) -> None:
+    """Each folder of `sources` that holds no .st file (plc/scenarios), on stderr with what it
+    holds: said, not passed over in silence ("20 file(s) checked" read as if its scenarios
+    were among them); a warning unless nothing at all was found (`fatal`)."""
+    from verifier.verify.sources import is_pattern, st_files_in
+
+    for folder in dict.fromkeys(s for s in sources if not is_pattern(s) and Path(s).is_dir()):
+        if not st_files_in(Path(folder)):
+            click.echo(f"{command}: {'' if fatal else 'warning: '}{folder}: {_no_st_in(Path(folder))}", err=True)
+
+
+def _no_st_in(folder: Path) -> str:
+    """What a folder that holds no .st file holds instead, and what to run on it: a folder
+    of scenarios (plc/scenarios) is for `uitamr verify --scenario`, which reads a folder's
+    .toml files, or for check itself when they are named (check reads a folder for .st only)."""
+    from collections import Counter
+
+    files = [p for p in folder.rglob("*") if p.is_file()]
+    if not files:
+        return "no .st file in it: the folder is empty"
+    kinds = Counter(p.suffix.lower() or "(no suffix)" for p in files).most_common()
+    held = " and ".join(f"{n} {kind}" for kind, n in kinds[:3]) + " file(s)"
+    held += f" and {sum(n for _, n in kinds[3:])} other(s)" if kinds[3:] else ""
+    text = f"no .st file in it or below it: it holds {held}"
+    scenarios = sorted(folder.glob("*.toml"))
+    if not scenarios:
+        return text + "; name the folders or files that hold the program's .st files"
+    # double quotes: a pattern check expands itself, so cmd and PowerShell may pass it on too
+    return (text + f"; its {len(scenarios)} .toml file(s) are scenarios: run them with `uitamr verify --scenario "
+            f"\"{folder}\"` (on the sources they name, or on .st files given as arguments), or check them by name "
+            f"with `uitamr check \"{folder / '*.toml'}\"`")
 
 
 def _lines_of(path: Path) -> list[str] | None:

@@ -25,7 +25,7 @@ from pathlib import Path
 import click
 
 from verifier.bundled import PLC_DIR
-from verifier.commands.check import expand_sources, platform_target
+from verifier.commands.check import expand_sources, platform_target, say_folders_without_st
 from verifier.sim.cpu import PROFILES
 from verifier.textfile import real_path
 
@@ -90,6 +90,15 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
             click.echo(f"uitamr export: {'; '.join(said)}", err=True)
             sys.exit(EXIT_USAGE)
         paths = expand_sources(sources)
+        scenarios = [str(p) for p in paths if p.suffix.lower() == ".toml"]
+        if scenarios:  # read as ST, a scenario's first key was "unexpected 'name'"
+            more = f" and {len(scenarios) - 3} more" if len(scenarios) > 3 else ""
+            click.echo(f"uitamr export: {', '.join(scenarios[:3])}{more}: a scenario (.toml), not ST source: "
+                       "export writes the POUs of .st files; run scenarios with uitamr verify --scenario", err=True)
+            sys.exit(EXIT_USAGE)
+        say_folders_without_st("uitamr export", sources, fatal=not paths)
+        if not paths:
+            sys.exit(EXIT_USAGE)
         # a folder that holds --out: the files of an earlier export there are not sources (bodies
         # without declarations: the second run of the same command failed on them)
         out = real_path(out_dir)

@@ -156,7 +156,7 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
         result.notes.append(f"the capture ended early: {lost}")
     capture_written = True
     try:
-        _finish([result], console, json_path, junit_path, trace_path, html_path)
+        _finish([result], console, json_path, junit_path, trace_path, html_path, "uitamr monitor")
     finally:
         # the capture is the line's only record (the reports can be made again from it by
         # `uitamr replay`): it is written even when a report cannot be
@@ -181,12 +181,13 @@ def exit_status(results) -> int:
     return {"fail": EXIT_FINDINGS, NO_TRAFFIC: EXIT_NO_TRAFFIC, "pass": EXIT_CLEAN}[overall_verdict(results)]
 
 
-def _finish(results, console: Console, json_path, junit_path, trace_path, html_path) -> None:
+def _finish(results, console: Console, json_path, junit_path, trace_path, html_path, command: str) -> None:
+    """The console report, then the report files, which name `command` as their maker."""
     from verifier.verify import report_console
 
     report_console.render(results, console)
     try:
-        write_reports(results, console, json_path, junit_path, trace_path, html_path)
+        write_reports(results, console, json_path, junit_path, trace_path, html_path, command)
     except ReportError as exc:
-        click.echo(f"uitamr: {exc}", err=True)
+        click.echo(f"{command}: {exc}", err=True)
         sys.exit(EXIT_UNUSABLE)

@@ -60,5 +60,5 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
                 session.feed(chunk)
             session.close()
             results.append(session.result())
-    _finish(results, console, json_path, junit_path, trace_path, html_path)
+    _finish(results, console, json_path, junit_path, trace_path, html_path, "uitamr replay")
     sys.exit(exit_status(results))

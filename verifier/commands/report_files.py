@@ -80,7 +80,9 @@ def check_not_inputs(inputs, *paths: str | None) -> None:
 
 
 def write_reports(results, console: Console, json_path=None, junit_path=None, trace_path=None,
-                  html_path=None) -> None:
+                  html_path=None, command: str = "uitamr verify") -> None:
+    """The report files asked for; `command` (`uitamr monitor`, `uitamr replay`) is named
+    in those that name their maker (JSON's tool, the JUnit suite, the page's heading)."""
     from verifier.verify import report_html, report_json, report_junit, report_trace
 
     writers = ((json_path, report_json), (junit_path, report_junit), (trace_path, report_trace),
@@ -88,7 +90,10 @@ def write_reports(results, console: Console, json_path=None, junit_path=None, tr
     for path, writer in writers:
         if path:
             try:
-                writer.write(results, Path(path))
+                if writer is report_trace:  # the frames alone: a trace names no maker
+                    writer.write(results, Path(path))
+                else:
+                    writer.write(results, Path(path), command=command)
             except OSError as exc:
                 raise ReportError(f"cannot write {path}: {exc.strerror or exc}") from None
             console.print(f"[dim]wrote {escape(str(path))}[/]")

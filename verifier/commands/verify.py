@@ -32,7 +32,7 @@ from verifier.textfile import real_path
 from verifier.verify.scenario import (
     CHANNELS, DEFAULT_DURATION_US, MAX_DURATION_US, PLATFORMS, Scenario, ScenarioError, default_scenario, load_scenario,
 )
-from verifier.verify.sources import SourceError, expand, unique
+from verifier.verify.sources import SourceError, expand, st_files_in, unique
 
 EXIT_PASS, EXIT_FAIL, EXIT_UNUSABLE = 0, 1, 2
 SHOW_PROGRESS_AFTER_S = 0.5
@@ -166,20 +166,22 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
             option = f"--scan {format_duration(scan)}" if scan is not None else ""
             if duration is not None:
                 option += (" and " if option else "") + f"--duration {format_duration(duration)}"
+            default = "" if key in scenario.key_lines or key != "scan" else ", the default"
             raise UnusableInput(
-                f"{scenario.where(key, scenario.key_lines.get(key))}: the scan time "
-                f"({format_duration(scenario.scan_us)}) is longer than the whole run "
+                f"{scenario.key_where(key)}: the scan time "
+                f"({format_duration(scenario.scan_us)}{default}) is longer than the whole run "
                 f"({format_duration(scenario.duration_us)})" + (f" with {option}" if option else ""))
         if scenario.scan_jitter_us >= scenario.scan_us:
             raise UnusableInput(
-                f"{scenario.where('scan_jitter', scenario.key_lines.get('scan_jitter'))}: must be shorter than "
+                f"{scenario.key_where('scan_jitter')}: must be shorter than "
                 f"the scan time ({format_duration(scenario.scan_us)})"
                 + (f" with --scan {format_duration(scan)}" if scan is not None else ""))
         if not scenario.sources:
             if scenario.path is None:
                 raise UnusableInput("the default scenario: no ST sources: give them as arguments (uitamr verify FILE.st ...)")
-            raise UnusableInput(f"{scenario.path}: no ST sources: list them in the file (sources = [\"plc/*.st\"], "
-                                "relative to it) or give them as arguments (uitamr verify FILE.st ...)")
+            raise UnusableInput(f"{scenario.key_where('sources')}: no ST sources: list them in the file "
+                                "(sources = [\"plc/*.st\"], relative to it) or give them as arguments "
+                                "(uitamr verify FILE.st ...)")
     return scenarios
 
 
@@ -226,7 +228,10 @@ def _scenario_files(names) -> list[Path]:
         if path.is_dir():
             found = sorted(path.glob("*.toml"))
             if not found:
-                raise UnusableInput(f"the folder {path} holds no scenario (.toml) file")
+                sources = st_files_in(path)  # a folder of ST sources given as the scenario
+                hint = (f" but {len(sources)} .st file(s): give it without --scenario, as SOURCES (uitamr verify "
+                        f"{name} ...)") if sources else ""
+                raise UnusableInput(f"the folder {path} holds no scenario (.toml) file{hint}")
             files += found
         elif path.suffix.lower() == ".st":  # as a .toml among the SOURCES is sent to --scenario
             raise UnusableInput(f"{name} is ST source, not a scenario: give it without --scenario "
@@ -245,6 +250,11 @@ def _source_files(sources) -> tuple[Path, ...]:
         try:
             found += expand(name, Path.cwd())
         except SourceError as exc:
+            scenarios = list(Path(name).glob("*.toml")) if Path(name).is_dir() else []
+            if scenarios:  # a folder of scenarios given as SOURCES (uitamr verify plc/scenarios)
+                raise UnusableInput(f"the folder {name} holds no .st file but {len(scenarios)} scenario (.toml) "
+                                    f"file(s): give it as --scenario {name} (with the .st files, if the scenarios "
+                                    "name none, as SOURCES)") from None
             raise UnusableInput(str(exc)) from None
     return unique(found)
 
@@ -295,14 +305,18 @@ class _LazyProgress:
             self._plain(now, done_us, label)
             return
         if self.bar is None:
-            if now - self.started < SHOW_PROGRESS_AFTER_S:
-                return
+            if now - self.started < SHOW_PROGRESS_AFTER_S or done_us >= self.total:
+                return  # a moment's work, or the work done: no bar to show (it would be erased at once)
             self.bar = Progress(
                 TextColumn("{task.description}"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"),
                 TimeElapsedColumn(), console=self.console, transient=True,
             )
+            # the task as far as the work is, before the bar is drawn: started first, its first
+            # frame said 0 % (add_task draws at once) though the run was well on, or even done
+            self.task = self.bar.add_task(label, total=self.total, completed=done_us)
             self.bar.start()
-            self.task = self.bar.add_task(label, total=self.total)
+            self.last_update = now
+            return
         if now - self.last_update < 0.1 and done_us < self.total:
             return
         self.last_update = now

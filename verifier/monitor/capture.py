@@ -202,9 +202,39 @@ def read_capture(path: Path) -> dict[str, list[Chunk]]:
         raise CaptureError(f"{path}: {exc}") from None
     first = next((line.lstrip() for line in text_lines(text)
                   if line.strip() and not line.lstrip().startswith("#")), "")
+    try:
+        if first.startswith("{"):
+            return parse_trace(text, str(path))
+        return {path.stem: parse_plain(text, str(path))}
+    except CaptureError as exc:
+        other = _other_kind(path, text, first)
+        if other is None:
+            raise
+        raise CaptureError(f"{exc}; {other}") from None
+
+
+def _other_kind(path: Path, text: str, first: str) -> str | None:
+    """What a file that is no capture is, when it is one of the toolkit's other files (a
+    scenario, ST source, a report), and what to give instead; None for anything else."""
+    suffix = path.suffix.lower()
+    instead = "replay reads a --trace file (JSON Lines) or a plain capture (docs/commissioning.md)"
+    if suffix == ".toml":
+        return f"this is a scenario file: run it with uitamr verify --scenario {path}; {instead}"
+    if suffix == ".st":
+        return f"this is ST source: run it with uitamr verify {path}; {instead}"
+    if first.startswith("<"):
+        kind = "--junit" if "<testsuite" in text[:4096] else "--html" if "<html" in text[:4096].lower() else None
+        if kind:
+            return f"this is a {kind} report; {instead}"
+        return None
     if first.startswith("{"):
-        return parse_trace(text, str(path))
-    return {path.stem: parse_plain(text, str(path))}
+        try:
+            data = json.loads(text)
+        except (ValueError, RecursionError):  # a trace's lines (or its records nested too deep)
+            return None
+        if isinstance(data, dict) and "verdict" in data and "scenarios" in data:
+            return f"this is a --json report; {instead}"
+    return None
 
 
 def format_plain(chunks: list[Chunk], comment: str = "", end_us: int | None = None) -> str:

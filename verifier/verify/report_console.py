@@ -23,15 +23,18 @@ def render(results: list[ScenarioResult], console: Console, *, first: int = FIRS
     if len(results) > 1 or verdict == "fail":
         console.print(_rule_table(results))
     silent = [r.no_traffic for r in results if r.no_traffic is not None]
+    # captures (`uitamr monitor`, `uitamr replay`) are no scenarios and hold no expectations
+    runs = "capture(s)" if results and all(r.captured for r in results) else "scenario(s)"
     if verdict == "pass":
-        console.print(f"[bold green]PASS[/]: {len(results)} scenario(s) compliant, every expectation met")
+        met = ", every expectation met" if any(r.expectations for r in results) or runs == "scenario(s)" else ""
+        console.print(f"[bold green]PASS[/]: {len(results)} {runs} compliant{met}")
     elif verdict == NO_TRAFFIC:
         more = f" (and {len(silent) - 1} more capture(s) with no bytes)" if len(silent) > 1 else ""
         console.print(f"[bold yellow]NO TRAFFIC[/]: {escape(silent[0])}{more}")
     else:
         failed = sum(r.verdict == "fail" for r in results)
         also = f", {len(silent)} saw no traffic" if silent else ""
-        console.print(f"[bold red]FAIL[/]: {failed} of {len(results)} scenario(s) failed{also}")
+        console.print(f"[bold red]FAIL[/]: {failed} of {len(results)} {runs} failed{also}")
 
 
 def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
@@ -40,12 +43,15 @@ def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
     tx = result.tx_count
     failed = len(result.failed_expectations)
     expectations = (
-        f"{failed} of {len(result.expectations)} expectation(s) failed" if failed
-        else f"{len(result.expectations)} expectation(s) met"
+        f", {failed} of {len(result.expectations)} expectation(s) failed" if failed
+        else "" if result.captured and not result.expectations  # a capture has none to meet
+        else f", {len(result.expectations)} expectation(s) met"
     )
+    # a capture's PLC is on the line ("the PLC on line" read as "online")
+    ran = "the PLC on the line" if result.captured else f"{escape(result.program or 'the PLC')} on {result.platform}"
     console.print(
-        f"{mark} [bold]{escape(escape_chars(result.name, str.isprintable))}[/]{where}: {escape(result.program or 'the PLC')} on {result.platform}, {tx} request{'' if tx == 1 else 's'} in "
-        f"{format_seconds(result.ended_us)}, {result.violation_count} violation(s), {expectations}"
+        f"{mark} [bold]{escape(escape_chars(result.name, str.isprintable))}[/]{where}: {ran}, {tx} request{'' if tx == 1 else 's'} in "
+        f"{format_seconds(result.ended_us)}, {result.violation_count} violation(s){expectations}"
     )
     for note in result.notes:
         console.print(f"    [dim]note: {escape(note)}[/]")

@@ -197,12 +197,13 @@ def scenario_view(index: int, result: ScenarioResult, frames_at_most: int = FRAM
     }
 
 
-def _pieces(results: list[ScenarioResult]) -> Iterator[str]:
-    """The page, piece by piece as the template gives it."""
+def _pieces(results: list[ScenarioResult], command: str) -> Iterator[str]:
+    """The page, piece by piece as the template gives it; `command`: the one that made it."""
     template = _environment().get_template("report.html.j2")
     each = frames_each(results)
     return template.generate(
         verdict=overall_verdict(results),
+        command=command,
         version=__version__,
         scenarios=[scenario_view(i, r, each) for i, r in enumerate(results)],
         px_per_ms=DEFAULT_PX_PER_MS,
@@ -212,12 +213,12 @@ def _pieces(results: list[ScenarioResult]) -> Iterator[str]:
     )
 
 
-def render(results: list[ScenarioResult]) -> str:
-    return "".join(_pieces(results))
+def render(results: list[ScenarioResult], command: str = "uitamr verify") -> str:
+    return "".join(_pieces(results, command))
 
 
-def write(results: list[ScenarioResult], path: Path) -> None:
+def write(results: list[ScenarioResult], path: Path, command: str = "uitamr verify") -> None:
     # written as the template goes: the page of a --matrix of soak tests is tens of MB, and
     # the whole text at once (with its pieces) was the largest thing the command held
     with whole_file(path, encoding="utf-8", errors=UNENCODABLE) as out:
-        out.writelines(_pieces(results))
+        out.writelines(_pieces(results, command))

@@ -96,11 +96,12 @@ def scenario_dict(result: ScenarioResult) -> dict[str, Any]:
     }
 
 
-def to_dict(results: list[ScenarioResult]) -> dict[str, Any]:
+def to_dict(results: list[ScenarioResult], command: str = "uitamr verify") -> dict[str, Any]:
+    """The report; `command`: the one that made it (a capture's is `uitamr monitor` or `uitamr replay`)."""
     return {
         "verdict": overall_verdict(results),
         "schema": SCHEMA_VERSION,
-        "tool": {"name": "uitamr verify", "version": __version__},
+        "tool": {"name": command, "version": __version__},
         "summary": {
             "scenarios": len(results),
             "passed": sum(r.passed for r in results),
@@ -116,9 +117,9 @@ def to_dict(results: list[ScenarioResult]) -> dict[str, Any]:
     }
 
 
-def write(results: list[ScenarioResult], path: Path) -> None:
+def write(results: list[ScenarioResult], path: Path, command: str = "uitamr verify") -> None:
     # streamed to the file: an indented dumps() of a long capture's findings (a 1 MB burst on
     # the monitor: 60,000 violations) holds every piece of the text in one list at once
     with whole_file(path, encoding="utf-8", errors=UNENCODABLE) as out:
-        json.dump(to_dict(results), out, indent=2, ensure_ascii=False)
+        json.dump(to_dict(results, command), out, indent=2, ensure_ascii=False)
         out.write("\n")

@@ -38,15 +38,17 @@ def _rule_failure_text(rule_id: str, result: ScenarioResult) -> str:
     return "\n".join(lines)
 
 
-def to_element(results: list[ScenarioResult]) -> ET.Element:
-    suites = ET.Element("testsuites", name="uitamr verify")
-    suite = ET.SubElement(suites, "testsuite", name="uitamr verify")
+def to_element(results: list[ScenarioResult], command: str = "uitamr verify") -> ET.Element:
+    """The report; `command`: the one that made it, the suite's name and the start of each
+    test case's class (`uitamr replay`, uitamr.replay.line, for a capture it re-checked)."""
+    suites = ET.Element("testsuites", name=command)
+    suite = ET.SubElement(suites, "testsuite", name=command)
     failures = errors = 0
     for result, name in zip(results, run_names(results)):
         case = ET.SubElement(
             suite,
             "testcase",
-            classname="uitamr.verify." + (result.platform or "plc"),
+            classname=command.replace(" ", ".") + "." + (result.platform or "plc"),
             name=name,
             time=f"{result.wall_s:.3f}",
         )
@@ -105,8 +107,8 @@ def _xml_safe(text: str | None) -> str | None:
     return None if text is None else escape_chars(text, lambda c: not _NOT_XML.match(c))
 
 
-def write(results: list[ScenarioResult], path: Path) -> None:
-    root = to_element(results)
+def write(results: list[ScenarioResult], path: Path, command: str = "uitamr verify") -> None:
+    root = to_element(results, command)
     for element in root.iter():
         element.text, element.tail = _xml_safe(element.text), _xml_safe(element.tail)
         for name, value in element.attrib.items():

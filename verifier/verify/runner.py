@@ -52,10 +52,11 @@ class _Plc:
         from verifier.sim.errors import LoadError
 
         if not scenario.sources:
-            raise UnusableInput(f"{_where(scenario)}: no ST sources: name them on the command line or in 'sources'")
+            raise UnusableInput(f"{scenario.key_where('sources')}: no ST sources: name them on the command line "
+                                "or in 'sources'")
         missing = [str(p) for p in scenario.sources if not p.is_file()]
         if missing:
-            raise UnusableInput(f"{_where(scenario)}: no such ST file: {', '.join(missing)}")
+            raise UnusableInput(f"{_key_where(scenario, 'sources')}: no such ST file: {', '.join(missing)}")
         try:
             self.project = verifier.load(
                 *[str(p) for p in scenario.sources],
@@ -119,9 +120,10 @@ class _Plc:
             if scenario.for_sources:  # the bundled file is not the user's to change
                 raise UnusableInput(f"--matrix runs one PROGRAM of your sources under the bundled fault sets: say which "
                                     f"with --program; the sources define: {listing}")
-            raise UnusableInput(
-                f"{_where(scenario)}: say which PROGRAM to run (--program or 'program'); the sources define: {listing}"
-            )
+            if scenario.path is None:  # no file to name it in: the option alone
+                raise UnusableInput(f"say which PROGRAM to run with --program; the sources define: {listing}")
+            raise UnusableInput(f"{scenario.key_where('program')}: say which PROGRAM to run (program = "
+                                f"\"{programs[0]}\" in the file, or --program); the sources define: {listing}")
         for name in programs:
             if name.upper() == scenario.program.upper():
                 return name
@@ -249,29 +251,31 @@ def _platform_hint(scenario: Scenario) -> str:
     fits, _ = platforms_that_load(scenario.sources)
     if not fits or scenario.platform in fits:
         return ""
-    if scenario.platform_from_option or scenario.path is None:  # no file's key to point at
-        told = f"--platform {scenario.platform}" if scenario.platform_from_option else f"the default, {scenario.platform}"
-        return (f"\n{_where(scenario)}: the sources load on {', '.join(fits)}, not on {scenario.platform} "
-                f"({told}): give --platform {fits[0]}")
-    line = scenario.key_lines.get("platform")
+    if scenario.platform_from_option:  # the option is to blame, not a file's key
+        return (f"\n--platform {scenario.platform}: the sources load on {', '.join(fits)}, not on "
+                f"{scenario.platform}: give --platform {fits[0]}")
+    if scenario.path is None:  # no file's key to point at
+        return (f"\nthe sources load on {', '.join(fits)}, not on {scenario.platform} (the default): "
+                f"give --platform {fits[0]}")
     defaulted = "platform" not in scenario.key_lines and scenario.platform == "fx3u"
     now = f"{scenario.platform} (the default)" if defaulted else scenario.platform
-    return (f"\n{scenario.where('platform', line)}: the sources load on {', '.join(fits)}, not on {now}: "
+    return (f"\n{scenario.key_where('platform')}: the sources load on {', '.join(fits)}, not on {now}: "
             f'set platform = "{fits[0]}" in the scenario, or give --platform {fits[0]}')
-
-
-def _where(scenario: Scenario) -> str:
-    return str(scenario.path) if scenario.path else f"scenario {scenario.name!r}"
 
 
 def _key_where(scenario: Scenario, key: str) -> str:
     """Where the scenario's `key` ('program', 'channel', 'sources') was given: `file:line:col:
-    key`, `--key` when the command line's option replaced the file's, else the file."""
+    key`, `--key` when the command line's option replaced the file's, the SOURCES arguments
+    when they replaced the file's sources, else the start of the file (Scenario.key_where)."""
     if key in scenario.key_lines:
         return scenario.where(key, scenario.key_lines[key])
-    if key != "sources" and getattr(scenario, f"{key}_from_option"):  # SOURCES are arguments, no option
+    if key == "sources" and scenario.sources:  # SOURCES are arguments, no option: name the files
+        shown = [_display_path(p) for p in scenario.sources[:3]]
+        more = f" and {len(scenario.sources) - 3} more" if len(scenario.sources) > 3 else ""
+        return f"SOURCES ({', '.join(shown)}{more})"
+    if key != "sources" and getattr(scenario, f"{key}_from_option"):
         return f"--{key}"  # given on the command line: no file is where to look
-    return _where(scenario)
+    return scenario.key_where(key)
 
 
 def _display_path(path: Path | None) -> str | None:

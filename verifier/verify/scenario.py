@@ -204,6 +204,15 @@ class Scenario:
             text += f":{line}"
         return f"{text}: {key}" if key else text
 
+    def key_where(self, key: str) -> str:
+        """`file:line:col: key` for the scenario's top-level `key`: where the file sets it, or
+        the start of the file (1:1) when it leaves the key out: the file is the table the key
+        belongs in, as a key missing from an [[inputs]] table is placed at its header."""
+        place = self.key_lines.get(key)
+        if place is None and self.path is not None:
+            place = Place(1, 1)
+        return self.where(key, place)
+
     def with_overrides(self, **changes: Any) -> "Scenario":
         changes = {k: v for k, v in changes.items() if v is not None}
         replaced = [key for key in ("program", "channel", "sources") if key in changes and key in self.key_lines]
