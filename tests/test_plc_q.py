@@ -427,3 +427,30 @@ def test_matrix_runs_a_program_that_leaves_the_receive_settings_to_the_module_pa
     assert result.exit_code == 0, result.output
     runs = json.loads(report.read_text())["scenarios"]
     assert runs and all(s["verdict"] == "pass" and not s["violations"] for s in runs)
+
+
+def test_the_bundled_q_garbage_scenario_needs_timer_0():
+    """plc/scenarios/q-garbage.toml sets the no-reception monitoring time, as its description
+    and plc-library.md (fault coverage) say every Q installation must: with it the 3 garbage
+    bytes end as a message, cost one retry, and the engine's 16#0105 of the 4 s of garbage
+    clears once the robot answers again. The same scenario without it fails for good: the
+    bytes wait in the module for 5 more, every later reply is read out of step, and the
+    engine still reports 16#0102 at the end of the run, long after the garbage stopped."""
+    from dataclasses import replace
+
+    from verifier.verify.runner import run_scenario
+    from verifier.verify.scenario import load_scenario
+
+    scenario = load_scenario(PLC / "scenarios" / "q-garbage.toml")
+    assert [c.no_reception_us for c in scenario.c24] == [5_000]
+    assert run_scenario(scenario).passed
+    without = replace(scenario, c24=tuple(replace(c, no_reception_us=None) for c in scenario.c24))
+    result = run_scenario(without)
+    assert not result.passed
+    engine = result.watched["fbEngine.o_uErrId"]
+    first = next(t for t, code in engine if code == 0x0102)
+    assert first < 10_000_000                                   # the single garbage at request 10
+    assert all(code != 0 for t, code in engine if t > first)    # never healthy again
+    assert engine[-1][1] == 0x0102
+    cycle = result.watched["fbCycle.o_uErrId"]
+    assert cycle[-1][1] == 0x0102 and cycle[-1][0] > 38_000_000     # failed again after the acknowledge

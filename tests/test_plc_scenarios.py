@@ -3,6 +3,7 @@ no rule broken, every expectation met. This is `uitamr verify` with no arguments
 test per scenario so a failure names its scenario."""
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -260,3 +261,31 @@ def test_an_exception_on_the_fx5_adprw_route_is_repeated_as_the_docs_say():
     from dataclasses import replace
     slow = replace(load_scenario(ROOT / "plc" / "scenarios" / "fx5u-adprw-exception.toml"), scan_us=120_000)
     assert run_scenario(slow).passed
+
+
+def _route(scenario):
+    """The column of docs/plc-library.md's fault coverage table a bundled scenario belongs in."""
+    if scenario.converter is not None:
+        return "TCP (FX5U, Q)"
+    if scenario.channel == "adp:1":
+        return {"fx3u": "FX3U ADPRW", "fx5u": "FX5U ADPRW"}[scenario.platform]
+    return {"fx3u": "FX3U RS2", "fx5u": "FX5U RS2", "q": "Q QJ71C24N"}[scenario.platform]
+
+
+def test_the_fault_coverage_table_names_every_bundled_scenario_in_its_route():
+    """docs/plc-library.md "Fault coverage of the bundled scenarios": every file of
+    plc/scenarios/ is in the table once, in the column of its route (a scenario added,
+    renamed or removed without the table is found here), and every name there is a file."""
+    text = (ROOT / "docs" / "plc-library.md").read_text(encoding="utf-8")
+    section = text.split("## Fault coverage of the bundled scenarios", 1)[1].split("\n## ", 1)[0]
+    rows = [line.strip().strip("|").split("|") for line in section.splitlines() if line.startswith("| ")]
+    header = [cell.strip() for cell in rows[0]]
+    assert header[0] == "fault"
+    placed = []
+    for row in rows[1:]:
+        for column, cell in zip(header[1:], row[1:]):
+            placed += [(name, column) for name in re.findall(r"`([a-z0-9-]+)`", cell)]
+    names = [name for name, _ in placed]
+    assert sorted(names) == sorted(p.stem for p in SCENARIOS)
+    for name, column in placed:
+        assert _route(load_scenario(ROOT / "plc" / "scenarios" / f"{name}.toml")) == column, name
