@@ -214,9 +214,10 @@ def press(device: str, at: str) -> str:
     return table("inputs", at=at, set=f"{{ {device} = true }}", pulse="500ms")
 
 
-def run_ladder(tmp_path, program, name, *parts, duration="45s", signal=None):
+def run_ladder(tmp_path, program, name, *parts, duration="45s", signal=None, scan="10ms"):
     (tmp_path / "UITAMR_LadderFx3.st").write_text(translate(program, "UITAMR_LadderFx3"))
-    text = SCENARIO.format(name=name, duration=duration) + press("X0", "2s")
+    text = SCENARIO.format(name=name, duration=duration).replace("\n[robot]", f'scan = "{scan}"\n\n[robot]', 1)
+    text += press("X0", "2s")
     text += table("expect", sent="stop", within="1s") + "".join(parts)
     if signal:
         text += f'\n[response_handling]\nsignal = "{signal}"\nwithin = "5s"\n'
@@ -251,6 +252,16 @@ def test_ladder_stops_the_cycle_on_anti_collision(tmp_path, program):
         tmp_path, program, "ladder: anti-collision",
         table("faults", kind="anti_collision", at_s=5.0),
         table("expect", that="Y3 AND D225 = 16#0201", after="5s", within="2s"), duration="10s")
+    assert result.passed, "\n".join(problems)
+
+
+def test_ladder_does_not_send_into_a_late_reply_it_is_receiving(tmp_path, program):
+    """R9 sends only when no byte of an unfinished reception is counted in D8403: with a
+    5 ms scan a reply 680 ms late was still arriving when the retry fell due, and the retry
+    went out 3.3 ms after its last byte (UITAMR-HALF-DUPLEX: t3.5 is 3.65 ms)."""
+    result, problems = run_ladder(
+        tmp_path, program, "ladder: late reply", table("faults", kind="late_reply", on_request=9, delay_ms=680),
+        duration="20s", scan="5ms")
     assert result.passed, "\n".join(problems)
 
 
