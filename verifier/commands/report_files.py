@@ -83,17 +83,18 @@ def write_reports(results, console: Console, json_path=None, junit_path=None, tr
                   html_path=None, command: str = "uitamr verify") -> None:
     """The report files asked for; `command` (`uitamr monitor`, `uitamr replay`) is named
     in those that name their maker (JSON's tool, the JUnit suite, the page's heading)."""
+    from functools import partial
+
     from verifier.verify import report_html, report_json, report_junit, report_trace
 
-    writers = ((json_path, report_json), (junit_path, report_junit), (trace_path, report_trace),
-               (html_path, report_html))
-    for path, writer in writers:
+    writers = ((json_path, partial(report_json.write, command=command)),
+               (junit_path, partial(report_junit.write, command=command)),
+               (trace_path, report_trace.write),  # the frames alone: a trace names no maker
+               (html_path, partial(report_html.write, command=command)))
+    for path, write in writers:
         if path:
             try:
-                if writer is report_trace:  # the frames alone: a trace names no maker
-                    writer.write(results, Path(path))
-                else:
-                    writer.write(results, Path(path), command=command)
+                write(results, Path(path))
             except OSError as exc:
                 raise ReportError(f"cannot write {path}: {exc.strerror or exc}") from None
             console.print(f"[dim]wrote {escape(str(path))}[/]")

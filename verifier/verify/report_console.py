@@ -9,7 +9,7 @@ from rich.table import Table
 from verifier.textfile import escape_chars
 
 from .durations import format_seconds
-from .result import NO_TRAFFIC, ScenarioResult, overall_verdict
+from .result import NO_TRAFFIC, ScenarioResult, all_captured, overall_verdict
 from .rules import RULES
 
 FIRST_VIOLATIONS = 3  # times listed per broken rule and scenario
@@ -24,7 +24,7 @@ def render(results: list[ScenarioResult], console: Console, *, first: int = FIRS
         console.print(_rule_table(results))
     silent = [r.no_traffic for r in results if r.no_traffic is not None]
     # captures (`uitamr monitor`, `uitamr replay`) are no scenarios and hold no expectations
-    runs = "capture(s)" if results and all(r.captured for r in results) else "scenario(s)"
+    runs = "capture(s)" if all_captured(results) else "scenario(s)"
     if verdict == "pass":
         met = ", every expectation met" if any(r.expectations for r in results) or runs == "scenario(s)" else ""
         console.print(f"[bold green]PASS[/]: {len(results)} {runs} compliant{met}")

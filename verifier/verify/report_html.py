@@ -19,7 +19,7 @@ from verifier.textfile import UNENCODABLE, whole_file
 from .durations import format_seconds
 from .events_shown import EVENTS_AT_MOST, event_class
 from .report_trace import LineTimes, blamed_frames, frame_count, records
-from .result import ScenarioResult, overall_verdict
+from .result import ScenarioResult, all_captured, overall_verdict
 from .rules import RULES
 
 DEFAULT_PX_PER_MS = 0.5
@@ -209,7 +209,7 @@ def _pieces(results: list[ScenarioResult], command: str) -> Iterator[str]:
         px_per_ms=DEFAULT_PX_PER_MS,
         failed=sum(not r.passed for r in results),
         total=len(results),
-        captured=bool(results) and all(r.captured for r in results),  # a page of no run is not a capture
+        captured=all_captured(results),
     )
 
 

@@ -204,6 +204,12 @@ def overall_verdict(results: list[ScenarioResult]) -> str:
     return NO_TRAFFIC if NO_TRAFFIC in verdicts else "pass"
 
 
+def all_captured(results: list[ScenarioResult]) -> bool:
+    """Every result is a capture's (`ScenarioResult.captured`): the reports speak of
+    captures, not scenarios; no result at all is no capture."""
+    return bool(results) and all(result.captured for result in results)
+
+
 def summarize_diagnostics(diagnostics, shown=lambda location: location) -> list[str]:
     """`diagnostics` (SimDiagnostic) grouped by place and by message, numbers aside: one
     line each, in the order they first happened, e.g. "×160, first at 0.250 s: RS2 fx3:1:
