@@ -46,10 +46,6 @@ def error_places(output: str) -> list[str]:
     return [line.split(": error: ")[0] for line in output.splitlines() if ": error: " in line]
 
 
-def target_of(platform: str) -> str:
-    return "gxworks3" if platform == "fx5u" else "gxworks2"
-
-
 @pytest.mark.parametrize("platform", sorted(REFUSED))
 def test_an_instruction_name_of_the_platform_is_refused_at_its_place(tmp_path, platform):
     names = REFUSED[platform]
