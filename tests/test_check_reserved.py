@@ -41,8 +41,9 @@ def labels(tmp_path: Path, names: list[str]) -> Path:
     return path
 
 
-def target_of(platform: str) -> str:
-    return "gxworks3" if platform == "fx5u" else "gxworks2"
+def error_places(output: str) -> list[str]:
+    """The `file:line:col` of each error line in a check's output."""
+    return [line.split(": error: ")[0] for line in output.splitlines() if ": error: " in line]
 
 
 @pytest.mark.parametrize("platform", sorted(REFUSED))
@@ -71,12 +72,9 @@ def test_an_instruction_of_another_cpu_family_is_a_name_on_this_one(tmp_path):
     # STOP is a Q instruction, RD3A an FX3 one, RETSTL an FX5 one: GX Works2 refuses each
     # only in a project of its CPU series
     path = labels(tmp_path, ["STOP", "RD3A", "RETSTL"])
-    assert [line.split(": error: ")[0] for line in run("--platform", "fx3u", path).output.splitlines()
-            if ": error: " in line] == [f"{path}:4:3"]
-    assert [line.split(": error: ")[0] for line in run("--platform", "q", path).output.splitlines()
-            if ": error: " in line] == [f"{path}:3:3"]
-    assert [line.split(": error: ")[0] for line in run("--platform", "fx5u", path).output.splitlines()
-            if ": error: " in line] == [f"{path}:5:3"]
+    assert error_places(run("--platform", "fx3u", path).output) == [f"{path}:4:3"]
+    assert error_places(run("--platform", "q", path).output) == [f"{path}:3:3"]
+    assert error_places(run("--platform", "fx5u", path).output) == [f"{path}:5:3"]
 
 
 def test_without_platform_the_names_every_cpu_of_the_editor_has_are_refused(tmp_path):
@@ -88,8 +86,7 @@ def test_without_platform_the_names_every_cpu_of_the_editor_has_are_refused(tmp_
         f"{path}:6:3: error: label name 'DBIN' is the name of a MELSEC instruction of the FX3U/FX3G CPU "
         "(GX Works2 refuses every instruction name of the CPU as a label, docs/st-dialect.md section 4); rename it"]
     gx3 = run("--target", "gxworks3", path).output
-    assert [line.split(": error: ")[0] for line in gx3.splitlines() if ": error: " in line] == [
-        f"{path}:5:3", f"{path}:6:3"]
+    assert error_places(gx3) == [f"{path}:5:3", f"{path}:6:3"]
     assert "label name 'RETSTL' is the name of a MELSEC instruction of the FX5U CPU" in gx3
     # IX (index modification of a whole ladder) is a Q instruction only
     assert f"{path}:7:3: error: label name 'iX'" in run("--platform", "q", path).output

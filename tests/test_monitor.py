@@ -42,10 +42,14 @@ CAPTURES = Path(__file__).resolve().parent / "captures"
 STOP, READ = frame("stop"), frame("read", "task")
 
 
-def session_of(chunks, tolerance_us: int = 20_000, **kw) -> MonitorSession:
+def session_of(chunks, tolerance_us: int = 20_000, end_us: int | None = None, **kw) -> MonitorSession:
+    """A session fed as `uitamr monitor` feeds it: each chunk as it came; with `end_us`, the
+    poll at the end of listening (a read that returned nothing); then the close."""
     session = MonitorSession(CaptureInfo("test", "test"), timing=LineTiming(tolerance_us=tolerance_us), **kw)
     for chunk in chunks:
         session.feed(chunk)
+    if end_us is not None:
+        session.poll(end_us)
     session.close()
     return session
 
@@ -86,17 +90,6 @@ def test_an_end_line_says_until_when_the_line_was_listened_to():
     assert parse_plain(format_plain(chunks[:1], end_us=2_250_000)) == chunks
 
 
-def _live(chunks: list[Chunk], end_us: int, tolerance_us: int) -> MonitorSession:
-    """A session fed as `uitamr monitor` feeds it: each chunk as it came, a poll when a read
-    returned nothing (here: at the end of listening), then the close."""
-    session = MonitorSession(CaptureInfo("site", "site"), timing=LineTiming(tolerance_us=tolerance_us))
-    for chunk in chunks:
-        session.feed(chunk)
-    session.poll(end_us)
-    session.close()
-    return session
-
-
 def _judged(session: MonitorSession) -> tuple:
     result = session.result()
     return ([(f.t_start_us, f.t_end_us, f.direction, f.data) for f in result.trace], result.duration_us,
@@ -116,7 +109,7 @@ def test_a_replay_of_the_monitors_capture_judges_as_the_live_session_did(pieces,
     for gap, data in pieces:
         t += gap
         chunks.append(Chunk(t, data))
-    live = _live(chunks, t + listened_after_us, tolerance_us)
+    live = session_of(chunks, tolerance_us, end_us=t + listened_after_us)
     text = format_plain(live.chunks, "site", end_us=live.last_us)
     replayed = session_of(parse_plain(text), tolerance_us)
     assert _judged(replayed) == _judged(live)
@@ -126,7 +119,7 @@ def test_a_capture_with_its_end_line_replays_the_silence_after_the_last_bytes(tm
     """The live session saw three bytes of a reply, then 2 s of silence: a short frame,
     judged. Without the `end` line the replay took them for a frame the end cut."""
     chunks = [Chunk(10_000, STOP), Chunk(21_000, STOP), Chunk(500_000, READ), Chunk(520_000, b"\x01\x01\x00")]
-    live = _live(chunks, 2_520_000, 20_000)
+    live = session_of(chunks, 20_000, end_us=2_520_000)
     assert live.frames[-1].data == b"\x01\x01\x00" and live.cut_off == b""
     capture = tmp_path / "site.txt"
     capture.write_text(format_plain(live.chunks, end_us=live.last_us), encoding="utf-8")

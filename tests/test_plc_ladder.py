@@ -193,6 +193,7 @@ sources = ["UITAMR_LadderFx3.st"]
 program = "UITAMR_LadderFx3"
 platform = "fx3u"
 duration = "{duration}"
+scan = "{scan}"
 
 [robot]
 point_duration_s = 6.0
@@ -216,8 +217,7 @@ def press(device: str, at: str) -> str:
 
 def run_ladder(tmp_path, program, name, *parts, duration="45s", signal=None, scan="10ms"):
     (tmp_path / "UITAMR_LadderFx3.st").write_text(translate(program, "UITAMR_LadderFx3"))
-    text = SCENARIO.format(name=name, duration=duration).replace("\n[robot]", f'scan = "{scan}"\n\n[robot]', 1)
-    text += press("X0", "2s")
+    text = SCENARIO.format(name=name, duration=duration, scan=scan) + press("X0", "2s")
     text += table("expect", sent="stop", within="1s") + "".join(parts)
     if signal:
         text += f'\n[response_handling]\nsignal = "{signal}"\nwithin = "5s"\n'

@@ -50,8 +50,9 @@ def _devices(text: str) -> set[str]:
 
 def _written(rung: list) -> set[str]:
     """Every device a rung reads or writes: its operands, and the device after the
-    destination of DIV (the remainder) and MUL (the high word of the product), as the
-    ladder's ST translation in test_plc_ladder.py writes them."""
+    destination of DIV (the remainder, as the ladder's ST translation in test_plc_ladder.py
+    writes it) and of MUL (the high word of the 32-bit product, which the FX3U writes and
+    the translation leaves out: no rung reads it)."""
     devices = {op for ins in rung for op in ins.operands}
     for ins in rung:
         if ins.op in ("DIV", "MUL"):
