@@ -346,6 +346,25 @@ def test_a_request_the_robot_talked_over_is_not_answered_and_the_pairing_does_no
     assert heard["UITAMR-HALF-DUPLEX"] == [] and heard["UITAMR-ONE-AT-A-TIME"] == []
 
 
+def test_an_overlap_within_the_host_timing_tolerance_does_not_make_a_request_talked_over():
+    """Host timestamps (a capture of tx/rx lines, --tolerance 20ms): a request that seems to
+    start 5 ms before the robot's previous frame ended may not have overlapped it at all, so
+    it still waits for its reply, as UITAMR-HALF-DUPLEX does not blame it either. Exact
+    times (verify, --tolerance 0): it did, and the robot cannot have read it."""
+    from verifier.verify.traffic import analyse
+
+    first = tx(0, READ_TASK)
+    slow = answer(first, delay_us=300 * MS)
+    early = _frame("tx", slow.t_end_us - 5 * MS, protocol.encode(READ_TASK, S))
+    reply = answer(early)
+    trace = [first, slow, early, reply]
+    lenient = analyse(trace, S, RuleOptions(timing_tolerance_us=20 * MS))
+    assert not lenient.exchanges[1].talked_over and lenient.exchanges[1].reply == reply
+    exact = analyse(trace, S, RuleOptions())
+    assert exact.exchanges[1].talked_over
+    assert check(trace, options=RuleOptions(timing_tolerance_us=20 * MS, min_period_us=1))["UITAMR-HALF-DUPLEX"] == []
+
+
 def test_one_at_a_time_waits_for_the_time_out_when_no_reply_comes():
     impatient = [tx(0, STOP)] + exchange(300, READ_TASK)
     (violation,) = check(impatient)["UITAMR-ONE-AT-A-TIME"]

@@ -234,17 +234,20 @@ class Pairing:
     def __init__(self, settings: protocol.Settings, options: RuleOptions):
         self.settings = settings
         self.reply_timeout_us = options.reply_timeout_us
+        # host timestamps (captures): an overlap within the tolerance may be the timing's
+        self._tolerance_us = options.timing_tolerance_us
         self.traffic = Traffic([], [], [], [])
         self._ends: list[int] = []  # when each request ended
         self._oldest = 0  # exchanges before this one are answered or timed out for good
         self._settled = 0
         self._given = 0  # requests given, those let go of (`forget`) included
-        self._robot_end_us = -1  # when the latest robot frame given ended
+        self._robot_frame: tuple[int, int] | None = None  # (start, end) of the latest robot frame given
 
     def request(self, frame: TraceFrameLike) -> None:
         traffic = self.traffic
+        robot = self._robot_frame
         traffic.exchanges.append(Exchange(self._given, frame, [], self.settings, self.reply_timeout_us,
-                                          talked_over=frame.t_start_us < self._robot_end_us))
+                                          talked_over=robot is not None and self._talked_over(frame, *robot)))
         self._given += 1
         traffic.tx.append(frame)
         self._ends.append(frame.t_end_us)
@@ -254,14 +257,16 @@ class Pairing:
         traffic, exchanges = self.traffic, self.traffic.exchanges
         traffic.rx.append(frame)
         t = frame.t_start_us
-        self._robot_end_us = max(self._robot_end_us, frame.t_end_us)
+        if self._robot_frame is None or frame.t_end_us >= self._robot_frame[1]:
+            self._robot_frame = (t, frame.t_end_us)
         count = bisect_right(self._ends, t)  # requests that ended before this frame began
         # requests given so far that overlap this frame (a live line gives the one still going
         # out when the robot began; `analyse`, which gives every request first, also those
         # that began while it was talking: `request` marks those on a live line)
         k = count
         while k < len(exchanges) and exchanges[k].request.t_start_us < frame.t_end_us:
-            exchanges[k].talked_over = True
+            if self._talked_over(exchanges[k].request, t, frame.t_end_us):
+                exchanges[k].talked_over = True
             k += 1
         if count == 0:
             traffic.rx_before_first_request.append(frame)
@@ -279,6 +284,12 @@ class Pairing:
             owner = exchanges[count - 1]
         owner.rx.append(frame)
         traffic.owners.setdefault(t, []).append(owner)
+
+    def _talked_over(self, request: TraceFrameLike, robot_start_us: int, robot_end_us: int) -> bool:
+        """The request and a robot frame overlapped on the line by more than the timing
+        tolerance (host timestamps: less may be the timing's, as UITAMR-HALF-DUPLEX judges)."""
+        overlap = min(request.t_end_us, robot_end_us) - max(request.t_start_us, robot_start_us)
+        return overlap > self._tolerance_us
 
     def give(self, frame: TraceFrameLike) -> None:
         """The next frame in `analyse`'s order: a request ("tx") or a robot frame ("rx");
