@@ -72,10 +72,17 @@ def test_a_retry_waits_while_a_late_reply_is_arriving(scan_ms):
     due while the 800 ms late reply was on the line, and the port sent it into the robot's
     frame (UITAMR-HALF-DUPLEX; the robot could not read the retry either). The RS2 port
     now listens before talking: while D8403 counts bytes of an unfinished reception the
-    send waits, and goes once the reception has ended."""
+    send waits, and goes once the reception has ended. Only that reply (on request 9) and
+    what the scenario expects of it by 30 s: its other faults and their expectations are
+    timed for its own 10 ms scan (the request numbers, the guard restart at 10.45 s, the
+    command that the replies from 30 s meet)."""
     from dataclasses import replace
     scenario = load_scenario(SCENARIOS[0].parent / "fx3u-late-reply.toml")
-    result = run_scenario(replace(scenario, scan_us=scan_ms * 1000))
+    faults = tuple(f for f in scenario.faults if f.on_request == 9 and f.delay_ms == 800)
+    expectations = tuple(e for e in scenario.expectations
+                         if e.after_us < 10_000_000 and e.window(scenario.duration_us)[1] <= 30_000_000)
+    assert len(faults) == 1 and len(expectations) >= 5, (faults, [e.label for e in expectations])
+    result = run_scenario(replace(scenario, scan_us=scan_ms * 1000, faults=faults, expectations=expectations))
     assert result.passed, [v.message for v in result.all_violations()[:5]] + [str(e) for e in result.failed_expectations]
 
 
