@@ -99,8 +99,9 @@ def _stretched(name: str, seconds: int, folder: Path):
 def test_a_long_run_gives_the_same_page_and_holds_few_events(tmp_path, monkeypatch, name, at_most):
     """Ten minutes: a robot answering with a bad CRC for five seconds (17 fault events, a few
     others: with a cap of 3 or 8 the faults overflow it), and one with garbage on the line
-    (2 faults, about 175 task events: the others overflow it). The page is the same as from
-    every event, and the run holds each class's first ones and the last second's."""
+    (14 faults: two single ones and 4 s of every reply; about 175 task events: the others
+    overflow it). The page is the same as from every event, and the run holds each class's
+    first ones and the last second's."""
     monkeypatch.setattr(runner_module, "STREAM_EVERY_US", 1_000_000)
     monkeypatch.setattr(report_html, "EVENTS_AT_MOST", at_most)
     scenario = _stretched(name, 600, tmp_path)
