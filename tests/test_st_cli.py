@@ -4,12 +4,14 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 from click.testing import CliRunner
 
 from st_helpers import CORPUS
 from verifier.cli import main
 
+ROOT = Path(__file__).resolve().parent.parent
 GOOD = CORPUS / "valid" / "statements.st"
 BAD = CORPUS / "invalid" / "int_from_word.st"
 SYNTAX = CORPUS / "invalid" / "missing_semicolon.st"
@@ -94,6 +96,21 @@ def test_a_folder_of_scenarios_says_what_it_holds_and_what_to_run(tmp_path, monk
     result = run(GOOD, "scenarios")
     assert result.exit_code == 0 and "1 file(s) checked" in result.output
     assert result.stderr.startswith("uitamr check: warning: scenarios: no .st file in it or below it: ")
+
+
+def test_the_toolkits_other_files_named_to_check_say_what_they_are():
+    """`uitamr check plc/ladder/UITAMR_LadderFx3.il` read the instruction list as ST and
+    said "1:1: error: unexpected ';'" (and exit 1, as if the ladder were a broken program);
+    the generated CSV the same. Each now says what the file is and what reads it (exit 2)."""
+    ladder = ROOT / "plc" / "ladder"
+    result = run(ladder / "UITAMR_LadderFx3.il")
+    assert result.exit_code == 2, result.output
+    assert result.stderr == (f"uitamr check: {ladder / 'UITAMR_LadderFx3.il'}: an instruction list (the ladder "
+                             "program), not ST: `python -m verifier.export.ladder FILE.il` reads it and names its "
+                             "mistakes (docs/plc-library.md)\n")
+    result = run(ladder / "UITAMR_LadderFx3.csv", GOOD)
+    assert result.exit_code == 2 and "a GX Works import file (generated), not ST source" in result.stderr
+    assert run(GOOD).exit_code == 0
 
 
 def test_a_pattern_is_expanded_as_verify_expands_it(tmp_path, monkeypatch):

@@ -57,14 +57,28 @@ def expand_sources(sources: tuple[str, ...]) -> list[Path]:
     return paths
 
 
+#: the toolkit's other files, which check would read as ST ("1:1: unexpected ';'"): what
+#: each is and what reads it
+_OTHER_KINDS = {
+    ".il": "an instruction list (the ladder program), not ST: `python -m verifier.export.ladder FILE.il` "
+           "reads it and names its mistakes (docs/plc-library.md)",
+    ".csv": "a GX Works import file (generated), not ST source: check the .st or .il it was made from",
+    ".jsonl": "a trace (JSON Lines), not ST: `uitamr replay` reads it",
+    ".json": "a report, not ST: `uitamr check` reads .st sources and scenarios (.toml)",
+    ".html": "a report, not ST: `uitamr check` reads .st sources and scenarios (.toml)",
+    ".xml": "a report, not ST: `uitamr check` reads .st sources and scenarios (.toml)",
+}
+
+
 def _not_a_source(path: Path) -> str | None:
-    """Why `path` cannot be checked at all (missing, a device, a pipe ...), or None.
-    Files that exist but hold no text are diagnosed with file:line:col instead."""
+    """Why `path` cannot be checked at all (missing, a device, a pipe, another kind of
+    the toolkit's files ...), or None. Files that exist but hold no text are diagnosed with
+    file:line:col instead."""
     from verifier.st import read_source
     from verifier.verify.sources import is_pattern
 
     if path.is_file():
-        return None
+        return _OTHER_KINDS.get(path.suffix.lower())
     if is_pattern(str(path)):
         return "matches no file"
     if not path.exists() and not path.is_symlink():
