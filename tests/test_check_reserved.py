@@ -127,9 +127,12 @@ def test_pulse_and_32_bit_forms_are_expanded_from_the_manual_columns():
 
 
 def test_every_name_is_an_identifier_and_every_family_is_a_cpu_profiles():
-    from verifier.sim.cpu import PROFILES
+    from verifier.sim.cpu import PROFILES, TARGET_CPUS
 
     assert dict(melsec.PLATFORM_FAMILY) == {name: p.family for name, p in PROFILES.items()}
+    # each editor's families are those of the CPUs it programs (verifier.sim.cpu.TARGET_CPUS)
+    assert {t: set(fs) for t, fs in melsec.TARGET_FAMILIES.items()} == {
+        t: {PROFILES[c].family for c in cpus} for t, cpus in TARGET_CPUS.items()}
     assert set(melsec.NAMES) == set(melsec.FAMILIES) == {p.family for p in PROFILES.values()}
     for family, names in melsec.NAMES.items():
         assert len(names) > 400, family  # each manual lists several hundred

@@ -571,3 +571,22 @@ def test_what_counts_as_overwritten_before_read(tmp_path, body, name, line):
     project = verifier.load(str(tmp_path / "Main.st"), str(tmp_path / "Globals.st"), target="gxworks2", cpu="fx3u")
     found = first_overwrite(project.files, "Main", name)
     assert (found.span.line if found is not None else None) == line, found
+
+
+@pytest.mark.parametrize("separator", ["\x0c", "\u2028", "\x1c", "\x85"])
+def test_the_note_quotes_the_overwriting_statement_past_a_line_separator_in_a_comment(tmp_path, monkeypatch, separator):
+    """A form feed or a Unicode line separator inside a comment is no new line for the ST
+    parser (it counts line feeds, textfile.text_lines): the statement the note quotes is the
+    one at the line it names, not the line after it (str.splitlines broke at them too)."""
+    (tmp_path / "Main.st").write_text(
+        f"PROGRAM Main\nVAR\n    b : BOOL;\n    n : INT;\nEND_VAR\n(* page{separator}break *)\nb := n > 0;\nn := n + 1;\n"
+        "Y0 := b;\nEND_PROGRAM\n", encoding="utf-8")
+    (tmp_path / "s.toml").write_text(
+        'sources = ["Main.st"]\nprogram = "Main"\nduration = "1s"\n'
+        '[[inputs]]\nat = "100ms"\nset = { b = true }\n[[expect]]\nthat = "Y0"\n', encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("--scenario", "s.toml", "--json", "r.json")
+    (run,) = json.loads((tmp_path / "r.json").read_text())["scenarios"]
+    notes = [note for note in run["notes"] if "does nothing" in note]
+    assert notes == ["s.toml:6:9: inputs[0].set: b = true does nothing: the program overwrites b in every scan "
+                     "before reading it, at Main.st:7:1 (b := n > 0;)"], result.output

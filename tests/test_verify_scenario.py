@@ -366,6 +366,12 @@ def test_reaching_a_point_the_robot_was_not_taught_is_an_impossible_expectation(
      "x.toml:3:1: not valid TOML: 'duration' is given twice (first on line 2): keep one"),
     ('program = "M"\n[robot]\nbattery_pct = 50\n  battery_pct = 40\n',
      "x.toml:4:3: not valid TOML: 'battery_pct' is given twice (first on line 3): keep one"),
+    # a line separator or a form feed in a comment is no new line for TOML (tomllib counts
+    # line feeds): the lines are numbered so, not as str.splitlines numbers them
+    ('program = "M"\n# a\u2028b\nduration = "20s"\nduration = "30s"\n',
+     "x.toml:4:1: not valid TOML: 'duration' is given twice (first on line 3): keep one"),
+    ('program = "M"\n# a\x85b\nduration = "20s"\nduration = "30s"\n',
+     "x.toml:4:1: not valid TOML: 'duration' is given twice (first on line 3): keep one"),
 ])
 def test_a_key_given_twice_is_named_with_its_first_line(text, expected):
     # tomllib's 'Cannot overwrite a value' at the end of the second value's line named

@@ -19,7 +19,7 @@ import re
 import tomllib
 from dataclasses import dataclass
 
-from verifier.textfile import has_lone_cr, place_of_char
+from verifier.textfile import has_lone_cr, place_of_char, text_lines
 
 
 @dataclass(frozen=True)
@@ -302,7 +302,7 @@ def _given_twice(source: str, place: Place) -> tuple[str, Place]:
     """tomllib's 'Cannot overwrite a value', said by the key: which key is given twice, and
     where first in the same table (`duration = ...` written twice: the second one is the
     mistake, placed at its key)."""
-    lines = source.splitlines()
+    lines = text_lines(source)  # numbered as tomllib numbers them (line feeds only)
     line = lines[place.line - 1] if place.line - 1 < len(lines) else ""
     key = _KEY_AT_START.match(line)
     if key is None:

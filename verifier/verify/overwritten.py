@@ -25,6 +25,7 @@ from typing import Any
 
 from verifier.st import ast
 from verifier.st.devices import parse_device
+from verifier.textfile import text_lines
 
 _ANY = None  # an index the source computes: it may be any element
 
@@ -358,7 +359,7 @@ def _snippet(text: str, span: ast.Span) -> str:
     """The source of `span` when it fits on one line (the statement or binding as written)."""
     if span.line != span.end_line or span.line < 1:
         return ""
-    lines = text.splitlines()
+    lines = text_lines(text)  # numbered as the parser numbers them (line feeds only)
     if span.line > len(lines):
         return ""
     return lines[span.line - 1][span.col - 1:span.end_col - 1].strip()

@@ -52,7 +52,7 @@ class _Plc:
         from verifier.sim.errors import LoadError
 
         if not scenario.sources:
-            raise UnusableInput(f"{scenario.key_where('sources')}: no ST sources: name them on the command line "
+            raise UnusableInput(f"{_key_where(scenario, 'sources')}: no ST sources: name them on the command line "
                                 "or in 'sources'")
         missing = [str(p) for p in scenario.sources if not p.is_file()]
         if missing:
@@ -122,7 +122,7 @@ class _Plc:
                                     f"with --program; the sources define: {listing}")
             if scenario.path is None:  # no file to name it in: the option alone
                 raise UnusableInput(f"say which PROGRAM to run with --program; the sources define: {listing}")
-            raise UnusableInput(f"{scenario.key_where('program')}: say which PROGRAM to run (program = "
+            raise UnusableInput(f"{_key_where(scenario, 'program')}: say which PROGRAM to run (program = "
                                 f"\"{programs[0]}\" in the file, or --program); the sources define: {listing}")
         for name in programs:
             if name.upper() == scenario.program.upper():
@@ -259,14 +259,15 @@ def _platform_hint(scenario: Scenario) -> str:
                 f"give --platform {fits[0]}")
     defaulted = "platform" not in scenario.key_lines and scenario.platform == "fx3u"
     now = f"{scenario.platform} (the default)" if defaulted else scenario.platform
-    return (f"\n{scenario.key_where('platform')}: the sources load on {', '.join(fits)}, not on {now}: "
+    return (f"\n{_key_where(scenario, 'platform')}: the sources load on {', '.join(fits)}, not on {now}: "
             f'set platform = "{fits[0]}" in the scenario, or give --platform {fits[0]}')
 
 
 def _key_where(scenario: Scenario, key: str) -> str:
-    """Where the scenario's `key` ('program', 'channel', 'sources') was given: `file:line:col:
-    key`, `--key` when the command line's option replaced the file's, the SOURCES arguments
-    when they replaced the file's sources, else the start of the file (Scenario.key_where)."""
+    """Where the scenario's `key` ('program', 'channel', 'sources', 'platform') was given:
+    `file:line:col: key`, `--key` when the command line's option replaced the file's, the
+    SOURCES arguments when they replaced the file's sources, else the start of the file
+    (Scenario.key_where). The runner's one way to place a key: it knows the command line."""
     if key in scenario.key_lines:
         return scenario.where(key, scenario.key_lines[key])
     if key == "sources" and scenario.sources:  # SOURCES are arguments, no option: name the files

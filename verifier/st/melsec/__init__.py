@@ -24,7 +24,8 @@ FAMILIES = MappingProxyType({
 #: `--platform` -> family (the families of verifier.sim.cpu.PROFILES; kept equal by
 #: tests/test_check_reserved.py)
 PLATFORM_FAMILY = MappingProxyType({"fx3u": "fx3", "fx3g": "fx3", "fx5u": "fx5", "q": "q"})
-#: `--target` -> the families its editor programs
+#: `--target` -> the families its editor programs (those of verifier.sim.cpu.TARGET_CPUS;
+#: kept equal by tests/test_check_reserved.py: verifier.st does not import the simulator)
 TARGET_FAMILIES = MappingProxyType({"gxworks2": ("fx3", "q"), "gxworks3": ("fx5",)})
 
 _LINE = re.compile(r"([A-Z][A-Z0-9_]*)(?:\s+([dp]+))?")
