@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+from file_helpers import write_files
 from verifier.commands.verify import bundled_scenarios, command
 
 REPO = Path(__file__).resolve().parents[1]
@@ -1006,13 +1007,12 @@ def test_a_function_block_as_program_and_a_channel_the_cpu_lacks_are_reported_at
     # issue 11: every scenario error has file:line:column; these two named the file only
     # ('s.toml: FB_X is a FUNCTION_BLOCK, not a PROGRAM', 's.toml: channel q:1 does not exist
     # on the fx3u CPU'), though the key that says so is in the file
-    (tmp_path / "MAIN.st").write_text(NEVER_REARMED, encoding="utf-8")
-    (tmp_path / "FB_X.st").write_text("FUNCTION_BLOCK FB_X\nVAR_INPUT i_b : BOOL; END_VAR\nEND_FUNCTION_BLOCK\n",
-                                      encoding="utf-8")
-    (tmp_path / "fb.toml").write_text('name = "x"\nsources = ["MAIN.st", "FB_X.st"]\nprogram = "FB_X"\n',
-                                      encoding="utf-8")
-    (tmp_path / "ch.toml").write_text('name = "x"\nsources = ["MAIN.st"]\nplatform = "fx3u"\nchannel = "q:1"\n',
-                                      encoding="utf-8")
+    write_files(tmp_path, {
+        "MAIN.st": NEVER_REARMED,
+        "FB_X.st": "FUNCTION_BLOCK FB_X\nVAR_INPUT i_b : BOOL; END_VAR\nEND_FUNCTION_BLOCK\n",
+        "fb.toml": 'name = "x"\nsources = ["MAIN.st", "FB_X.st"]\nprogram = "FB_X"\n',
+        "ch.toml": 'name = "x"\nsources = ["MAIN.st"]\nplatform = "fx3u"\nchannel = "q:1"\n',
+    })
     monkeypatch.chdir(tmp_path)
     result = invoke("--scenario", "fb.toml")
     assert result.exit_code == 2
