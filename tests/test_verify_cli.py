@@ -935,6 +935,16 @@ END_PROGRAM
 """
 
 
+def failures_of(tmp_path, monkeypatch, program, *args):
+    """`uitamr verify` of program as MAIN.st on the fx3u for 1 s, which fails: its JUnit
+    failures, message by rule."""
+    (tmp_path / "MAIN.st").write_text(program, encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("MAIN.st", "--platform", "fx3u", "--duration", "1s", "--junit", "v.xml", *args)
+    assert result.exit_code == 1, result.output
+    return {f.get("type"): f.get("message") for f in ET.parse(tmp_path / "v.xml").getroot().iter("failure")}
+
+
 @pytest.mark.parametrize("crc, crc_finding", [
     ("16#F629", None),  # 01 06 01 02 00 00 29 F6: both requests right, sent too close
     ("16#F6D9", "UITAMR-CRC: 1 violation(s); first at 0.010 s: the second of two requests ran together: "
@@ -947,11 +957,7 @@ def test_two_requests_run_together_are_judged_one_by_one(tmp_path, monkeypatch, 
     # the line makes one 16-byte frame of two requests 1.7 ms apart: UITAMR-CRC said
     # 'expected 29 ED (CRC-16/MODBUS of the first 14 bytes)' of a frame no one built, and
     # UITAMR-FORMAT only 'too long for an FC06 request: 16 bytes', not why
-    (tmp_path / "MAIN.st").write_text(back_to_back(crc), encoding="utf-8")
-    monkeypatch.chdir(tmp_path)
-    result = invoke("MAIN.st", "--platform", "fx3u", "--duration", "1s", "--junit", "v.xml", *path)
-    assert result.exit_code == 1, result.output
-    failures = {f.get("type"): f.get("message") for f in ET.parse(tmp_path / "v.xml").getroot().iter("failure")}
+    failures = failures_of(tmp_path, monkeypatch, back_to_back(crc), *path)
     assert failures.get("UITAMR-CRC") == crc_finding
     assert failures["UITAMR-FORMAT"] == (
         "UITAMR-FORMAT: 1 violation(s); first at 0.010 s: two requests ran together: 01 06 01 02 00 00 "
@@ -975,11 +981,7 @@ def test_three_requests_run_together_are_split_at_both_pauses(tmp_path, monkeypa
     # the line recorded the first pause only, and the bytes before it were worked out from
     # the frame's whole silence (both pauses): no split, and UITAMR-CRC said 'expected D3 2C
     # (CRC-16/MODBUS of the first 22 bytes)', UITAMR-FORMAT 'too long for an FC06 request: 24 bytes'
-    (tmp_path / "MAIN.st").write_text(back_to_back("16#F629", crc), encoding="utf-8")
-    monkeypatch.chdir(tmp_path)
-    result = invoke("MAIN.st", "--platform", "fx3u", "--duration", "1s", "--junit", "v.xml", "--json", "v.json", *path)
-    assert result.exit_code == 1, result.output
-    failures = {f.get("type"): f.get("message") for f in ET.parse(tmp_path / "v.xml").getroot().iter("failure")}
+    failures = failures_of(tmp_path, monkeypatch, back_to_back("16#F629", crc), "--json", "v.json", *path)
     assert failures.get("UITAMR-CRC") == crc_finding
     assert failures["UITAMR-FORMAT"] == (
         "UITAMR-FORMAT: 1 violation(s); first at 0.010 s: " + THREE_TOGETHER.format(crc="D9 F6" if crc_finding else "78 36")
