@@ -7,6 +7,12 @@ from dataclasses import asdict
 import verifier.sim
 
 
+#: indices of the port interface io_uPort of UITAMR_Engine (its PORT_<name> constants,
+#: docs/plc-library.md "The port interface"): request and reply flags and lengths, the port's
+#: error code, and where the frame to send and the reply received start (one byte per word)
+TX_REQ, TX_LEN, RX_DONE, RX_LEN, PORT_ERR, TX_BASE, RX_BASE = 0, 1, 2, 3, 4, 8, 24
+
+
 #: a function block with a TON (done 3 s after i_bExecute rises), as an integrator's first
 #: test of docs/testing-st.md loads it
 FB_DELAY = """

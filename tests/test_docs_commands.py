@@ -18,6 +18,7 @@ from pathlib import Path
 import click
 import pytest
 
+from doc_helpers import code_blocks
 from verifier.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -98,7 +99,7 @@ def _quoted_commands() -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
     blocks, inline = [], []
     for page in PAGES:
         text = (ROOT / page).read_text(encoding="utf-8")
-        for block in re.findall(r"```[\w]*\n(.*?)```", text, flags=re.S):
+        for block in code_blocks(text):
             blocks += [(page, command) for command in _block_commands(block)]
         inline += [(page, command) for command in _inline_commands(text)]
     return blocks, inline
@@ -221,7 +222,7 @@ def test_emulator_bench_recipe(tmp_path):
 
 
 def _python_blocks(page: str) -> list[str]:
-    return re.findall(r"```python\n(.*?)```", (ROOT / "docs" / page).read_text(encoding="utf-8"), flags=re.S)
+    return code_blocks((ROOT / "docs" / page).read_text(encoding="utf-8"), "python")
 
 
 def test_the_python_examples_of_verifier_md_run(monkeypatch):

@@ -172,16 +172,16 @@ def test_a_pattern_is_read_as_the_folders_and_files_it_matches(tmp_path, monkeyp
     (tmp_path / "empty").mkdir()
     (tmp_path / "src" / "Main.st").write_text("PROGRAM Main\nVAR\n    wX : INT;\nEND_VAR\nwX := wX + 1;\nEND_PROGRAM\n")
     args = ["--target", "gxworks2", "--out", "src/gx2", "sr[c]"]
-    first = CliRunner().invoke(command, args)
+    first = run(*args)
     assert first.exit_code == 0, first.output
-    second = CliRunner().invoke(command, args)
+    second = run(*args)
     assert second.exit_code == 0, second.output
     assert "1 file(s) in the --out folder src/gx2 left out of the sources (an earlier export)" in second.output
-    empty = CliRunner().invoke(command, ["--target", "gxworks2", "--out", "o", "emp*"])
+    empty = run("--target", "gxworks2", "--out", "o", "emp*")
     assert empty.exit_code == 2 and "emp*" in empty.output and "unreadable" not in empty.output, empty.output
     # worded as check and verify word it
     assert "'emp*' matches no file" in empty.output and "no such file" not in empty.output, empty.output
-    both = CliRunner().invoke(command, ["--target", "gxworks2", "--out", "o", "nope*.st", "gone.st"])
+    both = run("--target", "gxworks2", "--out", "o", "nope*.st", "gone.st")
     assert both.exit_code == 2
     assert "'nope*.st' matches no file; no such file or folder: gone.st" in both.output, both.output
 

@@ -11,6 +11,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings as hsettings, strategies as st
 
 import verifier
+from sim_helpers import RX_BASE, RX_DONE, RX_LEN, TX_BASE, TX_LEN, TX_REQ
 from verifier.protocol import (
     ControlReply, ControlRequest, ExceptionReply, Settings, StatusReply, StatusRequest,
     decode_request, encode,
@@ -19,7 +20,6 @@ from verifier.protocol import (
 ROOT = Path(__file__).resolve().parents[1]
 CORE = ROOT / "plc" / "core"
 SETTINGS = Settings()
-TX_REQ, TX_LEN, RX_DONE, RX_LEN, TX_BASE, RX_BASE = 0, 1, 2, 3, 8, 24
 
 HARNESS = """
 PROGRAM T_Engine

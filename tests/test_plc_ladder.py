@@ -28,9 +28,13 @@ def value(operand: str) -> str:
     return operand
 
 
-def timer_time(name: str, preset: str) -> str:
+def timer_ms(name: str, preset: str) -> int:
     unit = 10 if 200 <= int(name[1:]) <= 245 else 100     # FX3U: T200-T245 10 ms, T0-T199 100 ms
-    return f"T#{int(value(preset)) * unit}ms"
+    return int(value(preset)) * unit
+
+
+def timer_time(name: str, preset: str) -> str:
+    return f"T#{timer_ms(name, preset)}ms"
 
 
 def next_device(name: str) -> str:

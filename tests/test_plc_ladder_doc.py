@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from test_plc_ladder import next_device, timer_ms
 from verifier.export.ladder import parse_il
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -54,10 +55,7 @@ def _written(rung: list) -> set[str]:
     writes it) and of MUL (the high word of the 32-bit product, which the FX3U writes and
     the translation leaves out: no rung reads it)."""
     devices = {op for ins in rung for op in ins.operands}
-    for ins in rung:
-        if ins.op in ("DIV", "MUL"):
-            kind, number = re.fullmatch(r"([A-Z]+)(\d+)", ins.operands[2]).groups()
-            devices.add(f"{kind}{int(number) + 1}")
+    devices |= {next_device(ins.operands[2]) for ins in rung if ins.op in ("DIV", "MUL")}
     return devices
 
 
@@ -107,9 +105,9 @@ def test_the_values_a_row_gives_are_the_rungs(rung):
 
 def test_the_timer_times_are_the_il_presets():
     """"T200 pacing 300 ms" and the like, in the Devices paragraph and the rows, against the
-    preset of the timer's OUT (T200-T245 count 10 ms on the FX3U, as test_plc_ladder.py
-    translates them)."""
-    presets = {i.operands[0]: _value(i.operands[1]) * 10 for rung in _rungs().values() for i in rung
+    preset of the timer's OUT, in the FX3U's units as test_plc_ladder.py translates them
+    (T200-T245 count 10 ms)."""
+    presets = {i.operands[0]: timer_ms(*i.operands) for rung in _rungs().values() for i in rung
                if i.op == "OUT" and i.operands[0].startswith("T")}
     named = re.findall(r"\b(T\d+)\b[^.;|\d]{0,25}?\b(\d+) ms\b", " ".join(_section().split()))
     assert {timer for timer, _ in named} == set(presets)

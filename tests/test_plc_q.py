@@ -354,8 +354,7 @@ def test_a_c24_setting_for_the_module_the_program_drives_made_mid_run_leaves_the
     U2\\G310 := 0 stands there too, as at the first call (it was written over, and the
     word-units mistake linked)."""
     main = USER_MAIN.replace("U2\\G310 := 1;", "U2\\G310 := 0;")
-    project = verifier.load(*LIBRARY, sources={"Main.st": main}, cpu="q")
-    project.attach_serial("q:2", Line(Robot(Settings(), RobotConfig(), [])))
+    project = load_main(main)
     project.run_programs(["Main"], ms=1000)
     assert project.c24_addressed() == [2]
     project.configure_c24(None, 2, byte_units=True)

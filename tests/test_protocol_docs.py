@@ -7,6 +7,7 @@ from pathlib import Path
 
 from click.testing import CliRunner
 
+from doc_helpers import code_blocks
 from verifier.cli import main
 from verifier.protocol import Settings, command_from_words, crc_ok, encode, hex_bytes
 
@@ -54,7 +55,7 @@ def test_settings_table_matches_the_encoder():
 
 def sessions():
     """(argv, expected output) for each `$ uitamr frame ...` in the doc's code blocks."""
-    for block in re.findall(r"```\n(.*?)```", TEXT, flags=re.S):
+    for block in code_blocks(TEXT, ""):
         lines = block.splitlines()
         for index, line in enumerate(lines):
             if line.startswith("$ uitamr frame"):

@@ -7,6 +7,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from doc_helpers import code_blocks
 from verifier.amr.faults import FAULT_KINDS
 from verifier.protocol.catalogue import ERROR_TITLES, RobotError
 from verifier.verify.rules import RULES
@@ -15,10 +16,6 @@ ROOT = Path(__file__).resolve().parents[1]
 EN = (ROOT / "README.md").read_text(encoding="utf-8")
 ZH = (ROOT / "README.zh-TW.md").read_text(encoding="utf-8")
 READMES = {"README.md": EN, "README.zh-TW.md": ZH}
-
-
-def _code_blocks(text: str) -> list[str]:
-    return re.findall(r"```\w*\n(.*?)```", text, flags=re.S)
 
 
 def _pages(text: str) -> set[str]:
@@ -46,7 +43,7 @@ def _hex_words(text: str) -> set[str]:
 
 
 def test_the_same_commands_are_shown():
-    assert _code_blocks(ZH) == _code_blocks(EN)
+    assert code_blocks(ZH) == code_blocks(EN)
     assert _subcommands(ZH) == _subcommands(EN)
     assert _options(ZH) == _options(EN)
 

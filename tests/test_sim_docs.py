@@ -6,12 +6,14 @@ import os
 import re
 from pathlib import Path
 
+from doc_helpers import code_blocks
+
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "testing-st.md"
 
 
 def blocks(kind: str) -> list[str]:
-    return re.findall(rf"```{kind}\n(.*?)```", DOC.read_text(encoding="utf-8"), re.S)
+    return code_blocks(DOC.read_text(encoding="utf-8"), kind)
 
 
 def test_quick_start_runs(tmp_path, monkeypatch):

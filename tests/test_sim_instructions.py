@@ -8,6 +8,7 @@ from sim_helpers import FakeEndpoint, load_st
 from verifier.protocol import crc16, with_crc
 
 MANUAL_FRAME = [0x01, 0x03, 0x03, 0x02, 0x00, 0x14]  # FX3U FNC 188 example -> 41E4H
+STATUS_REPLY = bytes.fromhex("0101030000003c4e")  # a status reply (FC01, 3 data bytes 0) with its CRC: 8 bytes
 
 
 def packed(data: list[int]) -> list[int]:
@@ -165,11 +166,11 @@ def test_the_serial_log_can_be_turned_off_and_the_count_goes_on():
 def test_rs2_receives_by_count_then_waits_for_m8403_reset():
     ep = FakeEndpoint()
     project, p = rs2_project(ep)
-    ep.reply_at(25_000, bytes.fromhex("0101030000003c4e"))  # last byte at 33.3 ms
+    ep.reply_at(25_000, STATUS_REPLY)  # last byte at 33.3 ms
     project.run_programs(["P"], scans=3)     # scans at 20, 30, 40 ms
     assert project.devices["M8403"] is True
     assert project.devices["D8403"] == 8
-    assert list(p.uRecv) == packed(list(bytes.fromhex("0101030000003c4e")))
+    assert list(p.uRecv) == packed(list(STATUS_REPLY))
     ep.reply_at(45_000, b"\x99")             # arrives while M8403 is still ON
     project.run_programs(["P"], scans=1)
     assert project.devices["D8403"] == 8
@@ -184,7 +185,7 @@ def test_bytes_discarded_for_a_reception_never_rearmed_name_the_rs2_call_and_the
     # only saw "6 received byte(s) discarded because M8403 was still ON" in the JSON report
     ep = FakeEndpoint()
     project, p = rs2_project(ep)
-    ep.reply_at(25_000, bytes.fromhex("0101030000003c4e"))
+    ep.reply_at(25_000, STATUS_REPLY)
     project.run_programs(["P"], scans=3)
     ep.reply_at(45_000, b"\x99")
     project.run_programs(["P"], scans=1)
@@ -203,11 +204,11 @@ def test_bytes_after_a_reply_of_a_program_that_rearms_are_not_called_a_missing_r
     Once the program has reset M8403, the message says what happened instead."""
     ep = FakeEndpoint()
     project, p = rs2_project(ep)
-    ep.reply_at(25_000, bytes.fromhex("0101030000003c4e"))
+    ep.reply_at(25_000, STATUS_REPLY)
     project.run_programs(["P"], scans=3)
     project.devices["M8403"] = False         # the program reads the reply and re-arms
     project.run_programs(["P"], scans=1)
-    ep.reply_at(55_000, bytes.fromhex("0101030000003c4e"))   # last byte at 63.3 ms
+    ep.reply_at(55_000, STATUS_REPLY)   # last byte at 63.3 ms
     project.run_programs(["P"], scans=2)
     assert project.devices["M8403"] is True
     ep.reply_at(75_000, b"\x99\x98")        # noise right after the reply, before the reset
@@ -228,13 +229,13 @@ def test_bytes_dropped_long_after_the_last_reset_say_when_that_was():
     stopped, and the advice to reset it."""
     ep = FakeEndpoint()
     project, p = rs2_project(ep)
-    ep.reply_at(25_000, bytes.fromhex("0101030000003c4e"))
+    ep.reply_at(25_000, STATUS_REPLY)
     project.run_programs(["P"], scans=3)
     project.devices["M8403"] = False         # re-armed once...
     project.run_programs(["P"], scans=1)
-    ep.reply_at(55_000, bytes.fromhex("0101030000003c4e"))
+    ep.reply_at(55_000, STATUS_REPLY)
     project.run_programs(["P"], scans=2)     # ...and never again
-    ep.reply_at(2_000_000, bytes.fromhex("0101030000003c4e"))
+    ep.reply_at(2_000_000, STATUS_REPLY)
     project.run_programs(["P"], ms=2100)
     last = project.diagnostics[-1]
     assert "8 received byte(s) discarded" in last.message
@@ -327,10 +328,10 @@ def test_c24_output_and_input_with_buffer_memory_settings():
     assert buf[0xA4] == 511 and buf[0xA5] == 0x0D0A       # the module's defaults
     buf[0xA4] = 4                                          # receive 4 words
     buf[0xA5] = -1                                         # FFFFH: no end code
-    ep.reply_at(15_000, bytes.fromhex("0101030000003c4e"))
+    ep.reply_at(15_000, STATUS_REPLY)
     project.run_programs(["P"], scans=3)
     assert p.nDone == 1                                    # done bit ON for one scan
-    assert list(p.uRecv) == packed(list(bytes.fromhex("0101030000003c4e")))
+    assert list(p.uRecv) == packed(list(STATUS_REPLY))
     assert p.uInCtl[2] == 4 and p.uInCtl[1] == 0
     assert project.devices["X3"] is False                  # read request cleared
 

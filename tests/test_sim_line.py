@@ -32,13 +32,19 @@ def st_file(pou: str) -> Path:
     return path
 
 
-@pytest.mark.parametrize("cpu, target, port, program, channel", PLATFORMS, ids=[p[3] for p in PLATFORMS])
-def test_example_program_talks_to_the_robot(cpu, target, port, program, channel):
+def example_on_a_line(cpu, target, port, program, channel):
+    """The example PROGRAM and its port FB, 10 ms scans, on a line to a healthy robot."""
     project = verifier.load(*CORE, st_file(port), st_file(program), target=target, cpu=cpu, scan_ms=10)
     line = Line(Robot())
     project.attach_serial(channel, line)
     if cpu == "q":  # the module settings docs/import-gxworks2.md asks for: byte units, 8 bytes, no end code
         project.configure_c24(0, 1, byte_units=True, receive_count=8, end_code=0xFFFF, no_reception_ms=20)
+    return project, line
+
+
+@pytest.mark.parametrize("cpu, target, port, program, channel", PLATFORMS, ids=[p[3] for p in PLATFORMS])
+def test_example_program_talks_to_the_robot(cpu, target, port, program, channel):
+    project, line = example_on_a_line(cpu, target, port, program, channel)
     project.run_programs([program], ms=3000)
     tx = [f for f in line.trace if f.direction == "tx"]
     rx = [f for f in line.trace if f.direction == "rx"]
@@ -104,11 +110,7 @@ def test_stop_to_run_with_the_labels_kept_sends_the_stop_first(cpu, target, port
     restart test above passes without that line; here the CPU only stops for 0.5 s and its
     next scan is a first scan again with every label as it was (the simulator has no STOP
     mode of its own: virtual time passes unscanned, then the first-scan flag is set)."""
-    project = verifier.load(*CORE, st_file(port), st_file(program), target=target, cpu=cpu, scan_ms=10)
-    line = Line(Robot())
-    project.attach_serial(channel, line)
-    if cpu == "q":
-        project.configure_c24(0, 1, byte_units=True, receive_count=8, end_code=0xFFFF, no_reception_ms=20)
+    project, line = example_on_a_line(cpu, target, port, program, channel)
     project.run_programs([program], ms=3000)
     assert project.get(f"{program}.fbEngine.o_bInitDone") is True
     polled = [f.data[1] for f in line.trace if f.direction == "tx" and f.t_start_us > 600_000]

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from sim_helpers import comparable, load_st
+from sim_helpers import PORT_ERR, RX_DONE, RX_LEN, TX_BASE, TX_LEN, TX_REQ, comparable, load_st
 from verifier.amr import Robot
 from verifier.link import Line
 from verifier.link.converter import Converter, ConverterConfig
@@ -512,8 +512,8 @@ def test_tcp_link_send_and_receive_errors_are_0312_and_0313_as_the_error_table_s
     h.scan()
     assert h.fbLink.o_bConnected and h.fbLink.o_uErrId == 0
     for k, byte in enumerate(STOP):  # the engine's request on the port interface
-        h.uPort[8 + k] = byte
-    h.uPort[1], h.uPort[0] = len(STOP), 1
+        h.uPort[TX_BASE + k] = byte
+    h.uPort[TX_LEN], h.uPort[TX_REQ] = len(STOP), 1
     h.scan()
     assert h.fbLink.o_bSend
     assert [h.uSockSend[k] for k in range(5)] == [8, 0x0601, 0xA001, 0x0000, 0x1488]
@@ -522,8 +522,8 @@ def test_tcp_link_send_and_receive_errors_are_0312_and_0313_as_the_error_table_s
     h.bSendDone = h.bSendErr = False
     assert (h.fbLink.o_bErr, h.fbLink.o_uErrId, h.fbLink.o_uErrDetail) == (True, 0x0312, 0xC0A1)
     h.scan(2)
-    assert (h.uPort[2], h.uPort[3], h.uPort[4]) == (1, 0, 0x0312)  # the attempt failed, no bytes
-    h.uPort[2] = 0  # the engine took it
+    assert (h.uPort[RX_DONE], h.uPort[RX_LEN], h.uPort[PORT_ERR]) == (1, 0, 0x0312)  # the attempt failed, no bytes
+    h.uPort[RX_DONE] = 0  # the engine took it
     h.bRecvReady = True
     h.scan()
     assert h.fbLink.o_bRecv
@@ -532,4 +532,4 @@ def test_tcp_link_send_and_receive_errors_are_0312_and_0313_as_the_error_table_s
     h.bRecvDone = h.bRecvErr = False
     assert (h.fbLink.o_bErr, h.fbLink.o_uErrId, h.fbLink.o_uErrDetail) == (True, 0x0313, 0x1234)
     h.scan(3)
-    assert h.uPort[2] == 0  # no reply handed to the engine: its reply time-out decides
+    assert h.uPort[RX_DONE] == 0  # no reply handed to the engine: its reply time-out decides

@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+from file_helpers import write_files
 from verifier.commands.verify import bundled_scenarios, command
 
 REPO = Path(__file__).resolve().parents[1]
@@ -896,7 +897,18 @@ def test_a_reception_never_rearmed_is_named_on_the_console_and_in_junit(tmp_path
     assert notes == [lines[0].strip().removeprefix("simulator ")]
 
 
-BACK_TO_BACK = """PROGRAM MAIN
+def back_to_back(*point_crcs):
+    """The stop, then one FC06 point command (register 16#0102, 16#0103, ...) per CRC given, each
+    as soon as the CPU has sent the request before it: the requests run together on the line."""
+    points = "".join(f"""ELSIF wStep = {step} AND NOT M8402 THEN
+    uSend[0] := 16#0601;
+    uSend[1] := 16#0{step}01;
+    uSend[2] := 16#0000;
+    uSend[3] := {crc};
+    M8402 := TRUE;
+    wStep := {step + 1};
+""" for step, crc in enumerate(point_crcs, start=2))
+    return """PROGRAM MAIN
 VAR
     uSend : ARRAY[0..3] OF WORD;
     uRecv : ARRAY[0..3] OF WORD;
@@ -906,7 +918,7 @@ IF M8002 THEN
     D8400 := 16#1C81;
     D8409 := 5;
 END_IF;
-(* scan 1: the stop; scan 2, as soon as the CPU has sent it: the point command *)
+(* scan 1: the stop; scan 2, as soon as the CPU has sent it: the point command(s) *)
 IF wStep = 1 THEN
     uSend[0] := 16#0601;
     uSend[1] := 16#A001;
@@ -914,20 +926,23 @@ IF wStep = 1 THEN
     uSend[3] := 16#1488;
     M8402 := TRUE;
     wStep := 2;
-ELSIF wStep = 2 AND NOT M8402 THEN
-    uSend[0] := 16#0601;
-    uSend[1] := 16#0201;
-    uSend[2] := 16#0000;
-    uSend[3] := POINT2_CRC;
-    M8402 := TRUE;
-    wStep := 3;
-ELSIF wStep = 0 THEN
+""" + points + """ELSIF wStep = 0 THEN
     wStep := 1;
 END_IF;
 M8403 := FALSE;
 RS2(TRUE, uSend[0], 8, 8, 1, uRecv[0]);
 END_PROGRAM
 """
+
+
+def failures_of(tmp_path, monkeypatch, program, *args):
+    """`uitamr verify` of program as MAIN.st on the fx3u for 1 s, which fails: its JUnit
+    failures, message by rule."""
+    (tmp_path / "MAIN.st").write_text(program, encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("MAIN.st", "--platform", "fx3u", "--duration", "1s", "--junit", "v.xml", *args)
+    assert result.exit_code == 1, result.output
+    return {f.get("type"): f.get("message") for f in ET.parse(tmp_path / "v.xml").getroot().iter("failure")}
 
 
 @pytest.mark.parametrize("crc, crc_finding", [
@@ -942,11 +957,7 @@ def test_two_requests_run_together_are_judged_one_by_one(tmp_path, monkeypatch, 
     # the line makes one 16-byte frame of two requests 1.7 ms apart: UITAMR-CRC said
     # 'expected 29 ED (CRC-16/MODBUS of the first 14 bytes)' of a frame no one built, and
     # UITAMR-FORMAT only 'too long for an FC06 request: 16 bytes', not why
-    (tmp_path / "MAIN.st").write_text(BACK_TO_BACK.replace("POINT2_CRC", crc), encoding="utf-8")
-    monkeypatch.chdir(tmp_path)
-    result = invoke("MAIN.st", "--platform", "fx3u", "--duration", "1s", "--junit", "v.xml", *path)
-    assert result.exit_code == 1, result.output
-    failures = {f.get("type"): f.get("message") for f in ET.parse(tmp_path / "v.xml").getroot().iter("failure")}
+    failures = failures_of(tmp_path, monkeypatch, back_to_back(crc), *path)
     assert failures.get("UITAMR-CRC") == crc_finding
     assert failures["UITAMR-FORMAT"] == (
         "UITAMR-FORMAT: 1 violation(s); first at 0.010 s: two requests ran together: 01 06 01 02 00 00 "
@@ -954,18 +965,6 @@ def test_two_requests_run_together_are_judged_one_by_one(tmp_path, monkeypatch, 
         "less than t3.5 = 3.65 ms, so the robot takes them for one frame and discards it: leave at least t3.5 of "
         "silence between two requests (and wait for the reply, or its time-out, before the next)")
 
-
-# a third request, as soon as the CPU has sent the second: one 24-byte frame with two pauses
-THREE_BACK_TO_BACK = BACK_TO_BACK.replace("POINT2_CRC", "16#F629").replace("""    wStep := 3;
-ELSIF""", """    wStep := 3;
-ELSIF wStep = 3 AND NOT M8402 THEN
-    uSend[0] := 16#0601;
-    uSend[1] := 16#0301;
-    uSend[2] := 16#0000;
-    uSend[3] := POINT3_CRC;
-    M8402 := TRUE;
-    wStep := 4;
-ELSIF""")
 
 THREE_TOGETHER = ("three requests ran together: 01 06 01 02 00 00 29 F6 followed 01 06 01 A0 00 00 88 14 after a "
                   "silence of 1.667 ms, 01 06 01 03 00 00 {crc} followed that after 1.667 ms, each less than t3.5 = "
@@ -982,11 +981,7 @@ def test_three_requests_run_together_are_split_at_both_pauses(tmp_path, monkeypa
     # the line recorded the first pause only, and the bytes before it were worked out from
     # the frame's whole silence (both pauses): no split, and UITAMR-CRC said 'expected D3 2C
     # (CRC-16/MODBUS of the first 22 bytes)', UITAMR-FORMAT 'too long for an FC06 request: 24 bytes'
-    (tmp_path / "MAIN.st").write_text(THREE_BACK_TO_BACK.replace("POINT3_CRC", crc), encoding="utf-8")
-    monkeypatch.chdir(tmp_path)
-    result = invoke("MAIN.st", "--platform", "fx3u", "--duration", "1s", "--junit", "v.xml", "--json", "v.json", *path)
-    assert result.exit_code == 1, result.output
-    failures = {f.get("type"): f.get("message") for f in ET.parse(tmp_path / "v.xml").getroot().iter("failure")}
+    failures = failures_of(tmp_path, monkeypatch, back_to_back("16#F629", crc), "--json", "v.json", *path)
     assert failures.get("UITAMR-CRC") == crc_finding
     assert failures["UITAMR-FORMAT"] == (
         "UITAMR-FORMAT: 1 violation(s); first at 0.010 s: " + THREE_TOGETHER.format(crc="D9 F6" if crc_finding else "78 36")
@@ -1014,13 +1009,12 @@ def test_a_function_block_as_program_and_a_channel_the_cpu_lacks_are_reported_at
     # issue 11: every scenario error has file:line:column; these two named the file only
     # ('s.toml: FB_X is a FUNCTION_BLOCK, not a PROGRAM', 's.toml: channel q:1 does not exist
     # on the fx3u CPU'), though the key that says so is in the file
-    (tmp_path / "MAIN.st").write_text(NEVER_REARMED, encoding="utf-8")
-    (tmp_path / "FB_X.st").write_text("FUNCTION_BLOCK FB_X\nVAR_INPUT i_b : BOOL; END_VAR\nEND_FUNCTION_BLOCK\n",
-                                      encoding="utf-8")
-    (tmp_path / "fb.toml").write_text('name = "x"\nsources = ["MAIN.st", "FB_X.st"]\nprogram = "FB_X"\n',
-                                      encoding="utf-8")
-    (tmp_path / "ch.toml").write_text('name = "x"\nsources = ["MAIN.st"]\nplatform = "fx3u"\nchannel = "q:1"\n',
-                                      encoding="utf-8")
+    write_files(tmp_path, {
+        "MAIN.st": NEVER_REARMED,
+        "FB_X.st": "FUNCTION_BLOCK FB_X\nVAR_INPUT i_b : BOOL; END_VAR\nEND_FUNCTION_BLOCK\n",
+        "fb.toml": 'name = "x"\nsources = ["MAIN.st", "FB_X.st"]\nprogram = "FB_X"\n',
+        "ch.toml": 'name = "x"\nsources = ["MAIN.st"]\nplatform = "fx3u"\nchannel = "q:1"\n',
+    })
     monkeypatch.chdir(tmp_path)
     result = invoke("--scenario", "fb.toml")
     assert result.exit_code == 2

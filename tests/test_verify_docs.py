@@ -6,6 +6,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from file_helpers import write_files
 from verifier.verify.scenario import C24_KEYS, TOP_KEYS, parse_scenario
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
@@ -276,12 +277,11 @@ def test_the_device_messages_scenarios_md_quotes_are_what_check_prints(tmp_path)
 
     from verifier.cli import main
 
-    (tmp_path / "MAIN.st").write_text("PROGRAM MAIN\nVAR\n    iX : INT;\nEND_VAR\niX := iX + 1;\nEND_PROGRAM\n",
-                                      encoding="utf-8")
-    (tmp_path / "fx3.toml").write_text('platform = "fx3u"\nsources = ["MAIN.st"]\n[initial]\nSM400 = true\n',
-                                       encoding="utf-8")
-    (tmp_path / "fx5.toml").write_text('platform = "fx5u"\nsources = ["MAIN.st"]\n[initial]\nM8402 = true\n',
-                                       encoding="utf-8")
+    write_files(tmp_path, {
+        "MAIN.st": "PROGRAM MAIN\nVAR\n    iX : INT;\nEND_VAR\niX := iX + 1;\nEND_PROGRAM\n",
+        "fx3.toml": 'platform = "fx3u"\nsources = ["MAIN.st"]\n[initial]\nSM400 = true\n',
+        "fx5.toml": 'platform = "fx5u"\nsources = ["MAIN.st"]\n[initial]\nM8402 = true\n',
+    })
     text = " ".join(SCENARIOS_MD.split())
     for name, severity in (("fx3.toml", "error"), ("fx5.toml", "warning")):
         result = CliRunner().invoke(main, ["check", str(tmp_path / name)])
