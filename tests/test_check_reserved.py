@@ -22,7 +22,7 @@ REFUSED = {
     "fx3u": ["DBIN", "Sort", "meanp", "DHSCS", "DECMPP", "RD3A"],
     "fx3g": ["DBIN", "ivck", "SCL2P"],
     "q": ["DBIN", "DSORT", "Stop", "page", "QDRSET", "DSUMP"],
-    "fx5u": ["DBIN", "SortTbl", "EDMOV", "RETSTL", "DINT2FLTP", "INT2FLT"],
+    "fx5u": ["DBIN", "SortTbl", "EDMOV", "RETSTL", "DINT2FLTP", "INT2FLT", "AltD"],
 }
 #: names of no instruction of any family, nor otherwise reserved
 ACCEPTED = ["wDbinValue", "SortIndex", "iMean", "bStopReq", "nPage", "Sorted", "DBINX"]

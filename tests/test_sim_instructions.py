@@ -361,6 +361,7 @@ END_PROGRAM
     ep.reply_at(10_000, ep.sent[0][0])
     project.run_programs(["P"], scans=3)
     assert p.nDone == 1 and project.devices["D8402"] == 0 and project.devices["M8063"] is False
+    assert project.devices["M8402"] is False and project.devices["M8403"] is False
 
 
 def test_adprw_fx3_completion_is_reported_before_anything_is_sent_again():
@@ -411,8 +412,11 @@ def test_adprw_fx3_error_codes_are_those_of_the_modbus_manual(reply, code, detai
     """FX3U MODBUS Serial Communication Edition §12.6: D8402 holds the MODBUS error code
     (211 time-out, 212 exception, 205 CRC, 207 length, 213/214 mismatch), D8403 its details,
     M8063 ON and D8063 = 6321. The simulator used to write codes of its own (1, 2, 3, 104H),
-    so a program checked here reacted to codes a real FX3U never writes."""
+    so a program checked here reacted to codes a real FX3U never writes. The same list's
+    "Related Devices" column turns M8402 and M8403 ON with them (ch1); the simulator left
+    them OFF, so a program watching M8402 for a MODBUS error never saw one here."""
     project, ep, p = adprw_started(ADPRW_FX3_ERRORS)
+    assert project.devices["M8402"] is False and project.devices["M8403"] is False
     if reply is not None:
         ep.reply_at(ep.sent[0][1] + 12_000, reply)
     project.run_programs(["P"], ms=3500)                   # D8409 = 0: 3 s
@@ -420,6 +424,7 @@ def test_adprw_fx3_error_codes_are_those_of_the_modbus_manual(reply, code, detai
     assert project.devices["D8402"] == code
     assert project.devices["D8403"] == details
     assert project.devices["M8063"] is True and project.devices["D8063"] == 6321
+    assert project.devices["M8402"] is True and project.devices["M8403"] is True
 
 
 def test_adprw_fx3_a_good_transaction_keeps_the_last_error_code():

@@ -45,9 +45,13 @@ class Fx3ModbusDevices:
     error_flag: str
     serial_error: str  # serial communication error code register
     serial_error_code: int  # the code ADPRW stores there: "MODBUS error on ch1 / ch2"
+    # turned ON with the error code and with its details (§12.6 "Related Devices": "M8402
+    # set to ON, D8402 set to MODBUS Error Code, M8403 set to ON, D8403 set to Error Details")
+    code_flag: str
+    details_flag: str
 
 
 FX3_MODBUS_CHANNELS = {
-    1: Fx3ModbusDevices("D8409", "D8412", "D8402", "D8403", "M8063", "D8063", 6321),
-    2: Fx3ModbusDevices("D8429", "D8432", "D8422", "D8423", "M8438", "D8438", 3821),
+    1: Fx3ModbusDevices("D8409", "D8412", "D8402", "D8403", "M8063", "D8063", 6321, "M8402", "M8403"),
+    2: Fx3ModbusDevices("D8429", "D8432", "D8422", "D8423", "M8438", "D8438", 3821, "M8422", "M8423"),
 }

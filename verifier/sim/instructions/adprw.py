@@ -54,6 +54,8 @@ class AdprwMaster:
             self._err_details = dev.address(devices.error_details)
             self._serial_err = dev.address(devices.serial_error)
             self._serial_err_code = devices.serial_error_code
+            self._err_code_flag = dev.address(devices.code_flag)
+            self._err_details_flag = dev.address(devices.details_flag)
             self._done_flag = dev.address("M8029")
         else:
             self._timeout = self._retries = None
@@ -225,6 +227,11 @@ class AdprwMaster:
                 self._set(self._err_flag, True)
                 self._set(self._err_details, details)
                 self._set(self._serial_err, self._serial_err_code)
+                # FX-MB §12.6: M8402 and M8403 (ch1) go ON with D8402 and D8403; when the
+                # CPU turns them OFF is not on the pages read (ASSUMPTION: not before the
+                # program, power-on or STOP->RUN does, as M8063)
+                self._set(self._err_code_flag, True)
+                self._set(self._err_details_flag, True)
         elif d2 is not None:
             flags.append((d2, 0))
             if error:

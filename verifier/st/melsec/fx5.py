@@ -47,7 +47,7 @@ PLS
 PLF
 FF
 ALT p
-ALTDP
+ALTD p
 SFT p
 MC
 MCR
