@@ -283,3 +283,21 @@ def test_the_fault_defaults_emulator_md_gives_are_the_codes():
     assert f"`data` bytes (default `{garbage.data.hex(' ').upper()}`)" in rows["`garbage`"]
     assert f'`"{garbage.position}"`, the default' in rows["`garbage`"]
     assert f"`code` (default {Fault('exception', on_request=1).code:02d})" in rows["`exception`"]
+
+
+def test_the_fault_file_error_emulator_md_quotes_is_what_its_bench_toml_gives(tmp_path):
+    """emulator.md quotes a fault file mistake right before it prints `bench.toml`: that
+    file with its first fault's kind misspelt 'x' gives the quoted place and message (the
+    quote once named line 6 and faults[1], a file the page does not show)."""
+    from verifier.emulate.faultfile import FaultFileError, load_fault_file
+
+    text = (ROOT / "docs" / "emulator.md").read_text(encoding="utf-8")
+    quoted = re.search(r"\(`bench\.toml:(\d+:\d+: [^;`]+);", text).group(1)
+    bench = code_blocks(text.split("## Fault files", 1)[1], "toml")[0]
+    assert bench.count('kind = "anti_collision"') == 1
+    (tmp_path / "bench.toml").write_text(bench, encoding="utf-8")
+    assert len(load_fault_file(tmp_path / "bench.toml").faults) == 4  # as printed, it loads
+    (tmp_path / "bench.toml").write_text(bench.replace('kind = "anti_collision"', 'kind = "x"'), encoding="utf-8")
+    with pytest.raises(FaultFileError) as raised:
+        load_fault_file(tmp_path / "bench.toml")
+    assert f"bench.toml:{quoted};" in str(raised.value)

@@ -42,6 +42,11 @@ def _hex_words(text: str) -> set[str]:
     return set(re.findall(r"\b(?=[0-9]*[A-F])[0-9A-F]{4}\b", text)) - {"FC01", "FC06"}
 
 
+def _versions(text: str) -> set[str]:
+    """Numbers with a decimal point: the Python version and the manual's (V2.05)."""
+    return set(re.findall(r"(?<![\d.])\d+\.\d+(?![\d.])", text))
+
+
 def test_the_same_commands_are_shown():
     assert code_blocks(ZH) == code_blocks(EN)
     assert _subcommands(ZH) == _subcommands(EN)
@@ -58,6 +63,8 @@ def test_the_same_pages_are_linked():
 def test_the_same_frames_and_figures():
     assert _frames(ZH) == _frames(EN)
     assert _hex_words(ZH) == _hex_words(EN)
+    assert _versions(ZH) == _versions(EN), (f"only in README.md: {sorted(_versions(EN) - _versions(ZH))}; "
+                                            f"only in README.zh-TW.md: {sorted(_versions(ZH) - _versions(EN))}")
     assert len(RULES) == 8
     assert "the eight rules of `verify`" in EN and "`verify` 的八條規則" in ZH
 

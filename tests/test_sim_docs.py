@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import os
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 from doc_helpers import code_blocks
@@ -37,7 +39,14 @@ def test_quick_start_runs_outside_the_toolkit_with_the_library_named_by_plc_dir(
     assert documented in DOC.read_text(encoding="utf-8")
     code = blocks("python")[0]
     assert doc_path in code
-    exec(compile("import verifier.bundled\n" + code.replace(doc_path, documented), str(DOC), "exec"), {})
+    # in a fresh interpreter, as a user's script runs: the block's own `import verifier` is
+    # all it imports, so `verifier.bundled` must come with it (a pytest process has it already)
+    script = tmp_path / "quick_start.py"
+    script.write_text(code.replace(doc_path, documented), encoding="utf-8")
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    done = subprocess.run([sys.executable, str(script)], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
 
 
 def test_serial_example_runs(tmp_path, monkeypatch):

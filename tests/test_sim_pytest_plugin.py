@@ -53,3 +53,26 @@ def test_simulation_error_location_is_reported(pytester):
     result = pytester.runpytest_subprocess("-p", "no:cacheprovider")
     result.assert_outcomes(failed=1)
     assert "FB_OOB.st:4:3: index 2 is outside a[0..1]" in result.stdout.str()
+
+
+def test_st_that_does_not_load_is_reported_at_its_line_not_with_the_simulators_traceback(pytester):
+    """An integrator's ST with a syntax error, or a file named wrong in @pytest.mark.st: the
+    failure shows the test's own line and the LoadError's file:line:col, not pages of
+    traceback through verifier/sim (docs/testing-st.md: errors point at ST lines)."""
+    pytester.makefile(".st", Broken="FUNCTION_BLOCK Broken\nVAR\n    n : INT;\nEND_VAR\nn := n + ;\nEND_FUNCTION_BLOCK\n")
+    pytester.makepyfile(test_broken=textwrap.dedent("""
+        import pytest
+
+        def test_syntax(st_load):
+            st_load("Broken.st")
+
+        @pytest.mark.st("Missing.st")
+        def test_missing(st_project):
+            pass
+    """))
+    result = pytester.runpytest_subprocess("-p", "no:cacheprovider")
+    result.assert_outcomes(failed=1, errors=1)
+    out = result.stdout.str()
+    assert "Broken.st:5:" in out and "Missing.st:0:0: error: cannot read" in out
+    assert 'st_load("Broken.st")' in out          # the test's own line stays
+    assert "verifier/sim/" not in out and "pytest_plugin.py" not in out, out

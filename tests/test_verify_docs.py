@@ -337,3 +337,31 @@ def test_the_trace_of_an_hour_of_fx3u_healthy_is_the_size_verifier_md_says(tmp_p
                                      "--trace", str(trace)])
     assert done.exit_code == 0, done.output
     assert round(trace.stat().st_size / 2**20, 1) == said.pop()
+
+
+def test_ci_md_says_which_scenario_mistakes_only_verify_finds(tmp_path):
+    """ci.md: `uitamr check` does not load the program, so a scenario naming a PROGRAM the
+    sources do not define passes it; `uitamr verify` names it (exit 2) with the words the
+    page quotes. The page named only labels, and an integrator took the passing check for
+    a checked program name."""
+    from click.testing import CliRunner
+
+    from verifier.cli import main
+    from verifier.verify.result import UnusableInput
+    from verifier.verify.runner import run_scenario
+
+    text = (DOCS / "ci.md").read_text(encoding="utf-8")
+    quoted = re.search(r"`(no PROGRAM 'MIAN' in the sources)`", text)
+    assert quoted, "ci.md does not say that verify, not check, finds a wrong program name"
+    program = tmp_path / "MAIN.st"
+    program.write_text("PROGRAM MAIN\nVAR\n    n : INT;\nEND_VAR\nn := n + 1;\nEND_PROGRAM\n", encoding="utf-8")
+    scenario_text = f'sources = ["{program.as_posix()}"]\nprogram = "MIAN"\nduration = "1s"\n'
+    (tmp_path / "s.toml").write_text(scenario_text, encoding="utf-8")
+    checked = CliRunner().invoke(main, ["check", str(program), str(tmp_path / "s.toml")])
+    assert checked.exit_code == 0, checked.output
+    try:
+        run_scenario(parse_scenario(scenario_text, tmp_path / "s.toml"))
+    except UnusableInput as err:
+        assert quoted.group(1) in str(err), str(err)
+    else:
+        raise AssertionError("verify ran a scenario whose PROGRAM does not exist")

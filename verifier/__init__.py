@@ -2,6 +2,10 @@
 
 __version__ = "0.1.0"
 
+# `verifier.bundled.plc_dir()` names the library in a user's own tests (docs/testing-st.md)
+# after a plain `import verifier`; it only builds a path, so the import stays cheap.
+from verifier import bundled  # noqa: E402,F401
+
 
 def load(*paths, **options):
     """Load GX Works ST files into a simulated CPU (see docs/testing-st.md).

@@ -13,6 +13,7 @@ time — so a failing `assert fb.o_bDone` shows what the ST was doing and where.
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -76,10 +77,29 @@ def describe_project(project) -> str:
     return "\n".join(lines)
 
 
+def _load_error_report(item, excinfo) -> str | None:
+    """ST that does not load (a syntax error, a file named wrong) is the test's input, not a
+    fault of the toolkit: the report is the test's own lines that led to it and the
+    LoadError's file:line:col message, not the frames inside the plugin and the simulator's
+    loader. None for any other failure (pytest's report as usual)."""
+    errors = sys.modules.get("verifier.sim.errors")
+    if excinfo is None or errors is None or not excinfo.errisinstance(errors.LoadError):
+        return None
+    test_file = Path(str(item.path)).resolve()
+    lines = [f"{entry.path}:{entry.lineno + 1}: {str(entry.statement).strip()}"
+             for entry in excinfo.traceback if Path(str(entry.path)).resolve() == test_file]
+    # the error first: pytest's short summary quotes the report's first line
+    return "\n".join([f"E   {line}" for line in excinfo.exconly().splitlines()] + lines)
+
+
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_makereport(item, call):
     outcome = yield
     report = outcome.get_result()
+    if report.failed:
+        load_error = _load_error_report(item, call.excinfo)
+        if load_error is not None:
+            report.longrepr = load_error
     if report.when != "call" or not report.failed:
         return
     projects = list(getattr(item, "_st_projects", []))

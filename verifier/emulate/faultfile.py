@@ -38,7 +38,7 @@ class FaultFile:
 
 def load_fault_file(path: str | Path, own_address: int | None = None) -> FaultFile:
     """Read and check a fault file. Every error names the file, the line and the key
-    (``bench.toml:7:9: faults[1].kind: unknown fault 'x'; …``), as a scenario's do.
+    (``bench.toml:7:8: faults[0].kind: unknown fault 'x'; …``), as a scenario's do.
 
     ``own_address`` is the robot's address, when known: a ``wrong_address`` fault may not
     use it. The ``[robot]`` table is checked here, key by key, and returned as a table so
