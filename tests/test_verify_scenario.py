@@ -267,6 +267,10 @@ def test_the_nth_table_of_an_array_is_found():
     ('[[inputs]]\nat = "1s"', "inputs[0]", "needs 'at'"),
     ('[[inputs]]\nat = "1s"\nset = { x = "on" }', "inputs[0].set.x", "true/false or a number"),
     ('[[inputs]]\nat = "1s"\nset = { x = 3 }\npulse = "1s"', "inputs[0].pulse", "no BOOL"),
+    # was "inputs[0].pulse: ... this input sets no BOOL" at the pulse line: the 1 meant as a bit
+    ('[[inputs]]\nat = "1s"\nset = { X0 = 1 }\npulse = "1s"', "inputs[0].set.X0",
+     "is the number 1, and a pulse sets BOOL labels back after a while: write X0 = true for a bit"),
+    ('[[inputs]]\nat = "1s"\nset = { x = 3, b = 0 }\npulse = "1s"', "inputs[0].set.b", "write b = false for a bit"),
     ('[[inputs]]\nat = "99s"\nset = { x = 3 }', "inputs[0].at", "after the end"),
     ('[[expect]]\nthat = "a"\nnever = "b"', "expect[0]", "exactly one"),
     ('[[expect]]\nthat = "a AND"', "expect[0].that", "column"),

@@ -715,6 +715,12 @@ class _Reader:
                 raise self.fail(f"{key}.set.{name}", f"expected true/false or a number, got {shown(value)}")
         pulse = self.duration(item["pulse"], f"{key}.pulse") if "pulse" in item else None
         if pulse is not None and not any(isinstance(v, bool) for v in checked.values()):
+            bit_as_number = next((name for name, v in checked.items() if v in (0, 1)), None)
+            if bit_as_number is not None:  # `X0 = 1` meant as a bit: say so at the value, not at the pulse
+                value = checked[bit_as_number]
+                raise self.fail(f"{key}.set.{bit_as_number}",
+                                f"is the number {shown(value)}, and a pulse sets BOOL labels back after a while: "
+                                f"write {bit_as_number} = {'true' if value else 'false'} for a bit")
             raise self.fail(f"{key}.pulse", "a pulse sets BOOL labels back after a while; this input sets no BOOL")
         return InputStep(at, checked, pulse, key)
 
