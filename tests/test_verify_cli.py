@@ -1259,3 +1259,19 @@ def test_the_response_signal_ci_md_names_judges_a_fault_that_strikes_between_com
     assert run_scenario(_with_signal(mine, signal)).passed
     cycle = run_scenario(_with_signal(mine, "fbCycle.o_bErr"))
     assert [rule for rule, found in cycle.violations.items() if found] == ["UITAMR-RESPONSE-HANDLING"]
+
+
+def test_every_bad_scenario_file_is_named_in_one_run(tmp_path):
+    """Two scenario files with mistakes among three: both named, each at its place, and the
+    good one not run (verify stopped at the first mistake and left the second for the next
+    run, while `uitamr check` listed both)."""
+    first, good, second = (tmp_path / name for name in ("a.toml", "b.toml", "c.toml"))
+    first.write_text('program = "UITAMR_ExampleFx3"\nduration = "5 sec"\n')
+    good.write_text('program = "UITAMR_ExampleFx3"\nduration = "1s"\n')
+    second.write_text('program = "UITAMR_ExampleFx3"\n[[inputs]]\nat = "1s"\nset = { X0 = "on" }\n')
+    done = _run_cli("--scenario", first, "--scenario", good, "--scenario", second)
+    assert done.returncode == 2, done.stderr
+    lines = done.stderr.splitlines()
+    assert [line.split(": ")[1] for line in lines if line.startswith("error: ")] == \
+        [f"{first}:2:12", f"{second}:4:14"]
+    assert "Traceback" not in done.stderr and done.stdout == ""

@@ -83,9 +83,35 @@ def _is_zero(value) -> bool:
         return False
 
 
-def _unusable(message: str) -> None:
-    text_console(stderr=True).print(f"[bold red]error:[/] {escape(message)}", markup=True)
+def _unusable(message: str, *more: str) -> None:
+    console = text_console(stderr=True)
+    for text in (message, *more):
+        console.print(f"[bold red]error:[/] {escape(text)}", markup=True)
     sys.exit(EXIT_UNUSABLE)
+
+
+class ScenarioMistakes(UnusableInput):
+    """The mistakes of several scenario files, each its own message (file:line:col)."""
+
+    def __init__(self, errors: list[ScenarioError]):
+        self.messages = [str(e) for e in errors]
+        super().__init__("\n".join(self.messages))
+
+
+def _read_scenarios(files, platform: str | None = None) -> list[Scenario]:
+    """Every scenario file read; the mistakes of all of them reported together, as `uitamr
+    check` does (one at a time, a folder of scenarios took a run per mistake to clean up)."""
+    read, mistakes = [], []
+    for f in files:
+        try:
+            read.append(load_scenario(f, platform))
+        except ScenarioError as exc:
+            mistakes.append(exc)
+    if len(mistakes) == 1:
+        raise mistakes[0]
+    if mistakes:
+        raise ScenarioMistakes(mistakes)
+    return read
 
 
 #: the platform a serial channel belongs to, by the family of its default port (fx3:, fx5:,
@@ -102,7 +128,7 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
     resolved = _source_files(sources) if sources else ()
     scenario_files = _scenario_files(scenario_files)
     given = {real_path(f) for f in scenario_files}
-    own = [load_scenario(f, platform) for f in scenario_files]  # --platform: the CPU they run on
+    own = _read_scenarios(scenario_files, platform)  # --platform: the CPU they run on
     bundled_files: list[Path] = []
     if matrix or (not sources and not scenario_files):
         found = bundled_scenarios()
@@ -119,7 +145,7 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
     if resolved and matrix:
         # the user's program under the robot/fault set of every bundled scenario of its platform
         platform = platform or infer_platform(resolved)
-        bundled = [load_scenario(f) for f in bundled_files]
+        bundled = _read_scenarios(bundled_files)
         tcp = uses_tcp_route(resolved, program)  # serial programs under serial scenarios, TCP ones behind a converter
         bundled = [s.with_overrides(duration_us=duration, scan_us=scan, seed=seed) for s in bundled
                    if s.platform == platform and (s.converter is not None) == tcp]
@@ -129,7 +155,7 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
         scenarios = [s.with_overrides(**overrides) for s in own]
         scenarios += without_repeats([for_user_sources(s, resolved, program, channel) for s in bundled])
     else:
-        bundled = [load_scenario(f) for f in bundled_files]  # only without SOURCES: their own sources
+        bundled = _read_scenarios(bundled_files)  # only without SOURCES: their own sources
         if platform is not None and bundled:
             # the bundled examples are written for their platform: --platform picks them
             bundled = [s for s in bundled if s.platform == platform]
@@ -451,6 +477,8 @@ def command(sources, program, platform, channel, response_signal, scenario_files
             scenarios = [_with_signal(s, response_signal) for s in scenarios]
         inputs = [p for s in scenarios for p in ([s.path] if s.path else []) + list(s.sources)]
         check_not_inputs(inputs, json_path, junit_path, trace_path, html_path)
+    except ScenarioMistakes as exc:
+        _unusable(*exc.messages)
     except (ScenarioError, UnusableInput, ReportError) as exc:
         _unusable(str(exc))
     stderr = text_console(stderr=True)
