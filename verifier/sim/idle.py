@@ -55,7 +55,6 @@ random ones (tests/test_idle_skip.py): same report bytes.
 """
 from __future__ import annotations
 
-import operator
 import re
 from dataclasses import dataclass
 from functools import lru_cache
@@ -130,8 +129,8 @@ class IdleScans:
         self._judging_first = False
         self._deadlines: list[Callable[[int], float | None]] = []  # each poller's idle_deadline
         # cells instruction operands have written: compared by value from then on, whoever
-        # writes them later (cells list id -> (cells, indexes, getter of their values))
-        self._operand_cells: dict[int, tuple[list, set[int], Callable]] = {}
+        # writes them later (cells list id -> (cells, indexes))
+        self._operand_cells: dict[int, tuple[list, set[int]]] = {}
         facts = _source_facts(project.module.source)
         self.reason: str | None = None
         if facts.reads_et:
@@ -142,7 +141,11 @@ class IdleScans:
         self._timers: list[StdFB] = []
         self._walk(roots)
         self._labels = self._label_reader()
-        self._cells, self._whole = self._device_footprint(facts)
+        self._constant_cells, self._whole = self._device_footprint(facts)
+        # the whole state as one generated function (`_state_reader`), made again when what
+        # it reads grows: an operand writes a new cell, or a port is made on its first call
+        self._layout = 0
+        self._state = self._state_reader()
         self._clocks = self._relevant_clocks(facts, read_devices)
         if self.reason is None:
             rt.dirty_log = []
@@ -194,10 +197,9 @@ class IdleScans:
             if scalars:
                 self._objects.append((obj, scalars))
 
-    def _label_reader(self) -> Callable[[], tuple]:
-        """One generated function reading every label slot and copying every array: the
-        comparison runs twice per idle stretch, so it is kept to plain attribute loads."""
-        env: dict[str, object] = {}
+    def _label_parts(self, env: dict[str, object]) -> list[str]:
+        """The expressions reading every label slot and copying every array (their objects
+        put in `env`)."""
         parts = []
         for k, (obj, slots) in enumerate(self._objects):
             env[f"o{k}"] = obj
@@ -205,18 +207,50 @@ class IdleScans:
         for k, (obj, slot) in enumerate(self._arrays):
             env[f"a{k}"] = obj
             parts.append(f"a{k}.{slot}[:]")
+        return parts
+
+    def _label_reader(self) -> Callable[[], tuple]:
+        """One generated function reading every label slot and copying every array (what
+        bench/cycle_recurrence.py compares)."""
+        env: dict[str, object] = {}
+        parts = self._label_parts(env)
         source = "def labels():\n    return (" + ", ".join(parts) + ("," if len(parts) == 1 else "") + ")\n"
         exec(compile(source, "<idle-labels>", "exec"), env)
         return env["labels"]
+
+    def _state_reader(self) -> Callable[[], tuple]:
+        """The state `after_scan` compares, as one generated function of plain loads: every
+        label slot and array (`_label_parts`), the device and buffer cells named with a
+        constant index and those operands wrote (read by index), the areas reached any
+        other way (copied), every I/O model's `idle_state()` and the count of diagnostics.
+        It runs twice per idle stretch. Its first item is the layout's number: a state taken
+        with another layout (fewer cells, fewer ports) never equals one taken with this."""
+        self._layout += 1
+        env: dict[str, object] = {"rt": self.rt}
+        parts = [str(self._layout)] + self._label_parts(env)
+        cells = [(cells, indexes) for cells, indexes in self._constant_cells]
+        cells += [(cells, sorted(indexes)) for cells, indexes in self._operand_cells.values()]
+        for k, (memory, indexes) in enumerate(cells):
+            env[f"c{k}"] = memory
+            parts += [f"c{k}[{index}]" for index in indexes]
+        for k, memory in enumerate(self._whole):
+            env[f"w{k}"] = memory
+            parts.append(f"w{k}[:]")
+        self._state_pollers = len(self.rt.pollers)
+        for k, poller in enumerate(self.rt.pollers):
+            env[f"p{k}"] = poller.idle_state
+            parts.append(f"p{k}()")
+        env["diagnostics"] = self.rt.diagnostics
+        parts.append("len(diagnostics)")
+        source = "def state():\n    return (" + ", ".join(parts) + ")\n"
+        exec(compile(source, "<idle-state>", "exec"), env)
+        return env["state"]
 
     def _device_footprint(self, facts: "SourceFacts"):
         """The device and buffer cells the generated code names with a constant index, and
         the whole areas it reaches any other way (an index expression). Cells written
         through an instruction operand are logged by the operand (`Runtime.dirty_log`)."""
-        cells = []
-        for holder, ordered in facts.constant.items():
-            getter = operator.itemgetter(*ordered) if len(ordered) > 1 else (lambda c, i=ordered[0]: (c[i],))
-            cells.append((self._holders[holder], getter))
+        cells = [(self._holders[holder], ordered) for holder, ordered in facts.constant.items()]
         whole = [self._holders[holder] for holder in facts.whole if holder in self._holders]
         return cells, whole
 
@@ -277,6 +311,8 @@ class IdleScans:
             if self._first_skipped % FIRST_PROBE_EVERY:
                 self.first_states_skipped += 1
                 return  # not taken: `_previous` stays None, the next quiet scan takes its state
+        if len(pollers) != self._state_pollers:
+            self._state = self._state_reader()
         state = self._state()
         if self._judging_first:  # the first quiet scan's state: was it worth taking?
             if state == self._previous:
@@ -311,28 +347,14 @@ class IdleScans:
         for cells, index in log:
             entry = known.get(id(cells))
             if entry is None:
-                entry = known[id(cells)] = (cells, set(), None)
+                entry = known[id(cells)] = (cells, set())
             if index not in entry[1]:
                 entry[1].add(index)
                 grew = True
         log.clear()
         if grew:
-            for key, (cells, indexes, _) in known.items():
-                ordered = sorted(indexes)
-                getter = operator.itemgetter(*ordered) if len(ordered) > 1 else (lambda c, i=ordered[0]: (c[i],))
-                known[key] = (cells, indexes, getter)
+            self._state = self._state_reader()
         return grew
-
-    def _state(self):
-        rt = self.rt
-        return (
-            self._labels(),
-            [getter(cells) for cells, getter in self._cells],
-            [getter(cells) for cells, _, getter in self._operand_cells.values()],
-            [cells[:] for cells in self._whole],
-            [poller.idle_state() for poller in rt.pollers],
-            len(rt.diagnostics),
-        )
 
     def _timer_deadline_us(self) -> float:
         """The first instant a running timer's Q can change (timers read whole ticks)."""
