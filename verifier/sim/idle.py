@@ -69,6 +69,8 @@ INFINITY = float("inf")
 FIRST_SKIP_SCORE = 4
 FIRST_USEFUL = 4
 FIRST_PROBE_EVERY = 8
+# the cells instruction operands wrote are read by a generated function up to this many
+OPERAND_CELLS_GENERATED = 64
 _CONST_CELL = re.compile(r"\b(_A_[A-Z]+|_U[0-9A-F]+)\[(\d+)\]")
 _ANY_USE = re.compile(r"\b(_A_[A-Z]+|_U[0-9A-F]+)\b(?!\[\d+\])")
 _OPERAND_CONSTRUCTORS = ("_Ref(", "_BitRef(", "_DwordRef(")
@@ -142,9 +144,11 @@ class IdleScans:
         self._walk(roots)
         self._labels = self._label_reader()
         self._constant_cells, self._whole = self._device_footprint(facts)
-        # the whole state as one generated function (`_state_reader`), made again when what
-        # it reads grows: an operand writes a new cell, or a port is made on its first call
+        # the whole state as one generated function (`_state_reader`), made again when a port
+        # is made on its first call; it reads the cells operands wrote through `_operands[0]`,
+        # made again (`_operand_reader`) when an operand writes a new cell
         self._layout = 0
+        self._operands = [lambda: ()]
         self._state = self._state_reader()
         self._clocks = self._relevant_clocks(facts, read_devices)
         if self.reason is None:
@@ -221,18 +225,18 @@ class IdleScans:
     def _state_reader(self) -> Callable[[], tuple]:
         """The state `after_scan` compares, as one generated function of plain loads: every
         label slot and array (`_label_parts`), the device and buffer cells named with a
-        constant index and those operands wrote (read by index), the areas reached any
-        other way (copied), every I/O model's `idle_state()` and the count of diagnostics.
-        It runs twice per idle stretch. Its first item is the layout's number: a state taken
-        with another layout (fewer cells, fewer ports) never equals one taken with this."""
+        constant index, those operands wrote (`_operand_reader`, one item), the areas
+        reached any other way (copied), every I/O model's `idle_state()` and the count of
+        diagnostics. It runs twice per idle stretch. Made again when a port is made; its
+        first item is the layout's number, so a state taken with another layout never
+        equals one taken with this."""
         self._layout += 1
-        env: dict[str, object] = {"rt": self.rt}
+        env: dict[str, object] = {"operands": self._operands}
         parts = [str(self._layout)] + self._label_parts(env)
-        cells = [(cells, indexes) for cells, indexes in self._constant_cells]
-        cells += [(cells, sorted(indexes)) for cells, indexes in self._operand_cells.values()]
-        for k, (memory, indexes) in enumerate(cells):
+        for k, (memory, indexes) in enumerate(self._constant_cells):
             env[f"c{k}"] = memory
             parts += [f"c{k}[{index}]" for index in indexes]
+        parts.append("operands[0]()")
         for k, memory in enumerate(self._whole):
             env[f"w{k}"] = memory
             parts.append(f"w{k}[:]")
@@ -245,6 +249,23 @@ class IdleScans:
         source = "def state():\n    return (" + ", ".join(parts) + ")\n"
         exec(compile(source, "<idle-state>", "exec"), env)
         return env["state"]
+
+    def _operand_reader(self) -> Callable[[], tuple]:
+        """The values of the cells operands wrote, in order (cells list by cells list, each
+        by index): a generated function of plain loads while they are few, a loop beyond
+        OPERAND_CELLS_GENERATED (made again each time a cell is added, so a program filling
+        a large area through an operand would compile it once per new cell)."""
+        known = [(cells, sorted(indexes)) for cells, indexes in self._operand_cells.values()]
+        if sum(len(indexes) for _, indexes in known) > OPERAND_CELLS_GENERATED:
+            return lambda: tuple([cells[index] for cells, indexes in known for index in indexes])
+        env: dict[str, object] = {}
+        parts = []
+        for k, (cells, indexes) in enumerate(known):
+            env[f"k{k}"] = cells
+            parts += [f"k{k}[{index}]" for index in indexes]
+        source = "def cells():\n    return (" + "".join(f"{part}, " for part in parts) + ")\n"
+        exec(compile(source, "<idle-operand-cells>", "exec"), env)
+        return env["cells"]
 
     def _device_footprint(self, facts: "SourceFacts"):
         """The device and buffer cells the generated code names with a constant index, and
@@ -353,7 +374,7 @@ class IdleScans:
                 grew = True
         log.clear()
         if grew:
-            self._state = self._state_reader()
+            self._operands[0] = self._operand_reader()
         return grew
 
     def _timer_deadline_us(self) -> float:
