@@ -55,7 +55,6 @@ random ones (tests/test_idle_skip.py): same report bytes.
 """
 from __future__ import annotations
 
-import operator
 import re
 from dataclasses import dataclass
 from functools import lru_cache
@@ -70,6 +69,8 @@ INFINITY = float("inf")
 FIRST_SKIP_SCORE = 4
 FIRST_USEFUL = 4
 FIRST_PROBE_EVERY = 8
+# the cells instruction operands wrote are read by a generated function up to this many
+OPERAND_CELLS_GENERATED = 64
 _CONST_CELL = re.compile(r"\b(_A_[A-Z]+|_U[0-9A-F]+)\[(\d+)\]")
 _ANY_USE = re.compile(r"\b(_A_[A-Z]+|_U[0-9A-F]+)\b(?!\[\d+\])")
 _OPERAND_CONSTRUCTORS = ("_Ref(", "_BitRef(", "_DwordRef(")
@@ -130,8 +131,8 @@ class IdleScans:
         self._judging_first = False
         self._deadlines: list[Callable[[int], float | None]] = []  # each poller's idle_deadline
         # cells instruction operands have written: compared by value from then on, whoever
-        # writes them later (cells list id -> (cells, indexes, getter of their values))
-        self._operand_cells: dict[int, tuple[list, set[int], Callable]] = {}
+        # writes them later (cells list id -> (cells, indexes))
+        self._operand_cells: dict[int, tuple[list, set[int]]] = {}
         facts = _source_facts(project.module.source)
         self.reason: str | None = None
         if facts.reads_et:
@@ -142,7 +143,13 @@ class IdleScans:
         self._timers: list[StdFB] = []
         self._walk(roots)
         self._labels = self._label_reader()
-        self._cells, self._whole = self._device_footprint(facts)
+        self._constant_cells, self._whole = self._device_footprint(facts)
+        # the whole state as one generated function (`_state_reader`), made again when a port
+        # is made on its first call; it reads the cells operands wrote through `_operands[0]`,
+        # made again (`_operand_reader`) when an operand writes a new cell
+        self._layout = 0
+        self._operands = [lambda: ()]
+        self._state = self._state_reader()
         self._clocks = self._relevant_clocks(facts, read_devices)
         if self.reason is None:
             rt.dirty_log = []
@@ -194,10 +201,9 @@ class IdleScans:
             if scalars:
                 self._objects.append((obj, scalars))
 
-    def _label_reader(self) -> Callable[[], tuple]:
-        """One generated function reading every label slot and copying every array: the
-        comparison runs twice per idle stretch, so it is kept to plain attribute loads."""
-        env: dict[str, object] = {}
+    def _label_parts(self, env: dict[str, object]) -> list[str]:
+        """The expressions reading every label slot and copying every array (their objects
+        put in `env`)."""
         parts = []
         for k, (obj, slots) in enumerate(self._objects):
             env[f"o{k}"] = obj
@@ -205,18 +211,67 @@ class IdleScans:
         for k, (obj, slot) in enumerate(self._arrays):
             env[f"a{k}"] = obj
             parts.append(f"a{k}.{slot}[:]")
+        return parts
+
+    def _label_reader(self) -> Callable[[], tuple]:
+        """One generated function reading every label slot and copying every array (what
+        bench/cycle_recurrence.py compares)."""
+        env: dict[str, object] = {}
+        parts = self._label_parts(env)
         source = "def labels():\n    return (" + ", ".join(parts) + ("," if len(parts) == 1 else "") + ")\n"
         exec(compile(source, "<idle-labels>", "exec"), env)
         return env["labels"]
+
+    def _state_reader(self) -> Callable[[], tuple]:
+        """The state `after_scan` compares, as one generated function of plain loads: every
+        label slot and array (`_label_parts`), the device and buffer cells named with a
+        constant index, those operands wrote (`_operand_reader`, one item), the areas
+        reached any other way (copied), every I/O model's `idle_state()` and the count of
+        diagnostics. It runs twice per idle stretch. Made again when a port is made; its
+        first item is the layout's number, so a state taken with another layout never
+        equals one taken with this."""
+        self._layout += 1
+        env: dict[str, object] = {"operands": self._operands}
+        parts = [str(self._layout)] + self._label_parts(env)
+        for k, (memory, indexes) in enumerate(self._constant_cells):
+            env[f"c{k}"] = memory
+            parts += [f"c{k}[{index}]" for index in indexes]
+        parts.append("operands[0]()")
+        for k, memory in enumerate(self._whole):
+            env[f"w{k}"] = memory
+            parts.append(f"w{k}[:]")
+        self._state_pollers = len(self.rt.pollers)
+        for k, poller in enumerate(self.rt.pollers):
+            env[f"p{k}"] = poller.idle_state
+            parts.append(f"p{k}()")
+        env["diagnostics"] = self.rt.diagnostics
+        parts.append("len(diagnostics)")
+        source = "def state():\n    return (" + ", ".join(parts) + ")\n"
+        exec(compile(source, "<idle-state>", "exec"), env)
+        return env["state"]
+
+    def _operand_reader(self) -> Callable[[], tuple]:
+        """The values of the cells operands wrote, in order (cells list by cells list, each
+        by index): a generated function of plain loads while they are few, a loop beyond
+        OPERAND_CELLS_GENERATED (made again each time a cell is added, so a program filling
+        a large area through an operand would compile it once per new cell)."""
+        known = [(cells, sorted(indexes)) for cells, indexes in self._operand_cells.values()]
+        if sum(len(indexes) for _, indexes in known) > OPERAND_CELLS_GENERATED:
+            return lambda: tuple([cells[index] for cells, indexes in known for index in indexes])
+        env: dict[str, object] = {}
+        parts = []
+        for k, (cells, indexes) in enumerate(known):
+            env[f"k{k}"] = cells
+            parts += [f"k{k}[{index}]" for index in indexes]
+        source = "def cells():\n    return (" + "".join(f"{part}, " for part in parts) + ")\n"
+        exec(compile(source, "<idle-operand-cells>", "exec"), env)
+        return env["cells"]
 
     def _device_footprint(self, facts: "SourceFacts"):
         """The device and buffer cells the generated code names with a constant index, and
         the whole areas it reaches any other way (an index expression). Cells written
         through an instruction operand are logged by the operand (`Runtime.dirty_log`)."""
-        cells = []
-        for holder, ordered in facts.constant.items():
-            getter = operator.itemgetter(*ordered) if len(ordered) > 1 else (lambda c, i=ordered[0]: (c[i],))
-            cells.append((self._holders[holder], getter))
+        cells = [(self._holders[holder], ordered) for holder, ordered in facts.constant.items()]
         whole = [self._holders[holder] for holder in facts.whole if holder in self._holders]
         return cells, whole
 
@@ -277,6 +332,8 @@ class IdleScans:
             if self._first_skipped % FIRST_PROBE_EVERY:
                 self.first_states_skipped += 1
                 return  # not taken: `_previous` stays None, the next quiet scan takes its state
+        if len(pollers) != self._state_pollers:
+            self._state = self._state_reader()
         state = self._state()
         if self._judging_first:  # the first quiet scan's state: was it worth taking?
             if state == self._previous:
@@ -311,28 +368,14 @@ class IdleScans:
         for cells, index in log:
             entry = known.get(id(cells))
             if entry is None:
-                entry = known[id(cells)] = (cells, set(), None)
+                entry = known[id(cells)] = (cells, set())
             if index not in entry[1]:
                 entry[1].add(index)
                 grew = True
         log.clear()
         if grew:
-            for key, (cells, indexes, _) in known.items():
-                ordered = sorted(indexes)
-                getter = operator.itemgetter(*ordered) if len(ordered) > 1 else (lambda c, i=ordered[0]: (c[i],))
-                known[key] = (cells, indexes, getter)
+            self._operands[0] = self._operand_reader()
         return grew
-
-    def _state(self):
-        rt = self.rt
-        return (
-            self._labels(),
-            [getter(cells) for cells, getter in self._cells],
-            [getter(cells) for cells, _, getter in self._operand_cells.values()],
-            [cells[:] for cells in self._whole],
-            [poller.idle_state() for poller in rt.pollers],
-            len(rt.diagnostics),
-        )
 
     def _timer_deadline_us(self) -> float:
         """The first instant a running timer's Q can change (timers read whole ticks)."""
