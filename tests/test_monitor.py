@@ -162,6 +162,25 @@ def test_a_replay_of_the_monitors_trace_judges_as_the_live_session_did(tmp_path)
     assert json.loads((tmp_path / "r.jsonl").read_text().splitlines()[-1]) == {"scenario": "site.jsonl", "end": 9.998333}
 
 
+def test_a_replay_of_a_trace_keeps_its_times_when_the_first_frame_came_in_pieces(tmp_path):
+    """A loaded host read the first request in two pieces, 15 ms apart: live, that frame
+    starts 9.8 ms after the first byte (the session's 0). The replay of the monitor's trace
+    took its first frame's start for 0, so every time (the POWERON-STOP finding, the run's
+    length) came out 9.8 ms early (a way the real-line replay tests can differ from the
+    live run under load, as they once did in the duration)."""
+    from verifier.monitor.capture import parse_trace
+    from verifier.verify import report_trace
+
+    run_point = frame("run-point", "1")
+    live = session_of([Chunk(1_000_000, run_point[:3]), Chunk(1_015_000, run_point[3:]), Chunk(1_030_000, run_point),
+                       Chunk(1_300_000, STOP), Chunk(1_315_000, STOP)], 20_000, end_us=4_000_000)
+    assert live.frames[0].t_start_us > 0
+    trace = tmp_path / "site.jsonl"
+    report_trace.write([live.result()], trace)
+    replayed = session_of(parse_trace(trace.read_text(encoding="utf-8"))["test"], 20_000)
+    assert _judged(replayed) == _judged(live)
+
+
 def test_a_trace_without_its_end_record_still_replays(tmp_path):
     """A trace written before the end record (these are _no_reply_at_the_end's frames):
     the run ends at the last frame, as it did."""
@@ -616,7 +635,7 @@ def test_a_bad_master_on_a_real_line_gets_exactly_its_findings(line, tmp_path):
     # how long the line was listened to (the capture's `end` line); only the names differ
     live_run, replayed = (json.loads((tmp_path / name).read_text())["scenarios"][0] for name in ("m.json", "r.json"))
     differing = {key for key in live_run if live_run[key] != replayed[key]}
-    assert differing == {"name", "file", "description", "channel"}, differing
+    assert differing == {"name", "file", "description", "channel"}, {k: (live_run[k], replayed[k]) for k in differing}
     # so is the replay of the monitor's --trace (its end record: the run lasted the 3 s
     # listened to, not until the last frame at 1.3 s)
     done = subprocess.run(uitamr("replay", tmp_path / "m.jsonl", "--json", tmp_path / "t.json"),
@@ -624,7 +643,7 @@ def test_a_bad_master_on_a_real_line_gets_exactly_its_findings(line, tmp_path):
     assert done.returncode == 1, done.stdout + done.stderr
     replayed = json.loads((tmp_path / "t.json").read_text())["scenarios"][0]
     differing = {key for key in live_run if live_run[key] != replayed[key]}
-    assert differing == {"name", "file", "description", "channel"}, differing
+    assert differing == {"name", "file", "description", "channel"}, {k: (live_run[k], replayed[k]) for k in differing}
 
 
 @pytest.mark.serial
@@ -650,7 +669,7 @@ def test_a_request_left_unanswered_on_a_real_line_replays_from_the_trace_as_judg
     assert done.returncode == 1, done.stdout + done.stderr
     live_run, replayed = (json.loads((tmp_path / name).read_text())["scenarios"][0] for name in ("m.json", "r.json"))
     differing = {key for key in live_run if live_run[key] != replayed[key]}
-    assert differing == {"name", "file", "description", "channel"}, differing
+    assert differing == {"name", "file", "description", "channel"}, {k: (live_run[k], replayed[k]) for k in differing}
 
 
 @pytest.mark.serial
