@@ -131,6 +131,103 @@ def test_a_capture_with_its_end_line_replays_the_silence_after_the_last_bytes(tm
     assert _judged(session_of(parse_plain(capture.read_text(encoding="utf-8")))) == _judged(live)
 
 
+def _no_reply_at_the_end() -> MonitorSession:
+    """A live session: the stop and its echo, a read the robot never answers, then the
+    monitor listens on, silent, for 9.5 s (the failure outlasts RESPONSE-HANDLING's 5 s)."""
+    return session_of([Chunk(10_000, STOP), Chunk(21_000, STOP), Chunk(500_000, READ)], 20_000, end_us=10_000_000)
+
+
+def test_a_replay_of_the_monitors_trace_judges_as_the_live_session_did(tmp_path):
+    """A `monitor --trace` file ended at its last frame: its replay ended the run there, so
+    a request at the end with no reply was never judged overdue (the live session's
+    UITAMR-RESPONSE-HANDLING finding was gone, exit 0) and the run was 0.5 s, not 10 s.
+    The trace now ends each run with an end record, read as a capture's `end` line is."""
+    from verifier.monitor.capture import parse_trace
+    from verifier.verify import report_trace
+
+    live = _no_reply_at_the_end()
+    assert [v.rule for found in live.result().violations.values() for v in found] == ["UITAMR-RESPONSE-HANDLING"]
+    trace = tmp_path / "site.jsonl"
+    report_trace.write([live.result()], trace)
+    assert json.loads(trace.read_text(encoding="utf-8").splitlines()[-1]) == {"scenario": "test", "end": 9.998333}
+    done = subprocess.run(uitamr("replay", trace, "--json", tmp_path / "r.json", "--trace", tmp_path / "r.jsonl"),
+                          capture_output=True, text=True, timeout=WAIT_S)
+    assert done.returncode == 1, done.stdout + done.stderr
+    replayed = json.loads((tmp_path / "r.json").read_text())["scenarios"][0]
+    assert replayed["duration"] == pytest.approx(9.998333)
+    assert [(v["rule"], v["message"]) for v in replayed["violations"]] == [
+        (v.rule, v.message) for found in live.result().violations.values() for v in found]
+    assert _judged(session_of(parse_trace(trace.read_text(encoding="utf-8"))["test"], 20_000)) == _judged(live)
+    # the replay's own trace ends where the live session did, so it replays alike again
+    assert json.loads((tmp_path / "r.jsonl").read_text().splitlines()[-1]) == {"scenario": "site.jsonl", "end": 9.998333}
+
+
+def test_a_replay_of_a_trace_keeps_its_times_when_the_first_frame_came_in_pieces(tmp_path):
+    """A loaded host read the first request in two pieces, 15 ms apart: live, that frame
+    starts 9.8 ms after the first byte (the session's 0). The replay of the monitor's trace
+    took its first frame's start for 0, so every time (the POWERON-STOP finding, the run's
+    length) came out 9.8 ms early (a way the real-line replay tests can differ from the
+    live run under load, as they once did in the duration)."""
+    from verifier.monitor.capture import parse_trace
+    from verifier.verify import report_trace
+
+    run_point = frame("run-point", "1")
+    live = session_of([Chunk(1_000_000, run_point[:3]), Chunk(1_015_000, run_point[3:]), Chunk(1_030_000, run_point),
+                       Chunk(1_300_000, STOP), Chunk(1_315_000, STOP)], 20_000, end_us=4_000_000)
+    assert live.frames[0].t_start_us > 0
+    trace = tmp_path / "site.jsonl"
+    report_trace.write([live.result()], trace)
+    replayed = session_of(parse_trace(trace.read_text(encoding="utf-8"))["test"], 20_000)
+    assert _judged(replayed) == _judged(live)
+
+
+def test_a_trace_without_its_end_record_still_replays(tmp_path):
+    """A trace written before the end record (these are _no_reply_at_the_end's frames):
+    the run ends at the last frame, as it did."""
+    trace = tmp_path / "old.jsonl"
+    trace.write_text(
+        '{"scenario": "site", "t": 0.0, "t_end": 0.008333, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14", '
+        '"meaning": "stop (01/A0)", "origin": null, "tolerance": 0.02, "rules": []}\n'
+        '{"scenario": "site", "t": 0.011, "t_end": 0.019333, "dir": "rx", "hex": "01 06 01 A0 00 00 88 14", '
+        '"meaning": "echo: stop (01/A0)", "origin": null, "tolerance": 0.02, "rules": []}\n'
+        '{"scenario": "site", "t": 0.49, "t_end": 0.498333, "dir": "tx", "hex": "01 01 00 00 00 16 BD C4", '
+        '"meaning": "read task status (query 0)", "origin": null, "tolerance": 0.02, "rules": []}\n',
+        encoding="utf-8")
+    done = subprocess.run(uitamr("replay", trace, "--json", tmp_path / "r.json"), capture_output=True, text=True,
+                          timeout=WAIT_S)
+    assert done.returncode == 0, done.stdout + done.stderr
+    replayed = json.loads((tmp_path / "r.json").read_text())["scenarios"][0]
+    assert replayed["duration"] == pytest.approx(0.498333) and replayed["violations"] == []
+
+
+@pytest.mark.parametrize("lines, message", [
+    (['{"scenario": "a", "end": 0.5, "t": 0.1}'],
+     "t.jsonl:2:1: an end record holds only 'scenario' and 'end' (until when the line was listened to); it has 't'"),
+    (['{"scenario": "a", "end": 0.05}'], "t.jsonl:2:1: 'end' (0.05 s) is before the end of the record before (0.108 s)"),
+    (['{"scenario": "a", "end": -1}'], "t.jsonl:2:1: 'end' is -1; expected a time in seconds"),
+    (['{"scenario": "a", "end": 0.5}', '{"scenario": "a", "t": 0.6, "dir": "tx", "hex": "01"}'],
+     "t.jsonl:3:1: the run 'a' ended at its end record ({path}:2); move this record before it"),
+])
+def test_a_bad_end_record_is_named_with_its_line(tmp_path, lines, message):
+    path = tmp_path / "t.jsonl"
+    first = '{"scenario": "a", "t": 0.1, "t_end": 0.108, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}'
+    path.write_text("\n".join([first, *lines]) + "\n", encoding="utf-8")
+    done = subprocess.run(uitamr("replay", path), capture_output=True, text=True, timeout=WAIT_S)
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+    assert done.stderr.startswith(f"uitamr replay: {tmp_path}/{message.format(path=path)}"), done.stderr
+
+
+def test_each_run_of_a_trace_has_its_own_end(tmp_path):
+    path = tmp_path / "t.jsonl"
+    path.write_text('{"scenario": "a", "t": 0.1, "t_end": 0.108, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}\n'
+                    '{"scenario": "a", "end": 2.5}\n'
+                    '{"scenario": "b", "t": 0.1, "t_end": 0.108, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}\n',
+                    encoding="utf-8")
+    loaded = read_capture(path)
+    assert [(c.t_us, c.data) for c in loaded["a"]] == [(108_000, STOP), (2_500_000, b"")]
+    assert [(c.t_us, c.data) for c in loaded["b"]] == [(108_000, STOP)]
+
+
 def test_a_bad_trace_record_is_named_with_its_line(tmp_path):
     path = tmp_path / "t.jsonl"
     path.write_text('{"t": 0.1, "t_end": 0.108, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}\n{"t": 0.2, \n',
@@ -482,8 +579,9 @@ def test_replay_of_a_verify_trace_file(tmp_path):
     data = json.loads(report.read_text())
     assert data["verdict"] == "pass" and data["scenarios"][0]["violations"] == []
     original = [json.loads(line) for line in trace.read_text().splitlines()]
-    again = [json.loads(line) for line in (tmp_path / "r.jsonl").read_text().splitlines()]
+    *again, end = [json.loads(line) for line in (tmp_path / "r.jsonl").read_text().splitlines()]
     assert [(r["dir"], r["hex"], r["meaning"]) for r in again] == [(r["dir"], r["hex"], r["meaning"]) for r in original]
+    assert end == {"scenario": again[0]["scenario"], "end": data["scenarios"][0]["duration"]}  # the replay's run's end
     assert "<svg" in (tmp_path / "r.html").read_text()
 
 
@@ -537,7 +635,41 @@ def test_a_bad_master_on_a_real_line_gets_exactly_its_findings(line, tmp_path):
     # how long the line was listened to (the capture's `end` line); only the names differ
     live_run, replayed = (json.loads((tmp_path / name).read_text())["scenarios"][0] for name in ("m.json", "r.json"))
     differing = {key for key in live_run if live_run[key] != replayed[key]}
-    assert differing == {"name", "file", "description", "channel"}, differing
+    assert differing == {"name", "file", "description", "channel"}, {k: (live_run[k], replayed[k]) for k in differing}
+    # so is the replay of the monitor's --trace (its end record: the run lasted the 3 s
+    # listened to, not until the last frame at 1.3 s)
+    done = subprocess.run(uitamr("replay", tmp_path / "m.jsonl", "--json", tmp_path / "t.json"),
+                          capture_output=True, text=True, timeout=WAIT_S)
+    assert done.returncode == 1, done.stdout + done.stderr
+    replayed = json.loads((tmp_path / "t.json").read_text())["scenarios"][0]
+    differing = {key for key in live_run if live_run[key] != replayed[key]}
+    assert differing == {"name", "file", "description", "channel"}, {k: (live_run[k], replayed[k]) for k in differing}
+
+
+@pytest.mark.serial
+def test_a_request_left_unanswered_on_a_real_line_replays_from_the_trace_as_judged_live(line, tmp_path):
+    """The last request gets no reply (a bad CRC: the robot ignores it) and the monitor
+    listens on: live, the failure lasts past RESPONSE-HANDLING's 5 s. The replay of the
+    monitor's --trace ended at that request, so the finding was gone and the run 5 s
+    shorter; with the trace's end record it is the live judgement."""
+    monitor = monitor_on(line, tmp_path, "--duration", "8s", "--trace", tmp_path / "m.jsonl")
+    master = Master(line.plc)
+    try:
+        stop = frame("stop")
+        master.send(stop)
+        master.at(0.3)
+        master.send(stop[:-1] + bytes([stop[-1] ^ 0x01]), reply_length=None)
+    finally:
+        master.close()
+    out, err = monitor.communicate(timeout=WAIT_S)
+    assert monitor.returncode == 1, out + err
+    assert findings(tmp_path / "m.json")["UITAMR-RESPONSE-HANDLING"] == 1, out
+    done = subprocess.run(uitamr("replay", tmp_path / "m.jsonl", "--json", tmp_path / "r.json"),
+                          capture_output=True, text=True, timeout=WAIT_S)
+    assert done.returncode == 1, done.stdout + done.stderr
+    live_run, replayed = (json.loads((tmp_path / name).read_text())["scenarios"][0] for name in ("m.json", "r.json"))
+    differing = {key for key in live_run if live_run[key] != replayed[key]}
+    assert differing == {"name", "file", "description", "channel"}, {k: (live_run[k], replayed[k]) for k in differing}
 
 
 @pytest.mark.serial

@@ -100,7 +100,9 @@ def test_a_monitor_trace_replays_to_the_monitors_findings(tmp_path):
     exact = subprocess.run(uitamr("replay", str(trace), "--tolerance", "0"), capture_output=True, text=True,
                            timeout=60)
     assert exact.returncode == 1 and "UITAMR-PACING ×2" in exact.stdout
-    assert all(json.loads(line)["tolerance"] == DEFAULT_TOLERANCE_US / 1e6 for line in trace.read_text().splitlines())
+    *frames, end = (json.loads(line) for line in trace.read_text().splitlines())
+    assert all(record["tolerance"] == DEFAULT_TOLERANCE_US / 1e6 for record in frames)
+    assert end == {"scenario": "site", "end": live.ended_us / 1e6}  # the end record: a time, no frame
 
 
 def test_an_unreadable_capture_is_reported_as_section_6_quotes(tmp_path):

@@ -655,26 +655,41 @@ def test_conditions_evaluate_like_their_meaning(expression):
     assert parse_condition(text).holds(_VALUES) == expected
 
 
-def test_the_scenario_channels_are_the_simulators():
-    """A scenario (and --channel) offers every serial channel the simulator drives and no
-    other: the two lists are kept apart so that reading a scenario does not import the
-    simulator, and fx5:2 was once missing from this one."""
-    from verifier.sim.serial import CHANNELS as SIMULATED
-    from verifier.verify.scenario import CHANNELS
+def test_each_familys_channels_are_the_simulators():
+    """One table (verifier.plcfacts.FAMILY_CHANNELS) says which serial channels each CPU
+    family has, for the simulator and the scenario reader alike (which once kept a list of
+    its own, once missing fx5:2): every channel offered belongs to a family, every family is
+    a simulated CPU's, and adp:1 (the ADPRW MODBUS master) is on exactly the families the
+    instruction registry runs ADPRW on."""
+    from verifier import plcfacts
+    from verifier.sim.cpu import PROFILES
+    from verifier.sim.instructions import lookup
 
-    assert sorted(CHANNELS) == sorted(SIMULATED)
+    families = {p.family for p in PROFILES.values()}
+    assert set(plcfacts.FAMILY_CHANNELS) == families
+    assert set().union(*plcfacts.FAMILY_CHANNELS.values()) == set(plcfacts.CHANNELS)
+    for family, channels in plcfacts.FAMILY_CHANNELS.items():
+        assert list(channels) == [c for c in plcfacts.CHANNELS if c in channels], family  # CHANNELS' order
+        adprw, _ = lookup("ADPRW", family)
+        assert ("adp:1" in channels) == (family in adprw.families), family
 
 
-def test_reading_a_scenario_does_not_import_the_simulator():
-    """The reason the channel lists above are kept apart: `uitamr check` of a scenario file
-    and the scenario reader stay clear of the simulator until a run needs it (a module-level
-    import of its buffer-memory size once loaded it)."""
+def test_reading_every_bundled_scenario_does_not_import_the_simulator():
+    """Reading a scenario checks its `channel` (and `[initial]` buffer memory) as a run
+    would, from verifier.plcfacts: a scenario that set `channel` once imported the
+    simulator's compiler and runtime (about 25 verifier.sim modules) only to ask which
+    channels its CPU has."""
     import subprocess
     import sys
 
-    code = ("import sys, verifier.verify.scenario; "
+    from verifier.bundled import plc_dir
+
+    paths = sorted(str(p) for p in (plc_dir() / "scenarios").glob("*.toml"))
+    assert any("channel" in Path(p).read_text(encoding="utf-8") for p in paths)  # the case that imported it
+    code = ("import sys; from verifier.verify.scenario import load_scenario\n"
+            "for path in sys.argv[1:]: load_scenario(path)\n"
             "print(sorted(m for m in sys.modules if m.startswith('verifier.sim')))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    out = subprocess.run([sys.executable, "-c", code, *paths], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
 
 

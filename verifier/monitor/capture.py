@@ -130,8 +130,11 @@ def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
 def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
     """Our JSONL trace (`uitamr verify --trace`, `uitamr monitor --trace`): frames with
     their direction, grouped by scenario, in file order (a record ends at a line feed or a
-    CRLF; `read_capture` reads a file with lone CRs too)."""
+    CRLF; `read_capture` reads a file with lone CRs too). A run's end record (a monitor's
+    trace has one, docs/verifier.md) is a chunk with no bytes at its time, as a plain
+    capture's `end` line is: the replay polls until then, as the live session listened."""
     scenarios: dict[str, list[Chunk]] = {}
+    ended: dict[str, int] = {}  # scenario -> the line of its end record
     for number, raw in enumerate(text_lines(text), start=1):
         if not raw.strip():
             continue
@@ -147,12 +150,21 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
                                "deep") from None
         if not isinstance(record, dict):
             raise CaptureError(f"{name}:{number}:1: a trace record is a JSON object")
+        where = f"{name}:{number}:1"
+        scenario = str(record.get("scenario", name))
+        if scenario in ended:
+            raise CaptureError(f"{where}: the run {scenario!r} ended at its end record ({name}:{ended[scenario]}); "
+                               "move this record before it, or remove the end record")
+        if "end" in record:
+            chunks = scenarios.setdefault(scenario, [])
+            chunks.append(_end_chunk(record, chunks, where))
+            ended[scenario] = number
+            continue
         for key in ("t", "dir", "hex"):
             if key not in record:
                 raise CaptureError(f"{name}:{number}:1: the record has no {key!r}")
         if record["dir"] not in ("tx", "rx"):
-            raise CaptureError(f"{name}:{number}:1: 'dir' is {record['dir']!r}; expected \"tx\" or \"rx\"")
-        where = f"{name}:{number}:1"
+            raise CaptureError(f"{where}: 'dir' is {record['dir']!r}; expected \"tx\" or \"rx\"")
         hex_text = record["hex"]
         if not isinstance(hex_text, str) or not hex_text.strip() or not _HEX_BYTES.fullmatch(hex_text):
             raise CaptureError(f"{where}: 'hex' is {hex_text!r}; expected bytes in hex, two digits each, "
@@ -162,7 +174,6 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
         t_end = _seconds(record["t_end"], "t_end", where) if record.get("t_end") is not None else t_start
         if t_end < t_start:
             raise CaptureError(f"{where}: 't_end' ({t_end:g} s) is before 't' ({t_start:g} s)")
-        scenario = str(record.get("scenario", name))
         chunks = scenarios.setdefault(scenario, [])
         if chunks and round(t_start * 1_000_000) < chunks[-1].t_start_us:
             raise CaptureError(f"{where}: 't' ({t_start:g} s) is earlier than the record before of scenario "
@@ -178,6 +189,21 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
         chunks.append(Chunk(round(t_end * 1_000_000), data, record["dir"], round(t_start * 1_000_000),
                             None if tolerance is None else round(tolerance * 1_000_000)))
     return scenarios
+
+
+def _end_chunk(record: dict, chunks: list[Chunk], where: str) -> Chunk:
+    """A trace's end record (`{"scenario": ..., "end": seconds}`, which a monitor's trace
+    ends each run with): until when the line was listened to, as a chunk with no bytes,
+    as a plain capture's `end` line is read."""
+    other = sorted(set(record) - {"scenario", "end"})
+    if other:
+        raise CaptureError(f"{where}: an end record holds only 'scenario' and 'end' (until when the line was "
+                           f"listened to); it has {', '.join(map(repr, other))}")
+    end_us = round(_seconds(record["end"], "end", where) * 1_000_000)
+    if chunks and end_us < chunks[-1].t_us:
+        raise CaptureError(f"{where}: 'end' ({end_us / 1_000_000:g} s) is before the end of the record before "
+                           f"({chunks[-1].t_us / 1_000_000:g} s); a trace is in time order")
+    return Chunk(end_us, b"")
 
 
 _HEX_BYTES = re.compile(r"\s*(?:[0-9A-Fa-f]{2}\s*)*")

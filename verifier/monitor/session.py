@@ -75,8 +75,10 @@ class MonitorSession:
             return self.poll(chunk.t_us)
         self._open()
         if self._origin_us is None:
-            self._origin_us = (chunk.t_start_us if chunk.t_start_us is not None
-                               else chunk.t_us - self.timing.frame_us(len(chunk.data)))
+            # a trace's frames (their start given) are on the clock of the run that wrote
+            # them (a monitor's 0: its first byte; verify's: power-on), which the trace's
+            # end record counts on too; host chunks, from any origin, begin at the first byte
+            self._origin_us = 0 if chunk.t_start_us is not None else chunk.t_us - self.timing.frame_us(len(chunk.data))
         local = replace(chunk, t_us=chunk.t_us - self._origin_us,
                         t_start_us=None if chunk.t_start_us is None else chunk.t_start_us - self._origin_us)
         self.chunks.append(local)

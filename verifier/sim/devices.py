@@ -12,6 +12,8 @@ import operator
 import re
 from dataclasses import dataclass
 
+from verifier.plcfacts import BUFFER_WORDS  # words modelled per module (0..5FFFH); scenarios read it too
+
 from .cpu import FX3_SPECIAL, FX3_SPECIAL_RANGE, Area, CpuProfile, fx3_serial_equivalent, special_equivalent
 from .datatypes import wrap16, wrap32
 
@@ -74,11 +76,6 @@ def device_warning(name: str, cpu: CpuProfile) -> str | None:
     if digits or bit is not None:
         return None
     return _fx3_special_warning(area_name, number, name.strip(), cpu)
-
-
-#: Buffer-memory words the simulator models per module (0..5FFFH). ASSUMPTION: enough for
-#: the QJ71C24N areas and the QJ71E71 status words (5000H, 5005H) the library uses.
-BUFFER_WORDS = 0x6000
 
 
 def locate_buffer(d, cpu: CpuProfile) -> tuple[int, int]:

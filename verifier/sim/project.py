@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 from typing import Callable, Iterable
 
+from verifier import plcfacts
 from verifier.st import ast
 from verifier.st.check import called_without
 from verifier.st.source import read_source
@@ -17,7 +18,6 @@ from .cpu import profile_for
 from .errors import LoadError, SimulationError, option_error
 from .instructions import InstructionSet
 from .runtime import Runtime
-from .serial import CHANNELS, NOT_SIMULATED
 from .typesys import ArrayT, CompileError, StringT, StructT
 from .values import InstanceProxy, to_st, to_st_list, wrap
 
@@ -70,31 +70,6 @@ def _empty_folder(path: Path) -> ast.Diagnostic:
         hint = f"; name the folders that hold them: {named}"
     return ast.Diagnostic(str(path), 0, 0, "error", "no .st files in this folder (load reads a folder's own "
                           f"*.st files, not its subfolders){hint}")
-
-
-def serial_channels_of(cpu) -> list[str]:
-    """The serial channels a CPU (a cpu.CpuProfile) has: its own ports ("fx3:1", "fx3:2" /
-    "fx5:1", "fx5:2" / "q:1", "q:2") and, where it has ADPRW, the MODBUS master's ("adp:1")."""
-    from .instructions import lookup
-
-    adprw, _ = lookup("ADPRW", cpu.family)
-    families = {cpu.family, "adp"} if cpu.family in adprw.families else {cpu.family}
-    return [c for c in CHANNELS if c.split(":")[0] in families]
-
-
-def channel_problem(channel: str, cpu) -> str | None:
-    """Why `channel` cannot be attached on `cpu`, naming the channels it has; None if it can
-    (also for the scenario reader: a channel its platform lacks is an error at its line)."""
-    have = serial_channels_of(cpu)
-    if channel in have:
-        return None
-    if channel in CHANNELS:
-        problem = f"channel {channel} does not exist on the {cpu.name} CPU"
-    elif channel in NOT_SIMULATED:
-        problem = f"channel {channel} is not simulated: {NOT_SIMULATED[channel]}"
-    else:
-        problem = f"unknown serial channel {channel!r}"
-    return f"{problem}; the {cpu.name} CPU has {', '.join(have)}"
 
 
 class Project:
@@ -387,12 +362,12 @@ class Project:
 
     # ------------------------------------------------------------------ serial
     def serial_channels(self) -> list[str]:
-        """The serial channels this CPU has (`serial_channels_of`)."""
-        return serial_channels_of(self.cpu)
+        """The serial channels this CPU has (verifier.plcfacts.FAMILY_CHANNELS)."""
+        return plcfacts.serial_channels(self.cpu.name)
 
     def _serial_channel(self, channel: str):
         """The channel by name; ValueError naming the channels this CPU has otherwise."""
-        problem = channel_problem(channel, self.cpu)
+        problem = plcfacts.channel_problem(channel, self.cpu.name)
         if problem is not None:
             raise ValueError(problem)
         return self.rt.channel(channel)

@@ -14,10 +14,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 from fractions import Fraction
 
-CHANNELS = ("fx3:1", "fx3:2", "fx5:1", "fx5:2", "q:1", "q:2", "adp:1")
-#: channels a real CPU can have that the simulator does not drive, and why
-NOT_SIMULATED = {"adp:2": "the simulated ADPRW is the MODBUS master on adp:1 only (docs/instructions.md, ADPRW)"}
-
 
 @dataclass(frozen=True, slots=True)
 class SentFrame:

@@ -4,7 +4,10 @@ Fields: `t`, `t_end` (seconds of virtual time), `dir` ("tx" PLC→robot, "rx" ro
 `hex` (space-separated bytes), `meaning` (decoded), `origin` (the ST location that sent a
 tx frame, when known), `scenario`, and `rules` (ids of the rules this frame is evidence for);
 a trace of host times (`uitamr monitor`, `uitamr replay`) also has `tolerance` (seconds), which
-a replay of it allows again.
+a replay of it allows again, and ends each run that has frames with an end record
+`{"scenario": ..., "end": seconds}`: until when the line was listened to (`end_record`),
+so that a replay judges the silence after the last frame as the live session did (a reply
+still due, the run's length), as a plain capture's `end` line does.
 
 A run of `uitamr verify --trace` or `--html` does not hold its frames: it writes each
 one as a spool line while it goes (`spool_lines`: everything but `rules`, which only the
@@ -22,7 +25,7 @@ from verifier import protocol
 from verifier.textfile import UNENCODABLE, whole_file
 
 from .evidence import RuleOptions
-from .result import ScenarioResult, run_names
+from .result import LINE, ScenarioResult, run_names
 from .traffic import analyse, describe_bytes
 
 
@@ -156,3 +159,15 @@ def write(results: list[ScenarioResult], path: Path) -> None:
                 continue
             for record in records(result, name):
                 out.write(json.dumps(record, ensure_ascii=False) + "\n")
+            end = end_record(result, name)
+            if end is not None:
+                out.write(json.dumps(end, ensure_ascii=False) + "\n")
+
+
+def end_record(result: ScenarioResult, name: str) -> dict | None:
+    """The record after a line's frames (a monitor's or a replay's run that saw any): when
+    the run ended, i.e. until when the line was listened to. A simulated run's trace has
+    none: its lines are its frames alone."""
+    if result.platform != LINE or not frame_count(result):
+        return None
+    return {"scenario": name, "end": result.ended_us / 1_000_000}

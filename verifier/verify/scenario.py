@@ -17,6 +17,7 @@ from verifier.amr.config import RobotConfig
 from verifier.amr.faults import Fault, check_fault_addresses
 from verifier.amr.schema import ConfigError, unknown_key
 from verifier.digits import digit_problem
+from verifier.plcfacts import BUFFER_WORDS, CHANNELS, channel_problem, serial_channels
 from verifier.textfile import UnreadableText, read_utf8, text_lines
 from verifier.tomlpos import Place, decode_error_position, place_of_key, shown
 
@@ -34,7 +35,6 @@ PLATFORMS = {
     "fx5u": ("gxworks3", "fx5:1"),
     "q": ("gxworks2", "q:1"),
 }
-CHANNELS = ("fx3:1", "fx3:2", "fx5:1", "fx5:2", "q:1", "q:2", "adp:1")
 DEFAULT_DURATION_US = 60_000_000
 #: The longest run accepted (virtual time). A day of 10 ms scans takes the simulator about
 #: an hour; anything longer is almost always a typo ("1000h") and would look like a hang.
@@ -436,12 +436,9 @@ class _Reader:
             channel = self.string(data["channel"], "channel")
             if channel not in CHANNELS:
                 raise self.fail("channel", f"unknown channel {channel!r}; expected one of {', '.join(CHANNELS)}")
-            from verifier.sim.cpu import PROFILES
-            from verifier.sim.project import channel_problem, serial_channels_of
-
-            problem = channel_problem(channel, PROFILES[platform])  # as verify's load would refuse it
+            problem = channel_problem(channel, platform)  # as verify's load would refuse it
             if problem is not None:
-                owner = next((p for p in PLATFORMS if channel in serial_channels_of(PROFILES[p])), None)
+                owner = next((p for p in PLATFORMS if channel in serial_channels(p)), None)
                 if "platform" not in data and owner is not None:  # the platform is the default (or --platform's)
                     given = "--platform's" if self.platform_option else "the default platform"
                     problem += f" ({platform} is {given}: set platform = \"{owner}\", the CPU that has {channel})"
@@ -612,9 +609,6 @@ class _Reader:
             if problem := digit_problem(name):  # 'U0\G１６４'
                 raise self.fail(key, problem, at_name=True)
             match = BUFFER_MEMORY.match(name)
-            # the simulator's size, imported only here: reading a scenario does not load the simulator
-            from verifier.sim.devices import BUFFER_WORDS  # words modelled per module (0..5FFFH)
-
             if match and int(match.group(2)) >= BUFFER_WORDS:
                 raise self.fail(key, f"buffer memory ends at G{BUFFER_WORDS - 1} in the simulator")
             if not match and not DEVICE_NAME.match(name):

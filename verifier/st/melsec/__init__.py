@@ -13,6 +13,8 @@ from __future__ import annotations
 import re
 from types import MappingProxyType
 
+from verifier.plcfacts import PLATFORM_FAMILY
+
 from . import fx3, fx5, q
 
 #: family -> (the CPUs, the editor that refuses the names)
@@ -21,9 +23,7 @@ FAMILIES = MappingProxyType({
     "fx5": ("FX5U", "GX Works3"),
     "q": ("Q", "GX Works2"),
 })
-#: `--platform` -> family (the families of verifier.sim.cpu.PROFILES; kept equal by
-#: tests/test_check_reserved.py)
-PLATFORM_FAMILY = MappingProxyType({"fx3u": "fx3", "fx3g": "fx3", "fx5u": "fx5", "q": "q"})
+#: `--platform` -> family: verifier.plcfacts.PLATFORM_FAMILY (shared with the scenario reader)
 #: `--target` -> the families its editor programs (those of verifier.sim.cpu.TARGET_CPUS;
 #: kept equal by tests/test_check_reserved.py: verifier.st does not import the simulator)
 TARGET_FAMILIES = MappingProxyType({"gxworks2": ("fx3", "q"), "gxworks3": ("fx5",)})
