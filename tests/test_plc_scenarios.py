@@ -293,3 +293,14 @@ def test_the_fault_coverage_table_names_every_bundled_scenario_in_its_route():
     assert sorted(names) == sorted(p.stem for p in SCENARIOS)
     for name, column in placed:
         assert _route(load_scenario(ROOT / "plc" / "scenarios" / f"{name}.toml")) == column, name
+
+
+def test_the_fx3u_adprw_port_paragraph_names_every_scenario_that_verifies_it():
+    """docs/plc-library.md's FX3U-485ADP-MB paragraph ends with the bundled scenarios that
+    verify the port; it named four of the seven after session 26 added the ADPRW route's bad
+    CRC (205), wrong address (213) and garbage, the scenarios that show those codes."""
+    text = squeezed("docs/plc-library.md")
+    paragraph = text.split("Verified under `uitamr verify` by `plc/scenarios/fx3u-adprw-healthy.toml`", 1)[1]
+    paragraph = paragraph.split("As for every ADPRW detail above", 1)[0]
+    named = set(re.findall(r"`(fx3u-adprw-[a-z-]+)\.toml`", paragraph)) | {"fx3u-adprw-healthy"}
+    assert named == {p.stem for p in SCENARIOS if p.stem.startswith("fx3u-adprw-")}

@@ -80,3 +80,10 @@ def test_the_manuals_error_codes_go_by_the_names_the_tool_prints():
             assert ERROR_TITLES[error] in row, (name, ERROR_TITLES[error])
         for kind in ("anti_collision", "off_tape", "low_battery"):
             assert kind in FAULT_KINDS and f"`{kind}`" in row, (name, kind)
+
+
+def test_each_readme_links_the_other():
+    """A reader who lands on either README can reach the other: README.md ends with the
+    Chinese one's link, and README.zh-TW.md had no way back to the English one."""
+    assert "](README.zh-TW.md)" in EN
+    assert "](README.md)" in ZH

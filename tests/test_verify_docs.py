@@ -365,3 +365,25 @@ def test_ci_md_says_which_scenario_mistakes_only_verify_finds(tmp_path):
         assert quoted.group(1) in str(err), str(err)
     else:
         raise AssertionError("verify ran a scenario whose PROGRAM does not exist")
+
+
+def test_a_replay_trace_carries_a_tolerance_only_for_host_times_and_ends_with_the_end_record(tmp_path):
+    """verifier.md, `--trace FILE`: a line's trace (monitor, replay) ends each run with an
+    end record; a frame says its tolerance only when its times were judged with one, so a
+    replay of `uitamr verify`'s exact trace writes none (the page said every frame has one)."""
+    import json
+
+    from click.testing import CliRunner
+
+    from verifier.cli import main
+
+    text = " ".join((DOCS / "verifier.md").read_text(encoding="utf-8").split())
+    assert "none in a replay of an exactly timed trace" in text
+    scenario = Path(__file__).resolve().parents[1] / "plc" / "scenarios" / "fx3u-healthy.toml"
+    CliRunner().invoke(main, ["verify", "--scenario", str(scenario), "--duration", "2s",
+                              "--trace", str(tmp_path / "v.jsonl")])
+    replayed = CliRunner().invoke(main, ["replay", str(tmp_path / "v.jsonl"), "--trace", str(tmp_path / "r.jsonl")])
+    assert replayed.exit_code == 0, replayed.output
+    *frames, end = (json.loads(line) for line in (tmp_path / "r.jsonl").read_text(encoding="utf-8").splitlines())
+    assert frames and all("dir" in f and "tolerance" not in f for f in frames)
+    assert set(end) == {"scenario", "end"} and end["end"] == frames[-1]["t_end"]
