@@ -181,6 +181,28 @@ def test_a_replay_of_a_trace_keeps_its_times_when_the_first_frame_came_in_pieces
     assert _judged(replayed) == _judged(live)
 
 
+def test_a_monitors_trace_never_starts_before_0_so_its_replay_reads_it(tmp_path):
+    """The first request came in two pieces 0.5 ms apart (a TCP converter or a pty delivers
+    faster than the line), the first piece of two bytes: the first byte's start, estimated
+    in whole µs, came out 1 µs before the session's 0, the trace said `"t": -1e-06` and
+    `uitamr replay` refused the monitor's own trace (exit 2, "expected a time in seconds
+    from 0")."""
+    from verifier.monitor.capture import parse_trace
+    from verifier.verify import report_trace
+
+    live = session_of([Chunk(1_000_000, STOP[:2]), Chunk(1_000_500, STOP[2:]), Chunk(1_020_000, STOP)], 20_000,
+                      end_us=3_000_000)
+    assert live.frames[0].t_start_us == 0
+    trace = tmp_path / "site.jsonl"
+    report_trace.write([live.result()], trace)
+    assert json.loads(trace.read_text(encoding="utf-8").splitlines()[0])["t"] == 0
+    replayed = session_of(parse_trace(trace.read_text(encoding="utf-8"))["test"], 20_000)
+    assert _judged(replayed) == _judged(live)
+    done = subprocess.run(uitamr("replay", trace, "--json", tmp_path / "r.json"), capture_output=True, text=True,
+                          timeout=WAIT_S)
+    assert done.returncode == 0, done.stdout + done.stderr
+
+
 def test_a_trace_without_its_end_record_still_replays(tmp_path):
     """A trace written before the end record (these are _no_reply_at_the_end's frames):
     the run ends at the last frame, as it did."""

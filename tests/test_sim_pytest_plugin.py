@@ -76,3 +76,27 @@ def test_st_that_does_not_load_is_reported_at_its_line_not_with_the_simulators_t
     assert "Broken.st:5:" in out and "Missing.st:0:0: error: cannot read" in out
     assert 'st_load("Broken.st")' in out          # the test's own line stays
     assert "verifier/sim/" not in out and "pytest_plugin.py" not in out, out
+
+
+def test_a_load_error_report_keeps_the_users_fixture_line_and_whole_tracebacks_on_request(pytester):
+    """The short report of ST that does not load kept only the test file's lines: a load in
+    a conftest fixture showed no line of the user's at all; and --full-trace / --tb=long,
+    asked for to see inside the loader, still gave the short report."""
+    pytester.makefile(".st", Broken="FUNCTION_BLOCK Broken\nVAR\n    n : INT;\nEND_VAR\nn := n + ;\nEND_FUNCTION_BLOCK\n")
+    pytester.makeconftest(textwrap.dedent("""
+        import pytest
+
+        @pytest.fixture
+        def broken(st_load):
+            return st_load("Broken.st")
+    """))
+    pytester.makepyfile(test_broken="def test_fixture(broken):\n    pass\n")
+    result = pytester.runpytest_subprocess("-p", "no:cacheprovider")
+    result.assert_outcomes(errors=1)
+    out = result.stdout.str()
+    assert "Broken.st:5:" in out and 'conftest.py:5: return st_load("Broken.st")' in out, out
+    assert "verifier/sim/" not in out and "_pytest" not in out, out
+    for asked in ("--full-trace", "--tb=long"):
+        result = pytester.runpytest_subprocess("-p", "no:cacheprovider", asked)
+        result.assert_outcomes(errors=1)
+        assert "verifier/sim/" in result.stdout.str() and "Broken.st:5:" in result.stdout.str(), asked

@@ -1275,3 +1275,18 @@ def test_every_bad_scenario_file_is_named_in_one_run(tmp_path):
     assert [line.split(": ")[1] for line in lines if line.startswith("error: ")] == \
         [f"{first}:2:12", f"{second}:4:14"]
     assert "Traceback" not in done.stderr and done.stdout == ""
+
+
+def test_every_scenario_file_without_sources_is_named_in_one_run(tmp_path):
+    """Two scenario files that name no ST sources (none given as arguments either): both
+    named, each its own error line (verify named only the first and left the second for
+    the next run, while a mistake in reading the files names every file)."""
+    first, second = tmp_path / "a.toml", tmp_path / "b.toml"
+    first.write_text('program = "UITAMR_ExampleFx3"\nduration = "1s"\n')
+    second.write_text('duration = "2s"\nprogram = "UITAMR_ExampleFx3"\n')
+    done = _run_cli("--scenario", first, "--scenario", second)
+    assert done.returncode == 2, done.stderr
+    errors = [line for line in done.stderr.splitlines() if line.startswith("error: ")]
+    assert [line.split(": ")[1] for line in errors] == [f"{first}:1:1", f"{second}:1:1"]
+    assert all("no ST sources" in line for line in errors)
+    assert "Traceback" not in done.stderr and done.stdout == ""

@@ -271,6 +271,9 @@ def test_the_nth_table_of_an_array_is_found():
     ('[[inputs]]\nat = "1s"\nset = { X0 = 1 }\npulse = "1s"', "inputs[0].set.X0",
      "is the number 1, and a pulse sets BOOL labels back after a while: write X0 = true for a bit"),
     ('[[inputs]]\nat = "1s"\nset = { x = 3, b = 0 }\npulse = "1s"', "inputs[0].set.b", "write b = false for a bit"),
+    # a word device set to 1 with a pulse is no bit meant as a number: not told to write D0 = true
+    ('[[inputs]]\nat = "1s"\nset = { D0 = 1 }\npulse = "1s"', "inputs[0].pulse", "this input sets no BOOL"),
+    ('[[inputs]]\nat = "1s"\nset = { W1F = 0, SD8063 = 1 }\npulse = "1s"', "inputs[0].pulse", "no BOOL"),
     ('[[inputs]]\nat = "99s"\nset = { x = 3 }', "inputs[0].at", "after the end"),
     ('[[expect]]\nthat = "a"\nnever = "b"', "expect[0]", "exactly one"),
     ('[[expect]]\nthat = "a AND"', "expect[0].that", "column"),

@@ -79,15 +79,24 @@ def describe_project(project) -> str:
 
 def _load_error_report(item, excinfo) -> str | None:
     """ST that does not load (a syntax error, a file named wrong) is the test's input, not a
-    fault of the toolkit: the report is the test's own lines that led to it and the
-    LoadError's file:line:col message, not the frames inside the plugin and the simulator's
-    loader. None for any other failure (pytest's report as usual)."""
+    fault of the toolkit: the report is the user's own lines that led to it (the test's, a
+    helper's, a conftest fixture's) and the LoadError's file:line:col message, not the
+    frames inside the plugin, the simulator's loader and pytest. None for any other failure,
+    and when the run asks for whole tracebacks (--full-trace, --tb=long or native): pytest's
+    report as usual."""
     errors = sys.modules.get("verifier.sim.errors")
     if excinfo is None or errors is None or not excinfo.errisinstance(errors.LoadError):
         return None
-    test_file = Path(str(item.path)).resolve()
+    config = item.config
+    if config.getoption("fulltrace", False) or config.getoption("tbstyle", "auto") in ("long", "native"):
+        return None
+    import _pytest
+    import pluggy
+
+    theirs = [Path(module.__file__).resolve().parent for module in (sys.modules["verifier"], _pytest, pluggy)]
     lines = [f"{entry.path}:{entry.lineno + 1}: {str(entry.statement).strip()}"
-             for entry in excinfo.traceback if Path(str(entry.path)).resolve() == test_file]
+             for entry in excinfo.traceback
+             if not any(folder in Path(str(entry.path)).resolve().parents for folder in theirs)]
     # the error first: pytest's short summary quotes the report's first line
     return "\n".join([f"E   {line}" for line in excinfo.exconly().splitlines()] + lines)
 

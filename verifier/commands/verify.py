@@ -93,7 +93,7 @@ def _unusable(message: str, *more: str) -> None:
 class ScenarioMistakes(UnusableInput):
     """The mistakes of several scenario files, each its own message (file:line:col)."""
 
-    def __init__(self, errors: list[ScenarioError]):
+    def __init__(self, errors: list[Exception]):
         self.messages = [str(e) for e in errors]
         super().__init__("\n".join(self.messages))
 
@@ -186,29 +186,42 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
         raise UnusableInput(f"--scan {format_duration(scan)}: the scan time is longer than the whole run "
                             f"(--duration {format_duration(duration)})")
     for scenario in scenarios:
-        # each is fine in its file (checked there): an option on the command line clashes with it
-        if scenario.scan_us > scenario.duration_us:
-            key = "scan" if scan is None else "duration"  # the file's value the option met
-            option = f"--scan {format_duration(scan)}" if scan is not None else ""
-            if duration is not None:
-                option += (" and " if option else "") + f"--duration {format_duration(duration)}"
-            default = "" if key in scenario.key_lines or key != "scan" else ", the default"
-            raise UnusableInput(
-                f"{scenario.key_where(key)}: the scan time "
-                f"({format_duration(scenario.scan_us)}{default}) is longer than the whole run "
-                f"({format_duration(scenario.duration_us)})" + (f" with {option}" if option else ""))
-        if scenario.scan_jitter_us >= scenario.scan_us:
-            raise UnusableInput(
-                f"{scenario.key_where('scan_jitter')}: must be shorter than "
-                f"the scan time ({format_duration(scenario.scan_us)})"
-                + (f" with --scan {format_duration(scan)}" if scan is not None else ""))
-        if not scenario.sources:
-            if scenario.path is None:
-                raise UnusableInput("the default scenario: no ST sources: give them as arguments (uitamr verify FILE.st ...)")
-            raise UnusableInput(f"{scenario.key_where('sources')}: no ST sources: list them in the file "
-                                "(sources = [\"plc/*.st\"], relative to it) or give them as arguments "
-                                "(uitamr verify FILE.st ...)")
+        _check_options(scenario, scan, duration)  # the option is to blame: its first clash is enough
+    # a file that names no sources is the file's mistake: every such file named, as a mistake
+    # in reading them is (`_read_scenarios`)
+    mistakes = [UnusableInput(_no_sources(scenario)) for scenario in scenarios if not scenario.sources]
+    if len(mistakes) == 1:
+        raise mistakes[0]
+    if mistakes:
+        raise ScenarioMistakes(mistakes)
     return scenarios
+
+
+def _no_sources(scenario: Scenario) -> str:
+    if scenario.path is None:
+        return "the default scenario: no ST sources: give them as arguments (uitamr verify FILE.st ...)"
+    return (f"{scenario.key_where('sources')}: no ST sources: list them in the file "
+            "(sources = [\"plc/*.st\"], relative to it) or give them as arguments (uitamr verify FILE.st ...)")
+
+
+def _check_options(scenario: Scenario, scan: int | None, duration: int | None) -> None:
+    """UnusableInput when an option on the command line clashes with `scenario` (fine in its
+    file: checked there)."""
+    if scenario.scan_us > scenario.duration_us:
+        key = "scan" if scan is None else "duration"  # the file's value the option met
+        option = f"--scan {format_duration(scan)}" if scan is not None else ""
+        if duration is not None:
+            option += (" and " if option else "") + f"--duration {format_duration(duration)}"
+        default = "" if key in scenario.key_lines or key != "scan" else ", the default"
+        raise UnusableInput(
+            f"{scenario.key_where(key)}: the scan time "
+            f"({format_duration(scenario.scan_us)}{default}) is longer than the whole run "
+            f"({format_duration(scenario.duration_us)})" + (f" with {option}" if option else ""))
+    if scenario.scan_jitter_us >= scenario.scan_us:
+        raise UnusableInput(
+            f"{scenario.key_where('scan_jitter')}: must be shorter than "
+            f"the scan time ({format_duration(scenario.scan_us)})"
+            + (f" with --scan {format_duration(scan)}" if scan is not None else ""))
 
 
 def _cut_short(scenario: Scenario) -> Scenario:

@@ -123,12 +123,15 @@ class Framer:
         """`length` buffered bytes from `at` on as a frame: it ends when its last byte arrived
         and lasted its length at the line's speed, but began no earlier than its first byte
         arrived (a pty or a fast adapter delivers faster than the line) nor before the frame
-        before it ended. The caller drops the bytes (`_drop`) once it has cut its frames."""
+        before it ended, and the first frame not before 0, the session's first byte: the
+        first byte's arrival, estimated from its chunk's time in whole µs, less one byte's
+        time could come out 1 µs before it, and a trace refuses a negative time (a monitor's
+        trace its own replay refused). The caller drops the bytes (`_drop`) once it has cut
+        its frames."""
         data = bytes(self._buffer[at:at + length])
         first, end = self._arrivals[at], self._arrivals[at + length - 1]
-        start = max(end - self.timing.frame_us(length), first - self.timing.frame_us(1))
-        if self._previous_end_us is not None:
-            start = max(start, self._previous_end_us)
+        start = max(end - self.timing.frame_us(length), first - self.timing.frame_us(1),
+                    0 if self._previous_end_us is None else self._previous_end_us)
         self._previous_end_us = end
         return Frame(start, end, data)
 

@@ -63,6 +63,8 @@ TCP_CHANNEL = "tcp"
 BUFFER_MEMORY = re.compile(r"^U([0-9A-F]{1,3})\\G([0-9]+)$", re.IGNORECASE)
 #: Device names (X0, M8000, D100, SM400, ...) address the device memory, not labels.
 DEVICE_NAME = re.compile(r"^(?:(?:X|Y|B|W|SB|SW)[0-9A-F]+|(?:M|L|F|S|T|C|D|R|ZR|SM|SD)[0-9]+)$", re.IGNORECASE)
+#: Word devices (D100, W1F, SD8063, ZR0): a number set there is a word, never a bit meant as one
+WORD_DEVICE = re.compile(r"^(?:(?:W|SW)[0-9A-F]+|(?:D|R|ZR|SD)[0-9]+)$", re.IGNORECASE)
 _LABEL_PATH = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\[[0-9]+\])*(\.[A-Za-z_][A-Za-z0-9_]*(\[[0-9]+\])*)*$")
 
 Value = bool | int | float
@@ -709,7 +711,8 @@ class _Reader:
                 raise self.fail(f"{key}.set.{name}", f"expected true/false or a number, got {shown(value)}")
         pulse = self.duration(item["pulse"], f"{key}.pulse") if "pulse" in item else None
         if pulse is not None and not any(isinstance(v, bool) for v in checked.values()):
-            bit_as_number = next((name for name, v in checked.items() if v in (0, 1)), None)
+            bit_as_number = next((name for name, v in checked.items()
+                                  if v in (0, 1) and not WORD_DEVICE.match(name)), None)
             if bit_as_number is not None:  # `X0 = 1` meant as a bit: say so at the value, not at the pulse
                 value = checked[bit_as_number]
                 raise self.fail(f"{key}.set.{bit_as_number}",
