@@ -6,8 +6,9 @@ what a serial-to-TCP converter in transparent mode passes to the robot. Every re
 written in two TCP segments and every reply is read in pieces, as a converter may split
 them.
 
-Nothing wall-clock is asserted: requests keep at least the simulated spacing (sleeping can
-only make gaps longer), waits are bounded, and the emulator runs each robot task for 600 s
+Nothing wall-clock is asserted: each request waits at least the simulated spacing after
+the previous one as it was really sent (sleeping can only make gaps longer; on a loaded
+machine a late request once shortened the gap to the next, on time, one), waits are bounded, and the emulator runs each robot task for 600 s
 so the robot's answers do not depend on how late a request arrives.
 """
 from __future__ import annotations
@@ -30,6 +31,7 @@ pytestmark = pytest.mark.serial
 
 SCENARIO = Path(__file__).resolve().parents[1] / "plc" / "scenarios" / "fx5u-tcp-healthy.toml"
 REPLAYED_US = 6_000_000  # connect, power-on stop, status polls, run point 1, polls while it runs
+SEGMENT_PAUSE_S = 0.05  # between the two TCP segments of a request
 
 
 class RecordingConverter(Converter):
@@ -89,14 +91,20 @@ def test_tcp_client_sending_the_port_pous_bytes_gets_the_simulated_replies(start
     replies = []
     with socket.create_connection(("127.0.0.1", port), timeout=10) as sock:
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        t0 = time.monotonic()
-        first_us = port_pou_exchanges[0][0]
+        previous = None  # (simulated start in µs, wall time of its first half, of its second half)
         for start_us, request, reply in port_pou_exchanges:
-            delay = t0 + (start_us - first_us) / 1e6 - time.monotonic()
-            if delay > 0:
-                time.sleep(delay)
+            if previous is not None:
+                # the simulated gap counted from the previous request as it was really sent,
+                # whichever half the emulator dates it by: a late request (a loaded machine)
+                # never shortens the gap to the next one
+                gap_s = (start_us - previous[0]) / 1e6
+                delay = max(previous[1] + gap_s, previous[2] + gap_s - SEGMENT_PAUSE_S) - time.monotonic()
+                if delay > 0:
+                    time.sleep(delay)
+            first_half = time.monotonic()
             sock.sendall(request[:3])  # two TCP segments: the converter forwards both halves
-            time.sleep(0.05)
+            time.sleep(SEGMENT_PAUSE_S)
+            previous = (start_us, first_half, time.monotonic())
             sock.sendall(request[3:])
             got = read_in_pieces(sock, len(reply))
             assert crc16(got[:-2]) == int.from_bytes(got[-2:], "little")
