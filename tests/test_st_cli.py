@@ -113,6 +113,25 @@ def test_the_toolkits_other_files_named_to_check_say_what_they_are():
     assert run(GOOD).exit_code == 0
 
 
+def test_a_capture_named_to_check_is_told_by_its_content(tmp_path):
+    """`uitamr check capture.txt` (a capture of `uitamr monitor`, named like any text file)
+    was read as ST: "1:1: error: '#' must follow a radix", exit 1. Its content tells it: it
+    says what the file is and what reads it (exit 2); a .txt holding ST is still checked."""
+    capture = ROOT / "tests" / "captures" / "bad-master.txt"
+    result = run(capture)
+    assert result.exit_code == 2, result.output
+    assert result.stderr == (f"uitamr check: {capture}: a capture of `uitamr monitor --capture` (times and bytes "
+                             f"on the line), not ST: `uitamr replay {capture}` judges its frames "
+                             "(docs/commissioning.md)\n")
+    exported = tmp_path / "MAIN.txt"  # ST as an editor may export it
+    exported.write_text(GOOD.read_text(encoding="utf-8"), encoding="utf-8")
+    assert run(exported).exit_code == 0
+    comments = tmp_path / "notes.txt"  # nothing that tells a capture: read as ST, its mistake placed
+    comments.write_text("# to do\n", encoding="utf-8")
+    result = run(comments)
+    assert result.exit_code == 1 and f"{comments}:1:1: error:" in result.output, result.output
+
+
 def test_a_pattern_is_expanded_as_verify_expands_it(tmp_path, monkeypatch):
     """ci.md's commands (`uitamr check --platform fx3u plc/ verify/*.toml`, the VS Code task)
     rely on the shell to expand `*.toml`; cmd and PowerShell do not, and check took the

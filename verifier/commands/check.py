@@ -70,6 +70,21 @@ _OTHER_KINDS = {
 }
 
 
+def _capture_kind(path: Path) -> str | None:
+    """What `path` is when it reads as a capture of `uitamr monitor` (a .txt, told by its
+    content: an editor may export ST as .txt too), or None."""
+    from verifier.monitor.capture import CaptureError, read_capture
+
+    try:
+        captures = read_capture(path)
+    except CaptureError:  # not a capture: ST (or a mistake) to be read as ST
+        return None
+    if not any(chunk.data for chunks in captures.values() for chunk in chunks):
+        return None  # only comments or an end line: nothing tells it from an empty ST file
+    return (f"a capture of `uitamr monitor --capture` (times and bytes on the line), not ST: "
+            f"`uitamr replay {path}` judges its frames (docs/commissioning.md)")
+
+
 def _not_a_source(path: Path) -> str | None:
     """Why `path` cannot be checked at all (missing, a device, a pipe, another kind of
     the toolkit's files ...), or None. Files that exist but hold no text are diagnosed with
@@ -78,7 +93,10 @@ def _not_a_source(path: Path) -> str | None:
     from verifier.verify.sources import is_pattern
 
     if path.is_file():
-        return _OTHER_KINDS.get(path.suffix.lower())
+        suffix = path.suffix.lower()
+        if suffix in _OTHER_KINDS:
+            return _OTHER_KINDS[suffix]
+        return None if suffix in (".st", ".toml") else _capture_kind(path)
     if is_pattern(str(path)):
         return "matches no file"
     if not path.exists() and not path.is_symlink():
