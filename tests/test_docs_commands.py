@@ -23,7 +23,8 @@ from verifier.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGES = ["README.md", "README.zh-TW.md", "docs/commissioning.md", "docs/emulator.md", "docs/wiring-rs485.md",
-         "docs/wiring-rs232.md", "docs/ci.md", "docs/verifier.md", "docs/protocol.md"]
+         "docs/wiring-rs232.md", "docs/ci.md", "docs/verifier.md", "docs/protocol.md", "docs/import-gxworks2.md",
+         "docs/import-gxworks3.md", "docs/scenarios.md", "docs/tcp-converter.md", "plc/README.md"]
 SHELL_ENDS = {">", ">>", "|", "&", "&&", ";"}
 
 
