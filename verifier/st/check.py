@@ -1112,7 +1112,7 @@ def _in_library(name: str, plc_shown: Path | None = None) -> str | None:
     path = library_file(name)
     if path is None:
         return None
-    if plc_shown is not None:
+    if plc_shown is not None and (plc_shown / path.relative_to(PLC_DIR)).is_file():
         path = plc_shown / path.relative_to(PLC_DIR)
     return f"the UITAMR library declares it: add {path} (or its folder) to the sources"
 
@@ -1121,15 +1121,22 @@ def _plc_as_given(filenames: list[str]) -> Path | None:
     """The bundled plc/ folder by the path the sources reach it (`vendor/uitamr/plc` for
     `vendor/uitamr/plc/core/UITAMR_Engine.st` given through a submodule or symlink), so
     that a missing library file is named the way the integrator writes it; None when no
-    source lies in it."""
+    source lies in it. A copy of the library counts too (a git submodule is one: its
+    `vendor/uitamr/plc/core/UITAMR_Engine.st` is no link to the installed toolkit's file):
+    a source whose path ends as a library file's does under plc/ (`core/UITAMR_Engine.st`)."""
     for name in filenames:
         given = Path(name)
         try:
             inside = real_path(given).relative_to(PLC_DIR)
         except ValueError:
-            continue
+            inside = next((Path(*given.parts[k:]) for k in range(len(given.parts) - 1)
+                           if (PLC_DIR / Path(*given.parts[k:])).is_file()), None)
+            if inside is None:
+                continue
         if len(inside.parts) < len(given.parts):
             return given.parents[len(inside.parts) - 1]
+        if len(inside.parts) == len(given.parts) and not given.is_absolute():
+            return Path(".")
     return None
 
 
