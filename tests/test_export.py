@@ -672,9 +672,13 @@ def test_export_refuses_a_platform_its_target_does_not_program(tmp_path, platfor
 
 
 def test_export_needs_a_target_or_a_platform(tmp_path):
-    done = export("--out", tmp_path / "out")
-    assert done.exit_code == 2
-    assert "Missing option '--target'" in done.output
+    """The export of a folder with neither --target nor --platform: the error said only
+    "Missing option '--target'. Choose from: gxworks2, gxworks3", not that a CPU will do."""
+    done = export("--out", tmp_path / "out", ROOT / "plc" / "core")
+    assert done.exit_code == 2 and "Traceback" not in done.output
+    assert done.output.splitlines()[-1] == (
+        "Error: Missing option '--target' or '--platform': name the editor (--target gxworks2 for FX3U/FX3G "
+        "and Q, gxworks3 for FX5U) or the CPU, which implies it (--platform fx3g, fx3u, fx5u, q)")
     assert not (tmp_path / "out").exists()
 
 

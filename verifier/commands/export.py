@@ -76,8 +76,11 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
     if platform is not None:
         target = platform_target(platform, target, "export")
     elif target is None:
-        ctx = click.get_current_context()
-        raise click.MissingParameter(ctx=ctx, param=next(p for p in ctx.command.params if p.name == "target"))
+        # click's own "Missing option '--target'. Choose from: gxworks2, gxworks3" hid that
+        # naming the CPU will do
+        raise click.UsageError("Missing option '--target' or '--platform': name the editor (--target gxworks2 "
+                               "for FX3U/FX3G and Q, gxworks3 for FX5U) or the CPU, which implies it "
+                               f"(--platform {', '.join(sorted(PROFILES))})")
     if sources:
         from verifier.verify.sources import is_pattern, pattern_files, pattern_matches
 
