@@ -489,6 +489,18 @@ def test_the_import_pages_list_what_export_writes_for_the_example(tmp_path, page
     assert result.exit_code == 0, result.output
     written = [line.split("\t")[0] for line in (tmp_path / "IMPORT_ORDER.txt").read_text().splitlines()]
     assert re.findall(r"`(\w+)`", listed) + [example] == written
+    # "The ADPRW variant (`UITAMR_ExampleAdpFx3`) takes `A` and `B` in place of `C`, `D` and
+    # `E`; ... `UITAMR_ExampleTcpQ` takes `F` and `G` in its place": the other examples
+    variants = re.findall(r"`(UITAMR_\w+)`\)? takes ((?:`\w+`(?:, | and )?)+) in (?:place of ((?:`\w+`(?:, | and )?)+)"
+                          r"|its place)", text)
+    assert len(variants) == {"gxworks2": 3, "gxworks3": 2}[target], variants
+    replaced: list[str] = []
+    for variant, taken, dropped in variants:
+        replaced = re.findall(r"`(\w+)`", dropped) or replaced
+        out = tmp_path / variant
+        assert run("--target", target, "--out", str(out), "--program", variant).exit_code == 0
+        pous = {line.split("\t")[0] for line in (out / "IMPORT_ORDER.txt").read_text().splitlines()}
+        assert pous == (set(written) - {example} - set(replaced)) | set(re.findall(r"`(\w+)`", taken)) | {variant}, variant
 
 
 # ---- --platform: what is written, checked against the CPU as `uitamr check --platform` does ----
