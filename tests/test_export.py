@@ -214,6 +214,24 @@ def test_a_scenario_or_a_folder_without_st_is_named_as_such(tmp_path, monkeypatc
     assert result.stderr.startswith("uitamr export: warning: scenarios: no .st file in it or below it")
 
 
+def test_the_toolkits_other_files_named_to_export_say_what_they_are(tmp_path):
+    """`uitamr export` of the ladder's .il, a capture or a scenario saved as .txt read each
+    as ST ("1:1: error: unexpected ';'", "'#' must follow a radix", "unexpected 'name'",
+    exit 1); each now says what it is and what reads it, as `uitamr check` does (exit 2)."""
+    scenario = tmp_path / "healthy.toml.txt"
+    scenario.write_text((ROOT / "plc" / "scenarios" / "fx3u-healthy.toml").read_text(encoding="utf-8"),
+                        encoding="utf-8")
+    capture = ROOT / "tests" / "captures" / "bad-master.txt"
+    for source, what in [(ROOT / "plc" / "ladder" / "UITAMR_LadderFx3.il", "an instruction list (the ladder program)"),
+                         (capture, f"a capture of `uitamr monitor --capture` (times and bytes on the line), not ST: "
+                                   f"`uitamr replay {capture}` judges its frames"),
+                         (scenario, "a scenario (TOML), not ST: name it healthy.toml")]:
+        result = run("--target", "gxworks2", "--out", str(tmp_path / "out"), str(source), str(ROOT / "plc" / "core"))
+        assert result.exit_code == 2 and "Traceback" not in result.output
+        assert result.stderr.startswith(f"uitamr export: {source}: {what}"), result.stderr
+        assert not (tmp_path / "out").exists()
+
+
 def test_global_labels_get_their_own_table(tmp_path):
     src = tmp_path / "Main.st"
     src.write_text(

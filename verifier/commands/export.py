@@ -25,7 +25,7 @@ from pathlib import Path
 import click
 
 from verifier.bundled import PLC_DIR
-from verifier.commands.check import expand_sources, platform_target, say_folders_without_st
+from verifier.commands.check import expand_sources, not_st, platform_target, say_folders_without_st
 from verifier.sim.cpu import PROFILES
 from verifier.textfile import real_path
 
@@ -98,6 +98,11 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
             more = f" and {len(scenarios) - 3} more" if len(scenarios) > 3 else ""
             click.echo(f"uitamr export: {', '.join(scenarios[:3])}{more}: a scenario (.toml), not ST source: "
                        "export writes the POUs of .st files; run scenarios with uitamr verify --scenario", err=True)
+            sys.exit(EXIT_USAGE)
+        others = [(p, what) for p in paths if p.suffix.lower() != ".st" and (what := not_st(p))]
+        if others:  # read as ST, an .il was "1:1: unexpected ';'", a capture "'#' must follow a radix"
+            for p, what in others:
+                click.echo(f"uitamr export: {p}: {what}", err=True)
             sys.exit(EXIT_USAGE)
         say_folders_without_st("uitamr export", sources, fatal=not paths)
         if not paths:
