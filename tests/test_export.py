@@ -490,6 +490,24 @@ def test_export_of_an_unknown_program_names_the_programs_and_writes_nothing(tmp_
     assert not out.exists()
 
 
+@pytest.mark.parametrize("args, program, hint", [
+    (["--target", "gxworks2"], "UITAMR_ExampleFx5", "UITAMR_ExampleFx5 is bundled for fx5u: export it with --platform fx5u"),
+    (["--platform", "q"], "UITAMR_ExampleFx3",
+     "UITAMR_ExampleFx3 is bundled for fx3u, fx3g: export it with --platform fx3u (or fx3g)"),
+    (["--target", "gxworks3"], "UITAMR_ExampleQ", "UITAMR_ExampleQ is bundled for q: export it with --platform q")])
+def test_a_bundled_program_of_another_platform_is_named_with_the_platform_that_exports_it(tmp_path, args, program,
+                                                                                          hint):
+    """import-gxworks3.md's `--program UITAMR_ExampleFx5` with gxworks2.md's `--target
+    gxworks2` (or the FX3 example under `--platform q`): the error listed the PROGRAMs of
+    that export only, not that the example is bundled for another CPU and how to export it."""
+    result = run(*args, "--out", str(tmp_path / "out"), "--program", program)
+    assert result.exit_code == 2
+    assert result.stderr.startswith(f"uitamr export: nothing written: --program: no POU {program} in the sources")
+    assert result.stderr.rstrip().endswith(f"; {hint}"), result.stderr
+    assert "is bundled" not in run(*args, "--out", str(tmp_path / "out"), "--program", "Nope").stderr
+    assert not (tmp_path / "out").exists()
+
+
 def test_export_of_a_program_still_checks_every_file(tmp_path):
     (tmp_path / "lib.st").write_text(NEEDS)
     (tmp_path / "broken.st").write_text("FUNCTION_BLOCK Broken\nVAR\n    x : INT;\nEND_VAR\nx := TRUE;\nEND_FUNCTION_BLOCK\n")

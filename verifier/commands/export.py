@@ -150,7 +150,8 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
         click.echo(f"uitamr export: nothing written, {sum(d.is_error for d in e.diagnostics)} error(s)", err=True)
         sys.exit(EXIT_ERRORS)
     except UnknownProgram as e:
-        click.echo(f"uitamr export: nothing written: --program: {e}", err=True)
+        hint = "" if sources else _bundled_elsewhere(programs, paths)
+        click.echo(f"uitamr export: nothing written: --program: {e}{hint}", err=True)
         sys.exit(EXIT_USAGE)
     except OSError as e:
         click.echo(f"uitamr export: cannot write {e.filename or out_dir}: {e.strerror or e}", err=True)
@@ -165,6 +166,25 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
     if notes:
         click.echo(f"{len(notes)} initial value(s) not carried by the {target} label tables: "
                    f"see {Path(out_dir) / DROPPED_TABLE}")
+
+
+def _bundled_elsewhere(programs: tuple[str, ...], exported: list[Path]) -> str:
+    """For a --program of the bundled library that the chosen target or platform does not
+    export (`--target gxworks2 --program UITAMR_ExampleFx5`, copied from the other import
+    page), the platforms whose export holds it."""
+    from verifier.bundled import library_file
+
+    hints = []
+    for name in programs:
+        path = library_file(name)
+        if path is None or path in exported:
+            continue
+        where = sorted((cpu for cpu in PROFILES if path in bundled_sources(platform_target(cpu, None, "export"), cpu)),
+                       key=lambda cpu: (cpu == "fx3g", cpu))  # the FX3U, the library's first FX3
+        if where:
+            hints.append(f"{path.stem} is bundled for {', '.join(where)}: export it with "
+                         f"--platform {where[0]}" + (f" (or {', '.join(where[1:])})" if where[1:] else ""))
+    return "; " + "; ".join(hints) if hints else ""
 
 
 def _warn_of_another_editor(paths: tuple[Path, ...], target: str) -> None:
