@@ -340,3 +340,28 @@ def test_a_check_of_the_bundled_library_a_page_shows_is_clean(page, command, mon
 def test_the_pages_check_the_bundled_library_for_every_platform():
     assert {page for page, _ in CHECKS} >= {"docs/import-gxworks2.md", "docs/import-gxworks3.md", "plc/README.md"}
     assert {_argv(command)[_argv(command).index("--platform") + 1] for _, command in CHECKS} >= {"fx3u", "fx5u", "q"}
+
+
+def _anchors(page: Path) -> set[str]:
+    """The #anchors GitHub makes of a page's headings: lower case, punctuation dropped,
+    spaces to hyphens."""
+    headings = re.findall(r"^#+\s+(.*?)\s*$", page.read_text(encoding="utf-8"), flags=re.M)
+    return {re.sub(r"[^\w\- ]", "", heading.lower()).replace(" ", "-") for heading in headings}
+
+
+def test_the_links_of_the_pages_resolve():
+    """Every relative link of the READMEs and docs/ (the walked pages link each other, the
+    plc/ folders and sections: `st-dialect.md#9-uitamr-check`) names a file or folder that
+    is there and, for a section, a heading the page has."""
+    pages = [ROOT / "README.md", ROOT / "README.zh-TW.md", ROOT / "plc" / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    broken, checked = [], 0
+    for page in pages:
+        for target in re.findall(r"\]\(([^)\s]+)\)", page.read_text(encoding="utf-8")):
+            if re.match(r"(https?:|mailto:|\d)", target):  # a web page, or `Bit String[16-bit](0..39)`
+                continue
+            path, _, anchor = target.partition("#")
+            linked = (page.parent / path).resolve() if path else page
+            checked += 1
+            if not linked.exists() or (anchor and linked.suffix == ".md" and anchor not in _anchors(linked)):
+                broken.append(f"{page.relative_to(ROOT)}: {target}")
+    assert checked > 100 and not broken, broken
