@@ -333,6 +333,11 @@ def test_gxworks3_carries_initial_values_in_every_table(tmp_path):
     assert (out / "S_Pos.struct.tsv").read_text().splitlines() == [
         "Label Name\tData Type\tInitial Value\tComment", "wX\tWord [Signed]\t11\t", "wY\tWord [Signed]\t\t"]
     assert (out / "IMPORT_ORDER.txt").read_text().splitlines()[0] == "S_Pos\tSTRUCT"
+    # the import pages say what to do with that line: they said it only of FUNCTION,
+    # FUNCTION_BLOCK and PROGRAM lines
+    for page in ("import-gxworks2.md", "import-gxworks3.md"):
+        steps = (ROOT / "docs" / page).read_text(encoding="utf-8").split("IMPORT_ORDER.txt order", 1)[1]
+        assert "0. A `STRUCT` line" in steps.split("\n## ", 1)[0], page
 
 
 def test_the_help_names_every_kind_of_file_the_export_writes(tmp_path):
