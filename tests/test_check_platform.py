@@ -556,3 +556,39 @@ def test_scenario_files_alone_are_not_said_to_be_checked_for_gx_works2(tmp_path)
         "1 file(s) checked for gxworks3: 0 error(s), 0 warning(s)"
     st_file = write(tmp_path, program("x := 1;"))
     assert run(fx5, st_file).output.splitlines()[-1].startswith("2 file(s) checked for gxworks2:")
+
+
+GX3_ONLY = """FUNCTION_BLOCK FB_A
+VAR_OUTPUT_RETAIN
+    o_wKeep : INT;
+END_VAR
+VAR
+    wCount : INT := 5;
+    uVal : UINT;
+END_VAR
+wCount := wCount + 1;
+o_wKeep := wCount;
+uVal := uVal;
+END_FUNCTION_BLOCK
+"""
+
+
+@pytest.mark.parametrize("command", ["check", "export"])
+@pytest.mark.parametrize("platform", ["fx3u", "fx3g", "q"])
+def test_a_gx_works3_only_construct_under_a_gx_works2_cpu_is_not_told_to_use_gxworks3(tmp_path, command, platform):
+    """import-gxworks2.md's own-program commands with an initial value: `--platform q` said
+    'or use --target gxworks3', and following it was refused (exit 2: the Q is programmed in
+    GX Works2). With a GX Works2 CPU named the messages give only what works there; without
+    --platform they still offer GX Works3."""
+    path = write(tmp_path, GX3_ONLY, "FB_A.st")
+    args = ["--out", tmp_path / "out"] if command == "export" else []
+    done = CliRunner().invoke(main, [command, "--platform", platform, *map(str, args), str(path)])
+    assert done.exit_code == 1 and "Traceback" not in done.output
+    found = errors(done.output)
+    assert found == [f"{path}:2:1: error: VAR_OUTPUT_RETAIN exists only in GX Works3; use VAR_OUTPUT/VAR",
+                     f"{path}:6:21: error: GX Works2 label tables have no initial value column: 'wCount' would "
+                     "start at 0 on the PLC; set it in the program on the first scan or declare it VAR CONSTANT",
+                     f"{path}:7:12: error: type UINT does not exist in GX Works2: GX Works2 has no UINT; use WORD"]
+    assert not (tmp_path / "out").exists()
+    free = run(path)
+    assert sum("--target gxworks3" in line for line in errors(free.output)) == 3

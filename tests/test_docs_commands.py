@@ -23,7 +23,8 @@ from verifier.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGES = ["README.md", "README.zh-TW.md", "docs/commissioning.md", "docs/emulator.md", "docs/wiring-rs485.md",
-         "docs/wiring-rs232.md", "docs/ci.md", "docs/verifier.md", "docs/protocol.md"]
+         "docs/wiring-rs232.md", "docs/ci.md", "docs/verifier.md", "docs/protocol.md", "docs/import-gxworks2.md",
+         "docs/import-gxworks3.md", "docs/scenarios.md", "docs/tcp-converter.md", "plc/README.md"]
 SHELL_ENDS = {">", ">>", "|", "&", "&&", ";"}
 
 
@@ -301,3 +302,66 @@ def test_the_fault_file_error_emulator_md_quotes_is_what_its_bench_toml_gives(tm
     with pytest.raises(FaultFileError) as raised:
         load_fault_file(tmp_path / "bench.toml")
     assert f"bench.toml:{quoted};" in str(raised.value)
+
+
+def _plc_arguments(command: str) -> list[str]:
+    """The bundled files a command names (not a pattern: `plc/*.st` in ci.md is the
+    integrator's own plc/ folder)."""
+    return [word for word in _argv(command) if word.startswith("plc/") and not re.search(r"[*?\[]", word)]
+
+
+def test_the_bundled_files_the_commands_name_are_there():
+    """`uitamr check ... plc/examples/fx5/UITAMR_ExampleTcpFx5.st`, `--scenario
+    plc/scenarios/q-tcp-dropped.toml`: each bundled file or folder a page's command names
+    exists (a renamed scenario or example would leave the page's command failing)."""
+    named = {word for _, command in QUOTED + INLINE for word in _plc_arguments(command)}
+    assert {"plc/scenarios/q-tcp-dropped.toml", "plc/examples/fx5/UITAMR_ExampleTcpFx5.st"} <= named
+    missing = sorted(word for word in named if not (ROOT / word).exists())
+    assert not missing, missing
+
+
+CHECKS = sorted({(page, command) for page, command in QUOTED
+                 if _argv(command)[0] == "check" and _plc_arguments(command)
+                 and all(word.startswith(("-", "plc/")) or word in ("fx3u", "fx3g", "fx5u", "q")
+                         for word in _argv(command)[1:])})
+
+
+@pytest.mark.parametrize("page, command", CHECKS, ids=[f"{p}: {c}" for p, c in CHECKS])
+def test_a_check_of_the_bundled_library_a_page_shows_is_clean(page, command, monkeypatch):
+    """The pages' `uitamr check --platform fx3u plc/core plc/fx3 ...` lines before a
+    download: run from the repository as shown, they find nothing."""
+    from click.testing import CliRunner
+
+    monkeypatch.chdir(ROOT)
+    done = CliRunner().invoke(main, _argv(command))
+    assert done.exit_code == 0 and done.output.rstrip().endswith(": 0 error(s), 0 warning(s)"), (page, done.output)
+
+
+def test_the_pages_check_the_bundled_library_for_every_platform():
+    assert {page for page, _ in CHECKS} >= {"docs/import-gxworks2.md", "docs/import-gxworks3.md", "plc/README.md"}
+    assert {_argv(command)[_argv(command).index("--platform") + 1] for _, command in CHECKS} >= {"fx3u", "fx5u", "q"}
+
+
+def _anchors(page: Path) -> set[str]:
+    """The #anchors GitHub makes of a page's headings: lower case, punctuation dropped,
+    spaces to hyphens."""
+    headings = re.findall(r"^#+\s+(.*?)\s*$", page.read_text(encoding="utf-8"), flags=re.M)
+    return {re.sub(r"[^\w\- ]", "", heading.lower()).replace(" ", "-") for heading in headings}
+
+
+def test_the_links_of_the_pages_resolve():
+    """Every relative link of the READMEs and docs/ (the walked pages link each other, the
+    plc/ folders and sections: `st-dialect.md#9-uitamr-check`) names a file or folder that
+    is there and, for a section, a heading the page has."""
+    pages = [ROOT / "README.md", ROOT / "README.zh-TW.md", ROOT / "plc" / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    broken, checked = [], 0
+    for page in pages:
+        for target in re.findall(r"\]\(([^)\s]+)\)", page.read_text(encoding="utf-8")):
+            if re.match(r"(https?:|mailto:|\d)", target):  # a web page, or `Bit String[16-bit](0..39)`
+                continue
+            path, _, anchor = target.partition("#")
+            linked = (page.parent / path).resolve() if path else page
+            checked += 1
+            if not linked.exists() or (anchor and linked.suffix == ".md" and anchor not in _anchors(linked)):
+                broken.append(f"{page.relative_to(ROOT)}: {target}")
+    assert checked > 100 and not broken, broken

@@ -214,6 +214,24 @@ def test_a_scenario_or_a_folder_without_st_is_named_as_such(tmp_path, monkeypatc
     assert result.stderr.startswith("uitamr export: warning: scenarios: no .st file in it or below it")
 
 
+def test_the_toolkits_other_files_named_to_export_say_what_they_are(tmp_path):
+    """`uitamr export` of the ladder's .il, a capture or a scenario saved as .txt read each
+    as ST ("1:1: error: unexpected ';'", "'#' must follow a radix", "unexpected 'name'",
+    exit 1); each now says what it is and what reads it, as `uitamr check` does (exit 2)."""
+    scenario = tmp_path / "healthy.toml.txt"
+    scenario.write_text((ROOT / "plc" / "scenarios" / "fx3u-healthy.toml").read_text(encoding="utf-8"),
+                        encoding="utf-8")
+    capture = ROOT / "tests" / "captures" / "bad-master.txt"
+    for source, what in [(ROOT / "plc" / "ladder" / "UITAMR_LadderFx3.il", "an instruction list (the ladder program)"),
+                         (capture, f"a capture of `uitamr monitor --capture` (times and bytes on the line), not ST: "
+                                   f"`uitamr replay {capture}` judges its frames"),
+                         (scenario, "a scenario (TOML), not ST: name it healthy.toml")]:
+        result = run("--target", "gxworks2", "--out", str(tmp_path / "out"), str(source), str(ROOT / "plc" / "core"))
+        assert result.exit_code == 2 and "Traceback" not in result.output
+        assert result.stderr.startswith(f"uitamr export: {source}: {what}"), result.stderr
+        assert not (tmp_path / "out").exists()
+
+
 def test_global_labels_get_their_own_table(tmp_path):
     src = tmp_path / "Main.st"
     src.write_text(
@@ -315,6 +333,11 @@ def test_gxworks3_carries_initial_values_in_every_table(tmp_path):
     assert (out / "S_Pos.struct.tsv").read_text().splitlines() == [
         "Label Name\tData Type\tInitial Value\tComment", "wX\tWord [Signed]\t11\t", "wY\tWord [Signed]\t\t"]
     assert (out / "IMPORT_ORDER.txt").read_text().splitlines()[0] == "S_Pos\tSTRUCT"
+    # the import pages say what to do with that line: they said it only of FUNCTION,
+    # FUNCTION_BLOCK and PROGRAM lines
+    for page in ("import-gxworks2.md", "import-gxworks3.md"):
+        steps = (ROOT / "docs" / page).read_text(encoding="utf-8").split("IMPORT_ORDER.txt order", 1)[1]
+        assert "0. A `STRUCT` line" in steps.split("\n## ", 1)[0], page
 
 
 def test_the_help_names_every_kind_of_file_the_export_writes(tmp_path):
@@ -472,6 +495,24 @@ def test_export_of_an_unknown_program_names_the_programs_and_writes_nothing(tmp_
     assert not out.exists()
 
 
+@pytest.mark.parametrize("args, program, hint", [
+    (["--target", "gxworks2"], "UITAMR_ExampleFx5", "UITAMR_ExampleFx5 is bundled for fx5u: export it with --platform fx5u"),
+    (["--platform", "q"], "UITAMR_ExampleFx3",
+     "UITAMR_ExampleFx3 is bundled for fx3u, fx3g: export it with --platform fx3u (or fx3g)"),
+    (["--target", "gxworks3"], "UITAMR_ExampleQ", "UITAMR_ExampleQ is bundled for q: export it with --platform q")])
+def test_a_bundled_program_of_another_platform_is_named_with_the_platform_that_exports_it(tmp_path, args, program,
+                                                                                          hint):
+    """import-gxworks3.md's `--program UITAMR_ExampleFx5` with gxworks2.md's `--target
+    gxworks2` (or the FX3 example under `--platform q`): the error listed the PROGRAMs of
+    that export only, not that the example is bundled for another CPU and how to export it."""
+    result = run(*args, "--out", str(tmp_path / "out"), "--program", program)
+    assert result.exit_code == 2
+    assert result.stderr.startswith(f"uitamr export: nothing written: --program: no POU {program} in the sources")
+    assert result.stderr.rstrip().endswith(f"; {hint}"), result.stderr
+    assert "is bundled" not in run(*args, "--out", str(tmp_path / "out"), "--program", "Nope").stderr
+    assert not (tmp_path / "out").exists()
+
+
 def test_export_of_a_program_still_checks_every_file(tmp_path):
     (tmp_path / "lib.st").write_text(NEEDS)
     (tmp_path / "broken.st").write_text("FUNCTION_BLOCK Broken\nVAR\n    x : INT;\nEND_VAR\nx := TRUE;\nEND_FUNCTION_BLOCK\n")
@@ -489,6 +530,18 @@ def test_the_import_pages_list_what_export_writes_for_the_example(tmp_path, page
     assert result.exit_code == 0, result.output
     written = [line.split("\t")[0] for line in (tmp_path / "IMPORT_ORDER.txt").read_text().splitlines()]
     assert re.findall(r"`(\w+)`", listed) + [example] == written
+    # "The ADPRW variant (`UITAMR_ExampleAdpFx3`) takes `A` and `B` in place of `C`, `D` and
+    # `E`; ... `UITAMR_ExampleTcpQ` takes `F` and `G` in its place": the other examples
+    variants = re.findall(r"`(UITAMR_\w+)`\)? takes ((?:`\w+`(?:, | and )?)+) in (?:place of ((?:`\w+`(?:, | and )?)+)"
+                          r"|its place)", text)
+    assert len(variants) == {"gxworks2": 3, "gxworks3": 2}[target], variants
+    replaced: list[str] = []
+    for variant, taken, dropped in variants:
+        replaced = re.findall(r"`(\w+)`", dropped) or replaced
+        out = tmp_path / variant
+        assert run("--target", target, "--out", str(out), "--program", variant).exit_code == 0
+        pous = {line.split("\t")[0] for line in (out / "IMPORT_ORDER.txt").read_text().splitlines()}
+        assert pous == (set(written) - {example} - set(replaced)) | set(re.findall(r"`(\w+)`", taken)) | {variant}, variant
 
 
 # ---- --platform: what is written, checked against the CPU as `uitamr check --platform` does ----
@@ -672,9 +725,13 @@ def test_export_refuses_a_platform_its_target_does_not_program(tmp_path, platfor
 
 
 def test_export_needs_a_target_or_a_platform(tmp_path):
-    done = export("--out", tmp_path / "out")
-    assert done.exit_code == 2
-    assert "Missing option '--target'" in done.output
+    """The export of a folder with neither --target nor --platform: the error said only
+    "Missing option '--target'. Choose from: gxworks2, gxworks3", not that a CPU will do."""
+    done = export("--out", tmp_path / "out", ROOT / "plc" / "core")
+    assert done.exit_code == 2 and "Traceback" not in done.output
+    assert done.output.splitlines()[-1] == (
+        "Error: Missing option '--target' or '--platform': name the editor (--target gxworks2 for FX3U/FX3G "
+        "and Q, gxworks3 for FX5U) or the CPU, which implies it (--platform fx3g, fx3u, fx5u, q)")
     assert not (tmp_path / "out").exists()
 
 

@@ -127,6 +127,32 @@ def test_the_file_to_add_is_named_where_the_integrator_vendored_the_library(tmp_
                      "add vendor/uitamr/plc/fx3/UITAMR_PortFx3.st (or its folder) to the sources"]
 
 
+def test_the_file_to_add_is_named_in_a_vendored_copy_of_the_library(tmp_path, monkeypatch):
+    # import-gxworks2.md's own-program commands, the toolkit a git submodule: a copy, no
+    # link to the installed toolkit. The file to add was named by the installed toolkit's
+    # absolute path, not the vendor/uitamr/plc/q/UITAMR_PortQC24.st the integrator has.
+    import shutil
+
+    vendored = tmp_path / "vendor" / "uitamr" / "plc"
+    for folder in ("core", "q"):
+        shutil.copytree(PLC / folder, vendored / folder)
+    (tmp_path / "src").mkdir()
+    (tmp_path / "src" / "Main.st").write_text(
+        "PROGRAM Main\nVAR\n    fbPort : UITAMR_PortQC24;\nEND_VAR\nfbPort();\nEND_PROGRAM\n", encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    hint = "error: unknown type 'UITAMR_PortQC24'; the UITAMR library declares it: add {} (or its folder) to the sources"
+    result = CliRunner().invoke(check_command, ["--platform", "q", "vendor/uitamr/plc/core", "src"])
+    assert result.exit_code == 1, result.output
+    assert [line for line in result.output.splitlines() if ": error: " in line] == [
+        "src/Main.st:3:14: " + hint.format("vendor/uitamr/plc/q/UITAMR_PortQC24.st")]
+    monkeypatch.chdir(vendored)  # from inside the copy: the path from there
+    result = CliRunner().invoke(check_command, ["--platform", "q", "core", "../../../src"])
+    assert "../../../src/Main.st:3:14: " + hint.format("q/UITAMR_PortQC24.st") in result.output
+    shutil.rmtree(vendored / "q")  # a copy without the file: the installed toolkit's, which exists
+    result = CliRunner().invoke(check_command, ["--platform", "q", "core", "../../../src"])
+    assert hint.format(PLC / "q" / "UITAMR_PortQC24.st") in result.output
+
+
 def test_a_call_with_the_old_run_input_i_benable_is_told_its_new_name(tmp_path):
     """docs/plc-library.md: the engine's and the ports' run input i_bEnable is now i_bEN,
     and 'uitamr check names every call that still uses i_bEnable'. It named the call but

@@ -1,4 +1,4 @@
-"""docs/plc-library.md stays true to the library: its POU catalogue is what the
+"""docs/plc-library.md (and the pages that quote the library) stay true to it: its POU catalogue is what the
 declarations say, and every error code the ST can produce is in its table."""
 from __future__ import annotations
 
@@ -120,3 +120,37 @@ def test_the_library_page_leads_to_the_wiring_of_every_port():
         assert f"]({page})" in text.split("\n## ", 1)[0], f"plc-library.md's introduction does not link {page}"
         headings = [h for h in (ROOT / "docs" / page).read_text(encoding="utf-8").splitlines() if h.startswith("#")]
         assert all(any(board in h for h in headings) for board in boards), (page, headings)
+
+
+def _constants(pou: str) -> dict[str, str]:
+    """The named constants of a library POU as written (`T#500ms`, `16#0310`)."""
+    text = (ROOT / "plc" / "core" / f"{pou}.st").read_text(encoding="utf-8")
+    return dict(re.findall(r"^\s*(\w+) : \w+ := ([^;]+);", text, flags=re.M))
+
+
+def _ms(value: str) -> int:
+    number, unit = re.fullmatch(r"T#(\d+)(ms|s)", value).groups()
+    return int(number) * (1000 if unit == "s" else 1)
+
+
+def test_the_tcp_and_rs232_pages_quote_the_librarys_constants():
+    """tcp-converter.md's connection handling and timing chart, and wiring-rs232.md's
+    'everything else is the same', quote times and error codes that are constants of
+    UITAMR_TcpLink and UITAMR_Engine: held here to the ST, so a changed constant changes
+    the page."""
+    link, engine = _constants("UITAMR_TcpLink"), _constants("UITAMR_Engine")
+    tcp = " ".join((ROOT / "docs" / "tcp-converter.md").read_text(encoding="utf-8").split())
+    back_off = [_ms(link[f"BACKOFF_{n}"]) for n in range(1, 6)]
+    said = re.search(r"the next open follows after ([\d.]+) s, ([\d.]+) s, ([\d.]+) s, ([\d.]+) s and then every "
+                     r"([\d.]+) s", tcp)
+    assert said and [round(float(s) * 1000) for s in said.groups()] == back_off
+    assert f"BACKOFF {back_off[0] / 1000} s→OPENING" in tcp  # the chart
+    assert f"`RX_GAP_TIME` ({_ms(link['RX_GAP_TIME'])} ms)" in tcp
+    assert tcp.count(f"`REPLY_TIMEOUT`, {_ms(engine['REPLY_TIMEOUT'])} ms") == 1
+    assert tcp.count(f"`REPLY_TIMEOUT` ({_ms(engine['REPLY_TIMEOUT'])} ms)") == 2
+    for name, said_as in [("ERR_OPEN", "a refused or unanswered open is {}"), ("ERR_LOST", "closing the connection is {}"),
+                          ("ERR_NOT_CONNECTED", "is not sent: {}")]:
+        assert said_as.format(link[name]) in tcp, name
+    rs232 = " ".join((ROOT / "docs" / "wiring-rs232.md").read_text(encoding="utf-8").split())
+    assert (f"the {_ms(engine['PACE_TIME'])} ms pace, the {_ms(engine['REPLY_TIMEOUT'])} ms reply time-out"
+            in rs232)

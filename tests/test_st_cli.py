@@ -6,6 +6,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 from click.testing import CliRunner
 
 from st_helpers import CORPUS
@@ -130,6 +131,26 @@ def test_a_capture_named_to_check_is_told_by_its_content(tmp_path):
     comments.write_text("# to do\n", encoding="utf-8")
     result = run(comments)
     assert result.exit_code == 1 and f"{comments}:1:1: error:" in result.output, result.output
+
+
+@pytest.mark.parametrize("name, renamed", [("healthy.toml.txt", "healthy.toml"), ("healthy.txt", "healthy.toml")])
+def test_a_scenario_saved_under_another_name_is_told_by_its_content(tmp_path, name, renamed):
+    """A scenario Windows saved as `healthy.toml.txt` was read as ST: "1:1: error:
+    unexpected 'name'; expected 'FUNCTION', ...", exit 1. Its TOML with a scenario's keys
+    tells it: it says what the file is, the name check reads it by, and that verify runs
+    it as it is (exit 2); TOML without a scenario's key is still read as ST."""
+    scenario = tmp_path / name
+    scenario.write_text((ROOT / "plc" / "scenarios" / "fx3u-healthy.toml").read_text(encoding="utf-8"),
+                        encoding="utf-8")
+    result = run(scenario)
+    assert result.exit_code == 2, result.output
+    assert result.stderr == (f"uitamr check: {scenario}: a scenario (TOML), not ST: name it {renamed} (`uitamr "
+                             f"check` reads scenarios by that name); `uitamr verify --scenario {scenario}` runs it "
+                             "as it is\n")
+    other = tmp_path / "settings.txt"
+    other.write_text("x = 1\n", encoding="utf-8")
+    result = run(other)
+    assert result.exit_code == 1 and f"{other}:1:1: error: unexpected 'x'" in result.output
 
 
 def test_a_pattern_is_expanded_as_verify_expands_it(tmp_path, monkeypatch):

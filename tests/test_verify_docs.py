@@ -6,8 +6,10 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from doc_helpers import code_blocks
 from file_helpers import write_files
-from verifier.verify.scenario import C24_KEYS, TOP_KEYS, parse_scenario
+from verifier.verify.scenario import (C24_KEYS, CONVERTER_KEYS, EXPECT_KEYS, INPUT_KEYS, KINDS, PROTOCOL_KEYS,
+                                      RESPONSE_KEYS, RULES_KEYS, TOP_KEYS, parse_scenario)
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
 SCENARIOS_MD = (DOCS / "scenarios.md").read_text(encoding="utf-8")
@@ -20,6 +22,74 @@ def test_every_scenario_key_is_documented():
         assert f"`{key}`" in SCENARIOS_MD or f"[{key}]" in SCENARIOS_MD or f"[[{key}]]" in SCENARIOS_MD, key
     for key in C24_KEYS:
         assert re.search(rf"^{key} = ", SCENARIOS_MD, re.MULTILINE), key
+
+
+def _scenario_section(title: str) -> str:
+    return SCENARIOS_MD.split(f"\n## {title}", 1)[1].split("\n## ", 1)[0]
+
+
+def _table(section: str) -> dict[str, str]:
+    """A key table's rows: each key of the first column (`ip`, `port` are two) and the row's
+    last cell (the default, where the table has that column)."""
+    rows = {}
+    for line in section.splitlines():
+        if line.startswith("| `"):
+            cells = [cell.strip() for cell in line.strip("|").split(" | ")]
+            for key in re.findall(r"`([\w.]+)", cells[0]):
+                rows[key] = cells[-1]
+    return rows
+
+
+def test_the_key_tables_are_the_keys_the_reader_takes():
+    """Every key the scenario reader takes is in its section's table (or, for a table of
+    its own, has a section), and every key a table shows is one the reader takes: the
+    tables of [[inputs]], [[expect]], [rules], [response_handling] and [converter] were
+    not held to the reader, only the top-level keys and [[c24]]'s."""
+    top = _table(_scenario_section("Top-level keys"))
+    sections = {key for key in TOP_KEYS if re.search(rf"^## .*`\[{{1,2}}{key}\]{{1,2}}`", SCENARIOS_MD, re.M)}
+    assert set(top) <= set(TOP_KEYS) and set(top) | sections == set(TOP_KEYS), (set(TOP_KEYS) - set(top) - sections)
+    assert set(_table(_scenario_section("`[[inputs]]`"))) == set(INPUT_KEYS)
+    expect = _scenario_section("`[[expect]]`")
+    assert set(_table(expect)) == set(KINDS)
+    assert all(f"`{key}`" in expect for key in set(EXPECT_KEYS) - set(KINDS))
+    assert set(_table(_scenario_section("`[rules]` and `[response_handling]`"))) == (
+        {f"rules.{key}" for key in RULES_KEYS} | {f"response_handling.{key}" for key in RESPONSE_KEYS})
+    assert set(_table(_scenario_section("The TCP route: `[converter]`"))) == set(CONVERTER_KEYS)
+    protocol = _scenario_section("`[protocol]`")
+    assert set(re.findall(r"`(\w+)` \(", protocol)) == set(PROTOCOL_KEYS)
+
+
+def _as_toml(cell: str) -> str:
+    """A default as the table writes it (`"60s"`, `0`, `[]`, `fx3u`), as a TOML value."""
+    value = re.match(r"`([^`]*)`", cell).group(1)
+    return value if re.match(r'^("|\[|\d|true$|false$)', value) else f'"{value}"'
+
+
+def _same(a, b) -> bool:
+    ignored = {"key_lines"}
+    return {k: v for k, v in vars(a).items() if k not in ignored} == {k: v for k, v in vars(b).items() if k not in ignored}
+
+
+def test_the_documented_defaults_are_the_readers():
+    """Each default a key table gives, written out in a scenario, changes nothing: the
+    scenario reads as the one that leaves the key out."""
+    top = _table(_scenario_section("Top-level keys"))
+    for key in ("platform", "duration", "scan", "scan_jitter", "seed", "watch"):
+        assert _same(parse_scenario(f"{key} = {_as_toml(top[key])}\n"), parse_scenario("")), (key, top[key])
+    rules = _table(_scenario_section("`[rules]` and `[response_handling]`"))
+    for key in ("rules.min_period", "rules.reply_timeout", "response_handling.within"):
+        table, name = key.split(".")
+        assert _same(parse_scenario(f"[{table}]\n{name} = {_as_toml(rules[key])}\n"), parse_scenario("")), key
+    converter = _table(_scenario_section("The TCP route: `[converter]`"))
+    empty = parse_scenario('platform = "fx5u"\n[converter]\n').converter
+    for cells in {row: None for row in converter.values()}:
+        keys = [key for key, row in converter.items() if row == cells]
+        values = re.findall(r"`[^`]*`", cells)
+        assert len(values) == len(keys), (keys, cells)
+        text = "".join(f"{key} = {_as_toml(value)}\n" for key, value in zip(keys, values))
+        assert parse_scenario(f'platform = "fx5u"\n[converter]\n{text}').converter == empty, text
+    example = code_blocks(_scenario_section("The TCP route: `[converter]`"), "toml")[0]
+    assert parse_scenario('platform = "fx5u"\n' + example).converter != empty  # it loads, and sets something
 
 
 def test_the_plc_settings_example_is_a_valid_scenario():

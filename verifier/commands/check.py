@@ -85,6 +85,33 @@ def _capture_kind(path: Path) -> str | None:
             f"`uitamr replay {path}` judges its frames (docs/commissioning.md)")
 
 
+def _scenario_kind(path: Path) -> str | None:
+    """What `path` is when it reads as a scenario (TOML with a scenario's keys) though not
+    named .toml (Windows may save `s.toml` as `s.toml.txt`), or None."""
+    import tomllib
+
+    from verifier.verify.scenario import TOP_KEYS
+
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
+    except (OSError, UnicodeDecodeError, ValueError, RecursionError):  # not TOML: ST, or a mistake to place
+        return None
+    if not set(data) & set(TOP_KEYS):  # ST is no TOML; TOML without a scenario's key is no scenario
+        return None
+    renamed = path.stem if path.stem.lower().endswith(".toml") else f"{path.stem}.toml"
+    return (f"a scenario (TOML), not ST: name it {renamed} (`uitamr check` reads scenarios by that name); "
+            f"`uitamr verify --scenario {path}` runs it as it is")
+
+
+def not_st(path: Path) -> str | None:
+    """What the file `path` is when it is one of the toolkit's other files rather than ST
+    (by its suffix, or for a name that says neither .st nor .toml, by its content), or None."""
+    suffix = path.suffix.lower()
+    if suffix in _OTHER_KINDS:
+        return _OTHER_KINDS[suffix]
+    return None if suffix in (".st", ".toml") else _capture_kind(path) or _scenario_kind(path)
+
+
 def _not_a_source(path: Path) -> str | None:
     """Why `path` cannot be checked at all (missing, a device, a pipe, another kind of
     the toolkit's files ...), or None. Files that exist but hold no text are diagnosed with
@@ -93,10 +120,7 @@ def _not_a_source(path: Path) -> str | None:
     from verifier.verify.sources import is_pattern
 
     if path.is_file():
-        suffix = path.suffix.lower()
-        if suffix in _OTHER_KINDS:
-            return _OTHER_KINDS[suffix]
-        return None if suffix in (".st", ".toml") else _capture_kind(path)
+        return not_st(path)
     if is_pattern(str(path)):
         return "matches no file"
     if not path.exists() and not path.is_symlink():

@@ -25,7 +25,7 @@ from pathlib import Path
 import click
 
 from verifier.bundled import PLC_DIR
-from verifier.commands.check import expand_sources, platform_target, say_folders_without_st
+from verifier.commands.check import expand_sources, not_st, platform_target, say_folders_without_st
 from verifier.sim.cpu import PROFILES
 from verifier.textfile import real_path
 
@@ -76,8 +76,11 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
     if platform is not None:
         target = platform_target(platform, target, "export")
     elif target is None:
-        ctx = click.get_current_context()
-        raise click.MissingParameter(ctx=ctx, param=next(p for p in ctx.command.params if p.name == "target"))
+        # click's own "Missing option '--target'. Choose from: gxworks2, gxworks3" hid that
+        # naming the CPU will do
+        raise click.UsageError("Missing option '--target' or '--platform': name the editor (--target gxworks2 "
+                               "for FX3U/FX3G and Q, gxworks3 for FX5U) or the CPU, which implies it "
+                               f"(--platform {', '.join(sorted(PROFILES))})")
     if sources:
         from verifier.verify.sources import is_pattern, pattern_files, pattern_matches
 
@@ -95,6 +98,11 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
             more = f" and {len(scenarios) - 3} more" if len(scenarios) > 3 else ""
             click.echo(f"uitamr export: {', '.join(scenarios[:3])}{more}: a scenario (.toml), not ST source: "
                        "export writes the POUs of .st files; run scenarios with uitamr verify --scenario", err=True)
+            sys.exit(EXIT_USAGE)
+        others = [(p, what) for p in paths if p.suffix.lower() != ".st" and (what := not_st(p))]
+        if others:  # read as ST, an .il was "1:1: unexpected ';'", a capture "'#' must follow a radix"
+            for p, what in others:
+                click.echo(f"uitamr export: {p}: {what}", err=True)
             sys.exit(EXIT_USAGE)
         say_folders_without_st("uitamr export", sources, fatal=not paths)
         if not paths:
@@ -142,7 +150,8 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
         click.echo(f"uitamr export: nothing written, {sum(d.is_error for d in e.diagnostics)} error(s)", err=True)
         sys.exit(EXIT_ERRORS)
     except UnknownProgram as e:
-        click.echo(f"uitamr export: nothing written: --program: {e}", err=True)
+        hint = "" if sources else _bundled_elsewhere(programs, paths)
+        click.echo(f"uitamr export: nothing written: --program: {e}{hint}", err=True)
         sys.exit(EXIT_USAGE)
     except OSError as e:
         click.echo(f"uitamr export: cannot write {e.filename or out_dir}: {e.strerror or e}", err=True)
@@ -157,6 +166,25 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
     if notes:
         click.echo(f"{len(notes)} initial value(s) not carried by the {target} label tables: "
                    f"see {Path(out_dir) / DROPPED_TABLE}")
+
+
+def _bundled_elsewhere(programs: tuple[str, ...], exported: list[Path]) -> str:
+    """For a --program of the bundled library that the chosen target or platform does not
+    export (`--target gxworks2 --program UITAMR_ExampleFx5`, copied from the other import
+    page), the platforms whose export holds it."""
+    from verifier.bundled import library_file
+
+    hints = []
+    for name in programs:
+        path = library_file(name)
+        if path is None or path in exported:
+            continue
+        where = sorted((cpu for cpu in PROFILES if path in bundled_sources(platform_target(cpu, None, "export"), cpu)),
+                       key=lambda cpu: (cpu == "fx3g", cpu))  # the FX3U, the library's first FX3
+        if where:
+            hints.append(f"{path.stem} is bundled for {', '.join(where)}: export it with "
+                         f"--platform {where[0]}" + (f" (or {', '.join(where[1:])})" if where[1:] else ""))
+    return "; " + "; ".join(hints) if hints else ""
 
 
 def _warn_of_another_editor(paths: tuple[Path, ...], target: str) -> None:

@@ -115,6 +115,9 @@ class Checker:
         self.target = target
         #: the CPU families whose instruction names no label may take (docs/st-dialect.md §4)
         self.families = melsec.families_for(target, platform)
+        #: with --platform the CPU fixes the editor: "use --target gxworks3" for a GX Works2
+        #: CPU is no way out, it is refused as contradicting the CPU
+        self.editor_fixed = platform is not None
         self.table = SymbolTable(target)
         self.rep = _Reporter()
         self.pou: PouInfo | None = None
@@ -235,7 +238,8 @@ class Checker:
             self.rep.warning(block, f"{kw} in a PROGRAM: GX Works program blocks have no interface; "
                                     "use VAR or globals")
         if kw in ("VAR_OUTPUT_RETAIN", "VAR_PUBLIC", "VAR_PUBLIC_RETAIN") and self.target == "gxworks2":
-            self.rep.error(block, f"{kw} exists only in GX Works3; use VAR_OUTPUT/VAR (or --target gxworks3)")
+            self.rep.error(block, f"{kw} exists only in GX Works3; use VAR_OUTPUT/VAR"
+                                  + ("" if self.editor_fixed else " (or --target gxworks3)"))
 
     def _check_name(self, node, name: str, what: str) -> None:
         problem = label_name_problem(name, self.families)
@@ -257,15 +261,17 @@ class Checker:
                 return t
             if self.target == "gxworks2" and not v.constant and v.section != "VAR_IN_OUT" \
                     and not _is_zero(v.init):
+                ways = ("set it in the program on the first scan or declare it VAR CONSTANT" if self.editor_fixed
+                        else "set it in the program on the first scan, declare it VAR CONSTANT, or use --target "
+                             "gxworks3")
                 self.rep.error(v.init, f"GX Works2 label tables have no initial value column: '{v.name}' "
-                                       "would start at 0 on the PLC; set it in the program on the first "
-                                       "scan, declare it VAR CONSTANT, or use --target gxworks3")
+                                       f"would start at 0 on the PLC; {ways}")
         return t
 
     def resolve_type(self, ref: ast.TypeRef) -> T.Type:
         if isinstance(ref, ast.StringType):
             if ref.wide and self.target == "gxworks2":
-                self.rep.error(ref, library_missing("WSTRING"))
+                self.rep.error(ref, library_missing("WSTRING", editor_fixed=self.editor_fixed))
             if ref.length is not None and not 1 <= ref.length <= 255:
                 self.rep.error(ref, f"string length {ref.length} is outside 1..255")
             base = T.WSTRING if ref.wide else T.STRING
@@ -301,7 +307,7 @@ class Checker:
             self.rep.error(ref, f"'{ref.name}' is a {info.pou.kind}, not a type; only function blocks can be instantiated")
             return T.ANY
         if key in T.MISSING_TYPES:
-            self.rep.error(ref, library_missing(key, self.target))
+            self.rep.error(ref, library_missing(key, self.target, self.editor_fixed))
             return T.ANY
         if key in _UNMODELLED_FBS:
             self.rep.error(ref, f"unknown type '{ref.name}'; {_UNMODELLED_FBS[key]}")
@@ -1091,8 +1097,13 @@ def called_without(function: str, names: list[str]) -> str:
     return f"{function} is called without {_inputs(names)}; {NEEDS_EVERY_INPUT}"
 
 
-def library_missing(name: str, target: str = "gxworks2") -> str:
-    return f"type {name} does not exist in {_target_name(target)}: " + T.MISSING_TYPES.get(name, "")
+def library_missing(name: str, target: str = "gxworks2", editor_fixed: bool = False) -> str:
+    """Why type `name` is refused and what to use; with `editor_fixed` (a --platform whose
+    CPU only `target` programs) without the way out of the other editor."""
+    hint = T.MISSING_TYPES.get(name, "")
+    if editor_fixed:
+        hint = hint.replace(" (or --target gxworks3)", "")
+    return f"type {name} does not exist in {_target_name(target)}: " + hint
 
 
 def _in_library(name: str, plc_shown: Path | None = None) -> str | None:
@@ -1101,7 +1112,7 @@ def _in_library(name: str, plc_shown: Path | None = None) -> str | None:
     path = library_file(name)
     if path is None:
         return None
-    if plc_shown is not None:
+    if plc_shown is not None and (plc_shown / path.relative_to(PLC_DIR)).is_file():
         path = plc_shown / path.relative_to(PLC_DIR)
     return f"the UITAMR library declares it: add {path} (or its folder) to the sources"
 
@@ -1110,15 +1121,22 @@ def _plc_as_given(filenames: list[str]) -> Path | None:
     """The bundled plc/ folder by the path the sources reach it (`vendor/uitamr/plc` for
     `vendor/uitamr/plc/core/UITAMR_Engine.st` given through a submodule or symlink), so
     that a missing library file is named the way the integrator writes it; None when no
-    source lies in it."""
+    source lies in it. A copy of the library counts too (a git submodule is one: its
+    `vendor/uitamr/plc/core/UITAMR_Engine.st` is no link to the installed toolkit's file):
+    a source whose path ends as a library file's does under plc/ (`core/UITAMR_Engine.st`)."""
     for name in filenames:
         given = Path(name)
         try:
             inside = real_path(given).relative_to(PLC_DIR)
         except ValueError:
-            continue
+            inside = next((Path(*given.parts[k:]) for k in range(len(given.parts) - 1)
+                           if (PLC_DIR / Path(*given.parts[k:])).is_file()), None)
+            if inside is None:
+                continue
         if len(inside.parts) < len(given.parts):
             return given.parents[len(inside.parts) - 1]
+        if len(inside.parts) == len(given.parts) and not given.is_absolute():
+            return Path(".")
     return None
 
 
