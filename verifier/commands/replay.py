@@ -54,11 +54,22 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
         for capture_name, chunks in loaded.items():
             info = CaptureInfo(capture_name if len(loaded) > 1 else path.name, str(path), "capture",
                                line=f"{baud} {line_format}")
-            session = MonitorSession(info, settings, RuleOptions(reply_timeout_us=reply_timeout), timing,
-                                     from_power_on=not joined)
+            session = MonitorSession(info, settings, _rule_options(chunks, reply_timeout), timing,
+                                     from_power_on=not joined, signal_held=chunks[-1].signal_held if chunks else None,
+                                     events=chunks[-1].events if chunks else ())
             for chunk in chunks:
                 session.feed(chunk)
             session.close()
             results.append(session.result())
     _finish(results, console, json_path, junit_path, trace_path, html_path, "uitamr replay")
     sys.exit(exit_status(results))
+
+
+def _rule_options(chunks: list, reply_timeout_us: int | None) -> RuleOptions:
+    """The rules' settings for one run of a capture: those its trace's end record says the
+    run was judged with (a scenario's [rules] and [response_handling] within, a monitor's
+    --reply-timeout), else the defaults; --reply-timeout, when given, over both."""
+    recorded = dict(chunks[-1].rules) if chunks else {}
+    if reply_timeout_us is not None:
+        recorded["reply_timeout_us"] = reply_timeout_us
+    return RuleOptions(**recorded)
