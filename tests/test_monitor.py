@@ -42,8 +42,10 @@ CAPTURES = Path(__file__).resolve().parent / "captures"
 STOP, READ = frame("stop"), frame("read", "task")
 
 
-#: the rules' settings a trace's end record carries, at their defaults (docs/verifier.md)
-RULES_RECORDED = {"reply_timeout": 0.5, "min_period": 0.25, "response_within": 5.0}
+#: the rules' and the protocol's settings a trace's end record carries, at their defaults (docs/verifier.md)
+RULES_RECORDED = {"reply_timeout": 0.5, "min_period": 0.25, "response_within": 5.0,
+                  "protocol": {"address": 1, "field_order": "code-high", "codes_10_13": "decimal",
+                               "status_order": "query", "manual_stop_counts_as_stop": False}}
 
 def session_of(chunks, tolerance_us: int = 20_000, end_us: int | None = None, **kw) -> MonitorSession:
     """A session fed as `uitamr monitor` feeds it: each chunk as it came; with `end_us`, the
@@ -230,7 +232,7 @@ def test_a_trace_without_its_end_record_still_replays(tmp_path):
 @pytest.mark.parametrize("lines, message", [
     (['{"scenario": "a", "end": 0.5, "t": 0.1}'],
      "t.jsonl:2:1: an end record holds only 'scenario', 'end' (until when the line was listened to) and the run's "
-     "settings (reply_timeout, min_period, response_within, response_signal, response_signal_hint, "
+     "settings (reply_timeout, min_period, response_within, protocol, response_signal, response_signal_hint, "
      "response_signal_held); it has 't'"),
     (['{"scenario": "a", "end": 0.05}'], "t.jsonl:2:1: 'end' (0.05 s) is before the end of the record before (0.108 s)"),
     (['{"scenario": "a", "end": -1}'], "t.jsonl:2:1: 'end' is -1; expected a time in seconds"),

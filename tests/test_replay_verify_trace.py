@@ -158,6 +158,11 @@ FRAME = '{"scenario": "a", "t": 0.1, "t_end": 0.108, "dir": "tx", "hex": "01 06 
      "t.jsonl:2:1: 'response_signal_held' item 1 is [0.5, 0.4]; expected [[began, stopped], ...] in seconds"),
     (['{"scenario": "a", "end": 1, "response_signal_held": [[0.5, null]]}'],
      "t.jsonl:2:1: 'response_signal_held' without 'response_signal'"),
+    (['{"scenario": "a", "end": 1, "protocol": {"address": 300}}'],
+     "t.jsonl:2:1: 'protocol': robot address must be 1-247, got 300"),
+    (['{"scenario": "a", "end": 1, "protocol": {"baud": 9600}}'],
+     "t.jsonl:2:1: 'protocol' holds only address, field_order, codes_10_13, status_order, "
+     "manual_stop_counts_as_stop; it has 'baud'"),
     (['{"scenario": "a", "end": 1, "reply_timeout": "400ms"}'],
      "t.jsonl:2:1: 'reply_timeout' is \"400ms\"; expected a time in seconds"),
 ])
@@ -182,3 +187,19 @@ def test_a_reply_timeout_given_to_replay_is_taken_over_the_recorded_one(tmp_path
     assert "(late ×1)" in found[0]["message"]
     given = run("replay", path, "--reply-timeout", "500ms", "--json", tmp_path / "g.json")
     assert json.loads((tmp_path / "g.json").read_text())["scenarios"][0]["violations"] == [], given.stdout
+
+
+def test_a_scenarios_protocol_settings_replay_alike(tmp_path):
+    """A scenario whose robot is slave 2 ([protocol] address) while the program asks slave
+    1: verify's UITAMR-FORMAT says so against slave 2. The replay judged against slave 1
+    (its --address default) and found nothing; the end record carries the protocol settings,
+    and an --address given to replay still wins."""
+    text = (bundled_scenarios()[0].parent / "fx3u-healthy.toml").read_text(encoding="utf-8")
+    sources = bundled_scenarios()[0].parent.parent.as_posix()
+    scenario = tmp_path / "slave2.toml"
+    scenario.write_text(text.replace('"../', f'"{sources}/') + "\n[protocol]\naddress = 2\n", encoding="utf-8")
+    verified, replayed = verify_then_replay(tmp_path, "--scenario", scenario, "--duration", "2s")
+    assert any("the robot is slave 2" in message for rule, _, message in findings(verified)[0] if rule == "UITAMR-FORMAT")
+    assert differences(verified, replayed) == []
+    run("replay", tmp_path / "v.jsonl", "--address", "1", "--json", tmp_path / "a1.json")
+    assert not any(rule == "UITAMR-FORMAT" for rule, _, _ in findings(tmp_path / "a1.json")[0])

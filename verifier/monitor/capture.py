@@ -22,7 +22,7 @@ from __future__ import annotations
 import json
 import math
 import re
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -53,6 +53,7 @@ class Chunk:
     rules: tuple[tuple[str, Any], ...] = ()
     signal_held: tuple[tuple[int, int | None], ...] | None = None
     events: tuple[LineEvent, ...] = ()  # the run's event records (RULE_EVENTS), on its end record's chunk
+    settings: protocol.Settings | None = None  # the end record's protocol settings
 
 
 def tolerance_hides_pacing(tolerance_us: int) -> bool:
@@ -235,11 +236,11 @@ def _end_chunk(record: dict, chunks: list[Chunk], where: str) -> Chunk:
     which every trace ends each run with): until when the line was listened to, as a chunk
     with no bytes, as a plain capture's `end` line is read; and the rules' settings the run
     was judged with (`report_trace.RUN_SETTINGS`; a trace written before them has none)."""
-    known = {"scenario", "end", *RUN_SETTINGS, *_OUTPUTS}
+    known = {"scenario", "end", *RUN_SETTINGS, "protocol", *_OUTPUTS}
     other = sorted(set(record) - known)
     if other:
         raise CaptureError(f"{where}: an end record holds only 'scenario', 'end' (until when the line was listened "
-                           f"to) and the run's settings ({', '.join((*RUN_SETTINGS, *_OUTPUTS))}); it has "
+                           f"to) and the run's settings ({', '.join((*RUN_SETTINGS, 'protocol', *_OUTPUTS))}); it has "
                            f"{', '.join(map(repr, other))}")
     end_us = round(_seconds(record["end"], "end", where) * 1_000_000)
     if chunks and end_us < chunks[-1].t_us:
@@ -247,13 +248,32 @@ def _end_chunk(record: dict, chunks: list[Chunk], where: str) -> Chunk:
                            f"({chunks[-1].t_us / 1_000_000:g} s); a trace is in time order")
     rules = tuple((field, round(_seconds(record[key], key, where) * 1_000_000))
                   for key, field in RUN_SETTINGS.items() if key in record)
+    settings = _protocol(record["protocol"], where) if "protocol" in record else None
     if "response_signal" not in record:  # a line's run: the program's outputs were not seen
         stray = sorted(set(_OUTPUTS) & set(record))
         if stray:
             raise CaptureError(f"{where}: {stray[0]!r} without 'response_signal'; an end record that says the "
                                "program's outputs gives the signal (null: the run had none)")
-        return Chunk(end_us, b"", rules=rules)
-    return Chunk(end_us, b"", rules=rules + _signal(record, where), signal_held=_held(record, where))
+        return Chunk(end_us, b"", rules=rules, settings=settings)
+    return Chunk(end_us, b"", rules=rules + _signal(record, where), signal_held=_held(record, where),
+                 settings=settings)
+
+
+def _protocol(table, where: str) -> protocol.Settings:
+    """An end record's protocol settings (`{"address": 1, "field_order": "code-high", ...}`)."""
+    names = tuple(field.name for field in fields(protocol.Settings))
+    if not isinstance(table, dict):
+        raise CaptureError(f"{where}: 'protocol' is {json.dumps(table)}; expected an object of the protocol "
+                           f"settings ({', '.join(names)})")
+    other = sorted(set(table) - set(names))
+    if other:
+        raise CaptureError(f"{where}: 'protocol' holds only {', '.join(names)}; it has {', '.join(map(repr, other))}")
+    if isinstance(table.get("address"), bool):
+        raise CaptureError(f"{where}: 'protocol' address is {json.dumps(table['address'])}; expected 1-247")
+    try:
+        return protocol.Settings(**table)
+    except ValueError as exc:
+        raise CaptureError(f"{where}: 'protocol': {exc}") from None
 
 
 #: an end record's keys that say the program's outputs (a simulated run's)

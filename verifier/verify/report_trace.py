@@ -24,6 +24,7 @@ bytes (tests/test_verify_trace_spool.py, tests/test_verify_html_spool.py).
 from __future__ import annotations
 
 import json
+from dataclasses import asdict
 from pathlib import Path
 from typing import Collection, Iterator
 
@@ -188,13 +189,15 @@ def end_record(result: ScenarioResult, name: str) -> dict | None:
     """The record after a run's frames (a run that has any): when the run ended - until when
     the line was listened to; a simulated run's end in virtual time, which may be well after
     its last frame (a reply time-out still running, a silence) - and the rules' settings it
-    was judged with (`RUN_SETTINGS`), so that `uitamr replay` judges the trace as the run was.
+    was judged with (`RUN_SETTINGS`, and the protocol settings: the address, the manual's
+    choices), so that `uitamr replay` judges the trace as the run was.
     A run that saw the program's outputs (`uitamr verify`) adds its response signal and when
     it held: UITAMR-RESPONSE-HANDLING judges by them, and a line does not show them."""
     if not frame_count(result):
         return None
     record = {"scenario": name, "end": result.ended_us / 1_000_000,
-              **{key: getattr(result, field) / 1_000_000 for key, field in RUN_SETTINGS.items()}}
+              **{key: getattr(result, field) / 1_000_000 for key, field in RUN_SETTINGS.items()},
+              "protocol": asdict(result.settings)}
     if result.signal_held is not None:
         record["response_signal"] = result.response_signal
         if result.response_signal is None:
