@@ -203,3 +203,27 @@ def test_a_scenarios_protocol_settings_replay_alike(tmp_path):
     assert differences(verified, replayed) == []
     run("replay", tmp_path / "v.jsonl", "--address", "1", "--json", tmp_path / "a1.json")
     assert not any(rule == "UITAMR-FORMAT" for rule, _, _ in findings(tmp_path / "a1.json")[0])
+
+
+def test_a_monitors_reply_timeout_goes_with_its_trace(tmp_path):
+    """`uitamr monitor --reply-timeout 400ms`: its trace's end record says 0.4 s, and the
+    replay of the trace judges the 450 ms late echo as the monitor did (late), where the
+    default 500 ms took it as answered."""
+    from verifier.monitor.capture import Chunk
+    from verifier.monitor.framer import LineTiming
+    from verifier.monitor.session import CaptureInfo, MonitorSession
+    from verifier.verify import report_trace
+    from verifier.verify.evidence import RuleOptions
+
+    stop = bytes.fromhex("01 06 01 A0 00 00 88 14")
+    live = MonitorSession(CaptureInfo("site", "/dev/ttyUSB0"), options=RuleOptions(reply_timeout_us=400_000),
+                          timing=LineTiming(tolerance_us=0))
+    for chunk in (Chunk(8_333, stop, "tx", 0), Chunk(466_666, stop, "rx", 458_333), Chunk(6_000_000, b"")):
+        live.feed(chunk)
+    live.close()
+    monitored = live.result()
+    assert [v.rule for v in monitored.all_violations()] == ["UITAMR-RESPONSE-HANDLING"]
+    report_trace.write([monitored], tmp_path / "site.jsonl")
+    assert json.loads((tmp_path / "site.jsonl").read_text(encoding="utf-8").splitlines()[-1])["reply_timeout"] == 0.4
+    run("replay", tmp_path / "site.jsonl", "--json", tmp_path / "r.json")
+    assert findings(tmp_path / "r.json") == [[(v.rule, v.t_us / 1e6, v.message) for v in monitored.all_violations()]]
