@@ -92,29 +92,9 @@ def test_a_converters_drop_replays_as_a_lost_reply(tmp_path):
     assert '"event": "converter.dropped"' in (tmp_path / "v.jsonl").read_text(encoding="utf-8")
 
 
-STOP_WITH_A_BAD_CRC = """PROGRAM MAIN
-VAR
-    uSend : ARRAY[0..3] OF WORD;
-    uRecv : ARRAY[0..3] OF WORD;
-    bSent : BOOL;
-END_VAR
-IF M8002 THEN
-    D8400 := 16#1C81;
-    D8409 := 5;
-END_IF;
-(* the stop once, with its CRC bytes wrong: the robot never answers, nothing more is sent *)
-IF NOT bSent THEN
-    uSend[0] := 16#0601;
-    uSend[1] := 16#A001;
-    uSend[2] := 16#0000;
-    uSend[3] := 16#1489;
-    M8402 := TRUE;
-    bSent := TRUE;
-END_IF;
-M8403 := FALSE;
-RS2(TRUE, uSend[0], 8, 8, 1, uRecv[0]);
-END_PROGRAM
-"""
+#: the stop once, with its CRC bytes wrong (89 14 for 88 14): the robot never answers, and the
+#: program sends nothing more
+STOP_WITH_A_BAD_CRC = back_to_back().replace("uSend[3] := 16#1488;", "uSend[3] := 16#1489;")
 
 
 def test_a_silence_after_the_last_frame_is_judged_to_the_runs_end(tmp_path):
