@@ -234,7 +234,7 @@ def test_a_trace_without_its_end_record_still_replays(tmp_path):
      "t.jsonl:2:1: an end record holds only 'scenario', 'end' (until when the line was listened to) and the run's "
      "settings (reply_timeout, min_period, response_within, protocol, response_signal, response_signal_hint, "
      "response_signal_held); it has 't'"),
-    (['{"scenario": "a", "end": 0.05}'], "t.jsonl:2:1: 'end' (0.05 s) is before the end of the record before (0.108 s)"),
+    (['{"scenario": "a", "end": 0.05}'], "t.jsonl:2:1: 'end' (0.05 s) is before the start of the record before (0.1 s)"),
     (['{"scenario": "a", "end": -1}'], "t.jsonl:2:1: 'end' is -1; expected a time in seconds"),
     (['{"scenario": "a", "end": 0.5}', '{"scenario": "a", "t": 0.6, "dir": "tx", "hex": "01"}'],
      "t.jsonl:3:1: the run 'a' ended at its end record ({path}:2); move this record before it"),

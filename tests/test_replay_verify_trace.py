@@ -207,3 +207,16 @@ def test_a_monitors_reply_timeout_goes_with_its_trace(tmp_path):
     assert json.loads((tmp_path / "site.jsonl").read_text(encoding="utf-8").splitlines()[-1])["reply_timeout"] == 0.4
     run("replay", tmp_path / "site.jsonl", "--json", tmp_path / "r.json")
     assert findings(tmp_path / "r.json") == [[(v.rule, v.t_us / 1e6, v.message) for v in monitored.all_violations()]]
+
+
+def test_a_run_cut_while_a_frame_is_on_the_line_replays(tmp_path):
+    """`--duration 235ms` ends the run while the stop (0.230-0.238 s) is still going out: the
+    trace holds the frame whole and the run's end before its end; the replay reads it (an end
+    record is refused only before the start of the frame before it) and the run is 0.235 s
+    long, as verify's was."""
+    scenario = bundled_scenarios()[0].parent / "fx3u-healthy.toml"
+    verified, replayed = verify_then_replay(tmp_path, "--scenario", scenario, "--duration", "235ms")
+    *frames, end = (json.loads(line) for line in (tmp_path / "v.jsonl").read_text(encoding="utf-8").splitlines())
+    assert frames[-1]["t"] < end["end"] == 0.235 < frames[-1]["t_end"]
+    assert differences(verified, replayed) == []
+    assert ends(replayed) == ends(verified) == [0.235]

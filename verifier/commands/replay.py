@@ -62,6 +62,8 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
                                      events=chunks[-1].events if chunks else ())
             for chunk in chunks:
                 session.feed(chunk)
+            if chunks and not chunks[-1].data:  # an end record, or a capture's `end` line: the run's end
+                session.end_at(chunks[-1].t_us)
             session.close()
             results.append(session.result())
     _finish(results, console, json_path, junit_path, trace_path, html_path, "uitamr replay")

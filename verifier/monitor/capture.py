@@ -243,9 +243,10 @@ def _end_chunk(record: dict, chunks: list[Chunk], where: str) -> Chunk:
                            f"to) and the run's settings ({', '.join((*RUN_SETTINGS, 'protocol', *_OUTPUTS))}); it has "
                            f"{', '.join(map(repr, other))}")
     end_us = round(_seconds(record["end"], "end", where) * 1_000_000)
-    if chunks and end_us < chunks[-1].t_us:
-        raise CaptureError(f"{where}: 'end' ({end_us / 1_000_000:g} s) is before the end of the record before "
-                           f"({chunks[-1].t_us / 1_000_000:g} s); a trace is in time order")
+    # a run may end while its last frame is still on the line (verify --duration cut it)
+    if chunks and end_us < chunks[-1].t_start_us:
+        raise CaptureError(f"{where}: 'end' ({end_us / 1_000_000:g} s) is before the start of the record before "
+                           f"({chunks[-1].t_start_us / 1_000_000:g} s); a trace is in time order")
     rules = tuple((field, round(_seconds(record[key], key, where) * 1_000_000))
                   for key, field in RUN_SETTINGS.items() if key in record)
     settings = _protocol(record["protocol"], where) if "protocol" in record else None

@@ -69,6 +69,7 @@ class MonitorSession:
         self.frames: list[TraceRecord] = []
         self._origin_us: int | None = None  # host time of the first byte: t = 0 in reports
         self.last_us = 0
+        self._ended_us: int | None = None  # the run's end as a trace's end record gives it (`end_at`)
         # the live judgement: frames go to the pairing once no frame still to come can sort
         # before them (they start before the end of the latest frame), the rules judge what
         # the pairing has settled
@@ -109,6 +110,19 @@ class MonitorSession:
         self.last_us = max(self.last_us, now)
         return self._take(self.framer.poll(now))
 
+    def end_at(self, host_us: int) -> None:
+        """The run ended at host time `host_us` (a trace's end record): its length and the
+        end the rules judge to, also when a frame that began before it was still on the line
+        then (`uitamr verify --duration` cut it; the trace holds it whole), as the run was
+        judged; the latest byte or poll otherwise."""
+        if self._origin_us is not None:
+            self._ended_us = host_us - self._origin_us
+
+    @property
+    def run_end_us(self) -> int:
+        """Where the run ends: `end_at`'s time, else the latest byte or poll."""
+        return self.last_us if self._ended_us is None else self._ended_us
+
     def _open(self) -> None:
         if self._closed:
             raise RuntimeError("the monitoring session has ended: it takes no more bytes")
@@ -139,7 +153,7 @@ class MonitorSession:
     def violations(self, end_us: int | None = None) -> dict[str, list[Violation]]:
         """The whole capture judged at once, as if it ended at `end_us` (default: the latest
         byte or poll)."""
-        end = self.last_us if end_us is None else end_us
+        end = self.run_end_us if end_us is None else end_us
         evidence = RunEvidence(self.settings, self.frames, end, self.events, self.samples, self.options)
         found = check_all(evidence, analyse(self.frames, self.settings, self.options, self._drops))
         if not self.from_power_on:
@@ -152,7 +166,7 @@ class MonitorSession:
         word of replies that are still failing after the bound of UITAMR-RESPONSE-HANDLING
         (its final finding is then not returned again), also when the line has gone silent
         after a request whose reply is overdue."""
-        self._evidence.end_us = self.last_us  # the run lasts at least this long
+        self._evidence.end_us = self.run_end_us  # the run lasts at least this long
         if not self._in_line_order:
             new = self._judged_whole() if self._closed else []
         elif self._closed:
@@ -248,7 +262,7 @@ class MonitorSession:
     def result(self, listened_us: int | None = None) -> ScenarioResult:
         """The final judgement; `listened_us`: how long a live session listened (for a line
         on which nothing was seen)."""
-        end = self.last_us
+        end = self.run_end_us
         notes = list(self.info.notes)
         if self.timing.tolerance_us:
             notes.append(f"frames timed by the host; timing rules allow {self.timing.tolerance_us / 1000:g} ms "
