@@ -1,19 +1,20 @@
-"""`--trace FILE`: every frame on the line as JSON Lines, one frame per line.
+"""`--trace FILE`: every frame on the line as JSON Lines, one frame per line, and after each
+run's frames what the rules read besides them.
 
 Fields: `t`, `t_end` (seconds of virtual time), `dir` ("tx" PLC→robot, "rx" robot→PLC),
 `hex` (space-separated bytes), `meaning` (decoded), `origin` (the ST location that sent a
 tx frame, when known), `scenario`, and `rules` (ids of the rules this frame is evidence for);
 a trace of host times (`uitamr monitor`, `uitamr replay`) also has `tolerance` (seconds), which
-a replay of it allows again. After a run's frames come the line's events the rules read that
-the frames do not show (`event_record`: `{"scenario": ..., "t": seconds, "event": "gap" or
-"converter.dropped", "message": ...}`: a pause inside a PLC frame, a TCP converter that
-dropped the connection after forwarding a request). Every trace ends each run that has frames with an end record
-`{"scenario": ..., "end": seconds, "reply_timeout": s, "min_period": s, "response_within": s}`
-(`end_record`): until when the line was listened to (a simulated run: its end in virtual
-time), so that a replay judges the silence after the last frame as the run did (a reply
-still due, the run's length), as a plain capture's `end` line does; and the rules'
-settings the run was judged with (a scenario's [rules] and [response_handling] within, a
-monitor's --reply-timeout), which a replay judges with again.
+a replay of it allows again. After a run's frames come its event records (`event_record`:
+the line's events the rules read that the frames do not show, RULE_EVENTS: a pause inside a
+PLC frame, a TCP converter that dropped the connection after forwarding a request), then its
+end record (`end_record`): when the run ended - until when the line was listened to, a
+simulated run's end in virtual time - so that a replay judges the silence after the last
+frame as the run did (a reply still due, the run's length), as a plain capture's `end` line
+does; the rules' and the protocol's settings the run was judged with; and, for a run that saw
+the program's outputs (`uitamr verify`), its response signal and when it held. With them
+`uitamr replay` of the trace reaches the run's own rule findings
+(tests/test_replay_verify_trace.py).
 
 A run of `uitamr verify --trace` or `--html` does not hold its frames: it writes each
 one as a spool line while it goes (`spool_lines`: everything but `rules`, which only the
