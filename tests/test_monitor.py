@@ -42,6 +42,11 @@ CAPTURES = Path(__file__).resolve().parent / "captures"
 STOP, READ = frame("stop"), frame("read", "task")
 
 
+#: the rules' and the protocol's settings a trace's end record carries, at their defaults (docs/verifier.md)
+RULES_RECORDED = {"reply_timeout": 0.5, "min_period": 0.25, "response_within": 5.0,
+                  "protocol": {"address": 1, "field_order": "code-high", "codes_10_13": "decimal",
+                               "status_order": "query", "manual_stop_counts_as_stop": False}}
+
 def session_of(chunks, tolerance_us: int = 20_000, end_us: int | None = None, **kw) -> MonitorSession:
     """A session fed as `uitamr monitor` feeds it: each chunk as it came; with `end_us`, the
     poll at the end of listening (a read that returned nothing); then the close."""
@@ -149,7 +154,8 @@ def test_a_replay_of_the_monitors_trace_judges_as_the_live_session_did(tmp_path)
     assert [v.rule for found in live.result().violations.values() for v in found] == ["UITAMR-RESPONSE-HANDLING"]
     trace = tmp_path / "site.jsonl"
     report_trace.write([live.result()], trace)
-    assert json.loads(trace.read_text(encoding="utf-8").splitlines()[-1]) == {"scenario": "test", "end": 9.998333}
+    assert json.loads(trace.read_text(encoding="utf-8").splitlines()[-1]) == {"scenario": "test", "end": 9.998333,
+                                                                              **RULES_RECORDED}
     done = subprocess.run(uitamr("replay", trace, "--json", tmp_path / "r.json", "--trace", tmp_path / "r.jsonl"),
                           capture_output=True, text=True, timeout=WAIT_S)
     assert done.returncode == 1, done.stdout + done.stderr
@@ -159,7 +165,8 @@ def test_a_replay_of_the_monitors_trace_judges_as_the_live_session_did(tmp_path)
         (v.rule, v.message) for found in live.result().violations.values() for v in found]
     assert _judged(session_of(parse_trace(trace.read_text(encoding="utf-8"))["test"], 20_000)) == _judged(live)
     # the replay's own trace ends where the live session did, so it replays alike again
-    assert json.loads((tmp_path / "r.jsonl").read_text().splitlines()[-1]) == {"scenario": "site.jsonl", "end": 9.998333}
+    assert json.loads((tmp_path / "r.jsonl").read_text().splitlines()[-1]) == {"scenario": "site.jsonl",
+                                                                                "end": 9.998333, **RULES_RECORDED}
 
 
 def test_a_replay_of_a_trace_keeps_its_times_when_the_first_frame_came_in_pieces(tmp_path):
@@ -224,8 +231,10 @@ def test_a_trace_without_its_end_record_still_replays(tmp_path):
 
 @pytest.mark.parametrize("lines, message", [
     (['{"scenario": "a", "end": 0.5, "t": 0.1}'],
-     "t.jsonl:2:1: an end record holds only 'scenario' and 'end' (until when the line was listened to); it has 't'"),
-    (['{"scenario": "a", "end": 0.05}'], "t.jsonl:2:1: 'end' (0.05 s) is before the end of the record before (0.108 s)"),
+     "t.jsonl:2:1: an end record holds only 'scenario', 'end' (until when the line was listened to) and the run's "
+     "settings (reply_timeout, min_period, response_within, protocol, response_signal, response_signal_hint, "
+     "response_signal_held); it has 't'"),
+    (['{"scenario": "a", "end": 0.05}'], "t.jsonl:2:1: 'end' (0.05 s) is before the start of the record before (0.1 s)"),
     (['{"scenario": "a", "end": -1}'], "t.jsonl:2:1: 'end' is -1; expected a time in seconds"),
     (['{"scenario": "a", "end": 0.5}', '{"scenario": "a", "t": 0.6, "dir": "tx", "hex": "01"}'],
      "t.jsonl:3:1: the run 'a' ended at its end record ({path}:2); move this record before it"),
@@ -600,10 +609,13 @@ def test_replay_of_a_verify_trace_file(tmp_path):
     assert done.returncode == 0, done.stdout + done.stderr
     data = json.loads(report.read_text())
     assert data["verdict"] == "pass" and data["scenarios"][0]["violations"] == []
-    original = [json.loads(line) for line in trace.read_text().splitlines()]
+    *original, verify_end = [json.loads(line) for line in trace.read_text().splitlines()]
     *again, end = [json.loads(line) for line in (tmp_path / "r.jsonl").read_text().splitlines()]
     assert [(r["dir"], r["hex"], r["meaning"]) for r in again] == [(r["dir"], r["hex"], r["meaning"]) for r in original]
-    assert end == {"scenario": again[0]["scenario"], "end": data["scenarios"][0]["duration"]}  # the replay's run's end
+    # verify's run ended at 60 s of virtual time, and the replay's run there too; the replay's
+    # own trace says so again, with the rules' settings and the program's outputs verify recorded
+    assert verify_end["end"] == data["scenarios"][0]["duration"] == 60.0
+    assert end == dict(verify_end, scenario=again[0]["scenario"])
     assert "<svg" in (tmp_path / "r.html").read_text()
 
 

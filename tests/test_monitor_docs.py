@@ -102,7 +102,10 @@ def test_a_monitor_trace_replays_to_the_monitors_findings(tmp_path):
     assert exact.returncode == 1 and "UITAMR-PACING ×2" in exact.stdout
     *frames, end = (json.loads(line) for line in trace.read_text().splitlines())
     assert all(record["tolerance"] == DEFAULT_TOLERANCE_US / 1e6 for record in frames)
-    assert end == {"scenario": "site", "end": live.ended_us / 1e6}  # the end record: a time, no frame
+    assert end == {"scenario": "site", "end": live.ended_us / 1e6,  # the end record: a time and settings, no frame
+                   "reply_timeout": 0.5, "min_period": 0.25, "response_within": 5.0,
+                   "protocol": {"address": 1, "field_order": "code-high", "codes_10_13": "decimal",
+                                "status_order": "query", "manual_stop_counts_as_stop": False}}
 
 
 def test_an_unreadable_capture_is_reported_as_section_6_quotes(tmp_path):

@@ -82,6 +82,7 @@ def test_the_command_keeps_what_its_reports_list(tmp_path):
     assert any(event["kind"] == "robot.task" for event in data["line_events"])
     done = _verify("--scenario", scenario, "--trace", tmp_path / "t.jsonl", cwd=ROOT)
     assert done.returncode == 0, done.stdout + done.stderr
-    lines = (tmp_path / "t.jsonl").read_text(encoding="utf-8").splitlines()
+    *lines, end = (tmp_path / "t.jsonl").read_text(encoding="utf-8").splitlines()
     assert sum('"dir": "tx"' in line for line in lines) == data["frames"]["tx"]
     assert len(lines) == data["frames"]["tx"] + data["frames"]["rx"]
+    assert json.loads(end)["end"] == data["ended"]  # then the run's end record

@@ -2,9 +2,10 @@
 summary, and the HTML page rendered in headless Chromium and checked from its DOM."""
 from __future__ import annotations
 
+import dataclasses
 import io
-import re
 import json
+import re
 import shutil
 import subprocess
 import tempfile
@@ -127,8 +128,12 @@ def test_trace_is_one_frame_per_line_with_time_direction_hex_and_meaning(tmp_pat
     path = tmp_path / "t.jsonl"
     report_trace.write([bad_result()], path)
     lines = path.read_text().splitlines()
-    records = [json.loads(line) for line in lines]
+    *records, end = [json.loads(line) for line in lines]
     assert len(records) == 20
+    result = bad_result()  # the run's end and the rules' settings it was judged with
+    assert end == {"scenario": "broken", "end": result.ended_us / 1e6, "reply_timeout": result.reply_timeout_us / 1e6,
+                   "min_period": result.min_period_us / 1e6, "response_within": result.response_within_us / 1e6,
+                   "protocol": dataclasses.asdict(result.settings)}
     first, reply = records[0], records[1]
     assert first["t"] == 0.0 and first["dir"] == "tx" and first["hex"] == "01 06 01 03 00 00 78 36"
     assert "point" in first["meaning"] and first["origin"] == "UITAMR_Engine.st:210:9"

@@ -67,8 +67,10 @@ def line_options(command):
                           "of a monitor trace: the tolerance it was recorded with)."),
         click.option("--joined", is_flag=True,
                      help="The capture began after the PLC's power-on: do not judge UITAMR-POWERON-STOP."),
-        click.option("--reply-timeout", type=_Duration(), default="500ms", show_default=True,
-                     help="The PLC's reply time-out (UITAMR-ONE-AT-A-TIME, UITAMR-RESPONSE-HANDLING)."),
+        click.option("--reply-timeout", type=_Duration(),
+                     help="The PLC's reply time-out (UITAMR-ONE-AT-A-TIME, UITAMR-RESPONSE-HANDLING). "
+                          f"Default {protocol.DEFAULT_REPLY_TIMEOUT_US // 1000}ms (replay of a trace: the time-out "
+                          "its end record says the run was judged with)."),
     )
     for option in reversed(options):
         command = option(command)
@@ -118,6 +120,8 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
         click.echo(f"uitamr monitor: {exc}", err=True)
         sys.exit(EXIT_UNUSABLE)
     info = CaptureInfo(f"monitor {source.description}", source.description, channel, line=f"{baud} {line_format}")
+    if reply_timeout is None:
+        reply_timeout = protocol.DEFAULT_REPLY_TIMEOUT_US
     session = MonitorSession(info, settings, RuleOptions(reply_timeout_us=reply_timeout), timing,
                              from_power_on=not joined)
     stop = threading.Event()

@@ -27,6 +27,13 @@ _OPTIONS = (
 _NAMES = ("address", "field_order", "codes_10_13", "status_order", "manual_stop_counts_as_stop")
 
 
+def given_settings(settings: Settings) -> dict:
+    """Those of `settings` given on the command line (not left at their defaults), by field."""
+    context = click.get_current_context()
+    return {name: getattr(settings, name) for name in _NAMES
+            if context.get_parameter_source(name) is not click.core.ParameterSource.DEFAULT}
+
+
 def protocol_settings(command):
     """Add the protocol setting options to a click command and hand it one `settings`
     keyword argument (a `verifier.protocol.Settings`) instead of five loose values."""

@@ -9,12 +9,13 @@ capture that holds no bytes (nothing was verified).
 from __future__ import annotations
 
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import click
 
 from verifier.commands.monitor import EXIT_UNUSABLE, _finish, exit_status, line_options, line_timing
-from verifier.commands.protocol_options import protocol_settings
+from verifier.commands.protocol_options import given_settings, protocol_settings
 from verifier.commands.report_files import ReportError, check_folders, check_not_inputs, report_options, text_console
 from verifier.monitor.capture import CaptureError, read_capture
 from verifier.monitor.framer import DEFAULT_TOLERANCE_US
@@ -54,11 +55,26 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
         for capture_name, chunks in loaded.items():
             info = CaptureInfo(capture_name if len(loaded) > 1 else path.name, str(path), "capture",
                                line=f"{baud} {line_format}")
-            session = MonitorSession(info, settings, RuleOptions(reply_timeout_us=reply_timeout), timing,
-                                     from_power_on=not joined)
+            recorded = chunks[-1].settings if chunks else None  # the end record's: overridden by options given
+            run_settings = settings if recorded is None else replace(recorded, **given_settings(settings))
+            session = MonitorSession(info, run_settings, _rule_options(chunks, reply_timeout), timing,
+                                     from_power_on=not joined, signal_held=chunks[-1].signal_held if chunks else None,
+                                     events=chunks[-1].events if chunks else ())
             for chunk in chunks:
                 session.feed(chunk)
+            if chunks and not chunks[-1].data:  # an end record, or a capture's `end` line: the run's end
+                session.end_at(chunks[-1].t_us)
             session.close()
             results.append(session.result())
     _finish(results, console, json_path, junit_path, trace_path, html_path, "uitamr replay")
     sys.exit(exit_status(results))
+
+
+def _rule_options(chunks: list, reply_timeout_us: int | None) -> RuleOptions:
+    """The rules' settings for one run of a capture: those its trace's end record says the
+    run was judged with (a scenario's [rules] and [response_handling] within, a monitor's
+    --reply-timeout), else the defaults; --reply-timeout, when given, over both."""
+    recorded = dict(chunks[-1].rules) if chunks else {}
+    if reply_timeout_us is not None:
+        recorded["reply_timeout_us"] = reply_timeout_us
+    return RuleOptions(**recorded)

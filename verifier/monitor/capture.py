@@ -22,13 +22,17 @@ from __future__ import annotations
 import json
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
+from typing import Any
 
 from verifier import protocol
 from verifier.amr.schema import LARGEST  # the largest number of seconds any setting holds
 from verifier.digits import describe, foreign_digit
 from verifier.textfile import UnreadableText, lone_cr_as_line_feed, read_utf8, text_lines
+from verifier.verify.conditions import ConditionError, parse_condition
+from verifier.verify.report_trace import RUN_SETTINGS
+from verifier.verify.result import RULE_EVENTS, LineEvent
 
 
 @dataclass(frozen=True)
@@ -43,6 +47,13 @@ class Chunk:
     direction: str | None = None
     t_start_us: int | None = None  # a frame whose start is known exactly (our traces)
     tolerance_us: int | None = None  # a trace of host times (monitor --trace): their tolerance
+    # a trace's end record: the rules' settings the run was judged with, as (RuleOptions
+    # field, value): times in µs, and the response signal of a run that saw the program's
+    # outputs (`uitamr verify`), with when it held ((began, stopped) µs; None: not seen)
+    rules: tuple[tuple[str, Any], ...] = ()
+    signal_held: tuple[tuple[int, int | None], ...] | None = None
+    events: tuple[LineEvent, ...] = ()  # the run's event records (RULE_EVENTS), on its end record's chunk
+    settings: protocol.Settings | None = None  # the end record's protocol settings
 
 
 def tolerance_hides_pacing(tolerance_us: int) -> bool:
@@ -130,11 +141,15 @@ def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
 def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
     """Our JSONL trace (`uitamr verify --trace`, `uitamr monitor --trace`): frames with
     their direction, grouped by scenario, in file order (a record ends at a line feed or a
-    CRLF; `read_capture` reads a file with lone CRs too). A run's end record (a monitor's
-    trace has one, docs/verifier.md) is a chunk with no bytes at its time, as a plain
-    capture's `end` line is: the replay polls until then, as the live session listened."""
+    CRLF; `read_capture` reads a file with lone CRs too). A run's end record (docs/verifier.md;
+    a trace written before them has none) is a chunk with no bytes at its time, as a plain
+    capture's `end` line is: the replay polls until then, as the run listened; the rules'
+    settings and the program's outputs it carries, and the run's event records before it,
+    ride on that chunk (`Chunk.rules`, `signal_held`, `events`)."""
     scenarios: dict[str, list[Chunk]] = {}
     ended: dict[str, int] = {}  # scenario -> the line of its end record
+    events: dict[str, list[LineEvent]] = {}  # scenario -> its event records, until its end record
+    first_event: dict[str, int] = {}  # scenario -> the line of its first event record
     for number, raw in enumerate(text_lines(text), start=1):
         if not raw.strip():
             continue
@@ -157,8 +172,12 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
                                "move this record before it, or remove the end record")
         if "end" in record:
             chunks = scenarios.setdefault(scenario, [])
-            chunks.append(_end_chunk(record, chunks, where))
+            chunks.append(replace(_end_chunk(record, chunks, where), events=tuple(events.pop(scenario, ()))))
             ended[scenario] = number
+            continue
+        if "event" in record:
+            events.setdefault(scenario, []).append(_event(record, where))
+            first_event.setdefault(scenario, number)
             continue
         for key in ("t", "dir", "hex"):
             if key not in record:
@@ -188,22 +207,117 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
                                f"{protocol.MIN_PERIOD_US / 1_000_000:g} s")
         chunks.append(Chunk(round(t_end * 1_000_000), data, record["dir"], round(t_start * 1_000_000),
                             None if tolerance is None else round(tolerance * 1_000_000)))
+    for scenario in events:  # what the end record would have carried to the replay
+        raise CaptureError(f"{name}:{first_event[scenario]}:1: the run {scenario!r} has event records but no end "
+                           "record after them; a trace ends each run with its end record")
     return scenarios
 
 
-def _end_chunk(record: dict, chunks: list[Chunk], where: str) -> Chunk:
-    """A trace's end record (`{"scenario": ..., "end": seconds}`, which a monitor's trace
-    ends each run with): until when the line was listened to, as a chunk with no bytes,
-    as a plain capture's `end` line is read."""
-    other = sorted(set(record) - {"scenario", "end"})
+def _event(record: dict, where: str) -> LineEvent:
+    """An event record (`{"scenario": ..., "t": seconds, "event": kind, "message": text}`): a
+    line event the rules read that the frames do not show (RULE_EVENTS)."""
+    other = sorted(set(record) - {"scenario", "t", "event", "message"})
     if other:
-        raise CaptureError(f"{where}: an end record holds only 'scenario' and 'end' (until when the line was "
-                           f"listened to); it has {', '.join(map(repr, other))}")
+        raise CaptureError(f"{where}: an event record holds only 'scenario', 't', 'event' and 'message'; it has "
+                           f"{', '.join(map(repr, other))}")
+    if record["event"] not in RULE_EVENTS:
+        raise CaptureError(f"{where}: 'event' is {json.dumps(record['event'])}; expected one of "
+                           f"{', '.join(json.dumps(kind) for kind in RULE_EVENTS)}")
+    message = record.get("message", "")
+    if not isinstance(message, str):
+        raise CaptureError(f"{where}: 'message' is {json.dumps(message)}; expected a string")
+    if "t" not in record:
+        raise CaptureError(f"{where}: the event record has no 't'")
+    return LineEvent(round(_seconds(record["t"], "t", where) * 1_000_000), record["event"], message)
+
+
+def _end_chunk(record: dict, chunks: list[Chunk], where: str) -> Chunk:
+    """A trace's end record (`{"scenario": ..., "end": seconds, "reply_timeout": seconds, ...}`,
+    which every trace ends each run with): until when the line was listened to, as a chunk
+    with no bytes, as a plain capture's `end` line is read; and the rules' settings the run
+    was judged with (`report_trace.RUN_SETTINGS`; a trace written before them has none)."""
+    known = {"scenario", "end", *RUN_SETTINGS, "protocol", *_OUTPUTS}
+    other = sorted(set(record) - known)
+    if other:
+        raise CaptureError(f"{where}: an end record holds only 'scenario', 'end' (until when the line was listened "
+                           f"to) and the run's settings ({', '.join((*RUN_SETTINGS, 'protocol', *_OUTPUTS))}); it has "
+                           f"{', '.join(map(repr, other))}")
     end_us = round(_seconds(record["end"], "end", where) * 1_000_000)
-    if chunks and end_us < chunks[-1].t_us:
-        raise CaptureError(f"{where}: 'end' ({end_us / 1_000_000:g} s) is before the end of the record before "
-                           f"({chunks[-1].t_us / 1_000_000:g} s); a trace is in time order")
-    return Chunk(end_us, b"")
+    # a run may end while its last frame is still on the line (verify --duration cut it)
+    if chunks and end_us < chunks[-1].t_start_us:
+        raise CaptureError(f"{where}: 'end' ({end_us / 1_000_000:g} s) is before the start of the record before "
+                           f"({chunks[-1].t_start_us / 1_000_000:g} s); a trace is in time order")
+    rules = tuple((field, round(_seconds(record[key], key, where) * 1_000_000))
+                  for key, field in RUN_SETTINGS.items() if key in record)
+    settings = _protocol(record["protocol"], where) if "protocol" in record else None
+    if "response_signal" not in record:  # a line's run: the program's outputs were not seen
+        stray = sorted(set(_OUTPUTS) & set(record))
+        if stray:
+            raise CaptureError(f"{where}: {stray[0]!r} without 'response_signal'; an end record that says the "
+                               "program's outputs gives the signal (null: the run had none)")
+        return Chunk(end_us, b"", rules=rules, settings=settings)
+    return Chunk(end_us, b"", rules=rules + _signal(record, where), signal_held=_held(record, where),
+                 settings=settings)
+
+
+def _protocol(table, where: str) -> protocol.Settings:
+    """An end record's protocol settings (`{"address": 1, "field_order": "code-high", ...}`)."""
+    names = tuple(field.name for field in fields(protocol.Settings))
+    if not isinstance(table, dict):
+        raise CaptureError(f"{where}: 'protocol' is {json.dumps(table)}; expected an object of the protocol "
+                           f"settings ({', '.join(names)})")
+    other = sorted(set(table) - set(names))
+    if other:
+        raise CaptureError(f"{where}: 'protocol' holds only {', '.join(names)}; it has {', '.join(map(repr, other))}")
+    if isinstance(table.get("address"), bool):
+        raise CaptureError(f"{where}: 'protocol' address is {json.dumps(table['address'])}; expected 1-247")
+    try:
+        return protocol.Settings(**table)
+    except ValueError as exc:
+        raise CaptureError(f"{where}: 'protocol': {exc}") from None
+
+
+#: an end record's keys that say the program's outputs (a simulated run's)
+_OUTPUTS = ("response_signal", "response_signal_hint", "response_signal_held")
+
+
+def _signal(record: dict, where: str) -> tuple[tuple[str, Any], ...]:
+    """The response signal an end record names (None: the run had none) and the hint that
+    says what the program has instead, as RuleOptions fields."""
+    text, hint = record["response_signal"], record.get("response_signal_hint", "")
+    if not isinstance(hint, str):
+        raise CaptureError(f"{where}: 'response_signal_hint' is {json.dumps(hint)}; expected a string")
+    if text is None:
+        return ("response_signal", None), ("response_signal_hint", hint)
+    try:
+        signal = parse_condition(text)
+    except ConditionError as exc:
+        raise CaptureError(f"{where}: 'response_signal' is {json.dumps(text)}: {exc.message}") from None
+    return ("response_signal", signal), ("response_signal_hint", hint)
+
+
+def _held(record: dict, where: str) -> tuple[tuple[int, int | None], ...]:
+    """When the response signal held: [began, stopped] pairs in seconds, in time order,
+    stopped null for the last when it still held at the end of the run."""
+    held = record.get("response_signal_held", [])
+    if record["response_signal"] is None and held:
+        raise CaptureError(f"{where}: 'response_signal_held' without a 'response_signal'")
+    expected = ("expected [[began, stopped], ...] in seconds, in time order, stopped null for a stretch still "
+                "holding at the end")
+    if not isinstance(held, list):
+        raise CaptureError(f"{where}: 'response_signal_held' is {json.dumps(held)}; {expected}")
+    stretches: list[tuple[int, int | None]] = []
+    last = 0
+    for k, pair in enumerate(held):
+        if not isinstance(pair, list) or len(pair) != 2 or (pair[1] is None and k != len(held) - 1):
+            raise CaptureError(f"{where}: 'response_signal_held' item {k + 1} is {json.dumps(pair)}; {expected}")
+        began = round(_seconds(pair[0], "response_signal_held", where) * 1_000_000)
+        stopped = None if pair[1] is None else round(_seconds(pair[1], "response_signal_held", where) * 1_000_000)
+        if began < last or (stopped is not None and stopped <= began):
+            raise CaptureError(f"{where}: 'response_signal_held' item {k + 1} is {json.dumps(pair)}; {expected}")
+        stretches.append((began, stopped))
+        last = began if stopped is None else stopped
+    return tuple(stretches)
 
 
 _HEX_BYTES = re.compile(r"\s*(?:[0-9A-Fa-f]{2}\s*)*")

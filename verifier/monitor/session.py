@@ -11,14 +11,16 @@ verify` reads, and the same as judging the whole capture at once (`violations`).
 """
 from __future__ import annotations
 
+from bisect import bisect_right
 from dataclasses import dataclass, field, replace
+from typing import Sequence
 
 from verifier import protocol
 from verifier.protocol.codec import MAX_FRAME
-from verifier.verify.evidence import RuleOptions, RunEvidence, Violation
-from verifier.verify.result import LINE, ScenarioResult, TraceRecord
+from verifier.verify.evidence import RuleOptions, RunEvidence, Samples, Violation
+from verifier.verify.result import LINE, LineEvent, ScenarioResult, TraceRecord
 from verifier.verify.rules import Judgement, check_all
-from verifier.verify.traffic import Exchange, Pairing, analyse
+from verifier.verify.traffic import Exchange, Pairing, analyse, converter_drops
 
 from .capture import Chunk
 from .classify import Classifier
@@ -42,11 +44,24 @@ class CaptureInfo:
 class MonitorSession:
     def __init__(self, info: CaptureInfo, settings: protocol.Settings = protocol.DEFAULT_SETTINGS,
                  options: RuleOptions = RuleOptions(), timing: LineTiming = LineTiming(),
-                 from_power_on: bool = True):
+                 from_power_on: bool = True, signal_held: Sequence[tuple[int, int | None]] | None = None,
+                 events: Sequence[LineEvent] = ()):
+        """`signal_held`: when the program's response signal (`options.response_signal`)
+        held, for a trace of `uitamr verify` that recorded it; None (a line): the program's
+        outputs are not seen, and UITAMR-RESPONSE-HANDLING says so. `events`: the line
+        events the rules read that a trace recorded (RULE_EVENTS: pauses inside PLC frames,
+        a converter's drops), on the trace's clock."""
         self.info = info
         self.settings = settings
         self.timing = timing
-        self.options = replace(options, timing_tolerance_us=timing.tolerance_us, outputs_visible=False)
+        self.options = replace(options, timing_tolerance_us=timing.tolerance_us, outputs_visible=signal_held is not None)
+        self.signal_held = None if signal_held is None else list(signal_held)
+        self.samples = Samples()  # the PLC's variables: none on a line
+        self.events = sorted(events, key=lambda e: e.t_us)
+        self._drops = converter_drops(self.events)  # the next request at or after each lost its reply
+        self._drops_passed = 0
+        if self.options.outputs_visible and self.options.response_signal is not None:
+            self.samples.given(self.options.response_signal, self.signal_held)
         self.from_power_on = from_power_on
         self.framer = Framer(timing)
         self.classifier = Classifier(settings, self.options.reply_timeout_us, timing.tolerance_us)
@@ -54,11 +69,12 @@ class MonitorSession:
         self.frames: list[TraceRecord] = []
         self._origin_us: int | None = None  # host time of the first byte: t = 0 in reports
         self.last_us = 0
+        self._ended_us: int | None = None  # the run's end as a trace's end record gives it (`end_at`)
         # the live judgement: frames go to the pairing once no frame still to come can sort
         # before them (they start before the end of the latest frame), the rules judge what
         # the pairing has settled
         self._pairing = Pairing(settings, self.options)
-        self._evidence = RunEvidence(settings, self.frames, 0, (), options=self.options)
+        self._evidence = RunEvidence(settings, self.frames, 0, self.events, self.samples, self.options)
         self._judgement = Judgement(self._evidence, self._pairing.traffic)
         self.judged_frames = 0  # frames handed to the rules (each once)
         self._line_end_us: int | None = None  # the end of the latest frame
@@ -94,6 +110,19 @@ class MonitorSession:
         self.last_us = max(self.last_us, now)
         return self._take(self.framer.poll(now))
 
+    def end_at(self, host_us: int) -> None:
+        """The run ended at host time `host_us` (a trace's end record): its length and the
+        end the rules judge to, also when a frame that began before it was still on the line
+        then (`uitamr verify --duration` cut it; the trace holds it whole), as the run was
+        judged; the latest byte or poll otherwise."""
+        if self._origin_us is not None:
+            self._ended_us = host_us - self._origin_us
+
+    @property
+    def run_end_us(self) -> int:
+        """Where the run ends: `end_at`'s time, else the latest byte or poll."""
+        return self.last_us if self._ended_us is None else self._ended_us
+
     def _open(self) -> None:
         if self._closed:
             raise RuntimeError("the monitoring session has ended: it takes no more bytes")
@@ -124,9 +153,9 @@ class MonitorSession:
     def violations(self, end_us: int | None = None) -> dict[str, list[Violation]]:
         """The whole capture judged at once, as if it ended at `end_us` (default: the latest
         byte or poll)."""
-        end = self.last_us if end_us is None else end_us
-        evidence = RunEvidence(self.settings, self.frames, end, (), options=self.options)
-        found = check_all(evidence, analyse(self.frames, self.settings, self.options))
+        end = self.run_end_us if end_us is None else end_us
+        evidence = RunEvidence(self.settings, self.frames, end, self.events, self.samples, self.options)
+        found = check_all(evidence, analyse(self.frames, self.settings, self.options, self._drops))
         if not self.from_power_on:
             found[POWER_ON_RULE] = []
         return found
@@ -137,7 +166,7 @@ class MonitorSession:
         word of replies that are still failing after the bound of UITAMR-RESPONSE-HANDLING
         (its final finding is then not returned again), also when the line has gone silent
         after a request whose reply is overdue."""
-        self._evidence.end_us = self.last_us  # the run lasts at least this long
+        self._evidence.end_us = self.run_end_us  # the run lasts at least this long
         if not self._in_line_order:
             new = self._judged_whole() if self._closed else []
         elif self._closed:
@@ -198,7 +227,17 @@ class MonitorSession:
         """Hand frames up to `upto` to the pairing, in `analyse`'s order."""
         for frame in sorted(self.frames[self.judged_frames:upto], key=lambda f: (f.t_start_us, f.direction != "tx")):
             self._pairing.give(frame)
+            if frame.direction == "tx":
+                self._lost_at_converter(frame)
         self.judged_frames = max(self.judged_frames, upto)
+
+    def _lost_at_converter(self, request: TraceRecord) -> None:
+        """The request just given is the first at or after a converter's drop: its reply never
+        reached the PLC (as `analyse` marks it, `dropped_at`)."""
+        passed = bisect_right(self._drops, request.t_start_us)
+        if passed > self._drops_passed:
+            self._pairing.traffic.exchanges[-1].lost_at_converter = True
+            self._drops_passed = passed
 
     def _judged_whole(self) -> list[Violation]:
         """Frames that overlap (only a trace file's can; bytes from a line never do) make the
@@ -223,13 +262,18 @@ class MonitorSession:
     def result(self, listened_us: int | None = None) -> ScenarioResult:
         """The final judgement; `listened_us`: how long a live session listened (for a line
         on which nothing was seen)."""
-        end = self.last_us
+        end = self.run_end_us
         notes = list(self.info.notes)
         if self.timing.tolerance_us:
             notes.append(f"frames timed by the host; timing rules allow {self.timing.tolerance_us / 1000:g} ms "
                          "for the adapter's latency (--tolerance)")
         else:  # a verify trace, tx/rx lines or --tolerance 0: the times are the wire's
             notes.append("frames taken as exactly timed; timing rules allow 0 ms for latency (--tolerance)")
+        if self.signal_held is not None:
+            signal = self.options.response_signal
+            notes.append("the program's outputs as the trace recorded them: "
+                         + (f"{PROVISIONAL_RULE} judged by '{signal}'" if signal is not None
+                            else f"the run had no response signal for {PROVISIONAL_RULE}"))
         if not self.from_power_on:
             notes.append(f"the capture began after power-on: {POWER_ON_RULE} is not judged")
         if self.cut_off:
@@ -253,6 +297,11 @@ class MonitorSession:
             settings=self.settings,
             min_period_us=self.options.min_period_us,
             reply_timeout_us=self.options.reply_timeout_us,
+            response_within_us=self.options.response_within_us,
+            response_signal=None if self.options.response_signal is None else str(self.options.response_signal),
+            response_signal_hint=self.options.response_signal_hint,
+            signal_held=self.signal_held,
+            rule_events=list(self.events),
             trace=list(self.frames),
             violations=self._final(),
             ended_us=end,

@@ -99,6 +99,15 @@ class Samples:
                 spans.moment(t_us, values)
         return spans
 
+    def given(self, condition: Condition, stretches: Sequence[tuple[int, int | None]]) -> None:
+        """When `condition` held, known without its labels' values (a verify trace's end
+        record, `Spans.stretches`): `spans(condition)` answers from these."""
+        spans = self._spans[condition] = Spans(condition)
+        for began, stopped in stretches:
+            spans.began.append(began)
+            if stopped is not None:
+                spans.stopped.append(stopped)
+
     def value_at(self, name: str, t_us: int) -> Any:
         index = bisect_right(self._times.get(name, []), t_us) - 1
         return self.changes[name][index][1] if index >= 0 else None
@@ -171,6 +180,10 @@ class Spans:
             self.began.append(t_us)
         elif not holds and running:
             self.stopped.append(t_us)
+
+    def stretches(self) -> list[tuple[int, int | None]]:
+        """(began, stopped) of each stretch, stopped None for one still running."""
+        return [(began, self.stopped[k] if k < len(self.stopped) else None) for k, began in enumerate(self.began)]
 
     def first_running_after(self, t_us: int) -> int | None:
         """When the first stretch still running after `t_us` began (it may have begun

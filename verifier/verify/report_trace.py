@@ -1,13 +1,20 @@
-"""`--trace FILE`: every frame on the line as JSON Lines, one frame per line.
+"""`--trace FILE`: every frame on the line as JSON Lines, one frame per line, and after each
+run's frames what the rules read besides them.
 
 Fields: `t`, `t_end` (seconds of virtual time), `dir` ("tx" PLC→robot, "rx" robot→PLC),
 `hex` (space-separated bytes), `meaning` (decoded), `origin` (the ST location that sent a
 tx frame, when known), `scenario`, and `rules` (ids of the rules this frame is evidence for);
 a trace of host times (`uitamr monitor`, `uitamr replay`) also has `tolerance` (seconds), which
-a replay of it allows again, and ends each run that has frames with an end record
-`{"scenario": ..., "end": seconds}`: until when the line was listened to (`end_record`),
-so that a replay judges the silence after the last frame as the live session did (a reply
-still due, the run's length), as a plain capture's `end` line does.
+a replay of it allows again. After a run's frames come its event records (`event_record`:
+the line's events the rules read that the frames do not show, RULE_EVENTS: a pause inside a
+PLC frame, a TCP converter that dropped the connection after forwarding a request), then its
+end record (`end_record`): when the run ended - until when the line was listened to, a
+simulated run's end in virtual time - so that a replay judges the silence after the last
+frame as the run did (a reply still due, the run's length), as a plain capture's `end` line
+does; the rules' and the protocol's settings the run was judged with; and, for a run that saw
+the program's outputs (`uitamr verify`), its response signal and when it held. With them
+`uitamr replay` of the trace reaches the run's own rule findings
+(tests/test_replay_verify_trace.py).
 
 A run of `uitamr verify --trace` or `--html` does not hold its frames: it writes each
 one as a spool line while it goes (`spool_lines`: everything but `rules`, which only the
@@ -18,6 +25,7 @@ bytes (tests/test_verify_trace_spool.py, tests/test_verify_html_spool.py).
 from __future__ import annotations
 
 import json
+from dataclasses import asdict
 from pathlib import Path
 from typing import Collection, Iterator
 
@@ -25,7 +33,7 @@ from verifier import protocol
 from verifier.textfile import UNENCODABLE, whole_file
 
 from .evidence import RuleOptions
-from .result import LINE, ScenarioResult, run_names
+from .result import ScenarioResult, run_names
 from .traffic import analyse, describe_bytes
 
 
@@ -156,18 +164,46 @@ def write(results: list[ScenarioResult], path: Path) -> None:
         for result, name in zip(results, run_names(results)):
             if result.trace_file is not None:
                 out.writelines(_spooled(result, name))
-                continue
-            for record in records(result, name):
-                out.write(json.dumps(record, ensure_ascii=False) + "\n")
+            else:
+                for record in records(result, name):
+                    out.write(json.dumps(record, ensure_ascii=False) + "\n")
             end = end_record(result, name)
             if end is not None:
+                for event in result.rule_events:
+                    out.write(json.dumps(event_record(event, name), ensure_ascii=False) + "\n")
                 out.write(json.dumps(end, ensure_ascii=False) + "\n")
 
 
+def event_record(event, name: str) -> dict:
+    """A line event the rules read that the frames do not show (`RULE_EVENTS`: a pause inside
+    a PLC frame, a converter's drop), as a record after the run's frames."""
+    return {"scenario": name, "t": event.t_us / 1_000_000, "event": event.kind, "message": event.message}
+
+
+#: the rules' settings a run's end record carries: its key in the record -> the field (µs) of
+#: ScenarioResult and RuleOptions it is
+RUN_SETTINGS = {"reply_timeout": "reply_timeout_us", "min_period": "min_period_us",
+                "response_within": "response_within_us"}
+
+
 def end_record(result: ScenarioResult, name: str) -> dict | None:
-    """The record after a line's frames (a monitor's or a replay's run that saw any): when
-    the run ended, i.e. until when the line was listened to. A simulated run's trace has
-    none: its lines are its frames alone."""
-    if result.platform != LINE or not frame_count(result):
+    """The record after a run's frames (a run that has any): when the run ended - until when
+    the line was listened to; a simulated run's end in virtual time, which may be well after
+    its last frame (a reply time-out still running, a silence) - and the rules' settings it
+    was judged with (`RUN_SETTINGS`, and the protocol settings: the address, the manual's
+    choices), so that `uitamr replay` judges the trace as the run was.
+    A run that saw the program's outputs (`uitamr verify`) adds its response signal and when
+    it held: UITAMR-RESPONSE-HANDLING judges by them, and a line does not show them."""
+    if not frame_count(result):
         return None
-    return {"scenario": name, "end": result.ended_us / 1_000_000}
+    record = {"scenario": name, "end": result.ended_us / 1_000_000,
+              **{key: getattr(result, field) / 1_000_000 for key, field in RUN_SETTINGS.items()},
+              "protocol": asdict(result.settings)}
+    if result.signal_held is not None:
+        record["response_signal"] = result.response_signal
+        if result.response_signal is None:
+            record["response_signal_hint"] = result.response_signal_hint
+        else:
+            record["response_signal_held"] = [[began / 1_000_000, None if stopped is None else stopped / 1_000_000]
+                                              for began, stopped in result.signal_held]
+    return record

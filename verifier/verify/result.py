@@ -13,7 +13,7 @@ from typing import Any
 from verifier import protocol
 
 from .durations import format_seconds
-from .evidence import Violation
+from .evidence import DEFAULT_RESPONSE_WITHIN_US, Violation
 from .expectations import ExpectationResult
 
 
@@ -74,6 +74,11 @@ class LineEvent:
     message: str
 
 
+#: the line's events the rules read (UITAMR-FORMAT: a pause inside a PLC frame; the pairing:
+#: a converter that dropped the connection after forwarding a request)
+RULE_EVENTS = ("gap", "converter.dropped")
+
+
 @dataclass
 class ScenarioResult:
     name: str
@@ -90,6 +95,19 @@ class ScenarioResult:
     scan_jitter_us: int = 0
     min_period_us: int = protocol.MIN_PERIOD_US
     reply_timeout_us: int = protocol.DEFAULT_REPLY_TIMEOUT_US
+    # UITAMR-RESPONSE-HANDLING's bound ([response_handling] within); with the two above, what
+    # a trace's end record carries so that its replay judges with the run's own settings
+    response_within_us: int = DEFAULT_RESPONSE_WITHIN_US
+    # the program's outputs as UITAMR-RESPONSE-HANDLING judged them, for a trace's end record:
+    # the response signal (None: the run had none; `response_signal_hint` then names what
+    # could be it) and when it held ((began, stopped) µs, stopped None while still holding);
+    # `signal_held` None: the outputs were not seen (a line: monitor, replay of a capture)
+    response_signal: str | None = None
+    response_signal_hint: str = ""
+    signal_held: list[tuple[int, int | None]] | None = None
+    # the events the rules read besides the frames (RULE_EVENTS: a pause inside a PLC frame,
+    # a converter's drop), which a trace carries because its frames do not show them
+    rule_events: list[LineEvent] = field(default_factory=list)
     faults: list[str] = field(default_factory=list)
     converter: str | None = None  # the TCP route's converter, its settings and faults (not a fault itself)
     trace: list[TraceRecord] = field(default_factory=list)

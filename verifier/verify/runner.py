@@ -27,7 +27,7 @@ from .events_shown import thin_line_events
 from .evidence import RunEvidence, Samples
 from .expectations import judge
 from .overwritten import overwritten_input_notes
-from .result import KEEP_ALL, Keep, LineEvent, ScenarioResult, TraceRecord, UnusableInput, summarize_diagnostics
+from .result import KEEP_ALL, RULE_EVENTS, Keep, LineEvent, ScenarioResult, TraceRecord, UnusableInput, summarize_diagnostics
 from .rules import check_all
 from .scenario import BUFFER_MEMORY, DEVICE_NAME, Scenario, scenario_power_on_stop
 from .stream import Stream
@@ -328,6 +328,7 @@ class _NewRuleEvents:
         self.line, self.converter, self.drop_the_rest = line, converter, drop_the_rest
         self.gaps_read = 0
         self.converter_read = 0
+        self.read: list[LineEvent] = []  # every one returned, for the trace (ScenarioResult.rule_events)
 
     def __call__(self, end_us: float = float("inf")) -> list:
         gaps = self.line.gaps
@@ -340,6 +341,7 @@ class _NewRuleEvents:
             if self.drop_the_rest:
                 events.clear()
                 self.converter_read = 0
+        self.read += [LineEvent(e.t_us, e.kind, e.message) for e in new]
         return new
 
 
@@ -729,6 +731,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         violations, outcomes = _judge_whole(scenario, trace, end, events, samples, aborted is not None)
         tx_count = sum(1 for frame in trace if frame.direction == "tx")
         rx_count = len(trace) - tx_count
+    signal = scenario.options.response_signal
     return ScenarioResult(
         name=scenario.name,
         file=_display_path(scenario.path),
@@ -744,6 +747,11 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         settings=scenario.settings,
         min_period_us=scenario.options.min_period_us,
         reply_timeout_us=scenario.options.reply_timeout_us,
+        response_within_us=scenario.options.response_within_us,
+        response_signal=None if signal is None else str(signal),
+        response_signal_hint=scenario.options.response_signal_hint,
+        signal_held=[] if signal is None else samples.spans(signal).stretches(),
+        rule_events=rule_events.read if stream is not None else [e for e in events if e.kind in RULE_EVENTS],
         faults=[fault.describe() for fault in scenario.faults],
         converter=scenario.converter.describe() if scenario.converter is not None else None,
         trace=trace if keep.frames else [],
