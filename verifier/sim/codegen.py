@@ -648,9 +648,11 @@ class BodyCompiler(CallCompiler):
             # iterations than the watchdog allows go the guarded way: FOR i := 0 TO 2000000000
             # ran for hours instead of stopping with the CPU's watchdog timer error)
             v = self.new_tmp("_i")
+            head = len(self.em.lines)
             self.em.line(f"for {v} in range({start}, {end + (1 if step > 0 else -1)}, {step}):")
             self.em.indent()
             self.emit_lines(var.write(v))
+            body = len(self.em.lines)
             last = start + ((end - start) // step) * step
             known = isinstance(s.var, ast.Name)
             if known:  # inside the body the counter is the Python loop variable, in a known range
@@ -666,6 +668,8 @@ class BodyCompiler(CallCompiler):
             self.em.indent()
             self.emit_lines(var.write(repr(start + n * step)))
             self.em.dedent()
+            if step == 1 and n > 0 and len(self.em.lines) - body == 3:
+                self._copy_loop_as_slice(head, body, v, start, n)
             return
         sc, st = self.expr(s.start)
         ec, et = self.expr(s.end)
@@ -685,6 +689,37 @@ class BodyCompiler(CallCompiler):
         self.block(s.body)
         self.emit_lines(var.write(norm_code(t, f"{var.read} + {step_code}")))
         self.em.dedent()
+
+    def _copy_loop_as_slice(self, head: int, body: int, v: str, start: int, n: int) -> None:
+        """A FOR loop over constant bounds whose whole body copies one element of an array
+        label into another, index for index (`dst[i + a] := src[i + b]`: the 16-word copies
+        of the port FBs), emitted above as `for v in range(...)`, its counter's write, the
+        copy, and the `else:` with the counter's last value: run it as one slice assignment
+        (a list copy in C, the same elements), the counter then written once with its last
+        value, as the loop leaves it (nothing runs between the iterations that could read it:
+        the body is that one line, and its indexes are in range, the compiler having left out
+        their check). When both names hold the same list (VAR_IN_OUT handed the one array
+        twice), the element-by-element loop runs as before: an overlapping copy differs."""
+        lines, spans = self.em.lines, self.em.spans
+        copy = _ELEMENT_COPY.fullmatch(lines[body].strip())
+        if copy is None or copy["dst"] == copy["src"]:
+            return
+        dst, src = _index_offset(copy["di"], v), _index_offset(copy["si"], v)
+        if dst is None or src is None or start + dst < 0 or start + src < 0:
+            return
+        indent = lines[head][: len(lines[head]) - len(lines[head].lstrip())]
+        loop, loop_spans = lines[head:], spans[head:]
+        final = lines[-1].strip()  # the counter's last value, under the loop's `else:`
+        d, s = copy["dst"], copy["src"]
+        fast = [f"if {d} is not {s}:",
+                f"    {d}[{start + dst}:{start + dst + n}] = {s}[{start + src}:{start + src + n}]",
+                f"    {final}",
+                "else:"]
+        del lines[head:], spans[head:]
+        lines.extend(indent + text for text in fast)
+        spans.extend([loop_spans[0]] * len(fast))
+        lines.extend("    " + text for text in loop)
+        spans.extend(loop_spans)
 
     def stmt_While(self, s: ast.While):
         code, _ = self.expr(s.cond)
@@ -792,6 +827,27 @@ def cannot_fail(code: str) -> bool:
 
 
 _ARITH = {"+": int.__add__, "-": int.__sub__, "*": int.__mul__}
+
+
+# `dst[index] = src[index]`: an element copy between two label arrays (attribute chains),
+# each index the loop variable plus or minus a constant, with no range check emitted
+_ELEMENT_COPY = re.compile(r"(?P<dst>[A-Za-z_]\w*(?:\.\w+)+)\[(?P<di>[^\[\]]+)\] = "
+                           r"(?P<src>[A-Za-z_]\w*(?:\.\w+)+)\[(?P<si>[^\[\]]+)\]")
+
+
+def _index_offset(code: str, v: str) -> int | None:
+    """The constant c of an index `v`, `c + v`, `v + c` or `v - c` (in brackets or not);
+    None for anything else."""
+    if code == v:
+        return 0
+    if code.startswith("(") and code.endswith(")"):
+        code = code[1:-1]
+    m = re.fullmatch(rf"(\d+) \+ {v}|{v} ([+-]) (\d+)", code)
+    if m is None:
+        return None
+    if m.group(1) is not None:
+        return int(m.group(1))
+    return int(m.group(3)) * (1 if m.group(2) == "+" else -1)
 
 
 def _int_range(t):

@@ -46,6 +46,19 @@ cost a scan, never make a wrong jump), and every eighth is still taken to see wh
 has become of use.  Which states are taken changes which scans run at most, never what
 they do (tests/test_idle_skip.py).
 
+The scan a jump lands on.  A jump goes to the first instant something can change (a timer
+reaching PT, a byte, a time-out, an input), and the scan there usually does change
+something: on the TCP route the engine builds its next request when the pace timer ends,
+while no watched label moves and the port is quiet, so that scan counts as quiet and its
+state (about 9 µs there) was taken to differ from the next scan's, once a request.  A
+second score, kept apart from the first quiet scan's and judged the same way (of use if it
+equals the state before the jump or the next quiet scan's), leaves it out when it was of
+no use lately: `_previous` is set to None, so the next quiet scan takes its state and the
+one after compares, exactly as after a busy scan (at most two scans more, never a
+wrong jump); every eighth is still taken.  A jump cut short by the caller's stop (`uitamr verify`
+runs a virtual second at a time) is not to a change: the scan there usually leaves the
+state as it was and lets the run jump on at once, so its state is always taken.
+
 Not skippable (the run then goes scan by scan, as before): a program that reads a timer's
 ET, arrays of arrays, and labels of a type the walk does not know.  `IdleScans.reason`
 says which.
@@ -69,6 +82,8 @@ INFINITY = float("inf")
 FIRST_SKIP_SCORE = 4
 FIRST_USEFUL = 4
 FIRST_PROBE_EVERY = 8
+# which score judges a state taken (`IdleScans._judging`): a first quiet scan's, a landing one's
+FIRST, LANDING = 0, 1
 # the cells instruction operands wrote are read by a generated function up to this many
 OPERAND_CELLS_GENERATED = 64
 _CONST_CELL = re.compile(r"\b(_A_[A-Z]+|_U[0-9A-F]+)\[(\d+)\]")
@@ -104,6 +119,16 @@ def _source_facts(source: str) -> SourceFacts:
                        tuple(whole), frozenset(reached))
 
 
+def _generated(name: str, expression: str, env: dict[str, object], filename: str) -> Callable[[], tuple]:
+    """`def name(): return expression`, compiled, with each object of `env` it reads bound as a
+    default argument: a local variable of the function, read faster than a global (the
+    state is some 300 loads, taken twice per idle stretch). Called with no arguments."""
+    defaults = "".join(f"{key}={key}, " for key in env)
+    source = f"def {name}({defaults}):\n    return {expression}\n"
+    exec(compile(source, filename, "exec"), env)
+    return env[name]
+
+
 def _never_idle(now: int) -> None:
     """The idle deadline of an I/O model that cannot tell: it may change something at
     every scan."""
@@ -128,7 +153,15 @@ class IdleScans:
         self._first_score = 0
         self._first_skipped = 0
         self.first_states_skipped = 0
-        self._judging_first = False
+        # the same for the state of the scan a jump lands on (module docstring, "The scan a
+        # jump lands on"): set by `_jump` when it went to a change, not to the caller's stop
+        self._landing = False
+        self._landing_score = 0
+        self._landing_skipped = 0
+        self.landing_states_skipped = 0
+        # the state taken that is still to be judged: None, FIRST or LANDING (its score)
+        self._judging: int | None = None
+        self.states_taken = 0
         self._deadlines: list[Callable[[int], float | None]] = []  # each poller's idle_deadline
         # cells instruction operands have written: compared by value from then on, whoever
         # writes them later (cells list id -> (cells, indexes))
@@ -218,9 +251,8 @@ class IdleScans:
         bench/cycle_recurrence.py compares)."""
         env: dict[str, object] = {}
         parts = self._label_parts(env)
-        source = "def labels():\n    return (" + ", ".join(parts) + ("," if len(parts) == 1 else "") + ")\n"
-        exec(compile(source, "<idle-labels>", "exec"), env)
-        return env["labels"]
+        return _generated("labels", "(" + ", ".join(parts) + ("," if len(parts) == 1 else "") + ")", env,
+                          "<idle-labels>")
 
     def _state_reader(self) -> Callable[[], tuple]:
         """The state `after_scan` compares, as one generated function of plain loads: every
@@ -246,9 +278,7 @@ class IdleScans:
             parts.append(f"p{k}()")
         env["diagnostics"] = self.rt.diagnostics
         parts.append("len(diagnostics)")
-        source = "def state():\n    return (" + ", ".join(parts) + ")\n"
-        exec(compile(source, "<idle-state>", "exec"), env)
-        return env["state"]
+        return _generated("state", "(" + ", ".join(parts) + ")", env, "<idle-state>")
 
     def _operand_reader(self) -> Callable[[], tuple]:
         """The values of the cells operands wrote, in order (cells list by cells list, each
@@ -263,9 +293,7 @@ class IdleScans:
         for k, (cells, indexes) in enumerate(known):
             env[f"k{k}"] = cells
             parts += [f"k{k}[{index}]" for index in indexes]
-        source = "def cells():\n    return (" + "".join(f"{part}, " for part in parts) + ")\n"
-        exec(compile(source, "<idle-operand-cells>", "exec"), env)
-        return env["cells"]
+        return _generated("cells", "(" + "".join(f"{part}, " for part in parts) + ")", env, "<idle-operand-cells>")
 
     def _device_footprint(self, facts: "SourceFacts"):
         """The device and buffer cells the generated code names with a constant index, and
@@ -307,56 +335,86 @@ class IdleScans:
         rt = self.rt
         changed = self._new_operand_cells() if rt.dirty_log else False
         busy, self.busy = self.busy, False
+        landing, self._landing = self._landing, False
         if busy or changed or rt.scan_count < 2:
             self._previous, self._quiet = None, 0
-            if self._judging_first:
-                self._first_wasted()
+            if self._judging is not None:
+                self._wasted()
             return
         now = rt.now_us
-        deadline = self.next_input_us()
         pollers = rt.pollers
         if len(pollers) != len(self._deadlines):  # a port is made on its first call
             self._deadlines = [getattr(p, "idle_deadline", None) or _never_idle for p in pollers]
+        deadline = INFINITY
         for idle_deadline in self._deadlines:
             until = idle_deadline(now)
             if until is None or until <= now:
                 self._previous, self._quiet = None, 0
-                if self._judging_first:
-                    self._first_wasted()
+                if self._judging is not None:
+                    self._wasted()
                 return
             if until < deadline:
                 deadline = until
+        deadline = min(deadline, self.next_input_us())
         self._quiet += 1
-        if self._quiet == 1 and self._first_score >= FIRST_SKIP_SCORE:
-            self._first_skipped += 1
-            if self._first_skipped % FIRST_PROBE_EVERY:
-                self.first_states_skipped += 1
-                return  # not taken: `_previous` stays None, the next quiet scan takes its state
+        judged = None  # the kind of state this one is, when it is to be judged
+        if self._quiet == 1:
+            judged = FIRST
+            if self._first_score >= FIRST_SKIP_SCORE:
+                self._first_skipped += 1
+                if self._first_skipped % FIRST_PROBE_EVERY:
+                    self.first_states_skipped += 1
+                    return  # not taken: `_previous` stays None, the next quiet scan takes its state
+        elif landing:
+            judged = LANDING
+            if self._landing_score >= FIRST_SKIP_SCORE:
+                self._landing_skipped += 1
+                if self._landing_skipped % FIRST_PROBE_EVERY:
+                    self.landing_states_skipped += 1
+                    self._previous = None  # as for a first quiet scan: the next one takes its state
+                    return
         if len(pollers) != self._state_pollers:
             self._state = self._state_reader()
         state = self._state()
-        if self._judging_first:  # the first quiet scan's state: was it worth taking?
-            if state == self._previous:
-                self._judging_first = False
-                self._first_score = max(0, self._first_score - FIRST_USEFUL)
+        self.states_taken += 1
+        same = state == self._previous
+        if self._judging is not None:  # the state before was a first or landing one: was it worth taking?
+            if same:
+                self._useful()
             else:
-                self._first_wasted()
-        elif self._quiet == 1:
-            self._judging_first = True
-        if state != self._previous:
+                self._wasted()
+        if not same:
+            if judged == LANDING:
+                self._judging = LANDING  # of use if the next quiet scan's state equals it
+            elif judged == FIRST:
+                self._judging = FIRST
             self._previous = state
             return
+        if judged == LANDING:  # equal to the state before the jump: of use at once
+            self._landing_score = max(0, self._landing_score - FIRST_USEFUL)
         deadline = min(deadline, self._timer_deadline_us(), self._clock_deadline_us(started_us))
-        if stop_us is not None:
-            deadline = min(deadline, stop_us)
+        to_change = True
+        if stop_us is not None and stop_us <= deadline:
+            deadline, to_change = stop_us, False  # the caller's stop: nothing need change there
         if now < deadline < INFINITY:
-            self._jump(deadline)
+            self._jump(deadline, to_change)
 
-    def _first_wasted(self) -> None:
-        """The scan after a first quiet scan whose state was taken is not quiet, or its
-        state differs: that state was not worth taking."""
-        self._judging_first = False
-        self._first_score = min(FIRST_SKIP_SCORE + 2, self._first_score + 1)
+    def _useful(self) -> None:
+        """The state judged (`_judging`) equals the next one: it was worth taking."""
+        if self._judging == FIRST:
+            self._first_score = max(0, self._first_score - FIRST_USEFUL)
+        else:
+            self._landing_score = max(0, self._landing_score - FIRST_USEFUL)
+        self._judging = None
+
+    def _wasted(self) -> None:
+        """The scan after a first quiet scan (or a scan a jump landed on) whose state was
+        taken is not quiet, or its state differs: that state was not worth taking."""
+        if self._judging == FIRST:
+            self._first_score = min(FIRST_SKIP_SCORE + 2, self._first_score + 1)
+        else:
+            self._landing_score = min(FIRST_SKIP_SCORE + 2, self._landing_score + 1)
+        self._judging = None
 
     def _new_operand_cells(self) -> bool:
         """Take in the cells instruction operands wrote since the last scan; True when one
@@ -406,8 +464,10 @@ class IdleScans:
             first = min(first, (started_us // half + 1) * half)
         return first
 
-    def _jump(self, deadline: float) -> None:
-        """Move on over every scan that would start before `deadline`, as those scans would."""
+    def _jump(self, deadline: float, to_change: bool = False) -> None:
+        """Move on over every scan that would start before `deadline`, as those scans would.
+        `to_change`: `deadline` is the first instant something can change (not the
+        caller's stop), so the scan landed on is judged as a landing one."""
         rt = self.rt
         count = rt.scan_count
         now, step, jitter = rt.now_us, rt.scan_us, rt.jitter_us
@@ -428,3 +488,4 @@ class IdleScans:
             poller.skipped(count, scans)
         self.skipped_scans += scans
         self.jumps += 1
+        self._landing = to_change

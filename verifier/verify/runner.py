@@ -6,6 +6,7 @@ after the run (rules, expectations, reports) works on plain data.
 """
 from __future__ import annotations
 
+import gc
 import math
 import os
 import re
@@ -699,6 +700,13 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     rule_events = _NewRuleEvents(line, converter, drop_the_rest=not keep.details)
     taken_us = 0
     events_dropped = 0
+    # what was made before the run (the compiled program, the scenario, the caller's objects)
+    # is kept out of the garbage collector's full passes while the run goes: an hour of
+    # fx3u-healthy made two, each walking every object again (about 5 % of the hour's CPU
+    # time). Not when the caller froze objects itself: unfreezing would thaw theirs too.
+    freeze = gc.isenabled() and gc.get_freeze_count() == 0
+    if freeze:
+        gc.freeze()
     try:
         while plc.now_us < end:
             plc.run(min(end, plc.now_us + PROGRESS_STEP_US), apply_inputs, sample)
@@ -715,6 +723,9 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         exc.location = _relative(exc.location, os.getcwd())  # as the frames' origins name ST files
         aborted = str(exc)
         end = min(end, plc.now_us)
+    finally:
+        if freeze:
+            gc.unfreeze()
     if converter is not None:
         converter.advance(max(end, converter.now_us))
     else:
