@@ -518,8 +518,17 @@ def test_a_window_that_opens_after_the_run_fails_with_advice(kind, condition):
 
 def test_a_sent_or_reached_point_window_that_opens_after_the_run_fails():
     for text in ('sent = "stop"', "reached_point = 1"):
-        (result,) = _judge(f'[[expect]]\n{text}\nafter = "10s"\n', _evidence({}))
-        assert not result.passed and "before the window opened at 10.000 s" in result.detail
+        (result,) = _judge(f'[[expect]]\n{text}\nafter = "10.5s"\n', _evidence({}))
+        assert not result.passed and "before the window opened at 10.500 s" in result.detail
+
+
+@pytest.mark.parametrize("kind, condition", [("that", "ok"), ("always", "ok"), ("never", "NOT ok")])
+def test_a_window_that_opens_as_the_run_ends_is_not_said_to_open_after_it(kind, condition):
+    # was "the run ended at 10.000 s, before the window opened at 10.000 s"
+    (result,) = _judge(f'[[expect]]\n{kind} = "{condition}"\nafter = "10s"\n', _evidence({"ok": [(0, True)]}))
+    assert not result.passed
+    assert result.detail == ("the run ended at 10.000 s, the moment the window opened, leaving nothing to judge: "
+                             "make the scenario's duration longer")
 
 
 def _tx(t_ms, request):

@@ -106,11 +106,11 @@ def verdict(expectation: Expectation, evidence: RunEvidence, watch: "ExchangeWat
 def _too_short(evidence: RunEvidence, moment: str, at_us: int) -> str:
     """Why a window the run ended before it `moment` ("opened", "closed") at `at_us` was not
     judged, with the remedy."""
+    when = (f"the moment the window {moment}, leaving nothing to judge" if at_us == evidence.end_us
+            else f"before the window {moment} at {format_seconds(at_us)}")  # not "at 20 s, before ... at 20 s"
     if evidence.stopped_early:
-        return f"the simulation stopped at {format_seconds(evidence.end_us)}, before the window {moment} at " \
-               f"{format_seconds(at_us)}"
-    return (f"the run ended at {format_seconds(evidence.end_us)}, before the window {moment} at "
-            f"{format_seconds(at_us)}: {_longer(evidence)}")
+        return f"the simulation stopped at {format_seconds(evidence.end_us)}, {when}"
+    return f"the run ended at {format_seconds(evidence.end_us)}, {when}: {_longer(evidence)}"
 
 
 def _longer(evidence: RunEvidence) -> str:
