@@ -108,7 +108,7 @@ def bad_master(device: str) -> None:
         master.send(bad_stop, reply_length=None)  # 100 ms again, and a wrong CRC: no reply
         master.at(0.95)
         master.send(stop)
-        master.at(1.3)
+        master.at(1.6)  # 650 ms after the stop: a stalled relay must not make it a PACING finding
         master.send(read)
     finally:
         master.close()

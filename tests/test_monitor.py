@@ -671,7 +671,7 @@ def test_a_bad_master_on_a_real_line_gets_exactly_its_findings(line, tmp_path):
     differing = {key for key in live_run if live_run[key] != replayed[key]}
     assert differing == {"name", "file", "description", "channel"}, {k: (live_run[k], replayed[k]) for k in differing}
     # so is the replay of the monitor's --trace (its end record: the run lasted the 3 s
-    # listened to, not until the last frame at 1.3 s)
+    # listened to, not until the last frame at 1.6 s)
     done = subprocess.run(uitamr("replay", tmp_path / "m.jsonl", "--json", tmp_path / "t.json"),
                           capture_output=True, text=True, timeout=WAIT_S)
     assert done.returncode == 1, done.stdout + done.stderr
