@@ -466,6 +466,48 @@ def test_two_reports_to_one_file_are_refused_before_the_run(tmp_path):
     assert done.returncode == 2 and "are the same file" in done.stderr and not report.exists()
 
 
+def test_a_run_that_cannot_start_writes_its_mistakes_as_junit_errors(tmp_path):
+    """Exit 2 with --junit left no report (a CI server's test summary showed nothing, or
+    the last run's report still lying there): now each mistake is an <error> test case
+    whose message is its place, and the run still exits 2 with the errors on stderr."""
+    report = tmp_path / "v.xml"
+    report.write_text("<testsuites name='the last run'/>", encoding="utf-8")
+    first, second = tmp_path / "a.toml", tmp_path / "b.toml"
+    first.write_text('program = "UITAMR_ExampleFx3"\nduration = "5q"\n', encoding="utf-8")
+    second.write_text('program = "UITAMR_ExampleFx3"\n[[expect]]\nthat = "o_bOK"\nwithin = "5"\n', encoding="utf-8")
+    done = _run_cli("--scenario", first, "--scenario", second, "--junit", report)
+    assert done.returncode == 2, done.stdout + done.stderr
+    assert f"a.toml:2:12: duration: '5q' is not a duration" in done.stderr
+    assert f"wrote {report} (these errors as test cases)" in done.stderr
+    root = ET.parse(report).getroot()
+    assert (root.get("tests"), root.get("failures"), root.get("errors")) == ("2", "0", "2")
+    cases = root.findall("./testsuite/testcase")
+    assert [case.get("file") for case in cases] == [str(first), str(second)]
+    errors = [case.find("error") for case in cases]
+    assert all(e.get("type") == "unusable-input" for e in errors)
+    assert errors[0].get("message").startswith(f"{first}:2:12: duration: '5q' is not a duration")
+    assert errors[1].get("message").startswith(f"{second}:4:10: ")
+
+
+def test_st_that_does_not_load_is_a_junit_error_at_its_place(tmp_path):
+    write_files(tmp_path, {"MAIN.st": "PROGRAM MAIN\nVAR\n    x : INT;\nEND_VAR\nx := ;\nEND_PROGRAM\n"})
+    result = invoke(tmp_path / "MAIN.st", "--platform", "fx3u", "--junit", tmp_path / "v.xml")
+    assert result.exit_code == 2, result.output
+    (case,) = ET.parse(tmp_path / "v.xml").getroot().findall("./testsuite/testcase")
+    assert case.get("name") == str(tmp_path / "MAIN.st") and case.get("classname") == "uitamr.verify.input"
+    assert case.find("error").get("message").startswith(f"{tmp_path / 'MAIN.st'}:5:6: error: expected an expression")
+
+
+def test_the_junit_of_a_run_that_cannot_start_is_not_written_over_an_input(tmp_path):
+    scenario = tmp_path / "s.toml"
+    text = 'program = "UITAMR_ExampleFx3"\nduration = "5q"\n'
+    scenario.write_text(text, encoding="utf-8")
+    done = _run_cli("--scenario", scenario, "--junit", scenario)
+    assert done.returncode == 2 and "'5q' is not a duration" in done.stderr
+    assert "the JUnit report was not written: " in done.stderr and "one of the run's input files" in done.stderr
+    assert scenario.read_text(encoding="utf-8") == text
+
+
 def test_a_named_pipe_as_scenario_is_refused_not_waited_on(tmp_path):
     fifo = tmp_path / "s.toml"
     os.mkfifo(fifo)

@@ -83,11 +83,36 @@ def _is_zero(value) -> bool:
         return False
 
 
-def _unusable(message: str, *more: str) -> None:
+def _unusable(message: str, *more: str, done: str | None = None) -> None:
+    """Exit 2 with the errors; `done`: what was still written (a report of them)."""
     console = text_console(stderr=True)
     for text in (message, *more):
         console.print(f"[bold red]error:[/] {escape(text)}", markup=True)
+    if done:
+        console.print(f"[dim]{escape(done)}[/]")
     sys.exit(EXIT_UNUSABLE)
+
+
+def _unusable_input(junit_path: str | None, inputs, *messages: str) -> None:
+    """Exit 2 for input the run cannot use (a scenario's mistake, ST that does not load),
+    after writing the mistakes to --junit's file as errors: a CI server then shows what to
+    fix, where it found no report before (or the last run's). Not over one of the run's
+    input files (`inputs`: those given, as far as they are known)."""
+    done = None
+    if junit_path:
+        from verifier.verify import report_junit
+
+        try:
+            check_not_inputs(inputs, junit_path)
+            report_junit.write_unusable(list(messages), Path(junit_path))
+        except ReportError as exc:
+            messages = (*messages, f"the JUnit report was not written: {exc}")
+        except OSError as exc:
+            messages = (*messages, f"the JUnit report was not written: cannot write {junit_path}: "
+                                   f"{exc.strerror or exc}")
+        else:
+            done = f"wrote {junit_path} (these errors as test cases)"
+    _unusable(*messages, done=done)
 
 
 class ScenarioMistakes(UnusableInput):
@@ -491,8 +516,10 @@ def command(sources, program, platform, channel, response_signal, scenario_files
         inputs = [p for s in scenarios for p in ([s.path] if s.path else []) + list(s.sources)]
         check_not_inputs(inputs, json_path, junit_path, trace_path, html_path)
     except ScenarioMistakes as exc:
-        _unusable(*exc.messages)
-    except (ScenarioError, UnusableInput, ReportError) as exc:
+        _unusable_input(junit_path, (*sources, *scenario_files), *exc.messages)
+    except (ScenarioError, UnusableInput) as exc:
+        _unusable_input(junit_path, (*sources, *scenario_files), str(exc))
+    except ReportError as exc:
         _unusable(str(exc))
     stderr = text_console(stderr=True)
     progress = _LazyProgress(stderr, sum(s.duration_us for s in scenarios), stderr.is_terminal)
@@ -513,7 +540,7 @@ def command(sources, program, platform, channel, response_signal, scenario_files
                 results = _run_all(scenarios, jobs, progress, every_scan, keep)
             except (ScenarioError, UnusableInput) as exc:
                 progress.stop()
-                _unusable(str(exc))
+                _unusable_input(junit_path, inputs, str(exc))
             progress.stop()
             try:
                 report_console.render(results, console, first=first)

@@ -2,7 +2,8 @@
 
 One <testcase> per scenario; one <failure> per broken rule (type = the rule id) and per
 failed expectation (type = "expectation"); an <error> when the simulation stopped, or when
-a monitored line or a capture had no bytes (type = "no-traffic").
+a monitored line or a capture had no bytes (type = "no-traffic"). A run that could not
+start (exit 2) gets one <error type="unusable-input"> per mistake instead.
 """
 from __future__ import annotations
 
@@ -107,8 +108,40 @@ def _xml_safe(text: str | None) -> str | None:
     return None if text is None else escape_chars(text, lambda c: not _NOT_XML.match(c))
 
 
+#: the first place a message names (`s.toml:2:12: ...`, `  plc/MAIN.st:5:6: error: ...`)
+_PLACE = re.compile(r"^\s*(?P<file>\S(?:.*?\S)?):\d+:\d+: ", re.M)
+
+
+def unusable_element(messages: list[str], command: str = "uitamr verify") -> ET.Element:
+    """The report of a run that could not start (exit 2): one test case per mistake, an
+    `<error type="unusable-input">` whose message is the mistake's first place (file:line:col)
+    and whose text is the whole message, so that the CI server shows what to fix instead of
+    a missing report (or the last run's)."""
+    suites = ET.Element("testsuites", name=command, tests=str(len(messages)), failures="0",
+                        errors=str(len(messages)))
+    suite = ET.SubElement(suites, "testsuite", name=command, tests=str(len(messages)), failures="0",
+                          errors=str(len(messages)))
+    for message in messages:
+        place = _PLACE.search(message)
+        case = ET.SubElement(suite, "testcase", classname=command.replace(" ", ".") + ".input",
+                             name=place["file"] if place else "input", time="0.000")
+        if place:
+            case.set("file", place["file"])
+        first = (message[place.start():].lstrip() if place else message).splitlines() or [""]
+        element = ET.SubElement(case, "error", message=first[0], type="unusable-input")
+        element.text = message
+    return suites
+
+
+def write_unusable(messages: list[str], path: Path, command: str = "uitamr verify") -> None:
+    _write_tree(unusable_element(messages, command), path)
+
+
 def write(results: list[ScenarioResult], path: Path, command: str = "uitamr verify") -> None:
-    root = to_element(results, command)
+    _write_tree(to_element(results, command), path)
+
+
+def _write_tree(root: ET.Element, path: Path) -> None:
     for element in root.iter():
         element.text, element.tail = _xml_safe(element.text), _xml_safe(element.tail)
         for name, value in element.attrib.items():
