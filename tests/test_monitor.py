@@ -18,6 +18,7 @@ import subprocess
 import threading
 import time
 import warnings
+import xml.etree.ElementTree as ET
 from collections import Counter
 from pathlib import Path
 
@@ -523,6 +524,20 @@ def test_a_capture_on_one_line_has_the_findings_of_the_same_bytes_over_many_line
         reports.append(json.loads(report.read_text())["scenarios"][0])
     assert reports[0]["violations"] and reports[0]["violations"] == reports[1]["violations"]
     assert reports[0]["rules"] == reports[1]["rules"]
+
+
+def test_a_capture_replay_cannot_read_is_a_junit_error_at_its_place(tmp_path):
+    """Exit 2 with --junit left no report for the CI server to show (or the last run's)."""
+    capture, report = tmp_path / "c.txt", tmp_path / "r.xml"
+    capture.write_text("0.1 01 0G\n", encoding="utf-8")
+    done = subprocess.run(uitamr("replay", capture, "--junit", report), capture_output=True, text=True,
+                          timeout=WAIT_S)
+    assert done.returncode == 2 and f"{capture}:1:8: '0G' is not a byte in hex" in done.stderr, done.stderr
+    root = ET.parse(report).getroot()
+    assert (root.get("name"), root.get("errors")) == ("uitamr replay", "1")
+    (case,) = root.findall("./testsuite/testcase")
+    assert (case.get("classname"), case.get("file")) == ("uitamr.replay.input", str(capture))
+    assert case.find("error").get("message").startswith(f"{capture}:1:8: '0G' is not a byte in hex")
 
 
 def test_a_bad_byte_far_into_a_long_line_is_named_by_its_column(tmp_path):

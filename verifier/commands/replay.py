@@ -16,7 +16,8 @@ import click
 
 from verifier.commands.monitor import EXIT_UNUSABLE, _finish, exit_status, line_options, line_timing
 from verifier.commands.protocol_options import given_settings, protocol_settings
-from verifier.commands.report_files import ReportError, check_folders, check_not_inputs, report_options, text_console
+from verifier.commands.report_files import (ReportError, check_folders, check_not_inputs, junit_of_mistakes,
+                                             report_options, text_console)
 from verifier.monitor.capture import CaptureError, read_capture
 from verifier.monitor.framer import DEFAULT_TOLERANCE_US
 from verifier.monitor.session import CaptureInfo, MonitorSession
@@ -44,6 +45,8 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
             loaded = read_capture(path)
         except CaptureError as exc:
             click.echo(f"uitamr replay: {exc}", err=True)
+            if junit_path:  # the CI server shows the mistake, not a missing report
+                click.echo(f"uitamr replay: {junit_of_mistakes(junit_path, [str(exc)], 'uitamr replay')[1]}", err=True)
             sys.exit(EXIT_UNUSABLE)
         is_trace = any(chunk.direction is not None for chunks in loaded.values() for chunk in chunks)
         # a monitor's trace says the tolerance its host times were judged with; other frames

@@ -79,6 +79,23 @@ def check_not_inputs(inputs, *paths: str | None) -> None:
             raise ReportError(f"{path} is one of the run's input files: write the report to another file")
 
 
+def junit_of_mistakes(junit_path, messages: list[str], command: str, inputs=()) -> tuple[bool, str]:
+    """For a run that cannot start (exit 2): its mistakes written to --junit's file as errors
+    (`report_junit.unusable_element`), so that a CI server shows what to fix rather than no
+    report or the last run's; never over one of the run's input files (`inputs`, as far as
+    they are known). Returns whether it was written and the line that says so, or why not."""
+    from verifier.verify import report_junit
+
+    try:
+        check_not_inputs(inputs, junit_path)
+        report_junit.write_unusable(messages, Path(junit_path), command)
+    except ReportError as exc:
+        return False, f"the JUnit report was not written: {exc}"
+    except OSError as exc:
+        return False, f"the JUnit report was not written: cannot write {junit_path}: {exc.strerror or exc}"
+    return True, f"wrote {junit_path} (these errors as test cases)"
+
+
 def write_reports(results, console: Console, json_path=None, junit_path=None, trace_path=None,
                   html_path=None, command: str = "uitamr verify") -> None:
     """The report files asked for; `command` (`uitamr monitor`, `uitamr replay`) is named

@@ -20,8 +20,8 @@ from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
 from verifier.commands.numbers import INT, IntRange
-from verifier.commands.report_files import (ReportError, check_folders, check_not_inputs, report_options,
-                                             text_console, write_reports)
+from verifier.commands.report_files import (ReportError, check_folders, check_not_inputs, junit_of_mistakes,
+                                             report_options, text_console, write_reports)
 from verifier.verify.durations import format_duration, format_seconds, parse_duration_us
 from verifier.verify import spool
 from verifier.verify.events_shown import EVENTS_AT_MOST
@@ -95,23 +95,12 @@ def _unusable(message: str, *more: str, done: str | None = None) -> None:
 
 def _unusable_input(junit_path: str | None, inputs, *messages: str) -> None:
     """Exit 2 for input the run cannot use (a scenario's mistake, ST that does not load),
-    after writing the mistakes to --junit's file as errors: a CI server then shows what to
-    fix, where it found no report before (or the last run's). Not over one of the run's
-    input files (`inputs`: those given, as far as they are known)."""
+    after writing the mistakes to --junit's file as errors (not over one of `inputs`, the
+    run's input files as far as they are known)."""
     done = None
     if junit_path:
-        from verifier.verify import report_junit
-
-        try:
-            check_not_inputs(inputs, junit_path)
-            report_junit.write_unusable(list(messages), Path(junit_path))
-        except ReportError as exc:
-            messages = (*messages, f"the JUnit report was not written: {exc}")
-        except OSError as exc:
-            messages = (*messages, f"the JUnit report was not written: cannot write {junit_path}: "
-                                   f"{exc.strerror or exc}")
-        else:
-            done = f"wrote {junit_path} (these errors as test cases)"
+        written, said = junit_of_mistakes(junit_path, list(messages), "uitamr verify", inputs)
+        messages, done = (messages, said) if written else ((*messages, said), None)
     _unusable(*messages, done=done)
 
 
