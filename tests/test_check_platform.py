@@ -213,9 +213,19 @@ def test_every_bundled_library_set_checks_clean_on_its_platform(platform, source
 
 
 def test_the_bundled_sets_cover_every_platform_verify_runs():
-    from verifier.verify.scenario import PLATFORMS
+    # the FX3G runs the FX3U's (scenario.BUNDLED_AS): the FX3 set checks clean on it below
+    from verifier.verify.scenario import PLATFORMS, bundled_platform
 
-    assert {platform for platform, _ in _bundled_sets()} == set(PLATFORMS)
+    assert {platform for platform, _ in _bundled_sets()} == {bundled_platform(p) for p in PLATFORMS}
+
+
+def test_the_fx3_sets_check_clean_on_the_fx3g_that_verify_runs_them_on():
+    sets = [sources for platform, sources in _bundled_sets() if platform == "fx3u"]
+    assert sets
+    for sources in sets:
+        done = run("--platform", "fx3g", *sources)
+        assert done.exit_code == 0, done.output
+        assert done.output.endswith("on the fx3g CPU: 0 error(s), 0 warning(s)\n")
 
 
 @pytest.mark.parametrize("own, other", [("fx3u", "q"), ("q", "fx3u"), ("q", "fx3g")])
@@ -497,8 +507,8 @@ def test_a_scenario_that_sets_an_fx3_special_number_on_another_cpu_gets_the_st_w
 
 
 def test_a_scenario_without_platform_is_judged_for_an_fx3g_with_its_ranges(tmp_path):
-    # ci.md: a file that names no platform is judged for --platform; verify runs an FX3G
-    # program as an fx3u (no scenario platform of its own), but its devices are the FX3G's
+    # ci.md: a file that names no platform is judged for --platform, as `uitamr verify
+    # --platform fx3g` runs it: on the FX3G, with its ranges
     scenario = write(tmp_path, '[initial]\nX200 = true\n', "s.toml")
     on_fx3g = run("--platform", "fx3g", scenario)
     assert on_fx3g.exit_code == 1, on_fx3g.output

@@ -70,6 +70,21 @@ def _same(a, b) -> bool:
     return {k: v for k, v in vars(a).items() if k not in ignored} == {k: v for k, v in vars(b).items() if k not in ignored}
 
 
+def test_the_platforms_the_pages_list_are_the_ones_verify_takes():
+    """scenarios.md's `platform` row gives each platform with its dialect and default port,
+    the example's comment and verifier.md's --platform row name every one: fx3g was
+    accepted by check and export, refused by verify, and these lists said nothing of it."""
+    from verifier.verify.scenario import PLATFORMS
+
+    row = next(line for line in SCENARIOS_MD.splitlines() if line.startswith("| `platform` |"))
+    editors = {"gxworks2": "GX Works2", "gxworks3": "GX Works3"}
+    listed = re.findall(r"`(\w+)` \((GX Works\d)[^,]*, (?:port )?`([\w:]+)`", row)
+    assert listed == [(name, editors[target], port) for name, (target, port) in PLATFORMS.items()], listed
+    assert "# " + " | ".join(PLATFORMS) + "\n" in SCENARIOS_MD  # the complete example's comment
+    option = next(line for line in VERIFIER_MD.splitlines() if line.startswith("| `--platform "))
+    assert option.startswith("| `--platform " + "\\|".join(PLATFORMS) + "` |"), option
+
+
 def test_the_documented_defaults_are_the_readers():
     """Each default a key table gives, written out in a scenario, changes nothing: the
     scenario reads as the one that leaves the key out."""

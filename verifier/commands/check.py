@@ -179,21 +179,19 @@ def check_scenario(path: Path, platform: str | None = None) -> list[Diagnostic]:
     sources it names (not the labels it uses: those need the program loaded, which
     `uitamr verify` does). `platform` (--platform): the CPU of a file that names none, as
     `uitamr verify --platform` runs it."""
-    from verifier.verify.scenario import PLATFORMS, ScenarioError, load_scenario
+    from verifier.verify.scenario import ScenarioError, load_scenario
 
     try:
-        scenario = load_scenario(path, platform if platform in PLATFORMS else None)
+        scenario = load_scenario(path, platform)  # --platform: a CPU verify runs (PLATFORMS)
     except ScenarioError as exc:
         message = f"{exc.key}: {exc.message}" if exc.key else exc.message
         return [Diagnostic(str(path), exc.line or 0, exc.col or 0, "error", message)]
-    # an FX3G (no scenario platform of its own: verify runs it as an fx3u) has its own ranges
-    cpu = platform if platform == "fx3g" and "platform" not in scenario.key_lines else scenario.platform
-    return _scenario_devices(scenario, cpu)
+    return _scenario_devices(scenario, scenario.platform)
 
 
 def _scenario_devices(scenario, cpu_name: str) -> list[Diagnostic]:
     """The devices of [initial] and [[inputs]] that CPU `cpu_name` (the scenario's platform,
-    or --platform's fx3g for a file that names none) does not have, each at its key, as
+    or --platform's for a file that names none) does not have, each at its key, as
     `uitamr verify` refuses them (exit 2) before the first scan."""
     from verifier.sim.cpu import PROFILES
     from verifier.sim.devices import device_problem, device_warning
@@ -237,7 +235,7 @@ def render(diag: Diagnostic, lines: list[str] | None) -> str:
 @click.option("--platform", type=click.Choice(sorted(PROFILES), case_sensitive=False), default=None,
               help="Also check every device (name, range, index register) and instruction against "
                    "this CPU, as `uitamr verify --platform` loads it (fx3g: the FX3G CPU profile, "
-                   "which verify has no scenarios for); errors under rule UITAMR-ST-CPU. Implies the "
+                   "its smaller X/Y and R ranges); errors under rule UITAMR-ST-CPU. Implies the "
                    "dialect; a --target whose editor does not program the CPU is refused. Default: "
                    "no CPU check.")
 @click.option("--format", "fmt", type=click.Choice(["text", "json", "github", "sarif"]), default="text",

@@ -30,7 +30,8 @@ from verifier.bundled import plc_dir as bundled_plc_dir
 from verifier.digits import digit_problem
 from verifier.textfile import real_path
 from verifier.verify.scenario import (
-    CHANNELS, DEFAULT_DURATION_US, MAX_DURATION_US, PLATFORMS, Scenario, ScenarioError, default_scenario, load_scenario,
+    CHANNELS, DEFAULT_DURATION_US, MAX_DURATION_US, PLATFORMS, TOLD_PLATFORMS, Scenario, ScenarioError, bundled_platform,
+    default_scenario, load_scenario,
 )
 from verifier.verify.sources import SourceError, expand, st_files_in, unique
 
@@ -129,8 +130,9 @@ def _read_scenarios(files, platform: str | None = None) -> list[Scenario]:
 
 
 #: the platform a serial channel belongs to, by the family of its default port (fx3:, fx5:,
-#: q:); adp:1 is on FX3 and FX5 CPUs alike, so it names none
-_CHANNEL_PLATFORMS = {channel.split(":")[0]: platform for platform, (_, channel) in PLATFORMS.items()}
+#: q:); adp:1 is on FX3 and FX5 CPUs alike, so it names none; fx3: is the FX3U's, as a
+#: program is told from its sources (an FX3G is named with --platform fx3g)
+_CHANNEL_PLATFORMS = {PLATFORMS[platform][1].split(":")[0]: platform for platform in TOLD_PLATFORMS}
 
 
 def _scenarios(sources, program, platform, channel, scenario_files, matrix, duration, scan, seed) -> list[Scenario]:
@@ -161,8 +163,10 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
         platform = platform or infer_platform(resolved)
         bundled = _read_scenarios(bundled_files)
         tcp = uses_tcp_route(resolved, program)  # serial programs under serial scenarios, TCP ones behind a converter
-        bundled = [s.with_overrides(duration_us=duration, scan_us=scan, seed=seed) for s in bundled
-                   if s.platform == platform and (s.converter is not None) == tcp]
+        # an FX3G runs the FX3U's scenarios on its own CPU profile (scenario.BUNDLED_AS)
+        bundled = [_on_platform(s.with_overrides(platform=platform, duration_us=duration, scan_us=scan, seed=seed),
+                                s.platform)
+                   for s in bundled if s.platform == bundled_platform(platform) and (s.converter is not None) == tcp]
         if not bundled:
             route = "over TCP" if tcp else "on a serial line"
             raise UnusableInput(f"no bundled scenario is written for the {platform} {route}")
@@ -171,8 +175,9 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
     else:
         bundled = _read_scenarios(bundled_files)  # only without SOURCES: their own sources
         if platform is not None and bundled:
-            # the bundled examples are written for their platform: --platform picks them
-            bundled = [s for s in bundled if s.platform == platform]
+            # the bundled examples are written for their platform: --platform picks them (an
+            # FX3G the FX3U's, run on the FX3G below: scenario.BUNDLED_AS)
+            bundled = [s for s in bundled if s.platform == bundled_platform(platform)]
             if not bundled and not own:
                 raise UnusableInput(f"no bundled scenario is written for the {platform}")
         if not own and not bundled:
@@ -188,7 +193,7 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
                     "default: a healthy robot behind a healthy converter at the address the program opens, "
                     "no faults, no inputs"))]
         scenarios = [s.with_overrides(**overrides) for s in own]
-        scenarios += [s.with_overrides(**{**overrides, "platform": None}) for s in bundled]
+        scenarios += [_on_platform(s.with_overrides(**overrides), s.platform) for s in bundled]
     if duration is not None:
         scenarios = [_cut_short(s) for s in scenarios]
     # what the command line set, for the messages that blame an option rather than a file's line
@@ -209,6 +214,16 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
     if mistakes:
         raise ScenarioMistakes(mistakes)
     return scenarios
+
+
+def _on_platform(scenario: Scenario, written_for: str) -> Scenario:
+    """`scenario` (a bundled one, written for `written_for`) with a note when --platform runs
+    it on another CPU (the FX3U's scenarios on an FX3G: scenario.BUNDLED_AS); its name still
+    says the platform it was written for."""
+    if scenario.platform == written_for:
+        return scenario
+    note = f"written for the {written_for}, run on the {scenario.platform} CPU profile (--platform {scenario.platform})"
+    return replace(scenario, notes=scenario.notes + (note,))
 
 
 def _no_sources(scenario: Scenario) -> str:
@@ -458,7 +473,7 @@ def _terminate_as_exit():
 @click.argument("sources", nargs=-1, type=click.Path())
 @click.option("--program", help="The PROGRAM POU to run (default: the scenario's, or the only one).")
 @click.option("--platform", type=click.Choice(sorted(PLATFORMS), case_sensitive=False),
-              help="PLC platform (sets the ST dialect, the CPU and the serial port). Default: the scenario's; with SOURCES and no scenario, told from the devices and instructions the sources use. Without SOURCES: runs the bundled scenarios of that platform.")
+              help="PLC platform (sets the ST dialect, the CPU and the serial port); fx3g: an FX3G, the FX3 library on the FX3G CPU profile. Default: the scenario's; with SOURCES and no scenario, told from the devices and instructions the sources use (never fx3g). Without SOURCES: runs the bundled scenarios of that platform (fx3g: the fx3u ones, on the FX3G).")
 @click.option("--channel", type=click.Choice(CHANNELS),
               help="The PLC serial port the robot hangs on (default: the scenario's, or the platform's first port).")
 @click.option("--scenario", "scenario_files", multiple=True, type=click.Path(),

@@ -4,7 +4,8 @@ The sources are loaded for every platform's CPU (its engineering tool's dialect,
 devices and its instructions). Serial programs use instructions and special devices that
 exist on one CPU only — RS2 with M8402/D8403 (FX3U), RS2 with SM/SD (FX5U), G_OUTPUT /
 G_INPUT (Q with QJ71C24N) — so exactly one load succeeds. A program that uses nothing
-platform-specific loads everywhere and the platform cannot be told.
+platform-specific loads everywhere and the platform cannot be told. The FX3G is never told
+from the sources (scenario.TOLD_PLATFORMS): what loads on it loads on the FX3U too.
 """
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ import re
 from pathlib import Path
 
 from .result import UnusableInput
-from .scenario import PLATFORMS
+from .scenario import PLATFORMS, TOLD_PLATFORMS, bundled_platform
 
 
 class PlatformUnknown(UnusableInput):
@@ -20,14 +21,15 @@ class PlatformUnknown(UnusableInput):
 
 
 def platforms_that_load(sources: tuple[Path, ...]) -> tuple[list[str], dict[str, str]]:
-    """(platforms whose CPU loads the sources, {platform: first load error} for the others)."""
+    """(platforms whose CPU loads the sources, {platform: first load error} for the others),
+    of the platforms sources are told apart by (TOLD_PLATFORMS: not the FX3G)."""
     import verifier
     from verifier.sim.errors import LoadError
 
     fits, errors = [], {}
-    for platform, (target, _) in PLATFORMS.items():
+    for platform in TOLD_PLATFORMS:
         try:
-            verifier.load(*[str(p) for p in sources], target=target, cpu=platform)
+            verifier.load(*[str(p) for p in sources], target=PLATFORMS[platform][0], cpu=platform)
         except LoadError as exc:
             lines = [line.strip() for line in str(exc).splitlines()[1:] if line.strip()]
             errors[platform] = lines[0] if lines else str(exc)
@@ -46,9 +48,11 @@ def infer_platform(sources: tuple[Path, ...]) -> str:
             raise UnusableInput(f"the sources do not load: {next(iter(errors.values()))}")
         reasons = "; ".join(f"{platform}: {error}" for platform, error in errors.items())
         raise UnusableInput(f"the sources load on no platform ({reasons})")
+    # the platforms named only, never told (an FX3G), beside the one whose scenarios they run
+    say = [named for platform in fits for named in PLATFORMS if bundled_platform(named) == platform]
     raise PlatformUnknown(
         f"cannot tell the platform from the sources: they load on {', '.join(fits)} alike (they use no "
-        "device or instruction of one platform only); say --platform " + "|".join(fits)
+        "device or instruction of one platform only); say --platform " + "|".join(say)
     )
 
 

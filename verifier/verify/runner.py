@@ -30,7 +30,7 @@ from .expectations import judge
 from .overwritten import overwritten_input_notes
 from .result import KEEP_ALL, RULE_EVENTS, Keep, LineEvent, ScenarioResult, TraceRecord, UnusableInput, summarize_diagnostics
 from .rules import check_all
-from .scenario import BUFFER_MEMORY, DEVICE_NAME, Scenario, scenario_power_on_stop
+from .scenario import BUFFER_MEMORY, DEFAULT_PLATFORM, DEVICE_NAME, Scenario, bundled_platform, scenario_power_on_stop
 from .stream import Stream
 from .traffic import analyse, converter_drops
 
@@ -252,13 +252,22 @@ def _platform_hint(scenario: Scenario) -> str:
     fits, _ = platforms_that_load(scenario.sources)
     if not fits or scenario.platform in fits:
         return ""
+    larger = bundled_platform(scenario.platform)
+    if larger != scenario.platform and larger in fits:
+        # an FX3G program that names a device only the FX3U has: the program does not fit
+        # the CPU named, and another platform to give would hide that
+        named = f"--platform {scenario.platform}" if scenario.platform_from_option else _key_where(scenario, "platform")
+        return (f"\n{named}: the sources load on the {larger} but not on the {scenario.platform}, which has fewer "
+                f"devices (docs/instructions.md §2; `uitamr check --platform {scenario.platform}` lists every one it "
+                f"lacks): for an {scenario.platform.upper()} use devices it has; for an {larger.upper()} give "
+                f"--platform {larger}")
     if scenario.platform_from_option:  # the option is to blame, not a file's key
         return (f"\n--platform {scenario.platform}: the sources load on {', '.join(fits)}, not on "
                 f"{scenario.platform}: give --platform {fits[0]}")
     if scenario.path is None:  # no file's key to point at
         return (f"\nthe sources load on {', '.join(fits)}, not on {scenario.platform} (the default): "
                 f"give --platform {fits[0]}")
-    defaulted = "platform" not in scenario.key_lines and scenario.platform == "fx3u"
+    defaulted = "platform" not in scenario.key_lines and scenario.platform == DEFAULT_PLATFORM
     now = f"{scenario.platform} (the default)" if defaulted else scenario.platform
     return (f"\n{_key_where(scenario, 'platform')}: the sources load on {', '.join(fits)}, not on {now}: "
             f'set platform = "{fits[0]}" in the scenario, or give --platform {fits[0]}')

@@ -30,11 +30,29 @@ from .expectations import KINDS, Expectation, describe_window
 from .sources import SourceError, expand, unique
 
 PLATFORMS = {
-    # platform: (ST dialect of its engineering tool, default serial channel)
+    # platform: (ST dialect of its engineering tool, default serial channel); each a CPU
+    # profile of verifier.sim.cpu, its serial channels those of plcfacts.serial_channels
     "fx3u": ("gxworks2", "fx3:1"),
+    "fx3g": ("gxworks2", "fx3:1"),
     "fx5u": ("gxworks3", "fx5:1"),
     "q": ("gxworks2", "q:1"),
 }
+#: A platform without bundled scenarios of its own -> the platform whose bundled scenarios
+#: (and so library and examples) it runs, on its own CPU profile: the FX3G runs the FX3 ones,
+#: written for the FX3U, with the FX3G's smaller X/Y and R ranges (verifier/sim/cpu.py).
+BUNDLED_AS = {"fx3g": "fx3u"}
+#: The platforms sources are told apart by when nobody names one (verifier.verify.platform):
+#: the FX3G's devices are a part of the FX3U's and its instructions are the FX3's
+#: (tests/test_verify_fx3g.py), so whatever loads on an FX3G loads on an FX3U too; an FX3G
+#: is named (--platform fx3g, platform = "fx3g"), never told from the sources.
+TOLD_PLATFORMS = tuple(platform for platform in PLATFORMS if platform not in BUNDLED_AS)
+
+
+def bundled_platform(platform: str) -> str:
+    """The platform whose bundled scenarios `platform` runs (itself, or BUNDLED_AS's)."""
+    return BUNDLED_AS.get(platform, platform)
+
+
 DEFAULT_DURATION_US = 60_000_000
 #: The longest run accepted (virtual time). A day of 10 ms scans takes the simulator about
 #: an hour; anything longer is almost always a typo ("1000h") and would look like a hang.
@@ -127,7 +145,7 @@ class Scenario:
     description: str = ""
     sources: tuple[Path, ...] = ()
     program: str | None = None
-    platform: str = "fx3u"
+    platform: str = DEFAULT_PLATFORM
     channel: str | None = None
     duration_us: int = DEFAULT_DURATION_US
     scan_us: int = DEFAULT_SCAN_US
@@ -440,7 +458,7 @@ class _Reader:
                 raise self.fail("channel", f"unknown channel {channel!r}; expected one of {', '.join(CHANNELS)}")
             problem = channel_problem(channel, platform)  # as verify's load would refuse it
             if problem is not None:
-                owner = next((p for p in PLATFORMS if channel in serial_channels(p)), None)
+                owner = next((p for p in TOLD_PLATFORMS if channel in serial_channels(p)), None)
                 if "platform" not in data and owner is not None:  # the platform is the default (or --platform's)
                     given = "--platform's" if self.platform_option else "the default platform"
                     problem += f" ({platform} is {given}: set platform = \"{owner}\", the CPU that has {channel})"
