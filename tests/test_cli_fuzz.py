@@ -7,7 +7,8 @@ big, values of the wrong type, nesting hundreds deep).
 Whatever the input, a command ends with its documented exit status and never a
 traceback (CliRunner is run with catch_exceptions=False: an exception fails the test);
 an error names its place (file:line:col, or file: line L, column C (byte N)); the input
-file is as it was; and a report is whole or not written. (test_st_fuzz.py fuzzes the ST
+file is as it was; and a report is whole or not written (on exit 2, --junit holds the
+mistake as an error test case). (test_st_fuzz.py fuzzes the ST
 reader itself; test_cli_robustness.py single values of a scenario and any bytes as a
 file; this file goes through the commands with inputs close to real ones.)
 """
@@ -17,6 +18,7 @@ import json
 import re
 import tempfile
 import tomllib
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 from hypothesis import HealthCheck, given, settings, strategies as st
@@ -103,7 +105,10 @@ def test_a_mutated_capture_is_judged_or_an_error_at_its_place(content):
             match = re.match(REPLAY_ERROR.format(path=re.escape(str(capture))), result.stderr)
             assert match, result.stderr
             assert all(int(n) >= 1 for n in match.groups() if n is not None), result.stderr
-            assert not any(path.exists() for path in reports.values())
+            assert not any(reports[kind].exists() for kind in ("json", "jsonl", "html"))
+            # the JUnit is the mistake, whole: one error test case at the place the console names
+            (case,) = ET.parse(reports["xml"]).getroot().findall("./testsuite/testcase")
+            assert case.find("error").get("type") == "unusable-input"
             return
         json.loads(reports["json"].read_text(encoding="utf-8"))
         assert reports["html"].read_text(encoding="utf-8").rstrip().endswith("</html>")
