@@ -396,8 +396,9 @@ def test_a_scenario_without_platform_is_judged_for_the_platform_given(tmp_path):
     alone = run(scenario)  # no --platform: the file's own default, fx3u, as ci.md says
     assert alone.exit_code == 1
     ci_md = " ".join((ROOT / "docs" / "ci.md").read_text(encoding="utf-8").split())
-    assert ("a file that names none is judged for `--platform`, the CPU `uitamr verify --platform` runs it on, "
-            "and without `--platform` for the fx3u") in ci_md
+    assert ("with `--platform`, that CPU, the one `uitamr verify --platform` runs every scenario on (also a file "
+            "that names its own `platform`); without it, the file's `platform`, and for a file that names none the "
+            "fx3u") in ci_md
     assert errors(alone.output)[0] == (
         f"{scenario}:8:1: error: converter: the TCP route needs a PLC with an Ethernet port the library drives "
         "(fx5u or q); this scenario names no platform, so it is 'fx3u' (the default): add platform = \"fx5u\" "
@@ -515,8 +516,21 @@ def test_a_scenario_without_platform_is_judged_for_an_fx3g_with_its_ranges(tmp_p
     assert errors(on_fx3g.output) == [f"{scenario}:2:8: error: initial.X200: device X200 does not exist on the fx3g: "
                                       "X runs X0..X177"]
     assert run("--platform", "fx3u", scenario).exit_code == 0  # the FX3U has X200
+    # a file that names its own platform: verify --platform runs it on --platform's CPU, so
+    # check judges it there too (it said 0 errors where verify refused X200 at its key)
     named = write(tmp_path, 'platform = "fx3u"\n\n[initial]\nX200 = true\n', "named.toml")
-    assert run("--platform", "fx3g", named).exit_code == 0  # the file's own platform decides
+    on_fx3g = run("--platform", "fx3g", named)
+    assert on_fx3g.exit_code == 1, on_fx3g.output
+    assert errors(on_fx3g.output) == [f"{named}:4:8: error: initial.X200: device X200 does not exist on the fx3g: "
+                                      "X runs X0..X177"]
+    assert run(named).exit_code == 0  # without --platform: its own fx3u
+    healthy = (ROOT / "plc" / "scenarios" / "fx3u-healthy.toml").read_text(encoding="utf-8")
+    runnable = write(tmp_path, healthy.replace('"../', f'"{(ROOT / "plc").as_posix()}/') + "\n[initial]\nX200 = true\n",
+                     "runnable.toml")
+    x200 = f"{runnable}:{len(healthy.splitlines()) + 3}:8: "
+    verified = CliRunner().invoke(main, ["verify", "--platform", "fx3g", "--scenario", str(runnable)])
+    assert verified.exit_code == 2 and x200 + "initial.X200: device X200 does not exist on the fx3g" in verified.output
+    assert errors(run("--platform", "fx3g", runnable).output)[0].startswith(x200 + "error: initial.X200")
 
 
 def test_buffer_memory_past_the_model_is_a_load_error_at_its_place(tmp_path):
