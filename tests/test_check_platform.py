@@ -399,6 +399,12 @@ def test_a_scenario_without_platform_is_judged_for_the_platform_given(tmp_path):
     assert ("with `--platform`, that CPU, the one `uitamr verify --platform` runs every scenario on (also a file "
             "that names its own `platform`); without it, the file's `platform`, and for a file that names none the "
             "fx3u") in ci_md
+    scenarios_md = " ".join((ROOT / "docs" / "scenarios.md").read_text(encoding="utf-8").split())
+    assert ("set against the CPU `uitamr verify` runs the file on — with `--platform`, that CPU, also for a file "
+            "that names its own `platform`") in scenarios_md  # it said: against the file's own platform
+    st_dialect_md = " ".join((ROOT / "docs" / "st-dialect.md").read_text(encoding="utf-8").split())
+    assert ("checked against the CPU `uitamr verify` runs the file on (with `--platform`, that CPU, also for a file "
+            "that names its own `platform`") in st_dialect_md  # it said: against its platform, with or without
     assert errors(alone.output)[0] == (
         f"{scenario}:8:1: error: converter: the TCP route needs a PLC with an Ethernet port the library drives "
         "(fx5u or q); this scenario names no platform, so it is 'fx3u' (the default): add platform = \"fx5u\" "

@@ -475,3 +475,24 @@ def test_a_replay_trace_carries_a_tolerance_only_for_host_times_and_ends_with_th
     # settings and the program's outputs verify recorded go on with it
     verified = (tmp_path / "v.jsonl").read_text(encoding="utf-8").splitlines()
     assert end == dict(json.loads(verified[-1]), scenario=end["scenario"]) and end["end"] == 2.0 > frames[-1]["t_end"]
+
+
+def test_verifier_md_says_what_the_junit_of_a_run_that_cannot_start_holds():
+    """The exit-code table said 'No report is written' for exit 2 after --junit came to
+    list the mistakes; the --junit section is held to what report_junit writes, a mistake
+    with a place and one without (`--program MIAN`: name `input`, no `file`)."""
+    from verifier.verify.report_junit import unusable_element
+
+    section = " ".join(VERIFIER_MD.split("### `--junit FILE`", 1)[1].split("\n### ", 1)[0].split())
+    (row,) = [line for line in VERIFIER_MD.splitlines() if line.startswith("| 2 | unusable input")]
+    assert "`--junit`" in row and "(#--junit-file)" in row
+    root = unusable_element(["s.toml:4:1: duraton: unknown key\nmore", "--program: no PROGRAM 'MIAN' in the sources"])
+    placed, unplaced = root.findall("./testsuite/testcase")
+    assert f"classname `{placed.get('classname')}`" in section
+    assert f'<error type="{placed.find("error").get("type")}">' in section
+    assert placed.get("name") == placed.get("file") == "s.toml" and "name and `file` = the file it names" in section
+    assert placed.find("error").get("message") == "s.toml:4:1: duraton: unknown key"  # the first line
+    assert unplaced.get("name") == "input" and unplaced.get("file") is None
+    assert "name `input` and no `file`" in section and "`--program MIAN`" in section
+    replay = unusable_element(["c.txt:1:16: 'zz' is not a byte in hex"], "uitamr replay")
+    assert f"classname `{replay.find('./testsuite/testcase').get('classname')}`" in section
