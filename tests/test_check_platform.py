@@ -539,6 +539,20 @@ def test_a_scenario_without_platform_is_judged_for_an_fx3g_with_its_ranges(tmp_p
     assert errors(run("--platform", "fx3g", runnable).output)[0].startswith(x200 + "error: initial.X200")
 
 
+def test_a_scenarios_own_channel_is_judged_for_the_platform_given(tmp_path):
+    # verify --platform q attaches a platform = "fx3u" file's channel fx3:2 to the Q CPU and
+    # refuses it at its key (exit 2); check --platform q said 0 errors
+    (tmp_path / "N.st").write_text(program("x := x + 1;"), encoding="utf-8")
+    named = write(tmp_path, 'sources = ["N.st"]\nplatform = "fx3u"\nchannel = "fx3:2"\nduration = "1s"\n', "c.toml")
+    refusal = "channel: channel fx3:2 does not exist on the q CPU; the q CPU has q:1, q:2"
+    verified = CliRunner().invoke(main, ["verify", "--platform", "q", "--scenario", str(named)])
+    assert verified.exit_code == 2 and f"{named}:3:11: {refusal}" in verified.output, verified.output
+    on_q = run("--platform", "q", named)
+    assert on_q.exit_code == 1, on_q.output
+    assert errors(on_q.output) == [f"{named}:3:11: error: {refusal}"]
+    assert run("--platform", "fx3u", named).exit_code == 0 and run(named).exit_code == 0
+
+
 def test_buffer_memory_past_the_model_is_a_load_error_at_its_place(tmp_path):
     """`verify` (through the loader) stopped at U0\\G30000 with "simulator fault while
     running this statement: IndexError(...)"; it is now the check's error at load."""

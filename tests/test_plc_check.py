@@ -148,6 +148,9 @@ def test_the_file_to_add_is_named_in_a_vendored_copy_of_the_library(tmp_path, mo
     monkeypatch.chdir(vendored)  # from inside the copy: the path from there
     result = CliRunner().invoke(check_command, ["--platform", "q", "core", "../../../src"])
     assert "../../../src/Main.st:3:14: " + hint.format("q/UITAMR_PortQC24.st") in result.output
+    # the copy given by its absolute path: its own file, not the installed toolkit's
+    result = CliRunner().invoke(check_command, ["--platform", "q", str(vendored / "core"), str(tmp_path / "src")])
+    assert f"{tmp_path / 'src' / 'Main.st'}:3:14: " + hint.format(vendored / "q" / "UITAMR_PortQC24.st") in result.output
     shutil.rmtree(vendored / "q")  # a copy without the file: the installed toolkit's, which exists
     result = CliRunner().invoke(check_command, ["--platform", "q", "core", "../../../src"])
     assert hint.format(PLC / "q" / "UITAMR_PortQC24.st") in result.output

@@ -146,6 +146,11 @@ FRAME = '{"scenario": "a", "t": 0.1, "t_end": 0.108, "dir": "tx", "hex": "01 06 
      "manual_stop_counts_as_stop; it has 'baud'"),
     (['{"scenario": "a", "end": 1, "reply_timeout": "400ms"}'],
      "t.jsonl:2:1: 'reply_timeout' is \"400ms\"; expected a time in seconds"),
+    # a time-out of 0, which a scenario and --reply-timeout refuse, took every reply as late
+    (['{"scenario": "a", "end": 1, "reply_timeout": 0}'],
+     "t.jsonl:2:1: 'reply_timeout' is 0; expected a time in seconds longer than 0"),
+    (['{"scenario": "a", "end": 1, "min_period": 1e-9}'],
+     "t.jsonl:2:1: 'min_period' is 1e-09; expected a time in seconds longer than 0"),
 ])
 def test_a_bad_record_of_what_the_rules_read_is_named_with_its_line(tmp_path, lines, message):
     path = tmp_path / "t.jsonl"

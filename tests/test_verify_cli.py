@@ -508,6 +508,25 @@ def test_the_junit_of_a_run_that_cannot_start_is_not_written_over_an_input(tmp_p
     assert scenario.read_text(encoding="utf-8") == text
 
 
+def test_the_junit_of_a_run_that_cannot_start_is_not_written_over_a_file_of_a_named_folder(tmp_path):
+    """--scenario FOLDER and SOURCES given as a folder: their files are inputs too. The JUnit
+    report of a scenario's mistake was written over a.toml of the folder (and over an ST
+    source of a SOURCES folder), only the names as given being checked."""
+    folder, sources = tmp_path / "sc", tmp_path / "src"
+    folder.mkdir()
+    sources.mkdir()
+    kept = {folder / "a.toml": 'program = "MAIN"\n', folder / "b.toml": 'program = "MAIN"\nduration = "5q"\n'}
+    write_files(sources, {"MAIN.st": "PROGRAM MAIN\nVAR\n    x : INT;\nEND_VAR\nx := 1;\nEND_PROGRAM\n"})
+    kept[sources / "MAIN.st"] = (sources / "MAIN.st").read_text(encoding="utf-8")
+    for path, text in kept.items():
+        path.write_text(text, encoding="utf-8")
+    for report in (folder / "a.toml", sources / "MAIN.st"):
+        done = _run_cli(sources, "--scenario", folder, "--junit", report)
+        assert done.returncode == 2 and "'5q' is not a duration" in done.stderr, done.stderr
+        assert "the JUnit report was not written: " in done.stderr and "one of the run's input files" in done.stderr
+        assert {path: path.read_text(encoding="utf-8") for path in kept} == kept
+
+
 def test_a_named_pipe_as_scenario_is_refused_not_waited_on(tmp_path):
     fifo = tmp_path / "s.toml"
     os.mkfifo(fifo)

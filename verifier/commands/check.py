@@ -180,7 +180,8 @@ def check_scenario(path: Path, platform: str | None = None) -> list[Diagnostic]:
     `uitamr verify` does). `platform` (--platform): the CPU its devices are judged for, as
     `uitamr verify --platform` runs it, also a file that names its own (verify runs that on
     --platform's CPU too: `check --platform fx3g` of a `platform = "fx3u"` file with X200
-    said 0 errors where verify refused X200 at its key)."""
+    said 0 errors where verify refused X200 at its key), and the channel it names."""
+    from verifier.plcfacts import channel_problem
     from verifier.verify.scenario import ScenarioError, load_scenario
 
     try:
@@ -188,7 +189,16 @@ def check_scenario(path: Path, platform: str | None = None) -> list[Diagnostic]:
     except ScenarioError as exc:
         message = f"{exc.key}: {exc.message}" if exc.key else exc.message
         return [Diagnostic(str(path), exc.line or 0, exc.col or 0, "error", message)]
-    return _scenario_devices(scenario, platform or scenario.platform)
+    found = []
+    place = scenario.key_lines.get("channel")
+    if platform is not None and scenario.channel is not None and place is not None:
+        # the file's channel on --platform's CPU, which verify --platform attaches it to
+        # (check said 0 errors for a platform = "fx3u" file on fx3:2 where verify --platform q
+        # refused fx3:2 at its key)
+        problem = channel_problem(scenario.channel, platform)
+        if problem is not None:
+            found.append(Diagnostic(str(path), place.line, place.col, "error", f"channel: {problem}"))
+    return found + _scenario_devices(scenario, platform or scenario.platform)
 
 
 def _scenario_devices(scenario, cpu_name: str) -> list[Diagnostic]:

@@ -309,6 +309,25 @@ def _scenario_files(names) -> list[Path]:
     return files
 
 
+def _named_inputs(sources, scenario_files) -> list[Path]:
+    """The input files the command line names, for a run that could not start: SOURCES'
+    folders and patterns as their .st files, --scenario folders as their .toml files (a
+    name that stands for none, as given), so that the JUnit report of its mistakes is not
+    written over one of them."""
+    found: list[Path] = []
+    for name in sources:
+        try:
+            found += _source_files([name])
+        except UnusableInput:
+            found.append(Path(name))
+    for name in scenario_files:
+        try:
+            found += _scenario_files([name])
+        except UnusableInput:
+            found.append(Path(name))
+    return found
+
+
 def _source_files(sources) -> tuple[Path, ...]:
     """The .st files named on the command line: files, folders (recursively) or patterns."""
     found: list[Path] = []
@@ -520,9 +539,9 @@ def command(sources, program, platform, channel, response_signal, scenario_files
         inputs = [p for s in scenarios for p in ([s.path] if s.path else []) + list(s.sources)]
         check_not_inputs(inputs, json_path, junit_path, trace_path, html_path)
     except ScenarioMistakes as exc:
-        _unusable_input(junit_path, (*sources, *scenario_files), *exc.messages)
+        _unusable_input(junit_path, _named_inputs(sources, scenario_files), *exc.messages)
     except (ScenarioError, UnusableInput) as exc:
-        _unusable_input(junit_path, (*sources, *scenario_files), str(exc))
+        _unusable_input(junit_path, _named_inputs(sources, scenario_files), str(exc))
     except ReportError as exc:
         _unusable(str(exc))
     stderr = text_console(stderr=True)

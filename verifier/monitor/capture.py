@@ -247,8 +247,7 @@ def _end_chunk(record: dict, chunks: list[Chunk], where: str) -> Chunk:
     if chunks and end_us < chunks[-1].t_start_us:
         raise CaptureError(f"{where}: 'end' ({end_us / 1_000_000:g} s) is before the start of the record before "
                            f"({chunks[-1].t_start_us / 1_000_000:g} s); a trace is in time order")
-    rules = tuple((field, round(_seconds(record[key], key, where) * 1_000_000))
-                  for key, field in RUN_SETTINGS.items() if key in record)
+    rules = tuple((field, _positive_us(record[key], key, where)) for key, field in RUN_SETTINGS.items() if key in record)
     settings = _protocol(record["protocol"], where) if "protocol" in record else None
     if "response_signal" not in record:  # a line's run: the program's outputs were not seen
         stray = sorted(set(_OUTPUTS) & set(record))
@@ -330,6 +329,15 @@ def _seconds(value, key: str, where: str) -> float:
         raise CaptureError(f"{where}: {key!r} is {json.dumps(value)}; expected a time in seconds "
                            f"from 0 to {LARGEST:g}")
     return float(value)
+
+
+def _positive_us(value, key: str, where: str) -> int:
+    """A rule's time in an end record, in µs: longer than 0, as a scenario's [rules] and
+    --reply-timeout take it (a time-out of 0 took every reply as late)."""
+    us = round(_seconds(value, key, where) * 1_000_000)
+    if us <= 0:
+        raise CaptureError(f"{where}: {key!r} is {json.dumps(value)}; expected a time in seconds longer than 0")
+    return us
 
 
 def read_capture(path: Path) -> dict[str, list[Chunk]]:

@@ -1129,8 +1129,10 @@ def _plc_as_given(filenames: list[str]) -> Path | None:
         try:
             inside = real_path(given).relative_to(PLC_DIR)
         except ValueError:
-            inside = next((Path(*given.parts[k:]) for k in range(len(given.parts) - 1)
-                           if (PLC_DIR / Path(*given.parts[k:])).is_file()), None)
+            # the parts below the root of an absolute path (`PLC_DIR / "/x"` is "/x" itself)
+            parts = given.parts[1:] if given.anchor else given.parts
+            inside = next((Path(*parts[k:]) for k in range(len(parts) - 1)
+                           if (PLC_DIR / Path(*parts[k:])).is_file()), None)
             if inside is None:
                 continue
         if len(inside.parts) < len(given.parts):
