@@ -527,6 +527,17 @@ def test_the_junit_of_a_run_that_cannot_start_is_not_written_over_a_file_of_a_na
         assert {path: path.read_text(encoding="utf-8") for path in kept} == kept
 
 
+def test_the_junit_of_a_run_that_cannot_start_is_not_written_over_the_st_a_broken_scenario_names(tmp_path):
+    """The ST a broken scenario file names is not known when the run cannot start: a
+    --junit naming it replaced the program with XML. A file that holds no XML is kept."""
+    program = "PROGRAM MAIN\nVAR\n    x : INT;\nEND_VAR\nx := 1;\nEND_PROGRAM\n"
+    write_files(tmp_path, {"MAIN.st": program, "s.toml": 'sources = ["MAIN.st"]\nduration = "5q"\n'})
+    done = _run_cli("--scenario", tmp_path / "s.toml", "--junit", tmp_path / "MAIN.st")
+    assert done.returncode == 2 and "'5q' is not a duration" in done.stderr, done.stderr
+    assert "the JUnit report was not written: " in done.stderr and "holds no XML" in done.stderr
+    assert (tmp_path / "MAIN.st").read_text(encoding="utf-8") == program
+
+
 def test_a_named_pipe_as_scenario_is_refused_not_waited_on(tmp_path):
     fifo = tmp_path / "s.toml"
     os.mkfifo(fifo)

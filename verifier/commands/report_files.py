@@ -79,6 +79,21 @@ def check_not_inputs(inputs, *paths: str | None) -> None:
             raise ReportError(f"{path} is one of the run's input files: write the report to another file")
 
 
+def _not_over_other_content(path: Path) -> None:
+    """Refuse to replace a file that holds something else than XML: the input files of a
+    run that could not start are known only as far as it got (the ST a broken scenario
+    file names is not), so its JUnit report is never written over text that is no report."""
+    try:
+        with path.open("rb") as existing:
+            head = existing.read(64).lstrip(b"\xef\xbb\xbf \t\r\n")
+    except FileNotFoundError:
+        return
+    except OSError:
+        return  # a folder, a device ...: writing it says what is wrong
+    if head and not head.startswith(b"<"):
+        raise ReportError(f"{path} exists and holds no XML (an input file?): write the report to another file")
+
+
 def junit_of_mistakes(junit_path, messages: list[str], command: str, inputs=()) -> tuple[bool, str]:
     """For a run that cannot start (exit 2): its mistakes written to --junit's file as errors
     (`report_junit.unusable_element`), so that a CI server shows what to fix rather than no
@@ -88,6 +103,7 @@ def junit_of_mistakes(junit_path, messages: list[str], command: str, inputs=()) 
 
     try:
         check_not_inputs(inputs, junit_path)
+        _not_over_other_content(Path(junit_path))
         report_junit.write_unusable(messages, Path(junit_path), command)
     except ReportError as exc:
         return False, f"the JUnit report was not written: {exc}"
