@@ -82,8 +82,6 @@ INFINITY = float("inf")
 FIRST_SKIP_SCORE = 4
 FIRST_USEFUL = 4
 FIRST_PROBE_EVERY = 8
-# which score judges a state taken (`IdleScans._judging`): a first quiet scan's, a landing one's
-FIRST, LANDING = 0, 1
 # the cells instruction operands wrote are read by a generated function up to this many
 OPERAND_CELLS_GENERATED = 64
 _CONST_CELL = re.compile(r"\b(_A_[A-Z]+|_U[0-9A-F]+)\[(\d+)\]")
@@ -129,6 +127,35 @@ def _generated(name: str, expression: str, env: dict[str, object], filename: str
     return env[name]
 
 
+class _StateScore:
+    """Whether taking one kind of state (a first quiet scan's, a landing scan's: the module
+    docstring) has been of use lately: of no use FIRST_SKIP_SCORE times more than of use
+    (a use counts FIRST_USEFUL), it is left out, every FIRST_PROBE_EVERY-th still taken."""
+
+    __slots__ = ("score", "skipped", "states_skipped")
+
+    def __init__(self):
+        self.score = 0
+        self.skipped = 0  # the states this score could have left out
+        self.states_skipped = 0  # those it did
+
+    def leave_out(self) -> bool:
+        """Whether to leave this state out (not take it)."""
+        if self.score < FIRST_SKIP_SCORE:
+            return False
+        self.skipped += 1
+        if self.skipped % FIRST_PROBE_EVERY == 0:
+            return False  # a probe: has it become of use?
+        self.states_skipped += 1
+        return True
+
+    def useful(self) -> None:
+        self.score = max(0, self.score - FIRST_USEFUL)
+
+    def wasted(self) -> None:
+        self.score = min(FIRST_SKIP_SCORE + 2, self.score + 1)
+
+
 def _never_idle(now: int) -> None:
     """The idle deadline of an I/O model that cannot tell: it may change something at
     every scan."""
@@ -146,21 +173,16 @@ class IdleScans:
         self.skipped_scans = 0
         self.jumps = 0
         self._previous = None
-        # the first quiet scan's state (module docstring, "The first quiet scan"): how many
-        # quiet scans in a row so far, the score that decides whether to take it, the ones
-        # not taken, and whether the one taken is still to be judged
+        # how many quiet scans in a row so far; whether the scan that just ran is one a jump
+        # landed on (set by `_jump` when it went to a change, not to the caller's stop)
         self._quiet = 0
-        self._first_score = 0
-        self._first_skipped = 0
-        self.first_states_skipped = 0
-        # the same for the state of the scan a jump lands on (module docstring, "The scan a
-        # jump lands on"): set by `_jump` when it went to a change, not to the caller's stop
         self._landing = False
-        self._landing_score = 0
-        self._landing_skipped = 0
-        self.landing_states_skipped = 0
-        # the state taken that is still to be judged: None, FIRST or LANDING (its score)
-        self._judging: int | None = None
+        # whether to take the state of a first quiet scan (module docstring, "The first quiet
+        # scan") and of the scan a jump lands on ("The scan a jump lands on"), and the score
+        # of the one taken that is still to be judged
+        self._first = _StateScore()
+        self._landed = _StateScore()
+        self._judging: _StateScore | None = None
         self.states_taken = 0
         self._deadlines: list[Callable[[int], float | None]] = []  # each poller's idle_deadline
         # cells instruction operands have written: compared by value from then on, whoever
@@ -338,8 +360,7 @@ class IdleScans:
         landing, self._landing = self._landing, False
         if busy or changed or rt.scan_count < 2:
             self._previous, self._quiet = None, 0
-            if self._judging is not None:
-                self._wasted()
+            self._judged(useful=False)
             return
         now = rt.now_us
         pollers = rt.pollers
@@ -350,48 +371,31 @@ class IdleScans:
             until = idle_deadline(now)
             if until is None or until <= now:
                 self._previous, self._quiet = None, 0
-                if self._judging is not None:
-                    self._wasted()
+                self._judged(useful=False)
                 return
             if until < deadline:
                 deadline = until
         deadline = min(deadline, self.next_input_us())
         self._quiet += 1
-        judged = None  # the kind of state this one is, when it is to be judged
-        if self._quiet == 1:
-            judged = FIRST
-            if self._first_score >= FIRST_SKIP_SCORE:
-                self._first_skipped += 1
-                if self._first_skipped % FIRST_PROBE_EVERY:
-                    self.first_states_skipped += 1
-                    return  # not taken: `_previous` stays None, the next quiet scan takes its state
-        elif landing:
-            judged = LANDING
-            if self._landing_score >= FIRST_SKIP_SCORE:
-                self._landing_skipped += 1
-                if self._landing_skipped % FIRST_PROBE_EVERY:
-                    self.landing_states_skipped += 1
-                    self._previous = None  # as for a first quiet scan: the next one takes its state
-                    return
+        # the score of the kind of state this one is, when it is to be judged
+        judged = self._first if self._quiet == 1 else self._landed if landing else None
+        if judged is not None and judged.leave_out():
+            # not taken: with `_previous` None (a first quiet scan's already is) the next
+            # quiet scan takes its state
+            self._previous = None
+            return
         if len(pollers) != self._state_pollers:
             self._state = self._state_reader()
         state = self._state()
         self.states_taken += 1
         same = state == self._previous
-        if self._judging is not None:  # the state before was a first or landing one: was it worth taking?
-            if same:
-                self._useful()
-            else:
-                self._wasted()
+        self._judged(useful=same)  # the state before, a first or landing one: was it worth taking?
         if not same:
-            if judged == LANDING:
-                self._judging = LANDING  # of use if the next quiet scan's state equals it
-            elif judged == FIRST:
-                self._judging = FIRST
+            self._judging = judged  # of use if the next quiet scan's state equals it
             self._previous = state
             return
-        if judged == LANDING:  # equal to the state before the jump: of use at once
-            self._landing_score = max(0, self._landing_score - FIRST_USEFUL)
+        if judged is self._landed:  # equal to the state before the jump: of use at once
+            judged.useful()
         deadline = min(deadline, self._timer_deadline_us(), self._clock_deadline_us(started_us))
         to_change = True
         if stop_us is not None and stop_us <= deadline:
@@ -399,22 +403,27 @@ class IdleScans:
         if now < deadline < INFINITY:
             self._jump(deadline, to_change)
 
-    def _useful(self) -> None:
-        """The state judged (`_judging`) equals the next one: it was worth taking."""
-        if self._judging == FIRST:
-            self._first_score = max(0, self._first_score - FIRST_USEFUL)
+    def _judged(self, useful: bool) -> None:
+        """The state still to be judged (`_judging`, a first quiet scan's or a landing one's),
+        if any, was worth taking (the next quiet scan's state equals it) or not (that scan
+        is not quiet, or its state differs)."""
+        if self._judging is None:
+            return
+        if useful:
+            self._judging.useful()
         else:
-            self._landing_score = max(0, self._landing_score - FIRST_USEFUL)
+            self._judging.wasted()
         self._judging = None
 
-    def _wasted(self) -> None:
-        """The scan after a first quiet scan (or a scan a jump landed on) whose state was
-        taken is not quiet, or its state differs: that state was not worth taking."""
-        if self._judging == FIRST:
-            self._first_score = min(FIRST_SKIP_SCORE + 2, self._first_score + 1)
-        else:
-            self._landing_score = min(FIRST_SKIP_SCORE + 2, self._landing_score + 1)
-        self._judging = None
+    @property
+    def first_states_skipped(self) -> int:
+        """First quiet scans whose state was left out."""
+        return self._first.states_skipped
+
+    @property
+    def landing_states_skipped(self) -> int:
+        """Scans a jump landed on whose state was left out."""
+        return self._landed.states_skipped
 
     def _new_operand_cells(self) -> bool:
         """Take in the cells instruction operands wrote since the last scan; True when one
