@@ -18,7 +18,7 @@ from typing import Sequence
 from verifier import protocol
 from verifier.protocol.codec import MAX_FRAME
 from verifier.verify.evidence import RuleOptions, RunEvidence, Samples, Violation
-from verifier.verify.result import LINE, LineEvent, ScenarioResult, TraceRecord
+from verifier.verify.result import LINE, LineEvent, ScenarioResult, TraceRecord, judged_with
 from verifier.verify.rules import Judgement, check_all
 from verifier.verify.traffic import Exchange, Pairing, analyse, converter_drops
 
@@ -295,11 +295,7 @@ class MonitorSession:
             scan_us=0,
             seed=0,
             settings=self.settings,
-            min_period_us=self.options.min_period_us,
-            reply_timeout_us=self.options.reply_timeout_us,
-            response_within_us=self.options.response_within_us,
-            response_signal=None if self.options.response_signal is None else str(self.options.response_signal),
-            response_signal_hint=self.options.response_signal_hint,
+            **judged_with(self.options),
             signal_held=self.signal_held,
             rule_events=list(self.events),
             trace=list(self.frames),

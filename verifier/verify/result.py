@@ -13,7 +13,7 @@ from typing import Any
 from verifier import protocol
 
 from .durations import format_seconds
-from .evidence import DEFAULT_RESPONSE_WITHIN_US, Violation
+from .evidence import DEFAULT_RESPONSE_WITHIN_US, RuleOptions, Violation
 from .expectations import ExpectationResult
 
 
@@ -77,6 +77,16 @@ class LineEvent:
 #: the line's events the rules read (UITAMR-FORMAT: a pause inside a PLC frame; the pairing:
 #: a converter that dropped the connection after forwarding a request)
 RULE_EVENTS = ("gap", "converter.dropped")
+
+
+def judged_with(options: RuleOptions) -> dict[str, Any]:
+    """The rules' settings a run was judged with, as ScenarioResult's fields (what its
+    reports and a trace's end record say): the same for a simulated run and a line's."""
+    signal = options.response_signal
+    return {"min_period_us": options.min_period_us, "reply_timeout_us": options.reply_timeout_us,
+            "response_within_us": options.response_within_us,
+            "response_signal": None if signal is None else str(signal),
+            "response_signal_hint": options.response_signal_hint}
 
 
 @dataclass

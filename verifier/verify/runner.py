@@ -28,7 +28,8 @@ from .events_shown import thin_line_events
 from .evidence import RunEvidence, Samples
 from .expectations import judge
 from .overwritten import overwritten_input_notes
-from .result import KEEP_ALL, RULE_EVENTS, Keep, LineEvent, ScenarioResult, TraceRecord, UnusableInput, summarize_diagnostics
+from .result import (KEEP_ALL, RULE_EVENTS, Keep, LineEvent, ScenarioResult, TraceRecord, UnusableInput, judged_with,
+                     summarize_diagnostics)
 from .rules import check_all
 from .scenario import BUFFER_MEMORY, DEFAULT_PLATFORM, DEVICE_NAME, Scenario, bundled_platform, scenario_power_on_stop
 from .stream import Stream
@@ -765,11 +766,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         scan_jitter_us=scenario.scan_jitter_us,
         seed=scenario.seed,
         settings=scenario.settings,
-        min_period_us=scenario.options.min_period_us,
-        reply_timeout_us=scenario.options.reply_timeout_us,
-        response_within_us=scenario.options.response_within_us,
-        response_signal=None if signal is None else str(signal),
-        response_signal_hint=scenario.options.response_signal_hint,
+        **judged_with(scenario.options),
         signal_held=[] if signal is None else samples.spans(signal).stretches(),
         rule_events=rule_events.read if stream is not None else [e for e in events if e.kind in RULE_EVENTS],
         faults=[fault.describe() for fault in scenario.faults],
