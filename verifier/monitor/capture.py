@@ -145,10 +145,12 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
     a trace written before them has none) is a chunk with no bytes at its time, as a plain
     capture's `end` line is: the replay polls until then, as the run listened; the rules'
     settings and the program's outputs it carries, and the run's event records before it,
-    ride on that chunk (`Chunk.rules`, `signal_held`, `events`)."""
+    ride on that chunk (`Chunk.rules`, `signal_held`, `events`). Nothing of a run follows its
+    end record or lies after its `end` (an event record, a stretch the signal held)."""
     scenarios: dict[str, list[Chunk]] = {}
     ended: dict[str, int] = {}  # scenario -> the line of its end record
-    events: dict[str, list[LineEvent]] = {}  # scenario -> its event records, until its end record
+    # scenario -> its event records and their lines, until its end record
+    events: dict[str, list[tuple[LineEvent, int]]] = {}
     first_event: dict[str, int] = {}  # scenario -> the line of its first event record
     for number, raw in enumerate(text_lines(text), start=1):
         if not raw.strip():
@@ -172,11 +174,19 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
                                "move this record before it, or remove the end record")
         if "end" in record:
             chunks = scenarios.setdefault(scenario, [])
-            chunks.append(replace(_end_chunk(record, chunks, where), events=tuple(events.pop(scenario, ()))))
+            end = _end_chunk(record, chunks, where)
+            recorded = events.pop(scenario, [])
+            within = [(event.t_us, f"{name}:{line}:1", f"the event record at {event.t_us / 1e6:g} s")
+                      for event, line in recorded]
+            for k, (began, stopped) in enumerate(end.signal_held or ()):
+                last = began if stopped is None else stopped
+                within.append((last, where, f"'response_signal_held' item {k + 1}, held until {last / 1e6:g} s,"))
+            _nothing_after_the_end(end.t_us, within, number, scenario)
+            chunks.append(replace(end, events=tuple(event for event, _ in recorded)))
             ended[scenario] = number
             continue
         if "event" in record:
-            events.setdefault(scenario, []).append(_event(record, where))
+            events.setdefault(scenario, []).append((_event(record, where), number))
             first_event.setdefault(scenario, number)
             continue
         for key in ("t", "dir", "hex"):
@@ -211,6 +221,17 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
         raise CaptureError(f"{name}:{first_event[scenario]}:1: the run {scenario!r} has event records but no end "
                            "record after them; a trace ends each run with its end record")
     return scenarios
+
+
+def _nothing_after_the_end(end_us: int, records: list[tuple[int, str, str]], end_line: int, scenario: str) -> None:
+    """Refuse the first of `records` ((µs, file:line:col, what)) that lies after the run's end
+    (`end_us`, its end record on line `end_line`): a run's events and the stretches its signal
+    held are within it, so one after its end is a damaged or hand-edited trace, not the run."""
+    for t_us, where, what in records:
+        if t_us > end_us:
+            raise CaptureError(f"{where}: {what} is after the end of the run {scenario!r} ({end_us / 1_000_000:g} s, "
+                               f"its end record on line {end_line}); what a run records lies within it: correct "
+                               "the time or the end record's 'end', or remove what comes after it")
 
 
 def _event(record: dict, where: str) -> LineEvent:
