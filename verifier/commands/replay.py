@@ -22,6 +22,7 @@ from verifier.monitor.capture import CaptureError, read_capture
 from verifier.monitor.framer import DEFAULT_TOLERANCE_US
 from verifier.monitor.session import CaptureInfo, MonitorSession
 from verifier.verify.evidence import RuleOptions
+from verifier.verify.result import mistakes_of
 
 
 @click.command("replay")
@@ -46,7 +47,8 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
         except CaptureError as exc:
             click.echo(f"uitamr replay: {exc}", err=True)
             if junit_path:  # the CI server shows the mistake, not a missing report
-                click.echo(f"uitamr replay: {junit_of_mistakes(junit_path, [str(exc)], 'uitamr replay')[1]}", err=True)
+                said = junit_of_mistakes(junit_path, mistakes_of(exc), "uitamr replay")[1]
+                click.echo(f"uitamr replay: {said}", err=True)
             sys.exit(EXIT_UNUSABLE)
         is_trace = any(chunk.direction is not None for chunks in loaded.values() for chunk in chunks)
         # a monitor's trace says the tolerance its host times were judged with; other frames

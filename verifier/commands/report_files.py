@@ -94,17 +94,18 @@ def _not_over_other_content(path: Path) -> None:
         raise ReportError(f"{path} exists and holds no XML (an input file?): write the report to another file")
 
 
-def junit_of_mistakes(junit_path, messages: list[str], command: str, inputs=()) -> tuple[bool, str]:
-    """For a run that cannot start (exit 2): its mistakes written to --junit's file as errors
-    (`report_junit.unusable_element`), so that a CI server shows what to fix rather than no
-    report or the last run's; never over one of the run's input files (`inputs`, as far as
-    they are known). Returns whether it was written and the line that says so, or why not."""
+def junit_of_mistakes(junit_path, mistakes: list, command: str, inputs=()) -> tuple[bool, str]:
+    """For a run that cannot start (exit 2): its mistakes (`result.Mistake`, each with its
+    place) written to --junit's file as errors (`report_junit.unusable_element`), so that a
+    CI server shows what to fix rather than no report or the last run's; never over one of
+    the run's input files (`inputs`, as far as they are known). Returns whether it was
+    written and the line that says so, or why not."""
     from verifier.verify import report_junit
 
     try:
         check_not_inputs(inputs, junit_path)
         _not_over_other_content(Path(junit_path))
-        report_junit.write_unusable(messages, Path(junit_path), command)
+        report_junit.write_unusable(mistakes, Path(junit_path), command)
     except ReportError as exc:
         return False, f"the JUnit report was not written: {exc}"
     except OSError as exc:

@@ -1,0 +1,69 @@
+"""The JUnit report of a run that cannot start (exit 2: `uitamr verify --junit`, `uitamr
+replay --junit`): one error test case per mistake, at the place the mistake holds as data
+(file, line, column), never at one read back from its text (docs/verifier.md `--junit`)."""
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+
+from click.testing import CliRunner
+
+from file_helpers import write_files
+from verifier.cli import main
+from verifier.verify.report_junit import unusable_element
+from verifier.verify.result import Mistake
+
+BROKEN = "PROGRAM MAIN\nVAR\n    x : INT;\nEND_VAR\nx := ;\nEND_PROGRAM\n"
+GOOD = "PROGRAM GOOD\nVAR\n    x : INT;\nEND_VAR\nx := 1;\nEND_PROGRAM\n"
+
+
+def invoke(*args):
+    return CliRunner().invoke(main, [str(a) for a in args], catch_exceptions=False)
+
+
+def cases(report) -> list[ET.Element]:
+    return ET.parse(report).getroot().findall("./testsuite/testcase")
+
+
+def test_a_message_that_holds_a_place_like_text_is_no_file(tmp_path):
+    """`--program 'x:1:2: y'` names no file's line; the regex on the message took
+    "--program: no PROGRAM 'x" for the file of the test case."""
+    write_files(tmp_path, {"GOOD.st": GOOD})
+    result = invoke("verify", tmp_path / "GOOD.st", "--program", "x:1:2: y", "--junit", tmp_path / "v.xml")
+    assert result.exit_code == 2, result.output
+    (case,) = cases(tmp_path / "v.xml")
+    assert (case.get("name"), case.get("file")) == ("input", None)
+    assert case.find("error").get("message").startswith("--program: no PROGRAM 'x:1:2: y' in the sources")
+
+
+def test_st_that_loads_on_no_platform_is_at_its_own_file(tmp_path):
+    """`--matrix` tells the platform from the sources; ST that loads on none said "the
+    sources do not load: MAIN.st:5:6: ...", and the regex made the whole head of that line
+    the file's name."""
+    write_files(tmp_path, {"MAIN.st": BROKEN})
+    source = tmp_path / "MAIN.st"
+    result = invoke("verify", source, "--matrix", "--junit", tmp_path / "v.xml")
+    assert result.exit_code == 2, result.output
+    (case,) = cases(tmp_path / "v.xml")
+    assert case.get("name") == case.get("file") == str(source)
+    assert case.find("error").get("message").startswith(f"{source}:5:6: error: expected an expression")
+    assert case.find("error").text.startswith(f"the sources do not load: {source}:5:6: ")
+
+
+def test_a_capture_of_bytes_that_are_not_text_is_at_its_line_and_column(tmp_path):
+    capture = tmp_path / "site.txt"
+    capture.write_bytes(b"0.000 01 06\n0.100 01 \xff\xfe\n")
+    result = invoke("replay", capture, "--junit", tmp_path / "r.xml")
+    assert result.exit_code == 2, result.output
+    (case,) = cases(tmp_path / "r.xml")
+    assert case.get("name") == case.get("file") == str(capture)
+    assert case.find("error").get("message").startswith(f"{capture}: line 2, column 10 (byte 21)")
+
+
+def test_the_place_is_the_mistakes_data_not_its_text():
+    root = unusable_element([Mistake("no place, though it reads a:1:2: like one"),
+                             Mistake("the sources do not load: dir: x/M.st:3:4: error: bad", "dir: x/M.st", 3, 4)])
+    unplaced, placed = root.findall("./testsuite/testcase")
+    assert (unplaced.get("name"), unplaced.get("file")) == ("input", None)
+    assert unplaced.find("error").get("message") == "no place, though it reads a:1:2: like one"
+    assert placed.get("file") == "dir: x/M.st"
+    assert placed.find("error").get("message") == "dir: x/M.st:3:4: error: bad"
