@@ -44,7 +44,7 @@ def test_st_that_loads_on_no_platform_is_at_its_own_file(tmp_path):
     result = invoke("verify", source, "--matrix", "--junit", tmp_path / "v.xml")
     assert result.exit_code == 2, result.output
     (case,) = cases(tmp_path / "v.xml")
-    assert case.get("name") == case.get("file") == str(source)
+    assert (case.get("name"), case.get("file")) == (f"{source}:5:6", str(source))
     assert case.find("error").get("message").startswith(f"{source}:5:6: error: expected an expression")
     assert case.find("error").text.startswith(f"the sources do not load: {source}:5:6: ")
 
@@ -55,7 +55,7 @@ def test_a_capture_of_bytes_that_are_not_text_is_at_its_line_and_column(tmp_path
     result = invoke("replay", capture, "--junit", tmp_path / "r.xml")
     assert result.exit_code == 2, result.output
     (case,) = cases(tmp_path / "r.xml")
-    assert case.get("name") == case.get("file") == str(capture)
+    assert (case.get("name"), case.get("file")) == (f"{capture}:2:10", str(capture))
     assert case.find("error").get("message").startswith(f"{capture}: line 2, column 10 (byte 21)")
 
 
@@ -65,5 +65,23 @@ def test_the_place_is_the_mistakes_data_not_its_text():
     unplaced, placed = root.findall("./testsuite/testcase")
     assert (unplaced.get("name"), unplaced.get("file")) == ("input", None)
     assert unplaced.find("error").get("message") == "no place, though it reads a:1:2: like one"
-    assert placed.get("file") == "dir: x/M.st"
+    assert (placed.get("name"), placed.get("file")) == ("dir: x/M.st:3:4", "dir: x/M.st")
     assert placed.find("error").get("message") == "dir: x/M.st:3:4: error: bad"
+
+
+def test_mistakes_of_one_file_are_test_cases_of_their_own_names(tmp_path):
+    """Each mistake's test case was named by its file alone: two of one file were two test
+    cases of one name, which CI summaries merge or hide. Named by place now, numbered when
+    they share it (one scenario file given twice), the same on every run."""
+    write_files(tmp_path, {"a.toml": 'program = "P"\nduration = "5q"\n', "b.toml": 'duration = "1s"\nscan = "x"\n'})
+    report = tmp_path / "v.xml"
+    for _ in range(2):
+        result = invoke("verify", "--scenario", tmp_path / "a.toml", "--scenario", tmp_path,
+                        "--junit", report)
+        assert result.exit_code == 2, result.output
+        names = [case.get("name") for case in cases(report)]
+        assert names == [f"{tmp_path / 'a.toml'}:2:12 #1", f"{tmp_path / 'a.toml'}:2:12 #2",
+                         f"{tmp_path / 'b.toml'}:2:8"]
+    assert [case.get("file") for case in cases(report)] == [str(tmp_path / "a.toml")] * 2 + [str(tmp_path / "b.toml")]
+    numbered = unusable_element([Mistake("x"), Mistake("y"), Mistake("s.toml:1:1: z", "s.toml", 1, 1)])
+    assert [c.get("name") for c in numbered.findall("./testsuite/testcase")] == ["input #1", "input #2", "s.toml:1:1"]

@@ -8,6 +8,7 @@ start (exit 2) gets one <error type="unusable-input"> per mistake instead.
 from __future__ import annotations
 
 import re
+from collections import Counter
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -118,14 +119,28 @@ def unusable_element(mistakes: list[Mistake], command: str = "uitamr verify") ->
                         errors=str(len(mistakes)))
     suite = ET.SubElement(suites, "testsuite", name=command, tests=str(len(mistakes)), failures="0",
                           errors=str(len(mistakes)))
-    for mistake in mistakes:
+    for mistake, name in zip(mistakes, _mistake_names(mistakes)):
         case = ET.SubElement(suite, "testcase", classname=command.replace(" ", ".") + ".input",
-                             name=mistake.file or "input", time="0.000")
+                             name=name, time="0.000")
         if mistake.file is not None:
             case.set("file", mistake.file)
         element = ET.SubElement(case, "error", message=_headline(mistake), type="unusable-input")
         element.text = mistake.message
     return suites
+
+
+def _mistake_names(mistakes: list[Mistake]) -> list[str]:
+    """Each mistake's test case name: its place, `file:line:col` (`input` when it has none),
+    so that two mistakes of one file are two test cases a CI summary keeps apart, each named
+    the same from run to run while it stays; mistakes that share a place (or have none) are
+    numbered in order, `input #1`, `input #2`."""
+    names = [f"{m.file}:{m.line}:{m.col}" if m.file is not None else "input" for m in mistakes]
+    count, seen = Counter(names), Counter()
+    numbered = []
+    for name in names:
+        seen[name] += 1
+        numbered.append(f"{name} #{seen[name]}" if count[name] > 1 else name)
+    return numbered
 
 
 def _headline(mistake: Mistake) -> str:
