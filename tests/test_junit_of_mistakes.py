@@ -85,3 +85,59 @@ def test_mistakes_of_one_file_are_test_cases_of_their_own_names(tmp_path):
     assert [case.get("file") for case in cases(report)] == [str(tmp_path / "a.toml")] * 2 + [str(tmp_path / "b.toml")]
     numbered = unusable_element([Mistake("x"), Mistake("y"), Mistake("s.toml:1:1: z", "s.toml", 1, 1)])
     assert [c.get("name") for c in numbered.findall("./testsuite/testcase")] == ["input #1", "input #2", "s.toml:1:1"]
+
+
+OLD_RUN = "<testsuites name='an earlier run'/>"
+
+
+def _refused(tmp_path, *args):
+    """`uitamr verify GOOD.st ... --junit v.xml` over an earlier run's JUnit file."""
+    write_files(tmp_path, {"GOOD.st": GOOD, "v.xml": OLD_RUN})
+    result = invoke("verify", tmp_path / "GOOD.st", "--duration", "1s", *args, "--junit", tmp_path / "v.xml")
+    assert result.exit_code == 2, result.output
+    return result
+
+
+def test_another_reports_refused_path_is_the_junits_error(tmp_path):
+    """Exit 2 for --json's missing folder, two reports given one file or a report over an
+    input file left the earlier run's JUnit file as it was, and CI showed its results as
+    this run's; now the JUnit holds the mistake."""
+    source = tmp_path / "GOOD.st"
+    for args, said in [(["--json", tmp_path / "gone" / "r.json"], f"cannot write {tmp_path / 'gone' / 'r.json'}: "
+                                                                   "the folder"),
+                       (["--json", tmp_path / "r.out", "--html", tmp_path / "r.out"], "are the same file"),
+                       (["--json", source], f"{source} is one of the run's input files")]:
+        result = _refused(tmp_path, *args)
+        assert f"wrote {tmp_path / 'v.xml'} (these errors as test cases)" in result.output
+        (case,) = cases(tmp_path / "v.xml")
+        error = case.find("error")
+        assert (case.get("name"), error.get("type")) == ("input", "unusable-input")
+        assert said in error.get("message"), error.get("message")
+        assert source.read_text(encoding="utf-8") == GOOD
+
+
+def test_a_report_that_cannot_be_written_after_the_run_is_the_junits_error(tmp_path):
+    """--json to a full disk (/dev/full) fails after the run, before the JUnit was written:
+    exit 2, and the JUnit says why rather than holding the earlier run."""
+    result = _refused(tmp_path, "--json", "/dev/full")
+    (case,) = cases(tmp_path / "v.xml")
+    assert case.find("error").get("message").startswith("cannot write /dev/full: ")
+    assert f"wrote {tmp_path / 'v.xml'}" in result.output
+
+
+def test_a_junit_whose_own_path_is_refused_is_not_written(tmp_path):
+    """Two reports given the JUnit's own file: neither is written, and the file stays."""
+    result = _refused(tmp_path, "--json", tmp_path / "v.xml")
+    assert "are the same file" in result.output and "wrote" not in result.output
+    assert (tmp_path / "v.xml").read_text(encoding="utf-8") == OLD_RUN
+
+
+def test_replay_writes_another_reports_refusal_to_its_junit(tmp_path):
+    capture = tmp_path / "site.txt"
+    capture.write_text("0.000 01 06 01 A0 00 00 88 14\n", encoding="utf-8")
+    (tmp_path / "r.xml").write_text(OLD_RUN, encoding="utf-8")
+    result = invoke("replay", capture, "--json", tmp_path / "gone" / "r.json", "--junit", tmp_path / "r.xml")
+    assert result.exit_code == 2, result.output
+    (case,) = cases(tmp_path / "r.xml")
+    assert case.get("classname") == "uitamr.replay.input"
+    assert case.find("error").get("message").startswith(f"cannot write {tmp_path / 'gone' / 'r.json'}: the folder")

@@ -14,7 +14,8 @@ from pathlib import Path
 
 import click
 
-from verifier.commands.monitor import EXIT_UNUSABLE, _finish, exit_status, line_options, line_timing
+from verifier.commands.monitor import (EXIT_UNUSABLE, _finish, exit_status, line_options, line_timing,
+                                       refused_report_junit)
 from verifier.commands.protocol_options import given_settings, protocol_settings
 from verifier.commands.report_files import (ReportError, check_folders, check_not_inputs, junit_of_mistakes,
                                              report_options, text_console)
@@ -38,6 +39,7 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
         check_folders(json_path, junit_path, trace_path, html_path)
         check_not_inputs(captures, json_path, junit_path, trace_path, html_path)
     except ReportError as exc:
+        refused_report_junit(junit_path, exc, "uitamr replay", captures)
         raise click.UsageError(str(exc)) from None
     results = []
     for name in captures:
@@ -71,7 +73,7 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
                 session.end_at(chunks[-1].t_us)
             session.close()
             results.append(session.result())
-    _finish(results, console, json_path, junit_path, trace_path, html_path, "uitamr replay")
+    _finish(results, console, json_path, junit_path, trace_path, html_path, "uitamr replay", captures)
     sys.exit(exit_status(results))
 
 

@@ -21,7 +21,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
 from verifier.commands.numbers import INT, IntRange
 from verifier.commands.report_files import (ReportError, check_folders, check_not_inputs, junit_of_mistakes,
-                                             report_options, text_console, write_reports)
+                                             junit_of_refused_report, report_options, text_console, write_reports)
 from verifier.verify.durations import format_duration, format_seconds, parse_duration_us
 from verifier.verify import spool
 from verifier.verify.events_shown import EVENTS_AT_MOST
@@ -105,6 +105,16 @@ def _unusable_input(junit_path: str | None, inputs, error: Exception) -> None:
         written, said = junit_of_mistakes(junit_path, mistakes, "uitamr verify", inputs)
         messages, done = (messages, said) if written else ([*messages, said], None)
     _unusable(*messages, done=done)
+
+
+def _refused_report(junit_path: str | None, error: ReportError, inputs) -> None:
+    """Exit 2 for a report that cannot be written, after writing that mistake to --junit's
+    file when the refused report is another one (not over one of `inputs`)."""
+    junit = junit_of_refused_report(junit_path, error, "uitamr verify", inputs)
+    if junit is None:
+        _unusable(str(error))
+    written, said = junit
+    _unusable(str(error), done=said) if written else _unusable(str(error), said)
 
 
 class ScenarioMistakes(UnusableInput):
@@ -467,12 +477,12 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress,
 
 def _spool_folder(report_path: str, report: str) -> str:
     """A hidden folder beside the report (the trace, or else the page) for the runs' trace
-    lines (Keep.frames_to_file; verifier.verify.spool)."""
+    lines (Keep.frames_to_file; verifier.verify.spool); ReportError when it cannot be made."""
     folder = real_path(report_path).parent
     try:
         return spool.make(folder)
     except OSError as exc:
-        _unusable(f"cannot write the {report} in {folder}: {exc.strerror or exc}")
+        raise ReportError(f"cannot write the {report} in {folder}: {exc.strerror or exc}", report_path) from None
 
 
 @contextmanager
@@ -536,7 +546,7 @@ def command(sources, program, platform, channel, response_signal, scenario_files
     try:
         check_folders(json_path, junit_path, trace_path, html_path)
     except ReportError as exc:
-        _unusable(str(exc))
+        _refused_report(junit_path, exc, _named_inputs(sources, scenario_files))
     try:
         scenarios = _scenarios(sources, program, platform, channel, scenario_files, matrix, duration, scan, seed)
         if response_signal is not None:
@@ -546,14 +556,17 @@ def command(sources, program, platform, channel, response_signal, scenario_files
     except (ScenarioError, UnusableInput) as exc:
         _unusable_input(junit_path, _named_inputs(sources, scenario_files), exc)
     except ReportError as exc:
-        _unusable(str(exc))
+        _refused_report(junit_path, exc, inputs)
     stderr = text_console(stderr=True)
     progress = _LazyProgress(stderr, sum(s.duration_us for s in scenarios), stderr.is_terminal)
     # the reports that list frames do not make a run hold them: they go to files in a hidden
     # folder beside the trace (or the page), removed at the end whatever happens to the runs
     # and their workers
-    spool_folder = _spool_folder(trace_path or html_path, "trace" if trace_path else "HTML report") \
-        if trace_path or html_path else None
+    try:
+        spool_folder = _spool_folder(trace_path or html_path, "trace" if trace_path else "HTML report") \
+            if trace_path or html_path else None
+    except ReportError as exc:
+        _refused_report(junit_path, exc, inputs)
     try:
         with _terminate_as_exit():
             try:
@@ -572,7 +585,7 @@ def command(sources, program, platform, channel, response_signal, scenario_files
                 report_console.render(results, console, first=first)
                 write_reports(results, console, json_path, junit_path, trace_path, html_path)
             except ReportError as exc:
-                _unusable(str(exc))
+                _refused_report(junit_path, exc, inputs)
     finally:
         if spool_folder is not None:
             shutil.rmtree(spool_folder, ignore_errors=True)
