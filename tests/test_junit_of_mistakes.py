@@ -141,3 +141,14 @@ def test_replay_writes_another_reports_refusal_to_its_junit(tmp_path):
     (case,) = cases(tmp_path / "r.xml")
     assert case.get("classname") == "uitamr.replay.input"
     assert case.find("error").get("message").startswith(f"cannot write {tmp_path / 'gone' / 'r.json'}: the folder")
+
+
+def test_monitor_writes_another_reports_refusal_to_its_junit(tmp_path):
+    """Refused before the line is opened: no port is listened to."""
+    (tmp_path / "m.xml").write_text(OLD_RUN, encoding="utf-8")
+    result = invoke("monitor", "--tcp", "127.0.0.1:1", "--json", tmp_path / "gone" / "m.json",
+                    "--junit", tmp_path / "m.xml")
+    assert result.exit_code == 2, result.output
+    (case,) = cases(tmp_path / "m.xml")
+    assert case.get("classname") == "uitamr.monitor.input"
+    assert case.find("error").get("message").startswith(f"cannot write {tmp_path / 'gone' / 'm.json'}: the folder")
