@@ -261,10 +261,12 @@ def _platform_hint(scenario: Scenario) -> str:
         # an FX3G program that names a device only the FX3U has: the program does not fit
         # the CPU named, and another platform to give would hide that
         named = f"--platform {scenario.platform}" if scenario.platform_from_option else _key_where(scenario, "platform")
+        # the file's key names the CPU: it is the key to change (--platform only overrides it)
+        change = (f"set platform = \"{larger}\" in {scenario.path} (or give --platform {larger})"
+                  if not scenario.platform_from_option and scenario.path is not None else f"give --platform {larger}")
         return (f"\n{named}: the sources load on the {larger} but not on the {scenario.platform}, which has fewer "
                 f"devices (docs/instructions.md §2; `uitamr check --platform {scenario.platform}` lists every one it "
-                f"lacks): for an {scenario.platform.upper()} use devices it has; for an {larger.upper()} give "
-                f"--platform {larger}")
+                f"lacks): for an {scenario.platform.upper()} use devices it has; for an {larger.upper()} {change}")
     if scenario.platform_from_option:  # the option is to blame, not a file's key
         return (f"\n--platform {scenario.platform}: the sources load on {', '.join(fits)}, not on "
                 f"{scenario.platform}: give --platform {fits[0]}")
