@@ -139,6 +139,18 @@ FRAME = '{"scenario": "a", "t": 0.1, "t_end": 0.108, "dir": "tx", "hex": "01 06 
      "t.jsonl:2:1: 'response_signal_held' item 1 is [0.5, 0.4]; expected [[began, stopped], ...] in seconds"),
     (['{"scenario": "a", "end": 1, "response_signal_held": [[0.5, null]]}'],
      "t.jsonl:2:1: 'response_signal_held' without 'response_signal'"),
+    # what a run records lies within it: an event or a stretch of the signal after the end
+    # record's `end` is a damaged or hand-edited trace (they were taken silently)
+    (['{"scenario": "a", "t": 0.2, "event": "gap", "message": ""}',
+      '{"scenario": "a", "t": 5, "event": "gap", "message": ""}', '{"scenario": "a", "end": 1}'],
+     "t.jsonl:3:1: the event record at 5 s is after the end of the run 'a' (1 s, its end record on line 4); "
+     "what a run records lies within it: correct the time or the end record's 'end', or remove what comes after it"),
+    (['{"scenario": "a", "end": 1, "response_signal": "o_bErr", "response_signal_held": [[0.5, 0.7], [2, 3]]}'],
+     "t.jsonl:2:1: 'response_signal_held' item 2, held until 3 s, is after the end of the run 'a' (1 s, "),
+    (['{"scenario": "a", "end": 1, "response_signal": "o_bErr", "response_signal_held": [[0.5, 1.5]]}'],
+     "t.jsonl:2:1: 'response_signal_held' item 1, held until 1.5 s, is after the end of the run 'a' (1 s, "),
+    (['{"scenario": "a", "end": 1, "response_signal": "o_bErr", "response_signal_held": [[1.2, null]]}'],
+     "t.jsonl:2:1: 'response_signal_held' item 1, held until 1.2 s, is after the end of the run 'a' (1 s, "),
     (['{"scenario": "a", "end": 1, "protocol": {"address": 300}}'],
      "t.jsonl:2:1: 'protocol': robot address must be 1-247, got 300"),
     (['{"scenario": "a", "end": 1, "protocol": {"baud": 9600}}'],
@@ -158,6 +170,18 @@ def test_a_bad_record_of_what_the_rules_read_is_named_with_its_line(tmp_path, li
     done = run("replay", path, expect=(2,))
     assert "Traceback" not in done.stderr
     assert done.stderr.startswith(f"uitamr replay: {path}:{message.split(':', 1)[1]}"), done.stderr
+
+
+def test_events_and_signal_stretches_up_to_the_runs_end_are_taken(tmp_path):
+    """The bound of the check above is the end itself: an event at the end, and a stretch
+    that stops at the end or still holds from it, belong to the run (a verify run records
+    none later: its events and samples are taken up to its end)."""
+    path = tmp_path / "t.jsonl"
+    path.write_text("\n".join([FRAME, '{"scenario": "a", "t": 1, "event": "gap", "message": "x"}',
+                               '{"scenario": "a", "end": 1, "response_signal": "o_bErr", '
+                               '"response_signal_held": [[0.2, 1], [1, null]]}']) + "\n", encoding="utf-8")
+    done = run("replay", path)
+    assert "Traceback" not in done.stderr and done.stderr == "", done.stderr
 
 
 def test_a_reply_timeout_given_to_replay_is_taken_over_the_recorded_one(tmp_path):

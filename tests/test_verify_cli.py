@@ -494,7 +494,7 @@ def test_st_that_does_not_load_is_a_junit_error_at_its_place(tmp_path):
     result = invoke(tmp_path / "MAIN.st", "--platform", "fx3u", "--junit", tmp_path / "v.xml")
     assert result.exit_code == 2, result.output
     (case,) = ET.parse(tmp_path / "v.xml").getroot().findall("./testsuite/testcase")
-    assert case.get("name") == str(tmp_path / "MAIN.st") and case.get("classname") == "uitamr.verify.input"
+    assert case.get("name") == f"{tmp_path / 'MAIN.st'}:5:6" and case.get("classname") == "uitamr.verify.input"
     assert case.find("error").get("message").startswith(f"{tmp_path / 'MAIN.st'}:5:6: error: expected an expression")
 
 

@@ -133,6 +133,9 @@ def test_a_device_only_the_fx3u_has_is_an_error_at_its_place_on_the_fx3g(tmp_pat
     from_file = invoke("--scenario", scenario)
     assert from_file.exit_code == 2
     assert f"{scenario}:2:12: platform: the sources load on the fx3u but not on the fx3g" in from_file.output
+    # the file's key is what names the CPU: changing it is said, beside the option
+    assert (f"for an FX3U set platform = \"fx3u\" in {scenario} (or give --platform fx3u)"
+            in " ".join(from_file.output.split()))
     # a device the scenario sets: refused before the first scan, at its key
     healthy = tmp_path / "initial.toml"
     healthy.write_text(f'sources = {json.dumps([str(p) for p in (*FX3_DIRS, EXAMPLE)])}\nplatform = "fx3g"\n'

@@ -22,7 +22,8 @@ from rich.markup import escape
 from verifier import protocol
 from verifier.commands.emulate import STANDARD_BAUD_RATES, _tcp_endpoint
 from verifier.commands.protocol_options import protocol_settings
-from verifier.commands.report_files import ReportError, check_folders, report_options, text_console, write_reports
+from verifier.commands.report_files import (ReportError, check_folders, junit_of_refused_report, report_options,
+                                             text_console, write_reports)
 from verifier.commands.verify import _Duration
 from verifier.emulate.ports import serial_url_problem
 from verifier.monitor.capture import format_plain, tolerance_hides_pacing
@@ -105,6 +106,7 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
     try:
         check_folders(json_path, junit_path, trace_path, html_path, capture_path)
     except ReportError as exc:
+        refused_report_junit(junit_path, exc, "uitamr monitor")
         raise click.UsageError(str(exc)) from None
     timing = line_timing(baud, line_format, tolerance, DEFAULT_TOLERANCE_US)
     try:
@@ -185,7 +187,8 @@ def exit_status(results) -> int:
     return {"fail": EXIT_FINDINGS, NO_TRAFFIC: EXIT_NO_TRAFFIC, "pass": EXIT_CLEAN}[overall_verdict(results)]
 
 
-def _finish(results, console: Console, json_path, junit_path, trace_path, html_path, command: str) -> None:
+def _finish(results, console: Console, json_path, junit_path, trace_path, html_path, command: str,
+            inputs=()) -> None:
     """The console report, then the report files, which name `command` as their maker."""
     from verifier.verify import report_console
 
@@ -194,4 +197,13 @@ def _finish(results, console: Console, json_path, junit_path, trace_path, html_p
         write_reports(results, console, json_path, junit_path, trace_path, html_path, command)
     except ReportError as exc:
         click.echo(f"{command}: {exc}", err=True)
+        refused_report_junit(junit_path, exc, command, inputs)
         sys.exit(EXIT_UNUSABLE)
+
+
+def refused_report_junit(junit_path, error: ReportError, command: str, inputs=()) -> None:
+    """For exit 2 from another report than the JUnit (a refused path, one that cannot be
+    written): that mistake in --junit's file, and a line on stderr that says so or why not."""
+    junit = junit_of_refused_report(junit_path, error, command, inputs)
+    if junit is not None:
+        click.echo(f"{command}: {junit[1]}", err=True)

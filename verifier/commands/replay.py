@@ -14,7 +14,8 @@ from pathlib import Path
 
 import click
 
-from verifier.commands.monitor import EXIT_UNUSABLE, _finish, exit_status, line_options, line_timing
+from verifier.commands.monitor import (EXIT_UNUSABLE, _finish, exit_status, line_options, line_timing,
+                                       refused_report_junit)
 from verifier.commands.protocol_options import given_settings, protocol_settings
 from verifier.commands.report_files import (ReportError, check_folders, check_not_inputs, junit_of_mistakes,
                                              report_options, text_console)
@@ -22,6 +23,7 @@ from verifier.monitor.capture import CaptureError, read_capture
 from verifier.monitor.framer import DEFAULT_TOLERANCE_US
 from verifier.monitor.session import CaptureInfo, MonitorSession
 from verifier.verify.evidence import RuleOptions
+from verifier.verify.result import mistakes_of
 
 
 @click.command("replay")
@@ -37,6 +39,7 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
         check_folders(json_path, junit_path, trace_path, html_path)
         check_not_inputs(captures, json_path, junit_path, trace_path, html_path)
     except ReportError as exc:
+        refused_report_junit(junit_path, exc, "uitamr replay", captures)
         raise click.UsageError(str(exc)) from None
     results = []
     for name in captures:
@@ -46,7 +49,8 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
         except CaptureError as exc:
             click.echo(f"uitamr replay: {exc}", err=True)
             if junit_path:  # the CI server shows the mistake, not a missing report
-                click.echo(f"uitamr replay: {junit_of_mistakes(junit_path, [str(exc)], 'uitamr replay')[1]}", err=True)
+                said = junit_of_mistakes(junit_path, mistakes_of(exc), "uitamr replay")[1]
+                click.echo(f"uitamr replay: {said}", err=True)
             sys.exit(EXIT_UNUSABLE)
         is_trace = any(chunk.direction is not None for chunks in loaded.values() for chunk in chunks)
         # a monitor's trace says the tolerance its host times were judged with; other frames
@@ -69,7 +73,7 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
                 session.end_at(chunks[-1].t_us)
             session.close()
             results.append(session.result())
-    _finish(results, console, json_path, junit_path, trace_path, html_path, "uitamr replay")
+    _finish(results, console, json_path, junit_path, trace_path, html_path, "uitamr replay", captures)
     sys.exit(exit_status(results))
 
 

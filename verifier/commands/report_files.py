@@ -49,7 +49,12 @@ def report_options(command):
 
 
 class ReportError(Exception):
-    """A report file that cannot be written; the message names it."""
+    """A report file that cannot be written; the message names it, `paths` holds the report
+    paths it refuses (both of two reports given one file)."""
+
+    def __init__(self, message: str, *paths: str):
+        super().__init__(message)
+        self.paths = paths
 
 
 def check_folders(*paths: str | None) -> None:
@@ -62,9 +67,10 @@ def check_folders(*paths: str | None) -> None:
         resolved = real_path(path)
         if not resolved.parent.is_dir():
             what = "is a file, not a folder" if resolved.parent.exists() else "does not exist"
-            raise ReportError(f"cannot write {path}: the folder {resolved.parent} {what}")
+            raise ReportError(f"cannot write {path}: the folder {resolved.parent} {what}", path)
         if resolved in seen:
-            raise ReportError(f"{seen[resolved]} and {path} are the same file: give each report a file of its own")
+            raise ReportError(f"{seen[resolved]} and {path} are the same file: give each report a file of its own",
+                              seen[resolved], path)
         seen[resolved] = path
 
 
@@ -76,7 +82,7 @@ def check_not_inputs(inputs, *paths: str | None) -> None:
     resolved = {real_path(p) for p in inputs}
     for path in paths:
         if path and real_path(path) in resolved:
-            raise ReportError(f"{path} is one of the run's input files: write the report to another file")
+            raise ReportError(f"{path} is one of the run's input files: write the report to another file", path)
 
 
 def _not_over_other_content(path: Path) -> None:
@@ -91,25 +97,40 @@ def _not_over_other_content(path: Path) -> None:
     except OSError:
         return  # a folder, a device ...: writing it says what is wrong
     if head and not head.startswith(b"<"):
-        raise ReportError(f"{path} exists and holds no XML (an input file?): write the report to another file")
+        raise ReportError(f"{path} exists and holds no XML (an input file?): write the report to another file",
+                          str(path))
 
 
-def junit_of_mistakes(junit_path, messages: list[str], command: str, inputs=()) -> tuple[bool, str]:
-    """For a run that cannot start (exit 2): its mistakes written to --junit's file as errors
-    (`report_junit.unusable_element`), so that a CI server shows what to fix rather than no
-    report or the last run's; never over one of the run's input files (`inputs`, as far as
-    they are known). Returns whether it was written and the line that says so, or why not."""
+def junit_of_mistakes(junit_path, mistakes: list, command: str, inputs=()) -> tuple[bool, str]:
+    """For a run that cannot start (exit 2): its mistakes (`result.Mistake`, each with its
+    place) written to --junit's file as errors (`report_junit.unusable_element`), so that a
+    CI server shows what to fix rather than no report or the last run's; never over one of
+    the run's input files (`inputs`, as far as they are known). Returns whether it was
+    written and the line that says so, or why not."""
     from verifier.verify import report_junit
 
     try:
         check_not_inputs(inputs, junit_path)
         _not_over_other_content(Path(junit_path))
-        report_junit.write_unusable(messages, Path(junit_path), command)
+        report_junit.write_unusable(mistakes, Path(junit_path), command)
     except ReportError as exc:
         return False, f"the JUnit report was not written: {exc}"
     except OSError as exc:
         return False, f"the JUnit report was not written: cannot write {junit_path}: {exc.strerror or exc}"
     return True, f"wrote {junit_path} (these errors as test cases)"
+
+
+def junit_of_refused_report(junit_path, error: ReportError, command: str, inputs=()) -> tuple[bool, str] | None:
+    """For a run that exits 2 because another report than the JUnit cannot be written (its
+    folder does not exist, two reports given one file, a report over an input file, a full
+    disk): that mistake written to --junit's file as an error, as `junit_of_mistakes` does,
+    so that a CI server does not show an earlier run's file as this one's. None when there is
+    no --junit or the refused path is its own; else what `junit_of_mistakes` returns."""
+    from verifier.verify.result import Mistake
+
+    if not junit_path or any(real_path(path) == real_path(junit_path) for path in error.paths):
+        return None
+    return junit_of_mistakes(junit_path, [Mistake(str(error))], command, inputs)
 
 
 def write_reports(results, console: Console, json_path=None, junit_path=None, trace_path=None,
@@ -129,5 +150,5 @@ def write_reports(results, console: Console, json_path=None, junit_path=None, tr
             try:
                 write(results, Path(path))
             except OSError as exc:
-                raise ReportError(f"cannot write {path}: {exc.strerror or exc}") from None
+                raise ReportError(f"cannot write {path}: {exc.strerror or exc}", path) from None
             console.print(f"[dim]wrote {escape(str(path))}[/]")

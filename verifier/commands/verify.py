@@ -21,11 +21,11 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
 from verifier.commands.numbers import INT, IntRange
 from verifier.commands.report_files import (ReportError, check_folders, check_not_inputs, junit_of_mistakes,
-                                             report_options, text_console, write_reports)
+                                             junit_of_refused_report, report_options, text_console, write_reports)
 from verifier.verify.durations import format_duration, format_seconds, parse_duration_us
 from verifier.verify import spool
 from verifier.verify.events_shown import EVENTS_AT_MOST
-from verifier.verify.result import KEEP_ALL, Keep, ScenarioResult, UnusableInput
+from verifier.verify.result import KEEP_ALL, Keep, ScenarioResult, UnusableInput, mistakes_of
 from verifier.bundled import plc_dir as bundled_plc_dir
 from verifier.digits import digit_problem
 from verifier.textfile import real_path
@@ -94,23 +94,36 @@ def _unusable(message: str, *more: str, done: str | None = None) -> None:
     sys.exit(EXIT_UNUSABLE)
 
 
-def _unusable_input(junit_path: str | None, inputs, *messages: str) -> None:
+def _unusable_input(junit_path: str | None, inputs, error: Exception) -> None:
     """Exit 2 for input the run cannot use (a scenario's mistake, ST that does not load),
-    after writing the mistakes to --junit's file as errors (not over one of `inputs`, the
-    run's input files as far as they are known)."""
+    after writing the mistakes to --junit's file as errors, each at the place the error
+    holds (not over one of `inputs`, the run's input files as far as they are known)."""
+    mistakes = mistakes_of(error)
+    messages = [mistake.message for mistake in mistakes]
     done = None
     if junit_path:
-        written, said = junit_of_mistakes(junit_path, list(messages), "uitamr verify", inputs)
-        messages, done = (messages, said) if written else ((*messages, said), None)
+        written, said = junit_of_mistakes(junit_path, mistakes, "uitamr verify", inputs)
+        messages, done = (messages, said) if written else ([*messages, said], None)
     _unusable(*messages, done=done)
 
 
+def _refused_report(junit_path: str | None, error: ReportError, inputs) -> None:
+    """Exit 2 for a report that cannot be written, after writing that mistake to --junit's
+    file when the refused report is another one (not over one of `inputs`)."""
+    junit = junit_of_refused_report(junit_path, error, "uitamr verify", inputs)
+    if junit is None:
+        _unusable(str(error))
+    written, said = junit
+    _unusable(str(error), done=said) if written else _unusable(str(error), said)
+
+
 class ScenarioMistakes(UnusableInput):
-    """The mistakes of several scenario files, each its own message (file:line:col)."""
+    """The mistakes of several scenario files, each its own message (file:line:col) and
+    place (`mistakes`)."""
 
     def __init__(self, errors: list[Exception]):
-        self.messages = [str(e) for e in errors]
-        super().__init__("\n".join(self.messages))
+        self.mistakes = [mistake for error in errors for mistake in mistakes_of(error)]
+        super().__init__("\n".join(mistake.message for mistake in self.mistakes))
 
 
 def _read_scenarios(files, platform: str | None = None) -> list[Scenario]:
@@ -208,7 +221,8 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
         _check_options(scenario, scan, duration)  # the option is to blame: its first clash is enough
     # a file that names no sources is the file's mistake: every such file named, as a mistake
     # in reading them is (`_read_scenarios`)
-    mistakes = [UnusableInput(_no_sources(scenario)) for scenario in scenarios if not scenario.sources]
+    mistakes = [UnusableInput(_no_sources(scenario), at=scenario.key_at("sources"))
+                for scenario in scenarios if not scenario.sources]
     if len(mistakes) == 1:
         raise mistakes[0]
     if mistakes:
@@ -245,12 +259,13 @@ def _check_options(scenario: Scenario, scan: int | None, duration: int | None) -
         raise UnusableInput(
             f"{scenario.key_where(key)}: the scan time "
             f"({format_duration(scenario.scan_us)}{default}) is longer than the whole run "
-            f"({format_duration(scenario.duration_us)})" + (f" with {option}" if option else ""))
+            f"({format_duration(scenario.duration_us)})" + (f" with {option}" if option else ""),
+            at=scenario.key_at(key))
     if scenario.scan_jitter_us >= scenario.scan_us:
         raise UnusableInput(
             f"{scenario.key_where('scan_jitter')}: must be shorter than "
             f"the scan time ({format_duration(scenario.scan_us)})"
-            + (f" with --scan {format_duration(scan)}" if scan is not None else ""))
+            + (f" with --scan {format_duration(scan)}" if scan is not None else ""), at=scenario.key_at("scan_jitter"))
 
 
 def _cut_short(scenario: Scenario) -> Scenario:
@@ -462,12 +477,12 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress,
 
 def _spool_folder(report_path: str, report: str) -> str:
     """A hidden folder beside the report (the trace, or else the page) for the runs' trace
-    lines (Keep.frames_to_file; verifier.verify.spool)."""
+    lines (Keep.frames_to_file; verifier.verify.spool); ReportError when it cannot be made."""
     folder = real_path(report_path).parent
     try:
         return spool.make(folder)
     except OSError as exc:
-        _unusable(f"cannot write the {report} in {folder}: {exc.strerror or exc}")
+        raise ReportError(f"cannot write the {report} in {folder}: {exc.strerror or exc}", report_path) from None
 
 
 @contextmanager
@@ -531,26 +546,27 @@ def command(sources, program, platform, channel, response_signal, scenario_files
     try:
         check_folders(json_path, junit_path, trace_path, html_path)
     except ReportError as exc:
-        _unusable(str(exc))
+        _refused_report(junit_path, exc, _named_inputs(sources, scenario_files))
     try:
         scenarios = _scenarios(sources, program, platform, channel, scenario_files, matrix, duration, scan, seed)
         if response_signal is not None:
             scenarios = [_with_signal(s, response_signal) for s in scenarios]
         inputs = [p for s in scenarios for p in ([s.path] if s.path else []) + list(s.sources)]
         check_not_inputs(inputs, json_path, junit_path, trace_path, html_path)
-    except ScenarioMistakes as exc:
-        _unusable_input(junit_path, _named_inputs(sources, scenario_files), *exc.messages)
     except (ScenarioError, UnusableInput) as exc:
-        _unusable_input(junit_path, _named_inputs(sources, scenario_files), str(exc))
+        _unusable_input(junit_path, _named_inputs(sources, scenario_files), exc)
     except ReportError as exc:
-        _unusable(str(exc))
+        _refused_report(junit_path, exc, inputs)
     stderr = text_console(stderr=True)
     progress = _LazyProgress(stderr, sum(s.duration_us for s in scenarios), stderr.is_terminal)
     # the reports that list frames do not make a run hold them: they go to files in a hidden
     # folder beside the trace (or the page), removed at the end whatever happens to the runs
     # and their workers
-    spool_folder = _spool_folder(trace_path or html_path, "trace" if trace_path else "HTML report") \
-        if trace_path or html_path else None
+    try:
+        spool_folder = _spool_folder(trace_path or html_path, "trace" if trace_path else "HTML report") \
+            if trace_path or html_path else None
+    except ReportError as exc:
+        _refused_report(junit_path, exc, inputs)
     try:
         with _terminate_as_exit():
             try:
@@ -563,13 +579,13 @@ def command(sources, program, platform, channel, response_signal, scenario_files
                 results = _run_all(scenarios, jobs, progress, every_scan, keep)
             except (ScenarioError, UnusableInput) as exc:
                 progress.stop()
-                _unusable_input(junit_path, inputs, str(exc))
+                _unusable_input(junit_path, inputs, exc)
             progress.stop()
             try:
                 report_console.render(results, console, first=first)
                 write_reports(results, console, json_path, junit_path, trace_path, html_path)
             except ReportError as exc:
-                _unusable(str(exc))
+                _refused_report(junit_path, exc, inputs)
     finally:
         if spool_folder is not None:
             shutil.rmtree(spool_folder, ignore_errors=True)

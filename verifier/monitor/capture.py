@@ -24,7 +24,7 @@ import math
 import re
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 from verifier import protocol
 from verifier.amr.schema import LARGEST  # the largest number of seconds any setting holds
@@ -63,8 +63,27 @@ def tolerance_hides_pacing(tolerance_us: int) -> bool:
     return tolerance_us >= protocol.MIN_PERIOD_US
 
 
+class Where(NamedTuple):
+    """A place in a capture file; prints as `file:line:col`."""
+
+    file: str
+    line: int
+    col: int
+
+    def __str__(self) -> str:
+        return f"{self.file}:{self.line}:{self.col}"
+
+
 class CaptureError(Exception):
-    """A capture file that cannot be read; the message is `file:line:col: what`."""
+    """A capture file that cannot be read; the message is `file:line:col: what`, and `file`,
+    `line`, `col` hold the place (`where`; None: a file that cannot be read at all, whose
+    message names it alone)."""
+
+    def __init__(self, where: Where | None, text: str, *, message: str | None = None):
+        """`message`, when given, instead of `where: text` (a message that shows its place otherwise)."""
+        super().__init__(message if message is not None else text if where is None else f"{where}: {text}")
+        self.where = where
+        self.file, self.line, self.col = where if where is not None else (None, None, None)
 
 
 _TIME = re.compile(r"\s*([0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?=\s|$)")
@@ -83,23 +102,23 @@ def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
             continue
         if end_line is not None:
             col = len(line) - len(line.lstrip()) + 1
-            raise CaptureError(f"{name}:{number}:{col}: the capture ended at its `end` line ({name}:{end_line}); "
+            raise CaptureError(Where(name, number, col), f"the capture ended at its `end` line ({name}:{end_line}); "
                                "move this line before it, or remove the `end` line")
         foreign = foreign_digit(line)  # float() reads '٠.٥' as 0.5
         if foreign is not None:
-            raise CaptureError(f"{name}:{number}:{foreign + 1}: {describe(line[foreign])}")
+            raise CaptureError(Where(name, number, foreign + 1), f"{describe(line[foreign])}")
         time_match = _TIME.match(line)
         if time_match is None:
             col = len(line) - len(line.lstrip()) + 1
-            raise CaptureError(f"{name}:{number}:{col}: expected a time in seconds (e.g. 0.250) "
+            raise CaptureError(Where(name, number, col), "expected a time in seconds (e.g. 0.250) "
                                "at the start of the line")
         seconds = float(time_match.group(1))
         if seconds > LARGEST:  # the same bound as a trace record's time; 1e400 would not even be a number
-            raise CaptureError(f"{name}:{number}:{time_match.start(1) + 1}: time {time_match.group(1)} s is "
+            raise CaptureError(Where(name, number, time_match.start(1) + 1), f"time {time_match.group(1)} s is "
                                f"beyond {LARGEST:g} s; expected a time in seconds from 0 to {LARGEST:g}")
         t_us = round(seconds * 1_000_000)
         if last_t is not None and t_us < last_t:
-            raise CaptureError(f"{name}:{number}:{time_match.start(1) + 1}: time {time_match.group(1)} s is "
+            raise CaptureError(Where(name, number, time_match.start(1) + 1), f"time {time_match.group(1)} s is "
                                f"earlier than the line before ({last_t / 1_000_000:.6f} s); a capture "
                                "is in time order")
         pos = time_match.end()
@@ -108,7 +127,7 @@ def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
             rest = line[pos + end.end():]
             if rest.strip():
                 col = pos + end.end() + len(rest) - len(rest.lstrip()) + 1
-                raise CaptureError(f"{name}:{number}:{col}: an `end` line holds no bytes (it says until when the "
+                raise CaptureError(Where(name, number, col), "an `end` line holds no bytes (it says until when the "
                                    "line was listened to); put the bytes on a line of their own before it")
             chunks.append(Chunk(t_us, b""))
             last_t, end_line = t_us, number
@@ -127,12 +146,12 @@ def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
                 continue
             pair = _HEX_PAIR.match(rest, i)
             if pair is None:
-                raise CaptureError(f"{name}:{number}:{pos + i + 1}: {rest[i:i + 2]!r} is not a byte in "
+                raise CaptureError(Where(name, number, pos + i + 1), f"{rest[i:i + 2]!r} is not a byte in "
                                    "hex (two digits 0-9, A-F)")
             data.append(int(pair.group(), 16))
             i = pair.end()
         if not data:
-            raise CaptureError(f"{name}:{number}:{len(line) + 1}: the line has a time but no bytes")
+            raise CaptureError(Where(name, number, len(line) + 1), "the line has a time but no bytes")
         chunks.append(Chunk(t_us, bytes(data), direction))
         last_t = t_us
     return chunks
@@ -145,10 +164,12 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
     a trace written before them has none) is a chunk with no bytes at its time, as a plain
     capture's `end` line is: the replay polls until then, as the run listened; the rules'
     settings and the program's outputs it carries, and the run's event records before it,
-    ride on that chunk (`Chunk.rules`, `signal_held`, `events`)."""
+    ride on that chunk (`Chunk.rules`, `signal_held`, `events`). Nothing of a run follows its
+    end record or lies after its `end` (an event record, a stretch the signal held)."""
     scenarios: dict[str, list[Chunk]] = {}
     ended: dict[str, int] = {}  # scenario -> the line of its end record
-    events: dict[str, list[LineEvent]] = {}  # scenario -> its event records, until its end record
+    # scenario -> its event records and their lines, until its end record
+    events: dict[str, list[tuple[LineEvent, int]]] = {}
     first_event: dict[str, int] = {}  # scenario -> the line of its first event record
     for number, raw in enumerate(text_lines(text), start=1):
         if not raw.strip():
@@ -156,82 +177,101 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
         try:
             record = json.loads(raw)
         except json.JSONDecodeError as exc:
-            raise CaptureError(f"{name}:{number}:{exc.colno}: not a JSON trace record: {exc.msg}") from None
+            raise CaptureError(Where(name, number, exc.colno), f"not a JSON trace record: {exc.msg}") from None
         except ValueError:  # int() of more than 4300 digits
-            raise CaptureError(f"{name}:{number}:1: not a trace record: it holds a number too long to read "
+            raise CaptureError(Where(name, number, 1), "not a trace record: it holds a number too long to read "
                                "(more than 4300 digits)") from None
         except RecursionError:
-            raise CaptureError(f"{name}:{number}:1: not a trace record: arrays or objects nested thousands "
+            raise CaptureError(Where(name, number, 1), "not a trace record: arrays or objects nested thousands "
                                "deep") from None
         if not isinstance(record, dict):
-            raise CaptureError(f"{name}:{number}:1: a trace record is a JSON object")
-        where = f"{name}:{number}:1"
+            raise CaptureError(Where(name, number, 1), "a trace record is a JSON object")
+        where = Where(name, number, 1)
         scenario = str(record.get("scenario", name))
         if scenario in ended:
-            raise CaptureError(f"{where}: the run {scenario!r} ended at its end record ({name}:{ended[scenario]}); "
+            raise CaptureError(where, f"the run {scenario!r} ended at its end record ({name}:{ended[scenario]}); "
                                "move this record before it, or remove the end record")
         if "end" in record:
             chunks = scenarios.setdefault(scenario, [])
-            chunks.append(replace(_end_chunk(record, chunks, where), events=tuple(events.pop(scenario, ()))))
+            end = _end_chunk(record, chunks, where)
+            recorded = events.pop(scenario, [])
+            within = [(event.t_us, Where(name, line, 1), f"the event record at {event.t_us / 1e6:g} s")
+                      for event, line in recorded]
+            for k, (began, stopped) in enumerate(end.signal_held or ()):
+                last = began if stopped is None else stopped
+                within.append((last, where, f"'response_signal_held' item {k + 1}, held until {last / 1e6:g} s,"))
+            _nothing_after_the_end(end.t_us, within, number, scenario)
+            chunks.append(replace(end, events=tuple(event for event, _ in recorded)))
             ended[scenario] = number
             continue
         if "event" in record:
-            events.setdefault(scenario, []).append(_event(record, where))
+            events.setdefault(scenario, []).append((_event(record, where), number))
             first_event.setdefault(scenario, number)
             continue
         for key in ("t", "dir", "hex"):
             if key not in record:
-                raise CaptureError(f"{name}:{number}:1: the record has no {key!r}")
+                raise CaptureError(Where(name, number, 1), f"the record has no {key!r}")
         if record["dir"] not in ("tx", "rx"):
-            raise CaptureError(f"{where}: 'dir' is {record['dir']!r}; expected \"tx\" or \"rx\"")
+            raise CaptureError(where, f"'dir' is {record['dir']!r}; expected \"tx\" or \"rx\"")
         hex_text = record["hex"]
         if not isinstance(hex_text, str) or not hex_text.strip() or not _HEX_BYTES.fullmatch(hex_text):
-            raise CaptureError(f"{where}: 'hex' is {hex_text!r}; expected bytes in hex, two digits each, "
+            raise CaptureError(where, f"'hex' is {hex_text!r}; expected bytes in hex, two digits each, "
                                "e.g. \"01 06 01 A0 00 00 88 14\"")
         data = bytes.fromhex(hex_text)
         t_start = _seconds(record["t"], "t", where)
         t_end = _seconds(record["t_end"], "t_end", where) if record.get("t_end") is not None else t_start
         if t_end < t_start:
-            raise CaptureError(f"{where}: 't_end' ({t_end:g} s) is before 't' ({t_start:g} s)")
+            raise CaptureError(where, f"'t_end' ({t_end:g} s) is before 't' ({t_start:g} s)")
         chunks = scenarios.setdefault(scenario, [])
         if chunks and round(t_start * 1_000_000) < chunks[-1].t_start_us:
-            raise CaptureError(f"{where}: 't' ({t_start:g} s) is earlier than the record before of scenario "
+            raise CaptureError(where, f"'t' ({t_start:g} s) is earlier than the record before of scenario "
                                f"{scenario!r} ({chunks[-1].t_start_us / 1_000_000:g} s); a trace is in time "
                                "order, and two runs in one trace need names of their own")
         tolerance = _seconds(record["tolerance"], "tolerance", where) if record.get("tolerance") is not None else None
         if tolerance is not None and tolerance_hides_pacing(round(tolerance * 1_000_000)):
             # what `--tolerance` refuses: a digit lost in a hand edit (20 for 0.020) would pass
             # a PLC pacing at 100 ms
-            raise CaptureError(f"{where}: 'tolerance' is {json.dumps(record['tolerance'])} s; a monitor records its "
+            raise CaptureError(where, f"'tolerance' is {json.dumps(record['tolerance'])} s; a monitor records its "
                                f"--tolerance, which is below the pacing period of "
                                f"{protocol.MIN_PERIOD_US / 1_000_000:g} s")
         chunks.append(Chunk(round(t_end * 1_000_000), data, record["dir"], round(t_start * 1_000_000),
                             None if tolerance is None else round(tolerance * 1_000_000)))
     for scenario in events:  # what the end record would have carried to the replay
-        raise CaptureError(f"{name}:{first_event[scenario]}:1: the run {scenario!r} has event records but no end "
+        raise CaptureError(Where(name, first_event[scenario], 1), f"the run {scenario!r} has event records but no end "
                            "record after them; a trace ends each run with its end record")
     return scenarios
 
 
-def _event(record: dict, where: str) -> LineEvent:
+def _nothing_after_the_end(end_us: int, records: list[tuple[int, Where, str]], end_line: int, scenario: str) -> None:
+    """Refuse the first of `records` ((µs, place, what)) that lies after the run's end
+    (`end_us`, its end record on line `end_line`): a run's events and the stretches its signal
+    held are within it, so one after its end is a damaged or hand-edited trace, not the run."""
+    for t_us, where, what in records:
+        if t_us > end_us:
+            raise CaptureError(where, f"{what} is after the end of the run {scenario!r} ({end_us / 1_000_000:g} s, "
+                               f"its end record on line {end_line}); what a run records lies within it: correct "
+                               "the time or the end record's 'end', or remove what comes after it")
+
+
+def _event(record: dict, where: Where) -> LineEvent:
     """An event record (`{"scenario": ..., "t": seconds, "event": kind, "message": text}`): a
     line event the rules read that the frames do not show (RULE_EVENTS)."""
     other = sorted(set(record) - {"scenario", "t", "event", "message"})
     if other:
-        raise CaptureError(f"{where}: an event record holds only 'scenario', 't', 'event' and 'message'; it has "
+        raise CaptureError(where, "an event record holds only 'scenario', 't', 'event' and 'message'; it has "
                            f"{', '.join(map(repr, other))}")
     if record["event"] not in RULE_EVENTS:
-        raise CaptureError(f"{where}: 'event' is {json.dumps(record['event'])}; expected one of "
+        raise CaptureError(where, f"'event' is {json.dumps(record['event'])}; expected one of "
                            f"{', '.join(json.dumps(kind) for kind in RULE_EVENTS)}")
     message = record.get("message", "")
     if not isinstance(message, str):
-        raise CaptureError(f"{where}: 'message' is {json.dumps(message)}; expected a string")
+        raise CaptureError(where, f"'message' is {json.dumps(message)}; expected a string")
     if "t" not in record:
-        raise CaptureError(f"{where}: the event record has no 't'")
+        raise CaptureError(where, "the event record has no 't'")
     return LineEvent(round(_seconds(record["t"], "t", where) * 1_000_000), record["event"], message)
 
 
-def _end_chunk(record: dict, chunks: list[Chunk], where: str) -> Chunk:
+def _end_chunk(record: dict, chunks: list[Chunk], where: Where) -> Chunk:
     """A trace's end record (`{"scenario": ..., "end": seconds, "reply_timeout": seconds, ...}`,
     which every trace ends each run with): until when the line was listened to, as a chunk
     with no bytes, as a plain capture's `end` line is read; and the rules' settings the run
@@ -239,81 +279,81 @@ def _end_chunk(record: dict, chunks: list[Chunk], where: str) -> Chunk:
     known = {"scenario", "end", *RUN_SETTINGS, "protocol", *_OUTPUTS}
     other = sorted(set(record) - known)
     if other:
-        raise CaptureError(f"{where}: an end record holds only 'scenario', 'end' (until when the line was listened "
+        raise CaptureError(where, "an end record holds only 'scenario', 'end' (until when the line was listened "
                            f"to) and the run's settings ({', '.join((*RUN_SETTINGS, 'protocol', *_OUTPUTS))}); it has "
                            f"{', '.join(map(repr, other))}")
     end_us = round(_seconds(record["end"], "end", where) * 1_000_000)
     # a run may end while its last frame is still on the line (verify --duration cut it)
     if chunks and end_us < chunks[-1].t_start_us:
-        raise CaptureError(f"{where}: 'end' ({end_us / 1_000_000:g} s) is before the start of the record before "
+        raise CaptureError(where, f"'end' ({end_us / 1_000_000:g} s) is before the start of the record before "
                            f"({chunks[-1].t_start_us / 1_000_000:g} s); a trace is in time order")
     rules = tuple((field, _positive_us(record[key], key, where)) for key, field in RUN_SETTINGS.items() if key in record)
     settings = _protocol(record["protocol"], where) if "protocol" in record else None
     if "response_signal" not in record:  # a line's run: the program's outputs were not seen
         stray = sorted(set(_OUTPUTS) & set(record))
         if stray:
-            raise CaptureError(f"{where}: {stray[0]!r} without 'response_signal'; an end record that says the "
+            raise CaptureError(where, f"{stray[0]!r} without 'response_signal'; an end record that says the "
                                "program's outputs gives the signal (null: the run had none)")
         return Chunk(end_us, b"", rules=rules, settings=settings)
     return Chunk(end_us, b"", rules=rules + _signal(record, where), signal_held=_held(record, where),
                  settings=settings)
 
 
-def _protocol(table, where: str) -> protocol.Settings:
+def _protocol(table, where: Where) -> protocol.Settings:
     """An end record's protocol settings (`{"address": 1, "field_order": "code-high", ...}`)."""
     names = tuple(field.name for field in fields(protocol.Settings))
     if not isinstance(table, dict):
-        raise CaptureError(f"{where}: 'protocol' is {json.dumps(table)}; expected an object of the protocol "
+        raise CaptureError(where, f"'protocol' is {json.dumps(table)}; expected an object of the protocol "
                            f"settings ({', '.join(names)})")
     other = sorted(set(table) - set(names))
     if other:
-        raise CaptureError(f"{where}: 'protocol' holds only {', '.join(names)}; it has {', '.join(map(repr, other))}")
+        raise CaptureError(where, f"'protocol' holds only {', '.join(names)}; it has {', '.join(map(repr, other))}")
     if isinstance(table.get("address"), bool):
-        raise CaptureError(f"{where}: 'protocol' address is {json.dumps(table['address'])}; expected 1-247")
+        raise CaptureError(where, f"'protocol' address is {json.dumps(table['address'])}; expected 1-247")
     try:
         return protocol.Settings(**table)
     except ValueError as exc:
-        raise CaptureError(f"{where}: 'protocol': {exc}") from None
+        raise CaptureError(where, f"'protocol': {exc}") from None
 
 
 #: an end record's keys that say the program's outputs (a simulated run's)
 _OUTPUTS = ("response_signal", "response_signal_hint", "response_signal_held")
 
 
-def _signal(record: dict, where: str) -> tuple[tuple[str, Any], ...]:
+def _signal(record: dict, where: Where) -> tuple[tuple[str, Any], ...]:
     """The response signal an end record names (None: the run had none) and the hint that
     says what the program has instead, as RuleOptions fields."""
     text, hint = record["response_signal"], record.get("response_signal_hint", "")
     if not isinstance(hint, str):
-        raise CaptureError(f"{where}: 'response_signal_hint' is {json.dumps(hint)}; expected a string")
+        raise CaptureError(where, f"'response_signal_hint' is {json.dumps(hint)}; expected a string")
     if text is None:
         return ("response_signal", None), ("response_signal_hint", hint)
     try:
         signal = parse_condition(text)
     except ConditionError as exc:
-        raise CaptureError(f"{where}: 'response_signal' is {json.dumps(text)}: {exc.message}") from None
+        raise CaptureError(where, f"'response_signal' is {json.dumps(text)}: {exc.message}") from None
     return ("response_signal", signal), ("response_signal_hint", hint)
 
 
-def _held(record: dict, where: str) -> tuple[tuple[int, int | None], ...]:
+def _held(record: dict, where: Where) -> tuple[tuple[int, int | None], ...]:
     """When the response signal held: [began, stopped] pairs in seconds, in time order,
     stopped null for the last when it still held at the end of the run."""
     held = record.get("response_signal_held", [])
     if record["response_signal"] is None and held:
-        raise CaptureError(f"{where}: 'response_signal_held' without a 'response_signal'")
+        raise CaptureError(where, "'response_signal_held' without a 'response_signal'")
     expected = ("expected [[began, stopped], ...] in seconds, in time order, stopped null for a stretch still "
                 "holding at the end")
     if not isinstance(held, list):
-        raise CaptureError(f"{where}: 'response_signal_held' is {json.dumps(held)}; {expected}")
+        raise CaptureError(where, f"'response_signal_held' is {json.dumps(held)}; {expected}")
     stretches: list[tuple[int, int | None]] = []
     last = 0
     for k, pair in enumerate(held):
         if not isinstance(pair, list) or len(pair) != 2 or (pair[1] is None and k != len(held) - 1):
-            raise CaptureError(f"{where}: 'response_signal_held' item {k + 1} is {json.dumps(pair)}; {expected}")
+            raise CaptureError(where, f"'response_signal_held' item {k + 1} is {json.dumps(pair)}; {expected}")
         began = round(_seconds(pair[0], "response_signal_held", where) * 1_000_000)
         stopped = None if pair[1] is None else round(_seconds(pair[1], "response_signal_held", where) * 1_000_000)
         if began < last or (stopped is not None and stopped <= began):
-            raise CaptureError(f"{where}: 'response_signal_held' item {k + 1} is {json.dumps(pair)}; {expected}")
+            raise CaptureError(where, f"'response_signal_held' item {k + 1} is {json.dumps(pair)}; {expected}")
         stretches.append((began, stopped))
         last = began if stopped is None else stopped
     return tuple(stretches)
@@ -322,21 +362,21 @@ def _held(record: dict, where: str) -> tuple[tuple[int, int | None], ...]:
 _HEX_BYTES = re.compile(r"\s*(?:[0-9A-Fa-f]{2}\s*)*")
 
 
-def _seconds(value, key: str, where: str) -> float:
+def _seconds(value, key: str, where: Where) -> float:
     """A trace record's time in seconds: a finite number (not true/false), not negative."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
             or not 0 <= value <= LARGEST:
-        raise CaptureError(f"{where}: {key!r} is {json.dumps(value)}; expected a time in seconds "
+        raise CaptureError(where, f"{key!r} is {json.dumps(value)}; expected a time in seconds "
                            f"from 0 to {LARGEST:g}")
     return float(value)
 
 
-def _positive_us(value, key: str, where: str) -> int:
+def _positive_us(value, key: str, where: Where) -> int:
     """A rule's time in an end record, in µs: longer than 0, as a scenario's [rules] and
     --reply-timeout take it (a time-out of 0 took every reply as late)."""
     us = round(_seconds(value, key, where) * 1_000_000)
     if us <= 0:
-        raise CaptureError(f"{where}: {key!r} is {json.dumps(value)}; expected a time in seconds longer than 0")
+        raise CaptureError(where, f"{key!r} is {json.dumps(value)}; expected a time in seconds longer than 0")
     return us
 
 
@@ -347,7 +387,9 @@ def read_capture(path: Path) -> dict[str, list[Chunk]]:
         # a classic Mac OS file too (a JSON trace's strings hold no raw CR)
         text = lone_cr_as_line_feed(read_utf8(path))
     except UnreadableText as exc:
-        raise CaptureError(f"{path}: {exc}") from None
+        # bytes that are not text: `file: line L, column C (byte N): ...`, placed at them
+        where = None if exc.line is None else Where(str(path), exc.line, exc.col)
+        raise CaptureError(where, "", message=f"{path}: {exc}") from None
     first = next((line.lstrip() for line in text_lines(text)
                   if line.strip() and not line.lstrip().startswith("#")), "")
     try:
@@ -358,7 +400,7 @@ def read_capture(path: Path) -> dict[str, list[Chunk]]:
         other = _other_kind(path, text, first)
         if other is None:
             raise
-        raise CaptureError(f"{exc}; {other}") from None
+        raise CaptureError(exc.where, "", message=f"{exc}; {other}") from None
 
 
 def _other_kind(path: Path, text: str, first: str) -> str | None:

@@ -14,6 +14,15 @@ class LoadError(Exception):
         heading = "verifier.load was given an option it cannot use" if options else "ST sources have errors"
         super().__init__(f"{heading}:\n" + "\n".join("  " + s for s in lines))
 
+    def place(self) -> tuple[str, int, int] | None:
+        """(file, line, column) of the first diagnostic that names a source's line (not an
+        option of verifier.load), as its line of the message shows it; None if none does."""
+        for d in self.diagnostics:
+            file = getattr(d, "file", "?")
+            if not file.startswith(OPTION_PLACE):
+                return file, getattr(d, "line", 0), getattr(d, "col", 0)
+        return None
+
 
 #: the "file" of a diagnostic about an argument of verifier.load, not about a source:
 #: `verifier.load(scan_ms=0)`

@@ -11,17 +11,21 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .result import UnusableInput
 from .scenario import PLATFORMS, TOLD_PLATFORMS, bundled_platform
+
+if TYPE_CHECKING:
+    from verifier.sim.errors import LoadError
 
 
 class PlatformUnknown(UnusableInput):
     """The sources load on several platforms (or none); the message says which and why."""
 
 
-def platforms_that_load(sources: tuple[Path, ...]) -> tuple[list[str], dict[str, str]]:
-    """(platforms whose CPU loads the sources, {platform: first load error} for the others),
+def platforms_that_load(sources: tuple[Path, ...]) -> tuple[list[str], dict[str, "LoadError"]]:
+    """(platforms whose CPU loads the sources, {platform: its LoadError} for the others),
     of the platforms sources are told apart by (TOLD_PLATFORMS: not the FX3G)."""
     import verifier
     from verifier.sim.errors import LoadError
@@ -31,11 +35,16 @@ def platforms_that_load(sources: tuple[Path, ...]) -> tuple[list[str], dict[str,
         try:
             verifier.load(*[str(p) for p in sources], target=PLATFORMS[platform][0], cpu=platform)
         except LoadError as exc:
-            lines = [line.strip() for line in str(exc).splitlines()[1:] if line.strip()]
-            errors[platform] = lines[0] if lines else str(exc)
+            errors[platform] = exc
             continue
         fits.append(platform)
     return fits, errors
+
+
+def _first_error(exc: "LoadError") -> str:
+    """The first diagnostic's line of a LoadError's message."""
+    lines = [line.strip() for line in str(exc).splitlines()[1:] if line.strip()]
+    return lines[0] if lines else str(exc)
 
 
 def infer_platform(sources: tuple[Path, ...]) -> str:
@@ -44,9 +53,11 @@ def infer_platform(sources: tuple[Path, ...]) -> str:
     if len(fits) == 1:
         return fits[0]
     if not fits:
-        if len(set(errors.values())) == 1:  # the same mistake everywhere: an ST error
-            raise UnusableInput(f"the sources do not load: {next(iter(errors.values()))}")
-        reasons = "; ".join(f"{platform}: {error}" for platform, error in errors.items())
+        first = {platform: _first_error(exc) for platform, exc in errors.items()}
+        if len(set(first.values())) == 1:  # the same mistake everywhere: an ST error
+            exc = next(iter(errors.values()))
+            raise UnusableInput(f"the sources do not load: {_first_error(exc)}", at=exc.place())
+        reasons = "; ".join(f"{platform}: {error}" for platform, error in first.items())
         raise UnusableInput(f"the sources load on no platform ({reasons})")
     # the platforms named only, never told (an FX3G), beside the one whose scenarios they run
     say = [named for platform in fits for named in PLATFORMS if bundled_platform(named) == platform]

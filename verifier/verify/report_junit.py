@@ -8,13 +8,14 @@ start (exit 2) gets one <error type="unusable-input"> per mistake instead.
 from __future__ import annotations
 
 import re
+from collections import Counter
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 from verifier.textfile import escape_chars, whole_file
 
 from .durations import format_seconds
-from .result import ScenarioResult, run_names
+from .result import Mistake, ScenarioResult, run_names
 from .rules import RULES_BY_ID
 
 MAX_LISTED = 50  # violations written out per rule and scenario
@@ -108,33 +109,53 @@ def _xml_safe(text: str | None) -> str | None:
     return None if text is None else escape_chars(text, lambda c: not _NOT_XML.match(c))
 
 
-#: the first place a message names (`s.toml:2:12: ...`, `  plc/MAIN.st:5:6: error: ...`)
-_PLACE = re.compile(r"^\s*(?P<file>\S(?:.*?\S)?):\d+:\d+: ", re.M)
-
-
-def unusable_element(messages: list[str], command: str = "uitamr verify") -> ET.Element:
+def unusable_element(mistakes: list[Mistake], command: str = "uitamr verify") -> ET.Element:
     """The report of a run that could not start (exit 2): one test case per mistake, an
-    `<error type="unusable-input">` whose message is the mistake's first place (file:line:col)
-    and whose text is the whole message, so that the CI server shows what to fix instead of
-    a missing report (or the last run's)."""
-    suites = ET.Element("testsuites", name=command, tests=str(len(messages)), failures="0",
-                        errors=str(len(messages)))
-    suite = ET.SubElement(suites, "testsuite", name=command, tests=str(len(messages)), failures="0",
-                          errors=str(len(messages)))
-    for message in messages:
-        place = _PLACE.search(message)
+    `<error type="unusable-input">` whose message is the mistake's line that names its place
+    (file:line:col), from the place on, and whose text is the whole message, so that the CI
+    server shows what to fix instead of a missing report (or the last run's). The places are
+    the mistakes' own (`Mistake.file`, `line`, `col`), never read back from their text."""
+    suites = ET.Element("testsuites", name=command, tests=str(len(mistakes)), failures="0",
+                        errors=str(len(mistakes)))
+    suite = ET.SubElement(suites, "testsuite", name=command, tests=str(len(mistakes)), failures="0",
+                          errors=str(len(mistakes)))
+    for mistake, name in zip(mistakes, _mistake_names(mistakes)):
         case = ET.SubElement(suite, "testcase", classname=command.replace(" ", ".") + ".input",
-                             name=place["file"] if place else "input", time="0.000")
-        if place:
-            case.set("file", place["file"])
-        first = (message[place.start():].lstrip() if place else message).splitlines() or [""]
-        element = ET.SubElement(case, "error", message=first[0], type="unusable-input")
-        element.text = message
+                             name=name, time="0.000")
+        if mistake.file is not None:
+            case.set("file", mistake.file)
+        element = ET.SubElement(case, "error", message=_headline(mistake), type="unusable-input")
+        element.text = mistake.message
     return suites
 
 
-def write_unusable(messages: list[str], path: Path, command: str = "uitamr verify") -> None:
-    _write_tree(unusable_element(messages, command), path)
+def _mistake_names(mistakes: list[Mistake]) -> list[str]:
+    """Each mistake's test case name: its place, `file:line:col` (`input` when it has none),
+    so that two mistakes of one file are two test cases a CI summary keeps apart, each named
+    the same from run to run while it stays; mistakes that share a place (or have none) are
+    numbered in order, `input #1`, `input #2`."""
+    names = [f"{m.file}:{m.line}:{m.col}" if m.file is not None else "input" for m in mistakes]
+    count, seen = Counter(names), Counter()
+    numbered = []
+    for name in names:
+        seen[name] += 1
+        numbered.append(f"{name} #{seen[name]}" if count[name] > 1 else name)
+    return numbered
+
+
+def _headline(mistake: Mistake) -> str:
+    """The line of the message that shows the mistake's place, from the place on (`  plc/MAIN.st:5:6:
+    error: ...` under `ST sources have errors:`); the first line when it shows none."""
+    if mistake.file is not None:
+        shown = f"{mistake.file}:{mistake.line}:{mistake.col}: "
+        at = mistake.message.find(shown)
+        if at >= 0:
+            return mistake.message[at:].splitlines()[0]
+    return (mistake.message.splitlines() or [""])[0]
+
+
+def write_unusable(mistakes: list[Mistake], path: Path, command: str = "uitamr verify") -> None:
+    _write_tree(unusable_element(mistakes, command), path)
 
 
 def write(results: list[ScenarioResult], path: Path, command: str = "uitamr verify") -> None:

@@ -52,10 +52,44 @@ NO_TRAFFIC = "no-traffic"
 LINE = "line"
 
 
+@dataclass(frozen=True)
+class Mistake:
+    """One mistake of a run that cannot start (exit 2), as its JUnit report lists it: the
+    whole message, and the place in a file it names first (file, line, column), or none
+    when it names no file's line (`--program MIAN`, a source file that does not exist)."""
+
+    message: str
+    file: str | None = None
+    line: int | None = None
+    col: int | None = None
+
+
+def mistakes_of(error: Exception) -> list[Mistake]:
+    """The mistakes an exception of unusable input stands for, with their places as the
+    exception holds them (`file`, `line`, `col`: ScenarioError, UnusableInput, CaptureError;
+    `mistakes` for several, ScenarioMistakes); never read back from the message."""
+    several = getattr(error, "mistakes", None)
+    if several is not None:
+        return list(several)
+    file, line, col = (getattr(error, name, None) for name in ("file", "line", "col"))
+    if file is None or line is None or col is None:
+        return [Mistake(str(error))]
+    return [Mistake(str(error), str(file), line, col)]
+
+
 class UnusableInput(Exception):
     """Input the verifier cannot run (bad scenario, ST that does not load, unknown program).
 
-    The message is complete and meant for people; the command exits 2 with it."""
+    The message is complete and meant for people; the command exits 2 with it. `at`: the
+    place in a file the message names first, (file, line, column), for the JUnit report."""
+
+    def __init__(self, message: str, at: tuple[str, int, int] | None = None):
+        super().__init__(message)
+        self.file, self.line, self.col = at if at is not None else (None, None, None)
+
+    def __reduce__(self):  # across --jobs' worker processes with its place
+        at = None if self.file is None else (self.file, self.line, self.col)
+        return type(self), (str(self), at)
 
 
 @dataclass(frozen=True, slots=True)

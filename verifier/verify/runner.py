@@ -55,10 +55,11 @@ class _Plc:
 
         if not scenario.sources:
             raise UnusableInput(f"{_key_where(scenario, 'sources')}: no ST sources: name them on the command line "
-                                "or in 'sources'")
+                                "or in 'sources'", at=_key_at(scenario, 'sources'))
         missing = [str(p) for p in scenario.sources if not p.is_file()]
         if missing:
-            raise UnusableInput(f"{_key_where(scenario, 'sources')}: no such ST file: {', '.join(missing)}")
+            raise UnusableInput(f"{_key_where(scenario, 'sources')}: no such ST file: {', '.join(missing)}",
+                                at=_key_at(scenario, 'sources'))
         try:
             self.project = verifier.load(
                 *[str(p) for p in scenario.sources],
@@ -71,14 +72,14 @@ class _Plc:
                 programs=None if scenario.program is None else [scenario.program],
             )
         except LoadError as exc:
-            raise UnusableInput(str(exc) + _platform_hint(scenario)) from None
+            raise UnusableInput(str(exc) + _platform_hint(scenario), at=exc.place()) from None
         try:
             if isinstance(line, Converter):
                 self.project.attach_tcp(line)
             else:
                 self.project.attach_serial(scenario.serial_channel, line)
         except ValueError as exc:
-            raise UnusableInput(f"{_key_where(scenario, 'channel')}: {exc}") from None
+            raise UnusableInput(f"{_key_where(scenario, 'channel')}: {exc}", at=_key_at(scenario, 'channel')) from None
         self.name = self._program_name(scenario)
         self.program = self.project.program(self.name)
 
@@ -111,11 +112,12 @@ class _Plc:
         if other is not None and other.kind != "PROGRAM":  # the FB under test named instead of its caller
             raise UnusableInput(f"{_key_where(scenario, 'program')}: {other.name} is a {other.kind}, not a PROGRAM: "
                                 f"name the PROGRAM "
-                                f"that calls it (the sources define: {listing})")
+                                f"that calls it (the sources define: {listing})", at=_key_at(scenario, 'program'))
         if not programs:
             # SOURCES given on the command line: the file is all there is
             raise UnusableInput(f"{_key_where(scenario, 'sources')}: the sources define no PROGRAM, only function "
-                                "blocks and functions: give also the .st file of the PROGRAM to run")
+                                "blocks and functions: give also the .st file of the PROGRAM to run",
+                                at=_key_at(scenario, 'sources'))
         if scenario.program is None:
             if len(programs) == 1:
                 return programs[0]
@@ -125,12 +127,13 @@ class _Plc:
             if scenario.path is None:  # no file to name it in: the option alone
                 raise UnusableInput(f"say which PROGRAM to run with --program; the sources define: {listing}")
             raise UnusableInput(f"{_key_where(scenario, 'program')}: say which PROGRAM to run (program = "
-                                f"\"{programs[0]}\" in the file, or --program); the sources define: {listing}")
+                                f"\"{programs[0]}\" in the file, or --program); the sources define: {listing}",
+                                at=_key_at(scenario, 'program'))
         for name in programs:
             if name.upper() == scenario.program.upper():
                 return name
         raise UnusableInput(f"{_key_where(scenario, 'program')}: no PROGRAM {scenario.program!r} in the sources; "
-                            f"they define: {listing}")
+                            f"they define: {listing}", at=_key_at(scenario, 'program'))
 
     @property
     def now_us(self) -> int:
@@ -258,10 +261,12 @@ def _platform_hint(scenario: Scenario) -> str:
         # an FX3G program that names a device only the FX3U has: the program does not fit
         # the CPU named, and another platform to give would hide that
         named = f"--platform {scenario.platform}" if scenario.platform_from_option else _key_where(scenario, "platform")
+        # the file's key names the CPU: it is the key to change (--platform only overrides it)
+        change = (f"set platform = \"{larger}\" in {scenario.path} (or give --platform {larger})"
+                  if not scenario.platform_from_option and scenario.path is not None else f"give --platform {larger}")
         return (f"\n{named}: the sources load on the {larger} but not on the {scenario.platform}, which has fewer "
                 f"devices (docs/instructions.md §2; `uitamr check --platform {scenario.platform}` lists every one it "
-                f"lacks): for an {scenario.platform.upper()} use devices it has; for an {larger.upper()} give "
-                f"--platform {larger}")
+                f"lacks): for an {scenario.platform.upper()} use devices it has; for an {larger.upper()} {change}")
     if scenario.platform_from_option:  # the option is to blame, not a file's key
         return (f"\n--platform {scenario.platform}: the sources load on {', '.join(fits)}, not on "
                 f"{scenario.platform}: give --platform {fits[0]}")
@@ -288,6 +293,16 @@ def _key_where(scenario: Scenario, key: str) -> str:
     if key != "sources" and getattr(scenario, f"{key}_from_option"):
         return f"--{key}"  # given on the command line: no file is where to look
     return scenario.key_where(key)
+
+
+def _key_at(scenario: Scenario, key: str) -> tuple[str, int, int] | None:
+    """The place `_key_where(scenario, key)` names, as data (UnusableInput's `at`): none for
+    the SOURCES arguments or an option."""
+    if key in scenario.key_lines:
+        return scenario.at(scenario.key_lines[key])
+    if (key == "sources" and scenario.sources) or (key != "sources" and getattr(scenario, f"{key}_from_option")):
+        return None
+    return scenario.key_at(key)
 
 
 def _display_path(path: Path | None) -> str | None:
@@ -383,7 +398,7 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
             scenario = _without_default_signal(plc, scenario)
             continue
         if missing is not None:
-            raise UnusableInput(f"{scenario.where(use.key, line)}: {missing}")
+            raise UnusableInput(f"{scenario.where(use.key, line)}: {missing}", at=scenario.at(line))
         for name in use.names:
             value = _plain(plc.read(name))
             kinds[name] = "bool" if isinstance(value, bool) else "STRING" if isinstance(value, str) else "number"
@@ -393,7 +408,7 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
         if problem and use.optional:  # the default signal: an o_bErr that is not a BOOL is not it
             scenario = _without_default_signal(plc, scenario)
         elif problem:
-            raise UnusableInput(f"{scenario.where(use.key, use.line)}: {problem}")
+            raise UnusableInput(f"{scenario.where(use.key, use.line)}: {problem}", at=scenario.at(use.line))
     return scenario
 
 
@@ -453,9 +468,11 @@ def _input_problem(plc: _Plc, name: str, value: Any) -> str | None:
 def _apply_plc_settings(plc: _Plc, scenario: Scenario) -> None:
     """[[c24]] module settings, then [initial] devices and buffer memory, before the first scan."""
     for setting in scenario.c24:
-        where = scenario.where(setting.key, scenario.key_lines.get(setting.key))
+        where, at = scenario.where(setting.key, scenario.key_lines.get(setting.key)), \
+            scenario.at(scenario.key_lines.get(setting.key))
         if scenario.platform != "q":
-            raise UnusableInput(f"{where}: the QJ71C24N is a Q-series module; the platform is {scenario.platform}")
+            raise UnusableInput(f"{where}: the QJ71C24N is a Q-series module; the platform is {scenario.platform}",
+                                at=at)
         # unit None (--matrix): the settings go to whichever module the program drives
         try:
             plc.project.configure_c24(
@@ -465,10 +482,10 @@ def _apply_plc_settings(plc: _Plc, scenario: Scenario) -> None:
                 no_reception_format=setting.no_reception_format,
             )
         except (ValueError, KeyError) as exc:
-            raise UnusableInput(f"{where}: {exc}") from None
+            raise UnusableInput(f"{where}: {exc}", at=at) from None
     for name, value in scenario.initial:
         key = f"initial.{name}"
-        where = scenario.where(key, scenario.key_lines.get(key))
+        where, at = scenario.where(key, scenario.key_lines.get(key)), scenario.at(scenario.key_lines.get(key))
         buffer = BUFFER_MEMORY.match(name)
         if buffer:
             words = plc.project.c24_buffer(int(buffer.group(1), 16))
@@ -476,7 +493,7 @@ def _apply_plc_settings(plc: _Plc, scenario: Scenario) -> None:
             continue
         problem = plc.problem(name) or _input_problem(plc, name, value)
         if problem:
-            raise UnusableInput(f"{where}: {problem}")
+            raise UnusableInput(f"{where}: {problem}", at=at)
         plc.write(name, value)
 
 

@@ -224,14 +224,28 @@ class Scenario:
             text += f":{line}"
         return f"{text}: {key}" if key else text
 
+    def at(self, line: Place | None) -> tuple[str, int, int] | None:
+        """The place `where(key, line)` names, as data (UnusableInput's `at`): (file, line,
+        column), or None when it names no file's line."""
+        if self.path is None or line is None:
+            return None
+        return str(self.path), line.line, line.col
+
     def key_where(self, key: str) -> str:
         """`file:line:col: key` for the scenario's top-level `key`: where the file sets it, or
         the start of the file (1:1) when it leaves the key out: the file is the table the key
         belongs in, as a key missing from an [[inputs]] table is placed at its header."""
+        return self.where(key, self._key_place(key))
+
+    def key_at(self, key: str) -> tuple[str, int, int] | None:
+        """The place `key_where(key)` names, as data."""
+        return self.at(self._key_place(key))
+
+    def _key_place(self, key: str) -> Place | None:
         place = self.key_lines.get(key)
         if place is None and self.path is not None:
             place = Place(1, 1)
-        return self.where(key, place)
+        return place
 
     def with_overrides(self, **changes: Any) -> "Scenario":
         changes = {k: v for k, v in changes.items() if v is not None}

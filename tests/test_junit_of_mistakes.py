@@ -1,0 +1,154 @@
+"""The JUnit report of a run that cannot start (exit 2: `uitamr verify --junit`, `uitamr
+replay --junit`): one error test case per mistake, at the place the mistake holds as data
+(file, line, column), never at one read back from its text (docs/verifier.md `--junit`)."""
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+
+from click.testing import CliRunner
+
+from file_helpers import write_files
+from verifier.cli import main
+from verifier.verify.report_junit import unusable_element
+from verifier.verify.result import Mistake
+
+BROKEN = "PROGRAM MAIN\nVAR\n    x : INT;\nEND_VAR\nx := ;\nEND_PROGRAM\n"
+GOOD = "PROGRAM GOOD\nVAR\n    x : INT;\nEND_VAR\nx := 1;\nEND_PROGRAM\n"
+
+
+def invoke(*args):
+    return CliRunner().invoke(main, [str(a) for a in args], catch_exceptions=False)
+
+
+def cases(report) -> list[ET.Element]:
+    return ET.parse(report).getroot().findall("./testsuite/testcase")
+
+
+def test_a_message_that_holds_a_place_like_text_is_no_file(tmp_path):
+    """`--program 'x:1:2: y'` names no file's line; the regex on the message took
+    "--program: no PROGRAM 'x" for the file of the test case."""
+    write_files(tmp_path, {"GOOD.st": GOOD})
+    result = invoke("verify", tmp_path / "GOOD.st", "--program", "x:1:2: y", "--junit", tmp_path / "v.xml")
+    assert result.exit_code == 2, result.output
+    (case,) = cases(tmp_path / "v.xml")
+    assert (case.get("name"), case.get("file")) == ("input", None)
+    assert case.find("error").get("message").startswith("--program: no PROGRAM 'x:1:2: y' in the sources")
+
+
+def test_st_that_loads_on_no_platform_is_at_its_own_file(tmp_path):
+    """`--matrix` tells the platform from the sources; ST that loads on none said "the
+    sources do not load: MAIN.st:5:6: ...", and the regex made the whole head of that line
+    the file's name."""
+    write_files(tmp_path, {"MAIN.st": BROKEN})
+    source = tmp_path / "MAIN.st"
+    result = invoke("verify", source, "--matrix", "--junit", tmp_path / "v.xml")
+    assert result.exit_code == 2, result.output
+    (case,) = cases(tmp_path / "v.xml")
+    assert (case.get("name"), case.get("file")) == (f"{source}:5:6", str(source))
+    assert case.find("error").get("message").startswith(f"{source}:5:6: error: expected an expression")
+    assert case.find("error").text.startswith(f"the sources do not load: {source}:5:6: ")
+
+
+def test_a_capture_of_bytes_that_are_not_text_is_at_its_line_and_column(tmp_path):
+    capture = tmp_path / "site.txt"
+    capture.write_bytes(b"0.000 01 06\n0.100 01 \xff\xfe\n")
+    result = invoke("replay", capture, "--junit", tmp_path / "r.xml")
+    assert result.exit_code == 2, result.output
+    (case,) = cases(tmp_path / "r.xml")
+    assert (case.get("name"), case.get("file")) == (f"{capture}:2:10", str(capture))
+    assert case.find("error").get("message").startswith(f"{capture}: line 2, column 10 (byte 21)")
+
+
+def test_the_place_is_the_mistakes_data_not_its_text():
+    root = unusable_element([Mistake("no place, though it reads a:1:2: like one"),
+                             Mistake("the sources do not load: dir: x/M.st:3:4: error: bad", "dir: x/M.st", 3, 4)])
+    unplaced, placed = root.findall("./testsuite/testcase")
+    assert (unplaced.get("name"), unplaced.get("file")) == ("input", None)
+    assert unplaced.find("error").get("message") == "no place, though it reads a:1:2: like one"
+    assert (placed.get("name"), placed.get("file")) == ("dir: x/M.st:3:4", "dir: x/M.st")
+    assert placed.find("error").get("message") == "dir: x/M.st:3:4: error: bad"
+
+
+def test_mistakes_of_one_file_are_test_cases_of_their_own_names(tmp_path):
+    """Each mistake's test case was named by its file alone: two of one file were two test
+    cases of one name, which CI summaries merge or hide. Named by place now, numbered when
+    they share it (one scenario file given twice), the same on every run."""
+    write_files(tmp_path, {"a.toml": 'program = "P"\nduration = "5q"\n', "b.toml": 'duration = "1s"\nscan = "x"\n'})
+    report = tmp_path / "v.xml"
+    for _ in range(2):
+        result = invoke("verify", "--scenario", tmp_path / "a.toml", "--scenario", tmp_path,
+                        "--junit", report)
+        assert result.exit_code == 2, result.output
+        names = [case.get("name") for case in cases(report)]
+        assert names == [f"{tmp_path / 'a.toml'}:2:12 #1", f"{tmp_path / 'a.toml'}:2:12 #2",
+                         f"{tmp_path / 'b.toml'}:2:8"]
+    assert [case.get("file") for case in cases(report)] == [str(tmp_path / "a.toml")] * 2 + [str(tmp_path / "b.toml")]
+    numbered = unusable_element([Mistake("x"), Mistake("y"), Mistake("s.toml:1:1: z", "s.toml", 1, 1)])
+    assert [c.get("name") for c in numbered.findall("./testsuite/testcase")] == ["input #1", "input #2", "s.toml:1:1"]
+
+
+OLD_RUN = "<testsuites name='an earlier run'/>"
+
+
+def _refused(tmp_path, *args):
+    """`uitamr verify GOOD.st ... --junit v.xml` over an earlier run's JUnit file."""
+    write_files(tmp_path, {"GOOD.st": GOOD, "v.xml": OLD_RUN})
+    result = invoke("verify", tmp_path / "GOOD.st", "--duration", "1s", *args, "--junit", tmp_path / "v.xml")
+    assert result.exit_code == 2, result.output
+    return result
+
+
+def test_another_reports_refused_path_is_the_junits_error(tmp_path):
+    """Exit 2 for --json's missing folder, two reports given one file or a report over an
+    input file left the earlier run's JUnit file as it was, and CI showed its results as
+    this run's; now the JUnit holds the mistake."""
+    source = tmp_path / "GOOD.st"
+    for args, said in [(["--json", tmp_path / "gone" / "r.json"], f"cannot write {tmp_path / 'gone' / 'r.json'}: "
+                                                                   "the folder"),
+                       (["--json", tmp_path / "r.out", "--html", tmp_path / "r.out"], "are the same file"),
+                       (["--json", source], f"{source} is one of the run's input files")]:
+        result = _refused(tmp_path, *args)
+        assert f"wrote {tmp_path / 'v.xml'} (these errors as test cases)" in result.output
+        (case,) = cases(tmp_path / "v.xml")
+        error = case.find("error")
+        assert (case.get("name"), error.get("type")) == ("input", "unusable-input")
+        assert said in error.get("message"), error.get("message")
+        assert source.read_text(encoding="utf-8") == GOOD
+
+
+def test_a_report_that_cannot_be_written_after_the_run_is_the_junits_error(tmp_path):
+    """--json to a full disk (/dev/full) fails after the run, before the JUnit was written:
+    exit 2, and the JUnit says why rather than holding the earlier run."""
+    result = _refused(tmp_path, "--json", "/dev/full")
+    (case,) = cases(tmp_path / "v.xml")
+    assert case.find("error").get("message").startswith("cannot write /dev/full: ")
+    assert f"wrote {tmp_path / 'v.xml'}" in result.output
+
+
+def test_a_junit_whose_own_path_is_refused_is_not_written(tmp_path):
+    """Two reports given the JUnit's own file: neither is written, and the file stays."""
+    result = _refused(tmp_path, "--json", tmp_path / "v.xml")
+    assert "are the same file" in result.output and "wrote" not in result.output
+    assert (tmp_path / "v.xml").read_text(encoding="utf-8") == OLD_RUN
+
+
+def test_replay_writes_another_reports_refusal_to_its_junit(tmp_path):
+    capture = tmp_path / "site.txt"
+    capture.write_text("0.000 01 06 01 A0 00 00 88 14\n", encoding="utf-8")
+    (tmp_path / "r.xml").write_text(OLD_RUN, encoding="utf-8")
+    result = invoke("replay", capture, "--json", tmp_path / "gone" / "r.json", "--junit", tmp_path / "r.xml")
+    assert result.exit_code == 2, result.output
+    (case,) = cases(tmp_path / "r.xml")
+    assert case.get("classname") == "uitamr.replay.input"
+    assert case.find("error").get("message").startswith(f"cannot write {tmp_path / 'gone' / 'r.json'}: the folder")
+
+
+def test_monitor_writes_another_reports_refusal_to_its_junit(tmp_path):
+    """Refused before the line is opened: no port is listened to."""
+    (tmp_path / "m.xml").write_text(OLD_RUN, encoding="utf-8")
+    result = invoke("monitor", "--tcp", "127.0.0.1:1", "--json", tmp_path / "gone" / "m.json",
+                    "--junit", tmp_path / "m.xml")
+    assert result.exit_code == 2, result.output
+    (case,) = cases(tmp_path / "m.xml")
+    assert case.get("classname") == "uitamr.monitor.input"
+    assert case.find("error").get("message").startswith(f"cannot write {tmp_path / 'gone' / 'm.json'}: the folder")
