@@ -22,6 +22,7 @@ from verifier.link import Line
 from verifier.link.converter import Converter
 from verifier.sim.values import InstanceProxy, read_together
 from verifier.textfile import shown_path
+from verifier.tomlpos import Place
 
 from .durations import format_seconds
 from .events_shown import thin_line_events
@@ -54,12 +55,10 @@ class _Plc:
         from verifier.sim.errors import LoadError
 
         if not scenario.sources:
-            raise UnusableInput(f"{_key_where(scenario, 'sources')}: no ST sources: name them on the command line "
-                                "or in 'sources'", at=_key_at(scenario, 'sources'))
+            raise _key_mistake(scenario, "sources", "no ST sources: name them on the command line or in 'sources'")
         missing = [str(p) for p in scenario.sources if not p.is_file()]
         if missing:
-            raise UnusableInput(f"{_key_where(scenario, 'sources')}: no such ST file: {', '.join(missing)}",
-                                at=_key_at(scenario, 'sources'))
+            raise _key_mistake(scenario, "sources", f"no such ST file: {', '.join(missing)}")
         try:
             self.project = verifier.load(
                 *[str(p) for p in scenario.sources],
@@ -79,7 +78,7 @@ class _Plc:
             else:
                 self.project.attach_serial(scenario.serial_channel, line)
         except ValueError as exc:
-            raise UnusableInput(f"{_key_where(scenario, 'channel')}: {exc}", at=_key_at(scenario, 'channel')) from None
+            raise _key_mistake(scenario, "channel", str(exc)) from None
         self.name = self._program_name(scenario)
         self.program = self.project.program(self.name)
 
@@ -110,14 +109,12 @@ class _Plc:
         wanted = (scenario.program or "").upper()
         other = next((pou for f in self.project.files for pou in f.pous if pou.key == wanted), None)
         if other is not None and other.kind != "PROGRAM":  # the FB under test named instead of its caller
-            raise UnusableInput(f"{_key_where(scenario, 'program')}: {other.name} is a {other.kind}, not a PROGRAM: "
-                                f"name the PROGRAM "
-                                f"that calls it (the sources define: {listing})", at=_key_at(scenario, 'program'))
+            raise _key_mistake(scenario, "program", f"{other.name} is a {other.kind}, not a PROGRAM: name the "
+                               f"PROGRAM that calls it (the sources define: {listing})")
         if not programs:
             # SOURCES given on the command line: the file is all there is
-            raise UnusableInput(f"{_key_where(scenario, 'sources')}: the sources define no PROGRAM, only function "
-                                "blocks and functions: give also the .st file of the PROGRAM to run",
-                                at=_key_at(scenario, 'sources'))
+            raise _key_mistake(scenario, "sources", "the sources define no PROGRAM, only function blocks and "
+                               "functions: give also the .st file of the PROGRAM to run")
         if scenario.program is None:
             if len(programs) == 1:
                 return programs[0]
@@ -126,14 +123,13 @@ class _Plc:
                                     f"with --program; the sources define: {listing}")
             if scenario.path is None:  # no file to name it in: the option alone
                 raise UnusableInput(f"say which PROGRAM to run with --program; the sources define: {listing}")
-            raise UnusableInput(f"{_key_where(scenario, 'program')}: say which PROGRAM to run (program = "
-                                f"\"{programs[0]}\" in the file, or --program); the sources define: {listing}",
-                                at=_key_at(scenario, 'program'))
+            raise _key_mistake(scenario, "program", f"say which PROGRAM to run (program = \"{programs[0]}\" "
+                               f"in the file, or --program); the sources define: {listing}")
         for name in programs:
             if name.upper() == scenario.program.upper():
                 return name
-        raise UnusableInput(f"{_key_where(scenario, 'program')}: no PROGRAM {scenario.program!r} in the sources; "
-                            f"they define: {listing}", at=_key_at(scenario, 'program'))
+        raise _key_mistake(scenario, "program", f"no PROGRAM {scenario.program!r} in the sources; "
+                           f"they define: {listing}")
 
     @property
     def now_us(self) -> int:
@@ -305,6 +301,17 @@ def _key_at(scenario: Scenario, key: str) -> tuple[str, int, int] | None:
     return scenario.key_at(key)
 
 
+def _key_mistake(scenario: Scenario, key: str, text: str) -> UnusableInput:
+    """`text` as the mistake of the scenario's `key`: the message at `_key_where`, the place
+    (for the JUnit report) at `_key_at`, so that the two cannot disagree."""
+    return UnusableInput(f"{_key_where(scenario, key)}: {text}", at=_key_at(scenario, key))
+
+
+def _line_mistake(scenario: Scenario, key: str, line: Place | None, text: str) -> UnusableInput:
+    """`text` as the mistake of `key` at `line` of the scenario file: message and place."""
+    return UnusableInput(f"{scenario.where(key, line)}: {text}", at=scenario.at(line))
+
+
 def _display_path(path: Path | None) -> str | None:
     """A path as people want to read it: relative to the working folder when inside it, as
     the user reached it (textfile.shown_path)."""
@@ -398,7 +405,7 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
             scenario = _without_default_signal(plc, scenario)
             continue
         if missing is not None:
-            raise UnusableInput(f"{scenario.where(use.key, line)}: {missing}", at=scenario.at(line))
+            raise _line_mistake(scenario, use.key, line, missing)
         for name in use.names:
             value = _plain(plc.read(name))
             kinds[name] = "bool" if isinstance(value, bool) else "STRING" if isinstance(value, str) else "number"
@@ -408,7 +415,7 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
         if problem and use.optional:  # the default signal: an o_bErr that is not a BOOL is not it
             scenario = _without_default_signal(plc, scenario)
         elif problem:
-            raise UnusableInput(f"{scenario.where(use.key, use.line)}: {problem}", at=scenario.at(use.line))
+            raise _line_mistake(scenario, use.key, use.line, problem)
     return scenario
 
 
@@ -468,11 +475,10 @@ def _input_problem(plc: _Plc, name: str, value: Any) -> str | None:
 def _apply_plc_settings(plc: _Plc, scenario: Scenario) -> None:
     """[[c24]] module settings, then [initial] devices and buffer memory, before the first scan."""
     for setting in scenario.c24:
-        where, at = scenario.where(setting.key, scenario.key_lines.get(setting.key)), \
-            scenario.at(scenario.key_lines.get(setting.key))
+        line = scenario.key_lines.get(setting.key)
         if scenario.platform != "q":
-            raise UnusableInput(f"{where}: the QJ71C24N is a Q-series module; the platform is {scenario.platform}",
-                                at=at)
+            raise _line_mistake(scenario, setting.key, line,
+                                f"the QJ71C24N is a Q-series module; the platform is {scenario.platform}")
         # unit None (--matrix): the settings go to whichever module the program drives
         try:
             plc.project.configure_c24(
@@ -482,10 +488,9 @@ def _apply_plc_settings(plc: _Plc, scenario: Scenario) -> None:
                 no_reception_format=setting.no_reception_format,
             )
         except (ValueError, KeyError) as exc:
-            raise UnusableInput(f"{where}: {exc}", at=at) from None
+            raise _line_mistake(scenario, setting.key, line, str(exc)) from None
     for name, value in scenario.initial:
         key = f"initial.{name}"
-        where, at = scenario.where(key, scenario.key_lines.get(key)), scenario.at(scenario.key_lines.get(key))
         buffer = BUFFER_MEMORY.match(name)
         if buffer:
             words = plc.project.c24_buffer(int(buffer.group(1), 16))
@@ -493,7 +498,7 @@ def _apply_plc_settings(plc: _Plc, scenario: Scenario) -> None:
             continue
         problem = plc.problem(name) or _input_problem(plc, name, value)
         if problem:
-            raise UnusableInput(f"{where}: {problem}", at=at)
+            raise _line_mistake(scenario, key, scenario.key_lines.get(key), problem)
         plc.write(name, value)
 
 
