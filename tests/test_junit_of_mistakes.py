@@ -118,11 +118,18 @@ def test_another_reports_refused_path_is_the_junits_error(tmp_path):
 
 def test_a_report_that_cannot_be_written_after_the_run_is_the_junits_error(tmp_path):
     """--json to a full disk (/dev/full) fails after the run, before the JUnit was written:
-    exit 2, and the JUnit says why rather than holding the earlier run."""
+    exit 2, and the JUnit says why rather than holding the earlier run; the run's own test
+    case stays beside the error (it was lost: the error was the file's one test case)."""
     result = _refused(tmp_path, "--json", "/dev/full")
-    (case,) = cases(tmp_path / "v.xml")
-    assert case.find("error").get("message").startswith("cannot write /dev/full: ")
-    assert f"wrote {tmp_path / 'v.xml'}" in result.output
+    root = ET.parse(tmp_path / "v.xml").getroot()
+    run, refused = root.findall("./testsuite")
+    (case,) = run.findall("testcase")
+    assert case.get("classname") == "uitamr.verify.fx3u" and "requests" in case.find("system-out").text
+    (error_case,) = refused.findall("testcase")
+    assert error_case.find("error").get("message").startswith("cannot write /dev/full: ")
+    assert (root.get("tests"), root.get("errors"), root.get("failures")) == (
+        "2", str(int(run.get("errors")) + 1), run.get("failures"))
+    assert f"wrote {tmp_path / 'v.xml'} (the runs' results, and this error as a test case)" in result.output
 
 
 def test_a_junit_whose_own_path_is_refused_is_not_written(tmp_path):

@@ -197,13 +197,13 @@ def _finish(results, console: Console, json_path, junit_path, trace_path, html_p
         write_reports(results, console, json_path, junit_path, trace_path, html_path, command)
     except ReportError as exc:
         click.echo(f"{command}: {exc}", err=True)
-        refused_report_junit(junit_path, exc, command, inputs)
+        refused_report_junit(junit_path, exc, command, inputs, results)
         sys.exit(EXIT_UNUSABLE)
 
 
-def refused_report_junit(junit_path, error: ReportError, command: str, inputs=()) -> None:
+def refused_report_junit(junit_path, error: ReportError, command: str, inputs=(), results=()) -> None:
     """For exit 2 from another report than the JUnit (a refused path, one that cannot be
     written): that mistake in --junit's file, and a line on stderr that says so or why not."""
-    junit = junit_of_refused_report(junit_path, error, command, inputs)
+    junit = junit_of_refused_report(junit_path, error, command, inputs, results)
     if junit is not None:
         click.echo(f"{command}: {junit[1]}", err=True)

@@ -101,36 +101,41 @@ def _not_over_other_content(path: Path) -> None:
                           str(path))
 
 
-def junit_of_mistakes(junit_path, mistakes: list, command: str, inputs=()) -> tuple[bool, str]:
+def junit_of_mistakes(junit_path, mistakes: list, command: str, inputs=(), results=()) -> tuple[bool, str]:
     """For a run that cannot start (exit 2): its mistakes (`result.Mistake`, each with its
     place) written to --junit's file as errors (`report_junit.unusable_element`), so that a
     CI server shows what to fix rather than no report or the last run's; never over one of
-    the run's input files (`inputs`, as far as they are known). Returns whether it was
-    written and the line that says so, or why not."""
+    the run's input files (`inputs`, as far as they are known). `results`: the runs done
+    before the mistake, kept in the file beside it. Returns whether it was written and the
+    line that says so, or why not."""
     from verifier.verify import report_junit
 
     try:
         check_not_inputs(inputs, junit_path)
         _not_over_other_content(Path(junit_path))
-        report_junit.write_unusable(mistakes, Path(junit_path), command)
+        report_junit.write_unusable(mistakes, Path(junit_path), command, results)
     except ReportError as exc:
         return False, f"the JUnit report was not written: {exc}"
     except OSError as exc:
         return False, f"the JUnit report was not written: cannot write {junit_path}: {exc.strerror or exc}"
+    if results:
+        return True, f"wrote {junit_path} (the runs' results, and this error as a test case)"
     return True, f"wrote {junit_path} (these errors as test cases)"
 
 
-def junit_of_refused_report(junit_path, error: ReportError, command: str, inputs=()) -> tuple[bool, str] | None:
+def junit_of_refused_report(junit_path, error: ReportError, command: str, inputs=(),
+                            results=()) -> tuple[bool, str] | None:
     """For a run that exits 2 because another report than the JUnit cannot be written (its
     folder does not exist, two reports given one file, a report over an input file, a full
     disk): that mistake written to --junit's file as an error, as `junit_of_mistakes` does,
-    so that a CI server does not show an earlier run's file as this one's. None when there is
-    no --junit or the refused path is its own; else what `junit_of_mistakes` returns."""
+    so that a CI server does not show an earlier run's file as this one's; `results` (a report
+    that failed after the runs) stay in it beside the error. None when there is no --junit or
+    the refused path is its own; else what `junit_of_mistakes` returns."""
     from verifier.verify.result import Mistake
 
     if not junit_path or any(real_path(path) == real_path(junit_path) for path in error.paths):
         return None
-    return junit_of_mistakes(junit_path, [Mistake(str(error))], command, inputs)
+    return junit_of_mistakes(junit_path, [Mistake(str(error))], command, inputs, results)
 
 
 def write_reports(results, console: Console, json_path=None, junit_path=None, trace_path=None,

@@ -107,10 +107,11 @@ def _unusable_input(junit_path: str | None, inputs, error: Exception) -> None:
     _unusable(*messages, done=done)
 
 
-def _refused_report(junit_path: str | None, error: ReportError, inputs) -> None:
+def _refused_report(junit_path: str | None, error: ReportError, inputs, results=()) -> None:
     """Exit 2 for a report that cannot be written, after writing that mistake to --junit's
-    file when the refused report is another one (not over one of `inputs`)."""
-    junit = junit_of_refused_report(junit_path, error, "uitamr verify", inputs)
+    file when the refused report is another one (not over one of `inputs`), beside the
+    `results` of the runs when they were done."""
+    junit = junit_of_refused_report(junit_path, error, "uitamr verify", inputs, results)
     if junit is None:
         _unusable(str(error))
     written, said = junit
@@ -585,7 +586,7 @@ def command(sources, program, platform, channel, response_signal, scenario_files
                 report_console.render(results, console, first=first)
                 write_reports(results, console, json_path, junit_path, trace_path, html_path)
             except ReportError as exc:
-                _refused_report(junit_path, exc, inputs)
+                _refused_report(junit_path, exc, inputs, results)
     finally:
         if spool_folder is not None:
             shutil.rmtree(spool_folder, ignore_errors=True)

@@ -109,16 +109,21 @@ def _xml_safe(text: str | None) -> str | None:
     return None if text is None else escape_chars(text, lambda c: not _NOT_XML.match(c))
 
 
-def unusable_element(mistakes: list[Mistake], command: str = "uitamr verify") -> ET.Element:
+def unusable_element(mistakes: list[Mistake], command: str = "uitamr verify",
+                     results: list[ScenarioResult] = ()) -> ET.Element:
     """The report of a run that could not start (exit 2): one test case per mistake, an
     `<error type="unusable-input">` whose message is the mistake's line that names its place
     (file:line:col), from the place on, and whose text is the whole message, so that the CI
     server shows what to fix instead of a missing report (or the last run's). The places are
-    the mistakes' own (`Mistake.file`, `line`, `col`), never read back from their text."""
-    suites = ET.Element("testsuites", name=command, tests=str(len(mistakes)), failures="0",
-                        errors=str(len(mistakes)))
+    the mistakes' own (`Mistake.file`, `line`, `col`), never read back from their text.
+    `results`: the runs that were done before the mistake (another report that could not be
+    written after them), kept as their own test suite before the mistakes' one."""
+    suites = to_element(results, command) if results else ET.Element("testsuites", name=command, tests="0",
+                                                                      failures="0", errors="0")
     suite = ET.SubElement(suites, "testsuite", name=command, tests=str(len(mistakes)), failures="0",
                           errors=str(len(mistakes)))
+    for total, added in (("tests", len(mistakes)), ("errors", len(mistakes))):
+        suites.set(total, str(int(suites.get(total)) + added))
     for mistake, name in zip(mistakes, _mistake_names(mistakes)):
         case = ET.SubElement(suite, "testcase", classname=command.replace(" ", ".") + ".input",
                              name=name, time="0.000")
@@ -154,8 +159,9 @@ def _headline(mistake: Mistake) -> str:
     return (mistake.message.splitlines() or [""])[0]
 
 
-def write_unusable(mistakes: list[Mistake], path: Path, command: str = "uitamr verify") -> None:
-    _write_tree(unusable_element(mistakes, command), path)
+def write_unusable(mistakes: list[Mistake], path: Path, command: str = "uitamr verify",
+                   results: list[ScenarioResult] = ()) -> None:
+    _write_tree(unusable_element(mistakes, command, results), path)
 
 
 def write(results: list[ScenarioResult], path: Path, command: str = "uitamr verify") -> None:
