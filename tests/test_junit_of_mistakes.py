@@ -159,3 +159,35 @@ def test_monitor_writes_another_reports_refusal_to_its_junit(tmp_path):
     (case,) = cases(tmp_path / "m.xml")
     assert case.get("classname") == "uitamr.monitor.input"
     assert case.find("error").get("message").startswith(f"cannot write {tmp_path / 'gone' / 'm.json'}: the folder")
+
+
+TWO_ERRORS = "PROGRAM MAIN\nVAR\n    x : INT;\nEND_VAR\nx := y;\nx := z;\nEND_PROGRAM\n"
+
+
+def test_each_error_of_st_that_does_not_load_is_a_test_case_at_its_place(tmp_path):
+    """ST with two errors was one test case at the first error's place, so a CI summary (and
+    its annotations) showed one of them; now one test case each, while the console still
+    lists them under one heading."""
+    write_files(tmp_path, {"MAIN.st": TWO_ERRORS, "a.toml": 'sources = ["MAIN.st"]\nduration = "1s"\n'})
+    source = tmp_path / "MAIN.st"
+    for args in ([source], ["--scenario", tmp_path / "a.toml", "--scenario", tmp_path / "a.toml", "--jobs", "2"]):
+        result = invoke("verify", *args, "--junit", tmp_path / "v.xml")
+        assert result.exit_code == 2, result.output
+        assert result.output.count("ST sources have errors:") == 1, result.output
+        found = [(case.get("name"), case.get("file"), case.find("error").get("message")) for case in cases(tmp_path / "v.xml")]
+        assert found == [(f"{source}:5:6", str(source), f"{source}:5:6: error: undefined label 'y'; declare it in a VAR block"),
+                         (f"{source}:6:6", str(source), f"{source}:6:6: error: undefined label 'z'; declare it in a VAR block")]
+
+
+def test_the_places_of_an_unusable_input_cross_worker_processes():
+    """--jobs sends a worker's UnusableInput back pickled: its place and its several
+    mistakes come with it."""
+    import pickle
+
+    from verifier.verify.result import UnusableInput, mistakes_of
+
+    each = [Mistake("M.st:1:2: error: a", "M.st", 1, 2), Mistake("M.st:3:4: error: b", "M.st", 3, 4)]
+    error = pickle.loads(pickle.dumps(UnusableInput("ST sources have errors: ...", at=("M.st", 1, 2), mistakes=each)))
+    assert (error.file, error.line, error.col, mistakes_of(error)) == ("M.st", 1, 2, each)
+    alone = pickle.loads(pickle.dumps(UnusableInput("s.toml:2:3: program: x", at=("s.toml", 2, 3))))
+    assert mistakes_of(alone) == [Mistake("s.toml:2:3: program: x", "s.toml", 2, 3)]

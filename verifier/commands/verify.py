@@ -99,7 +99,9 @@ def _unusable_input(junit_path: str | None, inputs, error: Exception) -> None:
     after writing the mistakes to --junit's file as errors, each at the place the error
     holds (not over one of `inputs`, the run's input files as far as they are known)."""
     mistakes = mistakes_of(error)
-    messages = [mistake.message for mistake in mistakes]
+    # the console shows each scenario file's mistake as its own error line, and ST that does
+    # not load as one message listing its errors (the JUnit report has a test case for each)
+    messages = [mistake.message for mistake in mistakes] if isinstance(error, ScenarioMistakes) else [str(error)]
     done = None
     if junit_path:
         written, said = junit_of_mistakes(junit_path, mistakes, "uitamr verify", inputs)

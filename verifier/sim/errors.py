@@ -23,6 +23,13 @@ class LoadError(Exception):
                 return file, getattr(d, "line", 0), getattr(d, "col", 0)
         return None
 
+    def located(self) -> list[tuple[str, int, int, str]]:
+        """(file, line, column, its line of the message) of each error that names a source's
+        line, in the message's order: the mistakes a report can place one by one."""
+        return [(d.file, getattr(d, "line", 0), getattr(d, "col", 0), _format_diag(d)) for d in self.diagnostics
+                if not getattr(d, "file", "?").startswith(OPTION_PLACE)
+                and getattr(d, "severity", "error") == "error"]
+
 
 #: the "file" of a diagnostic about an argument of verifier.load, not about a source:
 #: `verifier.load(scan_ms=0)`

@@ -81,15 +81,20 @@ class UnusableInput(Exception):
     """Input the verifier cannot run (bad scenario, ST that does not load, unknown program).
 
     The message is complete and meant for people; the command exits 2 with it. `at`: the
-    place in a file the message names first, (file, line, column), for the JUnit report."""
+    place in a file the message names first, (file, line, column), for the JUnit report;
+    `mistakes`: the several mistakes one message lists, each at its own place (the errors
+    of ST that does not load), for the JUnit report's test cases."""
 
-    def __init__(self, message: str, at: tuple[str, int, int] | None = None):
+    def __init__(self, message: str, at: tuple[str, int, int] | None = None,
+                 mistakes: list[Mistake] | None = None):
         super().__init__(message)
         self.file, self.line, self.col = at if at is not None else (None, None, None)
+        if mistakes is not None:
+            self.mistakes = list(mistakes)
 
-    def __reduce__(self):  # across --jobs' worker processes with its place
+    def __reduce__(self):  # across --jobs' worker processes with its places
         at = None if self.file is None else (self.file, self.line, self.col)
-        return type(self), (str(self), at)
+        return type(self), (str(self), at, getattr(self, "mistakes", None))
 
 
 @dataclass(frozen=True, slots=True)

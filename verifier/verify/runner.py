@@ -29,8 +29,8 @@ from .events_shown import thin_line_events
 from .evidence import RunEvidence, Samples
 from .expectations import judge
 from .overwritten import overwritten_input_notes
-from .result import (KEEP_ALL, RULE_EVENTS, Keep, LineEvent, ScenarioResult, TraceRecord, UnusableInput, judged_with,
-                     summarize_diagnostics)
+from .result import (KEEP_ALL, RULE_EVENTS, Keep, LineEvent, Mistake, ScenarioResult, TraceRecord, UnusableInput,
+                     judged_with, summarize_diagnostics)
 from .rules import check_all
 from .scenario import BUFFER_MEMORY, DEFAULT_PLATFORM, DEVICE_NAME, Scenario, bundled_platform, scenario_power_on_stop
 from .stream import Stream
@@ -71,7 +71,10 @@ class _Plc:
                 programs=None if scenario.program is None else [scenario.program],
             )
         except LoadError as exc:
-            raise UnusableInput(str(exc) + _platform_hint(scenario), at=exc.place()) from None
+            hint = _platform_hint(scenario)
+            # one JUnit test case per error, each at its place (the message lists them all)
+            each = [Mistake(text + hint, file, line, col) for file, line, col, text in exc.located()]
+            raise UnusableInput(str(exc) + hint, at=exc.place(), mistakes=each or None) from None
         try:
             if isinstance(line, Converter):
                 self.project.attach_tcp(line)
