@@ -154,3 +154,42 @@ def test_the_tcp_and_rs232_pages_quote_the_librarys_constants():
     rs232 = " ".join((ROOT / "docs" / "wiring-rs232.md").read_text(encoding="utf-8").split())
     assert (f"the {_ms(engine['PACE_TIME'])} ms pace, the {_ms(engine['REPLY_TIMEOUT'])} ms reply time-out"
             in rs232)
+
+
+def test_the_timing_chart_says_what_a_10ms_scan_puts_on_the_line():
+    """plc-library.md's timing charts give the constants (300 ms pace, attempts 700 ms
+    apart, 16#0101 at 1,900 ms); the simulation of the bundled examples at their 10 ms scan
+    shows 310 ms, 720 ms and 1,940 ms (a timer is seen done in the scan after its time, the
+    port sends in the scan after the engine asked), and 630 ms on the ADPRW route. The page
+    now says so with the figures held here to `uitamr verify` runs, and fx3u-no-reply's
+    description, which said 700 ms, to the same figure."""
+    from dataclasses import replace
+
+    from verifier.verify.runner import run_scenario
+    from verifier.verify.scenario import load_scenario
+
+    text = " ".join(DOC.read_text(encoding="utf-8").split())
+    said = re.search(r"requests start (\d+) ms apart; a silent robot gets its attempts (\d+) ms apart .*?"
+                     r"the command ends ([\d,]+) ms after the first attempt went out .*? in `fx3u-no-reply`, "
+                     r"and the same on every RS2, C24 and TCP route \(([^)]*)\)\. On an ADPRW route .*? "
+                     r"(\d+) ms apart, and the command ends \(16#0108\) ([\d,]+) ms after the first "
+                     r"\(`fx3u-adprw-no-reply`\)", text)
+    assert said, "plc-library.md no longer says what a 10 ms scan puts on the line"
+    pace, attempts, ends, others, adp_attempts, adp_ends = said.groups()
+    routes = {"fx3u-no-reply": (int(attempts), int(ends.replace(",", "")))}
+    routes |= {name: routes["fx3u-no-reply"] for name in re.findall(r"`([\w-]+)`", others)}
+    routes["fx3u-adprw-no-reply"] = (int(adp_attempts), int(adp_ends.replace(",", "")))
+    assert len(routes) == 6
+    for name, (apart, ended) in routes.items():
+        scenario = load_scenario(ROOT / "plc" / "scenarios" / f"{name}.toml")
+        assert scenario.scan_us == 10_000, name
+        result = run_scenario(replace(scenario, duration_us=7_000_000, expectations=()))
+        sent = [r.t_start_us for r in result.trace if r.direction == "tx"]
+        gaps = [(b - a) // 1000 for a, b in zip(sent, sent[1:])]
+        assert set(gaps) == {int(pace), apart}, (name, sorted(set(gaps)))
+        first_unanswered = sent[gaps.index(apart)]
+        # to the scan: on the TCP route the trace has each frame on the robot's line, after
+        # the converter's delay (2 ms in the *-tcp-no-reply scenarios)
+        assert round((result.signal_held[0][0] - first_unanswered) / 1000, -1) == ended, name
+    description = load_scenario(ROOT / "plc" / "scenarios" / "fx3u-no-reply.toml").description
+    assert f"{attempts} ms apart" in description
