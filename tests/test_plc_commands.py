@@ -170,3 +170,35 @@ def test_hold_to_jog_needs_a_second_instance_for_the_stop():
     page = (PLC.parent / "docs" / "plc-library.md").read_text()
     for text in (header, page):
         assert "second instance" in text and "UITAMR_PanelFx3" in text
+
+
+def test_every_table_2_command_has_a_wrapper_as_uitamr_command_says():
+    """UITAMR_Command's header sent integrators to it "for commands without a wrapper, e.g.
+    coordinate reset or manual mode" while UITAMR_SetMode wraps both. Each wrapper of code 1
+    is run here (own mailbox, no engine) and what it posts is read back: every table-2
+    command of the manual is posted by one, and the header now says so and names the
+    wrapper of those two."""
+    from verifier.protocol.catalogue import RobotCommand
+
+    cases = [("UITAMR_Tape", f"i_wAction := {a}") for a in range(1, 9)]
+    cases += [("UITAMR_SetMode", f"i_wMode := {m}") for m in (1, 2)]
+    cases += [("UITAMR_Pause", ""), ("UITAMR_Stop", "")]
+    decls = "".join(f"    fb{i} : {fb};\n    uMbx{i} : ARRAY[0..15] OF WORD;\n" for i, (fb, _) in enumerate(cases))
+    calls = "".join(f"fb{i}(i_bEN := TRUE, i_bExecute := bGo, {arg + ', ' if arg else ''}io_uMbx := uMbx{i});\n"
+                    for i, (_, arg) in enumerate(cases))
+    harness = f"PROGRAM T_Wrappers\nVAR\n    bGo : BOOL;\n{decls}END_VAR\n{calls}END_PROGRAM\n"
+    project = verifier.load(PLC / "core", sources={"T_Wrappers.st": harness})
+    h = project.program("T_Wrappers")
+    project.run_programs(["T_Wrappers"], scans=1)
+    h.bGo = True
+    project.run_programs(["T_Wrappers"], scans=1)
+    posted = set()
+    for i, _ in enumerate(cases):
+        mbx = getattr(h, f"uMbx{i}")
+        slot = 8 if mbx[8] == 1 else 0  # UITAMR_Stop posts to the priority slot
+        assert mbx[slot] == 1, cases[i]  # requested
+        posted.add((mbx[slot + 2], mbx[slot + 3]))
+    assert {(1, int(c)) for c in RobotCommand} <= posted
+    header = " ".join((PLC / "core" / "UITAMR_Command.st").read_text(encoding="utf-8").split("*)", 1)[0].split())
+    assert "without a wrapper" not in header
+    assert "every command of the manual has one (coordinate reset and manual mode: UITAMR_SetMode)" in header
