@@ -193,3 +193,36 @@ def test_the_timing_chart_says_what_a_10ms_scan_puts_on_the_line():
         assert round((result.signal_held[0][0] - first_unanswered) / 1000, -1) == ended, name
     description = load_scenario(ROOT / "plc" / "scenarios" / "fx3u-no-reply.toml").description
     assert f"{attempts} ms apart" in description
+
+
+def test_0304_is_named_as_the_port_headers_name_it_and_looks_like_a_silent_robot():
+    """16#0304 is "invalid channel" in the serial ports' headers and "invalid connection
+    number" in the TCP ports'; plc-library.md's table and commissioning.md named only the
+    channel, so an FX5U/E71 integrator with connection 9 read of a channel they never set.
+    Both pages now name both, and what commissioning.md says the engine shows (16#0101,
+    detail 1, nothing sent) is what an FX5U engine behind either port shows."""
+    import verifier
+
+    meanings = set()
+    for path in (ROOT / "plc").rglob("UITAMR_Port*.st"):
+        header = " ".join(path.read_text(encoding="utf-8").split("*)", 1)[0].split())
+        meanings |= set(re.findall(r"16#0304 (invalid [a-z]+(?: number)?)", header))
+    assert meanings == {"invalid channel", "invalid connection number"}
+    row = re.search(r"^\| 16#0304 \|(.*)$", DOC.read_text(encoding="utf-8"), flags=re.M).group(1)
+    commissioning = " ".join((ROOT / "docs" / "commissioning.md").read_text(encoding="utf-8").split())
+    said = re.search(r"the port FB's `o_uErrId` 16#0304: ([^.]*)\.", commissioning).group(1)
+    for meaning in meanings:
+        assert meaning in row and meaning.split(" ", 1)[1] in said, meaning
+    for port, argument in (("UITAMR_PortFx5", "i_wChannel := 3"),
+                           ("UITAMR_PortTcpFx5", "i_wConnection := 9, i_udIpAddress := 16#C0A80332, "
+                                                 "i_uTcpPort := 4001, i_uLocalPort := 5000")):
+        harness = (f"PROGRAM T_Bad\nVAR\n    fbPort : {port};\n    fbEngine : UITAMR_Engine;\n"
+                   "    uMbx : ARRAY[0..15] OF WORD;\n    uPort : ARRAY[0..39] OF WORD;\nEND_VAR\n"
+                   f"fbPort(i_bEN := TRUE, {argument}, io_uPort := uPort);\n"
+                   "fbEngine(i_bEN := NOT SM402, i_wAddress := 1, i_bMonitor := FALSE, io_uMbx := uMbx, "
+                   "io_uPort := uPort);\nEND_PROGRAM\n")
+        project = verifier.load(ROOT / "plc" / "core", ROOT / "plc" / "fx5", sources={"T_Bad.st": harness},
+                                target="gxworks3", cpu="fx5u")
+        project.run_programs(["T_Bad"], until_us=3_000_000)
+        bad = project.program("T_Bad")
+        assert (bad.fbPort.o_uErrId, bad.fbEngine.o_uErrId, bad.fbEngine.o_uErrDetail) == (0x0304, 0x0101, 1), port
