@@ -226,3 +226,42 @@ def test_0304_is_named_as_the_port_headers_name_it_and_looks_like_a_silent_robot
         project.run_programs(["T_Bad"], until_us=3_000_000)
         bad = project.program("T_Bad")
         assert (bad.fbPort.o_uErrId, bad.fbEngine.o_uErrId, bad.fbEngine.o_uErrDetail) == (0x0304, 0x0101, 1), port
+
+
+def test_the_tcp_examples_name_the_details_the_engine_gets_from_the_tcp_link():
+    """The TCP examples' headers said commands end with 16#0108 "detail 16#0310..16#0314",
+    but UITAMR_TcpLink hands the engine only 16#0311, 16#0312 and 16#0314 (a refused open
+    and a failed receive never fail an attempt; 16#0310 and 16#0313 are the port's own
+    o_uErrId). The headers and plc-library.md's 16#0108 row now name the codes the ST
+    hands over, and the bundled refused-converter runs show the engine's detail among them."""
+    from dataclasses import replace
+
+    from verifier.verify.runner import run_scenario
+    from verifier.verify.scenario import load_scenario
+
+    link = (ROOT / "plc" / "core" / "UITAMR_TcpLink.st").read_text(encoding="utf-8")
+    constants = _constants("UITAMR_TcpLink")
+    handed = {int(constants[name][3:], 16) for name in re.findall(r"uHeldErr := (ERR_\w+);", link)} - {0}
+    assert handed == {0x0311, 0x0312, 0x0314}
+
+    def codes(text: str) -> set[int]:
+        return {int(c, 16) for c in re.findall(r"16#(03[0-9A-F]{2})", text)}
+
+    for example in ("fx5/UITAMR_ExampleTcpFx5.st", "q/UITAMR_ExampleTcpQ.st"):
+        header = " ".join((ROOT / "plc" / "examples" / example).read_text(encoding="utf-8").split("*)", 1)[0].split())
+        said = re.search(r"ends with 16#0108 \(D102\), the engine's detail being (.*?); the port's own code", header)
+        assert said and codes(said.group(1)) == handed, example
+    row = re.search(r"^\| 16#0108 \|[^|]*\|([^|]*)\|", DOC.read_text(encoding="utf-8"), flags=re.M).group(1)
+    in_row = {int(c, 16) for c in re.findall(r"(?:16#|/)(03[0-9A-F]{2})", row)}  # "16#0311/0312/0314"
+    assert {c for c in in_row if 0x0310 <= c <= 0x031F} == handed
+    for name in ("fx5u-tcp-refused", "q-tcp-refused"):
+        scenario = load_scenario(ROOT / "plc" / "scenarios" / f"{name}.toml")
+        result = run_scenario(replace(scenario, duration_us=8_000_000, expectations=(),
+                                      watch=("fbEngine.o_uErrId", "fbEngine.o_uErrDetail")))
+        ids = result.watched["fbEngine.o_uErrId"]
+
+        def id_at(t_us: int) -> int:  # the error id in force when the detail was sampled
+            return [value for t, value in ids if t <= t_us][-1]
+
+        details = {value for t, value in result.watched["fbEngine.o_uErrDetail"] if id_at(t) == 0x0108}
+        assert details and details <= handed, (name, details)
