@@ -265,3 +265,18 @@ def test_the_tcp_examples_name_the_details_the_engine_gets_from_the_tcp_link():
 
         details = {value for t, value in result.watched["fbEngine.o_uErrDetail"] if id_at(t) == 0x0108}
         assert details and details <= handed, (name, details)
+
+
+def test_a_command_fb_lists_0301_only_if_it_has_a_parameter_to_refuse():
+    """Every command FB's header listed "16#0301 parameter out of range", UITAMR_Stop's and
+    UITAMR_Pause's too, which have no parameter and call UITAMR_Command with
+    i_bParamErr := FALSE: an integrator looked for a parameter that is not there. Now a
+    wrapper's header names 16#0301 exactly when it can report it."""
+    wrappers = [p for p in (ROOT / "plc" / "core").glob("UITAMR_*.st")
+                if "fbCmd : UITAMR_Command;" in p.read_text(encoding="utf-8")]
+    assert len(wrappers) == 10
+    for path in wrappers:
+        text = path.read_text(encoding="utf-8")
+        header, body = text.split("*)", 1)
+        checks = "i_bParamErr := FALSE" not in body
+        assert ("16#0301" in header.split("Outputs:", 1)[1].replace("never 16#0301", "")) == checks, path.name
