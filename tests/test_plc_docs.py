@@ -280,3 +280,18 @@ def test_a_command_fb_lists_0301_only_if_it_has_a_parameter_to_refuse():
         header, body = text.split("*)", 1)
         checks = "i_bParamErr := FALSE" not in body
         assert ("16#0301" in header.split("Outputs:", 1)[1].replace("never 16#0301", "")) == checks, path.name
+
+
+def test_the_error_table_says_where_a_wrappers_detail_is():
+    """The error table's detail column is headed `o_uErrDetail`, which no wrapper
+    (UITAMR_RunPoint ...) has: their detail is in their UITAMR_Command instance fbCmd. The
+    page now says so, and it names the instance the wrappers really hold."""
+    wrappers = []
+    for path in (ROOT / "plc" / "core").glob("UITAMR_*.st"):
+        text = path.read_text(encoding="utf-8")
+        if "fbCmd : UITAMR_Command;" in text:
+            wrappers.append(path.stem)
+            assert "o_uErrDetail" not in text.split("*)", 1)[1], path.stem
+    assert len(wrappers) == 10
+    table = " ".join(DOC.read_text(encoding="utf-8").partition("## Error codes")[2].partition("| code |")[0].split())
+    assert "their internal instance `fbCmd`" in table and "`fbRun.fbCmd.o_uErrDetail`" in table
