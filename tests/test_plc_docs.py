@@ -295,3 +295,17 @@ def test_the_error_table_says_where_a_wrappers_detail_is():
     assert len(wrappers) == 10
     table = " ".join(DOC.read_text(encoding="utf-8").partition("## Error codes")[2].partition("| code |")[0].split())
     assert "their internal instance `fbCmd`" in table and "`fbRun.fbCmd.o_uErrDetail`" in table
+
+
+def test_the_fx3_example_says_how_to_set_bUseRs232_as_wiring_rs232_does():
+    """UITAMR_ExampleFx3's label comment said "(set before RUN)", while wiring-rs232.md says
+    to assign it above the fbPort call (the port reads it in its first scan only; GX Works2
+    has no initial value for the label). The example now says what the page says."""
+    example = (ROOT / "plc" / "examples" / "fx3" / "UITAMR_ExampleFx3.st").read_text(encoding="utf-8")
+    page = " ".join((ROOT / "docs" / "wiring-rs232.md").read_text(encoding="utf-8").split())
+    assert "with an assignment above the `fbPort` call (`bUseRs232 := TRUE;`" in page
+    assert "set before RUN" not in example
+    comment = re.search(r"bUseRs232 : BOOL; +\(\* (.*) \*\)", example).group(1)
+    assert "assignment above the fbPort call" in comment
+    assert "bUseRs232 := TRUE; (or an input already ON at RUN) above the fbPort call" in " ".join(
+        example.split("*)", 1)[0].split())
