@@ -309,3 +309,18 @@ def test_the_fx3_example_says_how_to_set_bUseRs232_as_wiring_rs232_does():
     assert "assignment above the fbPort call" in comment
     assert "bUseRs232 := TRUE; (or an input already ON at RUN) above the fbPort call" in " ".join(
         example.split("*)", 1)[0].split())
+
+
+def test_the_engine_header_gives_every_detail_the_error_table_gives():
+    """The error table gives a detail for 16#0101 (1 = the port never finished sending),
+    16#0105 (length or byte count), 16#0108 (the port's code) and 16#0301 (the kind or the
+    code); UITAMR_Engine's header, which an integrator reads in GX Works, named none of those
+    for o_uErrDetail. It now names each, as the table does."""
+    engine = (ROOT / "plc" / "core" / "UITAMR_Engine.st").read_text(encoding="utf-8")
+    header = " ".join(engine.split("*)", 1)[0].split())
+    detail = header.split("o_uErrDetail", 1)[1].split("o_bReady", 1)[0]
+    table = DOC.read_text(encoding="utf-8").partition("## Error codes")[2]
+    assert "| 16#0101 | no reply after 3 attempts | 1 = the port never finished sending |" in table
+    for said in ("1 = the port never finished sending", "length or byte count", "port code (16#0108)",
+                 "kind or code (16#0301)", "exception code", "robot code", "the address out of range"):
+        assert said in detail, said
