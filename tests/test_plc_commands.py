@@ -170,3 +170,80 @@ def test_hold_to_jog_needs_a_second_instance_for_the_stop():
     page = (PLC.parent / "docs" / "plc-library.md").read_text()
     for text in (header, page):
         assert "second instance" in text and "UITAMR_PanelFx3" in text
+
+
+def test_every_table_2_command_has_a_wrapper_as_uitamr_command_says():
+    """UITAMR_Command's header sent integrators to it "for commands without a wrapper, e.g.
+    coordinate reset or manual mode" while UITAMR_SetMode wraps both. Each wrapper of code 1
+    is run here (own mailbox, no engine) and what it posts is read back: every table-2
+    command of the manual is posted by one, and the header now says so and names the
+    wrapper of those two."""
+    from verifier.protocol.catalogue import RobotCommand
+
+    cases = [("UITAMR_Tape", f"i_wAction := {a}") for a in range(1, 9)]
+    cases += [("UITAMR_SetMode", f"i_wMode := {m}") for m in (1, 2)]
+    cases += [("UITAMR_Pause", ""), ("UITAMR_Stop", "")]
+    decls = "".join(f"    fb{i} : {fb};\n    uMbx{i} : ARRAY[0..15] OF WORD;\n" for i, (fb, _) in enumerate(cases))
+    calls = "".join(f"fb{i}(i_bEN := TRUE, i_bExecute := bGo, {arg + ', ' if arg else ''}io_uMbx := uMbx{i});\n"
+                    for i, (_, arg) in enumerate(cases))
+    harness = f"PROGRAM T_Wrappers\nVAR\n    bGo : BOOL;\n{decls}END_VAR\n{calls}END_PROGRAM\n"
+    project = verifier.load(PLC / "core", sources={"T_Wrappers.st": harness})
+    h = project.program("T_Wrappers")
+    project.run_programs(["T_Wrappers"], scans=1)
+    h.bGo = True
+    project.run_programs(["T_Wrappers"], scans=1)
+    posted = set()
+    for i, _ in enumerate(cases):
+        mbx = getattr(h, f"uMbx{i}")
+        slot = 8 if mbx[8] == 1 else 0  # UITAMR_Stop posts to the priority slot
+        assert mbx[slot] == 1, cases[i]  # requested
+        posted.add((mbx[slot + 2], mbx[slot + 3]))
+    assert {(1, int(c)) for c in RobotCommand} <= posted
+    header = " ".join((PLC / "core" / "UITAMR_Command.st").read_text(encoding="utf-8").split("*)", 1)[0].split())
+    assert "without a wrapper" not in header
+    assert "every command of the manual has one (coordinate reset and manual mode: UITAMR_SetMode)" in header
+
+
+DIRECT = """
+PROGRAM T_Direct
+VAR
+    fbPort : UITAMR_PortFx3;
+    fbEngine : UITAMR_Engine;
+    fbCmd : UITAMR_Command;
+    uMbx : ARRAY[0..15] OF WORD;
+    uPort : ARRAY[0..39] OF WORD;
+    bGo : BOOL;
+    wKind : INT;
+    wCode : INT;
+    wCommand : INT;
+END_VAR
+fbPort(i_bEN := TRUE, i_wChannel := 1, i_bRs232 := FALSE, io_uPort := uPort);
+fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := FALSE, io_uMbx := uMbx, io_uPort := uPort);
+fbCmd(i_bEN := TRUE, i_bExecute := bGo, i_wKind := wKind, i_wCode := wCode, i_wCommand := wCommand,
+      i_bParamErr := FALSE, i_bPriority := FALSE, io_uMbx := uMbx);
+END_PROGRAM
+"""
+
+
+def test_the_0301_detail_of_a_direct_uitamr_command_is_what_the_table_says():
+    """plc-library.md gave 16#0301 no detail, but the engine sets one when UITAMR_Command is
+    called directly with values it does not check: the kind when that is out of range, else
+    the control code given - also when the command or the query is the culprit (a query of
+    9 with i_wCode 7 shows detail 7). The table now says so; held here by running it."""
+    import re
+
+    project = verifier.load(PLC / "core", PLC / "fx3", sources={"T_Direct.st": DIRECT})
+    line = Line(Robot())
+    project.attach_serial("fx3:1", line)
+    h = project.program("T_Direct")
+    project.run_programs(["T_Direct"], until_us=1_500_000)
+    for kind, code, command, detail in [(5, 1, 3, 5), (2, 14, 0, 14), (2, 1, 300, 1), (3, 7, 9, 7)]:
+        h.wKind, h.wCode, h.wCommand, h.bGo = kind, code, command, True
+        project.run_programs(["T_Direct"], until_us=project.now_us + 100_000)
+        assert (h.fbCmd.o_bErr, h.fbCmd.o_uErrId, h.fbCmd.o_uErrDetail) == (True, 0x0301, detail)
+        h.bGo = False
+        project.run_programs(["T_Direct"], until_us=project.now_us + 50_000)
+    doc = (PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8")
+    row = " ".join(re.search(r"^\| 16#0301 \|(.*)$", doc, flags=re.M).group(1).split())
+    assert ("the kind (outside 1..3), else the `i_wCode` given - also when the command (0..255) or, "
+            "for kind 3, the query (0..3) is the one out of range") in row.replace("—", "-")

@@ -211,6 +211,10 @@ def test_parser_rejects_the_wrong_function(harness):
 def test_parser_rejects_a_wrong_byte_count(harness):
     fb = parse(harness, with_crc(bytes([1, 1, 2, 0, 0, 0])), 1)
     assert fb.o_uErrId == 0x0105 and fb.o_uDetail == 2
+    # the header's o_uDetail said "received length (16#0105)" only: 2 is the byte count here
+    header = (ROOT / "plc" / "core" / "UITAMR_ParseReply.st").read_text(encoding="utf-8").split("*)", 1)[0]
+    detail = " ".join(header.split("o_uDetail", 1)[1].split("o_bException", 1)[0].split())
+    assert "byte count of a status reply" in detail
 
 
 @pytest.mark.parametrize("length", [0, 1, 4, 17])

@@ -154,3 +154,173 @@ def test_the_tcp_and_rs232_pages_quote_the_librarys_constants():
     rs232 = " ".join((ROOT / "docs" / "wiring-rs232.md").read_text(encoding="utf-8").split())
     assert (f"the {_ms(engine['PACE_TIME'])} ms pace, the {_ms(engine['REPLY_TIMEOUT'])} ms reply time-out"
             in rs232)
+
+
+def test_the_timing_chart_says_what_a_10ms_scan_puts_on_the_line():
+    """plc-library.md's timing charts give the constants (300 ms pace, attempts 700 ms
+    apart, 16#0101 at 1,900 ms); the simulation of the bundled examples at their 10 ms scan
+    shows 310 ms, 720 ms and 1,940 ms (a timer is seen done in the scan after its time, the
+    port sends in the scan after the engine asked), and 630 ms on the ADPRW route. The page
+    now says so with the figures held here to `uitamr verify` runs, and fx3u-no-reply's
+    description, which said 700 ms, to the same figure."""
+    from dataclasses import replace
+
+    from verifier.verify.runner import run_scenario
+    from verifier.verify.scenario import load_scenario
+
+    text = " ".join(DOC.read_text(encoding="utf-8").split())
+    said = re.search(r"requests start (\d+) ms apart; a silent robot gets its attempts (\d+) ms apart .*?"
+                     r"the command ends ([\d,]+) ms after the first attempt went out .*? in `fx3u-no-reply`, "
+                     r"and the same on every RS2, C24 and TCP route \(([^)]*)\)\. On an ADPRW route .*? "
+                     r"(\d+) ms apart, and the command ends \(16#0108\) ([\d,]+) ms after the first "
+                     r"\(`fx3u-adprw-no-reply`\)", text)
+    assert said, "plc-library.md no longer says what a 10 ms scan puts on the line"
+    pace, attempts, ends, others, adp_attempts, adp_ends = said.groups()
+    routes = {"fx3u-no-reply": (int(attempts), int(ends.replace(",", "")))}
+    routes |= {name: routes["fx3u-no-reply"] for name in re.findall(r"`([\w-]+)`", others)}
+    routes["fx3u-adprw-no-reply"] = (int(adp_attempts), int(adp_ends.replace(",", "")))
+    assert len(routes) == 6
+    for name, (apart, ended) in routes.items():
+        scenario = load_scenario(ROOT / "plc" / "scenarios" / f"{name}.toml")
+        assert scenario.scan_us == 10_000, name
+        result = run_scenario(replace(scenario, duration_us=7_000_000, expectations=()))
+        sent = [r.t_start_us for r in result.trace if r.direction == "tx"]
+        gaps = [(b - a) // 1000 for a, b in zip(sent, sent[1:])]
+        assert set(gaps) == {int(pace), apart}, (name, sorted(set(gaps)))
+        first_unanswered = sent[gaps.index(apart)]
+        # to the scan: on the TCP route the trace has each frame on the robot's line, after
+        # the converter's delay (2 ms in the *-tcp-no-reply scenarios)
+        assert round((result.signal_held[0][0] - first_unanswered) / 1000, -1) == ended, name
+    description = load_scenario(ROOT / "plc" / "scenarios" / "fx3u-no-reply.toml").description
+    assert f"{attempts} ms apart" in description
+
+
+def test_0304_is_named_as_the_port_headers_name_it_and_looks_like_a_silent_robot():
+    """16#0304 is "invalid channel" in the serial ports' headers and "invalid connection
+    number" in the TCP ports'; plc-library.md's table and commissioning.md named only the
+    channel, so an FX5U/E71 integrator with connection 9 read of a channel they never set.
+    Both pages now name both, and what commissioning.md says the engine shows (16#0101,
+    detail 1, nothing sent) is what an FX5U engine behind either port shows."""
+    import verifier
+
+    meanings = set()
+    for path in (ROOT / "plc").rglob("UITAMR_Port*.st"):
+        header = " ".join(path.read_text(encoding="utf-8").split("*)", 1)[0].split())
+        meanings |= set(re.findall(r"16#0304 (invalid [a-z]+(?: number)?)", header))
+    assert meanings == {"invalid channel", "invalid connection number"}
+    row = re.search(r"^\| 16#0304 \|(.*)$", DOC.read_text(encoding="utf-8"), flags=re.M).group(1)
+    commissioning = " ".join((ROOT / "docs" / "commissioning.md").read_text(encoding="utf-8").split())
+    said = re.search(r"the port FB's `o_uErrId` 16#0304: ([^.]*)\.", commissioning).group(1)
+    for meaning in meanings:
+        assert meaning in row and meaning.split(" ", 1)[1] in said, meaning
+    for port, argument in (("UITAMR_PortFx5", "i_wChannel := 3"),
+                           ("UITAMR_PortTcpFx5", "i_wConnection := 9, i_udIpAddress := 16#C0A80332, "
+                                                 "i_uTcpPort := 4001, i_uLocalPort := 5000")):
+        harness = (f"PROGRAM T_Bad\nVAR\n    fbPort : {port};\n    fbEngine : UITAMR_Engine;\n"
+                   "    uMbx : ARRAY[0..15] OF WORD;\n    uPort : ARRAY[0..39] OF WORD;\nEND_VAR\n"
+                   f"fbPort(i_bEN := TRUE, {argument}, io_uPort := uPort);\n"
+                   "fbEngine(i_bEN := NOT SM402, i_wAddress := 1, i_bMonitor := FALSE, io_uMbx := uMbx, "
+                   "io_uPort := uPort);\nEND_PROGRAM\n")
+        project = verifier.load(ROOT / "plc" / "core", ROOT / "plc" / "fx5", sources={"T_Bad.st": harness},
+                                target="gxworks3", cpu="fx5u")
+        project.run_programs(["T_Bad"], until_us=3_000_000)
+        bad = project.program("T_Bad")
+        assert (bad.fbPort.o_uErrId, bad.fbEngine.o_uErrId, bad.fbEngine.o_uErrDetail) == (0x0304, 0x0101, 1), port
+
+
+def test_the_tcp_examples_name_the_details_the_engine_gets_from_the_tcp_link():
+    """The TCP examples' headers said commands end with 16#0108 "detail 16#0310..16#0314",
+    but UITAMR_TcpLink hands the engine only 16#0311, 16#0312 and 16#0314 (a refused open
+    and a failed receive never fail an attempt; 16#0310 and 16#0313 are the port's own
+    o_uErrId). The headers and plc-library.md's 16#0108 row now name the codes the ST
+    hands over, and the bundled refused-converter runs show the engine's detail among them."""
+    from dataclasses import replace
+
+    from verifier.verify.runner import run_scenario
+    from verifier.verify.scenario import load_scenario
+
+    link = (ROOT / "plc" / "core" / "UITAMR_TcpLink.st").read_text(encoding="utf-8")
+    constants = _constants("UITAMR_TcpLink")
+    handed = {int(constants[name][3:], 16) for name in re.findall(r"uHeldErr := (ERR_\w+);", link)} - {0}
+    assert handed == {0x0311, 0x0312, 0x0314}
+
+    def codes(text: str) -> set[int]:
+        return {int(c, 16) for c in re.findall(r"16#(03[0-9A-F]{2})", text)}
+
+    for example in ("fx5/UITAMR_ExampleTcpFx5.st", "q/UITAMR_ExampleTcpQ.st"):
+        header = " ".join((ROOT / "plc" / "examples" / example).read_text(encoding="utf-8").split("*)", 1)[0].split())
+        said = re.search(r"ends with 16#0108 \(D102\), the engine's detail being (.*?); the port's own code", header)
+        assert said and codes(said.group(1)) == handed, example
+    row = re.search(r"^\| 16#0108 \|[^|]*\|([^|]*)\|", DOC.read_text(encoding="utf-8"), flags=re.M).group(1)
+    in_row = {int(c, 16) for c in re.findall(r"(?:16#|/)(03[0-9A-F]{2})", row)}  # "16#0311/0312/0314"
+    assert {c for c in in_row if 0x0310 <= c <= 0x031F} == handed
+    for name in ("fx5u-tcp-refused", "q-tcp-refused"):
+        scenario = load_scenario(ROOT / "plc" / "scenarios" / f"{name}.toml")
+        result = run_scenario(replace(scenario, duration_us=8_000_000, expectations=(),
+                                      watch=("fbEngine.o_uErrId", "fbEngine.o_uErrDetail")))
+        ids = result.watched["fbEngine.o_uErrId"]
+
+        def id_at(t_us: int) -> int:  # the error id in force when the detail was sampled
+            return [value for t, value in ids if t <= t_us][-1]
+
+        details = {value for t, value in result.watched["fbEngine.o_uErrDetail"] if id_at(t) == 0x0108}
+        assert details and details <= handed, (name, details)
+
+
+def test_a_command_fb_lists_0301_only_if_it_has_a_parameter_to_refuse():
+    """Every command FB's header listed "16#0301 parameter out of range", UITAMR_Stop's and
+    UITAMR_Pause's too, which have no parameter and call UITAMR_Command with
+    i_bParamErr := FALSE: an integrator looked for a parameter that is not there. Now a
+    wrapper's header names 16#0301 exactly when it can report it."""
+    wrappers = [p for p in (ROOT / "plc" / "core").glob("UITAMR_*.st")
+                if "fbCmd : UITAMR_Command;" in p.read_text(encoding="utf-8")]
+    assert len(wrappers) == 10
+    for path in wrappers:
+        text = path.read_text(encoding="utf-8")
+        header, body = text.split("*)", 1)
+        checks = "i_bParamErr := FALSE" not in body
+        assert ("16#0301" in header.split("Outputs:", 1)[1].replace("never 16#0301", "")) == checks, path.name
+
+
+def test_the_error_table_says_where_a_wrappers_detail_is():
+    """The error table's detail column is headed `o_uErrDetail`, which no wrapper
+    (UITAMR_RunPoint ...) has: their detail is in their UITAMR_Command instance fbCmd. The
+    page now says so, and it names the instance the wrappers really hold."""
+    wrappers = []
+    for path in (ROOT / "plc" / "core").glob("UITAMR_*.st"):
+        text = path.read_text(encoding="utf-8")
+        if "fbCmd : UITAMR_Command;" in text:
+            wrappers.append(path.stem)
+            assert "o_uErrDetail" not in text.split("*)", 1)[1], path.stem
+    assert len(wrappers) == 10
+    table = " ".join(DOC.read_text(encoding="utf-8").partition("## Error codes")[2].partition("| code |")[0].split())
+    assert "their internal instance `fbCmd`" in table and "`fbRun.fbCmd.o_uErrDetail`" in table
+
+
+def test_the_fx3_example_says_how_to_set_bUseRs232_as_wiring_rs232_does():
+    """UITAMR_ExampleFx3's label comment said "(set before RUN)", while wiring-rs232.md says
+    to assign it above the fbPort call (the port reads it in its first scan only; GX Works2
+    has no initial value for the label). The example now says what the page says."""
+    example = (ROOT / "plc" / "examples" / "fx3" / "UITAMR_ExampleFx3.st").read_text(encoding="utf-8")
+    page = " ".join((ROOT / "docs" / "wiring-rs232.md").read_text(encoding="utf-8").split())
+    assert "with an assignment above the `fbPort` call (`bUseRs232 := TRUE;`" in page
+    assert "set before RUN" not in example
+    comment = re.search(r"bUseRs232 : BOOL; +\(\* (.*) \*\)", example).group(1)
+    assert "assignment above the fbPort call" in comment
+    assert "bUseRs232 := TRUE; (or an input already ON at RUN) above the fbPort call" in " ".join(
+        example.split("*)", 1)[0].split())
+
+
+def test_the_engine_header_gives_every_detail_the_error_table_gives():
+    """The error table gives a detail for 16#0101 (1 = the port never finished sending),
+    16#0105 (length or byte count), 16#0108 (the port's code) and 16#0301 (the kind or the
+    code); UITAMR_Engine's header, which an integrator reads in GX Works, named none of those
+    for o_uErrDetail. It now names each, as the table does."""
+    engine = (ROOT / "plc" / "core" / "UITAMR_Engine.st").read_text(encoding="utf-8")
+    header = " ".join(engine.split("*)", 1)[0].split())
+    detail = header.split("o_uErrDetail", 1)[1].split("o_bReady", 1)[0]
+    table = DOC.read_text(encoding="utf-8").partition("## Error codes")[2]
+    assert "| 16#0101 | no reply after 3 attempts | 1 = the port never finished sending |" in table
+    for said in ("1 = the port never finished sending", "length or byte count", "port code (16#0108)",
+                 "kind or code (16#0301)", "exception code", "robot code", "the address out of range"):
+        assert said in detail, said

@@ -137,3 +137,26 @@ def test_an_instruction_the_guide_quotes_is_in_its_rung():
     for rung, text in quoted:
         op, *operands = text.split()
         assert any(i.op == op and list(i.operands) == operands for i in _rungs()[rung]), f"{rung}: {text}"
+
+
+def test_the_devices_paragraph_lists_every_register_the_ladder_writes():
+    """An integrator keeps their own data clear of the ladder's devices by the Devices
+    paragraph (and the .il's heading), so it must name every data register the rungs write:
+    the reply's CRC and byte count (D214, D215) and the product of R6's MUL, which in 16-bit
+    operation fills two registers (D230 and D231, the high word: FX Series Programming
+    Manual §5.3.3, cited in the paragraph). Before, D214, D215, D230 and D231 were in no
+    list, and D231 nowhere on the page."""
+    section = _section()
+    paragraph = " ".join(section[section.index("Devices:"):section.index("| rung |")].split())
+    listed = _devices(paragraph)
+    writes = {"MOV": -1, "ADD": -1, "MUL": -1, "DIV": -1, "WAND": -1, "CRC": 1, "INC": 0}
+    written = set()
+    for instructions in _rungs().values():
+        for ins in instructions:
+            if ins.op in writes:
+                written.add(ins.operands[writes[ins.op]])
+                if ins.op in ("MUL", "DIV"):  # 32-bit product / the remainder in D+1
+                    written.add(next_device(ins.operands[-1]))
+    own = {d for d in written if re.fullmatch(r"D\d+", d) and int(d[1:]) < 8000}
+    assert own and sorted(own - listed) == []
+    assert "MUL" in paragraph and "§5.3.3" in paragraph

@@ -453,3 +453,37 @@ def test_the_bundled_q_garbage_scenario_needs_timer_0():
     assert engine[-1][1] == 0x0102
     cycle = result.watched["fbCycle.o_uErrId"]
     assert cycle[-1][1] == 0x0102 and cycle[-1][0] > 38_000_000     # failed again after the acknowledge
+
+
+def test_a_send_the_module_ends_with_an_error_fails_the_attempt_at_once():
+    """plc-library.md's 16#0108 row named 16#0306 among the port codes the engine gets, but
+    UITAMR_PortQC24 kept a G_OUTPUT error to its own o_uErrId: the engine waited 500 ms for
+    a reply to a frame that never went out, three times, and reported 16#0101 - a silent
+    robot, though the module refused the send. Now the attempt fails at once with 16#0108,
+    detail 16#0306, as the TCP ports do for a failed send. The simulator has no model of
+    when the module ends OUTPUT with an error, so the module's G_OUTPUT is made to end that
+    way (error code 7F20H, an arbitrary module code) for every frame from 1 s on."""
+    project, line, _ = rig([], no_reception_ms=5)
+    prog = project.program("UITAMR_ExampleQ")
+    run(project, 1000)
+    assert prog.fbEngine.o_bInitDone
+    module = project._instructions().c24(0)
+    refused = []
+
+    def output(s1, s2, d, loc_id):  # the module's completion with an error: d + 1 ON, code in s1 + 1
+        refused.append(project.now_us)
+        s1.set(1, 0x7F20)
+        module._finish(d, ok=False)
+        return True
+
+    module.output = output
+    run(project, 1500)
+    engine = prog.fbEngine
+    assert (engine.o_uErrId, engine.o_uErrDetail) == (0x0108, 0x0306)
+    assert (prog.fbPort.o_uErrId, prog.fbPort.o_uErrDetail) == (0x0306, 0x7F20)
+    # three attempts paced 310 ms apart, none waiting out the 500 ms reply time-out (then
+    # the monitor's polls fail the same way)
+    assert len(refused) >= 3 and refused[2] - refused[0] < 2 * 500_000
+    assert [f for f in line.trace if f.direction == "tx" and f.t_start_us > 1_000_000] == []
+    doc = (PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8")
+    assert re.search(r"^\| 16#0108 \|[^|]*\| port code \(16#0306/", doc, flags=re.M)
