@@ -247,3 +247,33 @@ def test_the_0301_detail_of_a_direct_uitamr_command_is_what_the_table_says():
     row = " ".join(re.search(r"^\| 16#0301 \|(.*)$", doc, flags=re.M).group(1).split())
     assert ("the kind (outside 1..3), else the `i_wCode` given - also when the command (0..255) or, "
             "for kind 3, the query (0..3) is the one out of range") in row.replace("—", "-")
+
+
+def test_a_relative_move_is_accepted_while_it_rounds_into_the_command_byte():
+    """UITAMR_MoveRelative rounds |i_eValue| / 0.1 m (0.01 rad) to the nearest unit but
+    refused anything above 255.0 units before rounding: 25.54 m, which rounds to 255 (the
+    byte's largest value, 25.5 m), ended with 16#0301 while 25.46 m, which rounds to 255
+    too, was sent. It now refuses only what rounds above 255 (255.5 units or more, in
+    REAL: 25.55 m is 255.49998 and 2.555 rad 255.50002), as its header says."""
+    cases = [(1, "25.54", 6, 255), (3, "-25.54", 11, 255), (4, "2.554", 12, 255), (2, "25.549", 8, 255),
+             (2, "-25.46", 9, 255), (1, "25.55", 6, 255),
+             (1, "25.56", None, None), (4, "-2.556", None, None), (1, "25.551", None, None),
+             (4, "2.555", None, None)]
+    decls = "".join(f"    fb{i} : UITAMR_MoveRelative;\n    uMbx{i} : ARRAY[0..15] OF WORD;\n"
+                    for i in range(len(cases)))
+    calls = "".join(f"fb{i}(i_bEN := TRUE, i_bExecute := bGo, i_wAxis := {axis}, i_eValue := {value}, "
+                    f"io_uMbx := uMbx{i});\n" for i, (axis, value, _, _) in enumerate(cases))
+    harness = f"PROGRAM T_Move\nVAR\n    bGo : BOOL;\n{decls}END_VAR\n{calls}END_PROGRAM\n"
+    project = verifier.load(PLC / "core", sources={"T_Move.st": harness})
+    h = project.program("T_Move")
+    project.run_programs(["T_Move"], scans=1)
+    h.bGo = True
+    project.run_programs(["T_Move"], scans=1)
+    for i, (axis, value, code, units) in enumerate(cases):
+        fb, mbx = getattr(h, f"fb{i}"), getattr(h, f"uMbx{i}")
+        if code is None:      # refused: 16#0301 at once, nothing posted
+            assert (fb.o_bErr, fb.o_uErrId, mbx[0]) == (True, 0x0301, 0), (axis, value)
+        else:                 # posted: requested, that code and that distance
+            assert (fb.o_bErr, mbx[0], mbx[2], mbx[3]) == (False, 1, code, units), (axis, value)
+    header = " ".join((PLC / "core" / "UITAMR_MoveRelative.st").read_text(encoding="utf-8").split("*)", 1)[0].split())
+    assert "25.54 m sends 255; at 255.5 or more (25.56 m, 2.556 rad) 16#0301, nothing sent" in header
