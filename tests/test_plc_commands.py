@@ -172,6 +172,21 @@ def test_hold_to_jog_needs_a_second_instance_for_the_stop():
         assert "second instance" in text and "UITAMR_PanelFx3" in text
 
 
+def post_once(cases):
+    """One instance per (FB, its input assignments) with its own mailbox and no engine, all
+    given one rising edge of i_bExecute: the program after that scan (fb<i>, uMbx<i>)."""
+    decls = "".join(f"    fb{i} : {fb};\n    uMbx{i} : ARRAY[0..15] OF WORD;\n" for i, (fb, _) in enumerate(cases))
+    calls = "".join(f"fb{i}(i_bEN := TRUE, i_bExecute := bGo, {arg + ', ' if arg else ''}io_uMbx := uMbx{i});\n"
+                    for i, (_, arg) in enumerate(cases))
+    harness = f"PROGRAM T_Wrappers\nVAR\n    bGo : BOOL;\n{decls}END_VAR\n{calls}END_PROGRAM\n"
+    project = verifier.load(PLC / "core", sources={"T_Wrappers.st": harness})
+    h = project.program("T_Wrappers")
+    project.run_programs(["T_Wrappers"], scans=1)
+    h.bGo = True
+    project.run_programs(["T_Wrappers"], scans=1)
+    return h
+
+
 def test_every_table_2_command_has_a_wrapper_as_uitamr_command_says():
     """UITAMR_Command's header sent integrators to it "for commands without a wrapper, e.g.
     coordinate reset or manual mode" while UITAMR_SetMode wraps both. Each wrapper of code 1
@@ -183,15 +198,7 @@ def test_every_table_2_command_has_a_wrapper_as_uitamr_command_says():
     cases = [("UITAMR_Tape", f"i_wAction := {a}") for a in range(1, 9)]
     cases += [("UITAMR_SetMode", f"i_wMode := {m}") for m in (1, 2)]
     cases += [("UITAMR_Pause", ""), ("UITAMR_Stop", "")]
-    decls = "".join(f"    fb{i} : {fb};\n    uMbx{i} : ARRAY[0..15] OF WORD;\n" for i, (fb, _) in enumerate(cases))
-    calls = "".join(f"fb{i}(i_bEN := TRUE, i_bExecute := bGo, {arg + ', ' if arg else ''}io_uMbx := uMbx{i});\n"
-                    for i, (_, arg) in enumerate(cases))
-    harness = f"PROGRAM T_Wrappers\nVAR\n    bGo : BOOL;\n{decls}END_VAR\n{calls}END_PROGRAM\n"
-    project = verifier.load(PLC / "core", sources={"T_Wrappers.st": harness})
-    h = project.program("T_Wrappers")
-    project.run_programs(["T_Wrappers"], scans=1)
-    h.bGo = True
-    project.run_programs(["T_Wrappers"], scans=1)
+    h = post_once(cases)
     posted = set()
     for i, _ in enumerate(cases):
         mbx = getattr(h, f"uMbx{i}")
@@ -259,16 +266,8 @@ def test_a_relative_move_is_accepted_while_it_rounds_into_the_command_byte():
              (2, "-25.46", 9, 255), (1, "25.55", 6, 255),
              (1, "25.56", None, None), (4, "-2.556", None, None), (1, "25.551", None, None),
              (4, "2.555", None, None)]
-    decls = "".join(f"    fb{i} : UITAMR_MoveRelative;\n    uMbx{i} : ARRAY[0..15] OF WORD;\n"
-                    for i in range(len(cases)))
-    calls = "".join(f"fb{i}(i_bEN := TRUE, i_bExecute := bGo, i_wAxis := {axis}, i_eValue := {value}, "
-                    f"io_uMbx := uMbx{i});\n" for i, (axis, value, _, _) in enumerate(cases))
-    harness = f"PROGRAM T_Move\nVAR\n    bGo : BOOL;\n{decls}END_VAR\n{calls}END_PROGRAM\n"
-    project = verifier.load(PLC / "core", sources={"T_Move.st": harness})
-    h = project.program("T_Move")
-    project.run_programs(["T_Move"], scans=1)
-    h.bGo = True
-    project.run_programs(["T_Move"], scans=1)
+    h = post_once([("UITAMR_MoveRelative", f"i_wAxis := {axis}, i_eValue := {value}")
+                   for axis, value, _, _ in cases])
     for i, (axis, value, code, units) in enumerate(cases):
         fb, mbx = getattr(h, f"fb{i}"), getattr(h, f"uMbx{i}")
         if code is None:      # refused: 16#0301 at once, nothing posted
