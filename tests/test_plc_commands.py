@@ -172,6 +172,21 @@ def test_hold_to_jog_needs_a_second_instance_for_the_stop():
         assert "second instance" in text and "UITAMR_PanelFx3" in text
 
 
+def post_once(cases):
+    """One instance per (FB, its input assignments) with its own mailbox and no engine, all
+    given one rising edge of i_bExecute: the program after that scan (fb<i>, uMbx<i>)."""
+    decls = "".join(f"    fb{i} : {fb};\n    uMbx{i} : ARRAY[0..15] OF WORD;\n" for i, (fb, _) in enumerate(cases))
+    calls = "".join(f"fb{i}(i_bEN := TRUE, i_bExecute := bGo, {arg + ', ' if arg else ''}io_uMbx := uMbx{i});\n"
+                    for i, (_, arg) in enumerate(cases))
+    harness = f"PROGRAM T_Wrappers\nVAR\n    bGo : BOOL;\n{decls}END_VAR\n{calls}END_PROGRAM\n"
+    project = verifier.load(PLC / "core", sources={"T_Wrappers.st": harness})
+    h = project.program("T_Wrappers")
+    project.run_programs(["T_Wrappers"], scans=1)
+    h.bGo = True
+    project.run_programs(["T_Wrappers"], scans=1)
+    return h
+
+
 def test_every_table_2_command_has_a_wrapper_as_uitamr_command_says():
     """UITAMR_Command's header sent integrators to it "for commands without a wrapper, e.g.
     coordinate reset or manual mode" while UITAMR_SetMode wraps both. Each wrapper of code 1
@@ -183,15 +198,7 @@ def test_every_table_2_command_has_a_wrapper_as_uitamr_command_says():
     cases = [("UITAMR_Tape", f"i_wAction := {a}") for a in range(1, 9)]
     cases += [("UITAMR_SetMode", f"i_wMode := {m}") for m in (1, 2)]
     cases += [("UITAMR_Pause", ""), ("UITAMR_Stop", "")]
-    decls = "".join(f"    fb{i} : {fb};\n    uMbx{i} : ARRAY[0..15] OF WORD;\n" for i, (fb, _) in enumerate(cases))
-    calls = "".join(f"fb{i}(i_bEN := TRUE, i_bExecute := bGo, {arg + ', ' if arg else ''}io_uMbx := uMbx{i});\n"
-                    for i, (_, arg) in enumerate(cases))
-    harness = f"PROGRAM T_Wrappers\nVAR\n    bGo : BOOL;\n{decls}END_VAR\n{calls}END_PROGRAM\n"
-    project = verifier.load(PLC / "core", sources={"T_Wrappers.st": harness})
-    h = project.program("T_Wrappers")
-    project.run_programs(["T_Wrappers"], scans=1)
-    h.bGo = True
-    project.run_programs(["T_Wrappers"], scans=1)
+    h = post_once(cases)
     posted = set()
     for i, _ in enumerate(cases):
         mbx = getattr(h, f"uMbx{i}")
@@ -247,3 +254,25 @@ def test_the_0301_detail_of_a_direct_uitamr_command_is_what_the_table_says():
     row = " ".join(re.search(r"^\| 16#0301 \|(.*)$", doc, flags=re.M).group(1).split())
     assert ("the kind (outside 1..3), else the `i_wCode` given - also when the command (0..255) or, "
             "for kind 3, the query (0..3) is the one out of range") in row.replace("—", "-")
+
+
+def test_a_relative_move_is_accepted_while_it_rounds_into_the_command_byte():
+    """UITAMR_MoveRelative rounds |i_eValue| / 0.1 m (0.01 rad) to the nearest unit but
+    refused anything above 255.0 units before rounding: 25.54 m, which rounds to 255 (the
+    byte's largest value, 25.5 m), ended with 16#0301 while 25.46 m, which rounds to 255
+    too, was sent. It now refuses only what rounds above 255 (255.5 units or more, in
+    REAL: 25.55 m is 255.49998 and 2.555 rad 255.50002), as its header says."""
+    cases = [(1, "25.54", 6, 255), (3, "-25.54", 11, 255), (4, "2.554", 12, 255), (2, "25.549", 8, 255),
+             (2, "-25.46", 9, 255), (1, "25.55", 6, 255),
+             (1, "25.56", None, None), (4, "-2.556", None, None), (1, "25.551", None, None),
+             (4, "2.555", None, None)]
+    h = post_once([("UITAMR_MoveRelative", f"i_wAxis := {axis}, i_eValue := {value}")
+                   for axis, value, _, _ in cases])
+    for i, (axis, value, code, units) in enumerate(cases):
+        fb, mbx = getattr(h, f"fb{i}"), getattr(h, f"uMbx{i}")
+        if code is None:      # refused: 16#0301 at once, nothing posted
+            assert (fb.o_bErr, fb.o_uErrId, mbx[0]) == (True, 0x0301, 0), (axis, value)
+        else:                 # posted: requested, that code and that distance
+            assert (fb.o_bErr, mbx[0], mbx[2], mbx[3]) == (False, 1, code, units), (axis, value)
+    header = " ".join((PLC / "core" / "UITAMR_MoveRelative.st").read_text(encoding="utf-8").split("*)", 1)[0].split())
+    assert "25.54 m sends 255; at 255.5 or more (25.56 m, 2.556 rad) 16#0301, nothing sent" in header

@@ -366,9 +366,11 @@ def test_out_of_range_parameters_send_nothing(rig):
 
 # 1.3 m / 0.1 and 0.59 m / 0.2 are 12.999999 and 2.9499998 in REAL: an FX3 CPU's
 # REAL_TO_INT drops the fraction (docs/instructions.md §3), the FBs must still send 13 and 3
+# (25.54 m rounds to 255, the byte's largest value: sent, not refused)
 @pytest.mark.parametrize("axis,value,code,units", [(1, 1.5, 6, 15), (1, -2.0, 7, 20), (2, 0.3, 8, 3),
                                                    (3, -25.5, 11, 255), (4, -0.25, 13, 25), (4, 2.55, 12, 255),
-                                                   (1, 1.3, 6, 13), (1, -1.3, 7, 13), (4, 0.29, 12, 29)])
+                                                   (1, 1.3, 6, 13), (1, -1.3, 7, 13), (4, 0.29, 12, 29),
+                                                   (1, 25.54, 6, 255)])
 def test_relative_moves_in_engineering_units(rig, axis, value, code, units):
     h, port = rig
     port.run(1500, until=lambda x: x.fbEngine.o_bInitDone)

@@ -341,3 +341,28 @@ def test_ladder_reports_a_silent_robot_when_the_stop_was_pressed(tmp_path, progr
         table("expect", that="Y3 AND D225 = 16#0101", after="4s", within="5s"), duration="12s",
         signal="Y3")
     assert result.passed, "\n".join(problems)
+
+
+def test_ladder_error_id_is_the_code_of_the_fault_it_shows(tmp_path, program):
+    """D225 kept the code of a failed attempt after its retry had succeeded (R12 and R15
+    wrote it on every failed attempt: a bad CRC left 16#0102 with no fault), and the code of
+    an acknowledged fault for good: an HMI read a stale error. It now behaves as the ST
+    example's cycle error (UITAMR_PointCycle's o_uErrId, D101 of UITAMR_ExampleFx3): written
+    when the fault M103 / Y3 is set, kept while it stands (a stop with X1 in the fault keeps
+    both), cleared by the acknowledge X2; a failed attempt that a retry makes good shows
+    nothing, as the engine reports a job's code only when the job ends."""
+    result, problems = run_ladder(
+        tmp_path, program, "ladder: error id follows the fault",
+        table("faults", kind="bad_crc", on_request=6),
+        table("faults", kind="no_reply", at_s=9.0, count=1),
+        table("faults", kind="no_reply", at_s=16.0, duration_s=4.0),
+        press("X1", "21s"), press("X2", "24s"), press("X0", "26s"),
+        table("expect", never="(D225 <> 0) <> Y3"),
+        table("expect", that="Y3 AND D225 = 16#0101", after="16s", within="5s"),
+        table("expect", always="Y3 AND D225 = 16#0101", after="21s", within="2900ms"),
+        table("expect", that="NOT Y3 AND D225 = 0", after="24s", within="1s"),
+        table("expect", reached_point=2, after="26s", within="30s"), duration="60s")
+    assert result.passed, "\n".join(problems)
+    tx = [f for f in result.trace if f.direction == "tx"]
+    assert len({f.data for f in tx if 8_000_000 < f.t_start_us < 15_000_000}) < len(
+        [f for f in tx if 8_000_000 < f.t_start_us < 15_000_000]), "no retry was exercised"
