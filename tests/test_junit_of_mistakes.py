@@ -4,6 +4,7 @@ replay --junit`): one error test case per mistake, at the place the mistake hold
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 from click.testing import CliRunner
 
@@ -191,3 +192,49 @@ def test_the_places_of_an_unusable_input_cross_worker_processes():
     assert (error.file, error.line, error.col, mistakes_of(error)) == ("M.st", 1, 2, each)
     alone = pickle.loads(pickle.dumps(UnusableInput("s.toml:2:3: program: x", at=("s.toml", 2, 3))))
     assert mistakes_of(alone) == [Mistake("s.toml:2:3: program: x", "s.toml", 2, 3)]
+
+
+def _monitor_of_a_closed_stream(tmp_path, *args):
+    """`uitamr monitor --tcp` against a server that sends the stop and its echo, then closes
+    the connection (the session ends by itself), over an earlier run's JUnit file."""
+    import socket
+    import threading
+
+    (tmp_path / "m.xml").write_text(OLD_RUN, encoding="utf-8")
+    stop = bytes.fromhex("01 06 01 A0 00 00 88 14")
+    with socket.create_server(("127.0.0.1", 0)) as server:
+        def stream():
+            connection, _ = server.accept()
+            with connection:
+                connection.sendall(stop)
+                connection.sendall(stop)
+
+        thread = threading.Thread(target=stream, daemon=True)
+        thread.start()
+        result = invoke("monitor", "--tcp", f"127.0.0.1:{server.getsockname()[1]}", "--duration", "5s", *args,
+                        "--junit", tmp_path / "m.xml")
+        thread.join(timeout=5)
+    assert result.exit_code == 2, result.output
+    return result
+
+
+def test_a_monitor_capture_that_cannot_be_written_is_the_junits_error(tmp_path):
+    """--capture to a full disk exits 2 after the reports were written: the JUnit held the
+    session's test case alone, so CI read a run that exits 2 as its verdict, without the
+    reason; now the capture's error follows the session's test case, as a report's does.
+    With --json failing too, both errors are in the file."""
+    result = _monitor_of_a_closed_stream(tmp_path, "--capture", "/dev/full")
+    assert "cannot write the capture /dev/full" in result.output
+    root = ET.parse(tmp_path / "m.xml").getroot()
+    run, refused = root.findall("./testsuite")
+    assert [case.get("classname") for case in run.findall("testcase")] == ["uitamr.monitor.line"]
+    (error_case,) = refused.findall("testcase")
+    assert error_case.find("error").get("message").startswith("cannot write the capture /dev/full: ")
+    assert root.get("tests") == "2" and root.get("errors") == str(int(run.get("errors")) + 1)
+    result = _monitor_of_a_closed_stream(tmp_path, "--json", "/dev/full", "--capture", "/proc/version")
+    assert "the runs' results, and these errors as test cases" in result.output
+    root = ET.parse(tmp_path / "m.xml").getroot()
+    messages = [case.find("error").get("message") for case in root.findall("./testsuite")[1].findall("testcase")]
+    assert [m.split(":", 1)[0] for m in messages] == ["cannot write /dev/full", "cannot write the capture /proc/version"]
+    page = " ".join((Path(__file__).parents[1] / "docs" / "verifier.md").read_text(encoding="utf-8").split())
+    assert "`uitamr monitor`'s `--capture` too: a capture it cannot write is an error after the session's test case" in page
