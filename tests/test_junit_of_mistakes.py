@@ -238,3 +238,24 @@ def test_a_monitor_capture_that_cannot_be_written_is_the_junits_error(tmp_path):
     assert [m.split(":", 1)[0] for m in messages] == ["cannot write /dev/full", "cannot write the capture /proc/version"]
     page = " ".join((Path(__file__).parents[1] / "docs" / "verifier.md").read_text(encoding="utf-8").split())
     assert "`uitamr monitor`'s `--capture` too: a capture it cannot write is an error after the session's test case" in page
+
+
+def test_every_exception_of_placed_mistakes_keeps_them_through_pickle():
+    """UnusableInput's pickling rebuilt an exception by calling its class with (message, at,
+    mistakes): ScenarioMistakes, whose constructor takes the errors, could not be rebuilt
+    (TypeError), and CaptureError, whose place became constructor arguments, neither."""
+    import pickle
+
+    from verifier.commands.verify import ScenarioMistakes
+    from verifier.monitor.capture import CaptureError, Where
+    from verifier.verify.result import UnusableInput, mistakes_of
+
+    several = ScenarioMistakes([UnusableInput("a.toml:1:2: program: x", at=("a.toml", 1, 2)),
+                                UnusableInput("--scan 5s: longer than the run")])
+    capture = CaptureError(Where("c.txt", 2, 3), "'0G' is not a byte in hex")
+    unreadable = CaptureError(Where("c.txt", 2, 10), "", message="c.txt: line 2, column 10 (byte 21): not UTF-8")
+    for error in (several, capture, unreadable, CaptureError(None, "c.txt: no such file")):
+        again = pickle.loads(pickle.dumps(error))
+        assert (type(again), str(again), mistakes_of(again)) == (type(error), str(error), mistakes_of(error))
+    assert mistakes_of(pickle.loads(pickle.dumps(capture))) == [
+        Mistake("c.txt:2:3: '0G' is not a byte in hex", "c.txt", 2, 3)]

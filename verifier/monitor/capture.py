@@ -85,6 +85,13 @@ class CaptureError(Exception):
         self.where = where
         self.file, self.line, self.col = where if where is not None else (None, None, None)
 
+    def __reduce__(self):  # its place with it: the constructor takes it apart from the message
+        return _capture_error, (self.where, str(self))
+
+
+def _capture_error(where: Where | None, message: str) -> CaptureError:
+    return CaptureError(where, "", message=message)
+
 
 _TIME = re.compile(r"\s*([0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?=\s|$)")
 _HEX_PAIR = re.compile(r"[0-9A-Fa-f]{2}")
