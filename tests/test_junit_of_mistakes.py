@@ -259,3 +259,22 @@ def test_every_exception_of_placed_mistakes_keeps_them_through_pickle():
         assert (type(again), str(again), mistakes_of(again)) == (type(error), str(error), mistakes_of(error))
     assert mistakes_of(pickle.loads(pickle.dumps(capture))) == [
         Mistake("c.txt:2:3: '0G' is not a byte in hex", "c.txt", 2, 3)]
+
+
+def test_a_monitor_whose_line_cannot_be_opened_writes_that_to_its_junit(tmp_path):
+    """A converter that refuses the connection (or a serial port another program holds)
+    ended the monitor with exit 2 and left the earlier run's JUnit file as it was: CI showed
+    that run's results as this one's. Now the file holds the error."""
+    import socket
+
+    (tmp_path / "m.xml").write_text(OLD_RUN, encoding="utf-8")
+    with socket.create_server(("127.0.0.1", 0)) as server:
+        port = server.getsockname()[1]
+    result = invoke("monitor", "--tcp", f"127.0.0.1:{port}", "--junit", tmp_path / "m.xml")
+    assert result.exit_code == 2, result.output
+    assert f"wrote {tmp_path / 'm.xml'} (these errors as test cases)" in result.output
+    (case,) = cases(tmp_path / "m.xml")
+    assert case.get("classname") == "uitamr.monitor.input"
+    assert case.find("error").get("message").startswith(f"cannot connect to 127.0.0.1:{port}: ")
+    page = " ".join((Path(__file__).parents[1] / "docs" / "verifier.md").read_text(encoding="utf-8").split())
+    assert "`uitamr monitor --junit` for a line it cannot open" in page

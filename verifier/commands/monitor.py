@@ -22,8 +22,8 @@ from rich.markup import escape
 from verifier import protocol
 from verifier.commands.emulate import STANDARD_BAUD_RATES, _tcp_endpoint
 from verifier.commands.protocol_options import protocol_settings
-from verifier.commands.report_files import (ReportError, check_folders, junit_of_refused_report, report_options,
-                                             text_console, write_reports)
+from verifier.commands.report_files import (ReportError, check_folders, junit_of_mistakes, junit_of_refused_report,
+                                             report_options, text_console, write_reports)
 from verifier.commands.verify import _Duration
 from verifier.emulate.ports import serial_url_problem
 from verifier.monitor.capture import format_plain, tolerance_hides_pacing
@@ -32,7 +32,7 @@ from verifier.monitor.session import CaptureInfo, MonitorSession
 from verifier.monitor.sources import SerialSource, SourceError, TcpSource, now_us
 from verifier.monitor.view import MonitorView
 from verifier.verify.evidence import RuleOptions
-from verifier.verify.result import NO_TRAFFIC, overall_verdict
+from verifier.verify.result import NO_TRAFFIC, Mistake, overall_verdict
 
 EXIT_CLEAN, EXIT_FINDINGS, EXIT_UNUSABLE, EXIT_NO_TRAFFIC = 0, 1, 2, 3
 #: how often the rules judge what the line has settled since the last time
@@ -118,8 +118,9 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
             host, port = _tcp_endpoint(tcp)
             source = TcpSource(host, port)
             channel = "tcp"
-    except SourceError as exc:
+    except SourceError as exc:  # the line cannot be opened: the JUnit says so, not the last run's results
         click.echo(f"uitamr monitor: {exc}", err=True)
+        mistakes_junit(junit_path, [Mistake(str(exc))], "uitamr monitor")
         sys.exit(EXIT_UNUSABLE)
     info = CaptureInfo(f"monitor {source.description}", source.description, channel, line=f"{baud} {line_format}")
     if reply_timeout is None:
@@ -214,6 +215,14 @@ def _reports(results, console: Console, json_path, junit_path, trace_path, html_
         click.echo(f"{command}: {exc}", err=True)
         return [exc]
     return []
+
+
+def mistakes_junit(junit_path, mistakes: list[Mistake], command: str) -> None:
+    """For exit 2 before a session (a line that cannot be opened, a capture that cannot be
+    read): the mistakes in --junit's file, when one is given, and a line on stderr that says
+    so or why not."""
+    if junit_path:
+        click.echo(f"{command}: {junit_of_mistakes(junit_path, mistakes, command)[1]}", err=True)
 
 
 def refused_report_junit(junit_path, errors: ReportError | list[ReportError], command: str, inputs=(),
