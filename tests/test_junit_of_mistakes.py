@@ -4,6 +4,7 @@ replay --junit`): one error test case per mistake, at the place the mistake hold
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 from click.testing import CliRunner
 
@@ -191,3 +192,89 @@ def test_the_places_of_an_unusable_input_cross_worker_processes():
     assert (error.file, error.line, error.col, mistakes_of(error)) == ("M.st", 1, 2, each)
     alone = pickle.loads(pickle.dumps(UnusableInput("s.toml:2:3: program: x", at=("s.toml", 2, 3))))
     assert mistakes_of(alone) == [Mistake("s.toml:2:3: program: x", "s.toml", 2, 3)]
+
+
+def _monitor_of_a_closed_stream(tmp_path, *args):
+    """`uitamr monitor --tcp` against a server that sends the stop and its echo, then closes
+    the connection (the session ends by itself), over an earlier run's JUnit file."""
+    import socket
+    import threading
+
+    (tmp_path / "m.xml").write_text(OLD_RUN, encoding="utf-8")
+    stop = bytes.fromhex("01 06 01 A0 00 00 88 14")
+    with socket.create_server(("127.0.0.1", 0)) as server:
+        def stream():
+            connection, _ = server.accept()
+            with connection:
+                connection.sendall(stop)
+                connection.sendall(stop)
+
+        thread = threading.Thread(target=stream, daemon=True)
+        thread.start()
+        result = invoke("monitor", "--tcp", f"127.0.0.1:{server.getsockname()[1]}", "--duration", "5s", *args,
+                        "--junit", tmp_path / "m.xml")
+        thread.join(timeout=5)
+    assert result.exit_code == 2, result.output
+    return result
+
+
+def test_a_monitor_capture_that_cannot_be_written_is_the_junits_error(tmp_path):
+    """--capture to a full disk exits 2 after the reports were written: the JUnit held the
+    session's test case alone, so CI read a run that exits 2 as its verdict, without the
+    reason; now the capture's error follows the session's test case, as a report's does.
+    With --json failing too, both errors are in the file."""
+    result = _monitor_of_a_closed_stream(tmp_path, "--capture", "/dev/full")
+    assert "cannot write the capture /dev/full" in result.output
+    root = ET.parse(tmp_path / "m.xml").getroot()
+    run, refused = root.findall("./testsuite")
+    assert [case.get("classname") for case in run.findall("testcase")] == ["uitamr.monitor.line"]
+    (error_case,) = refused.findall("testcase")
+    assert error_case.find("error").get("message").startswith("cannot write the capture /dev/full: ")
+    assert root.get("tests") == "2" and root.get("errors") == str(int(run.get("errors")) + 1)
+    result = _monitor_of_a_closed_stream(tmp_path, "--json", "/dev/full", "--capture", "/proc/version")
+    assert "the runs' results, and these errors as test cases" in result.output
+    root = ET.parse(tmp_path / "m.xml").getroot()
+    messages = [case.find("error").get("message") for case in root.findall("./testsuite")[1].findall("testcase")]
+    assert [m.split(":", 1)[0] for m in messages] == ["cannot write /dev/full", "cannot write the capture /proc/version"]
+    page = " ".join((Path(__file__).parents[1] / "docs" / "verifier.md").read_text(encoding="utf-8").split())
+    assert "`uitamr monitor`'s `--capture` too: a capture it cannot write is an error after the session's test case" in page
+
+
+def test_every_exception_of_placed_mistakes_keeps_them_through_pickle():
+    """UnusableInput's pickling rebuilt an exception by calling its class with (message, at,
+    mistakes): ScenarioMistakes, whose constructor takes the errors, could not be rebuilt
+    (TypeError), and CaptureError, whose place became constructor arguments, neither."""
+    import pickle
+
+    from verifier.commands.verify import ScenarioMistakes
+    from verifier.monitor.capture import CaptureError, Where
+    from verifier.verify.result import UnusableInput, mistakes_of
+
+    several = ScenarioMistakes([UnusableInput("a.toml:1:2: program: x", at=("a.toml", 1, 2)),
+                                UnusableInput("--scan 5s: longer than the run")])
+    capture = CaptureError(Where("c.txt", 2, 3), "'0G' is not a byte in hex")
+    unreadable = CaptureError(Where("c.txt", 2, 10), "", message="c.txt: line 2, column 10 (byte 21): not UTF-8")
+    for error in (several, capture, unreadable, CaptureError(None, "c.txt: no such file")):
+        again = pickle.loads(pickle.dumps(error))
+        assert (type(again), str(again), mistakes_of(again)) == (type(error), str(error), mistakes_of(error))
+    assert mistakes_of(pickle.loads(pickle.dumps(capture))) == [
+        Mistake("c.txt:2:3: '0G' is not a byte in hex", "c.txt", 2, 3)]
+
+
+def test_a_monitor_whose_line_cannot_be_opened_writes_that_to_its_junit(tmp_path):
+    """A converter that refuses the connection (or a serial port another program holds)
+    ended the monitor with exit 2 and left the earlier run's JUnit file as it was: CI showed
+    that run's results as this one's. Now the file holds the error."""
+    import socket
+
+    (tmp_path / "m.xml").write_text(OLD_RUN, encoding="utf-8")
+    with socket.create_server(("127.0.0.1", 0)) as server:
+        port = server.getsockname()[1]
+    result = invoke("monitor", "--tcp", f"127.0.0.1:{port}", "--junit", tmp_path / "m.xml")
+    assert result.exit_code == 2, result.output
+    assert f"wrote {tmp_path / 'm.xml'} (these errors as test cases)" in result.output
+    (case,) = cases(tmp_path / "m.xml")
+    assert case.get("classname") == "uitamr.monitor.input"
+    assert case.find("error").get("message").startswith(f"cannot connect to 127.0.0.1:{port}: ")
+    page = " ".join((Path(__file__).parents[1] / "docs" / "verifier.md").read_text(encoding="utf-8").split())
+    assert "`uitamr monitor --junit` for a line it cannot open" in page

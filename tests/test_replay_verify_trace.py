@@ -150,7 +150,8 @@ FRAME = '{"scenario": "a", "t": 0.1, "t_end": 0.108, "dir": "tx", "hex": "01 06 
     (['{"scenario": "a", "end": 1, "response_signal": "o_bErr", "response_signal_held": [[0.5, 1.5]]}'],
      "t.jsonl:2:1: 'response_signal_held' item 1, held until 1.5 s, is after the end of the run 'a' (1 s, "),
     (['{"scenario": "a", "end": 1, "response_signal": "o_bErr", "response_signal_held": [[1.2, null]]}'],
-     "t.jsonl:2:1: 'response_signal_held' item 1, held until 1.2 s, is after the end of the run 'a' (1 s, "),
+     # still holding at the end: it began after it (it was "held until 1.2 s", its start)
+     "t.jsonl:2:1: 'response_signal_held' item 1, holding from 1.2 s on, is after the end of the run 'a' (1 s, "),
     (['{"scenario": "a", "end": 1, "protocol": {"address": 300}}'],
      "t.jsonl:2:1: 'protocol': robot address must be 1-247, got 300"),
     (['{"scenario": "a", "end": 1, "protocol": {"baud": 9600}}'],

@@ -22,8 +22,8 @@ from rich.markup import escape
 from verifier import protocol
 from verifier.commands.emulate import STANDARD_BAUD_RATES, _tcp_endpoint
 from verifier.commands.protocol_options import protocol_settings
-from verifier.commands.report_files import (ReportError, check_folders, junit_of_refused_report, report_options,
-                                             text_console, write_reports)
+from verifier.commands.report_files import (ReportError, check_folders, junit_of_mistakes, junit_of_refused_report,
+                                             report_options, text_console, write_reports)
 from verifier.commands.verify import _Duration
 from verifier.emulate.ports import serial_url_problem
 from verifier.monitor.capture import format_plain, tolerance_hides_pacing
@@ -32,7 +32,7 @@ from verifier.monitor.session import CaptureInfo, MonitorSession
 from verifier.monitor.sources import SerialSource, SourceError, TcpSource, now_us
 from verifier.monitor.view import MonitorView
 from verifier.verify.evidence import RuleOptions
-from verifier.verify.result import NO_TRAFFIC, overall_verdict
+from verifier.verify.result import NO_TRAFFIC, Mistake, overall_verdict
 
 EXIT_CLEAN, EXIT_FINDINGS, EXIT_UNUSABLE, EXIT_NO_TRAFFIC = 0, 1, 2, 3
 #: how often the rules judge what the line has settled since the last time
@@ -118,8 +118,9 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
             host, port = _tcp_endpoint(tcp)
             source = TcpSource(host, port)
             channel = "tcp"
-    except SourceError as exc:
+    except SourceError as exc:  # the line cannot be opened: the JUnit says so, not the last run's results
         click.echo(f"uitamr monitor: {exc}", err=True)
+        mistakes_junit(junit_path, [Mistake(str(exc))], "uitamr monitor")
         sys.exit(EXIT_UNUSABLE)
     info = CaptureInfo(f"monitor {source.description}", source.description, channel, line=f"{baud} {line_format}")
     if reply_timeout is None:
@@ -160,9 +161,9 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
     result = session.result(listened_us=round((time.monotonic() - started) * 1_000_000))
     if lost:
         result.notes.append(f"the capture ended early: {lost}")
-    capture_written = True
+    failed: list[ReportError] = []
     try:
-        _finish([result], console, json_path, junit_path, trace_path, html_path, "uitamr monitor")
+        failed += _reports([result], console, json_path, junit_path, trace_path, html_path, "uitamr monitor")
     finally:
         # the capture is the line's only record (the reports can be made again from it by
         # `uitamr replay`): it is written even when a report cannot be
@@ -174,11 +175,15 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
             try:
                 Path(capture_path).write_text(text, encoding="utf-8")
             except OSError as exc:
-                click.echo(f"uitamr monitor: cannot write the capture {capture_path}: {exc.strerror or exc}", err=True)
-                capture_written = False
+                failed.append(ReportError(f"cannot write the capture {capture_path}: {exc.strerror or exc}",
+                                          capture_path))
+                click.echo(f"uitamr monitor: {failed[-1]}", err=True)
             else:
                 console.print(f"[dim]wrote {escape(str(capture_path))}[/]")
-    sys.exit(exit_status([result]) if capture_written else EXIT_UNUSABLE)
+    if failed:  # exit 2: --junit's file says why, after the session's test case
+        refused_report_junit(junit_path, failed, "uitamr monitor", (), [result])
+        sys.exit(EXIT_UNUSABLE)
+    sys.exit(exit_status([result]))
 
 
 def exit_status(results) -> int:
@@ -189,7 +194,18 @@ def exit_status(results) -> int:
 
 def _finish(results, console: Console, json_path, junit_path, trace_path, html_path, command: str,
             inputs=()) -> None:
-    """The console report, then the report files, which name `command` as their maker."""
+    """The console report, then the report files, which name `command` as their maker; exit 2
+    when one cannot be written, with that mistake in --junit's file."""
+    failed = _reports(results, console, json_path, junit_path, trace_path, html_path, command)
+    if failed:
+        refused_report_junit(junit_path, failed, command, inputs, results)
+        sys.exit(EXIT_UNUSABLE)
+
+
+def _reports(results, console: Console, json_path, junit_path, trace_path, html_path,
+             command: str) -> list[ReportError]:
+    """The console report, then the report files; the report that could not be written (said
+    on stderr), if one could not."""
     from verifier.verify import report_console
 
     report_console.render(results, console)
@@ -197,13 +213,22 @@ def _finish(results, console: Console, json_path, junit_path, trace_path, html_p
         write_reports(results, console, json_path, junit_path, trace_path, html_path, command)
     except ReportError as exc:
         click.echo(f"{command}: {exc}", err=True)
-        refused_report_junit(junit_path, exc, command, inputs, results)
-        sys.exit(EXIT_UNUSABLE)
+        return [exc]
+    return []
 
 
-def refused_report_junit(junit_path, error: ReportError, command: str, inputs=(), results=()) -> None:
-    """For exit 2 from another report than the JUnit (a refused path, one that cannot be
-    written): that mistake in --junit's file, and a line on stderr that says so or why not."""
-    junit = junit_of_refused_report(junit_path, error, command, inputs, results)
+def mistakes_junit(junit_path, mistakes: list[Mistake], command: str) -> None:
+    """For exit 2 before a session (a line that cannot be opened, a capture that cannot be
+    read): the mistakes in --junit's file, when one is given, and a line on stderr that says
+    so or why not."""
+    if junit_path:
+        click.echo(f"{command}: {junit_of_mistakes(junit_path, mistakes, command)[1]}", err=True)
+
+
+def refused_report_junit(junit_path, errors: ReportError | list[ReportError], command: str, inputs=(),
+                         results=()) -> None:
+    """For exit 2 from other reports than the JUnit (a refused path, one that cannot be
+    written): those mistakes in --junit's file, and a line on stderr that says so or why not."""
+    junit = junit_of_refused_report(junit_path, errors, command, inputs, results)
     if junit is not None:
         click.echo(f"{command}: {junit[1]}", err=True)

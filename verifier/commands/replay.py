@@ -15,10 +15,9 @@ from pathlib import Path
 import click
 
 from verifier.commands.monitor import (EXIT_UNUSABLE, _finish, exit_status, line_options, line_timing,
-                                       refused_report_junit)
+                                       mistakes_junit, refused_report_junit)
 from verifier.commands.protocol_options import given_settings, protocol_settings
-from verifier.commands.report_files import (ReportError, check_folders, check_not_inputs, junit_of_mistakes,
-                                             report_options, text_console)
+from verifier.commands.report_files import ReportError, check_folders, check_not_inputs, report_options, text_console
 from verifier.monitor.capture import CaptureError, read_capture
 from verifier.monitor.framer import DEFAULT_TOLERANCE_US
 from verifier.monitor.session import CaptureInfo, MonitorSession
@@ -48,9 +47,7 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
             loaded = read_capture(path)
         except CaptureError as exc:
             click.echo(f"uitamr replay: {exc}", err=True)
-            if junit_path:  # the CI server shows the mistake, not a missing report
-                said = junit_of_mistakes(junit_path, mistakes_of(exc), "uitamr replay")[1]
-                click.echo(f"uitamr replay: {said}", err=True)
+            mistakes_junit(junit_path, mistakes_of(exc), "uitamr replay")  # the CI server shows the mistake
             sys.exit(EXIT_UNUSABLE)
         is_trace = any(chunk.direction is not None for chunks in loaded.values() for chunk in chunks)
         # a monitor's trace says the tolerance its host times were judged with; other frames

@@ -119,23 +119,26 @@ def junit_of_mistakes(junit_path, mistakes: list, command: str, inputs=(), resul
     except OSError as exc:
         return False, f"the JUnit report was not written: cannot write {junit_path}: {exc.strerror or exc}"
     if results:
-        return True, f"wrote {junit_path} (the runs' results, and this error as a test case)"
+        these = "this error as a test case" if len(mistakes) == 1 else "these errors as test cases"
+        return True, f"wrote {junit_path} (the runs' results, and {these})"
     return True, f"wrote {junit_path} (these errors as test cases)"
 
 
-def junit_of_refused_report(junit_path, error: ReportError, command: str, inputs=(),
+def junit_of_refused_report(junit_path, errors: ReportError | list[ReportError], command: str, inputs=(),
                             results=()) -> tuple[bool, str] | None:
-    """For a run that exits 2 because another report than the JUnit cannot be written (its
-    folder does not exist, two reports given one file, a report over an input file, a full
-    disk): that mistake written to --junit's file as an error, as `junit_of_mistakes` does,
-    so that a CI server does not show an earlier run's file as this one's; `results` (a report
-    that failed after the runs) stay in it beside the error. None when there is no --junit or
-    the refused path is its own; else what `junit_of_mistakes` returns."""
+    """For a run that exits 2 because other reports than the JUnit cannot be written (a
+    folder that does not exist, two reports given one file, a report over an input file, a
+    full disk; `uitamr monitor`'s capture too): those mistakes written to --junit's file as
+    errors, as `junit_of_mistakes` does, so that a CI server does not show an earlier run's
+    file as this one's; `results` (reports that failed after the runs) stay in it beside the
+    errors. None when there is no --junit or a refused path is its own; else what
+    `junit_of_mistakes` returns."""
     from verifier.verify.result import Mistake
 
-    if not junit_path or any(real_path(path) == real_path(junit_path) for path in error.paths):
+    errors = [errors] if isinstance(errors, ReportError) else list(errors)
+    if not junit_path or any(real_path(path) == real_path(junit_path) for error in errors for path in error.paths):
         return None
-    return junit_of_mistakes(junit_path, [Mistake(str(error))], command, inputs, results)
+    return junit_of_mistakes(junit_path, [Mistake(str(error)) for error in errors], command, inputs, results)
 
 
 def write_reports(results, console: Console, json_path=None, junit_path=None, trace_path=None,

@@ -85,6 +85,13 @@ class CaptureError(Exception):
         self.where = where
         self.file, self.line, self.col = where if where is not None else (None, None, None)
 
+    def __reduce__(self):  # its place with it: the constructor takes it apart from the message
+        return _capture_error, (self.where, str(self))
+
+
+def _capture_error(where: Where | None, message: str) -> CaptureError:
+    return CaptureError(where, "", message=message)
+
 
 _TIME = re.compile(r"\s*([0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?=\s|$)")
 _HEX_PAIR = re.compile(r"[0-9A-Fa-f]{2}")
@@ -198,8 +205,10 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
             within = [(event.t_us, Where(name, line, 1), f"the event record at {event.t_us / 1e6:g} s")
                       for event, line in recorded]
             for k, (began, stopped) in enumerate(end.signal_held or ()):
-                last = began if stopped is None else stopped
-                within.append((last, where, f"'response_signal_held' item {k + 1}, held until {last / 1e6:g} s,"))
+                # a stretch still holding at the end (stopped null) began after it
+                last, held = (began, f"holding from {began / 1e6:g} s on") if stopped is None else \
+                    (stopped, f"held until {stopped / 1e6:g} s")
+                within.append((last, where, f"'response_signal_held' item {k + 1}, {held},"))
             _nothing_after_the_end(end.t_us, within, number, scenario)
             chunks.append(replace(end, events=tuple(event for event, _ in recorded)))
             ended[scenario] = number

@@ -15,13 +15,10 @@ class LoadError(Exception):
         super().__init__(f"{heading}:\n" + "\n".join("  " + s for s in lines))
 
     def place(self) -> tuple[str, int, int] | None:
-        """(file, line, column) of the first diagnostic that names a source's line (not an
+        """(file, line, column) of the first error that names a source's line (not an
         option of verifier.load), as its line of the message shows it; None if none does."""
-        for d in self.diagnostics:
-            file = getattr(d, "file", "?")
-            if not file.startswith(OPTION_PLACE):
-                return file, getattr(d, "line", 0), getattr(d, "col", 0)
-        return None
+        located = self.located()
+        return located[0][:3] if located else None
 
     def located(self) -> list[tuple[str, int, int, str]]:
         """(file, line, column, its line of the message) of each error that names a source's

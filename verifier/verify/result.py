@@ -94,7 +94,15 @@ class UnusableInput(Exception):
 
     def __reduce__(self):  # across --jobs' worker processes with its places
         at = None if self.file is None else (self.file, self.line, self.col)
-        return type(self), (str(self), at, getattr(self, "mistakes", None))
+        return _unusable_input, (type(self), str(self), at, getattr(self, "mistakes", None))
+
+
+def _unusable_input(kind: type, message: str, at, mistakes) -> UnusableInput:
+    """An UnusableInput (or a subclass, whatever its constructor takes: ScenarioMistakes) as
+    pickled: its message, place and mistakes."""
+    error = kind.__new__(kind, message)
+    UnusableInput.__init__(error, message, at, mistakes)
+    return error
 
 
 @dataclass(frozen=True, slots=True)

@@ -283,31 +283,29 @@ def _key_where(scenario: Scenario, key: str) -> str:
     `file:line:col: key`, `--key` when the command line's option replaced the file's, the
     SOURCES arguments when they replaced the file's sources, else the start of the file
     (Scenario.key_where). The runner's one way to place a key: it knows the command line."""
+    return _key_place(scenario, key)[0]
+
+
+def _key_place(scenario: Scenario, key: str) -> tuple[str, tuple[str, int, int] | None]:
+    """`_key_where(scenario, key)`, and the place it names as data (UnusableInput's `at`):
+    none for the SOURCES arguments or an option."""
     if key in scenario.key_lines:
-        return scenario.where(key, scenario.key_lines[key])
+        line = scenario.key_lines[key]
+        return scenario.where(key, line), scenario.at(line)
     if key == "sources" and scenario.sources:  # SOURCES are arguments, no option: name the files
         shown = [_display_path(p) for p in scenario.sources[:3]]
         more = f" and {len(scenario.sources) - 3} more" if len(scenario.sources) > 3 else ""
-        return f"SOURCES ({', '.join(shown)}{more})"
+        return f"SOURCES ({', '.join(shown)}{more})", None
     if key != "sources" and getattr(scenario, f"{key}_from_option"):
-        return f"--{key}"  # given on the command line: no file is where to look
-    return scenario.key_where(key)
-
-
-def _key_at(scenario: Scenario, key: str) -> tuple[str, int, int] | None:
-    """The place `_key_where(scenario, key)` names, as data (UnusableInput's `at`): none for
-    the SOURCES arguments or an option."""
-    if key in scenario.key_lines:
-        return scenario.at(scenario.key_lines[key])
-    if (key == "sources" and scenario.sources) or (key != "sources" and getattr(scenario, f"{key}_from_option")):
-        return None
-    return scenario.key_at(key)
+        return f"--{key}", None  # given on the command line: no file is where to look
+    return scenario.key_where(key), scenario.key_at(key)
 
 
 def _key_mistake(scenario: Scenario, key: str, text: str) -> UnusableInput:
-    """`text` as the mistake of the scenario's `key`: the message at `_key_where`, the place
-    (for the JUnit report) at `_key_at`, so that the two cannot disagree."""
-    return UnusableInput(f"{_key_where(scenario, key)}: {text}", at=_key_at(scenario, key))
+    """`text` as the mistake of the scenario's `key`: the message and the place (for the
+    JUnit report) from `_key_place`, so that the two cannot disagree."""
+    where, at = _key_place(scenario, key)
+    return UnusableInput(f"{where}: {text}", at=at)
 
 
 def _line_mistake(scenario: Scenario, key: str, line: Place | None, text: str) -> UnusableInput:
