@@ -278,3 +278,16 @@ def test_a_monitor_whose_line_cannot_be_opened_writes_that_to_its_junit(tmp_path
     assert case.find("error").get("message").startswith(f"cannot connect to 127.0.0.1:{port}: ")
     page = " ".join((Path(__file__).parents[1] / "docs" / "verifier.md").read_text(encoding="utf-8").split())
     assert "`uitamr monitor --junit` for a line it cannot open" in page
+
+
+def test_matrix_on_st_that_loads_nowhere_names_every_error(tmp_path):
+    """`--matrix` tells the platform from the sources; ST with two errors said only the first
+    ('the sources do not load: ...:5:6: ...'), on the console and in the JUnit, where a run
+    without --matrix lists both: now both, one test case each."""
+    write_files(tmp_path, {"MAIN.st": TWO_ERRORS})
+    source = tmp_path / "MAIN.st"
+    result = invoke("verify", source, "--matrix", "--junit", tmp_path / "v.xml")
+    assert result.exit_code == 2, result.output
+    assert f"the sources do not load: {source}:5:6: error: undefined label 'y'" in result.output
+    assert f"{source}:6:6: error: undefined label 'z'" in result.output
+    assert [case.get("name") for case in cases(tmp_path / "v.xml")] == [f"{source}:5:6", f"{source}:6:6"]

@@ -13,7 +13,7 @@ import re
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from .result import UnusableInput
+from .result import Mistake, UnusableInput
 from .scenario import PLATFORMS, TOLD_PLATFORMS, bundled_platform
 
 if TYPE_CHECKING:
@@ -56,7 +56,13 @@ def infer_platform(sources: tuple[Path, ...]) -> str:
         first = {platform: _first_error(exc) for platform, exc in errors.items()}
         if len(set(first.values())) == 1:  # the same mistake everywhere: an ST error
             exc = next(iter(errors.values()))
-            raise UnusableInput(f"the sources do not load: {_first_error(exc)}", at=exc.place())
+            # every error of the sources, as a run without --matrix lists them; one JUnit test case each
+            located = exc.located()
+            if not located:
+                raise UnusableInput(f"the sources do not load: {_first_error(exc)}", at=exc.place())
+            each = [Mistake(f"the sources do not load: {text}", file, line, col) for file, line, col, text in located]
+            raise UnusableInput("the sources do not load: " + "\n  ".join(text for *_, text in located),
+                                at=located[0][:3], mistakes=each)
         reasons = "; ".join(f"{platform}: {error}" for platform, error in first.items())
         raise UnusableInput(f"the sources load on no platform ({reasons})")
     # the platforms named only, never told (an FX3G), beside the one whose scenarios they run
