@@ -111,7 +111,8 @@ def _xml_safe(text: str | None) -> str | None:
 
 def unusable_element(mistakes: list[Mistake], command: str = "uitamr verify",
                      results: list[ScenarioResult] = ()) -> ET.Element:
-    """The report of a run that could not start (exit 2): one test case per mistake, an
+    """The report of a run that exits 2 (it could not start, or a report could not be written
+    after the runs): one test case per mistake, an
     `<error type="unusable-input">` whose message is the mistake's line that names its place
     (file:line:col), from the place on, and whose text is the whole message, so that the CI
     server shows what to fix instead of a missing report (or the last run's). The places are
