@@ -22,7 +22,7 @@ from rich.markup import escape
 from verifier import protocol
 from verifier.commands.emulate import STANDARD_BAUD_RATES, _tcp_endpoint
 from verifier.commands.protocol_options import protocol_settings
-from verifier.commands.report_files import (ReportError, check_folders, junit_of_mistakes, junit_of_refused_report,
+from verifier.commands.report_files import (ReportError, check_folders, mistakes_junit, refused_report_junit,
                                              report_options, text_console, write_reports)
 from verifier.commands.verify import _Duration
 from verifier.emulate.ports import serial_url_problem
@@ -215,20 +215,3 @@ def _reports(results, console: Console, json_path, junit_path, trace_path, html_
         click.echo(f"{command}: {exc}", err=True)
         return [exc]
     return []
-
-
-def mistakes_junit(junit_path, mistakes: list[Mistake], command: str) -> None:
-    """For exit 2 before a session (a line that cannot be opened, a capture that cannot be
-    read): the mistakes in --junit's file, when one is given, and a line on stderr that says
-    so or why not."""
-    if junit_path:
-        click.echo(f"{command}: {junit_of_mistakes(junit_path, mistakes, command)[1]}", err=True)
-
-
-def refused_report_junit(junit_path, errors: ReportError | list[ReportError], command: str, inputs=(),
-                         results=()) -> None:
-    """For exit 2 from other reports than the JUnit (a refused path, one that cannot be
-    written): those mistakes in --junit's file, and a line on stderr that says so or why not."""
-    junit = junit_of_refused_report(junit_path, errors, command, inputs, results)
-    if junit is not None:
-        click.echo(f"{command}: {junit[1]}", err=True)

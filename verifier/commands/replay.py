@@ -14,10 +14,10 @@ from pathlib import Path
 
 import click
 
-from verifier.commands.monitor import (EXIT_UNUSABLE, _finish, exit_status, line_options, line_timing,
-                                       mistakes_junit, refused_report_junit)
+from verifier.commands.monitor import EXIT_UNUSABLE, _finish, exit_status, line_options, line_timing
 from verifier.commands.protocol_options import given_settings, protocol_settings
-from verifier.commands.report_files import ReportError, check_folders, check_not_inputs, report_options, text_console
+from verifier.commands.report_files import (ReportError, check_folders, check_not_inputs, mistakes_junit,
+                                             refused_report_junit, report_options, text_console)
 from verifier.monitor.capture import CaptureError, read_capture
 from verifier.monitor.framer import DEFAULT_TOLERANCE_US
 from verifier.monitor.session import CaptureInfo, MonitorSession

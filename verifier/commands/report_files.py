@@ -141,6 +141,23 @@ def junit_of_refused_report(junit_path, errors: ReportError | list[ReportError],
     return junit_of_mistakes(junit_path, [Mistake(str(error)) for error in errors], command, inputs, results)
 
 
+def mistakes_junit(junit_path, mistakes: list, command: str) -> None:
+    """For exit 2 before a session (a line that cannot be opened, a capture that cannot be
+    read): the mistakes in --junit's file, when one is given, and a line on stderr that says
+    so or why not."""
+    if junit_path:
+        click.echo(f"{command}: {junit_of_mistakes(junit_path, mistakes, command)[1]}", err=True)
+
+
+def refused_report_junit(junit_path, errors: ReportError | list[ReportError], command: str, inputs=(),
+                         results=()) -> None:
+    """For exit 2 from other reports than the JUnit (a refused path, one that cannot be
+    written): those mistakes in --junit's file, and a line on stderr that says so or why not."""
+    junit = junit_of_refused_report(junit_path, errors, command, inputs, results)
+    if junit is not None:
+        click.echo(f"{command}: {junit[1]}", err=True)
+
+
 def write_reports(results, console: Console, json_path=None, junit_path=None, trace_path=None,
                   html_path=None, command: str = "uitamr verify") -> None:
     """The report files asked for; `command` (`uitamr monitor`, `uitamr replay`) is named

@@ -102,22 +102,25 @@ def _unusable_input(junit_path: str | None, inputs, error: Exception) -> None:
     # the console shows each scenario file's mistake as its own error line, and ST that does
     # not load as one message listing its errors (the JUnit report has a test case for each)
     messages = [mistake.message for mistake in mistakes] if isinstance(error, ScenarioMistakes) else [str(error)]
-    done = None
-    if junit_path:
-        written, said = junit_of_mistakes(junit_path, mistakes, "uitamr verify", inputs)
-        messages, done = (messages, said) if written else ([*messages, said], None)
-    _unusable(*messages, done=done)
+    _unusable_after(messages, junit_of_mistakes(junit_path, mistakes, "uitamr verify", inputs) if junit_path else None)
 
 
 def _refused_report(junit_path: str | None, error: ReportError, inputs, results=()) -> None:
     """Exit 2 for a report that cannot be written, after writing that mistake to --junit's
     file when the refused report is another one (not over one of `inputs`), beside the
     `results` of the runs when they were done."""
-    junit = junit_of_refused_report(junit_path, error, "uitamr verify", inputs, results)
+    _unusable_after([str(error)], junit_of_refused_report(junit_path, error, "uitamr verify", inputs, results))
+
+
+def _unusable_after(messages: list[str], junit: tuple[bool, str] | None) -> None:
+    """Exit 2 with `messages`, after what writing --junit's file gave (None: no JUnit to
+    write): the line that it was written, or why not as one more error."""
     if junit is None:
-        _unusable(str(error))
+        _unusable(*messages)
     written, said = junit
-    _unusable(str(error), done=said) if written else _unusable(str(error), said)
+    if written:
+        _unusable(*messages, done=said)
+    _unusable(*messages, said)
 
 
 class ScenarioMistakes(UnusableInput):
