@@ -63,14 +63,24 @@ ROUTES = {
 }
 
 
-def stray_scenario(route: str, delay_ms: int) -> str:
+NOISE = """
+[[faults]]          # ... and it is line noise instead of the reply
+kind = "garbage"
+on_request = 8
+data = "A5 5A FF"
+"""
+
+
+def stray_scenario(route: str, delay_ms: int, noise: bool = False) -> str:
     """The scenario TOML for `route`: request 6 (the monitor's battery read at 1.78 s) gets
     no reply twice, its third attempt a reply `delay_ms` late - after the engine's time-out
-    and guard time, as the run-point command of the cycle started at 2 s falls due."""
+    and guard time, as the run-point command of the cycle started at 2 s falls due. With
+    `noise`, three bytes of garbage come instead of that late reply."""
     sources, program, platform, start, top, tables = ROUTES[route]
     paths = ", ".join(f'"{(PLC / s).as_posix()}"' for s in sources)
-    return f'''name = "{route}: a late reply arrives as the next request is due ({delay_ms} ms)"
-description = "The third attempt of a status read is answered {delay_ms} ms late, after the engine gave up on it; the run-point command that follows must get its own reply, not that one."
+    what = "line noise" if noise else "a late reply"
+    return f'''name = "{route}: {what} arrives as the next request is due ({delay_ms} ms)"
+description = "The third attempt of a status read is answered {delay_ms} ms late ({what}), after the engine gave up on it; the run-point command that follows must get its own reply, not that."
 sources = [{paths}]
 program = "{program}"
 platform = "{platform}"
@@ -95,7 +105,7 @@ count = 2
 kind = "late_reply"
 on_request = 8
 delay_ms = {delay_ms}
-
+{NOISE if noise else ""}
 [[expect]]
 name = "the stop command goes first"
 sent = "stop"
@@ -114,9 +124,10 @@ never = "fbCycle.o_bErr"
 
 @pytest.mark.parametrize("delay_ms", [672, 680, 686])
 @pytest.mark.parametrize("route", list(ROUTES))
-def test_a_late_reply_due_as_the_next_request_goes_out_is_not_taken_as_its_reply(route, delay_ms, tmp_path):
+@pytest.mark.parametrize("noise", [False, True], ids=["late-reply", "noise"])
+def test_bytes_due_as_the_next_request_goes_out_are_not_taken_as_its_reply(route, delay_ms, noise, tmp_path):
     path = tmp_path / f"{route}-stray-{delay_ms}.toml"
-    path.write_text(stray_scenario(route, delay_ms), encoding="utf-8")
+    path.write_text(stray_scenario(route, delay_ms, noise), encoding="utf-8")
     result = run_scenario(load_scenario(path))
     found = {rule: [v.message for v in found] for rule, found in result.violations.items() if found}
     assert result.passed, (found, [o for o in result.expectations if not o.passed])
