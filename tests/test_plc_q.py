@@ -487,3 +487,48 @@ def test_a_send_the_module_ends_with_an_error_fails_the_attempt_at_once():
     assert [f for f in line.trace if f.direction == "tx" and f.t_start_us > 1_000_000] == []
     doc = (PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8")
     assert re.search(r"^\| 16#0108 \|[^|]*\| port code \(16#0306/", doc, flags=re.M)
+
+
+def test_a_send_error_is_signalled_when_a_stray_message_was_read_during_the_send():
+    """The known gap: a G_OUTPUT that ended with an error failed the attempt only when no
+    message was held (IF NOT bRecvHeld). A stray message (a second device's chatter, a
+    reply given up on) that ended while the send was under way was read and held, the send
+    error went only to the port's o_uErrId, and the engine took the stray message as the
+    reply to a frame that never went out. Now the send error replaces it: the attempt
+    fails (16#0108 / 16#0306 for that attempt) and is repeated. The module's G_OUTPUT is
+    made to end with an error (7F20H) two scans after one send from 1 s on, and a
+    well-formed status reply (battery normal) is put in the module's receive area in the
+    scan after that send started."""
+    project, line, _ = rig([], no_reception_ms=5)
+    prog = project.program("UITAMR_ExampleQ")
+    run(project, 1000)
+    assert prog.fbEngine.o_bInitDone and prog.fbEngine.o_wCommErrCount == 0
+    module = project._instructions().c24(0)
+    normal_output = module.output
+    refused = []
+
+    def output(s1, s2, d, loc_id):
+        refused.append([s1, d, 0])
+        module.output = normal_output           # one send only
+        return True
+
+    def during_the_send(p):
+        for item in refused:
+            s1, d, scans = item
+            item[2] = scans + 1
+            if scans == 0:                      # a stray message ends in the module
+                chan = module.channels[1]
+                chan.frames.append((bytes.fromhex("0101030000003C4E"), 0, p.now_us))
+                module._signals(chan)
+            elif scans == 1:                    # the send ends with an error
+                s1.set(1, 0x7F20)
+                module._finish(d, ok=False)
+    module.output = output
+    seen = []
+    run(project, 1500, during_the_send, lambda p: seen.append(
+        ((prog.fbPort.o_uErrId, prog.fbPort.o_uErrDetail), prog.fbEngine.o_wCommErrCount)))
+    assert len(refused) == 1 and refused[0][2] >= 2
+    assert (0x0306, 0x7F20) in {port for port, _ in seen}   # the port saw the error ...
+    # ... and so does the engine: the attempt failed and was repeated
+    assert prog.fbEngine.o_wCommErrCount == 1 and prog.fbEngine.o_wRetryCount == 1
+    assert not prog.fbEngine.o_bErr                          # the repeat got the robot's reply

@@ -533,3 +533,42 @@ def test_tcp_link_send_and_receive_errors_are_0312_and_0313_as_the_error_table_s
     assert (h.fbLink.o_bErr, h.fbLink.o_uErrId, h.fbLink.o_uErrDetail) == (True, 0x0313, 0x1234)
     h.scan(3)
     assert h.uPort[RX_DONE] == 0  # no reply handed to the engine: its reply time-out decides
+
+
+def test_tcp_link_signals_a_failed_send_also_when_bytes_were_held_meanwhile():
+    """A failed send failed the engine's attempt only when no bytes were held
+    (IF NOT bHeld): bytes that came while the send was under way (a second device, a
+    reply given up on) were held and handed to the engine as the reply to a frame that
+    never went out, and the 16#0312 stayed on the port's own o_uErrId. Now the failed
+    send replaces them (port word 4 = 16#0312, no bytes), as with nothing held."""
+    import verifier
+
+    h = verifier.load(Path(__file__).resolve().parents[1] / "plc" / "core",
+                      sources={"T_Tcp.st": TCP_LINK_HARNESS}).program("T_Tcp")
+    h.bEN = True
+    h.scan()
+    h.bOpenDone = h.bConnected = True
+    h.scan()
+    h.bOpenDone = False
+    h.scan()
+    for k, byte in enumerate(STOP):
+        h.uPort[TX_BASE + k] = byte
+    h.uPort[TX_LEN], h.uPort[TX_REQ] = len(STOP), 1
+    h.scan()
+    assert h.fbLink.o_bSend
+    h.bRecvReady = True                     # a well-formed status reply arrives meanwhile
+    h.scan()
+    assert h.fbLink.o_bRecv
+    stray = bytes.fromhex("0101030000003C4E")
+    h.uSockRecv[0] = len(stray)
+    for k in range(4):
+        h.uSockRecv[1 + k] = stray[2 * k] | stray[2 * k + 1] << 8
+    h.bRecvReady, h.bRecvDone = False, True
+    h.scan()
+    h.bRecvDone = False
+    h.bSendDone, h.bSendErr, h.uSendStatus = True, True, 0xC0A1
+    h.scan()
+    h.bSendDone = h.bSendErr = False
+    assert (h.fbLink.o_uErrId, h.fbLink.o_uErrDetail) == (0x0312, 0xC0A1)
+    h.scan(2)
+    assert (h.uPort[RX_DONE], h.uPort[RX_LEN], h.uPort[PORT_ERR]) == (1, 0, 0x0312)
