@@ -64,9 +64,9 @@ _OTHER_KINDS = {
            "reads it and names its mistakes (docs/plc-library.md)",
     ".csv": "a GX Works import file (generated), not ST source: check the .st or .il it was made from",
     ".jsonl": "a trace (JSON Lines), not ST: `uitamr replay` reads it",
-    ".json": "a report, not ST: `uitamr check` reads .st sources and scenarios (.toml)",
-    ".html": "a report, not ST: `uitamr check` reads .st sources and scenarios (.toml)",
-    ".xml": "a report, not ST: `uitamr check` reads .st sources and scenarios (.toml)",
+    ".json": "a report, not ST: give the .st sources it reports on",
+    ".html": "a report, not ST: give the .st sources it reports on",
+    ".xml": "a report, not ST: give the .st sources it reports on",
 }
 
 
