@@ -2,6 +2,8 @@
 and the wall-clock core driven by a fake clock."""
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 from hypothesis import given, settings as hsettings, strategies as st
 
@@ -126,6 +128,34 @@ def test_bad_fault_files_name_the_file_the_line_and_the_key(tmp_path, text, wher
         load_fault_file(path)
     assert str(caught.value).startswith(f"{path}{where}")
 
+
+
+CAPTURE = Path(__file__).resolve().parent / "captures" / "bad-master.txt"
+
+
+@pytest.mark.parametrize("name, text, says", [
+    ("site.txt", CAPTURE.read_text(encoding="utf-8"),
+     "this is a capture of `uitamr monitor --capture` (times and bytes on the line): `uitamr replay {path}` judges"),
+    ("site.jsonl", '{"t": 0.0, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}\n',
+     "this is a trace (JSON Lines) of `uitamr verify` or `uitamr monitor`: `uitamr replay {path}` judges"),
+])
+def test_a_capture_given_as_a_fault_file_or_a_scenario_is_named_as_one(tmp_path, name, text, says):
+    """`--faults site.txt` or `--scenario site.txt`, the capture from site in place of the
+    fault script, said only "site.txt:5:10: not valid TOML: Expected '=' after a key"."""
+    from verifier.verify.scenario import ScenarioError, load_scenario
+
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(FaultFileError) as caught:
+        load_fault_file(path)
+    assert "not valid TOML" in str(caught.value) and says.format(path=path) in str(caught.value)
+    with pytest.raises(ScenarioError) as caught:
+        load_scenario(path)
+    assert "not valid TOML" in str(caught.value) and says.format(path=path) in str(caught.value)
+    path.write_text("[[faults]\n", encoding="utf-8")  # TOML gone wrong stays just that
+    with pytest.raises(FaultFileError) as caught:
+        load_fault_file(path)
+    assert "this is" not in str(caught.value)
 
 def test_fault_file_refuses_a_wrong_address_fault_with_the_robots_own_address(tmp_path):
     path = tmp_path / "bench.toml"

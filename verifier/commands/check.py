@@ -71,18 +71,16 @@ _OTHER_KINDS = {
 
 
 def _capture_kind(path: Path) -> str | None:
-    """What `path` is when it reads as a capture of `uitamr monitor` (a .txt, told by its
-    content: an editor may export ST as .txt too), or None."""
-    from verifier.monitor.capture import CaptureError, read_capture
+    """What `path` is when it reads as a capture of `uitamr monitor` or a trace (a .txt, told
+    by its content: an editor may export ST as .txt too), or None."""
+    from verifier.monitor.capture import capture_kind
+    from verifier.textfile import UnreadableText, read_utf8
 
     try:
-        captures = read_capture(path)
-    except CaptureError:  # not a capture: ST (or a mistake) to be read as ST
+        what = capture_kind(read_utf8(path), str(path))
+    except UnreadableText:  # not a capture: ST (or a mistake) to be read as ST
         return None
-    if not any(chunk.data for chunks in captures.values() for chunk in chunks):
-        return None  # only comments or an end line: nothing tells it from an empty ST file
-    return (f"a capture of `uitamr monitor --capture` (times and bytes on the line), not ST: "
-            f"`uitamr replay {path}` judges its frames (docs/commissioning.md)")
+    return None if what is None else f"{what}, not ST: `uitamr replay {path}` judges its frames (docs/commissioning.md)"
 
 
 def _scenario_kind(path: Path) -> str | None:
