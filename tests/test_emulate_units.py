@@ -94,6 +94,24 @@ def test_noise_then_silence_then_a_request_is_always_recovered(chunks):
     assert frames_of(asm.feed(STOP_FRAME, t + 1)) == [STOP_FRAME]
 
 
+
+def test_a_line_on_which_no_frame_has_a_good_crc_is_said_to_be_at_another_speed():
+    """A PLC at 19200 into the emulator at 9600 (or A and B swapped): every frame is garbled,
+    no reply goes out, and the summary said only "2 frames in, 0 replies out, 2 unanswered".
+    The bytes are what a 9600 8N1 receiver reads of the stop and a status read sent at 19200,
+    as emulator.md's troubleshooting table quotes the first."""
+    emulator = Emulator(Robot(), [].append, FakeClock())
+    for data in (bytes.fromhex("28 08 08 68"), bytes.fromhex("18 08 68 AB")):
+        assert emulator.handle(ReceivedFrame(data, 0, 0, "silence")) is None
+    said = emulator.summary()
+    assert said.endswith("; no frame had a good CRC: the PLC is probably at another baud rate or parity than the "
+                         "emulator's port (--baud; the robot's is 9600 8N1), or A and B are swapped"), said
+    page = " ".join((Path(__file__).resolve().parents[1] / "docs" / "emulator.md").read_text(encoding="utf-8").split())
+    assert "the summary line ends `no frame had a good CRC: ...`" in page
+    assert "as `28 08 08 68`: half its bytes" in page
+    emulator.handle(ReceivedFrame(STOP_FRAME, 0, 0, "length"))  # one good frame: the PLC's own mistakes
+    assert "no frame had a good CRC" not in emulator.summary()
+
 # ---- the fault file ------------------------------------------------------------------------
 
 def test_fault_file_with_robot_table(tmp_path):
