@@ -1336,3 +1336,27 @@ def test_an_html_report_of_a_capture_spanning_years_stays_small(tmp_path):
     assert done.returncode in (0, 1), done.stderr
     assert (tmp_path / "r.html").stat().st_size < 2_000_000
     assert report_html.MAJOR_TICKS_AT_MOST == 5000
+
+
+@pytest.mark.serial
+def test_a_report_or_capture_named_as_the_port_is_refused_not_sent_onto_the_line(tmp_path):
+    """`uitamr monitor --serial /dev/ttyUSB0 --capture /dev/ttyUSB0` (the port typed twice)
+    wrote the capture's text onto the robot's line - the monitor that "never transmits" - and
+    said "wrote /dev/ttyUSB0". A pty stands for the adapter: its other end reads the line."""
+    line_end, port_end = os.openpty()
+    port = os.ttyname(port_end)
+    try:
+        for option in ("--capture", "--json"):
+            done = subprocess.run(uitamr("monitor", "--serial", port, option, port, "--duration", "1s"),
+                                  capture_output=True, text=True, timeout=WAIT_S)
+            assert done.returncode == 2, done.stdout + done.stderr
+            assert f"{port} is the port the monitor listens on, and the monitor never writes to the line" in done.stderr
+            os.set_blocking(line_end, False)
+            try:
+                sent = os.read(line_end, 4096)
+            except BlockingIOError:
+                sent = b""
+            assert sent == b"", sent
+    finally:
+        os.close(line_end)
+        os.close(port_end)

@@ -31,6 +31,7 @@ from verifier.monitor.framer import DEFAULT_TOLERANCE_US, LineTiming
 from verifier.monitor.session import CaptureInfo, MonitorSession
 from verifier.monitor.sources import SerialSource, SourceError, TcpSource, now_us
 from verifier.monitor.view import MonitorView
+from verifier.textfile import real_path
 from verifier.verify.evidence import RuleOptions
 from verifier.verify.result import NO_TRAFFIC, Mistake, overall_verdict
 
@@ -102,6 +103,12 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
     problem = serial_url_problem(serial_url) if serial_url is not None else None
     if problem:
         raise click.BadParameter(problem, param_hint="--serial")
+    if serial_url is not None:  # `--capture /dev/ttyUSB0`: the capture's text went out onto the robot's line
+        port = real_path(serial_url)
+        onto = [p for p in (capture_path, json_path, junit_path, trace_path, html_path) if p and real_path(p) == port]
+        if onto:
+            raise click.UsageError(f"{onto[0]} is the port the monitor listens on, and the monitor never writes to "
+                                   "the line: give a file for the report or the capture")
     console = text_console()
     try:
         check_folders(json_path, junit_path, trace_path, html_path, capture_path)
