@@ -1360,3 +1360,18 @@ def test_a_report_or_capture_named_as_the_port_is_refused_not_sent_onto_the_line
     finally:
         os.close(line_end)
         os.close(port_end)
+
+
+def test_replay_of_a_serial_port_points_to_the_monitor():
+    """`uitamr replay /dev/ttyUSB0`, the port given to the command that reads captures, said
+    only "cannot read: not a regular file (a character device)"."""
+    line_end, port_end = os.openpty()
+    port = os.ttyname(port_end)
+    try:
+        done = subprocess.run(uitamr("replay", port), capture_output=True, text=True, timeout=WAIT_S)
+    finally:
+        os.close(line_end)
+        os.close(port_end)
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert (f"uitamr replay: {port}: cannot read: not a regular file (a character device): a serial port, not a "
+            f"capture; `uitamr monitor --serial {port}` listens on it") in done.stderr, done.stderr
