@@ -829,15 +829,21 @@ def test_noise_on_the_line_gives_findings_not_a_crash(line, tmp_path):
     assert findings(tmp_path / "m.json")  # something to show
 
 
-@pytest.mark.serial
-def test_ctrl_c_stops_the_monitor_and_the_reports_are_written(line, tmp_path):
-    monitor = monitor_on(line, tmp_path, "--capture", tmp_path / "c.txt")
-    master = Master(line.plc)
+def _monitor_that_saw_the_stop(bus: LineBus, tmp_path: Path, *extra) -> subprocess.Popen:
+    """A monitor (with --json m.json and `extra`) on the line, once the stop and its echo passed."""
+    monitor = monitor_on(bus, tmp_path, *extra)
+    master = Master(bus.plc)
     try:
         master.send(STOP)
     finally:
         master.close()
     time.sleep(0.5)
+    return monitor
+
+
+@pytest.mark.serial
+def test_ctrl_c_stops_the_monitor_and_the_reports_are_written(line, tmp_path):
+    monitor = _monitor_that_saw_the_stop(line, tmp_path, "--capture", tmp_path / "c.txt")
     monitor.send_signal(signal.SIGINT)
     out, err = monitor.communicate(timeout=WAIT_S)
     assert monitor.returncode == 0, out + err
@@ -846,31 +852,24 @@ def test_ctrl_c_stops_the_monitor_and_the_reports_are_written(line, tmp_path):
     assert b"".join(c.data for c in chunks) == STOP + STOP  # the request and its echo
 
 
-
 @pytest.mark.serial
 def test_a_second_ctrl_c_while_the_reports_are_written_loses_none_of_them(line, tmp_path):
     """Pressed again because the monitor seemed slow to stop, Ctrl-C met the default handler
     (it was put back once the port was closed): a KeyboardInterrupt while the reports were
     written, "Aborted!", an exit status of 1 or death by SIGINT rather than the session's 0,
     and of the five files only the capture. Here Ctrl-C is pressed until the capture is there."""
-    files = {"--json": "m.json", "--junit": "m.xml", "--html": "m.html", "--trace": "m.jsonl", "--capture": "c.txt"}
-    monitor = start("monitor", "--serial", line.tap, *[a for option, name in files.items()
-                                                       for a in (option, tmp_path / name)])
-    wait_for_line(monitor, "listening")
-    master = Master(line.plc)
-    try:
-        master.send(STOP)
-    finally:
-        master.close()
-    time.sleep(0.5)
+    files = {"--junit": "m.xml", "--html": "m.html", "--trace": "m.jsonl", "--capture": "c.txt"}
+    monitor = _monitor_that_saw_the_stop(line, tmp_path, *[a for option, name in files.items()
+                                                           for a in (option, tmp_path / name)])
     while monitor.poll() is None and not (tmp_path / "c.txt").exists():
         monitor.send_signal(signal.SIGINT)
         time.sleep(0.005)
     out, err = monitor.communicate(timeout=WAIT_S)
     assert monitor.returncode == 0, out + err
     assert "Traceback" not in err and "Aborted" not in err and "KeyboardInterrupt" not in err, err
-    assert [name for name in files.values() if not (tmp_path / name).exists()] == []
+    assert [name for name in ["m.json", *files.values()] if not (tmp_path / name).exists()] == []
     assert json.loads((tmp_path / "m.json").read_text())["verdict"] == "pass"
+
 
 # --------------------------------------------------------------------- the converter route (TCP)
 class BadMasterStream:
