@@ -111,6 +111,9 @@ def test_a_line_on_which_no_frame_has_a_good_crc_is_said_to_be_at_another_speed(
     assert "as `28 08 08 68`: half its bytes" in page
     emulator.handle(ReceivedFrame(STOP_FRAME, 0, 0, "length"))  # one good frame: the PLC's own mistakes
     assert "no frame had a good CRC" not in emulator.summary()
+    swapped = Emulator(Robot(), [].append, FakeClock())  # its CRC high byte first: the PLC's CRC, not the line
+    swapped.handle(ReceivedFrame(STOP_FRAME[:6] + STOP_FRAME[:5:-1], 0, 0, "silence"))
+    assert "no frame had a good CRC" not in swapped.summary()
 
 # ---- the fault file ------------------------------------------------------------------------
 

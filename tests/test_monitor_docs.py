@@ -85,6 +85,9 @@ def test_a_plc_at_19200_read_at_9600_is_said_to_be_on_another_speed(tmp_path):
     assert quoted and quoted.group(1) == note.group(1)
     good = subprocess.run(uitamr("replay", CAPTURES / "bad-master.txt"), capture_output=True, text=True, timeout=60)
     assert "not one of" not in good.stdout  # one bad CRC among good frames: the PLC's own
+    capture.write_text("0.3 01 06 01 A0 00 00 14 88\n1.0 end\n", encoding="utf-8")  # CRC high byte first
+    swapped = subprocess.run(uitamr("replay", capture), capture_output=True, text=True, timeout=60)
+    assert "UITAMR-CRC" in swapped.stdout and "not one of" not in swapped.stdout  # the PLC's CRC, not the line
 
 def test_a_monitor_trace_replays_to_the_monitors_findings(tmp_path):
     """commissioning.md §6 replays `monitor --trace` files. Their times are the host's, so
