@@ -246,3 +246,24 @@ def test_an_export_file_that_cannot_be_written_to_its_end_is_named_and_not_left_
     assert result.stderr.endswith("uitamr export: cannot write out/UITAMR_AdpBridge.st: File too large\n")
     assert all(path.stat().st_size < 3000 for path in (tmp_path / "out").iterdir())
     assert not (tmp_path / "out" / "UITAMR_AdpBridge.st").exists()
+
+
+def test_ctrl_c_in_the_middle_of_a_replay_is_not_a_finding(monkeypatch, tmp_path):
+    """Ctrl-C in `uitamr replay` of a long capture (it reads for seconds) was click's
+    "Aborted!" and exit status 1, which replay's callers read as "the PLC broke a rule". It
+    is 130 (128 + SIGINT, as the shell reports it), said as an interruption with no verdict,
+    and writes no report. The KeyboardInterrupt is raised where Ctrl-C lands in a replay: in
+    the middle of feeding the capture's chunks."""
+    from verifier.monitor.session import MonitorSession
+
+    def interrupted(self, chunk):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(MonitorSession, "feed", interrupted)
+    capture = Path(__file__).resolve().parent / "captures" / "bad-master.txt"
+    result = CliRunner().invoke(main, ["replay", str(capture), "--json", str(tmp_path / "r.json")])
+    assert result.exit_code == 130, result.output
+    assert "uitamr replay: interrupted (Ctrl-C) before it finished: no verdict" in result.output
+    assert "Aborted" not in result.output and not (tmp_path / "r.json").exists()
+    page = " ".join((Path(__file__).resolve().parents[1] / "docs" / "commissioning.md").read_text(encoding="utf-8").split())
+    assert "Ctrl-C in the middle of a replay ends it with exit status 130 and no verdict" in page

@@ -187,7 +187,7 @@ def test_a_second_emulator_on_the_same_port_is_refused(pty_pair, start_emulator)
     robot_end, master_end = pty_pair
     first = start_emulator("--serial", robot_end)
     second = run_cli("--serial", robot_end, "--exit-after", "5")
-    assert second.returncode == 1
+    assert second.returncode == 2  # a mistake on the command line, as monitor's on a held port
     assert f"cannot open serial port {robot_end}: another program has it locked" in second.stderr
     assert "Traceback" not in second.stderr
     assert read_status(master_end, Query.TASK) == (0, 0)  # the first still answers
@@ -206,7 +206,7 @@ def test_a_port_a_monitor_holds_is_refused_naming_the_monitor(pty_pair):
     try:
         assert "listening on" in monitor.stdout.readline()
         refused = run_cli("--serial", robot_end, "--exit-after", "5")
-        assert refused.returncode == 1
+        assert refused.returncode == 2
         assert (f"cannot open serial port {robot_end}: another program has it locked (another uitamr "
                 "emulate, or a uitamr monitor?)") in refused.stderr, refused.stderr
     finally:
@@ -520,7 +520,10 @@ def test_the_scripted_fault_line_says_count_duration_and_filter_together(tmp_pat
     (("--tcp", "0", "--anti-collision-at", "-1"), "--anti-collision-at: must be at least 0.0", 2),
     (("--tcp", "0", "--turnaround-ms", "-3"), "--turnaround-ms: must be at least 0.0", 2),
     (("--tcp", "0", "--exception-on", "2:300"), "--exception-on: must be at most 255", 2),
-    (("--serial", "/nonexistent/ttyUSB9"), "cannot open serial port /nonexistent/ttyUSB9", 1),
+    # was exit 1 (monitor said 2 of the same port) and pyserial's "[Errno 2] could not open port
+    # /nonexistent/ttyUSB9: [Errno 2] No such file or directory: ...", with nothing to do
+    (("--serial", "/nonexistent/ttyUSB9"), "uitamr emulate: cannot open serial port /nonexistent/ttyUSB9: no such port: "
+     "check its name and that the adapter is plugged in (Linux: `ls /dev/ttyUSB*", 2),
     (("--serial", "loop://"), "loop:// sends every byte back", 2),
     (("--serial", "spy://loop://?logging=debug"), "loop:// sends every byte back", 2),
     (("--serial", "/nonexistent/ttyUSB9", "--baud", "0"), "0 is not a standard serial speed", 2),
@@ -550,6 +553,26 @@ def test_cli_mistakes_get_a_clear_message(args, message, code):
     assert "Traceback" not in result.stderr
     assert "stopped after" not in result.stdout  # it never ran: no summary as if it had
 
+
+
+def test_a_port_that_cannot_be_opened_says_what_to_check_on_site():
+    """The mistakes at the adapter: a wrong name (or the adapter not plugged in), a user not in
+    the port's group, a port another program has open. Both commands repeated pyserial's
+    "[Errno 2] could not open port X: [Errno 2] No such file or directory: 'X'"; emulate
+    exited 1 where monitor exited 2."""
+    from verifier.emulate.ports import why_not_opened
+
+    monitor = subprocess.run([sys.executable, "-m", "verifier.cli", "monitor", "--serial", "/nonexistent/ttyUSB9",
+                              "--duration", "1s"], capture_output=True, text=True, timeout=WAIT_S)
+    assert monitor.returncode == 2
+    assert "uitamr monitor: cannot open /nonexistent/ttyUSB9: no such port: check its name" in monitor.stderr
+    assert "Errno" not in monitor.stderr
+    # root (the test runner) opens any port: pyserial's own exceptions for the other two
+    denied = serial.SerialException(13, "could not open port /dev/ttyUSB0: [Errno 13] Permission denied")
+    assert why_not_opened(denied).startswith("permission denied: your user may not open it; add it to the port's "
+                                             "group (`ls -l` names the group, dialout on Debian and Ubuntu")
+    busy = serial.SerialException(16, "could not open port /dev/ttyUSB0: [Errno 16] Device or resource busy")
+    assert why_not_opened(busy).startswith("the port is busy: another program has it open")
 
 def test_an_ipv6_listener_is_logged_as_tcp_takes_it_back(start_emulator):
     """The log's address pastes back into --tcp: [::1]:PORT, not ::1:PORT."""

@@ -2,6 +2,8 @@
 and the wall-clock core driven by a fake clock."""
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 from hypothesis import given, settings as hsettings, strategies as st
 
@@ -92,6 +94,27 @@ def test_noise_then_silence_then_a_request_is_always_recovered(chunks):
     assert frames_of(asm.feed(STOP_FRAME, t + 1)) == [STOP_FRAME]
 
 
+
+def test_a_line_on_which_no_frame_has_a_good_crc_is_said_to_be_at_another_speed():
+    """A PLC at 19200 into the emulator at 9600 (or A and B swapped): every frame is garbled,
+    no reply goes out, and the summary said only "2 frames in, 0 replies out, 2 unanswered".
+    The bytes are what a 9600 8N1 receiver reads of the stop and a status read sent at 19200,
+    as emulator.md's troubleshooting table quotes the first."""
+    emulator = Emulator(Robot(), [].append, FakeClock())
+    for data in (bytes.fromhex("28 08 08 68"), bytes.fromhex("18 08 68 AB")):
+        assert emulator.handle(ReceivedFrame(data, 0, 0, "silence")) is None
+    said = emulator.summary()
+    assert said.endswith("; no frame had a good CRC: the PLC is probably at another baud rate or parity than the "
+                         "emulator's port (--baud; the robot's is 9600 8N1), or A and B are swapped"), said
+    page = " ".join((Path(__file__).resolve().parents[1] / "docs" / "emulator.md").read_text(encoding="utf-8").split())
+    assert "the summary line ends `no frame had a good CRC: ...`" in page
+    assert "as `28 08 08 68`: half its bytes" in page
+    emulator.handle(ReceivedFrame(STOP_FRAME, 0, 0, "length"))  # one good frame: the PLC's own mistakes
+    assert "no frame had a good CRC" not in emulator.summary()
+    swapped = Emulator(Robot(), [].append, FakeClock())  # its CRC high byte first: the PLC's CRC, not the line
+    swapped.handle(ReceivedFrame(STOP_FRAME[:6] + STOP_FRAME[:5:-1], 0, 0, "silence"))
+    assert "no frame had a good CRC" not in swapped.summary()
+
 # ---- the fault file ------------------------------------------------------------------------
 
 def test_fault_file_with_robot_table(tmp_path):
@@ -126,6 +149,34 @@ def test_bad_fault_files_name_the_file_the_line_and_the_key(tmp_path, text, wher
         load_fault_file(path)
     assert str(caught.value).startswith(f"{path}{where}")
 
+
+
+CAPTURE = Path(__file__).resolve().parent / "captures" / "bad-master.txt"
+
+
+@pytest.mark.parametrize("name, text, says", [
+    ("site.txt", CAPTURE.read_text(encoding="utf-8"),
+     "this is a capture of `uitamr monitor --capture` (times and bytes on the line): `uitamr replay {path}` judges"),
+    ("site.jsonl", '{"t": 0.0, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}\n',
+     "this is a trace (JSON Lines) of `uitamr verify` or `uitamr monitor`: `uitamr replay {path}` judges"),
+])
+def test_a_capture_given_as_a_fault_file_or_a_scenario_is_named_as_one(tmp_path, name, text, says):
+    """`--faults site.txt` or `--scenario site.txt`, the capture from site in place of the
+    fault script, said only "site.txt:5:10: not valid TOML: Expected '=' after a key"."""
+    from verifier.verify.scenario import ScenarioError, load_scenario
+
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(FaultFileError) as caught:
+        load_fault_file(path)
+    assert "not valid TOML" in str(caught.value) and says.format(path=path) in str(caught.value)
+    with pytest.raises(ScenarioError) as caught:
+        load_scenario(path)
+    assert "not valid TOML" in str(caught.value) and says.format(path=path) in str(caught.value)
+    path.write_text("[[faults]\n", encoding="utf-8")  # TOML gone wrong stays just that
+    with pytest.raises(FaultFileError) as caught:
+        load_fault_file(path)
+    assert "this is" not in str(caught.value)
 
 def test_fault_file_refuses_a_wrong_address_fault_with_the_robots_own_address(tmp_path):
     path = tmp_path / "bench.toml"

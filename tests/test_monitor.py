@@ -829,21 +829,46 @@ def test_noise_on_the_line_gives_findings_not_a_crash(line, tmp_path):
     assert findings(tmp_path / "m.json")  # something to show
 
 
-@pytest.mark.serial
-def test_ctrl_c_stops_the_monitor_and_the_reports_are_written(line, tmp_path):
-    monitor = monitor_on(line, tmp_path, "--capture", tmp_path / "c.txt")
-    master = Master(line.plc)
+def _monitor_that_saw_the_stop(bus: LineBus, tmp_path: Path, *extra) -> subprocess.Popen:
+    """A monitor (with --json m.json and `extra`) on the line, once the stop and its echo passed."""
+    monitor = monitor_on(bus, tmp_path, *extra)
+    master = Master(bus.plc)
     try:
         master.send(STOP)
     finally:
         master.close()
     time.sleep(0.5)
+    return monitor
+
+
+@pytest.mark.serial
+def test_ctrl_c_stops_the_monitor_and_the_reports_are_written(line, tmp_path):
+    monitor = _monitor_that_saw_the_stop(line, tmp_path, "--capture", tmp_path / "c.txt")
     monitor.send_signal(signal.SIGINT)
     out, err = monitor.communicate(timeout=WAIT_S)
     assert monitor.returncode == 0, out + err
     assert json.loads((tmp_path / "m.json").read_text())["verdict"] == "pass"
     (chunks,) = read_capture(tmp_path / "c.txt").values()
     assert b"".join(c.data for c in chunks) == STOP + STOP  # the request and its echo
+
+
+@pytest.mark.serial
+def test_a_second_ctrl_c_while_the_reports_are_written_loses_none_of_them(line, tmp_path):
+    """Pressed again because the monitor seemed slow to stop, Ctrl-C met the default handler
+    (it was put back once the port was closed): a KeyboardInterrupt while the reports were
+    written, "Aborted!", an exit status of 1 or death by SIGINT rather than the session's 0,
+    and of the five files only the capture. Here Ctrl-C is pressed until the capture is there."""
+    files = {"--junit": "m.xml", "--html": "m.html", "--trace": "m.jsonl", "--capture": "c.txt"}
+    monitor = _monitor_that_saw_the_stop(line, tmp_path, *[a for option, name in files.items()
+                                                           for a in (option, tmp_path / name)])
+    while monitor.poll() is None and not (tmp_path / "c.txt").exists():
+        monitor.send_signal(signal.SIGINT)
+        time.sleep(0.005)
+    out, err = monitor.communicate(timeout=WAIT_S)
+    assert monitor.returncode == 0, out + err
+    assert "Traceback" not in err and "Aborted" not in err and "KeyboardInterrupt" not in err, err
+    assert [name for name in ["m.json", *files.values()] if not (tmp_path / name).exists()] == []
+    assert json.loads((tmp_path / "m.json").read_text())["verdict"] == "pass"
 
 
 # --------------------------------------------------------------------- the converter route (TCP)
@@ -1310,3 +1335,42 @@ def test_an_html_report_of_a_capture_spanning_years_stays_small(tmp_path):
     assert done.returncode in (0, 1), done.stderr
     assert (tmp_path / "r.html").stat().st_size < 2_000_000
     assert report_html.MAJOR_TICKS_AT_MOST == 5000
+
+
+@pytest.mark.serial
+def test_a_report_or_capture_named_as_the_port_is_refused_not_sent_onto_the_line(tmp_path):
+    """`uitamr monitor --serial /dev/ttyUSB0 --capture /dev/ttyUSB0` (the port typed twice)
+    wrote the capture's text onto the robot's line - the monitor that "never transmits" - and
+    said "wrote /dev/ttyUSB0". A pty stands for the adapter: its other end reads the line."""
+    line_end, port_end = os.openpty()
+    port = os.ttyname(port_end)
+    try:
+        for option in ("--capture", "--json"):
+            done = subprocess.run(uitamr("monitor", "--serial", port, option, port, "--duration", "1s"),
+                                  capture_output=True, text=True, timeout=WAIT_S)
+            assert done.returncode == 2, done.stdout + done.stderr
+            assert f"{port} is the port the monitor listens on, and the monitor never writes to the line" in done.stderr
+            os.set_blocking(line_end, False)
+            try:
+                sent = os.read(line_end, 4096)
+            except BlockingIOError:
+                sent = b""
+            assert sent == b"", sent
+    finally:
+        os.close(line_end)
+        os.close(port_end)
+
+
+def test_replay_of_a_serial_port_points_to_the_monitor():
+    """`uitamr replay /dev/ttyUSB0`, the port given to the command that reads captures, said
+    only "cannot read: not a regular file (a character device)"."""
+    line_end, port_end = os.openpty()
+    port = os.ttyname(port_end)
+    try:
+        done = subprocess.run(uitamr("replay", port), capture_output=True, text=True, timeout=WAIT_S)
+    finally:
+        os.close(line_end)
+        os.close(port_end)
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert (f"uitamr replay: {port}: cannot read: not a regular file (a character device): a serial port, not a "
+            f"capture; `uitamr monitor --serial {port}` listens on it") in done.stderr, done.stderr

@@ -69,6 +69,26 @@ def test_the_no_traffic_verdict_is_what_the_monitor_says():
     assert f"```\nNO TRAFFIC: {result.no_traffic}\n```" in DOC
 
 
+
+def test_a_plc_at_19200_read_at_9600_is_said_to_be_on_another_speed(tmp_path):
+    """§2: a PLC at 19200 into a 9600 monitor gave only CRC and FORMAT findings ("unknown
+    function code 0x08"), which §5's table sends to the PLC's CRC routine and frame builder;
+    the note §2 quotes now points at the line's speed first. The bytes are what a 9600 8N1
+    receiver reads (sampling mid-bit) of the stop and four status reads sent at 19200."""
+    capture = tmp_path / "fast.txt"
+    capture.write_text("0.3 28 08 08 68\n" + "".join(f"{0.3 * n:.1f} 18 08 68 AB\n" for n in range(2, 6))
+                       + "2.5 end\n", encoding="utf-8")
+    done = subprocess.run(uitamr("replay", capture), capture_output=True, text=True, timeout=60)
+    note = re.search(r"note: (not one of .*)", done.stdout)
+    assert note, done.stdout + done.stderr
+    quoted = re.search(r"`(not one of the .*?)`", " ".join(DOC.split()))
+    assert quoted and quoted.group(1) == note.group(1)
+    good = subprocess.run(uitamr("replay", CAPTURES / "bad-master.txt"), capture_output=True, text=True, timeout=60)
+    assert "not one of" not in good.stdout  # one bad CRC among good frames: the PLC's own
+    capture.write_text("0.3 01 06 01 A0 00 00 14 88\n1.0 end\n", encoding="utf-8")  # CRC high byte first
+    swapped = subprocess.run(uitamr("replay", capture), capture_output=True, text=True, timeout=60)
+    assert "UITAMR-CRC" in swapped.stdout and "not one of" not in swapped.stdout  # the PLC's CRC, not the line
+
 def test_a_monitor_trace_replays_to_the_monitors_findings(tmp_path):
     """commissioning.md §6 replays `monitor --trace` files. Their times are the host's, so
     the replay must allow the tolerance the monitor allowed: a PLC pacing at 240 ms passes

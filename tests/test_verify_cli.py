@@ -119,6 +119,24 @@ def test_a_scenario_given_as_source_is_pointed_to_scenario_option():
     assert f"{scenario} is a scenario, not ST source: give it as --scenario {scenario}" in done.stderr
 
 
+
+def test_a_capture_trace_or_report_given_as_source_says_what_it_is(tmp_path, monkeypatch):
+    """`uitamr verify site.txt`, the capture a site session left, was read as ST: "site.txt:1:1:
+    error: '#' must follow a radix", and a trace or a JSON report "unexpected character '{'",
+    where `uitamr check` and `uitamr export` say what the file is and what reads it."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "site.txt").write_text("# uitamr monitor capture of /dev/ttyUSB0, 9600 8N1\n"
+                                       "0.001042 01 06 01 A0 00 00 88 14\n0.5 end\n", encoding="utf-8")
+    (tmp_path / "site.jsonl").write_text('{"t": 0.0, "dir": "tx", "hex": "01 06 01 A0 00 00 88 14"}\n')
+    (tmp_path / "site.json").write_text('{"verdict": "pass", "scenarios": []}\n')
+    for name, says in (("site.txt", "site.txt: a capture of `uitamr monitor --capture` (times and bytes on the "
+                                    "line), not ST: `uitamr replay site.txt` judges its frames"),
+                       ("site.jsonl", "site.jsonl: a trace (JSON Lines), not ST: `uitamr replay` reads it"),
+                       ("site.json", "site.json: a report, not ST: give the .st sources it reports on")):
+        result = invoke(name, *map(str, FX3_SOURCES))
+        assert result.exit_code == 2, result.output
+        assert says in result.output and "radix" not in result.output and "'{'" not in result.output
+
 def test_st_source_given_as_a_scenario_is_pointed_to_the_arguments():
     """`--scenario Main.st` said 'Main.st:1:9: not valid TOML: Expected '=' after a key',
     which does not say the file went to the wrong option."""

@@ -26,6 +26,10 @@ SUBCOMMANDS = {
 }
 
 
+#: the exit status of a command stopped by Ctrl-C before it finished (128 + SIGINT)
+EXIT_INTERRUPTED = 130
+
+
 class UnusablePath(click.ClickException):
     """A path given on the command line that cannot be used; exit status 2, as for
     every other unusable input."""
@@ -46,6 +50,14 @@ class LazyGroup(click.Group):
     def invoke(self, ctx: click.Context):
         try:
             return super().invoke(ctx)
+        except KeyboardInterrupt:
+            # Ctrl-C in `uitamr replay` of a long capture (or a verify) was click's "Aborted!"
+            # and exit 1, which these commands' callers read as "findings". 130 = 128 + SIGINT,
+            # as the shell reports a program that Ctrl-C stopped. (monitor and emulate take
+            # Ctrl-C as their stop and finish their reports or summary.)
+            click.echo(f"\nuitamr {ctx.invoked_subcommand}: interrupted (Ctrl-C) before it finished: "
+                       "no verdict", err=True)
+            sys.exit(EXIT_INTERRUPTED)
         except OSError as exc:
             # A path the file system refuses (a name too long, a folder that cannot be read,
             # a symlink loop) is the user's to fix: say which, never a traceback. An OSError

@@ -64,25 +64,23 @@ _OTHER_KINDS = {
            "reads it and names its mistakes (docs/plc-library.md)",
     ".csv": "a GX Works import file (generated), not ST source: check the .st or .il it was made from",
     ".jsonl": "a trace (JSON Lines), not ST: `uitamr replay` reads it",
-    ".json": "a report, not ST: `uitamr check` reads .st sources and scenarios (.toml)",
-    ".html": "a report, not ST: `uitamr check` reads .st sources and scenarios (.toml)",
-    ".xml": "a report, not ST: `uitamr check` reads .st sources and scenarios (.toml)",
+    ".json": "a report, not ST: give the .st sources it reports on",
+    ".html": "a report, not ST: give the .st sources it reports on",
+    ".xml": "a report, not ST: give the .st sources it reports on",
 }
 
 
 def _capture_kind(path: Path) -> str | None:
-    """What `path` is when it reads as a capture of `uitamr monitor` (a .txt, told by its
-    content: an editor may export ST as .txt too), or None."""
-    from verifier.monitor.capture import CaptureError, read_capture
+    """What `path` is when it reads as a capture of `uitamr monitor` or a trace (a .txt, told
+    by its content: an editor may export ST as .txt too), or None."""
+    from verifier.monitor.capture import capture_kind
+    from verifier.textfile import UnreadableText, read_utf8
 
     try:
-        captures = read_capture(path)
-    except CaptureError:  # not a capture: ST (or a mistake) to be read as ST
+        what = capture_kind(read_utf8(path), str(path))
+    except UnreadableText:  # not a capture: ST (or a mistake) to be read as ST
         return None
-    if not any(chunk.data for chunks in captures.values() for chunk in chunks):
-        return None  # only comments or an end line: nothing tells it from an empty ST file
-    return (f"a capture of `uitamr monitor --capture` (times and bytes on the line), not ST: "
-            f"`uitamr replay {path}` judges its frames (docs/commissioning.md)")
+    return None if what is None else f"{what}, not ST: `uitamr replay {path}` judges its frames (docs/commissioning.md)"
 
 
 def _scenario_kind(path: Path) -> str | None:

@@ -31,6 +31,7 @@ from verifier.monitor.framer import DEFAULT_TOLERANCE_US, LineTiming
 from verifier.monitor.session import CaptureInfo, MonitorSession
 from verifier.monitor.sources import SerialSource, SourceError, TcpSource, now_us
 from verifier.monitor.view import MonitorView
+from verifier.textfile import real_path
 from verifier.verify.evidence import RuleOptions
 from verifier.verify.result import NO_TRAFFIC, Mistake, overall_verdict
 
@@ -102,6 +103,12 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
     problem = serial_url_problem(serial_url) if serial_url is not None else None
     if problem:
         raise click.BadParameter(problem, param_hint="--serial")
+    if serial_url is not None:  # `--capture /dev/ttyUSB0`: the capture's text went out onto the robot's line
+        port = real_path(serial_url)
+        onto = [p for p in (capture_path, json_path, junit_path, trace_path, html_path) if p and real_path(p) == port]
+        if onto:
+            raise click.UsageError(f"{onto[0]} is the port the monitor listens on, and the monitor never writes to "
+                                   "the line: give a file for the report or the capture")
     console = text_console()
     try:
         check_folders(json_path, junit_path, trace_path, html_path, capture_path)
@@ -127,8 +134,17 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
         reply_timeout = protocol.DEFAULT_REPLY_TIMEOUT_US
     session = MonitorSession(info, settings, RuleOptions(reply_timeout_us=reply_timeout), timing,
                              from_power_on=not joined)
-    stop = threading.Event()
-    previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGINT, signal.SIGTERM)}
+    stop, said_stopping = threading.Event(), threading.Event()
+
+    def on_signal(_signum, _frame) -> None:
+        # a second Ctrl-C while the reports were being written (a moment, on a long session)
+        # lost them all but the capture, in a KeyboardInterrupt: it waits for them instead
+        if stop.is_set() and not said_stopping.is_set():
+            said_stopping.set()
+            click.echo("uitamr monitor: stopping: the reports and the capture are being written", err=True)
+        stop.set()
+
+    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
     started = time.monotonic()
     deadline = None if duration is None else started + duration / 1_000_000
     lost: str | None = None
@@ -138,52 +154,54 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
                   f"{timing.tolerance_us / 1000:g} ms); Ctrl-C stops[/]")
     console.file.flush()
     try:
-        with MonitorView(console, settings, source.description, quiet) as view:
-            next_check = time.monotonic() + CHECK_EVERY_S
-            while not stop.is_set() and (deadline is None or time.monotonic() < deadline):
+        try:
+            with MonitorView(console, settings, source.description, quiet) as view:
+                next_check = time.monotonic() + CHECK_EVERY_S
+                while not stop.is_set() and (deadline is None or time.monotonic() < deadline):
+                    try:
+                        chunk = source.read()
+                    except SourceError as exc:
+                        lost = str(exc)
+                        break
+                    view.frames(session.feed(chunk) if chunk is not None else session.poll(now_us()))
+                    if time.monotonic() >= next_check:
+                        view.findings(session.check())
+                        next_check = time.monotonic() + CHECK_EVERY_S
+                view.frames(session.close())
+                view.findings(session.check())
+        finally:
+            source.close()
+        if lost:
+            console.print(f"[yellow]stopped: {escape(lost)}[/]")
+        result = session.result(listened_us=round((time.monotonic() - started) * 1_000_000))
+        if lost:
+            result.notes.append(f"the capture ended early: {lost}")
+        failed: list[ReportError] = []
+        try:
+            failed += _reports([result], console, json_path, junit_path, trace_path, html_path, "uitamr monitor")
+        finally:
+            # the capture is the line's only record (the reports can be made again from it by
+            # `uitamr replay`): it is written even when a report cannot be
+            if capture_path:
+                comment = f"uitamr monitor capture of {source.description}, {baud} {line_format}"
+                if lost:
+                    comment += f"\nthe capture ended early: {lost}"
+                text = format_plain(session.chunks, comment, end_us=session.last_us if session.chunks else None)
                 try:
-                    chunk = source.read()
-                except SourceError as exc:
-                    lost = str(exc)
-                    break
-                view.frames(session.feed(chunk) if chunk is not None else session.poll(now_us()))
-                if time.monotonic() >= next_check:
-                    view.findings(session.check())
-                    next_check = time.monotonic() + CHECK_EVERY_S
-            view.frames(session.close())
-            view.findings(session.check())
-    finally:
-        source.close()
+                    Path(capture_path).write_text(text, encoding="utf-8")
+                except OSError as exc:
+                    failed.append(ReportError(f"cannot write the capture {capture_path}: {exc.strerror or exc}",
+                                              capture_path))
+                    click.echo(f"uitamr monitor: {failed[-1]}", err=True)
+                else:
+                    console.print(f"[dim]wrote {escape(str(capture_path))}[/]")
+        if failed:  # exit 2: --junit's file says why, after the session's test case
+            refused_report_junit(junit_path, failed, "uitamr monitor", (), [result])
+            sys.exit(EXIT_UNUSABLE)
+        sys.exit(exit_status([result]))
+    finally:  # the handlers stay until the reports and the capture are written
         for sig, handler in previous.items():
             signal.signal(sig, handler)
-    if lost:
-        console.print(f"[yellow]stopped: {escape(lost)}[/]")
-    result = session.result(listened_us=round((time.monotonic() - started) * 1_000_000))
-    if lost:
-        result.notes.append(f"the capture ended early: {lost}")
-    failed: list[ReportError] = []
-    try:
-        failed += _reports([result], console, json_path, junit_path, trace_path, html_path, "uitamr monitor")
-    finally:
-        # the capture is the line's only record (the reports can be made again from it by
-        # `uitamr replay`): it is written even when a report cannot be
-        if capture_path:
-            comment = f"uitamr monitor capture of {source.description}, {baud} {line_format}"
-            if lost:
-                comment += f"\nthe capture ended early: {lost}"
-            text = format_plain(session.chunks, comment, end_us=session.last_us if session.chunks else None)
-            try:
-                Path(capture_path).write_text(text, encoding="utf-8")
-            except OSError as exc:
-                failed.append(ReportError(f"cannot write the capture {capture_path}: {exc.strerror or exc}",
-                                          capture_path))
-                click.echo(f"uitamr monitor: {failed[-1]}", err=True)
-            else:
-                console.print(f"[dim]wrote {escape(str(capture_path))}[/]")
-    if failed:  # exit 2: --junit's file says why, after the session's test case
-        refused_report_junit(junit_path, failed, "uitamr monitor", (), [result])
-        sys.exit(EXIT_UNUSABLE)
-    sys.exit(exit_status([result]))
 
 
 def exit_status(results) -> int:

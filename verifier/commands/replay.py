@@ -46,6 +46,9 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
         try:
             loaded = read_capture(path)
         except CaptureError as exc:
+            if path.is_char_device():  # `uitamr replay /dev/ttyUSB0`: the port, not what was captured on it
+                exc = CaptureError(exc.where, "", message=f"{exc}: a serial port, not a capture; `uitamr monitor --serial "
+                                                     f"{name}` listens on it (replay reads the file its --capture wrote)")
             click.echo(f"uitamr replay: {exc}", err=True)
             mistakes_junit(junit_path, mistakes_of(exc), "uitamr replay")  # the CI server shows the mistake
             sys.exit(EXIT_UNUSABLE)

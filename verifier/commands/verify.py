@@ -19,6 +19,7 @@ from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
+from verifier.commands.check import not_st
 from verifier.commands.numbers import INT, IntRange
 from verifier.commands.report_files import (ReportError, check_folders, check_not_inputs, junit_of_mistakes,
                                              junit_of_refused_report, report_options, text_console, write_reports)
@@ -356,7 +357,8 @@ def _source_files(sources) -> tuple[Path, ...]:
         if Path(name).suffix.lower() == ".toml":
             raise UnusableInput(f"{name} is a scenario, not ST source: give it as --scenario {name}")
         try:
-            found += expand(name, Path.cwd())
+            files = expand(name, Path.cwd())
+            found += files
         except SourceError as exc:
             scenarios = list(Path(name).glob("*.toml")) if Path(name).is_dir() else []
             if scenarios:  # a folder of scenarios given as SOURCES (uitamr verify plc/scenarios)
@@ -364,6 +366,11 @@ def _source_files(sources) -> tuple[Path, ...]:
                                     f"file(s): give it as --scenario {name} (with the .st files, if the scenarios "
                                     "name none, as SOURCES)") from None
             raise UnusableInput(str(exc)) from None
+        # read as ST, a capture was "1:1: '#' must follow a radix" and a trace "unexpected character '{'"
+        shown = [Path(name)] if Path(name).is_file() else files  # as the user named it
+        others = [f"{path}: {what}" for path in shown if path.suffix.lower() != ".st" and (what := not_st(path))]
+        if others:
+            raise UnusableInput("; ".join(others))
     return unique(found)
 
 

@@ -13,6 +13,7 @@ from typing import Callable
 from verifier.amr import Robot
 from verifier.emulate.assembler import Dropped, ReceivedFrame
 from verifier.protocol.codec import decode_reply, decode_request, hex_bytes
+from verifier.protocol.crc import garbled
 from verifier.protocol.describe import describe
 from verifier.protocol.frames import FrameError, Request
 from verifier.protocol.timing import T3_5_US
@@ -59,6 +60,8 @@ class Emulator:
             self.line(item.t_us, "!!", f"{item.reason}{where}")
             return None
         self.stats["frames in"] += 1
+        if garbled(item.data):
+            self.stats["garbled"] += 1
         settings = self.robot.settings
         self.line(item.t_last_us, "<-", f"{hex_bytes(item.data)}  "
                   f"{describe(item.data, settings, 'request')}{where}")
@@ -119,7 +122,18 @@ class Emulator:
                 f"{counted(s['frames in'], 'frame', 'frames')} in, {counted(s['replies out'], 'reply', 'replies')} out, "
                 f"{s['no reply']} unanswered{not_sent}, {counted(s['faults'], 'fault event', 'fault events')}, "
                 f"{counted(s['dropped bytes'], 'flood byte', 'flood bytes')} dropped; robot {self.robot.mode}, "
-                f"error {int(self.robot.error):02d}")
+                f"error {int(self.robot.error):02d}{self._garbled()}")
+
+    def _garbled(self) -> str:
+        """What the summary adds when every frame was garbled (`crc.garbled`: no good CRC, nor
+        the protocol's shape): the bytes came at another speed or parity (a PLC at 19200 into
+        a 9600 port reads as half its bytes) or from a swapped pair; else "". A PLC that sends
+        well-formed frames with a wrong CRC has its own log line (byte 6: bad CRC)."""
+        frames = self.stats["frames in"]
+        if not frames or self.stats["garbled"] < frames:
+            return ""
+        return ("; no frame had a good CRC: the PLC is probably at another baud rate or parity than the "
+                "emulator's port (--baud; the robot's is 9600 8N1), or A and B are swapped")
 
 
 def counted(n: int, one: str, many: str) -> str:

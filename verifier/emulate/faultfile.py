@@ -53,8 +53,10 @@ def load_fault_file(path: str | Path, own_address: int | None = None) -> FaultFi
         data = tomllib.loads(text)
     except (ValueError, RecursionError) as err:
         # TOMLDecodeError, int()'s limit of 4300 digits, or arrays nested too deep for tomllib
+        from verifier.monitor.capture import capture_instead
+
         message, line = decode_error_position(err, text)
-        raise FaultFileError(f"{_where(path, line)}: not valid TOML: {message}") from None
+        raise FaultFileError(f"{_where(path, line)}: not valid TOML: {message}{capture_instead(text, path)}") from None
     try:
         reject_unknown_keys(data, FILE_KEYS, "")
         robot = data.get("robot", {})

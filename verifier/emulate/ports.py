@@ -121,7 +121,7 @@ def serve_serial(url: str, emulator: Emulator, stop: threading.Event, silence_us
         if getattr(err, "errno", None) in (errno.EAGAIN, errno.EWOULDBLOCK):
             raise PortError(f"cannot open serial port {url}: another program has it locked (another "
                             "uitamr emulate, or a uitamr monitor?); stop that one first") from None
-        raise PortError(f"cannot open serial port {url}: {err}") from None
+        raise PortError(f"cannot open serial port {url}: {why_not_opened(err)}") from None
     channel = _Channel(serial_assembler(baudrate, silence_us))
     gap_us = channel.assembler.silence_us
     longer = f", frame gap {gap_us / 1000:g} ms (t3.5 at {baudrate} bit/s)" if gap_us > silence_us else ""
@@ -232,6 +232,23 @@ def serve_tcp(host: str, port: int, emulator: Emulator, stop: threading.Event, s
         selector.close()
         server.close()
 
+
+
+def why_not_opened(err: Exception) -> str:
+    """Why pyserial could not open a port, and what to do, for the mistakes made on site: a
+    wrong name (or the adapter unplugged), a port the user may not open, one another program
+    holds. Anything else in pyserial's words ("[Errno 2] could not open port /dev/ttyUSB9:
+    [Errno 2] No such file or directory: '/dev/ttyUSB9'" said the first twice, and no more)."""
+    number = getattr(err, "errno", None)
+    if number == errno.ENOENT:
+        return ("no such port: check its name and that the adapter is plugged in (Linux: `ls /dev/ttyUSB* "
+                "/dev/ttyACM* /dev/serial/by-id/` lists the USB adapters; Windows: Device Manager, Ports (COM & LPT))")
+    if number in (errno.EACCES, errno.EPERM):
+        return ("permission denied: your user may not open it; add it to the port's group (`ls -l` names "
+                "the group, dialout on Debian and Ubuntu: `sudo usermod -aG dialout $USER`, then log in again)")
+    if number == errno.EBUSY:
+        return "the port is busy: another program has it open (a terminal program, ModemManager); close that first"
+    return str(err)
 
 def serial_url_problem(url: str) -> str | None:
     """What is wrong with a pyserial network URL (socket://, rfc2217://) before pyserial

@@ -399,8 +399,7 @@ def read_capture(path: Path) -> dict[str, list[Chunk]]:
         # bytes that are not text: `file: line L, column C (byte N): ...`, placed at them
         where = None if exc.line is None else Where(str(path), exc.line, exc.col)
         raise CaptureError(where, "", message=f"{path}: {exc}") from None
-    first = next((line.lstrip() for line in text_lines(text)
-                  if line.strip() and not line.lstrip().startswith("#")), "")
+    first = _first_line(text)
     try:
         if first.startswith("{"):
             return parse_trace(text, str(path))
@@ -410,6 +409,36 @@ def read_capture(path: Path) -> dict[str, list[Chunk]]:
         if other is None:
             raise
         raise CaptureError(exc.where, "", message=f"{exc}; {other}") from None
+
+
+def _first_line(text: str) -> str:
+    """The first line that is not blank or a comment, without its indentation."""
+    return next((line.lstrip() for line in text_lines(text) if line.strip() and not line.lstrip().startswith("#")), "")
+
+
+def capture_kind(text: str, name: str) -> str | None:
+    """What `text` is when it reads as a capture that holds bytes: "a capture of `uitamr
+    monitor --capture` (...)" or "a trace (JSON Lines) ..."; None for anything else (only
+    comments or an `end` line tell nothing). For the commands that read other files: a
+    capture given to them is named as such, not as a mistake at its first line."""
+    text = lone_cr_as_line_feed(text)
+    trace = _first_line(text).startswith("{")
+    try:
+        captures = parse_trace(text, name) if trace else {name: parse_plain(text, name)}
+    except (CaptureError, RecursionError):
+        return None
+    if not any(chunk.data for chunks in captures.values() for chunk in chunks):
+        return None
+    return ("a trace (JSON Lines) of `uitamr verify` or `uitamr monitor`" if trace
+            else "a capture of `uitamr monitor --capture` (times and bytes on the line)")
+
+
+
+def capture_instead(text: str, path: Path | str | None) -> str:
+    """What to say after "not valid TOML" of a capture given as a scenario or a fault file
+    (`--scenario site.txt`, `--faults site.txt`): what it is and what reads it; else ""."""
+    what = capture_kind(text, str(path or "<scenario>"))
+    return "" if what is None else f"; this is {what}: `uitamr replay {path or 'FILE'}` judges its frames"
 
 
 def _other_kind(path: Path, text: str, first: str) -> str | None:

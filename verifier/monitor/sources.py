@@ -41,6 +41,8 @@ class SerialSource:
     def __init__(self, port: str, baud: int, bytesize: int, parity: str, stopbits: float):
         import serial
 
+        from verifier.emulate.ports import why_not_opened
+
         try:
             # exclusive (Linux/macOS: flock; Windows ports always are): a second reader of the
             # same port - `uitamr emulate`, another monitor - takes every byte it reads away
@@ -54,7 +56,7 @@ class SerialSource:
                                   "emulate, or another uitamr monitor?); each would read only part of the "
                                   "line's bytes: stop that one first, or tap the line with a second "
                                   "adapter") from None
-            raise SourceError(f"cannot open {port}: {exc}") from None
+            raise SourceError(f"cannot open {port}: {why_not_opened(exc)}") from None
         self.description = port
         self._error = serial.SerialException
 

@@ -324,8 +324,10 @@ def parse_scenario(text: str, path: Path | None = None, platform: str | None = N
         data = tomllib.loads(text)
     except (ValueError, RecursionError) as exc:
         # TOMLDecodeError, int()'s limit of 4300 digits, or arrays nested too deep for tomllib
+        from verifier.monitor.capture import capture_instead
+
         message, place = decode_error_position(exc, text)
-        raise ScenarioError(path, "", f"not valid TOML: {message}", place) from None
+        raise ScenarioError(path, "", f"not valid TOML: {message}{capture_instead(text, path)}", place) from None
     return _Reader(text, path, platform).read(data)
 
 
