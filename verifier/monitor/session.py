@@ -31,7 +31,6 @@ POWER_ON_RULE = "UITAMR-POWERON-STOP"
 PROVISIONAL_RULE = "UITAMR-RESPONSE-HANDLING"  # the one rule with early word (Judgement.provisional)
 
 
-
 def garbled_line(frames: int, line: str) -> str:
     """The note of a session in which every frame is garbled (`crc.garbled`: no good CRC, nor
     the protocol's shape): a PLC at another speed or parity than the monitor reads (a PLC at
