@@ -291,6 +291,23 @@ def test_serial_reply_waits_for_t3_5_at_the_port_speed(pty_pair, start_emulator)
     assert emulator.stop()[0] == 0
 
 
+def test_two_replies_owed_at_once_leave_t3_5_of_silence_between_them(pty_pair, start_emulator):
+    """A master that sends two requests together (no silence between them) is owed two
+    replies; they went out back to back, one 16-byte run a Modbus master reads as one
+    frame with a bad CRC. Each reply now starts at least t3.5 after the previous one has
+    left the line (8 bytes at 9600: 8.33 ms + 3.65 ms). Judged on the emulator's own log."""
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end)
+    with serial.Serial(master_end, 9600, timeout=WAIT_S) as port:
+        port.write(STOP_FRAME + STATUS_TASK)
+        assert port.read(16) == STOP_FRAME + with_crc(bytes.fromhex("010103000000"))
+    first = emulator.wait_for(r"-> 01 06 01 A0").string
+    second = emulator.wait_for(r"-> 01 01 03 00 00 00").string
+    # 11.98 ms apart at least; the log counts whole ms, so at least 11 on its clock
+    assert round((log_time(second) - log_time(first)) * 1000) >= 11, emulator.lines
+    assert emulator.stop()[0] == 0
+
+
 # ---- TCP: pymodbus client and raw sockets -----------------------------------------------------
 
 def tcp_emulator(start_emulator, *args: str) -> tuple[EmulatorProcess, int]:
