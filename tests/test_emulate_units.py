@@ -79,6 +79,33 @@ def test_a_flood_is_dropped_until_the_line_goes_quiet():
     assert frames_of(asm.feed(STOP_FRAME, 30_000)) == [STOP_FRAME]
 
 
+def test_a_request_after_t3_5_of_quiet_ends_a_flood():
+    """t3.5 of silence ends any frame, a flood too: the request after it was lost with the
+    flood unless the quiet lasted the whole --frame-gap-ms."""
+    asm = RequestAssembler(silence_us=20_000)
+    assert asm.feed(bytes(300), 0) == []
+    assert asm.feed(STOP_FRAME[:3], 5_000) == []  # 5 ms of quiet, then a request in pieces
+    done = asm.feed(STOP_FRAME[3:] + STATUS, 6_000)
+    assert done[0] == Dropped(300, 0, done[0].reason) and "more than 256" in done[0].reason
+    assert done[1:] == [ReceivedFrame(STOP_FRAME, 5_000, 6_000, "length"),
+                        ReceivedFrame(STATUS, 6_000, 6_000, "length")]
+    assert asm.deadline_us() is None
+
+
+@hsettings(max_examples=200, deadline=None)
+@given(st.lists(st.tuples(st.binary(min_size=1, max_size=300), st.integers(0, T3_5_US - 1)), min_size=1),
+       st.integers(T3_5_US, 19_999))
+def test_a_flood_then_t3_5_of_quiet_then_a_request_is_always_answered(chunks, quiet_us):
+    asm = RequestAssembler(silence_us=20_000)
+    t, items = 0, asm.feed(bytes(257), 0)  # a flood from the first chunk on
+    for data, gap in chunks:  # never t3.5 of quiet: all of it the flood
+        t += gap
+        items += asm.feed(data, t)
+    items += asm.feed(STOP_FRAME, t + quiet_us)
+    assert frames_of(items) == [STOP_FRAME]
+    assert [i.data_len for i in items if isinstance(i, Dropped)] == [257 + sum(len(d) for d, _ in chunks)]
+
+
 @hsettings(max_examples=200, deadline=None)
 @given(st.lists(st.tuples(st.binary(max_size=40), st.integers(0, 30_000)), max_size=20))
 def test_noise_then_silence_then_a_request_is_always_recovered(chunks):
