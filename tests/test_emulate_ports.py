@@ -286,6 +286,20 @@ def test_serial_answers_a_request_after_t3_5_of_quiet_that_ends_a_flood(pty_pair
     assert emulator.stop()[0] == 0
 
 
+def test_pacing_late_logs_how_far_apart_the_requests_came(pty_pair, start_emulator):
+    """--pacing late, three reads sent together: the third was logged as coming -250 ms
+    after the second (counted from the second's delayed answer, not from when it came)."""
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end, "--pacing", "late")
+    with serial.Serial(master_end, 9600, timeout=WAIT_S) as port:
+        port.write(STATUS_TASK * 3)
+        assert port.read(24) == with_crc(bytes.fromhex("010103000000")) * 3
+    for n, late in ((2, "250.0"), (3, "500.0")):
+        emulator.wait_for(rf"\*\* pacing: request {n} came 0\.0 ms after the previous one "
+                          rf"\(must be > 250 ms\): answered {late} ms late$")
+    assert emulator.stop()[0] == 0
+
+
 def log_time(line: str) -> float:
     return float(line.split()[0])
 

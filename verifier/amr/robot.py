@@ -144,7 +144,8 @@ class Robot:
         self._drive = TRACKLESS
         self._point: int | None = None
         self._conditions: dict[int, _Condition] = {}
-        self._last_start_us: int | None = None
+        self._last_start_us: int | None = None  # the previous request's start (pacing "late": its answer's)
+        self._previous_start_us: int | None = None  # when the previous request really started
         self._state_faults = [_FaultState(f, i) for i, f in enumerate(faults) if f.is_state_fault]
         self._reply_faults = [_FaultState(f, i) for i, f in enumerate(faults) if not f.is_state_fault]
         self._battery_was_low = self.battery_low
@@ -315,11 +316,13 @@ class Robot:
 
     def _pacing(self, start: int, t_us: int, number: int) -> int | None:
         """Extra delay for a request that breaks the 250 ms pacing, or None to ignore it."""
-        last = self._last_start_us
+        last, previous = self._last_start_us, self._previous_start_us
+        self._previous_start_us = start
         if last is None or start - last > MIN_PERIOD_US:
             self._last_start_us = start
             return 0
-        gap_ms = (start - last) / 1000
+        # the gap the master left, from the previous request (not from a late answer to it)
+        gap_ms = (start - (previous if previous is not None else last)) / 1000
         policy = self.config.pacing
         if policy == "ignore":
             self._log(t_us, "pacing", f"request {number} came {gap_ms:.1f} ms after the previous one "
