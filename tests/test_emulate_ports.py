@@ -300,6 +300,22 @@ def test_pacing_late_logs_how_far_apart_the_requests_came(pty_pair, start_emulat
     assert emulator.stop()[0] == 0
 
 
+@pytest.mark.parametrize("request_body, exception", [
+    # a quantity Modbus itself refuses (not 1-2000) is exception 03 before the address is
+    # looked at (Modbus Application Protocol V1.1b3 §6.1, the Read Coils state diagram): these
+    # two were answered 02 for the query parameter 4 / 01 00
+    ("01 01 00 04 00 00", 3), ("01 01 01 00 07 D1", 3),
+    ("01 01 00 04 00 16", 2), ("01 01 00 04 00 01", 2),  # a quantity Modbus allows: the address
+    ("01 01 00 00 00 00", 3), ("01 01 00 00 00 17", 3),  # query 0, quantity not 22
+])
+def test_fc01_out_of_range_gets_the_exception_modbus_checks_first(pty_pair, start_emulator, request_body, exception):
+    robot_end, master_end = pty_pair
+    start_emulator("--serial", robot_end)
+    with serial.Serial(master_end, 9600, timeout=WAIT_S) as port:
+        port.write(with_crc(bytes.fromhex(request_body)))
+        assert port.read(5) == with_crc(bytes((1, 0x81, exception)))
+
+
 def log_time(line: str) -> float:
     return float(line.split()[0])
 

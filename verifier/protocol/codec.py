@@ -15,6 +15,7 @@ from verifier.protocol.catalogue import (
     FC_READ_COILS,
     FC_WRITE_SINGLE_REGISTER,
     FUNCTION_CODES,
+    MAX_COILS,
     STATUS_BYTE_COUNT,
     STATUS_QUANTITY,
     ControlCode,
@@ -263,6 +264,11 @@ def _unknown_function(data: bytes, address: int, function: int) -> None:
 
 def _decode_status_request(data: bytes, settings: Settings) -> StatusRequest:
     address, function = data[0], data[1]
+    quantity = int.from_bytes(data[4:6], "big")
+    # Modbus checks the quantity against 1-2000 before the address (Modbus Application
+    # Protocol V1.1b3 §6.1, the Read Coils state diagram): outside that, 03 whatever the address
+    if not 1 <= quantity <= MAX_COILS:
+        raise _bad_quantity(data, quantity)
     if data[2]:
         raise FrameError(
             f"query parameter high byte must be 00, got {data[2]:02X}", 2,
@@ -274,14 +280,16 @@ def _decode_status_request(data: bytes, settings: Settings) -> StatusRequest:
         raise FrameError(
             str(exc), 3, kind="query", exception=ILLEGAL_ADDRESS, address=address, function=function,
         ) from None
-    quantity = int.from_bytes(data[4:6], "big")
     if quantity != STATUS_QUANTITY:
-        offset = 4 if data[4] != 0 else 5
-        raise FrameError(
-            f"quantity must be 00 16 (22 coils), got {hex_bytes(data[4:6])} ({quantity})", offset,
-            kind="quantity", exception=ILLEGAL_VALUE, address=address, function=function,
-        )
+        raise _bad_quantity(data, quantity)
     return StatusRequest(address, query)
+
+
+def _bad_quantity(data: bytes, quantity: int) -> FrameError:
+    return FrameError(
+        f"quantity must be 00 16 (22 coils), got {hex_bytes(data[4:6])} ({quantity})", 4 if data[4] else 5,
+        kind="quantity", exception=ILLEGAL_VALUE, address=data[0], function=data[1],
+    )
 
 
 # --- decode replies ---------------------------------------------------------------------
