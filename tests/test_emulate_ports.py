@@ -316,6 +316,22 @@ def test_fc01_out_of_range_gets_the_exception_modbus_checks_first(pty_pair, star
         assert port.read(5) == with_crc(bytes((1, 0x81, exception)))
 
 
+@pytest.mark.parametrize("function", [0x00, 0x80, 0x83, 0xFF])
+def test_a_function_code_no_master_sends_gets_silence_and_the_log_says_why(pty_pair, start_emulator, function):
+    """Function 00 is not valid and 80-FF are exception replies (Modbus Application Protocol
+    V1.1b3 §4.1): no exception reply can answer them (80 | 80 is 80 again). The robot stays
+    silent, and the log said only "unknown function code" and "no reply", while another
+    unknown function code (03) gets exception 01."""
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end)
+    with serial.Serial(master_end, 9600, timeout=WAIT_S) as port:
+        port.write(with_crc(bytes((1, function, 0, 0, 0, 1))))
+        emulator.wait_for(rf"\*\* silent: request 1: byte 1: function code 0x{function:02X} is not one a master "
+                          r"sends \(00 is not a Modbus function code, 80-FF are exception replies\): no reply$")
+        port.write(STATUS_TASK)  # nothing came before the reply to this one
+        assert port.read(8) == with_crc(bytes.fromhex("010103000000"))
+
+
 def log_time(line: str) -> float:
     return float(line.split()[0])
 

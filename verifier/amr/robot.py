@@ -27,7 +27,6 @@ from verifier.amr.config import RobotConfig
 from verifier.amr.faults import Fault, check_fault_addresses
 from verifier.amr.motion import MAGNETIC, TRACKLESS, Motion
 from verifier.protocol.catalogue import (
-    EXCEPTION_FLAG,
     FC_READ_COILS,
     FC_WRITE_SINGLE_REGISTER,
     MOVE_CODES,
@@ -348,7 +347,7 @@ class Robot:
         except FrameError as err:
             self._start_request_faults(number, t_us)
             answer = exception_reply_for(err, self.settings)
-            if answer is None or not 1 <= function < EXCEPTION_FLAG:
+            if answer is None:
                 self._log(t_us, "silent", f"request {number}: {err}: no reply")
                 return None
             if exception_fault is not None:

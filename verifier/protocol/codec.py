@@ -251,6 +251,11 @@ def decode_request(data: bytes, settings: Settings = DEFAULT_SETTINGS) -> Contro
 def _unknown_function(data: bytes, address: int, function: int) -> None:
     known = "the robot knows 01 (read coils) and 06 (write single register)"
     if len(data) >= 4 and crc16(data[:-2]) == frame_crc(data):
+        if not answerable_function(function):
+            raise FrameError(
+                f"function code 0x{function:02X} is not one a master sends (00 is not a Modbus function "
+                "code, 80-FF are exception replies)", 1, kind="function", address=address, function=function,
+            )
         raise FrameError(
             f"unknown function code 0x{function:02X} ({known})", 1,
             kind="function", exception=ILLEGAL_FUNCTION, address=address, function=function,
@@ -412,13 +417,21 @@ def addressed_to_robot(address: int, settings: Settings = DEFAULT_SETTINGS) -> b
     return address in (0, settings.address)
 
 
+def answerable_function(function: int) -> bool:
+    """Whether an exception reply can answer this function code: not 00 (no Modbus function
+    code) nor 80-FF (exception replies themselves; 80 | 80 is 80 again), Modbus Application
+    Protocol V1.1b3 §4.1. A request with one of those gets silence."""
+    return 1 <= function < EXCEPTION_FLAG
+
+
 def exception_reply_for(error: FrameError, settings: Settings = DEFAULT_SETTINGS) -> ExceptionReply | None:
     """The exception reply a Modbus slave sends for a bad request, or None for silence.
 
     Silence when the frame is broken (length, CRC), addressed to another slave, or
     broadcast (a slave never answers a broadcast).
     """
-    if error.exception is None or error.address != settings.address or error.function is None:
+    if (error.exception is None or error.address != settings.address or error.function is None
+            or not answerable_function(error.function)):
         return None
     return ExceptionReply(error.address, error.function & ~EXCEPTION_FLAG, error.exception)
 
