@@ -272,14 +272,15 @@ def test_serial_survives_noise_truncated_frames_and_floods(pty_pair, start_emula
 
 
 def test_serial_answers_a_request_after_t3_5_of_quiet_that_ends_a_flood(pty_pair, start_emulator):
-    """300 bytes without a silence, then 8 ms of quiet (over t3.5, under the 20 ms frame
-    gap), then a request: the request was dropped with the flood."""
+    """300 bytes without a silence, then 0.3 s of quiet (over t3.5, under the 2 s frame gap
+    set here: a pty delivers bytes up to some 15 ms late, so a gap under the default 20 ms
+    does not survive it), then a request: the request was dropped with the flood."""
     robot_end, master_end = pty_pair
-    emulator = start_emulator("--serial", robot_end)
+    emulator = start_emulator("--serial", robot_end, "--frame-gap-ms", "2000")
     with serial.Serial(master_end, 9600, timeout=WAIT_S) as port:
         port.write(bytes(300))
         port.flush()
-        time.sleep(0.008)
+        time.sleep(0.3)
         port.write(STATUS_TASK)
         assert port.read(8) == with_crc(bytes.fromhex("010103000000"))
     emulator.wait_for(r"!! 300 bytes without a silence")
