@@ -24,6 +24,7 @@ import serial
 from pymodbus.client import ModbusTcpClient
 from pymodbus.framer import FramerType
 
+from linebus import LineBus
 from verifier.protocol import STOP_FRAME, ControlRequest, Query, StatusRequest, encode, with_crc
 
 pytestmark = pytest.mark.serial
@@ -331,6 +332,25 @@ def test_a_function_code_no_master_sends_gets_silence_and_the_log_says_why(pty_p
                           r"sends \(00 is not a Modbus function code, 80-FF are exception replies\): no reply$")
         port.write(STATUS_TASK)  # nothing came before the reply to this one
         assert port.read(8) == with_crc(bytes.fromhex("010103000000"))
+
+
+def test_an_adapter_that_echoes_the_robots_replies_does_not_set_it_answering_itself(tmp_path, start_emulator):
+    """A 2-wire adapter with local echo hands the emulator back every byte it sends. An FC06
+    echo is the request again, so the emulator answered its own reply, and that reply's
+    echo, some 70 times a second, for ever; the robot's transceiver does not hear itself."""
+    bus = LineBus(tmp_path, robot_hears_itself=True)
+    try:
+        emulator = start_emulator("--serial", bus.robot)
+        with serial.Serial(bus.plc, 9600, timeout=WAIT_S) as port:
+            port.write(STOP_FRAME)
+            assert port.read(8) == STOP_FRAME
+            emulator.wait_for(r"-- serial .* echoes what the emulator sends")
+            port.write(STATUS_TASK)  # the next request is still answered, and only it
+            assert port.read(8) == with_crc(bytes.fromhex("010103000000"))
+        code, summary = emulator.stop()
+    finally:
+        bus.close()
+    assert code == 0 and "2 frames in, 2 replies out, 0 unanswered" in summary, "\n".join(emulator.lines)
 
 
 def log_time(line: str) -> float:

@@ -14,7 +14,7 @@ from verifier.emulate import (
     RequestAssembler,
     load_fault_file,
 )
-from verifier.emulate.ports import serial_assembler
+from verifier.emulate.ports import _EchoFilter, serial_assembler
 from verifier.protocol import STOP_FRAME, T3_5_US, Query, StatusRequest, encode, with_crc
 
 STATUS = encode(StatusRequest(1, Query.TASK))
@@ -186,6 +186,20 @@ def test_serial_framing_follows_the_speed(baud, gap_us, t3_5_us):
         items += asm.feed(bytes((byte,)), k * 40_000)
     items += asm.poll(len(noise) * 40_000 + gap_us)
     assert frames_of(items) == ([noise] if baud == 300 else [bytes((b,)) for b in noise])
+
+
+def test_the_echo_filter_drops_only_an_echo_that_comes_in_time():
+    echo = _EchoFilter()
+    echo.sent(STOP_FRAME, 100)
+    assert echo.strip(STOP_FRAME[:3], 10) == b""  # the echo, in two chunks
+    assert echo.strip(STOP_FRAME[3:] + STATUS, 20) == STATUS  # a master's request right after it
+    assert echo.seen
+    assert echo.strip(STOP_FRAME, 30) == STOP_FRAME  # the same bytes again: no echo owed
+    echo.sent(STOP_FRAME, 100)
+    assert echo.strip(STATUS, 40) == STATUS  # other bytes: not an echo, and none expected now
+    assert echo.strip(STOP_FRAME, 50) == STOP_FRAME
+    echo.sent(STOP_FRAME, 100)
+    assert echo.strip(STOP_FRAME, 101) == STOP_FRAME  # too late to be the echo
 
 
 def test_missing_fault_file(tmp_path):

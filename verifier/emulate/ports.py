@@ -32,6 +32,10 @@ POLL_S = 0.005  # longest wait between looks at the clock (reply and silence dea
 
 # how long replies still owed to a peer that shut its sending side are waited for
 END_GRACE_US = 2_000_000
+# how long after a reply has left the line its echo may still come back through a USB
+# adapter (latency timers: 16 ms by default on FTDI chips) or a busy pty; a master that keeps
+# the 250 ms pacing sends its next request later than this
+ECHO_GRACE_US = 200_000
 
 
 class PortError(RuntimeError):
@@ -103,6 +107,33 @@ class _Channel:
         return [reply]
 
 
+class _EchoFilter:
+    """Drops the bytes a 2-wire adapter with local echo hands back of what the emulator
+    sent: the robot's transceiver does not hear itself, and an FC06 reply heard back is
+    the request again, which the emulator then answered, and so on for ever."""
+
+    def __init__(self) -> None:
+        self._expected = b""
+        self._until_us = 0
+        self.seen = False  # an echo has come back at least once
+
+    def sent(self, data: bytes, until_us: int) -> None:
+        self._expected, self._until_us = bytes(data), until_us
+
+    def strip(self, data: bytes, t_us: int) -> bytes:
+        """``data`` without the echo at its start, if it begins with the bytes expected."""
+        if not self._expected or t_us > self._until_us:
+            self._expected = b""
+            return data
+        n = min(len(data), len(self._expected))
+        if data[:n] != self._expected[:n]:
+            self._expected = b""  # not an echo: a master's bytes
+            return data
+        self._expected = self._expected[n:]
+        self.seen = True
+        return data[n:]
+
+
 def t3_5_at(baudrate: int) -> int:
     """t3.5, the silence that ends a frame, on a line at ``baudrate`` (µs)."""
     return LineConfig(baud=baudrate).frame_gap_us
@@ -135,6 +166,7 @@ def serve_serial(url: str, emulator: Emulator, stop: threading.Event, silence_us
     longer = f", frame gap {gap_us / 1000:g} ms (t3.5 at {baudrate} bit/s)" if gap_us > silence_us else ""
     emulator.note(f"listening on serial {url} at {baudrate} 8N1{longer}, "
                   f"robot address {emulator.robot.settings.address}")
+    echo = _EchoFilter()
     try:
         while not stop.is_set():
             try:
@@ -144,6 +176,12 @@ def serve_serial(url: str, emulator: Emulator, stop: threading.Event, silence_us
             except (serial.SerialException, OSError) as err:
                 raise PortError(f"serial port {url} failed: {err}", in_use=True) from None
             now = emulator.now_us()
+            if data:
+                heard_before = echo.seen
+                data = echo.strip(data, now)
+                if echo.seen and not heard_before:
+                    emulator.note(f"serial {url} echoes what the emulator sends (a 2-wire adapter with local "
+                                  "echo): the echo is dropped, as the robot does not hear its own replies")
             channel.take(emulator, channel.assembler.feed(data, now) if data else channel.assembler.poll(now))
             emulator.tick()
             now = emulator.now_us()
@@ -153,6 +191,7 @@ def serve_serial(url: str, emulator: Emulator, stop: threading.Event, silence_us
                     port.flush()
                 except (serial.SerialException, OSError) as err:
                     raise PortError(f"serial port {url} failed while writing: {err}", in_use=True) from None
+                echo.sent(reply.data, emulator.now_us() + channel.line.offset_us(len(reply.data)) + ECHO_GRACE_US)
                 emulator.sent(reply, now)
     finally:
         port.close()
