@@ -231,6 +231,21 @@ def test_mbpoll_sees_a_task_run_and_an_anti_collision_stop(pty_pair, start_emula
     assert emulator.stop()[0] == 0
 
 
+def test_a_manual_stop_taken_as_the_power_on_stop_is_logged_as_such(pty_pair, start_emulator):
+    """With --manual-stop-counts-as-stop the first 05/00 is the power-on stop, and the robot
+    then obeys motion commands; the log said only "ignored: ... not in manual mode", so the
+    point run that followed seemed to start without any stop."""
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end, "--manual-stop-counts-as-stop")
+    assert write_command(master_end, 0x05, 0x00).returncode == 0
+    emulator.wait_for(r"\*\* command: manual move stop moving: the power-on stop; not in manual mode, "
+                      r"nothing to stop$")
+    assert not [line for line in emulator.lines if "** ignored" in line], emulator.lines
+    assert write_command(master_end, 0x01, 3).returncode == 0
+    emulator.wait_for(r"\*\* task: run point/script 3: started")
+    assert emulator.stop()[0] == 0
+
+
 def test_mbpoll_gets_illegal_function_and_the_next_request_is_still_answered(pty_pair, start_emulator):
     robot_end, master_end = pty_pair
     emulator = start_emulator("--serial", robot_end)

@@ -508,7 +508,7 @@ class Robot:
             self.collision_range_stage = command
             self._log(t_us, "command", title)
         elif code == ControlCode.MANUAL:
-            self._manual_move(ManualMove(command), title, t_us)
+            self._manual_move(ManualMove(command), title, t_us, first_stop)
         elif code in MOVE_CODES:
             if self._may_move(title, t_us):
                 stage = self.speed_stage
@@ -569,13 +569,17 @@ class Robot:
             self._start(motions.point_run(point, self.pose, self.config, title), TRACKLESS, t_us)
             self._point = point
 
-    def _manual_move(self, move: ManualMove, title: str, t_us: int) -> None:
+    def _manual_move(self, move: ManualMove, title: str, t_us: int, first_stop: bool = False) -> None:
+        """``first_stop``: this 05/00 is the power-on stop (``manual_stop_counts_as_stop``)."""
         if self.mode != "manual":
-            self._log(t_us, "ignored", f"{title}: not in manual mode (send 01/E0 first)")
+            if first_stop:
+                self._log(t_us, "command", f"{title}: the power-on stop; not in manual mode, nothing to stop")
+            else:
+                self._log(t_us, "ignored", f"{title}: not in manual mode (send 01/E0 first)")
             return
         if move == ManualMove.STOP:
             halted = self._halt("manual stop")
-            self._log(t_us, "command", f"manual stop{halted}")
+            self._log(t_us, "command", f"manual stop{' (the power-on stop)' if first_stop else ''}{halted}")
             return
         if self._may_move(title, t_us):
             self._halt("next manual move")
