@@ -18,8 +18,11 @@ OPEN_TIMEOUT_S = 10
 
 
 class LineBus:
-    def __init__(self, folder: Path):
+    def __init__(self, folder: Path, robot_hears_itself: bool = False):
+        """``robot_hears_itself``: what the robot end writes comes back to it too, as on a
+        2-wire USB adapter with local echo (its receiver stays on while it sends)."""
         self.folder = folder
+        self._robot_echo = ("robot",) if robot_hears_itself else ()
         self.plc = str(folder / "plc")
         self.robot = str(folder / "robot")
         self.tap = str(folder / "tap")
@@ -51,7 +54,7 @@ class LineBus:
             view = view[written:]
 
     def _relay(self) -> None:
-        sources = {self._fds["plc"]: ("robot", "tap"), self._fds["robot"]: ("plc", "tap"),
+        sources = {self._fds["plc"]: ("robot", "tap"), self._fds["robot"]: ("plc", "tap", *self._robot_echo),
                    self._fds["tap"]: ()}  # the tap only listens: what it writes goes nowhere
         while not self._stop.is_set():
             ready, _, _ = select.select(list(sources), [], [], 0.05)

@@ -394,6 +394,18 @@ def test_pacing_late_answers_when_the_period_is_over():
     assert reply.delay_us == 5_000 + 150_001
 
 
+def test_pacing_late_says_how_far_apart_the_requests_really_came():
+    """Three requests 100 ms apart: the third was logged as coming -49.7 ms after the second
+    (measured from the second's delayed answer, not from when it came)."""
+    robot = Robot(config=RobotConfig(pacing="late"))
+    frame = status(Query.TASK)
+    for t_us in (100_000, 200_000, 300_000):
+        last = robot.on_request(frame, t_us)
+    messages = [e.message for e in robot.events if e.kind == "pacing"]
+    assert [m.split(" came ")[1].split(" after")[0] for m in messages] == ["100.0 ms", "100.0 ms"]
+    assert last.delay_us == 5_000 + 300_002  # still queued behind the second's late answer
+
+
 # ---- robustness and determinism --------------------------------------------------------------
 
 @hsettings(max_examples=200, deadline=None)

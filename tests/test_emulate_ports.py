@@ -24,6 +24,7 @@ import serial
 from pymodbus.client import ModbusTcpClient
 from pymodbus.framer import FramerType
 
+from linebus import LineBus
 from verifier.protocol import STOP_FRAME, ControlRequest, Query, StatusRequest, encode, with_crc
 
 pytestmark = pytest.mark.serial
@@ -230,6 +231,21 @@ def test_mbpoll_sees_a_task_run_and_an_anti_collision_stop(pty_pair, start_emula
     assert emulator.stop()[0] == 0
 
 
+def test_a_manual_stop_taken_as_the_power_on_stop_is_logged_as_such(pty_pair, start_emulator):
+    """With --manual-stop-counts-as-stop the first 05/00 is the power-on stop, and the robot
+    then obeys motion commands; the log said only "ignored: ... not in manual mode", so the
+    point run that followed seemed to start without any stop."""
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end, "--manual-stop-counts-as-stop")
+    assert write_command(master_end, 0x05, 0x00).returncode == 0
+    emulator.wait_for(r"\*\* command: manual move stop moving: the power-on stop; not in manual mode, "
+                      r"nothing to stop$")
+    assert not [line for line in emulator.lines if "** ignored" in line], emulator.lines
+    assert write_command(master_end, 0x01, 3).returncode == 0
+    emulator.wait_for(r"\*\* task: run point/script 3: started")
+    assert emulator.stop()[0] == 0
+
+
 def test_mbpoll_gets_illegal_function_and_the_next_request_is_still_answered(pty_pair, start_emulator):
     robot_end, master_end = pty_pair
     emulator = start_emulator("--serial", robot_end)
@@ -271,6 +287,87 @@ def test_serial_survives_noise_truncated_frames_and_floods(pty_pair, start_emula
     assert code == 0
 
 
+def test_serial_answers_a_request_after_t3_5_of_quiet_that_ends_a_flood(pty_pair, start_emulator):
+    """300 bytes without a silence, then 0.3 s of quiet (over t3.5, under the 2 s frame gap
+    set here: a pty delivers bytes up to some 15 ms late, so a gap under the default 20 ms
+    does not survive it), then a request: the request was dropped with the flood."""
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end, "--frame-gap-ms", "2000")
+    with serial.Serial(master_end, 9600, timeout=WAIT_S) as port:
+        port.write(bytes(300))
+        port.flush()
+        time.sleep(0.3)
+        port.write(STATUS_TASK)
+        assert port.read(8) == with_crc(bytes.fromhex("010103000000"))
+    emulator.wait_for(r"!! 300 bytes without a silence")
+    assert emulator.stop()[0] == 0
+
+
+def test_pacing_late_logs_how_far_apart_the_requests_came(pty_pair, start_emulator):
+    """--pacing late, three reads sent together: the third was logged as coming -250 ms
+    after the second (counted from the second's delayed answer, not from when it came)."""
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end, "--pacing", "late")
+    with serial.Serial(master_end, 9600, timeout=WAIT_S) as port:
+        port.write(STATUS_TASK * 3)
+        assert port.read(24) == with_crc(bytes.fromhex("010103000000")) * 3
+    for n, late in ((2, "250.0"), (3, "500.0")):
+        emulator.wait_for(rf"\*\* pacing: request {n} came 0\.0 ms after the previous one "
+                          rf"\(must be > 250 ms\): answered {late} ms late$")
+    assert emulator.stop()[0] == 0
+
+
+@pytest.mark.parametrize("request_body, exception", [
+    # a quantity Modbus itself refuses (not 1-2000) is exception 03 before the address is
+    # looked at (Modbus Application Protocol V1.1b3 §6.1, the Read Coils state diagram): these
+    # two were answered 02 for the query parameter 4 / 01 00
+    ("01 01 00 04 00 00", 3), ("01 01 01 00 07 D1", 3),
+    ("01 01 00 04 00 16", 2), ("01 01 00 04 00 01", 2),  # a quantity Modbus allows: the address
+    ("01 01 00 00 00 00", 3), ("01 01 00 00 00 17", 3),  # query 0, quantity not 22
+])
+def test_fc01_out_of_range_gets_the_exception_modbus_checks_first(pty_pair, start_emulator, request_body, exception):
+    robot_end, master_end = pty_pair
+    start_emulator("--serial", robot_end)
+    with serial.Serial(master_end, 9600, timeout=WAIT_S) as port:
+        port.write(with_crc(bytes.fromhex(request_body)))
+        assert port.read(5) == with_crc(bytes((1, 0x81, exception)))
+
+
+@pytest.mark.parametrize("function", [0x00, 0x80, 0x83, 0xFF])
+def test_a_function_code_no_master_sends_gets_silence_and_the_log_says_why(pty_pair, start_emulator, function):
+    """Function 00 is not valid and 80-FF are exception replies (Modbus Application Protocol
+    V1.1b3 §4.1): no exception reply can answer them (80 | 80 is 80 again). The robot stays
+    silent, and the log said only "unknown function code" and "no reply", while another
+    unknown function code (03) gets exception 01."""
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end)
+    with serial.Serial(master_end, 9600, timeout=WAIT_S) as port:
+        port.write(with_crc(bytes((1, function, 0, 0, 0, 1))))
+        emulator.wait_for(rf"\*\* silent: request 1: byte 1: function code 0x{function:02X} is not one a master "
+                          r"sends \(00 is not a Modbus function code, 80-FF are exception replies\): no reply$")
+        port.write(STATUS_TASK)  # nothing came before the reply to this one
+        assert port.read(8) == with_crc(bytes.fromhex("010103000000"))
+
+
+def test_an_adapter_that_echoes_the_robots_replies_does_not_set_it_answering_itself(tmp_path, start_emulator):
+    """A 2-wire adapter with local echo hands the emulator back every byte it sends. An FC06
+    echo is the request again, so the emulator answered its own reply, and that reply's
+    echo, some 70 times a second, for ever; the robot's transceiver does not hear itself."""
+    bus = LineBus(tmp_path, robot_hears_itself=True)
+    try:
+        emulator = start_emulator("--serial", bus.robot)
+        with serial.Serial(bus.plc, 9600, timeout=WAIT_S) as port:
+            port.write(STOP_FRAME)
+            assert port.read(8) == STOP_FRAME
+            emulator.wait_for(r"-- serial .* echoes what the emulator sends")
+            port.write(STATUS_TASK)  # the next request is still answered, and only it
+            assert port.read(8) == with_crc(bytes.fromhex("010103000000"))
+        code, summary = emulator.stop()
+    finally:
+        bus.close()
+    assert code == 0 and "2 frames in, 2 replies out, 0 unanswered" in summary, "\n".join(emulator.lines)
+
+
 def log_time(line: str) -> float:
     return float(line.split()[0])
 
@@ -288,6 +385,23 @@ def test_serial_reply_waits_for_t3_5_at_the_port_speed(pty_pair, start_emulator)
     # t3.5 = 29.167 ms; the log counts whole ms, compared as whole ms (0.030 - 0.001 is
     # 0.028999... in floating point, and failed when the request was logged at 1 ms)
     assert round((log_time(reply) - log_time(request)) * 1000) >= 29
+    assert emulator.stop()[0] == 0
+
+
+def test_two_replies_owed_at_once_leave_t3_5_of_silence_between_them(pty_pair, start_emulator):
+    """A master that sends two requests together (no silence between them) is owed two
+    replies; they went out back to back, one 16-byte run a Modbus master reads as one
+    frame with a bad CRC. Each reply now starts at least t3.5 after the previous one has
+    left the line (8 bytes at 9600: 8.33 ms + 3.65 ms). Judged on the emulator's own log."""
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end)
+    with serial.Serial(master_end, 9600, timeout=WAIT_S) as port:
+        port.write(STOP_FRAME + STATUS_TASK)
+        assert port.read(16) == STOP_FRAME + with_crc(bytes.fromhex("010103000000"))
+    first = emulator.wait_for(r"-> 01 06 01 A0").string
+    second = emulator.wait_for(r"-> 01 01 03 00 00 00").string
+    # 11.98 ms apart at least; the log counts whole ms, so at least 11 on its clock
+    assert round((log_time(second) - log_time(first)) * 1000) >= 11, emulator.lines
     assert emulator.stop()[0] == 0
 
 

@@ -16,7 +16,7 @@ from verifier.emulate import (
     RequestAssembler,
     load_fault_file,
 )
-from verifier.emulate.ports import serial_assembler
+from verifier.emulate.ports import _EchoFilter, serial_assembler
 from verifier.protocol import STOP_FRAME, T3_5_US, Query, StatusRequest, encode, with_crc
 
 STATUS = encode(StatusRequest(1, Query.TASK))
@@ -79,6 +79,33 @@ def test_a_flood_is_dropped_until_the_line_goes_quiet():
     assert dropped == [Dropped(408, 0, dropped[0].reason)]
     assert "more than 256" in dropped[0].reason
     assert frames_of(asm.feed(STOP_FRAME, 30_000)) == [STOP_FRAME]
+
+
+def test_a_request_after_t3_5_of_quiet_ends_a_flood():
+    """t3.5 of silence ends any frame, a flood too: the request after it was lost with the
+    flood unless the quiet lasted the whole --frame-gap-ms."""
+    asm = RequestAssembler(silence_us=20_000)
+    assert asm.feed(bytes(300), 0) == []
+    assert asm.feed(STOP_FRAME[:3], 5_000) == []  # 5 ms of quiet, then a request in pieces
+    done = asm.feed(STOP_FRAME[3:] + STATUS, 6_000)
+    assert done[0] == Dropped(300, 0, done[0].reason) and "more than 256" in done[0].reason
+    assert done[1:] == [ReceivedFrame(STOP_FRAME, 5_000, 6_000, "length"),
+                        ReceivedFrame(STATUS, 6_000, 6_000, "length")]
+    assert asm.deadline_us() is None
+
+
+@hsettings(max_examples=200, deadline=None)
+@given(st.lists(st.tuples(st.binary(min_size=1, max_size=300), st.integers(0, T3_5_US - 1)), min_size=1),
+       st.integers(T3_5_US, 19_999))
+def test_a_flood_then_t3_5_of_quiet_then_a_request_is_always_answered(chunks, quiet_us):
+    asm = RequestAssembler(silence_us=20_000)
+    t, items = 0, asm.feed(bytes(257), 0)  # a flood from the first chunk on
+    for data, gap in chunks:  # never t3.5 of quiet: all of it the flood
+        t += gap
+        items += asm.feed(data, t)
+    items += asm.feed(STOP_FRAME, t + quiet_us)
+    assert frames_of(items) == [STOP_FRAME]
+    assert [i.data_len for i in items if isinstance(i, Dropped)] == [257 + sum(len(d) for d, _ in chunks)]
 
 
 @hsettings(max_examples=200, deadline=None)
@@ -210,6 +237,20 @@ def test_serial_framing_follows_the_speed(baud, gap_us, t3_5_us):
         items += asm.feed(bytes((byte,)), k * 40_000)
     items += asm.poll(len(noise) * 40_000 + gap_us)
     assert frames_of(items) == ([noise] if baud == 300 else [bytes((b,)) for b in noise])
+
+
+def test_the_echo_filter_drops_only_an_echo_that_comes_in_time():
+    echo = _EchoFilter()
+    echo.sent(STOP_FRAME, 100)
+    assert echo.strip(STOP_FRAME[:3], 10) == b""  # the echo, in two chunks
+    assert echo.strip(STOP_FRAME[3:] + STATUS, 20) == STATUS  # a master's request right after it
+    assert echo.seen
+    assert echo.strip(STOP_FRAME, 30) == STOP_FRAME  # the same bytes again: no echo owed
+    echo.sent(STOP_FRAME, 100)
+    assert echo.strip(STATUS, 40) == STATUS  # other bytes: not an echo, and none expected now
+    assert echo.strip(STOP_FRAME, 50) == STOP_FRAME
+    echo.sent(STOP_FRAME, 100)
+    assert echo.strip(STOP_FRAME, 101) == STOP_FRAME  # too late to be the echo
 
 
 def test_missing_fault_file(tmp_path):

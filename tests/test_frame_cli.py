@@ -10,7 +10,7 @@ from hypothesis import given, settings as hypothesis_settings
 
 from verifier.cli import main
 from verifier.commands.frame import parse_hex
-from verifier.protocol import encode, hex_bytes, words_for
+from verifier.protocol import encode, hex_bytes, with_crc, words_for
 from verifier.protocol.strategies import requests
 
 
@@ -95,6 +95,21 @@ def test_decode_unknown_function_says_what_robot_answers():
     assert result.exit_code == 1
     assert "byte 1: unknown function code 0x03" in result.output
     assert "answer with exception 01: 01 83 01 80 F0" in result.output
+
+
+@pytest.mark.parametrize("function", [0x00, 0x80, 0x86, 0xFF])
+def test_decode_a_function_code_no_master_sends_as_a_request(function):
+    """00 and 80-FF with a good CRC, read as a request: `frame --decode` crashed with
+    ValueError (00, 80: an exception reply to function 0 cannot be built) or promised an
+    exception reply to function 06 (86), which a master would take for the real one."""
+    data = with_crc(bytes((1, function, 0, 0, 0, 1)))
+    result = run("--decode", hex_bytes(data), "--as", "request")
+    assert result.exception is None or isinstance(result.exception, SystemExit), repr(result.exception)
+    assert result.exit_code == 1, result.output
+    assert (f"byte 1: function code 0x{function:02X} is not one a master sends (00 is not a Modbus function "
+            "code, 80-FF are exception replies)") in result.output
+    assert f"the robot would stay silent (no exception reply can answer function code 0x{function:02X})" \
+        in result.output
 
 
 def test_decode_short_frame():

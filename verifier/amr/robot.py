@@ -27,7 +27,6 @@ from verifier.amr.config import RobotConfig
 from verifier.amr.faults import Fault, check_fault_addresses
 from verifier.amr.motion import MAGNETIC, TRACKLESS, Motion
 from verifier.protocol.catalogue import (
-    EXCEPTION_FLAG,
     FC_READ_COILS,
     FC_WRITE_SINGLE_REGISTER,
     MOVE_CODES,
@@ -144,7 +143,8 @@ class Robot:
         self._drive = TRACKLESS
         self._point: int | None = None
         self._conditions: dict[int, _Condition] = {}
-        self._last_start_us: int | None = None
+        self._last_start_us: int | None = None  # the previous request's start (pacing "late": its answer's)
+        self._previous_start_us: int | None = None  # when the previous request really started
         self._state_faults = [_FaultState(f, i) for i, f in enumerate(faults) if f.is_state_fault]
         self._reply_faults = [_FaultState(f, i) for i, f in enumerate(faults) if not f.is_state_fault]
         self._battery_was_low = self.battery_low
@@ -315,11 +315,13 @@ class Robot:
 
     def _pacing(self, start: int, t_us: int, number: int) -> int | None:
         """Extra delay for a request that breaks the 250 ms pacing, or None to ignore it."""
-        last = self._last_start_us
+        last, previous = self._last_start_us, self._previous_start_us
+        self._previous_start_us = start
         if last is None or start - last > MIN_PERIOD_US:
             self._last_start_us = start
             return 0
-        gap_ms = (start - last) / 1000
+        # the gap the master left, from the previous request (not from a late answer to it)
+        gap_ms = (start - (previous if previous is not None else last)) / 1000
         policy = self.config.pacing
         if policy == "ignore":
             self._log(t_us, "pacing", f"request {number} came {gap_ms:.1f} ms after the previous one "
@@ -345,7 +347,7 @@ class Robot:
         except FrameError as err:
             self._start_request_faults(number, t_us)
             answer = exception_reply_for(err, self.settings)
-            if answer is None or not 1 <= function < EXCEPTION_FLAG:
+            if answer is None:
                 self._log(t_us, "silent", f"request {number}: {err}: no reply")
                 return None
             if exception_fault is not None:
@@ -506,7 +508,7 @@ class Robot:
             self.collision_range_stage = command
             self._log(t_us, "command", title)
         elif code == ControlCode.MANUAL:
-            self._manual_move(ManualMove(command), title, t_us)
+            self._manual_move(ManualMove(command), title, t_us, first_stop)
         elif code in MOVE_CODES:
             if self._may_move(title, t_us):
                 stage = self.speed_stage
@@ -567,13 +569,17 @@ class Robot:
             self._start(motions.point_run(point, self.pose, self.config, title), TRACKLESS, t_us)
             self._point = point
 
-    def _manual_move(self, move: ManualMove, title: str, t_us: int) -> None:
+    def _manual_move(self, move: ManualMove, title: str, t_us: int, first_stop: bool = False) -> None:
+        """``first_stop``: this 05/00 is the power-on stop (``manual_stop_counts_as_stop``)."""
         if self.mode != "manual":
-            self._log(t_us, "ignored", f"{title}: not in manual mode (send 01/E0 first)")
+            if first_stop:
+                self._log(t_us, "command", f"{title}: the power-on stop; not in manual mode, nothing to stop")
+            else:
+                self._log(t_us, "ignored", f"{title}: not in manual mode (send 01/E0 first)")
             return
         if move == ManualMove.STOP:
             halted = self._halt("manual stop")
-            self._log(t_us, "command", f"manual stop{halted}")
+            self._log(t_us, "command", f"manual stop{' (the power-on stop)' if first_stop else ''}{halted}")
             return
         if self._may_move(title, t_us):
             self._halt("next manual move")

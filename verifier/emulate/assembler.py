@@ -13,7 +13,8 @@ literal t3.5 on arrival times would cut frames apart. The assembler therefore:
   hands over whatever came as one frame - the robot then applies the Modbus rules (bad CRC:
   silence; unknown function code with a good CRC: exception 01);
 * drops a run of more than 256 bytes without a silence (the longest Modbus RTU frame) as a
-  flood, and everything after it until the line falls silent.
+  flood, and everything after it until the line falls silent - or until a whole good
+  request arrives after at least t3.5 of quiet (below), which ends the flood there.
 
 * remembers where a chunk arrived after at least t3.5 of quiet (3.65 ms at 9600): if the
   bytes from there on make a whole request with a good CRC, that request is cut off and
@@ -91,6 +92,8 @@ class RequestAssembler:
         self._flooding = False
         self._flood_bytes = 0
         self._flood_started = 0
+        self._flood_tail: bytearray | None = None  # bytes of a flood since its last t3.5 quiet
+        self._flood_tail_us = 0  # when the first of them arrived
 
     @property
     def pending(self) -> bytes:
@@ -101,7 +104,7 @@ class RequestAssembler:
         The tail of a flood being dropped is not kept, so it is not returned either."""
         left = bytes(self._buffer)
         self._clear()
-        self._flooding = False
+        self._flooding, self._flood_tail = False, None
         return left
 
     def deadline_us(self) -> int | None:
@@ -113,19 +116,23 @@ class RequestAssembler:
     def feed(self, data: bytes, t_us: int) -> list[ReceivedFrame | Dropped]:
         """Bytes that arrived together at ``t_us``."""
         out: list[ReceivedFrame | Dropped] = self.poll(t_us)
-        if self._buffer and data and t_us - self._last_us >= self.t3_5_us:
+        quiet_before = bool(data) and t_us - self._last_us >= self.t3_5_us
+        if self._buffer and quiet_before:
             self._boundaries.append((len(self._buffer), t_us, self._last_us))
+        if self._flooding and quiet_before:
+            self._flood_tail, self._flood_tail_us = bytearray(), t_us
         for byte in data:
             if self._flooding:
                 self._flood_bytes += 1
                 self._last_us = t_us
+                out += self._request_ending_flood(byte, t_us)
                 continue
             if not self._buffer:
                 self._first_us = t_us
             self._buffer.append(byte)
             self._last_us = t_us
             if len(self._buffer) > self.max_frame:
-                self._flooding = True
+                self._flooding, self._flood_tail = True, None
                 self._flood_bytes = len(self._buffer)
                 self._flood_started = self._first_us
                 self._clear()
@@ -150,6 +157,28 @@ class RequestAssembler:
             return found
         return []
 
+    def _request_ending_flood(self, byte: int, t_us: int) -> list[ReceivedFrame | Dropped]:
+        """t3.5 of silence ends a flood as it ends any frame: a whole good request made of the
+        bytes since the flood's last quiet is answered, and the flood before it dropped."""
+        tail = self._flood_tail
+        if tail is None:
+            return []
+        tail.append(byte)
+        length = request_length(bytes(tail))
+        if (length is not None and len(tail) > length) or len(tail) > self.max_frame:
+            self._flood_tail = None  # no request: the flood goes on
+            return []
+        if len(tail) != length or not crc_ok(tail):
+            return []
+        dropped = self._flood_bytes - len(tail)
+        self._flooding, self._flood_tail = False, None
+        return [Dropped(dropped, self._flood_started, self._flood_reason(dropped)),
+                ReceivedFrame(bytes(tail), self._flood_tail_us, t_us, "length")]
+
+    def _flood_reason(self, count: int) -> str:
+        return (f"{count} bytes without a silence (more than {self.max_frame}, "
+                "the longest Modbus RTU frame): dropped")
+
     def _clear(self) -> None:
         self._buffer.clear()
         self._boundaries.clear()
@@ -159,10 +188,8 @@ class RequestAssembler:
         if t_us - self._last_us < self.silence_us:
             return []
         if self._flooding:
-            self._flooding = False
-            return [Dropped(self._flood_bytes, self._flood_started,
-                            f"{self._flood_bytes} bytes without a silence (more than {self.max_frame}, "
-                            "the longest Modbus RTU frame): dropped")]
+            self._flooding, self._flood_tail = False, None
+            return [Dropped(self._flood_bytes, self._flood_started, self._flood_reason(self._flood_bytes))]
         if not self._buffer:
             return []
         frame = ReceivedFrame(bytes(self._buffer), self._first_us, self._last_us, "silence")

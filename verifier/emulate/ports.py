@@ -32,6 +32,10 @@ POLL_S = 0.005  # longest wait between looks at the clock (reply and silence dea
 
 # how long replies still owed to a peer that shut its sending side are waited for
 END_GRACE_US = 2_000_000
+# how long after a reply has left the line its echo may still come back through a USB
+# adapter (latency timers: 16 ms by default on FTDI chips) or a busy pty; a master that keeps
+# the 250 ms pacing sends its next request later than this
+ECHO_GRACE_US = 200_000
 
 
 class PortError(RuntimeError):
@@ -50,6 +54,8 @@ class _Channel:
     assembler: RequestAssembler
     peer: str = ""
     outgoing: list[Outgoing] = field(default_factory=list)
+    line: LineConfig = field(default_factory=LineConfig)  # the robot's line (TCP: behind the converter)
+    line_free_us: int = 0  # t3.5 after the last reply left the line: the next may start
     ended_us: int | None = None  # when the peer closed its sending side (replies still owed)
     unread_at_end: bytes = b""  # a request it had not finished when it did
 
@@ -90,9 +96,42 @@ class _Channel:
         return "; " + ", ".join(lost) if lost else ""
 
     def due(self, now_us: int) -> list[Outgoing]:
-        ready = [o for o in self.outgoing if o.due_us <= now_us]
-        self.outgoing = [o for o in self.outgoing if o.due_us > now_us]
-        return ready
+        """The reply to send now, if one is due and the line is free: at most one, and
+        marked as sent. Two replies owed at once (a master that sent two requests together)
+        went out back to back, which a master reads as one frame with a bad CRC; Modbus
+        needs t3.5 of silence between frames (Modbus over Serial Line V1.02 §2.5.1.1)."""
+        if not self.outgoing or self.outgoing[0].due_us > now_us or now_us < self.line_free_us:
+            return []
+        reply = self.outgoing.pop(0)
+        self.line_free_us = now_us + self.line.offset_us(len(reply.data)) + self.line.frame_gap_us
+        return [reply]
+
+
+class _EchoFilter:
+    """Drops the bytes a 2-wire adapter with local echo hands back of what the emulator
+    sent: the robot's transceiver does not hear itself, and an FC06 reply heard back is
+    the request again, which the emulator then answered, and so on for ever."""
+
+    def __init__(self) -> None:
+        self._expected = b""
+        self._until_us = 0
+        self.seen = False  # an echo has come back at least once
+
+    def sent(self, data: bytes, until_us: int) -> None:
+        self._expected, self._until_us = bytes(data), until_us
+
+    def strip(self, data: bytes, t_us: int) -> bytes:
+        """``data`` without the echo at its start, if it begins with the bytes expected."""
+        if not self._expected or t_us > self._until_us:
+            self._expected = b""
+            return data
+        n = min(len(data), len(self._expected))
+        if data[:n] != self._expected[:n]:
+            self._expected = b""  # not an echo: a master's bytes
+            return data
+        self._expected = self._expected[n:]
+        self.seen = True
+        return data[n:]
 
 
 def t3_5_at(baudrate: int) -> int:
@@ -122,11 +161,12 @@ def serve_serial(url: str, emulator: Emulator, stop: threading.Event, silence_us
             raise PortError(f"cannot open serial port {url}: another program has it locked (another "
                             "uitamr emulate, or a uitamr monitor?); stop that one first") from None
         raise PortError(f"cannot open serial port {url}: {why_not_opened(err)}") from None
-    channel = _Channel(serial_assembler(baudrate, silence_us))
+    channel = _Channel(serial_assembler(baudrate, silence_us), line=LineConfig(baud=baudrate))
     gap_us = channel.assembler.silence_us
     longer = f", frame gap {gap_us / 1000:g} ms (t3.5 at {baudrate} bit/s)" if gap_us > silence_us else ""
     emulator.note(f"listening on serial {url} at {baudrate} 8N1{longer}, "
                   f"robot address {emulator.robot.settings.address}")
+    echo = _EchoFilter()
     try:
         while not stop.is_set():
             try:
@@ -136,15 +176,23 @@ def serve_serial(url: str, emulator: Emulator, stop: threading.Event, silence_us
             except (serial.SerialException, OSError) as err:
                 raise PortError(f"serial port {url} failed: {err}", in_use=True) from None
             now = emulator.now_us()
+            if data:
+                heard_before = echo.seen
+                data = echo.strip(data, now)
+                if echo.seen and not heard_before:
+                    emulator.note(f"serial {url} echoes what the emulator sends (a 2-wire adapter with local "
+                                  "echo): the echo is dropped, as the robot does not hear its own replies")
             channel.take(emulator, channel.assembler.feed(data, now) if data else channel.assembler.poll(now))
             emulator.tick()
-            for reply in channel.due(emulator.now_us()):
+            now = emulator.now_us()
+            for reply in channel.due(now):
                 try:
                     port.write(reply.data)
                     port.flush()
                 except (serial.SerialException, OSError) as err:
                     raise PortError(f"serial port {url} failed while writing: {err}", in_use=True) from None
-                emulator.sent(reply, emulator.now_us())
+                echo.sent(reply.data, emulator.now_us() + channel.line.offset_us(len(reply.data)) + ECHO_GRACE_US)
+                emulator.sent(reply, now)
     finally:
         port.close()
         if left_behind := channel.close(emulator):
@@ -216,13 +264,14 @@ def serve_tcp(host: str, port: int, emulator: Emulator, stop: threading.Event, s
                 channel.take(emulator, channel.assembler.poll(now))
             emulator.tick()
             for sock, channel in list(clients.items()):
-                for reply in channel.due(emulator.now_us()):
+                now = emulator.now_us()
+                for reply in channel.due(now):
                     try:
                         sock.sendall(reply.data)
                     except OSError as err:
                         drop(sock, f"lost while writing: {err}")
                         break
-                    emulator.sent(reply, emulator.now_us(), channel.peer)
+                    emulator.sent(reply, now, channel.peer)
             for sock, channel in list(clients.items()):
                 if channel.finished(emulator.now_us()):
                     drop(sock, "disconnected")

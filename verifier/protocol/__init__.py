@@ -30,6 +30,7 @@ from verifier.protocol.catalogue import (
 from verifier.protocol.codec import (
     STOP_FRAME,
     addressed_to_robot,
+    answerable_function,
     decode_reply,
     decode_request,
     encode,

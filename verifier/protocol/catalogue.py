@@ -15,6 +15,8 @@ EXCEPTION_FLAG = 0x80
 
 #: FC01 quantity field: always 22 coils (0x0016).
 STATUS_QUANTITY = 22
+#: the most coils one FC01 request may ask for (Modbus Application Protocol V1.1b3 §6.1)
+MAX_COILS = 2000
 #: FC01 reply byte count: 22 coils fill 3 bytes.
 STATUS_BYTE_COUNT = 3
 

@@ -15,6 +15,7 @@ from verifier.protocol.catalogue import (
     FC_READ_COILS,
     FC_WRITE_SINGLE_REGISTER,
     FUNCTION_CODES,
+    MAX_COILS,
     STATUS_BYTE_COUNT,
     STATUS_QUANTITY,
     ControlCode,
@@ -250,6 +251,11 @@ def decode_request(data: bytes, settings: Settings = DEFAULT_SETTINGS) -> Contro
 def _unknown_function(data: bytes, address: int, function: int) -> None:
     known = "the robot knows 01 (read coils) and 06 (write single register)"
     if len(data) >= 4 and crc16(data[:-2]) == frame_crc(data):
+        if not answerable_function(function):
+            raise FrameError(
+                f"function code 0x{function:02X} is not one a master sends (00 is not a Modbus function "
+                "code, 80-FF are exception replies)", 1, kind="function", address=address, function=function,
+            )
         raise FrameError(
             f"unknown function code 0x{function:02X} ({known})", 1,
             kind="function", exception=ILLEGAL_FUNCTION, address=address, function=function,
@@ -263,6 +269,11 @@ def _unknown_function(data: bytes, address: int, function: int) -> None:
 
 def _decode_status_request(data: bytes, settings: Settings) -> StatusRequest:
     address, function = data[0], data[1]
+    quantity = int.from_bytes(data[4:6], "big")
+    # Modbus checks the quantity against 1-2000 before the address (Modbus Application
+    # Protocol V1.1b3 §6.1, the Read Coils state diagram): outside that, 03 whatever the address
+    if not 1 <= quantity <= MAX_COILS:
+        raise _bad_quantity(data, quantity)
     if data[2]:
         raise FrameError(
             f"query parameter high byte must be 00, got {data[2]:02X}", 2,
@@ -274,14 +285,16 @@ def _decode_status_request(data: bytes, settings: Settings) -> StatusRequest:
         raise FrameError(
             str(exc), 3, kind="query", exception=ILLEGAL_ADDRESS, address=address, function=function,
         ) from None
-    quantity = int.from_bytes(data[4:6], "big")
     if quantity != STATUS_QUANTITY:
-        offset = 4 if data[4] != 0 else 5
-        raise FrameError(
-            f"quantity must be 00 16 (22 coils), got {hex_bytes(data[4:6])} ({quantity})", offset,
-            kind="quantity", exception=ILLEGAL_VALUE, address=address, function=function,
-        )
+        raise _bad_quantity(data, quantity)
     return StatusRequest(address, query)
+
+
+def _bad_quantity(data: bytes, quantity: int) -> FrameError:
+    return FrameError(
+        f"quantity must be 00 16 (22 coils), got {hex_bytes(data[4:6])} ({quantity})", 4 if data[4] else 5,
+        kind="quantity", exception=ILLEGAL_VALUE, address=data[0], function=data[1],
+    )
 
 
 # --- decode replies ---------------------------------------------------------------------
@@ -404,13 +417,21 @@ def addressed_to_robot(address: int, settings: Settings = DEFAULT_SETTINGS) -> b
     return address in (0, settings.address)
 
 
+def answerable_function(function: int) -> bool:
+    """Whether an exception reply can answer this function code: not 00 (no Modbus function
+    code) nor 80-FF (exception replies themselves; 80 | 80 is 80 again), Modbus Application
+    Protocol V1.1b3 §4.1. A request with one of those gets silence."""
+    return 1 <= function < EXCEPTION_FLAG
+
+
 def exception_reply_for(error: FrameError, settings: Settings = DEFAULT_SETTINGS) -> ExceptionReply | None:
     """The exception reply a Modbus slave sends for a bad request, or None for silence.
 
     Silence when the frame is broken (length, CRC), addressed to another slave, or
     broadcast (a slave never answers a broadcast).
     """
-    if error.exception is None or error.address != settings.address or error.function is None:
+    if (error.exception is None or error.address != settings.address or error.function is None
+            or not answerable_function(error.function)):
         return None
     return ExceptionReply(error.address, error.function & ~EXCEPTION_FLAG, error.exception)
 
