@@ -741,3 +741,22 @@ def test_a_log_reader_that_leaves_does_not_take_the_robot_off_the_line():
     assert "Traceback" not in err
     assert re.search(r"uitamr emulate: stopped after [\d.]+ s: 4 frames in, 4 replies out, .*"
                      r"\(the log's reader closed stdout; the robot kept serving until the stop\)", err), err
+
+
+def test_the_same_command_sent_again_soon_after_a_late_reply_is_answered_not_taken_for_an_echo(
+        pty_pair, start_emulator):
+    """An FC06 reply is its request byte for byte, so the echo filter for 2-wire adapters must
+    not take a master's next request for the echo. A reply 150 ms late, then the same stop
+    100 ms after it (266 ms after the first: within the pacing) went unanswered when any
+    copy within 200 ms of the reply was dropped as an echo; an echo comes back within the
+    adapter's latency (ECHO_GRACE_US)."""
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end, "--turnaround-ms", "150")
+    with serial.Serial(master_end, 9600, timeout=WAIT_S) as port:
+        port.write(STOP_FRAME)
+        assert port.read(8) == STOP_FRAME
+        time.sleep(0.1)
+        port.write(STOP_FRAME)
+        assert port.read(8) == STOP_FRAME, "\n".join(emulator.lines)
+    code, summary = emulator.stop()
+    assert code == 0 and "2 frames in, 2 replies out, 0 unanswered" in summary, "\n".join(emulator.lines)

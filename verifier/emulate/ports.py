@@ -33,9 +33,10 @@ POLL_S = 0.005  # longest wait between looks at the clock (reply and silence dea
 # how long replies still owed to a peer that shut its sending side are waited for
 END_GRACE_US = 2_000_000
 # how long after a reply has left the line its echo may still come back through a USB
-# adapter (latency timers: 16 ms by default on FTDI chips) or a busy pty; a master that keeps
-# the 250 ms pacing sends its next request later than this
-ECHO_GRACE_US = 200_000
+# adapter (latency timers: 16 ms by default on FTDI chips) or a busy pty. Kept short: an FC06
+# reply is its request byte for byte, so a master that sends the same command again this
+# soon after the reply (a retry after a reply that came late) would be taken for the echo
+ECHO_GRACE_US = 60_000
 
 
 class PortError(RuntimeError):
