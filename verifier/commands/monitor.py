@@ -22,8 +22,8 @@ from rich.markup import escape
 from verifier import protocol
 from verifier.commands.emulate import STANDARD_BAUD_RATES, _tcp_endpoint
 from verifier.commands.protocol_options import protocol_settings
-from verifier.commands.report_files import (ReportError, check_folders, mistakes_junit, refused_report_junit,
-                                             report_options, text_console, write_reports)
+from verifier.commands.report_files import (JudgingCommand, ReportError, check_folders, mistakes_junit,
+                                             refused_report_junit, report_options, text_console, write_reports)
 from verifier.commands.verify import _Duration
 from verifier.emulate.ports import serial_url_problem
 from verifier.monitor.capture import format_plain, tolerance_hides_pacing
@@ -83,7 +83,7 @@ def line_timing(baud: str, line_format: str, tolerance_us: int | None, default_t
     return LineTiming(int(baud), bits, default_tolerance_us if tolerance_us is None else tolerance_us)
 
 
-@click.command("monitor")
+@click.command("monitor", cls=JudgingCommand, maker="uitamr monitor")
 @click.option("--serial", "serial_url", metavar="PORT",
               help="Serial port or pyserial URL to listen on: /dev/ttyUSB0, COM3, socket://HOST:PORT, rfc2217://...")
 @click.option("--tcp", "tcp", metavar="HOST:PORT", help="A TCP server that streams the line's bytes (converter route).")
