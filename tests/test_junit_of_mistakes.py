@@ -340,3 +340,20 @@ def test_a_command_line_mistake_is_not_written_over_an_input_file(tmp_path):
         assert kept.read_text(encoding="utf-8") == before
     result = invoke("verify", "--bogus", "--junit")
     assert result.exit_code == 2 and "JUnit" not in result.stderr, result.output
+
+
+def test_monitors_own_command_line_checks_are_the_junits_error(tmp_path):
+    """Neither --serial nor --tcp, or a --serial URL without its port, is refused by the
+    monitor itself after click's parse, with click's usage message: it left the earlier
+    run's JUnit file as it was, as click's own refusals did."""
+    report = tmp_path / "m.xml"
+    for args, said in [([], "give exactly one of --serial PORT or --tcp HOST:PORT"),
+                       (["--serial", "socket://localhost"], "Invalid value for --serial: socket://localhost needs")]:
+        report.write_text(OLD_RUN, encoding="utf-8")
+        result = invoke("monitor", *args, "--junit", report)
+        assert result.exit_code == 2, result.output
+        assert f"Error: {said}" in result.stderr and "Usage: main monitor [OPTIONS]" in result.stderr
+        (case,) = cases(report)
+        assert case.get("classname") == "uitamr.monitor.input"
+        assert case.find("error").get("message").startswith(said)
+        assert "Usage: main monitor [OPTIONS]" in case.find("error").text

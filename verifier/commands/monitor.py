@@ -23,7 +23,8 @@ from verifier import protocol
 from verifier.commands.emulate import STANDARD_BAUD_RATES, _tcp_endpoint
 from verifier.commands.protocol_options import protocol_settings
 from verifier.commands.report_files import (JudgingCommand, ReportError, check_folders, mistakes_junit,
-                                             refused_report_junit, report_options, text_console, write_reports)
+                                             refused_report_junit, report_options, text_console, usage_error_junit,
+                                             write_reports)
 from verifier.commands.verify import _Duration
 from verifier.emulate.ports import serial_url_problem
 from verifier.monitor.capture import format_plain, tolerance_hides_pacing
@@ -97,11 +98,14 @@ def line_timing(baud: str, line_format: str, tolerance_us: int | None, default_t
 def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout, settings, duration,
             capture_path, json_path, junit_path, trace_path, html_path, quiet):
     """Listen on the robot's line and check every frame and gap against the manual, live."""
+    # mistakes of the command line as click's are: its message, and --junit's file says it too
+    ctx = click.get_current_context()
     if (serial_url is None) == (tcp is None):
-        raise click.UsageError("give exactly one of --serial PORT or --tcp HOST:PORT")
+        raise usage_error_junit(junit_path, click.UsageError("give exactly one of --serial PORT or --tcp HOST:PORT", ctx),
+                                "uitamr monitor")
     problem = serial_url_problem(serial_url) if serial_url is not None else None
     if problem:
-        raise click.BadParameter(problem, param_hint="--serial")
+        raise usage_error_junit(junit_path, click.BadParameter(problem, ctx, param_hint="--serial"), "uitamr monitor")
     console = text_console()
     try:
         check_folders(json_path, junit_path, trace_path, html_path, capture_path)

@@ -162,6 +162,13 @@ def usage_mistake(error: click.UsageError):
     return Mistake(f"{error.format_message()}\n\n{usage}" if usage else error.format_message())
 
 
+def usage_error_junit(junit_path, error: click.UsageError, command: str, inputs=()) -> click.UsageError:
+    """`error`, for its caller to raise (click shows it and exits 2), after it was written to
+    --junit's file as `usage_mistake` says it, when a file is given (not over `inputs`)."""
+    mistakes_junit(junit_path, [usage_mistake(error)], command, inputs)
+    return error
+
+
 class JudgingCommand(click.Command):
     """A command that writes the judging reports (`verify`, `monitor`, `replay`). A mistake
     in its command line (an unknown option, `--duration 5q`, an option without its value, a
@@ -182,8 +189,7 @@ class JudgingCommand(click.Command):
         except click.UsageError as error:
             if not extra.get("resilient_parsing"):
                 params = self._values_despite_mistakes(info_name, given, parent, extra)
-                mistakes_junit(params.get("junit_path"), [usage_mistake(error)], self.maker,
-                               self.inputs_of(params))
+                usage_error_junit(params.get("junit_path"), error, self.maker, self.inputs_of(params))
             raise
 
     def _values_despite_mistakes(self, info_name, args, parent, extra) -> dict:
