@@ -357,3 +357,26 @@ def test_monitors_own_command_line_checks_are_the_junits_error(tmp_path):
         assert case.get("classname") == "uitamr.monitor.input"
         assert case.find("error").get("message").startswith(said)
         assert "Usage: main monitor [OPTIONS]" in case.find("error").text
+
+
+def test_a_scenario_error_keeps_its_parts_through_pickle(tmp_path):
+    """ScenarioError could not be unpickled (its constructor takes file, key, message and
+    place, pickle gave it the message alone: TypeError), where UnusableInput and CaptureError
+    cross --jobs' worker processes; now it comes back whole, its place with it."""
+    import pickle
+
+    from verifier.verify.result import mistakes_of
+    from verifier.verify.scenario import ScenarioError, load_scenario
+
+    (tmp_path / "a.toml").write_text('duration = "1s"\nscan = "x"\n', encoding="utf-8")
+    try:
+        load_scenario(tmp_path / "a.toml")
+    except ScenarioError as exc:
+        read = exc
+    for error in (read, ScenarioError(None, "", "no sources"), ScenarioError(Path("b.toml"), "seed", "not a number")):
+        again = pickle.loads(pickle.dumps(error))
+        assert type(again) is ScenarioError
+        assert (str(again), again.file, again.key, again.message, again.line, again.col) == (
+            str(error), error.file, error.key, error.message, error.line, error.col)
+        assert mistakes_of(again) == mistakes_of(error)
+    assert (read.line, read.col) == (2, 8)
