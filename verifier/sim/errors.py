@@ -13,6 +13,9 @@ class LoadError(Exception):
         heading = "verifier.load was given an option it cannot use" if options else "ST sources have errors"
         super().__init__(f"{heading}:\n" + "\n".join("  " + s for s in self.lines()))
 
+    def __reduce__(self):  # pickled as its diagnostics: the message is made from them
+        return type(self), (self.diagnostics,)
+
     def lines(self) -> list[str]:
         """Each diagnostic, errors and warnings alike, in order, as its line of the message
         shows it (`file:line:col: severity: message`)."""
