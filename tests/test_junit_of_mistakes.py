@@ -380,3 +380,14 @@ def test_a_scenario_error_keeps_its_parts_through_pickle(tmp_path):
             str(error), error.file, error.key, error.message, error.line, error.col)
         assert mistakes_of(again) == mistakes_of(error)
     assert (read.line, read.col) == (2, 8)
+
+
+def test_a_name_too_long_beside_a_command_line_mistake_keeps_clicks_message(tmp_path):
+    """Naming the inputs of a refused command line (so as not to write the JUnit over one)
+    met the file system's 'File name too long' and that OSError took the place of click's
+    message; the names count as given then, and click's message is the one shown."""
+    report = tmp_path / "v.xml"
+    result = invoke("verify", "--junit", report, "--bogus", "a" * 5000)
+    assert result.exit_code == 2, result.output
+    assert "Error: No such option '--bogus'" in result.stderr and "File name too long" not in result.stderr
+    assert cases(report)[0].find("error").get("message").startswith("No such option '--bogus'")

@@ -351,8 +351,14 @@ def _named_inputs(sources, scenario_files) -> list[Path]:
 
 
 def _inputs_given(params: dict) -> list[Path]:
-    """`_named_inputs` of the values click read from a command line it refuses."""
-    return _named_inputs(params.get("sources") or (), params.get("scenario_files") or ())
+    """`_named_inputs` of the values click read from a command line it refuses; the names as
+    given when the file system refuses one (a name too long): click's message is the one
+    to show, not that."""
+    sources, scenario_files = params.get("sources") or (), params.get("scenario_files") or ()
+    try:
+        return _named_inputs(sources, scenario_files)
+    except OSError:
+        return [Path(name) for name in (*sources, *scenario_files)]
 
 
 def _source_files(sources) -> tuple[Path, ...]:
