@@ -98,11 +98,11 @@ def line_timing(baud: str, line_format: str, tolerance_us: int | None, default_t
 def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout, settings, duration,
             capture_path, json_path, junit_path, trace_path, html_path, quiet):
     """Listen on the robot's line and check every frame and gap against the manual, live."""
-    # mistakes of the command line as click's are: its message, and --junit's file says it too
+    # refused as click refuses an option (its usage message, exit 2), and in --junit's file too
     ctx = click.get_current_context()
     if (serial_url is None) == (tcp is None):
-        raise usage_error_junit(junit_path, click.UsageError("give exactly one of --serial PORT or --tcp HOST:PORT", ctx),
-                                "uitamr monitor")
+        mistake = click.UsageError("give exactly one of --serial PORT or --tcp HOST:PORT", ctx)
+        raise usage_error_junit(junit_path, mistake, "uitamr monitor")
     problem = serial_url_problem(serial_url) if serial_url is not None else None
     if problem:
         raise usage_error_junit(junit_path, click.BadParameter(problem, ctx, param_hint="--serial"), "uitamr monitor")
