@@ -291,3 +291,103 @@ def test_matrix_on_st_that_loads_nowhere_names_every_error(tmp_path):
     assert f"the sources do not load: {source}:5:6: error: undefined label 'y'" in result.output
     assert f"{source}:6:6: error: undefined label 'z'" in result.output
     assert [case.get("name") for case in cases(tmp_path / "v.xml")] == [f"{source}:5:6", f"{source}:6:6"]
+
+
+def test_a_command_line_mistake_is_the_junits_error(tmp_path):
+    """An unknown option, `--duration 5q`, an option without its value or a --platform that
+    is none exited 2 before the run was set up, and left the earlier run's JUnit file as it
+    was (or none): CI showed that run's results as this one's. Now click's message, naming
+    the option, is the file's error test case; click's usage message and exit 2 stay."""
+    capture = tmp_path / "site.txt"
+    capture.write_text("0.000 01 06 01 A0 00 00 88 14\n", encoding="utf-8")
+    report = tmp_path / "r.xml"
+    for args, said in [(["verify", "--duration", "5q"], "Invalid value for '--duration': '5q' is not a duration"),
+                       (["verify", "--bogus"], "No such option '--bogus'"),
+                       (["verify", "--platform", "fx9"], "Invalid value for '--platform': 'fx9' is not one of"),
+                       (["verify", "--junit", report, "--scan"], "Option '--scan' requires an argument."),
+                       (["replay", capture, "--tolerance", "5q"], "Invalid value for '--tolerance'"),
+                       (["monitor", "--tcp", "127.0.0.1:1", "--baud", "7"], "Invalid value for '--baud': '7'")]:
+        report.write_text(OLD_RUN, encoding="utf-8")
+        result = invoke(*args[:1], "--junit", report, *args[1:])
+        assert result.exit_code == 2, result.output
+        assert f"Error: {said}" in result.stderr and f"wrote {report} (these errors as test cases)" in result.stderr
+        (case,) = cases(report)
+        error = case.find("error")
+        assert (case.get("classname"), case.get("name"), error.get("type")) == (
+            f"uitamr.{args[0]}.input", "input", "unusable-input")
+        assert error.get("message").startswith(said), error.get("message")
+        if args[-1] != "--scan":  # click shows no usage line for an option without its value
+            assert f"Usage: main {args[0]} [OPTIONS]" in error.text, error.text
+    assert capture.read_text(encoding="utf-8") == "0.000 01 06 01 A0 00 00 88 14\n"
+    page = " ".join((Path(__file__).parents[1] / "docs" / "verifier.md").read_text(encoding="utf-8").split())
+    assert "refused by click before the run is set up, is an error test case too, for all three commands" in page
+
+
+def test_a_command_line_mistake_is_not_written_over_an_input_file(tmp_path):
+    """The JUnit of a refused command line keeps the rule of every exit 2: never over a
+    scenario, a source or a capture the command names; `--junit` without its file names
+    none, and click's message is all."""
+    write_files(tmp_path, {"a.toml": 'duration = "1s"\n', "site.txt": "0.000 01 06 01 A0 00 00 88 14\n"})
+    for args, kept in [(["verify", "--scenario", tmp_path / "a.toml", "--junit", tmp_path / "a.toml", "--bogus"],
+                        tmp_path / "a.toml"),
+                       (["replay", tmp_path / "site.txt", "--junit", tmp_path / "site.txt", "--bogus"],
+                        tmp_path / "site.txt")]:
+        before = kept.read_text(encoding="utf-8")
+        result = invoke(*args)
+        assert result.exit_code == 2, result.output
+        assert f"the JUnit report was not written: {kept} is one of the run's input files" in result.stderr
+        assert "Error: No such option '--bogus'" in result.stderr
+        assert kept.read_text(encoding="utf-8") == before
+    result = invoke("verify", "--bogus", "--junit")
+    assert result.exit_code == 2 and "JUnit" not in result.stderr, result.output
+
+
+def test_monitors_own_command_line_checks_are_the_junits_error(tmp_path):
+    """Neither --serial nor --tcp, or a --serial URL without its port, is refused by the
+    monitor itself after click's parse, with click's usage message: it left the earlier
+    run's JUnit file as it was, as click's own refusals did."""
+    report = tmp_path / "m.xml"
+    for args, said in [([], "give exactly one of --serial PORT or --tcp HOST:PORT"),
+                       (["--serial", "socket://localhost"], "Invalid value for --serial: socket://localhost needs")]:
+        report.write_text(OLD_RUN, encoding="utf-8")
+        result = invoke("monitor", *args, "--junit", report)
+        assert result.exit_code == 2, result.output
+        assert f"Error: {said}" in result.stderr and "Usage: main monitor [OPTIONS]" in result.stderr
+        (case,) = cases(report)
+        assert case.get("classname") == "uitamr.monitor.input"
+        assert case.find("error").get("message").startswith(said)
+        assert "Usage: main monitor [OPTIONS]" in case.find("error").text
+
+
+def test_a_scenario_error_keeps_its_parts_through_pickle(tmp_path):
+    """ScenarioError could not be unpickled (its constructor takes file, key, message and
+    place, pickle gave it the message alone: TypeError), where UnusableInput and CaptureError
+    cross --jobs' worker processes; now it comes back whole, its place with it."""
+    import pickle
+
+    from verifier.verify.result import mistakes_of
+    from verifier.verify.scenario import ScenarioError, load_scenario
+
+    (tmp_path / "a.toml").write_text('duration = "1s"\nscan = "x"\n', encoding="utf-8")
+    try:
+        load_scenario(tmp_path / "a.toml")
+    except ScenarioError as exc:
+        read = exc
+    for error in (read, ScenarioError(None, "", "no sources"), ScenarioError(Path("b.toml"), "seed", "not a number")):
+        again = pickle.loads(pickle.dumps(error))
+        assert type(again) is ScenarioError
+        assert (str(again), again.file, again.key, again.message, again.line, again.col) == (
+            str(error), error.file, error.key, error.message, error.line, error.col)
+        assert mistakes_of(again) == mistakes_of(error)
+    assert (read.line, read.col) == (2, 8)
+
+
+def test_a_name_too_long_beside_a_command_line_mistake_keeps_clicks_message(tmp_path):
+    """Naming the inputs of a refused command line (so as not to write the JUnit over one)
+    met the file system's 'File name too long' and that OSError took the place of click's
+    message; the names count as given then, and click's message is the one shown."""
+    report = tmp_path / "v.xml"
+    result = invoke("verify", "--junit", report, "--bogus", "a" * 5000)
+    assert result.exit_code == 2, result.output
+    assert "Error: No such option '--bogus'" in result.stderr and "File name too long" not in result.stderr
+    assert cases(report)[0].find("error").get("message").startswith("No such option '--bogus'")

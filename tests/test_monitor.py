@@ -1361,6 +1361,34 @@ def test_a_report_or_capture_named_as_the_port_is_refused_not_sent_onto_the_line
         os.close(port_end)
 
 
+def test_a_report_named_as_the_port_is_the_junits_error_and_a_junit_named_so_is_not_written(tmp_path):
+    """The refusal of a report named as the port is a command-line mistake like click's own:
+    it goes into --junit's file (CI shows it), unless that file is the port itself, which
+    would send the JUnit's XML onto the robot's line."""
+    line_end, port_end = os.openpty()
+    port = os.ttyname(port_end)
+    report = tmp_path / "m.xml"
+    try:
+        done = subprocess.run(uitamr("monitor", "--serial", port, "--json", port, "--junit", str(report),
+                                     "--duration", "1s"), capture_output=True, text=True, timeout=WAIT_S)
+        assert done.returncode == 2, done.stdout + done.stderr
+        error = ET.parse(report).getroot().find(".//testcase/error")
+        assert error is not None and "is the port the monitor listens on" in error.get("message")
+        done = subprocess.run(uitamr("monitor", "--serial", port, "--junit", port, "--duration", "1s"),
+                              capture_output=True, text=True, timeout=WAIT_S)
+        assert done.returncode == 2, done.stdout + done.stderr
+        assert f"{port} is the port the monitor listens on" in done.stderr
+        os.set_blocking(line_end, False)
+        try:
+            sent = os.read(line_end, 4096)
+        except BlockingIOError:
+            sent = b""
+        assert sent == b"", sent
+    finally:
+        os.close(line_end)
+        os.close(port_end)
+
+
 def test_replay_of_a_serial_port_points_to_the_monitor():
     """`uitamr replay /dev/ttyUSB0`, the port given to the command that reads captures, said
     only "cannot read: not a regular file (a character device)"."""

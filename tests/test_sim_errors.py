@@ -332,3 +332,17 @@ def test_a_bad_load_option_is_named_with_its_value_not_placed_in_the_sources(opt
     assert str(err.value).startswith(f"verifier.load was given an option it cannot use:\n"
                                      f"  verifier.load({place}): error: {message}")
     assert "<options>" not in str(err.value) and ":0:0" not in str(err.value)
+
+
+def test_a_load_error_keeps_its_message_through_pickle():
+    """A LoadError was pickled as its message and rebuilt by calling the class with it: the
+    message's characters became diagnostics ('?:0:0: error: S', ...), and str() was that; now
+    its diagnostics, and the message made from them, come back as they were."""
+    import pickle
+
+    with pytest.raises(LoadError) as err:
+        verifier.load(sources={"MAIN.st": "PROGRAM MAIN\nVAR\n    x : INT;\nEND_VAR\nx := y;\nEND_PROGRAM\n"})
+    again = pickle.loads(pickle.dumps(err.value))
+    assert (type(again), str(again), again.diagnostics, again.located()) == (
+        LoadError, str(err.value), err.value.diagnostics, err.value.located())
+    assert "MAIN.st:5:6: error: undefined label 'y'" in str(again)

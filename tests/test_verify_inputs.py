@@ -590,3 +590,37 @@ def test_the_note_quotes_the_overwriting_statement_past_a_line_separator_in_a_co
     notes = [note for note in run["notes"] if "does nothing" in note]
     assert notes == ["s.toml:6:9: inputs[0].set: b = true does nothing: the program overwrites b in every scan "
                      "before reading it, at Main.st:7:1 (b := n > 0;)"], result.output
+
+
+def _load_error(*diagnostics):
+    from verifier.sim.errors import LoadError
+    from verifier.st.ast import Diagnostic
+
+    return LoadError([Diagnostic(*d) for d in diagnostics])
+
+
+def test_the_error_compared_across_platforms_is_the_first_diagnostics_whole_line():
+    """infer_platform compares each platform's first diagnostic, read back from the message's
+    second line: a file name that holds a line break gave only its head ('odd'), the same for
+    every mistake in that file. Now the diagnostic's own line, from the data."""
+    from verifier.verify.platform import _first_error
+
+    error = _load_error(("odd\nname.st", 5, 6, "error", "undefined label 'y'"))
+    assert _first_error(error) == "odd\nname.st:5:6: error: undefined label 'y'"
+    assert _first_error(_load_error()) == str(_load_error())  # no diagnostic: the message
+
+
+def test_a_warning_before_the_errors_is_still_the_one_compared(monkeypatch):
+    """LoadError.located() gives errors only; the line compared across platforms stays the
+    first diagnostic's, a warning too: two platforms whose first warning is the same (and
+    whose errors differ) are one ST mistake, as before, said at the first error's place."""
+    from verifier.verify import platform as platform_module
+
+    loads = {"fx3u": _load_error(("M.st", 1, 1, "warning", "w"), ("M.st", 5, 6, "error", "a")),
+             "fx5u": _load_error(("M.st", 1, 1, "warning", "w"), ("M.st", 7, 8, "error", "b"))}
+    assert platform_module._first_error(loads["fx3u"]) == "M.st:1:1: warning: w"
+    monkeypatch.setattr(platform_module, "platforms_that_load", lambda sources: ([], loads))
+    with pytest.raises(platform_module.UnusableInput) as raised:
+        platform_module.infer_platform((Path("M.st"),))
+    assert str(raised.value) == "the sources do not load: M.st:5:6: error: a"
+    assert (raised.value.file, raised.value.line, raised.value.col) == ("M.st", 5, 6)

@@ -22,8 +22,9 @@ from rich.markup import escape
 from verifier import protocol
 from verifier.commands.emulate import STANDARD_BAUD_RATES, _tcp_endpoint
 from verifier.commands.protocol_options import protocol_settings
-from verifier.commands.report_files import (ReportError, check_folders, mistakes_junit, refused_report_junit,
-                                             report_options, text_console, write_reports)
+from verifier.commands.report_files import (JudgingCommand, ReportError, check_folders, mistakes_junit,
+                                             refused_report_junit, report_options, text_console, usage_error_junit,
+                                             write_reports)
 from verifier.commands.verify import _Duration
 from verifier.emulate.ports import serial_url_problem
 from verifier.monitor.capture import format_plain, tolerance_hides_pacing
@@ -84,7 +85,7 @@ def line_timing(baud: str, line_format: str, tolerance_us: int | None, default_t
     return LineTiming(int(baud), bits, default_tolerance_us if tolerance_us is None else tolerance_us)
 
 
-@click.command("monitor")
+@click.command("monitor", cls=JudgingCommand, maker="uitamr monitor")
 @click.option("--serial", "serial_url", metavar="PORT",
               help="Serial port or pyserial URL to listen on: /dev/ttyUSB0, COM3, socket://HOST:PORT, rfc2217://...")
 @click.option("--tcp", "tcp", metavar="HOST:PORT", help="A TCP server that streams the line's bytes (converter route).")
@@ -98,17 +99,21 @@ def line_timing(baud: str, line_format: str, tolerance_us: int | None, default_t
 def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout, settings, duration,
             capture_path, json_path, junit_path, trace_path, html_path, quiet):
     """Listen on the robot's line and check every frame and gap against the manual, live."""
+    # refused as click refuses an option (its usage message, exit 2), and in --junit's file too
+    ctx = click.get_current_context()
     if (serial_url is None) == (tcp is None):
-        raise click.UsageError("give exactly one of --serial PORT or --tcp HOST:PORT")
+        mistake = click.UsageError("give exactly one of --serial PORT or --tcp HOST:PORT", ctx)
+        raise usage_error_junit(junit_path, mistake, "uitamr monitor")
     problem = serial_url_problem(serial_url) if serial_url is not None else None
     if problem:
-        raise click.BadParameter(problem, param_hint="--serial")
+        raise usage_error_junit(junit_path, click.BadParameter(problem, ctx, param_hint="--serial"), "uitamr monitor")
     if serial_url is not None:  # `--capture /dev/ttyUSB0`: the capture's text went out onto the robot's line
         port = real_path(serial_url)
         onto = [p for p in (capture_path, json_path, junit_path, trace_path, html_path) if p and real_path(p) == port]
         if onto:
-            raise click.UsageError(f"{onto[0]} is the port the monitor listens on, and the monitor never writes to "
-                                   "the line: give a file for the report or the capture")
+            mistake = click.UsageError(f"{onto[0]} is the port the monitor listens on, and the monitor never writes "
+                                       "to the line: give a file for the report or the capture", ctx)
+            raise usage_error_junit(None if junit_path in onto else junit_path, mistake, "uitamr monitor")
     console = text_console()
     try:
         check_folders(json_path, junit_path, trace_path, html_path, capture_path)

@@ -16,8 +16,8 @@ import click
 
 from verifier.commands.monitor import EXIT_UNUSABLE, _finish, exit_status, line_options, line_timing
 from verifier.commands.protocol_options import given_settings, protocol_settings
-from verifier.commands.report_files import (ReportError, check_folders, check_not_inputs, mistakes_junit,
-                                             refused_report_junit, report_options, text_console)
+from verifier.commands.report_files import (JudgingCommand, ReportError, check_folders, check_not_inputs,
+                                             mistakes_junit, refused_report_junit, report_options, text_console)
 from verifier.monitor.capture import CaptureError, read_capture
 from verifier.monitor.framer import DEFAULT_TOLERANCE_US
 from verifier.monitor.session import CaptureInfo, MonitorSession
@@ -25,7 +25,8 @@ from verifier.verify.evidence import RuleOptions
 from verifier.verify.result import mistakes_of
 
 
-@click.command("replay")
+@click.command("replay", cls=JudgingCommand, maker="uitamr replay",
+               inputs_of=lambda params: params.get("captures") or ())
 @click.argument("captures", nargs=-1, required=True, type=click.Path())
 @line_options
 @protocol_settings

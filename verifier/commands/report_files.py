@@ -2,6 +2,7 @@
 of options, one writer loop, so a capture from site gives the same files as a CI run."""
 from __future__ import annotations
 
+import io
 import os
 import sys
 from pathlib import Path
@@ -141,12 +142,66 @@ def junit_of_refused_report(junit_path, errors: ReportError | list[ReportError],
     return junit_of_mistakes(junit_path, [Mistake(str(error)) for error in errors], command, inputs, results)
 
 
-def mistakes_junit(junit_path, mistakes: list, command: str) -> None:
+def mistakes_junit(junit_path, mistakes: list, command: str, inputs=()) -> None:
     """For exit 2 before a session (a line that cannot be opened, a capture that cannot be
-    read): the mistakes in --junit's file, when one is given, and a line on stderr that says
-    so or why not."""
+    read, a mistake in the command line): the mistakes in --junit's file, when one is given
+    (not over one of `inputs`), and a line on stderr that says so or why not."""
     if junit_path:
-        click.echo(f"{command}: {junit_of_mistakes(junit_path, mistakes, command)[1]}", err=True)
+        click.echo(f"{command}: {junit_of_mistakes(junit_path, mistakes, command, inputs)[1]}", err=True)
+
+
+def usage_mistake(error: click.UsageError):
+    """A mistake in the command line as its JUnit test case says it: click's message (it
+    names the option: "Invalid value for '--duration': ...") on the first line, then the
+    usage and help lines click prints above it on stderr."""
+    from verifier.verify.result import Mistake
+
+    shown = io.StringIO()
+    error.show(shown)
+    usage = shown.getvalue().rstrip().removesuffix(f"Error: {error.format_message()}").rstrip()
+    return Mistake(f"{error.format_message()}\n\n{usage}" if usage else error.format_message())
+
+
+def usage_error_junit(junit_path, error: click.UsageError, command: str, inputs=()) -> click.UsageError:
+    """`error`, for its caller to raise (click shows it and exits 2), after it was written to
+    --junit's file as `usage_mistake` says it, when a file is given (not over `inputs`)."""
+    mistakes_junit(junit_path, [usage_mistake(error)], command, inputs)
+    return error
+
+
+class JudgingCommand(click.Command):
+    """A command that writes the judging reports (`verify`, `monitor`, `replay`). A mistake
+    in its command line (an unknown option, `--duration 5q`, an option without its value, a
+    --platform that is none) exits 2 with click's usage message as before, and is also
+    written to --junit's file as an error test case when the arguments give one, as click
+    reads them: a CI server shows the mistake, not an earlier run's report or none. `maker`:
+    the command as the report names it; `inputs_of`: the input files the parsed values
+    name (the JUnit is not written over them)."""
+
+    def __init__(self, *args, maker: str, inputs_of=lambda params: (), **kwargs):
+        super().__init__(*args, **kwargs)
+        self.maker, self.inputs_of = maker, inputs_of
+
+    def make_context(self, info_name, args, parent=None, **extra):
+        given = list(args)  # the parser uses up the list it reads
+        try:
+            return super().make_context(info_name, args, parent, **extra)
+        except click.UsageError as error:
+            if not extra.get("resilient_parsing"):
+                params = self._values_despite_mistakes(info_name, given, parent, extra)
+                usage_error_junit(params.get("junit_path"), error, self.maker, self.inputs_of(params))
+            raise
+
+    def _values_despite_mistakes(self, info_name, args, parent, extra) -> dict:
+        """The values click reads from `args` when it passes over what it cannot use (click's
+        resilient parsing, as for shell completion, with unknown options let through): an
+        empty dict when even that fails (`--junit` without its file)."""
+        try:
+            ctx = super().make_context(info_name, args, parent,
+                                       **{**extra, "resilient_parsing": True, "ignore_unknown_options": True})
+        except click.UsageError:
+            return {}
+        return ctx.params
 
 
 def refused_report_junit(junit_path, errors: ReportError | list[ReportError], command: str, inputs=(),

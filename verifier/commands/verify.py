@@ -21,8 +21,9 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
 from verifier.commands.check import not_st
 from verifier.commands.numbers import INT, IntRange
-from verifier.commands.report_files import (ReportError, check_folders, check_not_inputs, junit_of_mistakes,
-                                             junit_of_refused_report, report_options, text_console, write_reports)
+from verifier.commands.report_files import (JudgingCommand, ReportError, check_folders, check_not_inputs,
+                                             junit_of_mistakes, junit_of_refused_report, report_options, text_console,
+                                             write_reports)
 from verifier.verify.durations import format_duration, format_seconds, parse_duration_us
 from verifier.verify import spool
 from verifier.verify.events_shown import EVENTS_AT_MOST
@@ -350,6 +351,17 @@ def _named_inputs(sources, scenario_files) -> list[Path]:
     return found
 
 
+def _inputs_given(params: dict) -> list[Path]:
+    """`_named_inputs` of the values click read from a command line it refuses; the names as
+    given when the file system refuses one (a name too long): click's message is the one
+    to show, not that."""
+    sources, scenario_files = params.get("sources") or (), params.get("scenario_files") or ()
+    try:
+        return _named_inputs(sources, scenario_files)
+    except OSError:
+        return [Path(name) for name in (*sources, *scenario_files)]
+
+
 def _source_files(sources) -> tuple[Path, ...]:
     """The .st files named on the command line: files, folders (recursively) or patterns."""
     found: list[Path] = []
@@ -516,7 +528,8 @@ def _terminate_as_exit():
         signal.signal(signal.SIGTERM, previous)
 
 
-@click.command(context_settings={"help_option_names": ["-h", "--help"]})
+@click.command(cls=JudgingCommand, maker="uitamr verify", inputs_of=_inputs_given,
+               context_settings={"help_option_names": ["-h", "--help"]})
 @click.argument("sources", nargs=-1, type=click.Path())
 @click.option("--program", help="The PROGRAM POU to run (default: the scenario's, or the only one).")
 @click.option("--platform", type=click.Choice(sorted(PLATFORMS), case_sensitive=False),

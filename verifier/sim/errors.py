@@ -9,10 +9,17 @@ class LoadError(Exception):
 
     def __init__(self, diagnostics):
         self.diagnostics = list(diagnostics)
-        lines = [_format_diag(d) for d in self.diagnostics]
         options = all(getattr(d, "file", "").startswith(OPTION_PLACE) for d in self.diagnostics)
         heading = "verifier.load was given an option it cannot use" if options else "ST sources have errors"
-        super().__init__(f"{heading}:\n" + "\n".join("  " + s for s in lines))
+        super().__init__(f"{heading}:\n" + "\n".join("  " + s for s in self.lines()))
+
+    def __reduce__(self):  # pickled as its diagnostics: the message is made from them
+        return type(self), (self.diagnostics,)
+
+    def lines(self) -> list[str]:
+        """Each diagnostic, errors and warnings alike, in order, as its line of the message
+        shows it (`file:line:col: severity: message`)."""
+        return [_format_diag(d) for d in self.diagnostics]
 
     def place(self) -> tuple[str, int, int] | None:
         """(file, line, column) of the first error that names a source's line (not an

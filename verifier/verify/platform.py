@@ -42,8 +42,10 @@ def platforms_that_load(sources: tuple[Path, ...]) -> tuple[list[str], dict[str,
 
 
 def _first_error(exc: "LoadError") -> str:
-    """The first diagnostic's line of a LoadError's message."""
-    lines = [line.strip() for line in str(exc).splitlines()[1:] if line.strip()]
+    """A LoadError's first diagnostic, whatever its severity (the one the platforms' loads
+    are compared by: not `LoadError.located`'s first, which passes over warnings), as its
+    line of the message shows it; the message when it holds none."""
+    lines = exc.lines()
     return lines[0] if lines else str(exc)
 
 

@@ -100,6 +100,10 @@ class ScenarioError(Exception):
             where += f":{place}"
         super().__init__(f"{where}: {key + ': ' if key else ''}{message}")
 
+    def __reduce__(self):  # across --jobs' worker processes, as UnusableInput: the constructor takes the parts
+        place = None if self.line is None else Place(self.line, self.col)
+        return type(self), (self.file, self.key, self.message, place)
+
 
 @dataclass(frozen=True)
 class InputStep:
