@@ -846,6 +846,32 @@ def test_ctrl_c_stops_the_monitor_and_the_reports_are_written(line, tmp_path):
     assert b"".join(c.data for c in chunks) == STOP + STOP  # the request and its echo
 
 
+def test_a_frame_waiting_whole_on_the_port_is_one_chunk_so_a_host_stall_cannot_split_it():
+    """The monitor waits for a frame's first byte, then reads the rest. It took the rest in
+    a read of its own: a host that stalled the monitor between the two reads for 31 ms or
+    more (a loaded machine) gave the 7 bytes a later time, the framer took that as a
+    silence after the first byte, and one stop command was judged as a 1-byte frame and a
+    7-byte one. The bytes already waiting come with the first one, in one chunk."""
+    from verifier.monitor.sources import SerialSource
+
+    controller, device = os.openpty()
+    source = SerialSource(os.ttyname(device), 9600, 8, "N", 1)
+    source.port.timeout = WAIT_S  # the read waits for the first byte, as on a quiet line
+    writer = threading.Timer(0.2, os.write, (controller, STOP))  # the whole frame at once, once the read waits
+    try:
+        writer.start()
+        chunk = source.read()
+    finally:
+        writer.join()
+        source.close()
+        os.close(device)
+        os.close(controller)
+    assert chunk is not None and chunk.data == STOP
+    # what a stall between two reads of it made of the frame
+    split = session_of([Chunk(0, STOP[:1]), Chunk(40_000, STOP[1:])])
+    assert split.frames[0].data == STOP[:1]
+
+
 # --------------------------------------------------------------------- the converter route (TCP)
 class BadMasterStream:
     """A TCP server on 127.0.0.1 that streams the bad master's line to the one client that
