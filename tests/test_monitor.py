@@ -27,8 +27,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from linebus import LineBus
-from monitor_helpers import (BAD_MASTER_FINDINGS, SETTINGS, WAIT_S, Master, bad_master, findings, frame,
-                             start, uitamr, wait_for_line)
+from monitor_helpers import (BAD_MASTER_FINDINGS, SETTINGS, WAIT_S, Master, bad_master, diagnosis, findings,
+                             frame, start, uitamr, wait_for_line)
 from verifier import protocol
 from verifier.commands.frame import mbpoll_command
 from verifier.monitor.capture import CaptureError, Chunk, format_plain, parse_plain, read_capture
@@ -666,10 +666,11 @@ def monitor_on(bus: LineBus, tmp_path: Path, *extra) -> subprocess.Popen:
 def test_a_bad_master_on_a_real_line_gets_exactly_its_findings(line, tmp_path):
     monitor = monitor_on(line, tmp_path, "--duration", "3s", "--capture", tmp_path / "c.txt",
                          "--junit", tmp_path / "m.xml", "--html", tmp_path / "m.html", "--trace", tmp_path / "m.jsonl")
-    bad_master(line.plc)
+    master = bad_master(line.plc)
     out, err = monitor.communicate(timeout=WAIT_S)
-    assert monitor.returncode == 1, out + err
-    assert findings(tmp_path / "m.json") == Counter(BAD_MASTER_FINDINGS)
+    seen = diagnosis(out, err, tmp_path / "c.txt", master)
+    assert monitor.returncode == 1 and (tmp_path / "m.json").exists(), seen
+    assert findings(tmp_path / "m.json") == Counter(BAD_MASTER_FINDINGS), seen
     live, summary = out.split("\nFAIL monitor ", 1)
     # each finding was printed live (its time, rule, message and frames), before the summary
     assert re.search(r"^0\.000 s  UITAMR-POWERON-STOP: the first control command after power-on is run "
@@ -679,7 +680,7 @@ def test_a_bad_master_on_a_real_line_gets_exactly_its_findings(line, tmp_path):
     assert "<testcase" in (tmp_path / "m.xml").read_text() and "<svg" in (tmp_path / "m.html").read_text()
     done = subprocess.run(uitamr("replay", tmp_path / "c.txt", "--json", tmp_path / "r.json"),
                           capture_output=True, text=True, timeout=WAIT_S)
-    assert done.returncode == 1 and findings(tmp_path / "r.json") == Counter(BAD_MASTER_FINDINGS)
+    assert done.returncode == 1 and findings(tmp_path / "r.json") == Counter(BAD_MASTER_FINDINGS), done.stdout + done.stderr
     # the replay of the capture is the live session's judgement: frames, findings, notes and
     # how long the line was listened to (the capture's `end` line); only the names differ
     live_run, replayed = (json.loads((tmp_path / name).read_text())["scenarios"][0] for name in ("m.json", "r.json"))
@@ -711,8 +712,9 @@ def test_a_request_left_unanswered_on_a_real_line_replays_from_the_trace_as_judg
     finally:
         master.close()
     out, err = monitor.communicate(timeout=WAIT_S)
-    assert monitor.returncode == 1, out + err
-    assert findings(tmp_path / "m.json")["UITAMR-RESPONSE-HANDLING"] == 1, out
+    seen = diagnosis(out, err, master=master)  # exit 1 with no m.json was a traceback: its stderr says which
+    assert monitor.returncode == 1 and (tmp_path / "m.json").exists(), seen
+    assert findings(tmp_path / "m.json")["UITAMR-RESPONSE-HANDLING"] == 1, seen
     done = subprocess.run(uitamr("replay", tmp_path / "m.jsonl", "--json", tmp_path / "r.json"),
                           capture_output=True, text=True, timeout=WAIT_S)
     assert done.returncode == 1, done.stdout + done.stderr
@@ -740,15 +742,17 @@ def test_mbpoll_and_the_emulator_seen_by_the_monitor(line, tmp_path):
     assert report["scenarios"][0]["frames"] == {"tx": 3, "rx": 3}
 
 
-_SEEN_REQUEST = re.compile(r"^\s*([0-9]+\.[0-9]+) s  PLC → robot ", re.M)
-
-
-def _host_stalls(master: Master, out: str) -> list[str]:
+def _host_stalls(master: Master, trace: Path) -> list[str]:
     """How the host stalled a real-time run, as measured apart from what is tested: the
     master woke late or waited in vain for a reply (Master.stalls), or the monitor saw two
-    requests further apart or closer than the master wrote them (its tap was not run)."""
+    requests further apart or closer than the master wrote them (its tap was not run). The
+    requests seen are the monitor's --trace's. They were read off its console, where a
+    finding prints its frames again: a run with findings never had its gaps compared, and
+    a stalled tap failed at once as a monitor that is wrong. (A monitor that saw another
+    number of requests than were written is wrong: that is no stall.)"""
     stalls = list(master.stalls)
-    seen = [float(t) for t in _SEEN_REQUEST.findall(out)]
+    records = [json.loads(line) for line in trace.read_text(encoding="utf-8").splitlines()] if trace.exists() else []
+    seen = [r["t"] for r in records if r.get("dir") == "tx"]
     if len(seen) == len(master.sent_at):
         for k in range(1, len(seen)):
             wrote, saw = master.sent_at[k] - master.sent_at[k - 1], seen[k] - seen[k - 1]
@@ -779,7 +783,8 @@ def test_the_simulated_plc_driving_the_emulator_is_compliant(tmp_path):
         robot = start("emulate", "--serial", bus.robot)
         try:
             wait_for_line(robot, "listening")
-            monitor = monitor_on(bus, folder, "--duration", "5.5s", "--tolerance", "50ms")  # host scheduling
+            monitor = monitor_on(bus, folder, "--duration", "5.5s", "--tolerance", "50ms",  # host scheduling
+                                 "--trace", folder / "m.jsonl", "--capture", folder / "c.txt")
             master = Master(bus.plc)
             try:
                 for request in requests:
@@ -792,14 +797,16 @@ def test_the_simulated_plc_driving_the_emulator_is_compliant(tmp_path):
             robot.terminate()
             robot.communicate(timeout=WAIT_S)
             bus.close()
+        seen = diagnosis(out, err, folder / "c.txt", master)
+        assert (folder / "m.json").exists(), seen
         clean = monitor.returncode == 0 and findings(folder / "m.json") == Counter()
-        stalls = _host_stalls(master, out)
+        stalls = _host_stalls(master, folder / "m.jsonl")
         if not clean and stalls:  # findings the host's stall can explain: this attempt proves nothing
-            stalled.append(f"attempt {attempt + 1}: " + "; ".join(stalls) + "\n" + out)
+            stalled.append(f"attempt {attempt + 1}: " + "; ".join(stalls) + "\n" + seen)
             continue
-        assert monitor.returncode == 0, out + err
-        assert findings(folder / "m.json") == Counter()
-        assert out.count("PLC → robot") == len(requests)
+        assert monitor.returncode == 0, seen
+        assert findings(folder / "m.json") == Counter(), seen
+        assert out.count("PLC → robot") == len(requests), seen
         if stalled:  # shown in the run's warnings summary: how often the host got in the way
             warnings.warn("host stalls before the clean attempt: " + " | ".join(s.splitlines()[0] for s in stalled))
         return
