@@ -6,6 +6,7 @@ import os
 import select
 import subprocess
 import sys
+import threading
 import time
 from collections import Counter
 from pathlib import Path
@@ -29,19 +30,25 @@ def start(*args, **kw) -> subprocess.Popen:
 
 
 def wait_for_line(proc: subprocess.Popen, words: str, timeout_s: float = WAIT_S) -> str:
-    """Read the process's stdout until a line holds `words` (it has started)."""
-    deadline = time.monotonic() + timeout_s
+    """Read the process's stdout until a line holds `words` (it has started, it has seen a
+    frame). A process that shows no such line in `timeout_s` is killed, and the failure
+    says what it printed. (This waited with select() on the pipe: lines that came in one
+    write with the one read were already in the reader's buffer, not the pipe, and were
+    never looked at; and its failure then read stderr to the end, so a process that ran
+    on hung the test instead of failing it.)"""
     seen = []
-    while time.monotonic() < deadline:
-        ready, _, _ = select.select([proc.stdout], [], [], 0.1)
-        if ready:
-            line = proc.stdout.readline()
+    watchdog = threading.Timer(timeout_s, proc.kill)
+    watchdog.start()
+    try:
+        for line in iter(proc.stdout.readline, ""):
             seen.append(line)
             if words in line:
                 return line
-            if not line and proc.poll() is not None:
-                break
-    raise AssertionError(f"no line with {words!r}; got {''.join(seen)!r}, stderr {proc.stderr.read()!r}")
+    finally:
+        watchdog.cancel()
+    proc.wait(timeout=timeout_s)
+    raise AssertionError(f"no line with {words!r} within {timeout_s} s (exit {proc.returncode}, killed when "
+                         f"negative); got {''.join(seen)!r}, stderr {proc.stderr.read()!r}")
 
 
 class Master:

@@ -844,7 +844,9 @@ def test_ctrl_c_stops_the_monitor_and_the_reports_are_written(line, tmp_path):
         master.send(STOP)
     finally:
         master.close()
-    time.sleep(0.5)
+    # Ctrl-C once the monitor has the echo: half a second's sleep was no proof that it had
+    # read it, and a monitor the host stalled as long was stopped with the echo unread
+    wait_for_line(monitor, "echo: stop")
     monitor.send_signal(signal.SIGINT)
     out, err = monitor.communicate(timeout=WAIT_S)
     assert monitor.returncode == 0, out + err
