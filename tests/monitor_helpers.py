@@ -11,6 +11,7 @@ import time
 from collections import Counter
 from pathlib import Path
 
+from linebus import LineBus
 from verifier import protocol
 
 SETTINGS = protocol.DEFAULT_SETTINGS
@@ -69,8 +70,9 @@ class Master:
     LATE_S = 0.05  # what the tests allow the host (the monitor's --tolerance)
     REPLY_TIMEOUT_S = 0.5  # the rules' reply time-out (docs/verifier.md)
 
-    def __init__(self, device: str):
-        self.fd = os.open(device, os.O_RDWR | os.O_NOCTTY)
+    def __init__(self, line: LineBus):
+        self.fd = os.open(line.plc, os.O_RDWR | os.O_NOCTTY)  # the replies come here
+        self.write = line.from_plc  # the requests go on the line from here (LineBus.from_plc)
         self.t0 = self.start = time.monotonic()
         self.sent_at: list[float] = []
         self.stalls: list[str] = []
@@ -96,7 +98,7 @@ class Master:
 
     def send(self, data: bytes, reply_length: int | None = 8, timeout_s: float = REPLY_TIMEOUT_S) -> bytes:
         self.sent_at.append(time.monotonic())
-        os.write(self.fd, data)
+        self.write(data)
         self.log.append(f"{self.sent_at[-1] - self.start:.3f} s wrote {data.hex(' ')}")
         got = b""
         deadline = time.monotonic() + timeout_s
@@ -115,10 +117,10 @@ class Master:
         os.close(self.fd)
 
 
-def bad_master(device: str) -> Master:
+def bad_master(line: LineBus) -> Master:
     """First command not stop, 100 ms pacing, one bad CRC: the findings of issue 10. The
     master, for what it measured (`Master.report`)."""
-    master = Master(device)
+    master = Master(line)
     try:
         run_point = frame("run-point", "1")
         read = frame("read", "task")

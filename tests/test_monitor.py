@@ -666,7 +666,7 @@ def monitor_on(bus: LineBus, tmp_path: Path, *extra) -> subprocess.Popen:
 def test_a_bad_master_on_a_real_line_gets_exactly_its_findings(line, tmp_path):
     monitor = monitor_on(line, tmp_path, "--duration", "3s", "--capture", tmp_path / "c.txt",
                          "--junit", tmp_path / "m.xml", "--html", tmp_path / "m.html", "--trace", tmp_path / "m.jsonl")
-    master = bad_master(line.plc)
+    master = bad_master(line)
     out, err = monitor.communicate(timeout=WAIT_S)
     seen = diagnosis(out, err, tmp_path / "c.txt", master)
     assert monitor.returncode == 1 and (tmp_path / "m.json").exists(), seen
@@ -703,7 +703,7 @@ def test_a_request_left_unanswered_on_a_real_line_replays_from_the_trace_as_judg
     monitor's --trace ended at that request, so the finding was gone and the run 5 s
     shorter; with the trace's end record it is the live judgement."""
     monitor = monitor_on(line, tmp_path, "--duration", "8s", "--trace", tmp_path / "m.jsonl")
-    master = Master(line.plc)
+    master = Master(line)
     try:
         stop = frame("stop")
         master.send(stop)
@@ -785,7 +785,7 @@ def test_the_simulated_plc_driving_the_emulator_is_compliant(tmp_path):
             wait_for_line(robot, "listening")
             monitor = monitor_on(bus, folder, "--duration", "5.5s", "--tolerance", "50ms",  # host scheduling
                                  "--trace", folder / "m.jsonl", "--capture", folder / "c.txt")
-            master = Master(bus.plc)
+            master = Master(bus)
             try:
                 for request in requests:
                     master.at(request.t_start_us / 1_000_000)
@@ -818,7 +818,7 @@ def test_the_simulated_plc_driving_the_emulator_is_compliant(tmp_path):
 @pytest.mark.serial
 def test_noise_on_the_line_gives_findings_not_a_crash(line, tmp_path):
     monitor = monitor_on(line, tmp_path, "--duration", "3s")
-    master = Master(line.plc)
+    master = Master(line)
     rng = random.Random(7)
     try:
         master.send(STOP)
@@ -839,7 +839,7 @@ def test_noise_on_the_line_gives_findings_not_a_crash(line, tmp_path):
 @pytest.mark.serial
 def test_ctrl_c_stops_the_monitor_and_the_reports_are_written(line, tmp_path):
     monitor = monitor_on(line, tmp_path, "--capture", tmp_path / "c.txt")
-    master = Master(line.plc)
+    master = Master(line)
     try:
         master.send(STOP)
     finally:
@@ -1324,7 +1324,7 @@ def test_the_capture_is_written_even_when_a_report_cannot_be(line, tmp_path):
     monitor = start("monitor", "--serial", line.tap, "--duration", "2s", "--json", "/proc/m.json",
                     "--capture", tmp_path / "c.txt")
     wait_for_line(monitor, "listening")
-    master = Master(line.plc)
+    master = Master(line)
     master.send(STOP)
     master.close()
     out, err = monitor.communicate(timeout=WAIT_S)
