@@ -53,8 +53,21 @@ class LineBus:
                 continue
             view = view[written:]
 
+    def from_plc(self, data: bytes) -> None:
+        """Bytes the PLC end puts on the line, straight to the tap and the robot from the
+        caller's thread (tests.monitor_helpers.Master): not through the PLC end's socat and
+        the relay thread, two more programs the host could stall on the way (seen: a
+        request 530 ms late on the wire, so 170 ms before the next one, a PACING finding
+        the PLC stand-in had not made). The tap first: it hears a request before the robot
+        can answer it."""
+        with self._lock:
+            self._write("tap", data)
+            self._write("robot", data)
+
     def _relay(self) -> None:
-        sources = {self._fds["plc"]: ("robot", "tap"), self._fds["robot"]: ("plc", "tap", *self._robot_echo),
+        # the tap first: what it hears before the PLC end does (a reply the PLC stand-in
+        # hears is on the tap before its next request can be)
+        sources = {self._fds["plc"]: ("tap", "robot"), self._fds["robot"]: ("tap", "plc", *self._robot_echo),
                    self._fds["tap"]: ()}  # the tap only listens: what it writes goes nowhere
         while not self._stop.is_set():
             ready, _, _ = select.select(list(sources), [], [], 0.05)

@@ -6,10 +6,12 @@ import os
 import select
 import subprocess
 import sys
+import threading
 import time
 from collections import Counter
 from pathlib import Path
 
+from linebus import LineBus
 from verifier import protocol
 
 SETTINGS = protocol.DEFAULT_SETTINGS
@@ -29,35 +31,57 @@ def start(*args, **kw) -> subprocess.Popen:
 
 
 def wait_for_line(proc: subprocess.Popen, words: str, timeout_s: float = WAIT_S) -> str:
-    """Read the process's stdout until a line holds `words` (it has started)."""
-    deadline = time.monotonic() + timeout_s
+    """Read the process's stdout until a line holds `words` (it has started, it has seen a
+    frame). A process that shows no such line in `timeout_s` is killed, and the failure
+    says what it printed. (This waited with select() on the pipe: lines that came in one
+    write with the one read were already in the reader's buffer, not the pipe, and were
+    never looked at; and its failure then read stderr to the end, so a process that ran
+    on hung the test instead of failing it.)"""
     seen = []
-    while time.monotonic() < deadline:
-        ready, _, _ = select.select([proc.stdout], [], [], 0.1)
-        if ready:
-            line = proc.stdout.readline()
+    watchdog = threading.Timer(timeout_s, proc.kill)
+    watchdog.start()
+    try:
+        for line in iter(proc.stdout.readline, ""):
             seen.append(line)
             if words in line:
                 return line
-            if not line and proc.poll() is not None:
-                break
-    raise AssertionError(f"no line with {words!r}; got {''.join(seen)!r}, stderr {proc.stderr.read()!r}")
+    finally:
+        watchdog.cancel()
+    proc.wait(timeout=timeout_s)
+    raise AssertionError(f"no line with {words!r} within {timeout_s} s (exit {proc.returncode}, killed when "
+                         f"negative); got {''.join(seen)!r}, stderr {proc.stderr.read()!r}")
 
 
 class Master:
     """A PLC stand-in on the line's PLC end: writes requests at chosen times, reads replies.
 
+    Like the PLC it stands for it sends one request at a time: it waits for the reply (up
+    to the reply time-out) before it sends the next. It waited 200 ms only: a robot the
+    host stalled longer answered after the next request had gone out, and the monitor
+    rightly found UITAMR-ONE-AT-A-TIME and UITAMR-HALF-DUPLEX on a line the test had
+    not meant to make.
+
     It also notes when the host stalled the run (`stalls`): when it woke up late for a
-    request, or a reply it waited for did not come in time (the emulator was not run).
-    `sent_at` holds when each request was written (monotonic seconds)."""
+    request (a reply that came late makes it late for the next one), or a reply it waited
+    for did not come (the emulator was not run). `sent_at` holds when each request was
+    written (monotonic seconds); `log` what it did and saw, with times, for a failure's
+    message (`report`)."""
 
     LATE_S = 0.05  # what the tests allow the host (the monitor's --tolerance)
+    REPLY_TIMEOUT_S = 0.5  # the rules' reply time-out (docs/verifier.md)
 
-    def __init__(self, device: str):
-        self.fd = os.open(device, os.O_RDWR | os.O_NOCTTY)
-        self.t0 = time.monotonic()
+    def __init__(self, line: LineBus):
+        self.fd = os.open(line.plc, os.O_RDWR | os.O_NOCTTY)  # the replies come here
+        self.write = line.from_plc  # the requests go on the line from here (LineBus.from_plc)
+        self.t0 = self.start = time.monotonic()
         self.sent_at: list[float] = []
         self.stalls: list[str] = []
+        self.log: list[str] = []
+
+    def report(self) -> str:
+        """What the master did and measured, for an assertion's message."""
+        return ("master (times from its start): " + "; ".join(self.log)
+                + "\nhost stalls measured: " + ("; ".join(self.stalls) or "none"))
 
     def at(self, t_s: float) -> None:
         """Wait until `t_s` after the start. A master that is late (a loaded host) moves
@@ -72,15 +96,18 @@ class Master:
             self.stalls.append(f"woke {(now - target) * 1000:.0f} ms late for the request at {t_s:.3f} s")
         self.t0 += now - target if now > target else 0.0
 
-    def send(self, data: bytes, reply_length: int | None = 8, timeout_s: float = 0.2) -> bytes:
+    def send(self, data: bytes, reply_length: int | None = 8, timeout_s: float = REPLY_TIMEOUT_S) -> bytes:
         self.sent_at.append(time.monotonic())
-        os.write(self.fd, data)
+        self.write(data)
+        self.log.append(f"{self.sent_at[-1] - self.start:.3f} s wrote {data.hex(' ')}")
         got = b""
         deadline = time.monotonic() + timeout_s
         while reply_length and len(got) < reply_length and time.monotonic() < deadline:
             ready, _, _ = select.select([self.fd], [], [], 0.01)
             if ready:
                 got += os.read(self.fd, 64)
+        if reply_length:
+            self.log.append(f"{len(got)} reply bytes after {(time.monotonic() - self.sent_at[-1]) * 1000:.0f} ms")
         if reply_length and len(got) < reply_length:
             self.stalls.append(f"{len(got)} of {reply_length} reply bytes within {timeout_s * 1000:.0f} ms "
                                f"of request {len(self.sent_at)}")
@@ -90,9 +117,10 @@ class Master:
         os.close(self.fd)
 
 
-def bad_master(device: str) -> None:
-    """First command not stop, 100 ms pacing, one bad CRC: the findings of issue 10."""
-    master = Master(device)
+def bad_master(line: LineBus) -> Master:
+    """First command not stop, 100 ms pacing, one bad CRC: the findings of issue 10. The
+    master, for what it measured (`Master.report`)."""
+    master = Master(line)
     try:
         run_point = frame("run-point", "1")
         read = frame("read", "task")
@@ -112,9 +140,23 @@ def bad_master(device: str) -> None:
         master.send(read)
     finally:
         master.close()
+    return master
 
 
 BAD_MASTER_FINDINGS = {"UITAMR-POWERON-STOP": 1, "UITAMR-PACING": 3, "UITAMR-CRC": 1}
+
+
+def diagnosis(out: str, err: str, capture: Path | None = None, master: Master | None = None) -> str:
+    """All a failed real-time run can say, for an assertion's message: the monitor's output
+    (every frame and finding with its time), its stderr (a traceback exits 1 too, as
+    findings do), the chunks it read with their host times, and what the master measured."""
+    parts = [out, f"--- monitor stderr ---\n{err or '(empty)'}"]
+    if capture is not None:
+        text = capture.read_text(encoding="utf-8") if capture.exists() else "(not written)"
+        parts.append(f"--- capture {capture.name} ---\n{text}")
+    if master is not None:
+        parts.append(master.report())
+    return "\n".join(parts)
 
 
 def findings(report: Path) -> Counter:

@@ -27,8 +27,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from linebus import LineBus
-from monitor_helpers import (BAD_MASTER_FINDINGS, SETTINGS, WAIT_S, Master, bad_master, findings, frame,
-                             start, uitamr, wait_for_line)
+from monitor_helpers import (BAD_MASTER_FINDINGS, SETTINGS, WAIT_S, Master, bad_master, diagnosis, findings,
+                             frame, start, uitamr, wait_for_line)
 from verifier import protocol
 from verifier.commands.frame import mbpoll_command
 from verifier.monitor.capture import CaptureError, Chunk, format_plain, parse_plain, read_capture
@@ -666,10 +666,11 @@ def monitor_on(bus: LineBus, tmp_path: Path, *extra) -> subprocess.Popen:
 def test_a_bad_master_on_a_real_line_gets_exactly_its_findings(line, tmp_path):
     monitor = monitor_on(line, tmp_path, "--duration", "3s", "--capture", tmp_path / "c.txt",
                          "--junit", tmp_path / "m.xml", "--html", tmp_path / "m.html", "--trace", tmp_path / "m.jsonl")
-    bad_master(line.plc)
+    master = bad_master(line)
     out, err = monitor.communicate(timeout=WAIT_S)
-    assert monitor.returncode == 1, out + err
-    assert findings(tmp_path / "m.json") == Counter(BAD_MASTER_FINDINGS)
+    seen = diagnosis(out, err, tmp_path / "c.txt", master)
+    assert monitor.returncode == 1 and (tmp_path / "m.json").exists(), seen
+    assert findings(tmp_path / "m.json") == Counter(BAD_MASTER_FINDINGS), seen
     live, summary = out.split("\nFAIL monitor ", 1)
     # each finding was printed live (its time, rule, message and frames), before the summary
     assert re.search(r"^0\.000 s  UITAMR-POWERON-STOP: the first control command after power-on is run "
@@ -679,7 +680,7 @@ def test_a_bad_master_on_a_real_line_gets_exactly_its_findings(line, tmp_path):
     assert "<testcase" in (tmp_path / "m.xml").read_text() and "<svg" in (tmp_path / "m.html").read_text()
     done = subprocess.run(uitamr("replay", tmp_path / "c.txt", "--json", tmp_path / "r.json"),
                           capture_output=True, text=True, timeout=WAIT_S)
-    assert done.returncode == 1 and findings(tmp_path / "r.json") == Counter(BAD_MASTER_FINDINGS)
+    assert done.returncode == 1 and findings(tmp_path / "r.json") == Counter(BAD_MASTER_FINDINGS), done.stdout + done.stderr
     # the replay of the capture is the live session's judgement: frames, findings, notes and
     # how long the line was listened to (the capture's `end` line); only the names differ
     live_run, replayed = (json.loads((tmp_path / name).read_text())["scenarios"][0] for name in ("m.json", "r.json"))
@@ -702,7 +703,7 @@ def test_a_request_left_unanswered_on_a_real_line_replays_from_the_trace_as_judg
     monitor's --trace ended at that request, so the finding was gone and the run 5 s
     shorter; with the trace's end record it is the live judgement."""
     monitor = monitor_on(line, tmp_path, "--duration", "8s", "--trace", tmp_path / "m.jsonl")
-    master = Master(line.plc)
+    master = Master(line)
     try:
         stop = frame("stop")
         master.send(stop)
@@ -711,8 +712,9 @@ def test_a_request_left_unanswered_on_a_real_line_replays_from_the_trace_as_judg
     finally:
         master.close()
     out, err = monitor.communicate(timeout=WAIT_S)
-    assert monitor.returncode == 1, out + err
-    assert findings(tmp_path / "m.json")["UITAMR-RESPONSE-HANDLING"] == 1, out
+    seen = diagnosis(out, err, master=master)  # exit 1 with no m.json was a traceback: its stderr says which
+    assert monitor.returncode == 1 and (tmp_path / "m.json").exists(), seen
+    assert findings(tmp_path / "m.json")["UITAMR-RESPONSE-HANDLING"] == 1, seen
     done = subprocess.run(uitamr("replay", tmp_path / "m.jsonl", "--json", tmp_path / "r.json"),
                           capture_output=True, text=True, timeout=WAIT_S)
     assert done.returncode == 1, done.stdout + done.stderr
@@ -740,15 +742,17 @@ def test_mbpoll_and_the_emulator_seen_by_the_monitor(line, tmp_path):
     assert report["scenarios"][0]["frames"] == {"tx": 3, "rx": 3}
 
 
-_SEEN_REQUEST = re.compile(r"^\s*([0-9]+\.[0-9]+) s  PLC → robot ", re.M)
-
-
-def _host_stalls(master: Master, out: str) -> list[str]:
+def _host_stalls(master: Master, trace: Path) -> list[str]:
     """How the host stalled a real-time run, as measured apart from what is tested: the
     master woke late or waited in vain for a reply (Master.stalls), or the monitor saw two
-    requests further apart or closer than the master wrote them (its tap was not run)."""
+    requests further apart or closer than the master wrote them (its tap was not run). The
+    requests seen are the monitor's --trace's. They were read off its console, where a
+    finding prints its frames again: a run with findings never had its gaps compared, and
+    a stalled tap failed at once as a monitor that is wrong. (A monitor that saw another
+    number of requests than were written is wrong: that is no stall.)"""
     stalls = list(master.stalls)
-    seen = [float(t) for t in _SEEN_REQUEST.findall(out)]
+    records = [json.loads(line) for line in trace.read_text(encoding="utf-8").splitlines()] if trace.exists() else []
+    seen = [r["t"] for r in records if r.get("dir") == "tx"]
     if len(seen) == len(master.sent_at):
         for k in range(1, len(seen)):
             wrote, saw = master.sent_at[k] - master.sent_at[k - 1], seen[k] - seen[k - 1]
@@ -779,8 +783,9 @@ def test_the_simulated_plc_driving_the_emulator_is_compliant(tmp_path):
         robot = start("emulate", "--serial", bus.robot)
         try:
             wait_for_line(robot, "listening")
-            monitor = monitor_on(bus, folder, "--duration", "5.5s", "--tolerance", "50ms")  # host scheduling
-            master = Master(bus.plc)
+            monitor = monitor_on(bus, folder, "--duration", "5.5s", "--tolerance", "50ms",  # host scheduling
+                                 "--trace", folder / "m.jsonl", "--capture", folder / "c.txt")
+            master = Master(bus)
             try:
                 for request in requests:
                     master.at(request.t_start_us / 1_000_000)
@@ -792,14 +797,16 @@ def test_the_simulated_plc_driving_the_emulator_is_compliant(tmp_path):
             robot.terminate()
             robot.communicate(timeout=WAIT_S)
             bus.close()
+        seen = diagnosis(out, err, folder / "c.txt", master)
+        assert (folder / "m.json").exists(), seen
         clean = monitor.returncode == 0 and findings(folder / "m.json") == Counter()
-        stalls = _host_stalls(master, out)
+        stalls = _host_stalls(master, folder / "m.jsonl")
         if not clean and stalls:  # findings the host's stall can explain: this attempt proves nothing
-            stalled.append(f"attempt {attempt + 1}: " + "; ".join(stalls) + "\n" + out)
+            stalled.append(f"attempt {attempt + 1}: " + "; ".join(stalls) + "\n" + seen)
             continue
-        assert monitor.returncode == 0, out + err
-        assert findings(folder / "m.json") == Counter()
-        assert out.count("PLC → robot") == len(requests)
+        assert monitor.returncode == 0, seen
+        assert findings(folder / "m.json") == Counter(), seen
+        assert out.count("PLC → robot") == len(requests), seen
         if stalled:  # shown in the run's warnings summary: how often the host got in the way
             warnings.warn("host stalls before the clean attempt: " + " | ".join(s.splitlines()[0] for s in stalled))
         return
@@ -811,7 +818,7 @@ def test_the_simulated_plc_driving_the_emulator_is_compliant(tmp_path):
 @pytest.mark.serial
 def test_noise_on_the_line_gives_findings_not_a_crash(line, tmp_path):
     monitor = monitor_on(line, tmp_path, "--duration", "3s")
-    master = Master(line.plc)
+    master = Master(line)
     rng = random.Random(7)
     try:
         master.send(STOP)
@@ -832,12 +839,14 @@ def test_noise_on_the_line_gives_findings_not_a_crash(line, tmp_path):
 def _monitor_that_saw_the_stop(bus: LineBus, tmp_path: Path, *extra) -> subprocess.Popen:
     """A monitor (with --json m.json and `extra`) on the line, once the stop and its echo passed."""
     monitor = monitor_on(bus, tmp_path, *extra)
-    master = Master(bus.plc)
+    master = Master(bus)
     try:
         master.send(STOP)
     finally:
         master.close()
-    time.sleep(0.5)
+    # Ctrl-C once the monitor has the echo: half a second's sleep was no proof that it had
+    # read it, and a monitor the host stalled as long was stopped with the echo unread
+    wait_for_line(monitor, "echo: stop")
     return monitor
 
 
@@ -869,6 +878,32 @@ def test_a_second_ctrl_c_while_the_reports_are_written_loses_none_of_them(line, 
     assert "Traceback" not in err and "Aborted" not in err and "KeyboardInterrupt" not in err, err
     assert [name for name in ["m.json", *files.values()] if not (tmp_path / name).exists()] == []
     assert json.loads((tmp_path / "m.json").read_text())["verdict"] == "pass"
+
+
+def test_a_frame_waiting_whole_on_the_port_is_one_chunk_so_a_host_stall_cannot_split_it():
+    """The monitor waits for a frame's first byte, then reads the rest. It took the rest in
+    a read of its own: a host that stalled the monitor between the two reads for 31 ms or
+    more (a loaded machine) gave the 7 bytes a later time, the framer took that as a
+    silence after the first byte, and one stop command was judged as a 1-byte frame and a
+    7-byte one. The bytes already waiting come with the first one, in one chunk."""
+    from verifier.monitor.sources import SerialSource
+
+    controller, device = os.openpty()
+    source = SerialSource(os.ttyname(device), 9600, 8, "N", 1)
+    source.port.timeout = WAIT_S  # the read waits for the first byte, as on a quiet line
+    writer = threading.Timer(0.2, os.write, (controller, STOP))  # the whole frame at once, once the read waits
+    try:
+        writer.start()
+        chunk = source.read()
+    finally:
+        writer.join()
+        source.close()
+        os.close(device)
+        os.close(controller)
+    assert chunk is not None and chunk.data == STOP
+    # what a stall between two reads of it made of the frame
+    split = session_of([Chunk(0, STOP[:1]), Chunk(40_000, STOP[1:])])
+    assert split.frames[0].data == STOP[:1]
 
 
 # --------------------------------------------------------------------- the converter route (TCP)
@@ -1314,7 +1349,7 @@ def test_the_capture_is_written_even_when_a_report_cannot_be(line, tmp_path):
     monitor = start("monitor", "--serial", line.tap, "--duration", "2s", "--json", "/proc/m.json",
                     "--capture", tmp_path / "c.txt")
     wait_for_line(monitor, "listening")
-    master = Master(line.plc)
+    master = Master(line)
     master.send(STOP)
     master.close()
     out, err = monitor.communicate(timeout=WAIT_S)

@@ -61,8 +61,15 @@ class SerialSource:
         self._error = serial.SerialException
 
     def read(self) -> Chunk | None:
+        """The bytes that came: the first one waited for, then all that are already there
+        with it, in one chunk. Bytes that were waiting together are never two chunks: were
+        the host to stall this process between two reads of one frame (a loaded machine,
+        a slow terminal), the second read's later time would look like a silence inside
+        the frame, and the frame would be judged as two."""
         try:
             data = self.port.read(self.port.in_waiting or 1)
+            if data and self.port.in_waiting:
+                data += self.port.read(self.port.in_waiting)
         except self._error as exc:
             raise SourceError(f"{self.description}: {exc}") from None
         if not data:
