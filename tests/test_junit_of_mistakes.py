@@ -391,3 +391,20 @@ def test_a_name_too_long_beside_a_command_line_mistake_keeps_clicks_message(tmp_
     assert result.exit_code == 2, result.output
     assert "Error: No such option '--bogus'" in result.stderr and "File name too long" not in result.stderr
     assert cases(report)[0].find("error").get("message").startswith("No such option '--bogus'")
+
+
+def test_a_report_is_not_written_to_a_file_named_like_an_option(tmp_path, monkeypatch):
+    """`--junit --duration 5q`: click took `--duration` for --junit's file, and the JUnit
+    (of the usage mistake, or of a capture "5q" that cannot be read) went to a file of that
+    name in the working folder. A report's file that begins with '-' is refused now, as a
+    usage mistake that names it; with a file given the JUnit is written."""
+    monkeypatch.chdir(tmp_path)
+    for command in ("monitor", "replay", "verify"):
+        for report in ("--junit", "--html"):
+            result = invoke(command, report, "--duration", "5q")
+            assert result.exit_code == 2, result.output
+            assert list(tmp_path.iterdir()) == [], (command, result.output)
+            assert f"Invalid value for '{report}': '--duration' is an option, not a file" in result.output
+        result = invoke(command, "--junit", "j.xml", "--duration", "5q")
+        assert result.exit_code == 2 and (tmp_path / "j.xml").is_file(), (command, result.output)
+        (tmp_path / "j.xml").unlink()
