@@ -60,6 +60,18 @@ def test_a_capture_of_bytes_that_are_not_text_is_at_its_line_and_column(tmp_path
     assert case.find("error").get("message").startswith(f"{capture}: line 2, column 10 (byte 21)")
 
 
+def test_a_capture_name_too_long_for_the_file_system_is_the_junits_error(tmp_path):
+    """`uitamr replay` asks whether a capture it cannot read is a serial port; with a name
+    the file system refuses (longer than NAME_MAX) that question raised OSError itself: the
+    command's own "cannot read" and its JUnit test case were lost to the generic path error."""
+    capture = tmp_path / ("c" * 5000)
+    result = invoke("replay", capture, "--junit", tmp_path / "r.xml")
+    assert result.exit_code == 2, result.output
+    assert "cannot read: File name too long" in result.output
+    (case,) = cases(tmp_path / "r.xml")
+    assert "cannot read: File name too long" in case.find("error").get("message")
+
+
 def test_the_place_is_the_mistakes_data_not_its_text():
     root = unusable_element([Mistake("no place, though it reads a:1:2: like one"),
                              Mistake("the sources do not load: dir: x/M.st:3:4: error: bad", "dir: x/M.st", 3, 4)])
