@@ -60,6 +60,18 @@ def test_a_capture_of_bytes_that_are_not_text_is_at_its_line_and_column(tmp_path
     assert case.find("error").get("message").startswith(f"{capture}: line 2, column 10 (byte 21)")
 
 
+def test_a_capture_name_too_long_for_the_file_system_is_the_junits_error(tmp_path):
+    """`uitamr replay` asks whether a capture it cannot read is a serial port; with a name
+    the file system refuses (longer than NAME_MAX) that question raised OSError itself: the
+    command's own "cannot read" and its JUnit test case were lost to the generic path error."""
+    capture = tmp_path / ("c" * 5000)
+    result = invoke("replay", capture, "--junit", tmp_path / "r.xml")
+    assert result.exit_code == 2, result.output
+    assert "cannot read: File name too long" in result.output
+    (case,) = cases(tmp_path / "r.xml")
+    assert "cannot read: File name too long" in case.find("error").get("message")
+
+
 def test_the_place_is_the_mistakes_data_not_its_text():
     root = unusable_element([Mistake("no place, though it reads a:1:2: like one"),
                              Mistake("the sources do not load: dir: x/M.st:3:4: error: bad", "dir: x/M.st", 3, 4)])
@@ -391,3 +403,20 @@ def test_a_name_too_long_beside_a_command_line_mistake_keeps_clicks_message(tmp_
     assert result.exit_code == 2, result.output
     assert "Error: No such option '--bogus'" in result.stderr and "File name too long" not in result.stderr
     assert cases(report)[0].find("error").get("message").startswith("No such option '--bogus'")
+
+
+def test_a_report_is_not_written_to_a_file_named_like_an_option(tmp_path, monkeypatch):
+    """`--junit --duration 5q`: click took `--duration` for --junit's file, and the JUnit
+    (of the usage mistake, or of a capture "5q" that cannot be read) went to a file of that
+    name in the working folder. A report's file that begins with '-' is refused now, as a
+    usage mistake that names it; with a file given the JUnit is written."""
+    monkeypatch.chdir(tmp_path)
+    for command in ("monitor", "replay", "verify"):
+        for report in ("--junit", "--html"):
+            result = invoke(command, report, "--duration", "5q")
+            assert result.exit_code == 2, result.output
+            assert list(tmp_path.iterdir()) == [], (command, result.output)
+            assert f"Invalid value for '{report}': '--duration' is an option, not a file" in result.output
+        result = invoke(command, "--junit", "j.xml", "--duration", "5q")
+        assert result.exit_code == 2 and (tmp_path / "j.xml").is_file(), (command, result.output)
+        (tmp_path / "j.xml").unlink()

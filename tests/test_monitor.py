@@ -1372,6 +1372,15 @@ def test_an_html_report_of_a_capture_spanning_years_stays_small(tmp_path):
     assert report_html.MAJOR_TICKS_AT_MOST == 5000
 
 
+def sent_onto_the_line(line_end: int) -> bytes:
+    """What the monitor wrote to the pty that stands for the adapter: its other end's bytes."""
+    os.set_blocking(line_end, False)
+    try:
+        return os.read(line_end, 4096)
+    except BlockingIOError:
+        return b""
+
+
 @pytest.mark.serial
 def test_a_report_or_capture_named_as_the_port_is_refused_not_sent_onto_the_line(tmp_path):
     """`uitamr monitor --serial /dev/ttyUSB0 --capture /dev/ttyUSB0` (the port typed twice)
@@ -1385,12 +1394,7 @@ def test_a_report_or_capture_named_as_the_port_is_refused_not_sent_onto_the_line
                                   capture_output=True, text=True, timeout=WAIT_S)
             assert done.returncode == 2, done.stdout + done.stderr
             assert f"{port} is the port the monitor listens on, and the monitor never writes to the line" in done.stderr
-            os.set_blocking(line_end, False)
-            try:
-                sent = os.read(line_end, 4096)
-            except BlockingIOError:
-                sent = b""
-            assert sent == b"", sent
+            assert sent_onto_the_line(line_end) == b""
     finally:
         os.close(line_end)
         os.close(port_end)
@@ -1413,12 +1417,7 @@ def test_a_report_named_as_the_port_is_the_junits_error_and_a_junit_named_so_is_
                               capture_output=True, text=True, timeout=WAIT_S)
         assert done.returncode == 2, done.stdout + done.stderr
         assert f"{port} is the port the monitor listens on" in done.stderr
-        os.set_blocking(line_end, False)
-        try:
-            sent = os.read(line_end, 4096)
-        except BlockingIOError:
-            sent = b""
-        assert sent == b"", sent
+        assert sent_onto_the_line(line_end) == b""
     finally:
         os.close(line_end)
         os.close(port_end)

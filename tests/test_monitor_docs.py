@@ -179,3 +179,25 @@ def test_how_soon_a_finding_is_printed_is_how_often_the_monitor_looks():
     assert CHECK_EVERY_S == 0.5
     assert "The monitor looks for findings twice a second" in text
     assert "a finding shows up to half a second after its frames" in text
+
+
+def test_what_a_host_stall_does_is_what_the_framer_does():
+    """The row on a stalled host said "a stall between reads cannot split a frame"; one
+    read takes the bytes that waited together, but a stall while a frame is still arriving
+    (half of it read, the rest read after the stall) cuts it once longer than t3.5 plus the
+    tolerance, as the row now says."""
+    from verifier.monitor.capture import Chunk
+    from verifier.monitor.framer import Framer
+
+    row = next(line for line in DOC.splitlines() if line.startswith("| the host does not run the monitor"))
+    assert "cannot split" not in row
+    assert "one longer than t3.5 plus the tolerance while a frame is still arriving cuts it in two" in row
+
+    def frames(stall_us: int) -> list[bytes]:
+        framer = Framer(LineTiming(9600, 10, DEFAULT_TOLERANCE_US))
+        out = framer.feed(Chunk(4_170, protocol.STOP_FRAME[:4]))
+        out += framer.feed(Chunk(4_170 + stall_us, protocol.STOP_FRAME[4:]))
+        return [frame.data for frame in out + framer.poll(10_000_000)]
+
+    assert frames(DEFAULT_TOLERANCE_US // 2) == [protocol.STOP_FRAME]
+    assert frames(DEFAULT_TOLERANCE_US + 4_000 + 5_000) == [protocol.STOP_FRAME[:4], protocol.STOP_FRAME[4:]]

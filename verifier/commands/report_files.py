@@ -33,12 +33,26 @@ def text_console(**options) -> Console:
     return _ReportConsole(highlight=False, soft_wrap=True, emoji=False, **options)
 
 
+class ReportPath(click.Path):
+    """A report's file: not a name that begins with '-', which is the next option taken for
+    the file left out (`--junit --duration 5q` wrote a report named "--duration")."""
+
+    def __init__(self):
+        super().__init__(dir_okay=False)
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, str) and value.startswith("-"):
+            self.fail(f"{value!r} is an option, not a file: give the report's file first "
+                      f"(./{value} for a file of that name)", param, ctx)
+        return super().convert(value, param, ctx)
+
+
 REPORT_OPTIONS = (
-    click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Write the verdict as JSON."),
-    click.option("--junit", "junit_path", type=click.Path(dir_okay=False),
+    click.option("--json", "json_path", type=ReportPath(), help="Write the verdict as JSON."),
+    click.option("--junit", "junit_path", type=ReportPath(),
                  help="Write JUnit XML (one testcase per scenario or capture)."),
-    click.option("--trace", "trace_path", type=click.Path(dir_okay=False), help="Write every frame as JSON Lines."),
-    click.option("--html", "html_path", type=click.Path(dir_okay=False),
+    click.option("--trace", "trace_path", type=ReportPath(), help="Write every frame as JSON Lines."),
+    click.option("--html", "html_path", type=ReportPath(),
                  help="Write a self-contained HTML report with a timing diagram."),
 )
 

@@ -116,22 +116,28 @@ class _EchoFilter:
     def __init__(self) -> None:
         self._expected = b""
         self._until_us = 0
+        self._held = b""  # bytes that match the echo's start, until it is whole
         self.seen = False  # an echo has come back at least once
 
     def sent(self, data: bytes, until_us: int) -> None:
-        self._expected, self._until_us = bytes(data), until_us
+        self._expected, self._until_us, self._held = bytes(data), until_us, b""
 
     def strip(self, data: bytes, t_us: int) -> bytes:
-        """``data`` without the echo at its start, if it begins with the bytes expected."""
+        """``data`` without the echo at its start, if it begins with the bytes expected.
+        Bytes that match only the echo's start are held: a master's next request begins
+        like the reply (address, function) and comes a byte at a time; they are given back
+        with the first byte that is not the echo's. An echo cut short is dropped."""
         if not self._expected or t_us > self._until_us:
-            self._expected = b""
+            self._expected, self._held = b"", b""
             return data
         n = min(len(data), len(self._expected))
         if data[:n] != self._expected[:n]:
-            self._expected = b""  # not an echo: a master's bytes
-            return data
-        self._expected = self._expected[n:]
-        self.seen = True
+            held, self._expected, self._held = self._held, b"", b""  # not an echo: a master's bytes
+            return held + data
+        self._expected, self._held = self._expected[n:], self._held + data[:n]
+        if self._expected:
+            return b""
+        self._held, self.seen = b"", True
         return data[n:]
 
 
