@@ -1381,46 +1381,49 @@ def sent_onto_the_line(line_end: int) -> bytes:
         return b""
 
 
-@pytest.mark.serial
-def test_a_report_or_capture_named_as_the_port_is_refused_not_sent_onto_the_line(tmp_path):
-    """`uitamr monitor --serial /dev/ttyUSB0 --capture /dev/ttyUSB0` (the port typed twice)
-    wrote the capture's text onto the robot's line - the monitor that "never transmits" - and
-    said "wrote /dev/ttyUSB0". A pty stands for the adapter: its other end reads the line."""
+@pytest.fixture
+def adapter_pty():
+    """(the line's end, the port's name): a pty stands for the USB adapter, its other end
+    reads what would go onto the robot's line."""
     line_end, port_end = os.openpty()
-    port = os.ttyname(port_end)
     try:
-        for option in ("--capture", "--json"):
-            done = subprocess.run(uitamr("monitor", "--serial", port, option, port, "--duration", "1s"),
-                                  capture_output=True, text=True, timeout=WAIT_S)
-            assert done.returncode == 2, done.stdout + done.stderr
-            assert f"{port} is the port the monitor listens on, and the monitor never writes to the line" in done.stderr
-            assert sent_onto_the_line(line_end) == b""
+        yield line_end, os.ttyname(port_end)
     finally:
         os.close(line_end)
         os.close(port_end)
 
 
-def test_a_report_named_as_the_port_is_the_junits_error_and_a_junit_named_so_is_not_written(tmp_path):
+def _refused_monitor(*args) -> subprocess.CompletedProcess:
+    done = subprocess.run(uitamr("monitor", *args, "--duration", "1s"), capture_output=True, text=True,
+                          timeout=WAIT_S)
+    assert done.returncode == 2, done.stdout + done.stderr
+    return done
+
+
+@pytest.mark.serial
+def test_a_report_or_capture_named_as_the_port_is_refused_not_sent_onto_the_line(adapter_pty):
+    """`uitamr monitor --serial /dev/ttyUSB0 --capture /dev/ttyUSB0` (the port typed twice)
+    wrote the capture's text onto the robot's line - the monitor that "never transmits" - and
+    said "wrote /dev/ttyUSB0"."""
+    line_end, port = adapter_pty
+    for option in ("--capture", "--json"):
+        done = _refused_monitor("--serial", port, option, port)
+        assert f"{port} is the port the monitor listens on, and the monitor never writes to the line" in done.stderr
+        assert sent_onto_the_line(line_end) == b""
+
+
+def test_a_report_named_as_the_port_is_the_junits_error_and_a_junit_named_so_is_not_written(tmp_path, adapter_pty):
     """The refusal of a report named as the port is a command-line mistake like click's own:
     it goes into --junit's file (CI shows it), unless that file is the port itself, which
     would send the JUnit's XML onto the robot's line."""
-    line_end, port_end = os.openpty()
-    port = os.ttyname(port_end)
+    line_end, port = adapter_pty
     report = tmp_path / "m.xml"
-    try:
-        done = subprocess.run(uitamr("monitor", "--serial", port, "--json", port, "--junit", str(report),
-                                     "--duration", "1s"), capture_output=True, text=True, timeout=WAIT_S)
-        assert done.returncode == 2, done.stdout + done.stderr
-        error = ET.parse(report).getroot().find(".//testcase/error")
-        assert error is not None and "is the port the monitor listens on" in error.get("message")
-        done = subprocess.run(uitamr("monitor", "--serial", port, "--junit", port, "--duration", "1s"),
-                              capture_output=True, text=True, timeout=WAIT_S)
-        assert done.returncode == 2, done.stdout + done.stderr
-        assert f"{port} is the port the monitor listens on" in done.stderr
-        assert sent_onto_the_line(line_end) == b""
-    finally:
-        os.close(line_end)
-        os.close(port_end)
+    _refused_monitor("--serial", port, "--json", port, "--junit", str(report))
+    error = ET.parse(report).getroot().find(".//testcase/error")
+    assert error is not None and "is the port the monitor listens on" in error.get("message")
+    done = _refused_monitor("--serial", port, "--junit", port)
+    assert f"{port} is the port the monitor listens on" in done.stderr
+    assert sent_onto_the_line(line_end) == b""
 
 
 def test_replay_of_a_serial_port_points_to_the_monitor():
