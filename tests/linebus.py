@@ -64,6 +64,15 @@ class LineBus:
             self._write("tap", data)
             self._write("robot", data)
 
+    def from_robot(self, data: bytes) -> None:
+        """Bytes the robot end puts on the line, straight to the tap and the PLC end from the
+        caller's thread: a robot answered in-process (tests.monitor_helpers.Master with a
+        `robot`), so that a reply goes out right after its request whatever the host does.
+        The tap first, as in the relay."""
+        with self._lock:
+            for name in ("tap", "plc", *self._robot_echo):
+                self._write(name, data)
+
     def _relay(self) -> None:
         # the tap first: what it hears before the PLC end does (a reply the PLC stand-in
         # hears is on the tap before its next request can be)

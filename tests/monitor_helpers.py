@@ -13,6 +13,7 @@ from pathlib import Path
 
 from linebus import LineBus
 from verifier import protocol
+from verifier.amr import Robot
 
 SETTINGS = protocol.DEFAULT_SETTINGS
 WAIT_S = 20
@@ -65,14 +66,22 @@ class Master:
     request (a reply that came late makes it late for the next one), or a reply it waited
     for did not come (the emulator was not run). `sent_at` holds when each request was
     written (monotonic seconds); `log` what it did and saw, with times, for a failure's
-    message (`report`)."""
+    message (`report`).
+
+    With a `robot` (the emulator's own model, verifier.amr.Robot) the master answers for
+    the robot itself: each reply goes on the line from the robot's end (LineBus.from_robot)
+    right after its request, from this thread, so a host stall delays request and reply
+    together and the gaps between requests are the ones the test wrote. A `uitamr emulate`
+    process the host stalled 230 ms or more answered so late that the next request, sent
+    after the reply, no longer broke the pacing: the wire was not the one the test meant."""
 
     LATE_S = 0.05  # what the tests allow the host (the monitor's --tolerance)
     REPLY_TIMEOUT_S = 0.5  # the rules' reply time-out (docs/verifier.md)
 
-    def __init__(self, line: LineBus):
+    def __init__(self, line: LineBus, robot: Robot | None = None):
         self.fd = os.open(line.plc, os.O_RDWR | os.O_NOCTTY)  # the replies come here
         self.write = line.from_plc  # the requests go on the line from here (LineBus.from_plc)
+        self.line, self.robot = line, robot
         self.t0 = self.start = time.monotonic()
         self.sent_at: list[float] = []
         self.stalls: list[str] = []
@@ -100,6 +109,8 @@ class Master:
         self.sent_at.append(time.monotonic())
         self.write(data)
         self.log.append(f"{self.sent_at[-1] - self.start:.3f} s wrote {data.hex(' ')}")
+        if self.robot is not None:
+            return self._answer(data)
         got = b""
         deadline = time.monotonic() + timeout_s
         while reply_length and len(got) < reply_length and time.monotonic() < deadline:
@@ -113,14 +124,27 @@ class Master:
                                f"of request {len(self.sent_at)}")
         return got
 
+    def _answer(self, request: bytes) -> bytes:
+        """The in-process robot's reply to `request`, on the line at once (none: silence).
+        Its clock is the line's: the request ended its time at 9600 baud after it was written."""
+        end_us = round((self.sent_at[-1] - self.start) * 1_000_000) + protocol.frame_time_us(len(request))
+        reply = self.robot.on_request(request, end_us)
+        if reply is None:
+            self.log.append("the robot stays silent")
+            return b""
+        self.line.from_robot(reply.data)
+        self.log.append(f"{time.monotonic() - self.start:.3f} s the robot answered {reply.data.hex(' ')}")
+        return reply.data
+
     def close(self) -> None:
         os.close(self.fd)
 
 
-def bad_master(line: LineBus) -> Master:
+def bad_master(line: LineBus, robot: Robot | None = None) -> Master:
     """First command not stop, 100 ms pacing, one bad CRC: the findings of issue 10. The
-    master, for what it measured (`Master.report`)."""
-    master = Master(line)
+    master, for what it measured (`Master.report`); with a `robot` it answers for it
+    (`Master`), else a robot on the line does."""
+    master = Master(line, robot)
     try:
         run_point = frame("run-point", "1")
         read = frame("read", "task")

@@ -30,6 +30,7 @@ from linebus import LineBus
 from monitor_helpers import (BAD_MASTER_FINDINGS, SETTINGS, WAIT_S, Master, bad_master, diagnosis, findings,
                              frame, start, uitamr, wait_for_line)
 from verifier import protocol
+from verifier.amr import Robot
 from verifier.commands.frame import mbpoll_command
 from verifier.monitor.capture import CaptureError, Chunk, format_plain, parse_plain, read_capture
 from verifier.monitor.framer import MAX_FRAME, Framer, LineTiming
@@ -662,11 +663,26 @@ def monitor_on(bus: LineBus, tmp_path: Path, *extra) -> subprocess.Popen:
     return monitor
 
 
+@pytest.fixture
+def bare_line(tmp_path):
+    """A line with nothing on its robot end: the test answers for the robot (Master's `robot`)."""
+    bus = LineBus(tmp_path)
+    try:
+        yield bus
+    finally:
+        bus.close()
+
+
 @pytest.mark.serial
-def test_a_bad_master_on_a_real_line_gets_exactly_its_findings(line, tmp_path):
+def test_a_bad_master_on_a_real_line_gets_exactly_its_findings(bare_line, tmp_path):
+    """The robot is the emulator's model answered in-process (Master's `robot`): with a
+    `uitamr emulate` process the host stalled 230 ms or more, the master's next request
+    went out after the late reply and broke no pacing - 1 to 2 runs in 30 on a loaded
+    2-core host found 2 UITAMR-PACING, not 3. The emulator on the line: the test after this one."""
+    line = bare_line
     monitor = monitor_on(line, tmp_path, "--duration", "3s", "--capture", tmp_path / "c.txt",
                          "--junit", tmp_path / "m.xml", "--html", tmp_path / "m.html", "--trace", tmp_path / "m.jsonl")
-    master = bad_master(line)
+    master = bad_master(line, Robot(SETTINGS))
     out, err = monitor.communicate(timeout=WAIT_S)
     seen = diagnosis(out, err, tmp_path / "c.txt", master)
     assert monitor.returncode == 1 and (tmp_path / "m.json").exists(), seen
@@ -694,6 +710,35 @@ def test_a_bad_master_on_a_real_line_gets_exactly_its_findings(line, tmp_path):
     replayed = json.loads((tmp_path / "t.json").read_text())["scenarios"][0]
     differing = {key for key in live_run if live_run[key] != replayed[key]}
     assert differing == {"name", "file", "description", "channel"}, {k: (live_run[k], replayed[k]) for k in differing}
+
+
+@pytest.mark.serial
+def test_the_emulator_answering_the_bad_master_is_seen_reply_for_reply(tmp_path):
+    """`uitamr emulate` on the line answers the bad master, and the monitor on the tap sees
+    every request the master wrote and every reply the emulator logged it sent, in order,
+    and the findings that do not depend on when the host ran the emulator (how many
+    requests broke the pacing does: a reply the host held back delays the next request)."""
+    bus = LineBus(tmp_path)
+    robot = start("emulate", "--serial", bus.robot)
+    try:
+        wait_for_line(robot, "listening")
+        monitor = monitor_on(bus, tmp_path, "--duration", "3s", "--trace", tmp_path / "m.jsonl")
+        master = bad_master(bus)
+        out, err = monitor.communicate(timeout=WAIT_S)
+    finally:
+        robot.terminate()
+        log, _ = robot.communicate(timeout=WAIT_S)
+        bus.close()
+    seen = diagnosis(out, err, master=master) + "\n--- emulator ---\n" + log
+    assert monitor.returncode == 1 and (tmp_path / "m.json").exists(), seen
+    found = findings(tmp_path / "m.json")
+    assert (found["UITAMR-POWERON-STOP"], found["UITAMR-CRC"]) == (1, 1), seen
+    records = [json.loads(r) for r in (tmp_path / "m.jsonl").read_text(encoding="utf-8").splitlines()]
+    requests = [bytes.fromhex(r["hex"]) for r in records if r.get("dir") == "tx"]
+    replies = [r["hex"] for r in records if r.get("dir") == "rx"]
+    assert requests == [bytes.fromhex(w.split(" wrote ")[1]) for w in master.log if " wrote " in w], seen
+    sent = re.findall(r"^ *\d+\.\d{3} s  -> ((?:[0-9A-F]{2} )*[0-9A-F]{2})  ", log, re.M)
+    assert len(sent) == 5 and replies == sent, seen  # the bad stop gets none
 
 
 @pytest.mark.serial
