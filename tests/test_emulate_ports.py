@@ -668,7 +668,6 @@ def test_cli_mistakes_get_a_clear_message(args, message, code):
     assert "stopped after" not in result.stdout  # it never ran: no summary as if it had
 
 
-
 def test_a_port_that_cannot_be_opened_says_what_to_check_on_site():
     """The mistakes at the adapter: a wrong name (or the adapter not plugged in), a user not in
     the port's group, a port another program has open. Both commands repeated pyserial's
@@ -687,6 +686,7 @@ def test_a_port_that_cannot_be_opened_says_what_to_check_on_site():
                                              "group (`ls -l` names the group, dialout on Debian and Ubuntu")
     busy = serial.SerialException(16, "could not open port /dev/ttyUSB0: [Errno 16] Device or resource busy")
     assert why_not_opened(busy).startswith("the port is busy: another program has it open")
+
 
 def test_an_ipv6_listener_is_logged_as_tcp_takes_it_back(start_emulator):
     """The log's address pastes back into --tcp: [::1]:PORT, not ::1:PORT."""

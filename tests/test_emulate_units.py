@@ -121,7 +121,6 @@ def test_noise_then_silence_then_a_request_is_always_recovered(chunks):
     assert frames_of(asm.feed(STOP_FRAME, t + 1)) == [STOP_FRAME]
 
 
-
 def test_a_line_on_which_no_frame_has_a_good_crc_is_said_to_be_at_another_speed():
     """A PLC at 19200 into the emulator at 9600 (or A and B swapped): every frame is garbled,
     no reply goes out, and the summary said only "2 frames in, 0 replies out, 2 unanswered".
@@ -177,7 +176,6 @@ def test_bad_fault_files_name_the_file_the_line_and_the_key(tmp_path, text, wher
     assert str(caught.value).startswith(f"{path}{where}")
 
 
-
 CAPTURE = Path(__file__).resolve().parent / "captures" / "bad-master.txt"
 
 
@@ -204,6 +202,7 @@ def test_a_capture_given_as_a_fault_file_or_a_scenario_is_named_as_one(tmp_path,
     with pytest.raises(FaultFileError) as caught:
         load_fault_file(path)
     assert "this is" not in str(caught.value)
+
 
 def test_fault_file_refuses_a_wrong_address_fault_with_the_robots_own_address(tmp_path):
     path = tmp_path / "bench.toml"

@@ -49,6 +49,7 @@ RULES_RECORDED = {"reply_timeout": 0.5, "min_period": 0.25, "response_within": 5
                   "protocol": {"address": 1, "field_order": "code-high", "codes_10_13": "decimal",
                                "status_order": "query", "manual_stop_counts_as_stop": False}}
 
+
 def session_of(chunks, tolerance_us: int = 20_000, end_us: int | None = None, **kw) -> MonitorSession:
     """A session fed as `uitamr monitor` feeds it: each chunk as it came; with `end_us`, the
     poll at the end of listening (a read that returned nothing); then the close."""

@@ -69,7 +69,6 @@ def test_the_no_traffic_verdict_is_what_the_monitor_says():
     assert f"```\nNO TRAFFIC: {result.no_traffic}\n```" in DOC
 
 
-
 def test_a_plc_at_19200_read_at_9600_is_said_to_be_on_another_speed(tmp_path):
     """§2: a PLC at 19200 into a 9600 monitor gave only CRC and FORMAT findings ("unknown
     function code 0x08"), which §5's table sends to the PLC's CRC routine and frame builder;
@@ -88,6 +87,7 @@ def test_a_plc_at_19200_read_at_9600_is_said_to_be_on_another_speed(tmp_path):
     capture.write_text("0.3 01 06 01 A0 00 00 14 88\n1.0 end\n", encoding="utf-8")  # CRC high byte first
     swapped = subprocess.run(uitamr("replay", capture), capture_output=True, text=True, timeout=60)
     assert "UITAMR-CRC" in swapped.stdout and "not one of" not in swapped.stdout  # the PLC's CRC, not the line
+
 
 def test_a_monitor_trace_replays_to_the_monitors_findings(tmp_path):
     """commissioning.md §6 replays `monitor --trace` files. Their times are the host's, so

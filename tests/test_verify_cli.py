@@ -119,7 +119,6 @@ def test_a_scenario_given_as_source_is_pointed_to_scenario_option():
     assert f"{scenario} is a scenario, not ST source: give it as --scenario {scenario}" in done.stderr
 
 
-
 def test_a_capture_trace_or_report_given_as_source_says_what_it_is(tmp_path, monkeypatch):
     """`uitamr verify site.txt`, the capture a site session left, was read as ST: "site.txt:1:1:
     error: '#' must follow a radix", and a trace or a JSON report "unexpected character '{'",
@@ -136,6 +135,7 @@ def test_a_capture_trace_or_report_given_as_source_says_what_it_is(tmp_path, mon
         result = invoke(name, *map(str, FX3_SOURCES))
         assert result.exit_code == 2, result.output
         assert says in result.output and "radix" not in result.output and "'{'" not in result.output
+
 
 def test_st_source_given_as_a_scenario_is_pointed_to_the_arguments():
     """`--scenario Main.st` said 'Main.st:1:9: not valid TOML: Expected '=' after a key',
@@ -266,7 +266,6 @@ def test_a_plain_run_tells_the_platform_from_the_sources(tmp_path):
     assert result.exit_code == 0, result.output
     (scenario,) = json.loads(report.read_text())["scenarios"]
     assert (scenario["platform"], scenario["channel"], scenario["program"]) == ("q", "q:1", "UITAMR_ExampleQ")
-
 
 
 def test_a_scenario_on_the_wrong_platform_says_which_platform_to_set(tmp_path):

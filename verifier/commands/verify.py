@@ -42,8 +42,6 @@ SHOW_PROGRESS_AFTER_S = 0.5
 PLAIN_PROGRESS_EVERY_S = 30.0  # progress lines in CI logs (not a terminal)
 
 
-
-
 def bundled_scenarios() -> list[Path]:
     return sorted((bundled_plc_dir() / "scenarios").glob("*.toml"))
 

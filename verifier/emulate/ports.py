@@ -289,7 +289,6 @@ def serve_tcp(host: str, port: int, emulator: Emulator, stop: threading.Event, s
         server.close()
 
 
-
 def why_not_opened(err: Exception) -> str:
     """Why pyserial could not open a port, and what to do, for the mistakes made on site: a
     wrong name (or the adapter unplugged), a port the user may not open, one another program
@@ -305,6 +304,7 @@ def why_not_opened(err: Exception) -> str:
     if number == errno.EBUSY:
         return "the port is busy: another program has it open (a terminal program, ModemManager); close that first"
     return str(err)
+
 
 def serial_url_problem(url: str) -> str | None:
     """What is wrong with a pyserial network URL (socket://, rfc2217://) before pyserial

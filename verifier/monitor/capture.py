@@ -433,7 +433,6 @@ def capture_kind(text: str, name: str) -> str | None:
             else "a capture of `uitamr monitor --capture` (times and bytes on the line)")
 
 
-
 def capture_instead(text: str, path: Path | str | None) -> str:
     """What to say after "not valid TOML" of a capture given as a scenario or a fault file
     (`--scenario site.txt`, `--faults site.txt`): what it is and what reads it; else ""."""

@@ -75,7 +75,6 @@ def infer_platform(sources: tuple[Path, ...]) -> str:
     )
 
 
-
 _COMMENT = re.compile(r"\(\*.*?\*\)|//[^\n]*", re.DOTALL)
 
 
