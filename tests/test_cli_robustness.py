@@ -267,3 +267,32 @@ def test_ctrl_c_in_the_middle_of_a_replay_is_not_a_finding(monkeypatch, tmp_path
     assert "Aborted" not in result.output and not (tmp_path / "r.json").exists()
     page = " ".join((Path(__file__).resolve().parents[1] / "docs" / "commissioning.md").read_text(encoding="utf-8").split())
     assert "Ctrl-C in the middle of a replay ends it with exit status 130 and no verdict" in page
+
+
+@pytest.mark.parametrize("command", ["monitor", "emulate"])
+@pytest.mark.parametrize("bare, option", [("/dev/ttyUSB0", "--serial"), ("COM3", "--serial"),
+                                          ("socket://10.0.0.5:4001", "--serial"),
+                                          ("127.0.0.1:4001", "--tcp"), ("[::1]:4001", "--tcp"), ("4001", "--tcp")])
+def test_a_port_typed_without_its_option_is_named_with_the_option_it_needs(command, bare, option):
+    """`uitamr monitor /dev/ttyUSB0` (the port without --serial, on site) got click's bare
+    "Got unexpected extra argument (/dev/ttyUSB0)"; now the option it needs is named."""
+    result = invoke(command, bare)
+    assert result.exit_code == 2, result.output
+    assert f"Error: {bare!r} is given without its option: {option} {bare}" in result.output
+
+
+@pytest.mark.parametrize("command", ["monitor", "emulate"])
+def test_words_beside_a_port_given_with_its_option_are_refused_as_such(command):
+    result = invoke(command, "--serial", "/dev/ttyUSB0", "x", "y")
+    assert result.exit_code == 2, result.output
+    assert "Error: unexpected arguments 'x' 'y': the command takes options only" in result.output
+
+
+def test_a_port_typed_without_its_option_is_the_monitors_junit_error(tmp_path):
+    """The monitor's CI job shows the mistake, as for click's own refusals."""
+    import xml.etree.ElementTree as ET
+
+    result = invoke("monitor", "/dev/ttyUSB0", "--junit", tmp_path / "m.xml")
+    assert result.exit_code == 2, result.output
+    error = ET.parse(tmp_path / "m.xml").getroot().find(".//testcase/error")
+    assert error is not None and error.get("message").startswith("'/dev/ttyUSB0' is given without its option")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import signal
 import sys
 import threading
@@ -160,7 +161,19 @@ def _flag_faults(no_reply, bad_crc, garbage, wrong_address, exception, late,
     return faults
 
 
-@click.command("emulate")
+def bare_arguments(args: list[str], port_given: bool) -> str | None:
+    """What is wrong with words given without an option (this command takes options only),
+    or None: a port typed without its option (`uitamr monitor /dev/ttyUSB0`, which click
+    calls an "unexpected extra argument") is named with the option it needs."""
+    if not args:
+        return None
+    if len(args) == 1 and not port_given:
+        option = "--tcp" if re.fullmatch(r"(\[[^\]]*\]|[A-Za-z0-9.-]*):\d+|\d+", args[0]) else "--serial"
+        return f"{args[0]!r} is given without its option: {option} {args[0]}"
+    return f"unexpected argument{'s' if len(args) > 1 else ''} {' '.join(map(repr, args))}: the command takes options only"
+
+
+@click.command("emulate", context_settings={"allow_extra_args": True})
 @click.option("--serial", "serial_url", metavar="PORT", callback=_serial_url,
               help="Serial port or pyserial URL: /dev/ttyUSB0, COM3, socket://HOST:PORT, rfc2217://HOST:PORT "
                    "(not loop://).")
@@ -200,6 +213,8 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
     Every frame is logged with its time, direction (<- request, -> reply), hex bytes and
     meaning; robot events (tasks, faults, ignored commands) are marked **.
     """
+    if problem := bare_arguments(click.get_current_context().args, serial_url is not None or tcp is not None):
+        raise click.UsageError(problem)
     if (serial_url is None) == (tcp is None):
         raise click.UsageError("give exactly one of --serial PORT or --tcp HOST:PORT")
     context = click.get_current_context()

@@ -20,7 +20,7 @@ from rich.console import Console
 from rich.markup import escape
 
 from verifier import protocol
-from verifier.commands.emulate import STANDARD_BAUD_RATES, _tcp_endpoint
+from verifier.commands.emulate import STANDARD_BAUD_RATES, _tcp_endpoint, bare_arguments
 from verifier.commands.protocol_options import protocol_settings
 from verifier.commands.report_files import (JudgingCommand, ReportError, check_folders, mistakes_junit,
                                              refused_report_junit, report_options, text_console, usage_error_junit,
@@ -85,7 +85,7 @@ def line_timing(baud: str, line_format: str, tolerance_us: int | None, default_t
     return LineTiming(int(baud), bits, default_tolerance_us if tolerance_us is None else tolerance_us)
 
 
-@click.command("monitor", cls=JudgingCommand, maker="uitamr monitor")
+@click.command("monitor", cls=JudgingCommand, maker="uitamr monitor", context_settings={"allow_extra_args": True})
 @click.option("--serial", "serial_url", metavar="PORT",
               help="Serial port or pyserial URL to listen on: /dev/ttyUSB0, COM3, socket://HOST:PORT, rfc2217://...")
 @click.option("--tcp", "tcp", metavar="HOST:PORT", help="A TCP server that streams the line's bytes (converter route).")
@@ -101,6 +101,8 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
     """Listen on the robot's line and check every frame and gap against the manual, live."""
     # refused as click refuses an option (its usage message, exit 2), and in --junit's file too
     ctx = click.get_current_context()
+    if problem := bare_arguments(ctx.args, serial_url is not None or tcp is not None):
+        raise usage_error_junit(junit_path, click.UsageError(problem, ctx), "uitamr monitor")
     if (serial_url is None) == (tcp is None):
         mistake = click.UsageError("give exactly one of --serial PORT or --tcp HOST:PORT", ctx)
         raise usage_error_junit(junit_path, mistake, "uitamr monitor")
