@@ -13,7 +13,7 @@ from typing import Callable
 from verifier.amr import Robot
 from verifier.emulate.assembler import Dropped, ReceivedFrame
 from verifier.protocol.codec import decode_reply, decode_request, hex_bytes
-from verifier.protocol.crc import garbled
+from verifier.protocol.stream import garbled
 from verifier.protocol.describe import describe
 from verifier.protocol.frames import FrameError, Request
 from verifier.protocol.timing import T3_5_US
@@ -125,7 +125,7 @@ class Emulator:
                 f"error {int(self.robot.error):02d}{self._garbled()}")
 
     def _garbled(self) -> str:
-        """What the summary adds when every frame was garbled (`crc.garbled`: no good CRC, nor
+        """What the summary adds when every frame was garbled (`stream.garbled`: no good CRC, nor
         the protocol's shape): the bytes came at another speed or parity (a PLC at 19200 into
         a 9600 port reads as half its bytes) or from a swapped pair; else "". A PLC that sends
         well-formed frames with a wrong CRC has its own log line (byte 6: bad CRC)."""

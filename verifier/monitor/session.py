@@ -17,7 +17,7 @@ from typing import Sequence
 
 from verifier import protocol
 from verifier.protocol.codec import MAX_FRAME
-from verifier.protocol.crc import garbled
+from verifier.protocol.stream import garbled
 from verifier.verify.evidence import RuleOptions, RunEvidence, Samples, Violation
 from verifier.verify.result import LINE, LineEvent, ScenarioResult, TraceRecord, judged_with
 from verifier.verify.rules import Judgement, check_all
@@ -32,7 +32,7 @@ PROVISIONAL_RULE = "UITAMR-RESPONSE-HANDLING"  # the one rule with early word (J
 
 
 def garbled_line(frames: int, line: str) -> str:
-    """The note of a session in which every frame is garbled (`crc.garbled`: no good CRC, nor
+    """The note of a session in which every frame is garbled (`stream.garbled`: no good CRC, nor
     the protocol's shape): a PLC at another speed or parity than the monitor reads (a PLC at
     19200 reads at 9600 as half its bytes, none a frame) or A and B swapped. The
     findings are CRC and FORMAT, whose table in commissioning.md points at the PLC's frame

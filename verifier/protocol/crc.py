@@ -49,12 +49,3 @@ def crc_ok(frame: bytes) -> bool:
     """True when the last two bytes of ``frame`` are the CRC of the bytes before them."""
     return len(frame) >= 3 and crc16(frame[:-2]) == frame_crc(frame)
 
-
-def garbled(frame: bytes) -> bool:
-    """True when ``frame`` is neither a frame with a good CRC nor one of this protocol's
-    shapes with a bad one (8 bytes, or an exception's 5, of function 01 or 06): bytes read
-    at another speed or parity than they were sent, or off a swapped pair, rather than a
-    frame whose CRC its sender computed wrong (or sent high byte first)."""
-    if crc_ok(frame):
-        return False
-    return not (len(frame) in (5, 8) and frame[1] & 0x7F in (0x01, 0x06))

@@ -11,6 +11,7 @@ from typing import Literal
 
 from verifier.protocol.catalogue import EXCEPTION_FLAG, FUNCTION_CODES
 from verifier.protocol.codec import EXCEPTION_REPLY_LENGTH, REPLY_LENGTHS, REQUEST_LENGTH
+from verifier.protocol.crc import crc_ok
 
 Direction = Literal["request", "reply"]
 
@@ -44,6 +45,14 @@ def frame_length_either_side(head: bytes) -> int | None:
         return frame_length(head, "reply") if function & ~EXCEPTION_FLAG in FUNCTION_CODES else None
     request, reply = frame_length(head, "request"), frame_length(head, "reply")
     return request if request == reply else None
+
+
+def garbled(frame: bytes) -> bool:
+    """True when ``frame`` has no good CRC and is not even one of this protocol's frames by
+    its length (`frame_length_either_side`: 8 bytes of function 01 or 06, or an exception's
+    5): bytes read at another speed or parity than they were sent, or off a swapped pair,
+    rather than a frame whose CRC its sender computed wrong (or sent high byte first)."""
+    return not crc_ok(frame) and frame_length_either_side(frame) != len(frame)
 
 
 def split_frames(data: bytes, direction: Direction) -> tuple[list[bytes], bytes]:
