@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 import os
-import re
 import signal
 import sys
 import threading
@@ -168,7 +167,11 @@ def bare_arguments(args: list[str], port_given: bool) -> str | None:
     if not args:
         return None
     if len(args) == 1 and not port_given:
-        option = "--tcp" if re.fullmatch(r"(\[[^\]]*\]|[A-Za-z0-9.-]*):\d+|\d+", args[0]) else "--serial"
+        try:
+            _tcp_endpoint(args[0])  # what --tcp takes (HOST:PORT, PORT), else a serial port's name
+            option = "--tcp"
+        except click.BadParameter:
+            option = "--serial"
         return f"{args[0]!r} is given without its option: {option} {args[0]}"
     return f"unexpected argument{'s' if len(args) > 1 else ''} {' '.join(map(repr, args))}: the command takes options only"
 
