@@ -22,9 +22,9 @@ from rich.markup import escape
 from verifier import protocol
 from verifier.commands.emulate import STANDARD_BAUD_RATES, _tcp_endpoint, bare_arguments
 from verifier.commands.protocol_options import protocol_settings
-from verifier.commands.report_files import (JudgingCommand, ReportError, check_folders, mistakes_junit,
-                                             refused_report_junit, report_options, text_console, usage_error_junit,
-                                             write_reports)
+from verifier.commands.report_files import (JudgingCommand, ReportError, check_folders, check_not_inputs,
+                                             mistakes_junit, refused_report_junit, report_options, text_console,
+                                             usage_error_junit, write_reports)
 from verifier.commands.verify import _Duration
 from verifier.emulate.ports import serial_url_problem
 from verifier.monitor.capture import format_plain, tolerance_hides_pacing
@@ -32,7 +32,6 @@ from verifier.monitor.framer import DEFAULT_TOLERANCE_US, LineTiming
 from verifier.monitor.session import CaptureInfo, MonitorSession
 from verifier.monitor.sources import SerialSource, SourceError, TcpSource, now_us
 from verifier.monitor.view import MonitorView
-from verifier.textfile import real_path
 from verifier.verify.evidence import RuleOptions
 from verifier.verify.result import NO_TRAFFIC, Mistake, overall_verdict
 
@@ -109,13 +108,13 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
     problem = serial_url_problem(serial_url) if serial_url is not None else None
     if problem:
         raise usage_error_junit(junit_path, click.BadParameter(problem, ctx, param_hint="--serial"), "uitamr monitor")
-    if serial_url is not None:  # `--capture /dev/ttyUSB0`: the capture's text went out onto the robot's line
-        port = real_path(serial_url)
-        onto = [p for p in (capture_path, json_path, junit_path, trace_path, html_path) if p and real_path(p) == port]
-        if onto:
-            mistake = click.UsageError(f"{onto[0]} is the port the monitor listens on, and the monitor never writes "
-                                       "to the line: give a file for the report or the capture", ctx)
-            raise usage_error_junit(None if junit_path in onto else junit_path, mistake, "uitamr monitor")
+    try:  # `--capture /dev/ttyUSB0`: the capture's text went out onto the robot's line
+        check_not_inputs([serial_url] if serial_url is not None else [], junit_path, capture_path, json_path,
+                         trace_path, html_path, what="the port the monitor listens on, and the monitor never writes "
+                                                     "to the line: give a file for the report or the capture")
+    except ReportError as exc:  # --junit first: when it is the port, the mistake is not written there
+        junit = None if junit_path in exc.paths else junit_path
+        raise usage_error_junit(junit, click.UsageError(str(exc), ctx), "uitamr monitor") from None
     console = text_console()
     try:
         check_folders(json_path, junit_path, trace_path, html_path, capture_path)

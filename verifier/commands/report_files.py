@@ -89,15 +89,17 @@ def check_folders(*paths: str | None) -> None:
         seen[resolved] = path
 
 
-def check_not_inputs(inputs, *paths: str | None) -> None:
+def check_not_inputs(inputs, *paths: str | None,
+                     what: str = "one of the run's input files: write the report to another file") -> None:
     """Refuse a report that would be written over one of the run's own input files (a
-    scenario, an ST source, a capture): the input would be lost."""
+    scenario, an ST source, a capture): the input would be lost. `what` says what the
+    inputs are and what to do ("PATH is WHAT"); the first path refused is the error's."""
     if not any(paths):
         return
     resolved = {real_path(p) for p in inputs}
     for path in paths:
         if path and real_path(path) in resolved:
-            raise ReportError(f"{path} is one of the run's input files: write the report to another file", path)
+            raise ReportError(f"{path} is {what}", path)
 
 
 def _not_over_other_content(path: Path) -> None:
