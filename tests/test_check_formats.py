@@ -171,6 +171,23 @@ def test_sarif_uris_are_percent_encoded_and_resolve_to_the_files(tmp_path):
     assert places == [inside.resolve(), other.resolve()]
 
 
+def test_a_file_reached_by_climbing_out_of_the_working_directory_gets_an_absolute_uri(tmp_path):
+    # `uitamr check ../lib/b.st` from the repository: the file is outside the working
+    # directory as surely as /abs/lib/b.st is, and gets the same absolute file: URI (a
+    # "../lib/b.st" reference under %SRCROOT% names nothing in the repository that code
+    # scanning can show); a path that only steps through a folder and back is folded
+    repo, lib = tmp_path / "repo", tmp_path / "lib"
+    (repo / "sub").mkdir(parents=True)
+    lib.mkdir()
+    for path in (repo / "a.st", lib / "b.st"):
+        path.write_bytes(BROKEN.read_bytes())
+    results = _sarif("sub/../a.st", "../lib/b.st", cwd=repo)["runs"][0]["results"]
+    artifacts = [result["locations"][0]["physicalLocation"]["artifactLocation"] for result in results]
+    assert artifacts == [{"uri": "a.st", "uriBaseId": "%SRCROOT%"}, {"uri": (lib / "b.st").as_uri()}]
+    done = run("--format", "github", "sub/../../lib/b.st", cwd=repo)
+    assert done.stdout.startswith(f"::error file={(lib / 'b.st').as_posix()},line=12,col=1,"), done.stdout
+
+
 def test_a_channel_the_scenarios_cpu_lacks_is_a_check_error_at_its_line(tmp_path):
     # `uitamr check` reads scenario files "as uitamr verify reads them": [[c24]] and
     # [converter] on the wrong CPU were errors at their line, but channel = "q:1" in an

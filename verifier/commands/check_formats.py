@@ -22,7 +22,7 @@ from pathlib import Path
 from urllib.parse import quote
 
 from verifier.st.ast import Diagnostic
-from verifier.textfile import shown_path
+from verifier.textfile import reached_path, shown_path
 
 TOOL_NAME = "uitamr check"
 SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
@@ -53,11 +53,13 @@ def relative(file: str) -> str:
     """The path as CI annotations want it: relative to the working directory (the
     repository root in a CI job) when it lies below it, as reached (a symlinked
     vendor/uitamr stays vendor/uitamr/...: textfile.shown_path, as the reports show paths),
-    with forward slashes."""
-    path = Path(file)
-    if not path.is_absolute():
-        return path.as_posix()
-    return Path(shown_path(path, os.getcwd())).as_posix()
+    with forward slashes; one outside it absolute, however it was given (`../lib/b.st` is
+    as much outside as `/abs/lib/b.st`)."""
+    cwd = os.getcwd()
+    shown = Path(shown_path(file, cwd))
+    if not shown.is_absolute() and Path(os.path.normpath(shown)).parts[:1] == ("..",):
+        shown = reached_path(file, cwd)
+    return shown.as_posix()
 
 
 def to_json(findings: list[Finding], target: str, files: list[str], platform: str | None = None) -> str:
