@@ -17,7 +17,7 @@ SCENARIOS = sorted((ROOT / "plc" / "scenarios").glob("*.toml"))
 
 def test_there_are_bundled_scenarios_for_every_platform():
     names = [p.name for p in SCENARIOS]
-    for prefix in ("fx3u-", "fx5u-", "q-", "fx5u-adprw-", "fx3u-adprw-"):
+    for prefix in ("fx3u-", "fx3g-", "fx5u-", "q-", "fx5u-adprw-", "fx3u-adprw-"):
         assert any(n.startswith(prefix) for n in names), prefix
 
 
@@ -272,8 +272,8 @@ def _route(scenario):
     if scenario.converter is not None:
         return "TCP (FX5U, Q)"
     if scenario.channel == "adp:1":
-        return {"fx3u": "FX3U ADPRW", "fx5u": "FX5U ADPRW"}[scenario.platform]
-    return {"fx3u": "FX3U RS2", "fx5u": "FX5U RS2", "q": "Q QJ71C24N"}[scenario.platform]
+        return {"fx3u": "FX3U/FX3G ADPRW", "fx3g": "FX3U/FX3G ADPRW", "fx5u": "FX5U ADPRW"}[scenario.platform]
+    return {"fx3u": "FX3U/FX3G RS2", "fx3g": "FX3U/FX3G RS2", "fx5u": "FX5U RS2", "q": "Q QJ71C24N"}[scenario.platform]
 
 
 def test_the_fault_coverage_table_names_every_bundled_scenario_in_its_route():

@@ -153,7 +153,7 @@ def test_the_bundled_scenarios_cover_every_fault_kind():
     kinds = {fault.kind for path in bundled_scenarios() for fault in load_scenario(path).faults}
     assert kinds == set(FAULT_KINDS)
     platforms = {load_scenario(path).platform for path in bundled_scenarios()}
-    assert platforms == {"fx3u", "fx5u", "q"}
+    assert platforms == {"fx3u", "fx3g", "fx5u", "q"}
 
 
 def test_the_readme_command_verifies_the_bundled_examples_in_parallel(tmp_path):

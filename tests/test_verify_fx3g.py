@@ -5,6 +5,7 @@ took it; a device only the FX3U has is an error at its file:line:col there. The 
 named, never told from the sources: what loads on it loads on the FX3U too."""
 from __future__ import annotations
 
+import ast
 import json
 import re
 import xml.etree.ElementTree as ET
@@ -145,17 +146,30 @@ def test_a_device_only_the_fx3u_has_is_an_error_at_its_place_on_the_fx3g(tmp_pat
     assert f"{healthy}:6:8: initial.X200: device X200 does not exist on the fx3g: X runs X0..X177" in refused.output
 
 
-def test_platform_fx3g_without_sources_runs_the_fx3_bundled_scenarios_on_the_fx3g(tmp_path):
+def _bundled_names(platform: str) -> list[str]:
+    return [s.name for s in map(load_scenario, bundled_scenarios()) if s.platform == platform]
+
+
+def test_platform_fx3g_without_sources_runs_its_own_and_the_fx3u_bundled_scenarios_on_the_fx3g(tmp_path):
+    """Its own fx3g-* scenarios and the FX3U's, all on the FX3G; only the FX3U's carry the
+    note that they were written for another CPU. Before the FX3G had scenarios of its own,
+    --platform fx3g picked the FX3U's only, and would have left the fx3g-* files out."""
     path = tmp_path / "fx3g.json"
     invoke("--platform", "fx3g", "--duration", "1s", "--json", path)  # 1 s: the verdict is not the point
     runs = report(path)["scenarios"]
-    fx3u = [load_scenario(p) for p in bundled_scenarios() if load_scenario(p).platform == "fx3u"]
-    assert sorted(r["name"] for r in runs) == sorted(s.name for s in fx3u) and runs
+    own, fx3u = _bundled_names("fx3g"), _bundled_names("fx3u")
+    assert own and fx3u
+    assert sorted(r["name"] for r in runs) == sorted(own + fx3u)
     assert {r["platform"] for r in runs} == {"fx3g"}
-    assert all("written for the fx3u, run on the fx3g CPU profile (--platform fx3g)" in r["notes"] for r in runs)
+    note = "written for the fx3u, run on the fx3g CPU profile (--platform fx3g)"
+    assert sorted(r["name"] for r in runs if note in r["notes"]) == sorted(fx3u)
+    # the FX3U's own run picks none of the FX3G's
+    fx3u_path = tmp_path / "fx3u.json"
+    invoke("--platform", "fx3u", "--duration", "1s", "--json", fx3u_path)
+    assert sorted(r["name"] for r in report(fx3u_path)["scenarios"]) == sorted(fx3u)
 
 
-def test_matrix_on_the_fx3g_runs_the_fx3u_fault_sets(tmp_path):
+def test_matrix_on_the_fx3g_runs_the_fx3u_fault_sets_and_its_own(tmp_path):
     sources = [*FX3_DIRS, EXAMPLE]
     found = {}
     for platform in ("fx3u", "fx3g"):
@@ -163,8 +177,77 @@ def test_matrix_on_the_fx3g_runs_the_fx3u_fault_sets(tmp_path):
         done = invoke(*sources, "--matrix", "--platform", platform, "--duration", "1s", "--json", path)
         assert done.exit_code in (0, 1), done.output
         found[platform] = report(path)["scenarios"]
-    assert [r["name"] for r in found["fx3g"]] == [r["name"] for r in found["fx3u"]] and found["fx3g"]
+    # a fault set that became the same run as another's (the same faults, cut to 1 s) runs
+    # once, its note naming the others
+    stands_for = re.compile(r"^also stands for (.*) \(the same run\)$")
+    covered = {platform: [r["name"] for r in runs] + [ast.literal_eval(m.group(1)) for r in runs for n in r["notes"]
+                                                      if (m := stands_for.match(n))]
+               for platform, runs in found.items()}
+    assert covered["fx3u"] and not set(covered["fx3u"]) & set(_bundled_names("fx3g"))
+    assert sorted(covered["fx3g"]) == sorted(covered["fx3u"] + _bundled_names("fx3g"))
     assert {r["platform"] for r in found["fx3g"]} == {"fx3g"}
+
+
+FX3G_SCENARIOS = sorted((PLC / "scenarios").glob("fx3g-*.toml"))
+
+
+def test_the_fx3g_has_bundled_scenarios_of_its_own_on_its_rs2_and_modbus_channels():
+    """An FX3G integrator's bundled proof and the files to start from: a healthy run and
+    faults, on the FX3G's RS2 channel 1 (FX3G-485-BD) and on the MODBUS master (adp:1)."""
+    scenarios = {path.stem: load_scenario(path) for path in FX3G_SCENARIOS}
+    assert {"fx3g-healthy", "fx3g-no-reply", "fx3g-bad-crc-persistent"} <= set(scenarios)
+    assert {s.platform for s in scenarios.values()} == {"fx3g"}
+    assert {s.serial_channel for s in scenarios.values()} == {"fx3:1", "adp:1"}
+    assert all(s.faults for name, s in scenarios.items() if name != "fx3g-healthy")
+    checked = CliRunner().invoke(main, ["check", "--platform", "fx3g", *map(str, FX3G_SCENARIOS)])
+    assert checked.exit_code == 0, checked.output
+
+
+#: a change to a copy of plc/ (file, text, replacement) -> the scenario and the expectations
+#: of it that must fail: the fx3g-* expectations pin what the library does on the FX3G
+BROKEN = {
+    "three attempts become two": ("core/UITAMR_Engine.st", "MAX_ATTEMPTS : INT := 3;", "MAX_ATTEMPTS : INT := 2;",
+                                  "fx3g-no-reply", ["not reported before the third attempt has failed"]),
+    "three attempts become four": ("core/UITAMR_Engine.st", "MAX_ATTEMPTS : INT := 3;", "MAX_ATTEMPTS : INT := 4;",
+                                   "fx3g-adprw-no-reply",
+                                   ["three attempts, then the error: two retries, three failed transactions",
+                                    "the fault stays latched on the FX3G's outputs (Y3, D101) until the acknowledge"]),
+    "no reply reported as 16#0103": ("core/UITAMR_Engine.st", "ERR_TIMEOUT : WORD := 16#0101;",
+                                     "ERR_TIMEOUT : WORD := 16#0103;", "fx3g-no-reply",
+                                     ["the failure is reported as no reply (16#0101) on the engine and the cycle",
+                                      "the fault stays latched on the FX3G's outputs (Y3, D101) until the acknowledge"]),
+    "a bad CRC reported as 16#0103": ("core/UITAMR_ParseReply.st", "ERR_CRC : WORD := 16#0102;",
+                                      "ERR_CRC : WORD := 16#0103;", "fx3g-bad-crc-persistent",
+                                      ["every reply corrupted: three attempts, then 16#0102 with detail 0 on the "
+                                       "engine (Y4, D102) and the cycle (Y3, D101)",
+                                       "the fault stays latched in the cycle (Y3, D101) until the acknowledge"]),
+    "channel 2 set up too": ("fx3/UITAMR_PortFx3.st", "        D8400 := wFormat;\n",
+                             "        D8400 := wFormat;\n        D8420 := wFormat;\n", "fx3g-healthy",
+                             ["channel 2 is never set up: the robot is on the board's channel 1"]),
+    "the adapter's time-out 500 ms": ("fx3/UITAMR_PortAdpFx3.st", "RESPONSE_TIMEOUT_MS : INT := 400;",
+                                      "RESPONSE_TIMEOUT_MS : INT := 500;", "fx3g-adprw-no-reply",
+                                      ["ch1 MODBUS master settings in the first scan: 400 ms slave response "
+                                       "time-out (D8409), no ADPRW retries (D8412)",
+                                       "the failure is reported as ADPRW no reply (16#0108) on the engine and the cycle",
+                                       "the fault stays latched on the FX3G's outputs (Y3, D101) until the acknowledge"]),
+}
+
+
+@pytest.mark.parametrize("change", sorted(BROKEN))
+def test_an_fx3g_scenario_fails_against_a_broken_copy_of_the_library(change, tmp_path):
+    import shutil
+
+    path, old, new, name, failing = BROKEN[change]
+    shutil.copytree(PLC, tmp_path / "plc")
+    broken = tmp_path / "plc" / path
+    text = broken.read_text(encoding="utf-8")
+    assert text.count(old) == 1, change
+    broken.write_text(text.replace(old, new), encoding="utf-8")
+    out = tmp_path / "r.json"
+    done = invoke("--scenario", tmp_path / "plc" / "scenarios" / f"{name}.toml", "--json", out)
+    assert done.exit_code == 1, done.output
+    (run,) = report(out)["scenarios"]
+    assert [e["expectation"] for e in run["expectations"] if not e["passed"]] == failing
 
 
 def test_the_fx3g_is_never_told_from_the_sources(tmp_path):

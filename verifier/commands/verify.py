@@ -32,7 +32,7 @@ from verifier.bundled import plc_dir as bundled_plc_dir
 from verifier.digits import digit_problem
 from verifier.textfile import real_path
 from verifier.verify.scenario import (
-    CHANNELS, DEFAULT_DURATION_US, MAX_DURATION_US, PLATFORMS, TOLD_PLATFORMS, Scenario, ScenarioError, bundled_platform,
+    CHANNELS, DEFAULT_DURATION_US, MAX_DURATION_US, PLATFORMS, TOLD_PLATFORMS, Scenario, ScenarioError, bundled_platforms,
     default_scenario, load_scenario,
 )
 from verifier.verify.sources import SourceError, expand, st_files_in, unique
@@ -182,10 +182,10 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
         platform = platform or infer_platform(resolved)
         bundled = _read_scenarios(bundled_files)
         tcp = uses_tcp_route(resolved, program)  # serial programs under serial scenarios, TCP ones behind a converter
-        # an FX3G runs the FX3U's scenarios on its own CPU profile (scenario.BUNDLED_AS)
+        # an FX3G runs the FX3U's scenarios on its own CPU profile beside its own (scenario.BUNDLED_AS)
         bundled = [_on_platform(s.with_overrides(platform=platform, duration_us=duration, scan_us=scan, seed=seed),
                                 s.platform)
-                   for s in bundled if s.platform == bundled_platform(platform) and (s.converter is not None) == tcp]
+                   for s in bundled if s.platform in bundled_platforms(platform) and (s.converter is not None) == tcp]
         if not bundled:
             route = "over TCP" if tcp else "on a serial line"
             raise UnusableInput(f"no bundled scenario is written for the {platform} {route}")
@@ -195,8 +195,8 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
         bundled = _read_scenarios(bundled_files)  # only without SOURCES: their own sources
         if platform is not None and bundled:
             # the bundled examples are written for their platform: --platform picks them (an
-            # FX3G the FX3U's, run on the FX3G below: scenario.BUNDLED_AS)
-            bundled = [s for s in bundled if s.platform == bundled_platform(platform)]
+            # FX3G its own and the FX3U's, those run on the FX3G below: scenario.BUNDLED_AS)
+            bundled = [s for s in bundled if s.platform in bundled_platforms(platform)]
             if not bundled and not own:
                 raise UnusableInput(f"no bundled scenario is written for the {platform}")
         if not own and not bundled:
@@ -531,7 +531,7 @@ def _terminate_as_exit():
 @click.argument("sources", nargs=-1, type=click.Path())
 @click.option("--program", help="The PROGRAM POU to run (default: the scenario's, or the only one).")
 @click.option("--platform", type=click.Choice(sorted(PLATFORMS), case_sensitive=False),
-              help="PLC platform (sets the ST dialect, the CPU and the serial port); fx3g: an FX3G, the FX3 library on the FX3G CPU profile. Default: the scenario's; with SOURCES and no scenario, told from the devices and instructions the sources use (never fx3g). Without SOURCES: runs the bundled scenarios of that platform (fx3g: the fx3u ones, on the FX3G).")
+              help="PLC platform (sets the ST dialect, the CPU and the serial port); fx3g: an FX3G, the FX3 library on the FX3G CPU profile. Default: the scenario's; with SOURCES and no scenario, told from the devices and instructions the sources use (never fx3g). Without SOURCES: runs the bundled scenarios of that platform (fx3g: its own fx3g-* and the fx3u ones, all on the FX3G).")
 @click.option("--channel", type=click.Choice(CHANNELS),
               help="The PLC serial port the robot hangs on (default: the scenario's, or the platform's first port).")
 @click.option("--scenario", "scenario_files", multiple=True, type=click.Path(),

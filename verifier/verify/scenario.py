@@ -37,9 +37,10 @@ PLATFORMS = {
     "fx5u": ("gxworks3", "fx5:1"),
     "q": ("gxworks2", "q:1"),
 }
-#: A platform without bundled scenarios of its own -> the platform whose bundled scenarios
-#: (and so library and examples) it runs, on its own CPU profile: the FX3G runs the FX3 ones,
-#: written for the FX3U, with the FX3G's smaller X/Y and R ranges (verifier/sim/cpu.py).
+#: A platform whose library and examples are another's -> that platform, whose bundled
+#: scenarios it runs too, on its own CPU profile: the FX3G runs the FX3 ones, written for
+#: the FX3U, with the FX3G's smaller X/Y and R ranges (verifier/sim/cpu.py), beside its own
+#: (plc/scenarios/fx3g-*.toml).
 BUNDLED_AS = {"fx3g": "fx3u"}
 #: The platforms sources are told apart by when nobody names one (verifier.verify.platform):
 #: the FX3G's devices are a part of the FX3U's and its instructions are the FX3's
@@ -51,6 +52,12 @@ TOLD_PLATFORMS = tuple(platform for platform in PLATFORMS if platform not in BUN
 def bundled_platform(platform: str) -> str:
     """The platform whose bundled scenarios `platform` runs (itself, or BUNDLED_AS's)."""
     return BUNDLED_AS.get(platform, platform)
+
+
+def bundled_platforms(platform: str) -> tuple[str, ...]:
+    """The platforms whose bundled scenarios `--platform platform` runs: its own, and those
+    of the platform it runs the library of (the FX3G: fx3g-* and the FX3U's fx3u-*)."""
+    return tuple(dict.fromkeys((platform, bundled_platform(platform))))
 
 
 DEFAULT_DURATION_US = 60_000_000
