@@ -324,3 +324,16 @@ def test_the_engine_header_gives_every_detail_the_error_table_gives():
     for said in ("1 = the port never finished sending", "length or byte count", "port code (16#0108)",
                  "kind or code (16#0301)", "exception code", "robot code", "the address out of range"):
         assert said in detail, said
+
+
+def test_plc_readme_names_the_rs485_boards_the_fx3_port_drives():
+    """plc/README.md's first row read "FX3U / FX3G + FX3U-485-BD": an FX3G takes the
+    FX3G-485-BD, and UITAMR_PortFx3's header names that board and the FX3U-485ADP as RS2
+    channels too. The row now names every RS-485 board or adapter the port's header does."""
+    header = " ".join((ROOT / "plc" / "fx3" / "UITAMR_PortFx3.st").read_text(encoding="utf-8").split("*)", 1)[0].split())
+    boards = set(re.findall(r"\bFX3[UG]-485(?:-BD|ADP)\b(?!-)", header))
+    assert boards == {"FX3U-485-BD", "FX3G-485-BD", "FX3U-485ADP"}
+    readme = (ROOT / "plc" / "README.md").read_text(encoding="utf-8")
+    row = next(line for line in readme.splitlines() if line.startswith("| FX3U / FX3G "))
+    assert "UITAMR_PortFx3.st" in row and "i_bRs232" not in row
+    assert {board for board in boards if board not in row} == set()
