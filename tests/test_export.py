@@ -751,3 +751,29 @@ def test_sources_of_the_other_editors_cpu_are_exported_with_a_warning_naming_the
            str(plc / "examples" / "fx3" / "UITAMR_ExampleFx3.st")]
     back = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(tmp_path / "c"), *fx3])
     assert "export them with --target gxworks2" in back.output
+
+
+
+def test_fx5_sources_exported_for_gxworks2_do_what_import_gxworks3_says(tmp_path):
+    """import-gxworks3.md said FX5U-only sources "(RS2 with SM8561, SP_SOCOPEN)" exported
+    with --target gxworks2 are written with a warning; the TCP port's SP_SOCOPEN (and the
+    FX5's ADPRW) are errors there and nothing is written. The page now tells the two apart;
+    each port it names does what it says."""
+    text = " ".join((ROOT / "docs" / "import-gxworks3.md").read_text(encoding="utf-8").split())
+    said = re.search(r"are either written with a warning that says to use `--target gxworks3` \((.*?)\), or refused "
+                     r"when they call an instruction GX Works2 does not have \((.*?)\): an error at each call that "
+                     r"names `--target gxworks3`, and nothing is written \(exit 1\)", text)
+    assert said, "import-gxworks3.md no longer says what --target gxworks2 does with FX5U sources"
+    warned, refused = (re.findall(r"`(UITAMR_\w+)`", part) for part in said.groups())
+    assert warned == ["UITAMR_PortFx5"] and refused == ["UITAMR_PortTcpFx5", "UITAMR_PortAdpFx5"]
+    for port in warned + refused:
+        out = tmp_path / port
+        result = CliRunner().invoke(command, ["--target", "gxworks2", "--out", str(out), str(ROOT / "plc" / "core"),
+                                              str(ROOT / "plc" / "fx5" / f"{port}.st")])
+        if port in warned:
+            assert result.exit_code == 0 and (out / f"{port}.st").exists(), result.output
+            assert "warning: the sources load on fx5u only" in result.output and "--target gxworks3" in result.output
+        else:
+            assert result.exit_code == 1 and not out.exists(), result.output
+            assert "error:" in result.output and "(or --target gxworks3)" in result.output, result.output
+            assert "uitamr export: nothing written" in result.output
