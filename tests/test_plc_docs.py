@@ -337,3 +337,28 @@ def test_plc_readme_names_the_rs485_boards_the_fx3_port_drives():
     row = next(line for line in readme.splitlines() if line.startswith("| FX3U / FX3G "))
     assert "UITAMR_PortFx3.st" in row and "i_bRs232" not in row
     assert {board for board in boards if board not in row} == set()
+
+
+def test_what_says_the_panel_has_every_command_fb_names_the_one_it_has_not():
+    """UITAMR_PanelFx3 was "every command FB on push buttons" (its header, the catalogue,
+    plc-library.md's layout and fault coverage, its scenario's name), but it has no
+    UITAMR_RunPoint: an engineer looked there for the point run. Every such claim now names
+    the command FB the panel lacks, taken here from the declarations."""
+    import tomllib
+
+    from verifier import st
+
+    wrappers = {p.stem for p in (ROOT / "plc" / "core").glob("UITAMR_*.st")
+                if "fbCmd : UITAMR_Command;" in p.read_text(encoding="utf-8")}
+    panel_path = ROOT / "plc" / "examples" / "fx3" / "UITAMR_PanelFx3.st"
+    (panel,) = st.parse(panel_path.read_text(encoding="utf-8"), str(panel_path)).pous
+    used = {getattr(label.type, "name", "") for block in panel.var_blocks for label in block.variables}
+    lacking = sorted(wrappers - used)
+    assert len(wrappers) == 10 and lacking == ["UITAMR_RunPoint"]
+    scenario = tomllib.loads((ROOT / "plc" / "scenarios" / "fx3u-panel-all-commands.toml").read_text(encoding="utf-8"))
+    text = DOC.read_text(encoding="utf-8")
+    claims = [panel_path.read_text(encoding="utf-8").splitlines()[1], scenario["name"],
+              *[line for line in text.splitlines() if "every command FB" in line]]
+    assert len(claims) >= 5  # header, scenario, layout row, coverage row, catalogue
+    for claim in claims:
+        assert all(name.removeprefix("UITAMR_") in claim for name in lacking), claim
