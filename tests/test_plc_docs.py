@@ -362,3 +362,19 @@ def test_what_says_the_panel_has_every_command_fb_names_the_one_it_has_not():
     assert len(claims) >= 5  # header, scenario, layout row, coverage row, catalogue
     for claim in claims:
         assert all(name.removeprefix("UITAMR_") in claim for name in lacking), claim
+
+
+def test_the_unit_of_the_fx3_receive_time_out_is_given_as_an_assumption_wherever_it_is_given():
+    """plc-library.md marks D8409's 10 ms unit an ASSUMPTION (no manual page gives it);
+    UITAMR_PortFx3's constant said "D8409: 5 x 10 ms = 50 ms" as a fact, and that comment
+    is what the GX Works label table shows. Every line of plc/ that gives the unit now
+    says it is an assumption."""
+    stated = []
+    for path in sorted((ROOT / "plc").rglob("*")):
+        if path.suffix not in (".st", ".il", ".toml"):
+            continue
+        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
+            if re.search(r"D8[34]29|D8409", line) and re.search(r"10 ms|x 10\b", line):
+                stated.append((f"{path.relative_to(ROOT)}:{number}", "ASSUMPTION" in line))
+    assert any(place.startswith("plc/fx3/UITAMR_PortFx3.st") for place, _ in stated)
+    assert [place for place, marked in stated if not marked] == []
