@@ -378,3 +378,23 @@ def test_the_unit_of_the_fx3_receive_time_out_is_given_as_an_assumption_wherever
                 stated.append((f"{path.relative_to(ROOT)}:{number}", "ASSUMPTION" in line))
     assert any(place.startswith("plc/fx3/UITAMR_PortFx3.st") for place, _ in stated)
     assert [place for place, marked in stated if not marked] == []
+
+
+def test_the_choice_table_gives_the_constants_defaults_as_the_st_declares_them():
+    """plc-library.md, "The manual's [choice]s, one constant each": every constant it names
+    is declared in the POU it names, with the default it gives (TRUE/FALSE, the times and
+    counts in order, the first command's code/command) - a changed default changes the page."""
+    section = DOC.read_text(encoding="utf-8").partition("## The manual's [choice]s")[2].partition("\n## ")[0]
+    rows = re.findall(r"^\| [^|]+ \| (`[^|]+) \| `(UITAMR_\w+)` \| ([^|]+) \|$", section, flags=re.M)
+    assert len(rows) == 7, rows
+    for names_cell, pou, default in rows:
+        names = re.findall(r"`(\w+)`", names_cell)
+        constants = _constants(pou)
+        values = [constants[name] for name in names]
+        said = re.findall(r"\d+ ms|\b\d+\b|TRUE|FALSE", default.split("(")[0])
+        if names == ["CMD_STOP"]:  # "`CMD_STOP` (01/A0)": the code is the engine's CODE_ROBOT
+            code, command = re.search(r"\((\w\w)/(\w\w)\)", names_cell).groups()
+            assert (constants["CODE_ROBOT"], constants["CMD_STOP"]) == (str(int(code, 16)), f"16#{command}")
+            continue
+        written = [f"{_ms(v)} ms" if v.startswith("T#") else v for v in values]
+        assert said == written, (names, default, values)
