@@ -398,3 +398,20 @@ def test_the_choice_table_gives_the_constants_defaults_as_the_st_declares_them()
             continue
         written = [f"{_ms(v)} ms" if v.startswith("T#") else v for v in values]
         assert said == written, (names, default, values)
+
+
+def test_import_gxworks2_registers_every_program_it_exports():
+    """import-gxworks2.md §4 said to register "`UITAMR_ExampleFx3` or `UITAMR_ExampleQ`":
+    an integrator with the ADPRW adapter, the panel or the QJ71E71-100 found no word about
+    the program they had created. The step now names every PROGRAM the GX Works2 export
+    writes, as the declarations say."""
+    from verifier import st
+
+    programs = set()
+    for folder in ("fx3", "q"):
+        for path in (ROOT / "plc" / "examples" / folder).glob("*.st"):
+            programs |= {p.name for p in st.parse(path.read_text(encoding="utf-8"), str(path)).pous
+                         if p.kind == "PROGRAM"}
+    text = " ".join((ROOT / "docs" / "import-gxworks2.md").read_text(encoding="utf-8").split())
+    step = text.split("## 4. Programs and tasks", 1)[1].split("## 5.", 1)[0]
+    assert len(programs) == 5 and set(re.findall(r"`(UITAMR_\w+)`", step)) == programs
