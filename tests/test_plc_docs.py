@@ -415,3 +415,31 @@ def test_import_gxworks2_registers_every_program_it_exports():
     text = " ".join((ROOT / "docs" / "import-gxworks2.md").read_text(encoding="utf-8").split())
     step = text.split("## 4. Programs and tasks", 1)[1].split("## 5.", 1)[0]
     assert len(programs) == 5 and set(re.findall(r"`(UITAMR_\w+)`", step)) == programs
+
+
+def test_the_label_prefixes_are_the_type_letters_the_library_page_lists():
+    """plc-library.md listed the type letters of the i_/o_/io_ labels as "b Bit, w
+    Word[Signed], u Word[Unsigned], e FLOAT, t Time", while the TCP ports take
+    `i_udIpAddress` (a DWORD) and `i_sUnit` (a STRING): an integrator naming their own
+    labels by the page had no letter for either. The list now has them, and every
+    interface label of plc/ carries the letters of its type as the GX Works2 table names it."""
+    from verifier import st
+    from verifier.export.types import TABLES
+
+    text = " ".join(DOC.read_text(encoding="utf-8").split())
+    listed = re.search(r"\(`i_`/`o_`/`io_` \+ type letters: (.*?)\) and GX Works' naming rules", text).group(1)
+    letters = dict(item.split(" ", 1) for item in listed.split(", "))
+    used = set()
+    for path in (ROOT / "plc").rglob("*.st"):
+        for pou in st.parse(path.read_text(encoding="utf-8"), str(path)).pous:
+            for block in pou.var_blocks:
+                if block.keyword not in ("VAR_INPUT", "VAR_OUTPUT", "VAR_IN_OUT"):
+                    continue
+                for label in block.variables:
+                    prefix = re.match(r"(?:i|o|io)_([a-z]+)[A-Z]", label.name).group(1)
+                    used.add(prefix)
+                    declared = getattr(label.type, "element", label.type)
+                    name = "STRING" if type(declared).__name__ == "StringType" else declared.name
+                    editor = TABLES["gxworks2"][name]
+                    assert prefix in letters and editor.startswith(letters[prefix]), (pou.name, label.name, editor)
+    assert {"ud", "s"} <= used
