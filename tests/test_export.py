@@ -777,3 +777,25 @@ def test_fx5_sources_exported_for_gxworks2_do_what_import_gxworks3_says(tmp_path
             assert result.exit_code == 1 and not out.exists(), result.output
             assert "error:" in result.output and "(or --target gxworks3)" in result.output, result.output
             assert "uitamr export: nothing written" in result.output
+
+
+@pytest.mark.parametrize("page, target", [("import-gxworks2.md", "gxworks2"), ("import-gxworks3.md", "gxworks3")])
+def test_the_import_steps_say_what_to_do_with_every_file_the_export_writes(tmp_path, page, target):
+    """The import pages' §3 (the steps in GX Works) said what to do with each POU's files and
+    each structure's table, but nothing of GlobalLabels.labels.tsv, which the export writes
+    for a program with VAR_GLOBAL (and §1 announces) and which is no line of
+    IMPORT_ORDER.txt: an integrator with global labels had no step for them. Each kind of
+    file written for such a program is now named in §3."""
+    source = tmp_path / "Main.st"
+    source.write_text("TYPE Rec :\nSTRUCT\n    wA : INT;\nEND_STRUCT;\nEND_TYPE\nVAR_GLOBAL\n    gRec : Rec;\nEND_VAR\n"
+                      "PROGRAM Main\nVAR\n    wB : INT;\nEND_VAR\nwB := gRec.wA;\nEND_PROGRAM\n", encoding="utf-8")
+    out = tmp_path / "out"
+    result = run("--target", target, "--out", str(out), str(source))
+    assert result.exit_code == 0, result.output
+    kinds = {re.sub(r"^(Main|Rec)(?=\.)", "NAME", p.name) for p in out.iterdir()}
+    assert kinds == {"IMPORT_ORDER.txt", "GlobalLabels.labels.tsv", "NAME.struct.tsv", "NAME.labels.tsv", "NAME.st"}
+    text = (ROOT / "docs" / page).read_text(encoding="utf-8")
+    steps = text.split("## 3. ", 1)[1].split("\n## ", 1)[0]
+    for kind in kinds:
+        named = kind.replace("NAME", "")
+        assert re.search(rf"`[^`]*{re.escape(named)}`", steps), (page, kind)
