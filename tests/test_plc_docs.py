@@ -443,3 +443,20 @@ def test_the_label_prefixes_are_the_type_letters_the_library_page_lists():
                     editor = TABLES["gxworks2"][name]
                     assert prefix in letters and editor.startswith(letters[prefix]), (pou.name, label.name, editor)
     assert {"ud", "s"} <= used
+
+
+def test_the_fx5_port_names_for_channel_2_the_board_the_rs2_model_has_there():
+    """UITAMR_PortFx5's header put "FX5-485-BD / FX5-485ADP" on serial channel 2, while
+    instructions.md §8 gives the simulator's channel 2 as the FX5-485-BD and the FX5
+    special relay list it cites has channels up to ch4 (the adapters'): an integrator with
+    an FX5-485ADP set i_wChannel := 2 for a port on ch3/ch4. The header now names only the
+    board for channel 2 and says the adapter is not driven, as instructions.md does."""
+    header = " ".join((ROOT / "plc" / "fx5" / "UITAMR_PortFx5.st").read_text(encoding="utf-8").split("*)", 1)[0].split())
+    channel_2 = re.search(r"serial channel 1 \(the FX5U built-in RS-485 port\) or 2 \(([^)]*)\)", header).group(1)
+    model = (ROOT / "docs" / "instructions.md").read_text(encoding="utf-8")
+    heading = re.search(r"^## 8\. RS2 — FX5 \(built-in RS-485 / ([^)]*)\), channel `fx5:1` / `fx5:2`$", model,
+                        flags=re.M).group(1)
+    assert channel_2 == f"an {heading}"
+    assert "An FX5-485ADP is not channel 2 but 3 or 4, which this FB does not drive" in header
+    section = " ".join(model.split("## 8. ", 1)[1].split("\n## ", 1)[0].split())
+    assert "an FX5-485ADP needs a port FB with the ch3/ch4 devices" in section
