@@ -365,3 +365,74 @@ def test_the_links_of_the_pages_resolve():
             if not linked.exists() or (anchor and linked.suffix == ".md" and anchor not in _anchors(linked)):
                 broken.append(f"{page.relative_to(ROOT)}: {target}")
     assert checked > 100 and not broken, broken
+
+
+IMPORT_PAGES = ("docs/import-gxworks2.md", "docs/import-gxworks3.md", "plc/README.md")
+EXPORTS = [(page, command) for page, command in QUOTED if page in IMPORT_PAGES and _argv(command)[0] == "export"]
+# "your program" of the pages' `vendor/uitamr ... src/` lines, one per CPU they name
+USER_MAIN = """PROGRAM Main
+VAR
+    fbPort : {port};
+    fbEngine : UITAMR_Engine;
+    fbRun : UITAMR_RunPoint;
+    uMbx : ARRAY[0..15] OF WORD;
+    uPort : ARRAY[0..39] OF WORD;
+END_VAR
+fbPort(i_bEN := TRUE, {port_args}, io_uPort := uPort);
+fbEngine(i_bEN := NOT SM402, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);
+fbRun(i_bEN := TRUE, i_bExecute := {start}, i_wPoint := 1, io_uMbx := uMbx);
+END_PROGRAM
+"""
+USER_PORTS = {"q": ("UITAMR_PortQC24", "i_uUnit := 16#0, i_wChannel := 1, i_bReadReq := X3, i_bRecvErr := X4", "X20"),
+              "fx5u": ("UITAMR_PortFx5", "i_wChannel := 1", "X0")}
+
+
+def test_the_export_lines_of_the_import_pages_run_and_write_what_they_say(tmp_path, monkeypatch):
+    """The `uitamr export` lines of import-gxworks2.md, import-gxworks3.md and plc/README.md,
+    run as given from an integrator's folder (the toolkit as a `vendor/uitamr` submodule, a
+    program `Main` in `src/`): each exits 0 without a warning, and writes what the line's
+    comment or the page says - the FX3 and Q ports for GX Works2, only the Q's part with
+    `--platform q`, the three FX5 ports for GX Works3, the same files with `--platform
+    fx5u`, and with `--program Main` only Main and the library POUs it uses."""
+    from click.testing import CliRunner
+
+    assert len(EXPORTS) == 7, EXPORTS
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "vendor").mkdir()
+    (tmp_path / "vendor" / "uitamr").symlink_to(ROOT, target_is_directory=True)
+    (tmp_path / "src").mkdir()
+    fx3_only = {p.stem for part in ("fx3", "examples/fx3") for p in (ROOT / "plc" / part).glob("*.st")}
+    previous: dict[str, bytes] = {}
+    for page, command in EXPORTS:
+        argv, comment = _argv(command), command.partition("#")[2].strip()
+        platform = argv[argv.index("--platform") + 1] if "--platform" in argv else None
+        if "src/" in argv:
+            port, port_args, start = USER_PORTS[platform]
+            (tmp_path / "src" / "Main.st").write_text(USER_MAIN.format(port=port, port_args=port_args, start=start),
+                                                      encoding="utf-8")
+        out = tmp_path / argv[argv.index("--out") + 1]
+        if out.exists():
+            for old in out.iterdir():
+                old.unlink()
+        done = CliRunner().invoke(main, argv)
+        assert done.exit_code == 0 and "warning" not in done.output, (page, command, done.output)
+        files = {p.name: p.read_bytes() for p in sorted(out.iterdir())}
+        written = {name.split(".")[0] for name in files} - {"IMPORT_ORDER"}
+        ports = {name for name in written if name.startswith("UITAMR_Port") and name not in ("UITAMR_PortLink",
+                                                                                               "UITAMR_PortPacking")}
+        if "--program" in argv:
+            assert "Main" in written and not {n for n in written if "Example" in n or "Panel" in n}, (command, written)
+            assert ports == {USER_PORTS[platform][0]}, (command, written)
+        elif comment == "library + FX3 and Q ports + examples" or comment == "paste-ready labels and bodies":
+            assert ports == {"UITAMR_PortFx3", "UITAMR_PortAdpFx3", "UITAMR_PortQC24", "UITAMR_PortE71"}, written
+            assert {"UITAMR_ExampleFx3", "UITAMR_ExampleQ", "UITAMR_ExampleTcpQ", "UITAMR_PanelFx3"} <= written
+        elif comment == "only the Q's part, checked against the Q CPU":
+            assert ports == {"UITAMR_PortQC24", "UITAMR_PortE71"} and not written & fx3_only, written
+        elif comment == "library + FX5 RS2, ADPRW and Ethernet ports + examples":
+            assert ports == {"UITAMR_PortFx5", "UITAMR_PortAdpFx5", "UITAMR_PortTcpFx5"}, written
+            assert {"UITAMR_ExampleFx5", "UITAMR_ExampleAdpFx5", "UITAMR_ExampleTcpFx5"} <= written
+            previous = files
+        elif comment == "the same, checked against the FX5U CPU first":
+            assert files == previous
+        else:
+            pytest.fail(f"{page}: `{command}`: a comment this test does not know what to hold to")

@@ -751,3 +751,51 @@ def test_sources_of_the_other_editors_cpu_are_exported_with_a_warning_naming_the
            str(plc / "examples" / "fx3" / "UITAMR_ExampleFx3.st")]
     back = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(tmp_path / "c"), *fx3])
     assert "export them with --target gxworks2" in back.output
+
+
+
+def test_fx5_sources_exported_for_gxworks2_do_what_import_gxworks3_says(tmp_path):
+    """import-gxworks3.md said FX5U-only sources "(RS2 with SM8561, SP_SOCOPEN)" exported
+    with --target gxworks2 are written with a warning; the TCP port's SP_SOCOPEN (and the
+    FX5's ADPRW) are errors there and nothing is written. The page now tells the two apart;
+    each port it names does what it says."""
+    text = " ".join((ROOT / "docs" / "import-gxworks3.md").read_text(encoding="utf-8").split())
+    said = re.search(r"are either written with a warning that says to use `--target gxworks3` \((.*?)\), or refused "
+                     r"when they call an instruction GX Works2 does not have \((.*?)\): an error at each call that "
+                     r"names `--target gxworks3`, and nothing is written \(exit 1\)", text)
+    assert said, "import-gxworks3.md no longer says what --target gxworks2 does with FX5U sources"
+    warned, refused = (re.findall(r"`(UITAMR_\w+)`", part) for part in said.groups())
+    assert warned == ["UITAMR_PortFx5"] and refused == ["UITAMR_PortTcpFx5", "UITAMR_PortAdpFx5"]
+    for port in warned + refused:
+        out = tmp_path / port
+        result = CliRunner().invoke(command, ["--target", "gxworks2", "--out", str(out), str(ROOT / "plc" / "core"),
+                                              str(ROOT / "plc" / "fx5" / f"{port}.st")])
+        if port in warned:
+            assert result.exit_code == 0 and (out / f"{port}.st").exists(), result.output
+            assert "warning: the sources load on fx5u only" in result.output and "--target gxworks3" in result.output
+        else:
+            assert result.exit_code == 1 and not out.exists(), result.output
+            assert "error:" in result.output and "(or --target gxworks3)" in result.output, result.output
+            assert "uitamr export: nothing written" in result.output
+
+
+@pytest.mark.parametrize("page, target", [("import-gxworks2.md", "gxworks2"), ("import-gxworks3.md", "gxworks3")])
+def test_the_import_steps_say_what_to_do_with_every_file_the_export_writes(tmp_path, page, target):
+    """The import pages' §3 (the steps in GX Works) said what to do with each POU's files and
+    each structure's table, but nothing of GlobalLabels.labels.tsv, which the export writes
+    for a program with VAR_GLOBAL (and §1 announces) and which is no line of
+    IMPORT_ORDER.txt: an integrator with global labels had no step for them. Each kind of
+    file written for such a program is now named in §3."""
+    source = tmp_path / "Main.st"
+    source.write_text("TYPE Rec :\nSTRUCT\n    wA : INT;\nEND_STRUCT;\nEND_TYPE\nVAR_GLOBAL\n    gRec : Rec;\nEND_VAR\n"
+                      "PROGRAM Main\nVAR\n    wB : INT;\nEND_VAR\nwB := gRec.wA;\nEND_PROGRAM\n", encoding="utf-8")
+    out = tmp_path / "out"
+    result = run("--target", target, "--out", str(out), str(source))
+    assert result.exit_code == 0, result.output
+    kinds = {re.sub(r"^(Main|Rec)(?=\.)", "NAME", p.name) for p in out.iterdir()}
+    assert kinds == {"IMPORT_ORDER.txt", "GlobalLabels.labels.tsv", "NAME.struct.tsv", "NAME.labels.tsv", "NAME.st"}
+    text = (ROOT / "docs" / page).read_text(encoding="utf-8")
+    steps = text.split("## 3. ", 1)[1].split("\n## ", 1)[0]
+    for kind in kinds:
+        named = kind.replace("NAME", "")
+        assert re.search(rf"`[^`]*{re.escape(named)}`", steps), (page, kind)

@@ -324,3 +324,139 @@ def test_the_engine_header_gives_every_detail_the_error_table_gives():
     for said in ("1 = the port never finished sending", "length or byte count", "port code (16#0108)",
                  "kind or code (16#0301)", "exception code", "robot code", "the address out of range"):
         assert said in detail, said
+
+
+def test_plc_readme_names_the_rs485_boards_the_fx3_port_drives():
+    """plc/README.md's first row read "FX3U / FX3G + FX3U-485-BD": an FX3G takes the
+    FX3G-485-BD, and UITAMR_PortFx3's header names that board and the FX3U-485ADP as RS2
+    channels too. The row now names every RS-485 board or adapter the port's header does."""
+    header = " ".join((ROOT / "plc" / "fx3" / "UITAMR_PortFx3.st").read_text(encoding="utf-8").split("*)", 1)[0].split())
+    boards = set(re.findall(r"\bFX3[UG]-485(?:-BD|ADP)\b(?!-)", header))
+    assert boards == {"FX3U-485-BD", "FX3G-485-BD", "FX3U-485ADP"}
+    readme = (ROOT / "plc" / "README.md").read_text(encoding="utf-8")
+    row = next(line for line in readme.splitlines() if line.startswith("| FX3U / FX3G "))
+    assert "UITAMR_PortFx3.st" in row and "i_bRs232" not in row
+    assert {board for board in boards if board not in row} == set()
+
+
+def test_what_says_the_panel_has_every_command_fb_names_the_one_it_has_not():
+    """UITAMR_PanelFx3 was "every command FB on push buttons" (its header, the catalogue,
+    plc-library.md's layout and fault coverage, its scenario's name), but it has no
+    UITAMR_RunPoint: an engineer looked there for the point run. Every such claim now names
+    the command FB the panel lacks, taken here from the declarations."""
+    import tomllib
+
+    from verifier import st
+
+    wrappers = {p.stem for p in (ROOT / "plc" / "core").glob("UITAMR_*.st")
+                if "fbCmd : UITAMR_Command;" in p.read_text(encoding="utf-8")}
+    panel_path = ROOT / "plc" / "examples" / "fx3" / "UITAMR_PanelFx3.st"
+    (panel,) = st.parse(panel_path.read_text(encoding="utf-8"), str(panel_path)).pous
+    used = {getattr(label.type, "name", "") for block in panel.var_blocks for label in block.variables}
+    lacking = sorted(wrappers - used)
+    assert len(wrappers) == 10 and lacking == ["UITAMR_RunPoint"]
+    scenario = tomllib.loads((ROOT / "plc" / "scenarios" / "fx3u-panel-all-commands.toml").read_text(encoding="utf-8"))
+    text = DOC.read_text(encoding="utf-8")
+    claims = [panel_path.read_text(encoding="utf-8").splitlines()[1], scenario["name"],
+              *[line for line in text.splitlines() if "every command FB" in line]]
+    assert len(claims) >= 5  # header, scenario, layout row, coverage row, catalogue
+    for claim in claims:
+        assert all(name.removeprefix("UITAMR_") in claim for name in lacking), claim
+
+
+def test_the_unit_of_the_fx3_receive_time_out_is_given_as_an_assumption_wherever_it_is_given():
+    """plc-library.md marks D8409's 10 ms unit an ASSUMPTION (no manual page gives it);
+    UITAMR_PortFx3's constant said "D8409: 5 x 10 ms = 50 ms" as a fact, and that comment
+    is what the GX Works label table shows. Every line of plc/ that gives the unit now
+    says it is an assumption."""
+    stated = []
+    for path in sorted((ROOT / "plc").rglob("*")):
+        if path.suffix not in (".st", ".il", ".toml"):
+            continue
+        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
+            if re.search(r"D8[34]29|D8409", line) and re.search(r"10 ms|x 10\b", line):
+                stated.append((f"{path.relative_to(ROOT)}:{number}", "ASSUMPTION" in line))
+    assert any(place.startswith("plc/fx3/UITAMR_PortFx3.st") for place, _ in stated)
+    assert [place for place, marked in stated if not marked] == []
+
+
+def test_the_choice_table_gives_the_constants_defaults_as_the_st_declares_them():
+    """plc-library.md, "The manual's [choice]s, one constant each": every constant it names
+    is declared in the POU it names, with the default it gives (TRUE/FALSE, the times and
+    counts in order, the first command's code/command) - a changed default changes the page."""
+    section = DOC.read_text(encoding="utf-8").partition("## The manual's [choice]s")[2].partition("\n## ")[0]
+    rows = re.findall(r"^\| [^|]+ \| (`[^|]+) \| `(UITAMR_\w+)` \| ([^|]+) \|$", section, flags=re.M)
+    assert len(rows) == 7, rows
+    for names_cell, pou, default in rows:
+        names = re.findall(r"`(\w+)`", names_cell)
+        constants = _constants(pou)
+        values = [constants[name] for name in names]
+        said = re.findall(r"\d+ ms|\b\d+\b|TRUE|FALSE", default.split("(")[0])
+        if names == ["CMD_STOP"]:  # "`CMD_STOP` (01/A0)": the code is the engine's CODE_ROBOT
+            code, command = re.search(r"\((\w\w)/(\w\w)\)", names_cell).groups()
+            assert (constants["CODE_ROBOT"], constants["CMD_STOP"]) == (str(int(code, 16)), f"16#{command}")
+            continue
+        written = [f"{_ms(v)} ms" if v.startswith("T#") else v for v in values]
+        assert said == written, (names, default, values)
+
+
+def test_import_gxworks2_registers_every_program_it_exports():
+    """import-gxworks2.md §4 said to register "`UITAMR_ExampleFx3` or `UITAMR_ExampleQ`":
+    an integrator with the ADPRW adapter, the panel or the QJ71E71-100 found no word about
+    the program they had created. The step now names every PROGRAM the GX Works2 export
+    writes, as the declarations say."""
+    from verifier import st
+
+    programs = set()
+    for folder in ("fx3", "q"):
+        for path in (ROOT / "plc" / "examples" / folder).glob("*.st"):
+            programs |= {p.name for p in st.parse(path.read_text(encoding="utf-8"), str(path)).pous
+                         if p.kind == "PROGRAM"}
+    text = " ".join((ROOT / "docs" / "import-gxworks2.md").read_text(encoding="utf-8").split())
+    step = text.split("## 4. Programs and tasks", 1)[1].split("## 5.", 1)[0]
+    assert len(programs) == 5 and set(re.findall(r"`(UITAMR_\w+)`", step)) == programs
+
+
+def test_the_label_prefixes_are_the_type_letters_the_library_page_lists():
+    """plc-library.md listed the type letters of the i_/o_/io_ labels as "b Bit, w
+    Word[Signed], u Word[Unsigned], e FLOAT, t Time", while the TCP ports take
+    `i_udIpAddress` (a DWORD) and `i_sUnit` (a STRING): an integrator naming their own
+    labels by the page had no letter for either. The list now has them, and every
+    interface label of plc/ carries the letters of its type as the GX Works2 table names it."""
+    from verifier import st
+    from verifier.export.types import TABLES
+
+    text = " ".join(DOC.read_text(encoding="utf-8").split())
+    listed = re.search(r"\(`i_`/`o_`/`io_` \+ type letters: (.*?)\) and GX Works' naming rules", text).group(1)
+    letters = dict(item.split(" ", 1) for item in listed.split(", "))
+    used = set()
+    for path in (ROOT / "plc").rglob("*.st"):
+        for pou in st.parse(path.read_text(encoding="utf-8"), str(path)).pous:
+            for block in pou.var_blocks:
+                if block.keyword not in ("VAR_INPUT", "VAR_OUTPUT", "VAR_IN_OUT"):
+                    continue
+                for label in block.variables:
+                    prefix = re.match(r"(?:i|o|io)_([a-z]+)[A-Z]", label.name).group(1)
+                    used.add(prefix)
+                    declared = getattr(label.type, "element", label.type)
+                    name = "STRING" if type(declared).__name__ == "StringType" else declared.name
+                    editor = TABLES["gxworks2"][name]
+                    assert prefix in letters and editor.startswith(letters[prefix]), (pou.name, label.name, editor)
+    assert {"ud", "s"} <= used
+
+
+def test_the_fx5_port_names_for_channel_2_the_board_the_rs2_model_has_there():
+    """UITAMR_PortFx5's header put "FX5-485-BD / FX5-485ADP" on serial channel 2, while
+    instructions.md §8 gives the simulator's channel 2 as the FX5-485-BD and the FX5
+    special relay list it cites has channels up to ch4 (the adapters'): an integrator with
+    an FX5-485ADP set i_wChannel := 2 for a port on ch3/ch4. The header now names only the
+    board for channel 2 and says the adapter is not driven, as instructions.md does."""
+    header = " ".join((ROOT / "plc" / "fx5" / "UITAMR_PortFx5.st").read_text(encoding="utf-8").split("*)", 1)[0].split())
+    channel_2 = re.search(r"serial channel 1 \(the FX5U built-in RS-485 port\) or 2 \(([^)]*)\)", header).group(1)
+    model = (ROOT / "docs" / "instructions.md").read_text(encoding="utf-8")
+    heading = re.search(r"^## 8\. RS2 — FX5 \(built-in RS-485 / ([^)]*)\), channel `fx5:1` / `fx5:2`$", model,
+                        flags=re.M).group(1)
+    assert channel_2 == f"an {heading}"
+    assert "An FX5-485ADP is not channel 2 but 3 or 4, which this FB does not drive" in header
+    section = " ".join(model.split("## 8. ", 1)[1].split("\n## ", 1)[0].split())
+    assert "an FX5-485ADP needs a port FB with the ch3/ch4 devices" in section

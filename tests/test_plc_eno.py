@@ -69,3 +69,41 @@ def test_eno_mirrors_en(projects, name):
         fb.scan()
         seen.append(bool(fb.o_bENO))
     assert seen == [True, False, True, False]
+
+
+def _says_outputs_go_to_zero(name):
+    """The FBs whose header says what i_bEN FALSE leaves on the outputs ("outputs FALSE /
+    0"), and the command FBs, which docs/plc-library.md's i_bEN table says it of."""
+    _, pou = FBS[name]
+    header = " ".join(next(PLC.rglob(f"{name}.st")).read_text(encoding="utf-8").split("*)", 1)[0].split())
+    return "FALSE / 0" in header or "fbCmd" in _labels(pou, "VAR")
+
+
+ZEROED = sorted(name for name in FBS if _says_outputs_go_to_zero(name))
+
+
+def test_the_fbs_that_say_their_outputs_go_to_zero_are_found():
+    assert {"UITAMR_PointCycle", "UITAMR_Command", "UITAMR_RunPoint", "UITAMR_BuildControl",
+            "UITAMR_PortLink"} <= set(ZEROED)
+
+
+@pytest.mark.parametrize("name", ZEROED)
+def test_en_off_leaves_every_output_false_or_zero(projects, name):
+    """UITAMR_PointCycle's header said "outputs go FALSE / 0" with i_bEN off, but o_wPoint
+    kept the point of the stopped cycle (D100 in the examples). Every FB that says so,
+    run with its inputs set and then disabled, now shows FALSE / 0 on every output."""
+    platform, pou = FBS[name]
+    fb = projects[platform].instance(name)
+    for block in pou.var_blocks:
+        if block.keyword != "VAR_INPUT":
+            continue
+        for label in block.variables:
+            kind = getattr(label.type, "name", None)
+            value = {"BOOL": True, "INT": 2, "WORD": 2, "REAL": 0.4}.get(kind)
+            if value is not None:
+                setattr(fb, label.name, value)
+    fb.scan(3)
+    fb.i_bEN = False
+    fb.scan(2)
+    left = {label: getattr(fb, label) for label in _labels(pou, "VAR_OUTPUT") if getattr(fb, label)}
+    assert not left, f"{name} with i_bEN FALSE: {left}"
