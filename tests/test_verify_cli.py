@@ -934,6 +934,32 @@ def test_a_fault_that_met_no_request_is_noted_at_its_line(tmp_path):
     assert sum("was not tested" in note for note in notes) == 2
 
 
+def test_a_state_fault_that_changed_nothing_is_noted_at_its_line(tmp_path):
+    """An integrator's off_tape fault while the robot ran points, not a tape command, and an
+    anti_collision with the range set to 0 m: the robot's log said "no effect", the run
+    passed (or failed on expectations) and nothing said the fault tested nothing - as
+    under --matrix, where the bundled off-tape scenario's fault meets a program that never
+    follows a tape. Each is now a note at its line, as a reply fault that met no request."""
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('program = "UITAMR_ExampleFx3"\nduration = "5s"\n\n'
+                        '[[faults]]\nkind = "off_tape"\nat_s = 2.0\n\n'
+                        '[robot]\ncollision_range_stage = 0\n\n'
+                        '[[faults]]\nkind = "anti_collision"\non_request = 3\n', encoding="utf-8")
+    report = tmp_path / "r.json"
+    result = invoke(*FX3_SOURCES, "--scenario", scenario, "--json", report)
+    assert result.exit_code == 0, result.output
+    assert (f"{scenario}:4:1: faults[0]: off_tape at 2 s: no magnetic-tape task (seek, follow, rotate) was "
+            "running when it struck, and it has no effect otherwise, so this fault was not tested") in result.output
+    assert re.search(rf"{re.escape(str(scenario))}:11:1: faults\[1\]: anti_collision on request 3: the "
+                     r"anti-collision range was 0 m \(off\) when it struck at [\d.]+ s, so this fault was not "
+                     r"tested", result.output), result.output
+    notes = json.loads(report.read_text())["scenarios"][0]["notes"]
+    assert sum("was not tested" in note for note in notes) == 2
+    # the same faults where they bite say nothing: the bundled off-tape scenario's tape task
+    result = invoke("--scenario", PLC / "scenarios" / "fx3u-off-tape.toml")
+    assert result.exit_code == 0 and "was not tested" not in result.output, result.output
+
+
 NEVER_REARMED = """PROGRAM MAIN
 VAR
     uSend : ARRAY[0..3] OF WORD;
