@@ -853,6 +853,26 @@ def test_a_healthy_converter_is_not_reported_as_a_fault(tmp_path):
     assert run["converter"] is None and run["faults"] == ["no_reply at 4 s for 4 s"], serial.output
 
 
+def test_the_junit_and_html_run_line_give_the_scan_jitter_the_seed_draws(tmp_path):
+    """A CI user reruns a failure from its JUnit or HTML report: both said "scan 10 ms, seed 7"
+    of a scenario with scan_jitter = "2ms" - a seed that draws nothing without the jitter -
+    and a scenario without a description began its <system-out> with an empty line."""
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('program = "UITAMR_ExampleFx3"\nduration = "2s"\nscan_jitter = "2ms"\nseed = 7\n',
+                        encoding="utf-8")
+    xml, page = tmp_path / "r.xml", tmp_path / "r.html"
+    result = invoke(*FX3_SOURCES, "--scenario", scenario, "--junit", xml, "--html", page)
+    assert result.exit_code == 0, result.output
+    out = ET.parse(xml).getroot().find(".//system-out").text
+    assert out.splitlines()[0] == ("program UITAMR_ExampleFx3 on fx3u (fx3:1), 2.000 s of virtual time, "
+                                   "scan 10 ms ±2 ms, seed 7"), out
+    assert "scan 10.0 ms ±2.0 ms · seed 7" in page.read_text(encoding="utf-8")
+    scenario.write_text('program = "UITAMR_ExampleFx3"\nduration = "2s"\nseed = 7\n', encoding="utf-8")
+    invoke(*FX3_SOURCES, "--scenario", scenario, "--junit", xml)  # no jitter: the line as before
+    assert ET.parse(xml).getroot().find(".//system-out").text.startswith(
+        "program UITAMR_ExampleFx3 on fx3u (fx3:1), 2.000 s of virtual time, scan 10 ms, seed 7\n")
+
+
 def test_a_misspelt_label_in_a_scenario_offers_the_label_meant(tmp_path):
     """'fbBat.o_bOK' for the instance fbBatt, 'o_bOkay' for o_bOK: the error says which label
     was probably meant; a name like no label gets no guess."""
