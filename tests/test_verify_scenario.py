@@ -267,6 +267,9 @@ def test_the_nth_table_of_an_array_is_found():
     ('[[inputs]]\nat = "1s"', "inputs[0]", "needs 'at'"),
     ('[[inputs]]\nat = "1s"\nset = { x = "on" }', "inputs[0].set.x", "true/false or a number"),
     ('[[inputs]]\nat = "1s"\nset = { x = 3 }\npulse = "1s"', "inputs[0].pulse", "no BOOL"),
+    # a BOOL label set to 3 with a pulse was only "this input sets no BOOL", which it was meant to
+    ('[[inputs]]\nat = "1s"\nset = { bLamp = 3 }\npulse = "1s"', "inputs[0].pulse",
+     "only numbers (bLamp = 3): write true or false for a BOOL label, or leave out the pulse"),
     # was "inputs[0].pulse: ... this input sets no BOOL" at the pulse line: the 1 meant as a bit
     ('[[inputs]]\nat = "1s"\nset = { X0 = 1 }\npulse = "1s"', "inputs[0].set.X0",
      "is the number 1, and a pulse sets BOOL labels back after a while: write X0 = true for a bit"),
