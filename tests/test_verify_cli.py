@@ -1361,6 +1361,11 @@ def test_matrix_on_the_bundled_example_keeps_its_response_signal(tmp_path):
     persistent = runs["FX3U: every reply has a bad CRC for 5 s"]
     assert persistent["verdict"] == "pass"
     assert not any("its response signal" in note for note in persistent["notes"])
+    # the panel's off-tape fault meets a program that never follows a tape: noted at the
+    # fault's line in the bundled file (the matrix dropped every line of the file)
+    off_tape = runs["FX3U: the robot leaves the tape while following it"]
+    assert any(re.search(r"fx3u-off-tape\.toml:\d+:1: faults\[0\]: off_tape at 4 s: no magnetic-tape task", note)
+               for note in off_tape["notes"]), off_tape["notes"]
     panel = tmp_path / "panel.json"  # the panel scenarios are written for UITAMR_PanelFx3
     sources = FX3_SOURCES[:-1] + [PLC / "examples" / "fx3" / "UITAMR_PanelFx3.st"]
     invoke(*sources, "--program", "UITAMR_PanelFx3", "--matrix", "--duration", "6s", "--json", panel)
