@@ -938,20 +938,26 @@ def test_a_fault_that_met_no_request_is_noted_at_its_line(tmp_path):
     """A scenario's fault whose window saw no request of its kind (here control commands
     while only status reads went out) or whose request number never came tested nothing,
     yet the run passed without a word: now each such fault is a note at its line."""
-    scenario = tmp_path / "s.toml"
-    scenario.write_text('program = "UITAMR_ExampleFx3"\nduration = "5s"\n\n'
-                        '[[faults]]\nkind = "bad_crc"\nat_s = 2.0\nduration_s = 1.0\nrequests = "control"\n\n'
-                        '[[faults]]\nkind = "exception"\non_request = 500\n\n'
-                        '[[faults]]\nkind = "no_reply"\nat_s = 3.0\n', encoding="utf-8")
-    report = tmp_path / "r.json"
-    result = invoke(*FX3_SOURCES, "--scenario", scenario, "--json", report)
-    assert result.exit_code == 0, result.output
+    scenario, result, notes = _run_with_faults(tmp_path, '[[faults]]\nkind = "bad_crc"\nat_s = 2.0\nduration_s = 1.0\n'
+                                                         'requests = "control"\n\n'
+                                                         '[[faults]]\nkind = "exception"\non_request = 500\n\n'
+                                                         '[[faults]]\nkind = "no_reply"\nat_s = 3.0\n')
     assert (f"{scenario}:4:1: faults[0]: bad_crc at 2 s for 1 s, control requests only: no control request "
             "reached the robot from 2 s for 1 s, so this fault was not tested") in result.output
     assert f"{scenario}:10:1: faults[1]: exception (code 04) on request 500: request 500 never reached" in result.output
     assert "faults[2]" not in result.output                  # the no_reply at 3 s met a status read
-    notes = json.loads(report.read_text())["scenarios"][0]["notes"]
     assert sum("was not tested" in note for note in notes) == 2
+
+
+def _run_with_faults(tmp_path, faults: str):
+    """The FX3U example for 5 s under `faults` (TOML from the scenario's line 4 on): the
+    scenario file, the command's result and the JSON report's notes."""
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('program = "UITAMR_ExampleFx3"\nduration = "5s"\n\n' + faults, encoding="utf-8")
+    report = tmp_path / "r.json"
+    result = invoke(*FX3_SOURCES, "--scenario", scenario, "--json", report)
+    assert result.exit_code == 0, result.output
+    return scenario, result, json.loads(report.read_text())["scenarios"][0]["notes"]
 
 
 def test_a_state_fault_that_changed_nothing_is_noted_at_its_line(tmp_path):
@@ -960,20 +966,14 @@ def test_a_state_fault_that_changed_nothing_is_noted_at_its_line(tmp_path):
     passed (or failed on expectations) and nothing said the fault tested nothing - as
     under --matrix, where the bundled off-tape scenario's fault meets a program that never
     follows a tape. Each is now a note at its line, as a reply fault that met no request."""
-    scenario = tmp_path / "s.toml"
-    scenario.write_text('program = "UITAMR_ExampleFx3"\nduration = "5s"\n\n'
-                        '[[faults]]\nkind = "off_tape"\nat_s = 2.0\n\n'
-                        '[robot]\ncollision_range_stage = 0\n\n'
-                        '[[faults]]\nkind = "anti_collision"\non_request = 3\n', encoding="utf-8")
-    report = tmp_path / "r.json"
-    result = invoke(*FX3_SOURCES, "--scenario", scenario, "--json", report)
-    assert result.exit_code == 0, result.output
+    scenario, result, notes = _run_with_faults(tmp_path, '[[faults]]\nkind = "off_tape"\nat_s = 2.0\n\n'
+                                                         '[robot]\ncollision_range_stage = 0\n\n'
+                                                         '[[faults]]\nkind = "anti_collision"\non_request = 3\n')
     assert (f"{scenario}:4:1: faults[0]: off_tape at 2 s: no magnetic-tape task (seek, follow, rotate) was "
             "running when it struck, and it has no effect otherwise, so this fault was not tested") in result.output
     assert re.search(rf"{re.escape(str(scenario))}:11:1: faults\[1\]: anti_collision on request 3: the "
                      r"anti-collision range was 0 m \(off\) when it struck at [\d.]+ s, so this fault was not "
                      r"tested", result.output), result.output
-    notes = json.loads(report.read_text())["scenarios"][0]["notes"]
     assert sum("was not tested" in note for note in notes) == 2
     # the same faults where they bite say nothing: the bundled off-tape scenario's tape task
     result = invoke("--scenario", PLC / "scenarios" / "fx3u-off-tape.toml")

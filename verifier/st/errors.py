@@ -127,6 +127,8 @@ def _nested_comment(text: str, pos: int) -> tuple[int, int, str] | None:
     return None
 
 
+#: what a TIME literal needs, for the ST checker and for scenario conditions alike
+TIME_LITERAL_HINT = "give every number its unit, d, h, m, s or ms (T#2s, T#1m30s, T#500ms)"
 #: a word with '#' after a name: a time literal (T#2s) or a typed one (INT#5) as written
 _HASH_WORD = re.compile(r"(?<![A-Za-z0-9_#.])([A-Za-z_][A-Za-z0-9_]*)#[-+0-9A-Za-z_.#]*")
 #: the time literal st.lark reads (TIME_LIT), the whole word
@@ -161,8 +163,7 @@ def _hash_literal(text: str, pos: int) -> tuple[int, int, str] | None:
             fixed = _TIME_PART.sub(lambda p: p.group(1) + _TIME_UNITS.get(p.group(2).lower(), p.group(2)), body)
             hint = (f"; did you mean {prefix}#{fixed}?"
                     if fixed != body and _TIME_WORD.fullmatch(f"{prefix}#{fixed}") else "")
-            return (line, col, f"'{word}' is not a TIME literal: give every number its unit, d, h, m, s or ms "
-                               f"(T#2s, T#1m30s, T#500ms){hint}")
+            return line, col, f"'{word}' is not a TIME literal: {TIME_LITERAL_HINT}{hint}"
         if prefix in _NUMBER_TYPES:
             value = word[len(prefix) + 1:]
             if prefix == "BOOL":

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from typing import Callable, Mapping
 
 from verifier.digits import describe, foreign_digit
+from verifier.st.errors import TIME_LITERAL_HINT
 from verifier.st.parser import _time_ms_text
 
 Value = bool | int | float
@@ -81,8 +82,7 @@ def _tokenize(text: str) -> list[_Token]:
         if not match or match.lastgroup == "name" and text.startswith("#", match.end()):
             literal = _TIME_PREFIX.match(text, position)
             if literal:  # T#2sec, T#500: the whole word, as the ST checker names it
-                raise ConditionError(f"{literal.group()!r} is not a TIME literal: give every number its unit, "
-                                     "d, h, m, s or ms (T#2s, T#1m30s, T#500ms)", position + 1)
+                raise ConditionError(f"{literal.group()!r} is not a TIME literal: {TIME_LITERAL_HINT}", position + 1)
         if not match:
             raise ConditionError(f"unexpected character {text[position]!r}", position + 1)
         kind = match.lastgroup
