@@ -10,7 +10,7 @@ import subprocess
 import pytest
 
 from monitor_helpers import uitamr
-from test_verify_cli import back_to_back
+from test_verify_cli import PLC, back_to_back
 from verifier.commands.verify import bundled_scenarios
 
 RUN_S = 120  # a whole command over every bundled scenario (about 6 s of CPU)
@@ -23,8 +23,7 @@ def run(*args, expect=(0, 1)) -> subprocess.CompletedProcess:
 
 
 def findings(report) -> list[list[tuple]]:
-    """Each run's rule findings in a --json report, in run order: (rule, time, message).
-    (A trace of one run is replayed under the trace's file name: runs are told by order.)"""
+    """Each run's rule findings in a --json report, in run order: (rule, time, message)."""
     data = json.loads(report.read_text(encoding="utf-8"))
     return [[(v["rule"], v["t"], v["message"]) for v in s["violations"]] for s in data["scenarios"]]
 
@@ -96,6 +95,17 @@ def test_a_converters_drop_replays_as_a_lost_reply(tmp_path):
 #: the stop once, with its CRC bytes wrong (89 14 for 88 14): the robot never answers, and the
 #: program sends nothing more
 STOP_WITH_A_BAD_CRC = back_to_back().replace("uSend[3] := 16#1488;", "uSend[3] := 16#1489;")
+
+
+def test_a_trace_of_one_run_replays_under_its_scenarios_name(tmp_path):
+    """An integrator's one scenario, `verify --trace`, then `replay` of the trace in CI: the
+    replay's console line, JSON and JUnit test case were named after the trace file
+    ('FAIL v.jsonl (v.jsonl)') while a trace of two runs kept each scenario's name - the
+    name its verify JUnit test case had. A monitor's trace keeps its file's name
+    (test_a_replay_of_the_monitors_trace_judges_as_the_live_session_did)."""
+    verified, replayed = verify_then_replay(tmp_path, "--scenario", PLC / "scenarios" / "fx3u-bad-crc.toml",
+                                            "--duration", "5s")
+    assert names(replayed) == names(verified) == ["FX3U: one reply with a corrupted CRC"]
 
 
 def test_a_silence_after_the_last_frame_is_judged_to_the_runs_end(tmp_path):

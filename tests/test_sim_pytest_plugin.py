@@ -2,6 +2,7 @@
 ST labels' values with their declaration locations."""
 from __future__ import annotations
 
+import re
 import textwrap
 
 from sim_helpers import FB_DELAY
@@ -75,6 +76,9 @@ def test_st_that_does_not_load_is_reported_at_its_line_not_with_the_simulators_t
     out = result.stdout.str()
     assert "Broken.st:5:" in out and "Missing.st:0:0: error: cannot read" in out
     assert 'st_load("Broken.st")' in out          # the test's own line stays
+    # the mark that named the missing file, where the fixture loaded it: no line of the
+    # user's was left at all, only the ERROR header's test name
+    assert re.search(r'test_broken\.py:6: @pytest\.mark\.st\("Missing\.st"\)', out), out
     assert "verifier/sim/" not in out and "pytest_plugin.py" not in out, out
 
 

@@ -853,6 +853,26 @@ def test_a_healthy_converter_is_not_reported_as_a_fault(tmp_path):
     assert run["converter"] is None and run["faults"] == ["no_reply at 4 s for 4 s"], serial.output
 
 
+def test_the_junit_and_html_run_line_give_the_scan_jitter_the_seed_draws(tmp_path):
+    """A CI user reruns a failure from its JUnit or HTML report: both said "scan 10 ms, seed 7"
+    of a scenario with scan_jitter = "2ms" - a seed that draws nothing without the jitter -
+    and a scenario without a description began its <system-out> with an empty line."""
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('program = "UITAMR_ExampleFx3"\nduration = "2s"\nscan_jitter = "2ms"\nseed = 7\n',
+                        encoding="utf-8")
+    xml, page = tmp_path / "r.xml", tmp_path / "r.html"
+    result = invoke(*FX3_SOURCES, "--scenario", scenario, "--junit", xml, "--html", page)
+    assert result.exit_code == 0, result.output
+    out = ET.parse(xml).getroot().find(".//system-out").text
+    assert out.splitlines()[0] == ("program UITAMR_ExampleFx3 on fx3u (fx3:1), 2.000 s of virtual time, "
+                                   "scan 10 ms ±2 ms, seed 7"), out
+    assert "scan 10.0 ms ±2.0 ms · seed 7" in page.read_text(encoding="utf-8")
+    scenario.write_text('program = "UITAMR_ExampleFx3"\nduration = "2s"\nseed = 7\n', encoding="utf-8")
+    invoke(*FX3_SOURCES, "--scenario", scenario, "--junit", xml)  # no jitter: the line as before
+    assert ET.parse(xml).getroot().find(".//system-out").text.startswith(
+        "program UITAMR_ExampleFx3 on fx3u (fx3:1), 2.000 s of virtual time, scan 10 ms, seed 7\n")
+
+
 def test_a_misspelt_label_in_a_scenario_offers_the_label_meant(tmp_path):
     """'fbBat.o_bOK' for the instance fbBatt, 'o_bOkay' for o_bOK: the error says which label
     was probably meant; a name like no label gets no guess."""
@@ -918,20 +938,46 @@ def test_a_fault_that_met_no_request_is_noted_at_its_line(tmp_path):
     """A scenario's fault whose window saw no request of its kind (here control commands
     while only status reads went out) or whose request number never came tested nothing,
     yet the run passed without a word: now each such fault is a note at its line."""
-    scenario = tmp_path / "s.toml"
-    scenario.write_text('program = "UITAMR_ExampleFx3"\nduration = "5s"\n\n'
-                        '[[faults]]\nkind = "bad_crc"\nat_s = 2.0\nduration_s = 1.0\nrequests = "control"\n\n'
-                        '[[faults]]\nkind = "exception"\non_request = 500\n\n'
-                        '[[faults]]\nkind = "no_reply"\nat_s = 3.0\n', encoding="utf-8")
-    report = tmp_path / "r.json"
-    result = invoke(*FX3_SOURCES, "--scenario", scenario, "--json", report)
-    assert result.exit_code == 0, result.output
+    scenario, result, notes = _run_with_faults(tmp_path, '[[faults]]\nkind = "bad_crc"\nat_s = 2.0\nduration_s = 1.0\n'
+                                                         'requests = "control"\n\n'
+                                                         '[[faults]]\nkind = "exception"\non_request = 500\n\n'
+                                                         '[[faults]]\nkind = "no_reply"\nat_s = 3.0\n')
     assert (f"{scenario}:4:1: faults[0]: bad_crc at 2 s for 1 s, control requests only: no control request "
             "reached the robot from 2 s for 1 s, so this fault was not tested") in result.output
     assert f"{scenario}:10:1: faults[1]: exception (code 04) on request 500: request 500 never reached" in result.output
     assert "faults[2]" not in result.output                  # the no_reply at 3 s met a status read
-    notes = json.loads(report.read_text())["scenarios"][0]["notes"]
     assert sum("was not tested" in note for note in notes) == 2
+
+
+def _run_with_faults(tmp_path, faults: str):
+    """The FX3U example for 5 s under `faults` (TOML from the scenario's line 4 on): the
+    scenario file, the command's result and the JSON report's notes."""
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('program = "UITAMR_ExampleFx3"\nduration = "5s"\n\n' + faults, encoding="utf-8")
+    report = tmp_path / "r.json"
+    result = invoke(*FX3_SOURCES, "--scenario", scenario, "--json", report)
+    assert result.exit_code == 0, result.output
+    return scenario, result, json.loads(report.read_text())["scenarios"][0]["notes"]
+
+
+def test_a_state_fault_that_changed_nothing_is_noted_at_its_line(tmp_path):
+    """An integrator's off_tape fault while the robot ran points, not a tape command, and an
+    anti_collision with the range set to 0 m: the robot's log said "no effect", the run
+    passed (or failed on expectations) and nothing said the fault tested nothing - as
+    under --matrix, where the bundled off-tape scenario's fault meets a program that never
+    follows a tape. Each is now a note at its line, as a reply fault that met no request."""
+    scenario, result, notes = _run_with_faults(tmp_path, '[[faults]]\nkind = "off_tape"\nat_s = 2.0\n\n'
+                                                         '[robot]\ncollision_range_stage = 0\n\n'
+                                                         '[[faults]]\nkind = "anti_collision"\non_request = 3\n')
+    assert (f"{scenario}:4:1: faults[0]: off_tape at 2 s: no magnetic-tape task (seek, follow, rotate) was "
+            "running when it struck, and it has no effect otherwise, so this fault was not tested") in result.output
+    assert re.search(rf"{re.escape(str(scenario))}:11:1: faults\[1\]: anti_collision on request 3: the "
+                     r"anti-collision range was 0 m \(off\) when it struck at [\d.]+ s, so this fault was not "
+                     r"tested", result.output), result.output
+    assert sum("was not tested" in note for note in notes) == 2
+    # the same faults where they bite say nothing: the bundled off-tape scenario's tape task
+    result = invoke("--scenario", PLC / "scenarios" / "fx3u-off-tape.toml")
+    assert result.exit_code == 0 and "was not tested" not in result.output, result.output
 
 
 NEVER_REARMED = """PROGRAM MAIN
@@ -1315,6 +1361,11 @@ def test_matrix_on_the_bundled_example_keeps_its_response_signal(tmp_path):
     persistent = runs["FX3U: every reply has a bad CRC for 5 s"]
     assert persistent["verdict"] == "pass"
     assert not any("its response signal" in note for note in persistent["notes"])
+    # the panel's off-tape fault meets a program that never follows a tape: noted at the
+    # fault's line in the bundled file (the matrix dropped every line of the file)
+    off_tape = runs["FX3U: the robot leaves the tape while following it"]
+    assert any(re.search(r"fx3u-off-tape\.toml:\d+:1: faults\[0\]: off_tape at 4 s: no magnetic-tape task", note)
+               for note in off_tape["notes"]), off_tape["notes"]
     panel = tmp_path / "panel.json"  # the panel scenarios are written for UITAMR_PanelFx3
     sources = FX3_SOURCES[:-1] + [PLC / "examples" / "fx3" / "UITAMR_PanelFx3.st"]
     invoke(*sources, "--program", "UITAMR_PanelFx3", "--matrix", "--duration", "6s", "--json", panel)

@@ -94,6 +94,20 @@ def test_condition_errors_name_the_column(text, column):
     assert info.value.column == column
 
 
+def test_a_time_literal_in_a_condition_reads_as_a_time_label_does():
+    """An integrator's `that = "fbLampTmr.ET > T#1s"` on a TON of their own: the condition
+    stopped at "unexpected character '#'", though TIME labels compare (in ms) and ST writes
+    their values so; a unit GX Works does not know is named as the ST checker names it."""
+    assert parse_condition("fbTimer.ET > T#1s").holds({"fbTimer.ET": 1010})
+    assert not parse_condition("fbTimer.ET > T#1s").holds({"fbTimer.ET": 1000})
+    assert parse_condition("t = TIME#1m30s AND u = t#-5ms AND v >= T#1.5S").holds({"t": 90_000, "u": -5, "v": 1500})
+    for text, column in (("et > T#1sec", 6), ("et > T#500", 6), ("(T#2s5 < et)", 2)):
+        with pytest.raises(ConditionError) as info:
+            parse_condition(text)
+        assert info.value.column == column and "is not a TIME literal: give every number its unit, d, h, m, s " \
+            "or ms" in info.value.message, (text, info.value.message)
+
+
 @pytest.mark.parametrize("text, column, hint", [
     ("Y4 AND D20 = 0x0201", 14, "write 16#0201"),
     ("w = 0b1010", 5, "write 2#1010"),
@@ -267,6 +281,9 @@ def test_the_nth_table_of_an_array_is_found():
     ('[[inputs]]\nat = "1s"', "inputs[0]", "needs 'at'"),
     ('[[inputs]]\nat = "1s"\nset = { x = "on" }', "inputs[0].set.x", "true/false or a number"),
     ('[[inputs]]\nat = "1s"\nset = { x = 3 }\npulse = "1s"', "inputs[0].pulse", "no BOOL"),
+    # a BOOL label set to 3 with a pulse was only "this input sets no BOOL", which it was meant to
+    ('[[inputs]]\nat = "1s"\nset = { bLamp = 3 }\npulse = "1s"', "inputs[0].pulse",
+     "only numbers (bLamp = 3): write true or false for a BOOL label, or leave out the pulse"),
     # was "inputs[0].pulse: ... this input sets no BOOL" at the pulse line: the 1 meant as a bit
     ('[[inputs]]\nat = "1s"\nset = { X0 = 1 }\npulse = "1s"', "inputs[0].set.X0",
      "is the number 1, and a pulse sets BOOL labels back after a while: write X0 = true for a bit"),

@@ -97,8 +97,30 @@ def _load_error_report(item, excinfo) -> str | None:
     lines = [f"{entry.path}:{entry.lineno + 1}: {str(entry.statement).strip()}"
              for entry in excinfo.traceback
              if not any(folder in Path(str(entry.path)).resolve().parents for folder in theirs)]
+    if not lines and item.get_closest_marker("st") is not None:
+        lines = [_st_mark_line(item)]  # the st_project fixture loaded it: the files were named there
     # the error first: pytest's short summary quotes the report's first line
     return "\n".join([f"E   {line}" for line in excinfo.exconly().splitlines()] + lines)
+
+
+def _st_mark_line(item) -> str:
+    """Where the test's `@pytest.mark.st(...)` names the files st_project loaded: the
+    decorator's line, else (a mark on the class or module) the test's own."""
+    import inspect
+
+    function = getattr(item, "function", None)
+    try:
+        source, first = inspect.getsourcelines(function)
+        path = inspect.getsourcefile(function)
+    except (TypeError, OSError):
+        source, first, path = [], 0, None
+    for number, text in enumerate(source, first):
+        if "mark.st(" in text:
+            return f"{path}:{number}: {text.strip()}"
+        if text.lstrip().startswith("def "):
+            break
+    fspath, lineno, name = item.location
+    return f"{fspath}:{(lineno or 0) + 1}: {name}"
 
 
 @pytest.hookimpl(hookwrapper=True)

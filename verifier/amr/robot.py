@@ -105,6 +105,12 @@ class _FaultState:
     start_us: int | None = None
     hits: int = 0
     done: bool = False
+    no_effect: str | None = None  # a state fault that struck and changed nothing: why
+
+
+def _when(fault: Fault, t_us: int) -> str:
+    """When a fault struck, for a fault triggered by a request number (one at `at_s` says so)."""
+    return "" if fault.at_us is not None else f" at {t_us / 1e6:g} s"
 
 
 @dataclass
@@ -209,6 +215,13 @@ class Robot:
         window passed, or their request never came, with nothing to disturb. A run that
         lists one here did not test that fault at all."""
         return [(state.index, state.fault) for state in self._reply_faults if state.hits == 0]
+
+    def state_faults_without_effect(self) -> list[tuple[int, Fault, str]]:
+        """The state faults (index, fault, why) that struck and changed nothing: an
+        ``off_tape`` while no magnetic-tape task ran, an ``anti_collision`` while the
+        anti-collision range was 0 m. Like a reply fault no request met, it tested nothing."""
+        return [(state.index, state.fault, state.no_effect) for state in self._state_faults
+                if state.no_effect is not None]
 
     # ---- time ----------------------------------------------------------------------------
 
@@ -463,12 +476,15 @@ class Robot:
         what = fault.describe()
         if fault.kind == "anti_collision":
             if self.collision_range_stage == 0:
+                state.no_effect = f"the anti-collision range was 0 m (off) when it struck{_when(fault, t_us)}"
                 self._log(t_us, "fault", f"{what}: no effect, anti-collision range is 0 m (off)")
                 return
             self._conditions[state.index] = _Condition(RobotError.ANTI_COLLISION, until, what)
             self._log(t_us, "fault", f"{what}: error 01" + self._halt("anti-collision stop"))
         elif fault.kind == "off_tape":
             if self.motion is None or not self.motion.uses_tape or self.mode not in ("running", "paused"):
+                state.no_effect = (f"no magnetic-tape task (seek, follow, rotate) was running when it "
+                                   f"struck{_when(fault, t_us)}, and it has no effect otherwise")
                 self._log(t_us, "fault", f"{what}: no effect, no magnetic-tape task running")
                 return
             self._conditions[state.index] = _Condition(RobotError.OFF_TAPE, until, what)

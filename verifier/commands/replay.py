@@ -59,9 +59,12 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
         recorded = [chunk.tolerance_us for chunks in loaded.values() for chunk in chunks
                     if chunk.tolerance_us is not None]
         default = DEFAULT_TOLERANCE_US if not is_trace else max(recorded, default=0)
+        verify_trace = is_trace and not recorded
         timing = line_timing(baud, line_format, tolerance, default)
         for capture_name, chunks in loaded.items():
-            info = CaptureInfo(capture_name if len(loaded) > 1 else path.name, str(path), "capture",
+            # a verify trace names its one run as its JUnit did, after the scenario; a monitor's
+            # trace and a plain capture are named after their file
+            info = CaptureInfo(capture_name if len(loaded) > 1 or verify_trace else path.name, str(path), "capture",
                                line=f"{baud} {line_format}")
             recorded = chunks[-1].settings if chunks else None  # the end record's: overridden by options given
             run_settings = settings if recorded is None else replace(recorded, **given_settings(settings))

@@ -548,15 +548,17 @@ class Instance(InstanceProxy):
                     raise TimeoutError(f"{self._label}: condition not met within {timeout_ms} ms of virtual time")
                 p._run([self._obj._body], None, 1)
             return self
-        p._run([self._obj._body], _stop_time(p.rt.now_us, ms, None, scans), scans)
+        p._run([self._obj._body], _stop_time(p.rt.now_us, ms, None, scans, until_word="until"), scans)
         return self
 
 
-def _stop_time(now: int, ms, until_us, scans=None, what: str = "ms"):
+def _stop_time(now: int, ms, until_us, scans=None, what: str = "ms", until_word: str = "until_us"):
+    """The virtual time to stop at. `until_word` is how the caller's own third way to say it
+    is spelt (an instance's run takes until=, run_programs until_us=)."""
     given = [f"{name}=" for name, v in (("ms", ms), ("scans", scans), ("until_us", until_us)) if v is not None]
     if len(given) > 1 and what == "ms":
         raise ValueError(f"say how long to run once: {' and '.join(given)} are both given; "
-                         "give one of ms=..., scans=... or until_us=...")
+                         f"give one of ms=..., scans=... or {until_word}=...")
     if ms is not None:
         if isinstance(ms, bool) or not isinstance(ms, (int, float)) or not math.isfinite(ms) or ms < 0:
             raise ValueError(f"{what} must be a finite number of milliseconds, 0 or more; got {ms!r}")

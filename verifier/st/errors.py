@@ -127,11 +127,66 @@ def _nested_comment(text: str, pos: int) -> tuple[int, int, str] | None:
     return None
 
 
+#: what a TIME literal needs, for the ST checker and for scenario conditions alike
+TIME_LITERAL_HINT = "give every number its unit, d, h, m, s or ms (T#2s, T#1m30s, T#500ms)"
+#: a word with '#' after a name: a time literal (T#2s) or a typed one (INT#5) as written
+_HASH_WORD = re.compile(r"(?<![A-Za-z0-9_#.])([A-Za-z_][A-Za-z0-9_]*)#[-+0-9A-Za-z_.#]*")
+#: the time literal st.lark reads (TIME_LIT), the whole word
+_TIME_WORD = re.compile(r"(T|TIME)#-?([0-9][0-9_]*(\.[0-9]+)?(ms|d|h|m|s)_?)+", re.IGNORECASE)
+#: units people write that TIME literals spell otherwise
+_TIME_UNITS = {"msec": "ms", "msecs": "ms", "sec": "s", "secs": "s", "second": "s", "seconds": "s",
+               "min": "m", "mins": "m", "minute": "m", "minutes": "m", "hr": "h", "hrs": "h",
+               "hour": "h", "hours": "h", "day": "d", "days": "d"}
+_TIME_PART = re.compile(r"([0-9][0-9_]*(?:\.[0-9]+)?)\s*([A-Za-z]+)")
+#: IEC elementary types a typed literal (INT#5) may be prefixed with
+_NUMBER_TYPES = {"BOOL", "INT", "DINT", "UINT", "UDINT", "SINT", "USINT", "LINT", "ULINT", "BYTE",
+                 "WORD", "DWORD", "LWORD", "REAL", "LREAL"}
+_DATE_TYPES = {"D", "DATE", "TOD", "TIME_OF_DAY", "DT", "DATE_AND_TIME", "LTIME", "LT"}
+
+
+def _hash_literal(text: str, pos: int) -> tuple[int, int, str] | None:
+    """A TIME literal with a unit GX Works does not know or none (`T#2sec`, `T#2`: lark read
+    `T#2s` and stumbled on `ec`, or found no literal and blamed the '#') and a typed literal
+    (`INT#5`, unsupported): the whole word, at its first character, with what to write."""
+    start = max(text.rfind("\n", 0, pos), text.rfind("\r", 0, pos)) + 1
+    for m in _HASH_WORD.finditer(text, start):
+        if m.start() > pos:
+            break
+        if pos >= m.end():
+            continue
+        word, prefix = m.group(), m.group(1).upper()
+        line, col = place_of_char(text, m.start())
+        if prefix in ("T", "TIME"):
+            if _TIME_WORD.fullmatch(word):
+                return None
+            body = word[len(prefix) + 1:]
+            fixed = _TIME_PART.sub(lambda p: p.group(1) + _TIME_UNITS.get(p.group(2).lower(), p.group(2)), body)
+            hint = (f"; did you mean {prefix}#{fixed}?"
+                    if fixed != body and _TIME_WORD.fullmatch(f"{prefix}#{fixed}") else "")
+            return line, col, f"'{word}' is not a TIME literal: {TIME_LITERAL_HINT}{hint}"
+        if prefix in _NUMBER_TYPES:
+            value = word[len(prefix) + 1:]
+            if prefix == "BOOL":
+                value = {"0": "FALSE", "1": "TRUE"}.get(value, value)
+            return (line, col, f"typed literals such as '{word}' are not supported (docs/st-dialect.md §3): "
+                               f"write the value alone, {value}" if value else
+                               f"typed literals such as '{word}' are not supported (docs/st-dialect.md §3): "
+                               "write the value alone")
+        if prefix in _DATE_TYPES:
+            return (line, col, f"'{word}': {prefix} literals are not supported; GX Works has no date or "
+                               "time-of-day types (docs/st-dialect.md §6)")
+        return None
+    return None
+
+
 def describe_syntax_error(exc: UnexpectedInput, text: str, parser: Lark) -> tuple[int, int, str]:
     """(line, column, message) for a lark exception raised while reading `text`."""
     nested = _nested_comment(text, _error_pos(exc, text))
     if nested is not None:
         return nested
+    literal = _hash_literal(text, _error_pos(exc, text))
+    if literal is not None:
+        return literal
     if isinstance(exc, (UnexpectedToken, UnexpectedEOF)):
         exc = diagnose.earlier_keyword_error(parser, text, _error_pos(exc, text)) or exc
     if isinstance(exc, UnexpectedCharacters):

@@ -5,7 +5,8 @@
     NOT fbRobot.o_bBusy OR (o_uState >= 3 AND o_uState <> 7)
 
 Names are label paths into the program instance (`fbRobot.o_bBusy`, `wBuf[2]`); literals
-are TRUE/FALSE, decimal and 2#/8#/16# integers (with `_` separators) and decimals.
+are TRUE/FALSE, decimal and 2#/8#/16# integers (with `_` separators), decimals and
+TIME literals (`T#1s`, `TIME#500ms`: their value in ms, as a TIME label reads).
 Comparison operators: = <> < <= > >=; logic: NOT, AND (or &), OR, XOR; parentheses.
 Parsing is strict and errors carry the column, so a scenario file's message can point at
 the character that is wrong.
@@ -17,6 +18,8 @@ from dataclasses import dataclass
 from typing import Callable, Mapping
 
 from verifier.digits import describe, foreign_digit
+from verifier.st.errors import TIME_LITERAL_HINT
+from verifier.st.parser import _time_ms_text
 
 Value = bool | int | float
 
@@ -31,6 +34,7 @@ class ConditionError(ValueError):
 _TOKEN = re.compile(
     r"""
     (?P<space>\s+)
+  | (?P<time>(?i:(?:TIME|T)\#-?(?:[0-9][0-9_]*(?:\.[0-9]+)?(?:ms|d|h|m|s)_?)+)(?![A-Za-z0-9_.\#]))
   | (?P<number>(?:2|8|16)\#[0-9A-Fa-f_]+|[0-9][0-9_]*(?:\.[0-9]+)?)
   | (?P<name>[A-Za-z_][A-Za-z0-9_]*(?:\[[0-9]+\])*(?:\.[A-Za-z_][A-Za-z0-9_]*(?:\[[0-9]+\])*)*)
   | (?P<op><>|<=|>=|=|<|>|&|\(|\)|-)
@@ -39,6 +43,8 @@ _TOKEN = re.compile(
 )
 
 _KEYWORDS = {"AND", "OR", "XOR", "NOT", "TRUE", "FALSE"}
+#: the start of a TIME literal, with whatever follows it in the word (for its error)
+_TIME_PREFIX = re.compile(r"(?:TIME|T)#[-0-9A-Za-z_.]*", re.IGNORECASE)
 
 
 @dataclass(frozen=True)
@@ -73,6 +79,10 @@ def _tokenize(text: str) -> list[_Token]:
     position = 0
     while position < len(text):
         match = _TOKEN.match(text, position)
+        if not match or match.lastgroup == "name" and text.startswith("#", match.end()):
+            literal = _TIME_PREFIX.match(text, position)
+            if literal:  # T#2sec, T#500: the whole word, as the ST checker names it
+                raise ConditionError(f"{literal.group()!r} is not a TIME literal: {TIME_LITERAL_HINT}", position + 1)
         if not match:
             raise ConditionError(f"unexpected character {text[position]!r}", position + 1)
         kind = match.lastgroup
@@ -88,6 +98,8 @@ def _tokenize(text: str) -> list[_Token]:
 
 
 def _number(token: _Token) -> Value:
+    if token.kind == "time":  # T#1s: a TIME label's value, in ms
+        return _time_ms_text(token.text)
     digits = token.text.replace("_", "")
     if len(digits) > 100:  # int() reads no more than 4300 digits; no label holds even 100
         raise ConditionError(f"a number of {len(digits)} digits: no PLC label holds one this long", token.column)
@@ -175,7 +187,7 @@ class _Parser:
 
     def operand(self):
         token = self.take()
-        if token.kind == "number":
+        if token.kind in ("number", "time"):
             return ("lit", _number(token))
         if token.kind == "keyword" and token.text in ("TRUE", "FALSE"):
             return ("lit", token.text == "TRUE")

@@ -75,7 +75,9 @@ def for_user_sources(scenario: Scenario, sources: tuple[Path, ...], program: str
         options=scenario.options if keep_signal else replace(scenario.options,
                                                              response_signal=parse_condition(DEFAULT_RESPONSE_SIGNAL)),
         response_signal_given=keep_signal,
-        key_lines={},
+        # what is applied keeps its line (a fault that tested nothing is noted there); the rest
+        # is not the run's
+        key_lines={key: place for key, place in scenario.key_lines.items() if key.startswith("faults[")},
         notes=scenario.notes + (note,),
         for_sources=True,
     )

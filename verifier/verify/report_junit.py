@@ -81,7 +81,7 @@ def to_element(results: list[ScenarioResult], command: str = "uitamr verify") ->
         tx, rx = result.tx_count, result.rx_count
         out.text = "\n".join(
             [
-                result.description,
+                *([result.description] if result.description else []),
                 result.run_line,
                 f"{tx} requests, {rx} replies",
                 *(f"note: {note}" for note in result.notes),

@@ -227,12 +227,14 @@ class ScenarioResult:
 
     @property
     def run_line(self) -> str:
-        """What ran, for people: the program on its CPU and the run's virtual time, scan and
-        seed; for a capture the line and how long its traffic is."""
+        """What ran, for people: the program on its CPU and the run's virtual time, scan (with
+        its jitter, which the seed draws) and seed; for a capture the line and how long its
+        traffic is."""
         if self.captured:
             return f"the PLC on the line ({self.channel}), {format_seconds(self.ended_us)} of traffic"
+        jitter = f" ±{self.scan_jitter_us / 1000:g} ms" if self.scan_jitter_us else ""
         return (f"program {self.program} on {self.platform} ({self.channel}), {format_seconds(self.ended_us)} of "
-                f"virtual time, scan {self.scan_us / 1000:g} ms, seed {self.seed}")
+                f"virtual time, scan {self.scan_us / 1000:g} ms{jitter}, seed {self.seed}")
 
     @property
     def verdict(self) -> str:

@@ -564,7 +564,8 @@ def _c24_notes(scenario: Scenario, plc: _Plc, violations: dict | None = None) ->
 def _missed_fault_notes(scenario: Scenario, robot, end_us: int) -> list[str]:
     """A reply fault that met no request (a window in which the program sent nothing, a
     request number never reached, `requests = "control"` while only status reads went
-    out) tested nothing, though the run may pass: said, at the fault's line. A window that
+    out) tested nothing, though the run may pass: said, at the fault's line; so did a state
+    fault that struck and changed nothing (off_tape with no tape task running). A window that
     opens only after the run's end (`end_us`: --duration, or a CPU that stopped) is not one
     the program left empty: --duration's own note names those faults, a stop is said as such."""
     notes = []
@@ -581,6 +582,10 @@ def _missed_fault_notes(scenario: Scenario, robot, end_us: int) -> list[str]:
         else:
             why = f"request {fault.on_request} never reached the robot"
         notes.append(f"{where}: {fault.describe()}: {why}, so this fault was not tested")
+    for index, fault, why in robot.state_faults_without_effect():
+        key = f"faults[{index}]"
+        notes.append(f"{scenario.where(key, scenario.key_lines.get(key))}: {fault.describe()}: {why}, "
+                     "so this fault was not tested")
     return notes
 
 

@@ -763,7 +763,10 @@ class _Reader:
                 raise self.fail(f"{key}.set.{bit_as_number}",
                                 f"is the number {shown(value)}, and a pulse sets BOOL labels back after a while: "
                                 f"write {bit_as_number} = {'true' if value else 'false'} for a bit")
-            raise self.fail(f"{key}.pulse", "a pulse sets BOOL labels back after a while; this input sets no BOOL")
+            numbers = ", ".join(f"{name} = {shown(value)}" for name, value in checked.items())
+            raise self.fail(f"{key}.pulse", f"a pulse sets BOOL labels back after a while; this input sets no BOOL, "
+                                            f"only numbers ({numbers}): write true or false for a BOOL label, "
+                                            "or leave out the pulse")
         return InputStep(at, checked, pulse, key)
 
     def expectation(self, item: dict, key: str, settings: protocol.Settings) -> Expectation:
