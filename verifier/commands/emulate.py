@@ -20,6 +20,7 @@ from verifier.emulate.ports import PortError, serial_url_problem, serve_serial, 
 from verifier.commands.numbers import INT
 from verifier.commands.protocol_options import protocol_settings
 from verifier.digits import digit_problem
+from verifier.stopflag import StopFlag
 
 
 def _tcp_endpoint(value: str) -> tuple[str, int]:
@@ -278,7 +279,7 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
     emulator = Emulator(Robot(settings, config, faults), log, t3_5_us=t3_5_at(baud))
     for fault in faults:
         emulator.note(f"scripted fault: {fault.describe()}")
-    stop = threading.Event()
+    stop = StopFlag()  # set in a signal handler: no lock (verifier/stopflag.py)
 
     def on_signal(signum, _frame) -> None:
         stop.set()

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import signal
 import sys
-import threading
 import time
 from pathlib import Path
 
@@ -32,6 +31,7 @@ from verifier.monitor.framer import DEFAULT_TOLERANCE_US, LineTiming
 from verifier.monitor.session import CaptureInfo, MonitorSession
 from verifier.monitor.sources import SerialSource, SourceError, TcpSource, now_us
 from verifier.monitor.view import MonitorView
+from verifier.stopflag import StopFlag
 from verifier.verify.evidence import RuleOptions
 from verifier.verify.result import NO_TRAFFIC, Mistake, overall_verdict
 
@@ -140,7 +140,7 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
         reply_timeout = protocol.DEFAULT_REPLY_TIMEOUT_US
     session = MonitorSession(info, settings, RuleOptions(reply_timeout_us=reply_timeout), timing,
                              from_power_on=not joined)
-    stop, said_stopping = threading.Event(), threading.Event()
+    stop, said_stopping = StopFlag(), StopFlag()  # set in a signal handler: no lock (verifier/stopflag.py)
 
     def on_signal(_signum, _frame) -> None:
         # a second Ctrl-C while the reports were being written (a moment, on a long session)

@@ -17,7 +17,6 @@ from __future__ import annotations
 import errno
 import selectors
 import socket
-import threading
 from dataclasses import dataclass, field
 
 import serial
@@ -26,6 +25,7 @@ from verifier.emulate.assembler import RequestAssembler
 from verifier.emulate.core import Emulator, Outgoing, counted
 from verifier.link.line import LineConfig
 from verifier.protocol.codec import hex_bytes
+from verifier.stopflag import StopFlag
 
 POLL_S = 0.005  # longest wait between looks at the clock (reply and silence deadlines)
 
@@ -154,7 +154,7 @@ def serial_assembler(baudrate: int, silence_us: int) -> RequestAssembler:
     return RequestAssembler(max(silence_us, t3_5_us), t3_5_us=t3_5_us)
 
 
-def serve_serial(url: str, emulator: Emulator, stop: threading.Event, silence_us: int,
+def serve_serial(url: str, emulator: Emulator, stop: StopFlag, silence_us: int,
                  baudrate: int = 9600) -> None:
     """Run until ``stop`` is set: read requests from ``url``, write replies when due."""
     try:
@@ -206,7 +206,7 @@ def serve_serial(url: str, emulator: Emulator, stop: threading.Event, silence_us
             emulator.note(f"serial {url} closed{left_behind}")
 
 
-def serve_tcp(host: str, port: int, emulator: Emulator, stop: threading.Event, silence_us: int,
+def serve_tcp(host: str, port: int, emulator: Emulator, stop: StopFlag, silence_us: int,
               on_listening=None) -> None:
     """Run until ``stop`` is set: accept clients on host:port; each has its own framing,
     all share the one robot."""
