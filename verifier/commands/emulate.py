@@ -274,8 +274,9 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
         if not quiet:
             log_anyway(line)
 
-    # no reply before t3.5 at the line's speed (TCP: the robot's 9600 line behind the converter)
-    emulator = Emulator(Robot(settings, config, faults), log, t3_5_us=t3_5_at(baud))
+    # no reply before t3.5 at the line's speed (TCP: the robot's 9600 line behind the converter);
+    # a serial port is opened 8N1 at --baud (ports.serve_serial)
+    emulator = Emulator(Robot(settings, config, faults), log, t3_5_us=t3_5_at(baud), read_at=f"{baud} 8N1")
     for fault in faults:
         emulator.note(f"scripted fault: {fault.describe()}")
     stop = threading.Event()
