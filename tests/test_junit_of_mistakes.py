@@ -420,3 +420,54 @@ def test_a_report_is_not_written_to_a_file_named_like_an_option(tmp_path, monkey
         result = invoke(command, "--junit", "j.xml", "--duration", "5q")
         assert result.exit_code == 2 and (tmp_path / "j.xml").is_file(), (command, result.output)
         (tmp_path / "j.xml").unlink()
+
+
+def test_a_mistake_before_the_command_is_the_junits_error(tmp_path):
+    """`uitamr --bogus verify --junit report.xml` (an option `uitamr` itself does not have)
+    or `uitamr verfy --junit report.xml` (a command it does not know) exited 2 with click's
+    message and wrote no JUnit: CI published an earlier run's file as this one's, or none.
+    The mistake is now the file's error test case, for the command click's resilient parse
+    finds after `uitamr`'s options; click's message and exit 2 stay."""
+    write_files(tmp_path, {"a.toml": 'duration = "1s"\n', "site.txt": "0.000 01 06 01 A0 00 00 88 14\n"})
+    report = tmp_path / "r.xml"
+    for args, classname, said in [
+            (["--bogus", "verify", "--scenario", tmp_path / "a.toml"], "uitamr.verify.input", "No such option '--bogus'."),
+            (["-x", "replay", tmp_path / "site.txt"], "uitamr.replay.input", "No such option '-x'."),
+            (["--bogus", "monitor", "--tcp", "127.0.0.1:1"], "uitamr.monitor.input", "No such option '--bogus'."),
+            (["verfy", "--scenario", tmp_path / "a.toml"], "uitamr.verfy.input", "No such command 'verfy'.")]:
+        report.write_text(OLD_RUN, encoding="utf-8")
+        result = invoke(*args, "--junit", report)
+        assert result.exit_code == 2, result.output
+        assert f"Error: {said}" in result.stderr and f"wrote {report} (these errors as test cases)" in result.stderr
+        (case,) = cases(report)
+        error = case.find("error")
+        assert (case.get("classname"), case.get("name"), error.get("type"), error.get("message")) == (
+            classname, "input", "unusable-input", said)
+        assert "Usage: main [OPTIONS] COMMAND [ARGS]..." in error.text
+    page = " ".join((Path(__file__).parents[1] / "docs" / "verifier.md").read_text(encoding="utf-8").split())
+    assert "So is a mistake in `uitamr`'s own part of the command line, before the command" in page
+
+
+def test_a_mistake_before_the_command_keeps_the_rules_of_every_junit(tmp_path):
+    """Never over an input file (the command's own, or any file that holds no XML for a
+    command `uitamr` does not know), nothing without a --junit file, and `uitamr --help`,
+    `--version` and a command without a JUnit (`check`) as they were."""
+    write_files(tmp_path, {"a.toml": 'duration = "1s"\n', "site.txt": "0.000 01 06 01 A0 00 00 88 14\n"})
+    for args, kept, why in [(["--bogus", "replay", tmp_path / "site.txt", "--junit", tmp_path / "site.txt"],
+                             tmp_path / "site.txt", "is one of the run's input files"),
+                            (["verfy", tmp_path / "a.toml", "--junit", tmp_path / "a.toml"],
+                             tmp_path / "a.toml", "exists and holds no XML")]:
+        before = kept.read_text(encoding="utf-8")
+        result = invoke(*args)
+        assert result.exit_code == 2, result.output
+        assert f"the JUnit report was not written: {kept} {why}" in result.stderr
+        assert kept.read_text(encoding="utf-8") == before
+    for args in (["--bogus", "verify", "--junit"], ["--bogus", "check", "--junit", tmp_path / "c.xml"], ["--bogus"],
+                 ["--junit", tmp_path / "c.xml"]):
+        result = invoke(*args)
+        assert result.exit_code == 2 and "JUnit" not in result.stderr and "wrote" not in result.stderr, result.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.toml", "site.txt"]
+    for args, said in [(["--help"], "Usage: main [OPTIONS] COMMAND [ARGS]..."), (["--version"], "uitamr, version ")]:
+        result = invoke(*args, "verify", "--junit", tmp_path / "c.xml")
+        assert result.exit_code == 0 and result.output.startswith(said), result.output
+    assert not (tmp_path / "c.xml").exists()

@@ -204,9 +204,14 @@ class JudgingCommand(click.Command):
             return super().make_context(info_name, args, parent, **extra)
         except click.UsageError as error:
             if not extra.get("resilient_parsing"):
-                params = self._values_despite_mistakes(info_name, given, parent, extra)
-                usage_error_junit(params.get("junit_path"), error, self.maker, self.inputs_of(params))
+                self.usage_error_junit(error, info_name, given, parent, extra)
             raise
+
+    def usage_error_junit(self, error: click.UsageError, info_name, args, parent, extra=None) -> None:
+        """`error` (this command's, or that of `uitamr` before it: `uitamr --bogus verify`)
+        written to the --junit file `args`, this command's arguments, give, when they give one."""
+        params = self._values_despite_mistakes(info_name, list(args), parent, extra or {})
+        usage_error_junit(params.get("junit_path"), error, self.maker, self.inputs_of(params))
 
     def _values_despite_mistakes(self, info_name, args, parent, extra) -> dict:
         """The values click reads from `args` when it passes over what it cannot use (click's
