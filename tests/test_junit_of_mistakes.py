@@ -471,3 +471,66 @@ def test_a_mistake_before_the_command_keeps_the_rules_of_every_junit(tmp_path):
         result = invoke(*args, "verify", "--junit", tmp_path / "c.xml")
         assert result.exit_code == 0 and result.output.startswith(said), result.output
     assert not (tmp_path / "c.xml").exists()
+
+
+#: a name longer than any file system takes (255 bytes a name; 4096 a path on Linux)
+VERY_LONG = "a" * 5000
+
+
+def test_an_input_name_too_long_is_the_junits_error(tmp_path):
+    """`uitamr verify <5000 characters>.st --junit v.xml`: asking whether the name is a folder
+    of scenarios raised the file system's OSError (ENAMETOOLONG), which only `uitamr`'s
+    generic path error caught: exit 2, but no JUnit, so CI showed an earlier run's file.
+    Now the name is an unusable input as any other, named with what is wrong."""
+    report = tmp_path / "v.xml"
+    for args, said in [([tmp_path / f"{VERY_LONG}.st"], f"{tmp_path / VERY_LONG}.st: File name too long"),
+                       (["--scenario", tmp_path / f"{VERY_LONG}.toml"],
+                        f"{tmp_path / VERY_LONG}.toml: cannot read: File name too long")]:
+        report.write_text(OLD_RUN, encoding="utf-8")
+        result = invoke("verify", *args, "--junit", report)
+        assert result.exit_code == 2, result.output
+        assert f"error: {said}" in result.output and f"wrote {report} (these errors as test cases)" in result.output
+        (case,) = cases(report)
+        assert case.find("error").get("message") == said
+
+
+def test_a_report_name_too_long_is_refused_before_the_run(tmp_path):
+    """A --junit (or --json) name the file system refuses was found only when the report was
+    written, after the whole run; now before it, as a folder that does not exist is, with
+    the name and what is wrong, and another report's refusal is the JUnit's error."""
+    write_files(tmp_path, {"GOOD.st": GOOD})
+    long_report = tmp_path / f"{VERY_LONG}.xml"
+    capture = tmp_path / "site.txt"
+    capture.write_text("0.000 01 06 01 A0 00 00 88 14\n", encoding="utf-8")
+    for args in (["verify", tmp_path / "GOOD.st", "--duration", "1s"], ["replay", capture],
+                 ["monitor", "--tcp", "127.0.0.1:1"]):
+        for report in (long_report, tmp_path / VERY_LONG / "v.xml"):
+            result = invoke(*args, "--junit", report)
+            assert result.exit_code == 2, result.output
+            assert f"cannot write {report}: File name too long" in result.output
+            assert "requests" not in result.output and "wrote" not in result.output  # no run, no report
+    result = invoke("verify", tmp_path / "GOOD.st", "--duration", "1s", "--json", tmp_path / f"{VERY_LONG}.json",
+                    "--junit", tmp_path / "v.xml")
+    assert result.exit_code == 2, result.output
+    (case,) = cases(tmp_path / "v.xml")
+    assert case.find("error").get("message") == f"cannot write {tmp_path / VERY_LONG}.json: File name too long"
+
+
+def test_a_path_the_file_system_refuses_anywhere_in_a_judging_command_is_the_junits_error(tmp_path, monkeypatch):
+    """Whatever path of the run the file system refuses where no code expected it (an
+    OSError that names its file), the command says `uitamr`'s generic path error, exit 2,
+    and its JUnit holds that error too."""
+    import errno
+
+    import verifier.commands.verify as verify
+
+    def refused(*_args, **_kw):
+        raise OSError(errno.ENAMETOOLONG, "File name too long", str(tmp_path / "deep.st"))
+
+    monkeypatch.setattr(verify, "_scenarios", refused)
+    report = tmp_path / "v.xml"
+    result = invoke("verify", "--junit", report)
+    assert result.exit_code == 2, result.output
+    assert f"Error: {tmp_path / 'deep.st'}: File name too long" in result.output
+    assert cases(report)[0].find("error").get("message") == f"{tmp_path / 'deep.st'}: File name too long"
+

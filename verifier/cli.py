@@ -36,6 +36,11 @@ class UnusablePath(click.ClickException):
 
     exit_code = 2
 
+    @classmethod
+    def of(cls, exc: OSError) -> UnusablePath:
+        """The error of an OSError about a path the user gave: the path and what is wrong."""
+        return cls(f"{exc.filename}: {exc.strerror or exc}")
+
 
 class LazyGroup(click.Group):
     def list_commands(self, ctx: click.Context) -> list[str]:
@@ -109,7 +114,7 @@ class LazyGroup(click.Group):
             # without a file name is not about a path the user gave, and stays one.
             if exc.filename is None:
                 raise
-            raise UnusablePath(f"{exc.filename}: {exc.strerror or exc}") from None
+            raise UnusablePath.of(exc) from None
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         with formatter.section("Commands"):

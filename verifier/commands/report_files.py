@@ -2,6 +2,7 @@
 of options, one writer loop, so a capture from site gives the same files as a CI run."""
 from __future__ import annotations
 
+import errno
 import io
 import os
 import sys
@@ -79,6 +80,11 @@ def check_folders(*paths: str | None) -> None:
     for path in paths:
         if not path:
             continue
+        try:
+            os.stat(path)
+        except OSError as exc:  # a name too long for the file system, a symlink loop: no file can be written there
+            if exc.errno in (errno.ENAMETOOLONG, errno.ELOOP):
+                raise ReportError(f"cannot write {path}: {exc.strerror}", path) from None
         resolved = real_path(path)
         if not resolved.parent.is_dir():
             what = "is a file, not a folder" if resolved.parent.exists() else "does not exist"
@@ -206,6 +212,23 @@ class JudgingCommand(click.Command):
             if not extra.get("resilient_parsing"):
                 self.usage_error_junit(error, info_name, given, parent, extra)
             raise
+
+    def invoke(self, ctx: click.Context):
+        try:
+            return super().invoke(ctx)
+        except OSError as exc:
+            # a path the file system refuses where the command did not expect it (a name too
+            # long, a symlink loop): `uitamr`'s own message and exit 2 (UnusablePath), and the
+            # JUnit of it, as for every other unusable input
+            if exc.filename is None:
+                raise
+            from verifier.cli import UnusablePath
+            from verifier.verify.result import Mistake
+
+            error = UnusablePath.of(exc)
+            mistakes_junit(ctx.params.get("junit_path"), [Mistake(error.message)], self.maker,
+                           self.inputs_of(ctx.params))
+            raise error from None
 
     def usage_error_junit(self, error: click.UsageError, info_name, args, parent, extra=None) -> None:
         """`error` (this command's, or that of `uitamr` before it: `uitamr --bogus verify`)
