@@ -534,3 +534,34 @@ def test_a_path_the_file_system_refuses_anywhere_in_a_judging_command_is_the_jun
     assert f"Error: {tmp_path / 'deep.st'}: File name too long" in result.output
     assert cases(report)[0].find("error").get("message") == f"{tmp_path / 'deep.st'}: File name too long"
 
+
+def test_a_junit_that_is_a_pipe_is_written_to_its_reader_not_read(tmp_path):
+    """`--junit` naming a FIFO (a CI uploader reading it): before writing the JUnit of a run
+    that cannot start, the file was opened to read, to see it holds no input, and that open
+    waited for a writer that never came - the command hung, with the pipe's reader waiting
+    too. A pipe is not read now; the report goes to its reader."""
+    import os
+    import subprocess
+    import sys
+    import threading
+
+    fifo = tmp_path / "junit.fifo"
+    os.mkfifo(fifo)
+    got: list[bytes] = []
+
+    def reader():
+        with open(fifo, "rb") as pipe:
+            got.append(pipe.read())
+
+    thread = threading.Thread(target=reader, daemon=True)
+    thread.start()
+    try:
+        done = subprocess.run([sys.executable, "-m", "verifier.cli", "replay", str(tmp_path / "gone.txt"),
+                               "--junit", str(fifo)], capture_output=True, text=True, timeout=60)
+    finally:
+        if thread.is_alive():  # whatever happened, the reader is let go
+            os.close(os.open(fifo, os.O_WRONLY | os.O_NONBLOCK))
+        thread.join(timeout=10)
+    assert done.returncode == 2, done.stdout + done.stderr
+    assert f"wrote {fifo} (these errors as test cases)" in done.stderr
+    assert got and b'type="unusable-input"' in got[0] and b"gone.txt" in got[0]

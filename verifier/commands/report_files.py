@@ -5,6 +5,7 @@ from __future__ import annotations
 import errno
 import io
 import os
+import stat
 import sys
 from pathlib import Path
 
@@ -113,12 +114,14 @@ def _not_over_other_content(path: Path) -> None:
     run that could not start are known only as far as it got (the ST a broken scenario
     file names is not), so its JUnit report is never written over text that is no report."""
     try:
+        if not stat.S_ISREG(path.stat().st_mode):
+            # a folder, a device, a pipe (opened to read, it would wait for a writer: a hang): writing
+            # it says what is wrong, or hands the report to the pipe's reader
+            return
         with path.open("rb") as existing:
             head = existing.read(64).lstrip(b"\xef\xbb\xbf \t\r\n")
-    except FileNotFoundError:
-        return
     except OSError:
-        return  # a folder, a device ...: writing it says what is wrong
+        return  # no such file, or one that cannot be read: writing it says what is wrong
     if head and not head.startswith(b"<"):
         raise ReportError(f"{path} exists and holds no XML (an input file?): write the report to another file",
                           str(path))
