@@ -296,3 +296,19 @@ def test_a_port_typed_without_its_option_is_the_monitors_junit_error(tmp_path):
     assert result.exit_code == 2, result.output
     error = ET.parse(tmp_path / "m.xml").getroot().find(".//testcase/error")
     assert error is not None and error.get("message").startswith("'/dev/ttyUSB0' is given without its option")
+
+
+def test_check_sarif_names_a_file_whose_name_is_not_utf8_by_its_bytes(tmp_path, monkeypatch):
+    """`uitamr check --format sarif` with an error in `\\x83v\\x83\\x8d.st` below the working
+    folder: percent-encoding the name for its SARIF URI raised UnicodeEncodeError (a
+    traceback); the URI now holds the name's bytes, as an absolute path's file: URI does."""
+    monkeypatch.chdir(tmp_path)
+    path = not_utf8(tmp_path, b"\x83v\x83\x8d.st")
+    path.write_text("PROGRAM P\nVAR x : INT; END_VAR\nx := ;\nEND_PROGRAM\n", encoding="utf-8")
+    result = invoke("check", "--format", "sarif", path.name)
+    assert result.exit_code == 1, result.output
+    (found,) = json.loads(result.output)["runs"][0]["results"]
+    location = found["locations"][0]["physicalLocation"]
+    assert location["artifactLocation"] == {"uri": "%83v%83%8D.st", "uriBaseId": "%SRCROOT%"}
+    assert location["region"]["startLine"] == 3
+
