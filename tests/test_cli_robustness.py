@@ -312,3 +312,26 @@ def test_check_sarif_names_a_file_whose_name_is_not_utf8_by_its_bytes(tmp_path, 
     assert location["artifactLocation"] == {"uri": "%83v%83%8D.st", "uriBaseId": "%SRCROOT%"}
     assert location["region"]["startLine"] == 3
 
+
+def test_export_of_a_pipe_or_a_device_is_refused_without_reading_it(tmp_path):
+    """`uitamr export ... FIFO` hung, and `... /dev/full` read zeros until the memory ran
+    out (MemoryError, a traceback): asking whether a file named neither .st nor .toml is a
+    scenario read it whole, whatever it was. Only a regular file is read now; these are
+    refused as `check` refuses them, naming what they are."""
+    import resource
+    import subprocess
+    import sys
+
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+
+    def at_most_a_gigabyte():
+        resource.setrlimit(resource.RLIMIT_AS, (1 << 30, 1 << 30))
+
+    for source, kind in [(fifo, "a pipe"), ("/dev/full", "a character device")]:
+        done = subprocess.run([sys.executable, "-m", "verifier.cli", "export", "--target", "gxworks2", "--out",
+                               str(tmp_path / "out"), str(source)], capture_output=True, text=True, timeout=60,
+                              preexec_fn=at_most_a_gigabyte)
+        assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
+        assert f"{source}:0:0: error: is not a regular file ({kind}); give a .st file" in done.stderr
+        assert "uitamr export: nothing written" in done.stderr
