@@ -565,3 +565,27 @@ def test_a_junit_that_is_a_pipe_is_written_to_its_reader_not_read(tmp_path):
     assert done.returncode == 2, done.stdout + done.stderr
     assert f"wrote {fifo} (these errors as test cases)" in done.stderr
     assert got and b'type="unusable-input"' in got[0] and b"gone.txt" in got[0]
+
+
+def test_an_empty_report_name_is_a_command_line_mistake(tmp_path, monkeypatch):
+    """`--junit "$REPORT"` with REPORT unset gave --junit an empty name, which was taken for
+    no report at all: the run went on, exit 0 or 1, and CI found no file (or an earlier
+    one). An empty name is a usage mistake now, named with its option, in the JUnit file
+    when another option names one. `monitor --capture` takes its file so too (it took
+    `--json` for the capture's name in `--capture --json r.json`)."""
+    monkeypatch.chdir(tmp_path)
+    capture = tmp_path / "site.txt"
+    capture.write_text("0.000 01 06 01 A0 00 00 88 14\n", encoding="utf-8")
+    runs = {"verify": ["--duration", "1s"], "replay": [capture], "monitor": ["--tcp", "127.0.0.1:1"]}
+    for command, args in runs.items():
+        for option in ("--json", "--junit", "--trace", "--html") + (("--capture",) if command == "monitor" else ()):
+            given = [option, ""] if option == "--junit" else [option, "", "--junit", tmp_path / "j.xml"]
+            result = invoke(command, *args, *given)
+            assert result.exit_code == 2, (command, option, result.output)
+            said = f"Invalid value for '{option}': the file's name is empty"
+            assert said in result.stderr, result.output
+            if option != "--junit":
+                assert cases(tmp_path / "j.xml")[0].find("error").get("message").startswith(said)
+    result = invoke("monitor", "--tcp", "127.0.0.1:1", "--capture", "--json", "r.json")
+    assert result.exit_code == 2 and "Invalid value for '--capture': '--json' is an option, not a file" in result.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["j.xml", "site.txt"]

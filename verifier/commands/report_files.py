@@ -37,7 +37,8 @@ def text_console(**options) -> Console:
 
 class ReportPath(click.Path):
     """A report's file: not a name that begins with '-', which is the next option taken for
-    the file left out (`--junit --duration 5q` wrote a report named "--duration")."""
+    the file left out (`--junit --duration 5q` wrote a report named "--duration"), nor an
+    empty one (`--junit "$REPORT"` with REPORT unset), which wrote no report and said nothing."""
 
     def __init__(self):
         super().__init__(dir_okay=False)
@@ -46,6 +47,9 @@ class ReportPath(click.Path):
         if isinstance(value, str) and value.startswith("-"):
             self.fail(f"{value!r} is an option, not a file: give the report's file first "
                       f"(./{value} for a file of that name)", param, ctx)
+        if value == "":
+            self.fail("the file's name is empty (a variable of the CI script that is not set?): give the "
+                      "file to write", param, ctx)
         return super().convert(value, param, ctx)
 
 
