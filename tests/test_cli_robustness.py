@@ -335,3 +335,13 @@ def test_export_of_a_pipe_or_a_device_is_refused_without_reading_it(tmp_path):
         assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
         assert f"{source}:0:0: error: is not a regular file ({kind}); give a .st file" in done.stderr
         assert "uitamr export: nothing written" in done.stderr
+
+
+def test_an_empty_fault_file_name_is_refused_not_taken_for_none():
+    """`uitamr emulate --faults "$FAULTS"` with FAULTS unset gave an empty name, taken for no
+    fault file: the bench test ran the healthy robot, exit 0, and a PLC's fault handling
+    passed without meeting a fault. Refused now, naming the option."""
+    result = invoke("emulate", "--tcp", "127.0.0.1:0", "--faults", "", "--exit-after", "0.2")
+    assert result.exit_code == 2, result.output
+    assert "Invalid value for --faults: the file's name is empty" in result.output
+    assert "stopped after" not in result.output

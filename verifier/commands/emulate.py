@@ -225,6 +225,9 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
         raise click.UsageError("--baud sets the speed of a --serial port; --tcp carries bytes without one")
     robot_table: dict = {}
     faults: list[Fault] = []
+    if faults_file == "":  # `--faults "$FAULTS"` with FAULTS unset ran the bench test without its faults
+        raise click.BadParameter("the file's name is empty (a variable of the script that is not set?): give "
+                                 "the fault file", param_hint="--faults")
     if faults_file:
         try:
             loaded = load_fault_file(faults_file, settings.address)
