@@ -87,7 +87,8 @@ class LazyGroup(click.Group):
                 rest = click.Command.parse_args(self, ctx, list(args))  # not Group's: keeps the name in
             except click.ClickException:
                 return
-            # `uitamr` has flags only: what click let through before the name is an option of its
+            # `uitamr` has flags only: each word click let through before the command's name is an
+            # option it does not know (`--bogus`), not a value
             words = iter(rest)
             name = next((word for word in words if not word.startswith("-")), None)
             if name is None:
