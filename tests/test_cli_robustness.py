@@ -296,3 +296,52 @@ def test_a_port_typed_without_its_option_is_the_monitors_junit_error(tmp_path):
     assert result.exit_code == 2, result.output
     error = ET.parse(tmp_path / "m.xml").getroot().find(".//testcase/error")
     assert error is not None and error.get("message").startswith("'/dev/ttyUSB0' is given without its option")
+
+
+def test_check_sarif_names_a_file_whose_name_is_not_utf8_by_its_bytes(tmp_path, monkeypatch):
+    """`uitamr check --format sarif` with an error in `\\x83v\\x83\\x8d.st` below the working
+    folder: percent-encoding the name for its SARIF URI raised UnicodeEncodeError (a
+    traceback); the URI now holds the name's bytes, as an absolute path's file: URI does."""
+    monkeypatch.chdir(tmp_path)
+    path = not_utf8(tmp_path, b"\x83v\x83\x8d.st")
+    path.write_text("PROGRAM P\nVAR x : INT; END_VAR\nx := ;\nEND_PROGRAM\n", encoding="utf-8")
+    result = invoke("check", "--format", "sarif", path.name)
+    assert result.exit_code == 1, result.output
+    (found,) = json.loads(result.output)["runs"][0]["results"]
+    location = found["locations"][0]["physicalLocation"]
+    assert location["artifactLocation"] == {"uri": "%83v%83%8D.st", "uriBaseId": "%SRCROOT%"}
+    assert location["region"]["startLine"] == 3
+
+
+def test_export_of_a_pipe_or_a_device_is_refused_without_reading_it(tmp_path):
+    """`uitamr export ... FIFO` hung, and `... /dev/full` read zeros until the memory ran
+    out (MemoryError, a traceback): asking whether a file named neither .st nor .toml is a
+    scenario read it whole, whatever it was. Only a regular file is read now; these are
+    refused as `check` refuses them, naming what they are."""
+    import resource
+    import subprocess
+    import sys
+
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+
+    def at_most_a_gigabyte():
+        resource.setrlimit(resource.RLIMIT_AS, (1 << 30, 1 << 30))
+
+    for source, kind in [(fifo, "a pipe"), ("/dev/full", "a character device")]:
+        done = subprocess.run([sys.executable, "-m", "verifier.cli", "export", "--target", "gxworks2", "--out",
+                               str(tmp_path / "out"), str(source)], capture_output=True, text=True, timeout=60,
+                              preexec_fn=at_most_a_gigabyte)
+        assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
+        assert f"{source}:0:0: error: is not a regular file ({kind}); give a .st file" in done.stderr
+        assert "uitamr export: nothing written" in done.stderr
+
+
+def test_an_empty_fault_file_name_is_refused_not_taken_for_none():
+    """`uitamr emulate --faults "$FAULTS"` with FAULTS unset gave an empty name, taken for no
+    fault file: the bench test ran the healthy robot, exit 0, and a PLC's fault handling
+    passed without meeting a fault. Refused now, naming the option."""
+    result = invoke("emulate", "--tcp", "127.0.0.1:0", "--faults", "", "--exit-after", "0.2")
+    assert result.exit_code == 2, result.output
+    assert "Invalid value for --faults: the file's name is empty" in result.output
+    assert "stopped after" not in result.output

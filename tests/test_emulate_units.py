@@ -130,16 +130,23 @@ def test_a_line_on_which_no_frame_has_a_good_crc_is_said_to_be_at_another_speed(
     for data in (bytes.fromhex("28 08 08 68"), bytes.fromhex("18 08 68 AB")):
         assert emulator.handle(ReceivedFrame(data, 0, 0, "silence")) is None
     said = emulator.summary()
-    assert said.endswith("; no frame had a good CRC: the PLC is probably at another baud rate or parity than the "
-                         "emulator's port (--baud; the robot's is 9600 8N1), or A and B are swapped"), said
+    # the words of `uitamr monitor`'s note (commissioning.md quotes it), from one place
+    assert said.endswith("; not one of the 2 frame(s) has a good CRC: the line is probably at another speed or "
+                         "parity than the 9600 8N1 it was read at, or A and B are swapped; check those before the "
+                         "PLC's CRC routine and frame builder"), said
+    fast = Emulator(Robot(), [].append, FakeClock(), read_at="19200 8N1")  # `uitamr emulate --baud 19200`
+    fast.handle(ReceivedFrame(bytes.fromhex("28 08 08 68"), 0, 0, "silence"))
+    assert fast.summary().endswith("; not one of the 1 frame(s) has a good CRC: the line is probably at another "
+                                   "speed or parity than the 19200 8N1 it was read at (the robot's is 9600 8N1), or "
+                                   "A and B are swapped; check those before the PLC's CRC routine and frame builder")
     page = " ".join((Path(__file__).resolve().parents[1] / "docs" / "emulator.md").read_text(encoding="utf-8").split())
-    assert "the summary line ends `no frame had a good CRC: ...`" in page
+    assert "the summary line ends `not one of the N frame(s) has a good CRC: ...`" in page
     assert "as `28 08 08 68`: half its bytes" in page
     emulator.handle(ReceivedFrame(STOP_FRAME, 0, 0, "length"))  # one good frame: the PLC's own mistakes
-    assert "no frame had a good CRC" not in emulator.summary()
+    assert "has a good CRC" not in emulator.summary()
     swapped = Emulator(Robot(), [].append, FakeClock())  # its CRC high byte first: the PLC's CRC, not the line
     swapped.handle(ReceivedFrame(STOP_FRAME[:6] + STOP_FRAME[:5:-1], 0, 0, "silence"))
-    assert "no frame had a good CRC" not in swapped.summary()
+    assert "has a good CRC" not in swapped.summary()
 
 # ---- the fault file ------------------------------------------------------------------------
 

@@ -420,3 +420,172 @@ def test_a_report_is_not_written_to_a_file_named_like_an_option(tmp_path, monkey
         result = invoke(command, "--junit", "j.xml", "--duration", "5q")
         assert result.exit_code == 2 and (tmp_path / "j.xml").is_file(), (command, result.output)
         (tmp_path / "j.xml").unlink()
+
+
+def test_a_mistake_before_the_command_is_the_junits_error(tmp_path):
+    """`uitamr --bogus verify --junit report.xml` (an option `uitamr` itself does not have)
+    or `uitamr verfy --junit report.xml` (a command it does not know) exited 2 with click's
+    message and wrote no JUnit: CI published an earlier run's file as this one's, or none.
+    The mistake is now the file's error test case, for the command click's resilient parse
+    finds after `uitamr`'s options; click's message and exit 2 stay."""
+    write_files(tmp_path, {"a.toml": 'duration = "1s"\n', "site.txt": "0.000 01 06 01 A0 00 00 88 14\n"})
+    report = tmp_path / "r.xml"
+    for args, classname, said in [
+            (["--bogus", "verify", "--scenario", tmp_path / "a.toml"], "uitamr.verify.input", "No such option '--bogus'."),
+            (["-x", "replay", tmp_path / "site.txt"], "uitamr.replay.input", "No such option '-x'."),
+            (["--bogus", "monitor", "--tcp", "127.0.0.1:1"], "uitamr.monitor.input", "No such option '--bogus'."),
+            (["verfy", "--scenario", tmp_path / "a.toml"], "uitamr.verfy.input", "No such command 'verfy'.")]:
+        report.write_text(OLD_RUN, encoding="utf-8")
+        result = invoke(*args, "--junit", report)
+        assert result.exit_code == 2, result.output
+        assert f"Error: {said}" in result.stderr and f"wrote {report} (these errors as test cases)" in result.stderr
+        (case,) = cases(report)
+        error = case.find("error")
+        assert (case.get("classname"), case.get("name"), error.get("type"), error.get("message")) == (
+            classname, "input", "unusable-input", said)
+        assert "Usage: main [OPTIONS] COMMAND [ARGS]..." in error.text
+    page = " ".join((Path(__file__).parents[1] / "docs" / "verifier.md").read_text(encoding="utf-8").split())
+    assert "So is a mistake in `uitamr`'s own part of the command line, before the command" in page
+
+
+def test_a_mistake_before_the_command_keeps_the_rules_of_every_junit(tmp_path):
+    """Never over an input file (the command's own, or any file that holds no XML for a
+    command `uitamr` does not know), nothing without a --junit file, and `uitamr --help`,
+    `--version` and a command without a JUnit (`check`) as they were."""
+    write_files(tmp_path, {"a.toml": 'duration = "1s"\n', "site.txt": "0.000 01 06 01 A0 00 00 88 14\n"})
+    for args, kept, why in [(["--bogus", "replay", tmp_path / "site.txt", "--junit", tmp_path / "site.txt"],
+                             tmp_path / "site.txt", "is one of the run's input files"),
+                            (["verfy", tmp_path / "a.toml", "--junit", tmp_path / "a.toml"],
+                             tmp_path / "a.toml", "exists and holds no XML")]:
+        before = kept.read_text(encoding="utf-8")
+        result = invoke(*args)
+        assert result.exit_code == 2, result.output
+        assert f"the JUnit report was not written: {kept} {why}" in result.stderr
+        assert kept.read_text(encoding="utf-8") == before
+    for args in (["--bogus", "verify", "--junit"], ["--bogus", "check", "--junit", tmp_path / "c.xml"], ["--bogus"],
+                 ["--junit", tmp_path / "c.xml"]):
+        result = invoke(*args)
+        assert result.exit_code == 2 and "JUnit" not in result.stderr and "wrote" not in result.stderr, result.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.toml", "site.txt"]
+    for args, said in [(["--help"], "Usage: main [OPTIONS] COMMAND [ARGS]..."), (["--version"], "uitamr, version ")]:
+        result = invoke(*args, "verify", "--junit", tmp_path / "c.xml")
+        assert result.exit_code == 0 and result.output.startswith(said), result.output
+    assert not (tmp_path / "c.xml").exists()
+
+
+#: a name longer than any file system takes (255 bytes a name; 4096 a path on Linux)
+VERY_LONG = "a" * 5000
+
+
+def test_an_input_name_too_long_is_the_junits_error(tmp_path):
+    """`uitamr verify <5000 characters>.st --junit v.xml`: asking whether the name is a folder
+    of scenarios raised the file system's OSError (ENAMETOOLONG), which only `uitamr`'s
+    generic path error caught: exit 2, but no JUnit, so CI showed an earlier run's file.
+    Now the name is an unusable input as any other, named with what is wrong."""
+    report = tmp_path / "v.xml"
+    for args, said in [([tmp_path / f"{VERY_LONG}.st"], f"{tmp_path / VERY_LONG}.st: File name too long"),
+                       (["--scenario", tmp_path / f"{VERY_LONG}.toml"],
+                        f"{tmp_path / VERY_LONG}.toml: cannot read: File name too long")]:
+        report.write_text(OLD_RUN, encoding="utf-8")
+        result = invoke("verify", *args, "--junit", report)
+        assert result.exit_code == 2, result.output
+        assert f"error: {said}" in result.output and f"wrote {report} (these errors as test cases)" in result.output
+        (case,) = cases(report)
+        assert case.find("error").get("message") == said
+
+
+def test_a_report_name_too_long_is_refused_before_the_run(tmp_path):
+    """A --junit (or --json) name the file system refuses was found only when the report was
+    written, after the whole run; now before it, as a folder that does not exist is, with
+    the name and what is wrong, and another report's refusal is the JUnit's error."""
+    write_files(tmp_path, {"GOOD.st": GOOD})
+    long_report = tmp_path / f"{VERY_LONG}.xml"
+    capture = tmp_path / "site.txt"
+    capture.write_text("0.000 01 06 01 A0 00 00 88 14\n", encoding="utf-8")
+    for args in (["verify", tmp_path / "GOOD.st", "--duration", "1s"], ["replay", capture],
+                 ["monitor", "--tcp", "127.0.0.1:1"]):
+        for report in (long_report, tmp_path / VERY_LONG / "v.xml"):
+            result = invoke(*args, "--junit", report)
+            assert result.exit_code == 2, result.output
+            assert f"cannot write {report}: File name too long" in result.output
+            assert "requests" not in result.output and "wrote" not in result.output  # no run, no report
+    result = invoke("verify", tmp_path / "GOOD.st", "--duration", "1s", "--json", tmp_path / f"{VERY_LONG}.json",
+                    "--junit", tmp_path / "v.xml")
+    assert result.exit_code == 2, result.output
+    (case,) = cases(tmp_path / "v.xml")
+    assert case.find("error").get("message") == f"cannot write {tmp_path / VERY_LONG}.json: File name too long"
+
+
+def test_a_path_the_file_system_refuses_anywhere_in_a_judging_command_is_the_junits_error(tmp_path, monkeypatch):
+    """Whatever path of the run the file system refuses where no code expected it (an
+    OSError that names its file), the command says `uitamr`'s generic path error, exit 2,
+    and its JUnit holds that error too."""
+    import errno
+
+    import verifier.commands.verify as verify
+
+    def refused(*_args, **_kw):
+        raise OSError(errno.ENAMETOOLONG, "File name too long", str(tmp_path / "deep.st"))
+
+    monkeypatch.setattr(verify, "_scenarios", refused)
+    report = tmp_path / "v.xml"
+    result = invoke("verify", "--junit", report)
+    assert result.exit_code == 2, result.output
+    assert f"Error: {tmp_path / 'deep.st'}: File name too long" in result.output
+    assert cases(report)[0].find("error").get("message") == f"{tmp_path / 'deep.st'}: File name too long"
+
+
+def test_a_junit_that_is_a_pipe_is_written_to_its_reader_not_read(tmp_path):
+    """`--junit` naming a FIFO (a CI uploader reading it): before writing the JUnit of a run
+    that cannot start, the file was opened to read, to see it holds no input, and that open
+    waited for a writer that never came - the command hung, with the pipe's reader waiting
+    too. A pipe is not read now; the report goes to its reader."""
+    import os
+    import subprocess
+    import sys
+    import threading
+
+    fifo = tmp_path / "junit.fifo"
+    os.mkfifo(fifo)
+    got: list[bytes] = []
+
+    def reader():
+        with open(fifo, "rb") as pipe:
+            got.append(pipe.read())
+
+    thread = threading.Thread(target=reader, daemon=True)
+    thread.start()
+    try:
+        done = subprocess.run([sys.executable, "-m", "verifier.cli", "replay", str(tmp_path / "gone.txt"),
+                               "--junit", str(fifo)], capture_output=True, text=True, timeout=60)
+    finally:
+        if thread.is_alive():  # whatever happened, the reader is let go
+            os.close(os.open(fifo, os.O_WRONLY | os.O_NONBLOCK))
+        thread.join(timeout=10)
+    assert done.returncode == 2, done.stdout + done.stderr
+    assert f"wrote {fifo} (these errors as test cases)" in done.stderr
+    assert got and b'type="unusable-input"' in got[0] and b"gone.txt" in got[0]
+
+
+def test_an_empty_report_name_is_a_command_line_mistake(tmp_path, monkeypatch):
+    """`--junit "$REPORT"` with REPORT unset gave --junit an empty name, which was taken for
+    no report at all: the run went on, exit 0 or 1, and CI found no file (or an earlier
+    one). An empty name is a usage mistake now, named with its option, in the JUnit file
+    when another option names one. `monitor --capture` takes its file so too (it took
+    `--json` for the capture's name in `--capture --json r.json`)."""
+    monkeypatch.chdir(tmp_path)
+    capture = tmp_path / "site.txt"
+    capture.write_text("0.000 01 06 01 A0 00 00 88 14\n", encoding="utf-8")
+    runs = {"verify": ["--duration", "1s"], "replay": [capture], "monitor": ["--tcp", "127.0.0.1:1"]}
+    for command, args in runs.items():
+        for option in ("--json", "--junit", "--trace", "--html") + (("--capture",) if command == "monitor" else ()):
+            given = [option, ""] if option == "--junit" else [option, "", "--junit", tmp_path / "j.xml"]
+            result = invoke(command, *args, *given)
+            assert result.exit_code == 2, (command, option, result.output)
+            said = f"Invalid value for '{option}': the file's name is empty"
+            assert said in result.stderr, result.output
+            if option != "--junit":
+                assert cases(tmp_path / "j.xml")[0].find("error").get("message").startswith(said)
+    result = invoke("monitor", "--tcp", "127.0.0.1:1", "--capture", "--json", "r.json")
+    assert result.exit_code == 2 and "Invalid value for '--capture': '--json' is an option, not a file" in result.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["j.xml", "site.txt"]

@@ -36,6 +36,11 @@ class UnusablePath(click.ClickException):
 
     exit_code = 2
 
+    @classmethod
+    def of(cls, exc: OSError) -> UnusablePath:
+        """The error of an OSError about a path the user gave: the path and what is wrong."""
+        return cls(f"{exc.filename}: {exc.strerror or exc}")
+
 
 class LazyGroup(click.Group):
     def list_commands(self, ctx: click.Context) -> list[str]:
@@ -46,6 +51,52 @@ class LazyGroup(click.Group):
             return None
         module = importlib.import_module(f"verifier.commands.{name}")
         return module.command
+
+    def make_context(self, info_name, args, parent=None, **extra):
+        given = list(args)  # the parser uses up the list it reads
+        try:
+            return super().make_context(info_name, args, parent, **extra)
+        except click.UsageError as error:  # `uitamr --bogus verify --junit report.xml`
+            if not extra.get("resilient_parsing"):
+                self._junit_of_mistake(error, info_name, given, parent)
+            raise
+
+    def resolve_command(self, ctx: click.Context, args: list[str]):
+        try:
+            return super().resolve_command(ctx, args)
+        except click.UsageError as error:  # `uitamr verfy --junit report.xml`
+            if not ctx.resilient_parsing:
+                self._junit_of_mistake(error, ctx.info_name, args, ctx.parent)
+            raise
+
+    def _junit_of_mistake(self, error: click.UsageError, info_name, args: list[str], parent) -> None:
+        """A mistake in `uitamr`'s own part of the command line (an option it does not have, a
+        command it does not know) exits 2 with click's usage message, as ever; when the
+        sub-command's arguments name a --junit file, the mistake is also written there as the
+        judging commands write their own (`JudgingCommand`): CI publishes that file, and
+        showed an earlier run's report or none. The sub-command is the first word click's
+        resilient parse leaves after `uitamr`'s options; one that `uitamr` does not know is
+        read for the report options alone (all three judging commands spell --junit so),
+        and its JUnit is named after it as typed."""
+        from verifier.commands.report_files import JudgingCommand, report_options
+
+        ctx = self.context_class(self, info_name=info_name, parent=parent, resilient_parsing=True,
+                                 ignore_unknown_options=True)
+        with ctx:
+            try:
+                rest = click.Command.parse_args(self, ctx, list(args))  # not Group's: keeps the name in
+            except click.ClickException:
+                return
+            # `uitamr` has flags only: each word click let through before the command's name is an
+            # option it does not know (`--bogus`), not a value
+            words = iter(rest)
+            name = next((word for word in words if not word.startswith("-")), None)
+            if name is None:
+                return
+            command = self.get_command(ctx, name) if name in SUBCOMMANDS else \
+                click.command(name, cls=JudgingCommand, maker=f"uitamr {name}")(report_options(lambda **_: None))
+            if isinstance(command, JudgingCommand):
+                command.usage_error_junit(error, name, list(words), ctx)
 
     def invoke(self, ctx: click.Context):
         try:
@@ -64,7 +115,7 @@ class LazyGroup(click.Group):
             # without a file name is not about a path the user gave, and stays one.
             if exc.filename is None:
                 raise
-            raise UnusablePath(f"{exc.filename}: {exc.strerror or exc}") from None
+            raise UnusablePath.of(exc) from None
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         with formatter.section("Commands"):

@@ -88,11 +88,12 @@ def _scenario_kind(path: Path) -> str | None:
     named .toml (Windows may save `s.toml` as `s.toml.txt`), or None."""
     import tomllib
 
+    from verifier.textfile import UnreadableText, read_utf8
     from verifier.verify.scenario import TOP_KEYS
 
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
-    except (OSError, UnicodeDecodeError, ValueError, RecursionError):  # not TOML: ST, or a mistake to place
+    try:  # read_utf8: a pipe or a device (/dev/zero) is not read, which waited or filled the memory
+        data = tomllib.loads(read_utf8(path))
+    except (UnreadableText, ValueError, RecursionError):  # not TOML: ST, or a mistake to place
         return None
     if not set(data) & set(TOP_KEYS):  # ST is no TOML; TOML without a scenario's key is no scenario
         return None

@@ -114,7 +114,9 @@ def _artifact(file: str) -> dict:
     path = relative(file)
     if Path(path).is_absolute():
         return {"uri": Path(path).as_uri()}
-    return {"uri": quote(path, safe="/"), "uriBaseId": "%SRCROOT%"}
+    # the name's own bytes (os.fsencode), as Path.as_uri quotes them: a name that is not UTF-8
+    # (b"\xfe.st", its bytes as lone surrogates) could not be encoded and ended in a traceback
+    return {"uri": quote(os.fsencode(path), safe="/"), "uriBaseId": "%SRCROOT%"}
 
 
 def to_sarif(findings: list[Finding], version: str, rules: dict[str, str] = RULES) -> str:

@@ -226,6 +226,9 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
         raise click.UsageError("--baud sets the speed of a --serial port; --tcp carries bytes without one")
     robot_table: dict = {}
     faults: list[Fault] = []
+    if faults_file == "":  # `--faults "$FAULTS"` with FAULTS unset ran the bench test without its faults
+        raise click.BadParameter("the file's name is empty (a variable of the script that is not set?): give "
+                                 "the fault file", param_hint="--faults")
     if faults_file:
         try:
             loaded = load_fault_file(faults_file, settings.address)
@@ -275,8 +278,9 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
         if not quiet:
             log_anyway(line)
 
-    # no reply before t3.5 at the line's speed (TCP: the robot's 9600 line behind the converter)
-    emulator = Emulator(Robot(settings, config, faults), log, t3_5_us=t3_5_at(baud))
+    # no reply before t3.5 at the line's speed (TCP: the robot's 9600 line behind the converter);
+    # a serial port is opened 8N1 at --baud (ports.serve_serial)
+    emulator = Emulator(Robot(settings, config, faults), log, t3_5_us=t3_5_at(baud), read_at=f"{baud} 8N1")
     for fault in faults:
         emulator.note(f"scripted fault: {fault.describe()}")
     stop = StopFlag()  # set in a signal handler: no lock (verifier/stopflag.py)

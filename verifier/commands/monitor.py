@@ -21,9 +21,9 @@ from rich.markup import escape
 from verifier import protocol
 from verifier.commands.emulate import STANDARD_BAUD_RATES, _tcp_endpoint, bare_arguments
 from verifier.commands.protocol_options import protocol_settings
-from verifier.commands.report_files import (JudgingCommand, ReportError, check_folders, check_not_inputs,
-                                             mistakes_junit, refused_report_junit, report_options, text_console,
-                                             usage_error_junit, write_reports)
+from verifier.commands.report_files import (JudgingCommand, ReportError, ReportPath, check_folders,
+                                             check_not_inputs, mistakes_junit, refused_report_junit, report_options,
+                                             text_console, usage_error_junit, write_reports)
 from verifier.commands.verify import _Duration
 from verifier.emulate.ports import serial_url_problem
 from verifier.monitor.capture import format_plain, tolerance_hides_pacing
@@ -91,7 +91,7 @@ def line_timing(baud: str, line_format: str, tolerance_us: int | None, default_t
 @line_options
 @protocol_settings
 @click.option("--duration", type=_Duration(), help="Stop by itself after this long, e.g. 10min (default: Ctrl-C).")
-@click.option("--capture", "capture_path", type=click.Path(dir_okay=False),
+@click.option("--capture", "capture_path", type=ReportPath(),
               help="Also write the raw chunks as a plain capture (for `uitamr replay` and tickets).")
 @report_options
 @click.option("--quiet", is_flag=True, help="Findings only, not every frame.")

@@ -2,8 +2,10 @@
 of options, one writer loop, so a capture from site gives the same files as a CI run."""
 from __future__ import annotations
 
+import errno
 import io
 import os
+import stat
 import sys
 from pathlib import Path
 
@@ -35,7 +37,8 @@ def text_console(**options) -> Console:
 
 class ReportPath(click.Path):
     """A report's file: not a name that begins with '-', which is the next option taken for
-    the file left out (`--junit --duration 5q` wrote a report named "--duration")."""
+    the file left out (`--junit --duration 5q` wrote a report named "--duration"), nor an
+    empty one (`--junit "$REPORT"` with REPORT unset), which wrote no report and said nothing."""
 
     def __init__(self):
         super().__init__(dir_okay=False)
@@ -44,6 +47,9 @@ class ReportPath(click.Path):
         if isinstance(value, str) and value.startswith("-"):
             self.fail(f"{value!r} is an option, not a file: give the report's file first "
                       f"(./{value} for a file of that name)", param, ctx)
+        if value == "":
+            self.fail("the file's name is empty (a variable of the CI script that is not set?): give the "
+                      "file to write", param, ctx)
         return super().convert(value, param, ctx)
 
 
@@ -79,6 +85,11 @@ def check_folders(*paths: str | None) -> None:
     for path in paths:
         if not path:
             continue
+        try:
+            os.stat(path)
+        except OSError as exc:  # a name too long for the file system, a symlink loop: no file can be written there
+            if exc.errno in (errno.ENAMETOOLONG, errno.ELOOP):
+                raise ReportError(f"cannot write {path}: {exc.strerror}", path) from None
         resolved = real_path(path)
         if not resolved.parent.is_dir():
             what = "is a file, not a folder" if resolved.parent.exists() else "does not exist"
@@ -107,12 +118,14 @@ def _not_over_other_content(path: Path) -> None:
     run that could not start are known only as far as it got (the ST a broken scenario
     file names is not), so its JUnit report is never written over text that is no report."""
     try:
+        if not stat.S_ISREG(path.stat().st_mode):
+            # a folder, a device, a pipe (opened to read, it would wait for a writer: a hang): writing
+            # it says what is wrong, or hands the report to the pipe's reader
+            return
         with path.open("rb") as existing:
             head = existing.read(64).lstrip(b"\xef\xbb\xbf \t\r\n")
-    except FileNotFoundError:
-        return
     except OSError:
-        return  # a folder, a device ...: writing it says what is wrong
+        return  # no such file, or one that cannot be read: writing it says what is wrong
     if head and not head.startswith(b"<"):
         raise ReportError(f"{path} exists and holds no XML (an input file?): write the report to another file",
                           str(path))
@@ -204,9 +217,31 @@ class JudgingCommand(click.Command):
             return super().make_context(info_name, args, parent, **extra)
         except click.UsageError as error:
             if not extra.get("resilient_parsing"):
-                params = self._values_despite_mistakes(info_name, given, parent, extra)
-                usage_error_junit(params.get("junit_path"), error, self.maker, self.inputs_of(params))
+                self.usage_error_junit(error, info_name, given, parent, extra)
             raise
+
+    def invoke(self, ctx: click.Context):
+        try:
+            return super().invoke(ctx)
+        except OSError as exc:
+            # a path the file system refuses where the command did not expect it (a name too
+            # long, a symlink loop): `uitamr`'s own message and exit 2 (UnusablePath), and the
+            # JUnit of it, as for every other unusable input
+            if exc.filename is None:
+                raise
+            from verifier.cli import UnusablePath
+            from verifier.verify.result import Mistake
+
+            error = UnusablePath.of(exc)
+            mistakes_junit(ctx.params.get("junit_path"), [Mistake(error.message)], self.maker,
+                           self.inputs_of(ctx.params))
+            raise error from None
+
+    def usage_error_junit(self, error: click.UsageError, info_name, args, parent, extra=None) -> None:
+        """`error` (this command's, or that of `uitamr` before it: `uitamr --bogus verify`)
+        written to the --junit file `args`, this command's arguments, give, when they give one."""
+        params = self._values_despite_mistakes(info_name, list(args), parent, extra or {})
+        usage_error_junit(params.get("junit_path"), error, self.maker, self.inputs_of(params))
 
     def _values_despite_mistakes(self, info_name, args, parent, extra) -> dict:
         """The values click reads from `args` when it passes over what it cannot use (click's

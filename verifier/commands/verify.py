@@ -35,7 +35,7 @@ from verifier.verify.scenario import (
     CHANNELS, DEFAULT_DURATION_US, MAX_DURATION_US, PLATFORMS, TOLD_PLATFORMS, Scenario, ScenarioError, bundled_platforms,
     default_scenario, load_scenario,
 )
-from verifier.verify.sources import SourceError, expand, st_files_in, unique
+from verifier.verify.sources import SourceError, expand, is_folder, st_files_in, unique
 
 EXIT_PASS, EXIT_FAIL, EXIT_UNUSABLE = 0, 1, 2
 SHOW_PROGRESS_AFTER_S = 0.5
@@ -314,7 +314,7 @@ def _scenario_files(names) -> list[Path]:
     files: list[Path] = []
     for name in names:
         path = Path(name)
-        if path.is_dir():
+        if is_folder(path):
             found = sorted(path.glob("*.toml"))
             if not found:
                 sources = st_files_in(path)  # a folder of ST sources given as the scenario
@@ -370,7 +370,7 @@ def _source_files(sources) -> tuple[Path, ...]:
             files = expand(name, Path.cwd())
             found += files
         except SourceError as exc:
-            scenarios = list(Path(name).glob("*.toml")) if Path(name).is_dir() else []
+            scenarios = list(Path(name).glob("*.toml")) if is_folder(name) else []
             if scenarios:  # a folder of scenarios given as SOURCES (uitamr verify plc/scenarios)
                 raise UnusableInput(f"the folder {name} holds no .st file but {len(scenarios)} scenario (.toml) "
                                     f"file(s): give it as --scenario {name} (with the .st files, if the scenarios "

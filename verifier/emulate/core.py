@@ -13,7 +13,7 @@ from typing import Callable
 from verifier.amr import Robot
 from verifier.emulate.assembler import Dropped, ReceivedFrame
 from verifier.protocol.codec import decode_reply, decode_request, hex_bytes
-from verifier.protocol.stream import garbled
+from verifier.protocol.stream import ROBOT_LINE, garbled, garbled_note
 from verifier.protocol.describe import describe
 from verifier.protocol.frames import FrameError, Request
 from verifier.protocol.timing import T3_5_US
@@ -35,12 +35,16 @@ class Emulator:
     sooner after its request, whatever the turnaround, because a slave cannot know the
     request has ended before that silence (Modbus over Serial Line V1.02 §2.5.1.1) - the
     same floor the verifier's line (``verifier.link.line``) puts under the turnaround.
+    ``read_at`` is the speed and framing the bytes are read at ("9600 8N1"; over TCP, the
+    converter's line), which the summary names when no frame has a good CRC.
     """
 
     def __init__(self, robot: Robot, log: Callable[[str], None],
-                 clock_ns: Callable[[], int] = time.monotonic_ns, t3_5_us: int = T3_5_US) -> None:
+                 clock_ns: Callable[[], int] = time.monotonic_ns, t3_5_us: int = T3_5_US,
+                 read_at: str = ROBOT_LINE) -> None:
         self.robot = robot
         self.t3_5_us = t3_5_us
+        self.read_at = read_at
         self._log = log
         self._clock_ns = clock_ns
         self._t0_ns = clock_ns()
@@ -126,14 +130,13 @@ class Emulator:
 
     def _garbled(self) -> str:
         """What the summary adds when every frame was garbled (`stream.garbled`: no good CRC, nor
-        the protocol's shape): the bytes came at another speed or parity (a PLC at 19200 into
-        a 9600 port reads as half its bytes) or from a swapped pair; else "". A PLC that sends
-        well-formed frames with a wrong CRC has its own log line (byte 6: bad CRC)."""
+        the protocol's shape): `stream.garbled_note`, in the words `uitamr monitor` uses; else
+        "". A PLC that sends well-formed frames with a wrong CRC has its own log line (byte 6:
+        bad CRC)."""
         frames = self.stats["frames in"]
         if not frames or self.stats["garbled"] < frames:
             return ""
-        return ("; no frame had a good CRC: the PLC is probably at another baud rate or parity than the "
-                "emulator's port (--baud; the robot's is 9600 8N1), or A and B are swapped")
+        return f"; {garbled_note(frames, self.read_at)}"
 
 
 def counted(n: int, one: str, many: str) -> str:

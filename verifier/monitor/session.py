@@ -17,7 +17,7 @@ from typing import Sequence
 
 from verifier import protocol
 from verifier.protocol.codec import MAX_FRAME
-from verifier.protocol.stream import garbled
+from verifier.protocol.stream import ROBOT_LINE, garbled, garbled_note
 from verifier.verify.evidence import RuleOptions, RunEvidence, Samples, Violation
 from verifier.verify.result import LINE, LineEvent, ScenarioResult, TraceRecord, judged_with
 from verifier.verify.rules import Judgement, check_all
@@ -31,18 +31,6 @@ POWER_ON_RULE = "UITAMR-POWERON-STOP"
 PROVISIONAL_RULE = "UITAMR-RESPONSE-HANDLING"  # the one rule with early word (Judgement.provisional)
 
 
-def garbled_line(frames: int, line: str) -> str:
-    """The note of a session in which every frame is garbled (`stream.garbled`: no good CRC, nor
-    the protocol's shape): a PLC at another speed or parity than the monitor reads (a PLC at
-    19200 reads at 9600 as half its bytes, none a frame) or A and B swapped. The
-    findings are CRC and FORMAT, whose table in commissioning.md points at the PLC's frame
-    builder; this says to look at the line first."""
-    robots = "" if line == "9600 8N1" else " (the robot's is 9600 8N1)"
-    return (f"not one of the {frames} frame(s) has a good CRC: the line is probably at another speed or "
-            f"parity than the {line} it was read at{robots}, or A and B are swapped; check those before "
-            "the PLC's CRC routine and frame builder")
-
-
 @dataclass
 class CaptureInfo:
     """What the reports say about where the bytes came from."""
@@ -50,7 +38,7 @@ class CaptureInfo:
     name: str
     source: str  # "/dev/ttyUSB0", "tcp 192.168.0.50:4001", "capture.txt"
     channel: str = "rs485"  # rs485 / tcp / capture
-    line: str = "9600 8N1"  # the line's speed and framing, as the monitor was told them
+    line: str = ROBOT_LINE  # the line's speed and framing, as the monitor was told them
     notes: list[str] = field(default_factory=list)
 
 
@@ -293,7 +281,7 @@ class MonitorSession:
             notes.append(f"the capture ended inside a frame: its first {len(self.cut_off)} byte(s) "
                          f"({protocol.hex_bytes(self.cut_off)}) were not judged")
         if self.frames and all(garbled(record.data) for record in self.frames):
-            notes.append(garbled_line(len(self.frames), self.info.line))
+            notes.append(garbled_note(len(self.frames), self.info.line))
         no_traffic = None
         if not self.frames:
             no_traffic = self._silence(listened_us)

@@ -55,6 +55,23 @@ def garbled(frame: bytes) -> bool:
     return not crc_ok(frame) and frame_length_either_side(frame) != len(frame)
 
 
+#: the robot's serial line (its manual: 9600 baud, 8 data bits, no parity, 1 stop bit)
+ROBOT_LINE = "9600 8N1"
+
+
+def garbled_note(frames: int, line: str) -> str:
+    """What `uitamr monitor`, `uitamr replay` and the emulator's summary say when every one
+    of `frames` frames is `garbled`: the bytes were read at another speed or parity than the
+    sender's (a PLC at 19200 read at 9600 gives half its bytes, none a frame) or off a
+    swapped pair. The findings are CRC and FORMAT, whose advice points at the PLC's frame
+    builder; this says to look at the line first. `line`: the speed and framing the bytes
+    were read at ("9600 8N1"), named beside the robot's when it is another."""
+    robots = "" if line == ROBOT_LINE else f" (the robot's is {ROBOT_LINE})"
+    return (f"not one of the {frames} frame(s) has a good CRC: the line is probably at another speed or "
+            f"parity than the {line} it was read at{robots}, or A and B are swapped; check those before "
+            "the PLC's CRC routine and frame builder")
+
+
 def split_frames(data: bytes, direction: Direction) -> tuple[list[bytes], bytes]:
     """Complete frames at the start of ``data`` and the bytes left over.
 
