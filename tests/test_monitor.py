@@ -675,40 +675,61 @@ def bare_line(tmp_path):
 
 
 @pytest.mark.serial
-def test_a_bad_master_on_a_real_line_gets_exactly_its_findings(bare_line, tmp_path):
+def test_a_bad_master_on_a_real_line_gets_exactly_its_findings(tmp_path):
     """The robot is the emulator's model answered in-process (Master's `robot`): with a
     `uitamr emulate` process the host stalled 230 ms or more, the master's next request
     went out after the late reply and broke no pacing - 1 to 2 runs in 30 on a loaded
-    2-core host found 2 UITAMR-PACING, not 3. The emulator on the line: the test after this one."""
-    line = bare_line
-    monitor = monitor_on(line, tmp_path, "--duration", "3s", "--capture", tmp_path / "c.txt",
-                         "--junit", tmp_path / "m.xml", "--html", tmp_path / "m.html", "--trace", tmp_path / "m.jsonl")
-    master = bad_master(line, Robot(SETTINGS))
-    out, err = monitor.communicate(timeout=WAIT_S)
-    seen = diagnosis(out, err, tmp_path / "c.txt", master)
-    assert monitor.returncode == 1 and (tmp_path / "m.json").exists(), seen
-    assert findings(tmp_path / "m.json") == Counter(BAD_MASTER_FINDINGS), seen
+    2-core host found 2 UITAMR-PACING, not 3. The emulator on the line: the test after this one.
+
+    The monitor is a process the host can stall too: a request it reads 130 ms late is no
+    longer 100 ms after the previous one. Other findings while that was measured (the
+    master woke late, or the monitor saw other gaps than were written: `_host_stalls`)
+    prove nothing and the attempt runs again on a fresh line; other findings with no stall
+    fail at once, and so do three stalled attempts."""
+    stalled = []
+    for attempt in range(3):
+        folder = tmp_path / f"attempt{attempt}"
+        folder.mkdir()
+        line = LineBus(folder)
+        try:
+            monitor = monitor_on(line, folder, "--duration", "3s", "--capture", folder / "c.txt", "--junit",
+                                 folder / "m.xml", "--html", folder / "m.html", "--trace", folder / "m.jsonl")
+            master = bad_master(line, Robot(SETTINGS))
+            out, err = monitor.communicate(timeout=WAIT_S)
+        finally:
+            line.close()
+        seen = diagnosis(out, err, folder / "c.txt", master)
+        assert monitor.returncode == 1 and (folder / "m.json").exists(), seen
+        if findings(folder / "m.json") == Counter(BAD_MASTER_FINDINGS):
+            break
+        stalls = _host_stalls(master, folder / "m.jsonl")
+        assert stalls, f"{findings(folder / 'm.json')} with no host stall measured\n{seen}"
+        stalled.append(f"attempt {attempt + 1}: " + "; ".join(stalls))
+    else:
+        pytest.fail("the host stalled the master or the monitor in every attempt:\n" + "\n".join(stalled))
+    if stalled:
+        warnings.warn("host stalls before the attempt that counted: " + " | ".join(stalled))
     live, summary = out.split("\nFAIL monitor ", 1)
     # each finding was printed live (its time, rule, message and frames), before the summary
     assert re.search(r"^0\.000 s  UITAMR-POWERON-STOP: the first control command after power-on is run "
                      r"point/script 1 \(01/01\)", live, re.M), out
     assert re.search(r"^ +0\.000 s  PLC → robot  01 06 01 01 00 00 D9 F6  run point/script 1", live, re.M), out
     assert Counter(re.findall(r"^\d+\.\d{3} s  (UITAMR-[A-Z-]+): ", live, re.M)) == Counter(BAD_MASTER_FINDINGS)
-    assert "<testcase" in (tmp_path / "m.xml").read_text() and "<svg" in (tmp_path / "m.html").read_text()
-    done = subprocess.run(uitamr("replay", tmp_path / "c.txt", "--json", tmp_path / "r.json"),
+    assert "<testcase" in (folder / "m.xml").read_text() and "<svg" in (folder / "m.html").read_text()
+    done = subprocess.run(uitamr("replay", folder / "c.txt", "--json", folder / "r.json"),
                           capture_output=True, text=True, timeout=WAIT_S)
-    assert done.returncode == 1 and findings(tmp_path / "r.json") == Counter(BAD_MASTER_FINDINGS), done.stdout + done.stderr
+    assert done.returncode == 1 and findings(folder / "r.json") == Counter(BAD_MASTER_FINDINGS), done.stdout + done.stderr
     # the replay of the capture is the live session's judgement: frames, findings, notes and
     # how long the line was listened to (the capture's `end` line); only the names differ
-    live_run, replayed = (json.loads((tmp_path / name).read_text())["scenarios"][0] for name in ("m.json", "r.json"))
+    live_run, replayed = (json.loads((folder / name).read_text())["scenarios"][0] for name in ("m.json", "r.json"))
     differing = {key for key in live_run if live_run[key] != replayed[key]}
     assert differing == {"name", "file", "description", "channel"}, {k: (live_run[k], replayed[k]) for k in differing}
     # so is the replay of the monitor's --trace (its end record: the run lasted the 3 s
     # listened to, not until the last frame at 1.6 s)
-    done = subprocess.run(uitamr("replay", tmp_path / "m.jsonl", "--json", tmp_path / "t.json"),
+    done = subprocess.run(uitamr("replay", folder / "m.jsonl", "--json", folder / "t.json"),
                           capture_output=True, text=True, timeout=WAIT_S)
     assert done.returncode == 1, done.stdout + done.stderr
-    replayed = json.loads((tmp_path / "t.json").read_text())["scenarios"][0]
+    replayed = json.loads((folder / "t.json").read_text())["scenarios"][0]
     differing = {key for key in live_run if live_run[key] != replayed[key]}
     assert differing == {"name", "file", "description", "channel"}, {k: (live_run[k], replayed[k]) for k in differing}
 
