@@ -764,13 +764,14 @@ def test_the_emulator_answering_the_bad_master_is_seen_reply_for_reply(tmp_path)
 
 
 @pytest.mark.serial
-def test_a_request_left_unanswered_on_a_real_line_replays_from_the_trace_as_judged_live(line, tmp_path):
+def test_a_request_left_unanswered_on_a_real_line_replays_from_the_trace_as_judged_live(bare_line, tmp_path):
     """The last request gets no reply (a bad CRC: the robot ignores it) and the monitor
     listens on: live, the failure lasts past RESPONSE-HANDLING's 5 s. The replay of the
     monitor's --trace ended at that request, so the finding was gone and the run 5 s
-    shorter; with the trace's end record it is the live judgement."""
-    monitor = monitor_on(line, tmp_path, "--duration", "8s", "--trace", tmp_path / "m.jsonl")
-    master = Master(line)
+    shorter; with the trace's end record it is the live judgement. The test answers for the
+    robot (Master's `robot`): the stop's echo is never late, whatever the host does."""
+    monitor = monitor_on(bare_line, tmp_path, "--duration", "8s", "--trace", tmp_path / "m.jsonl")
+    master = Master(bare_line, Robot(SETTINGS))
     try:
         stop = frame("stop")
         master.send(stop)
@@ -895,9 +896,11 @@ def test_noise_on_the_line_gives_findings_not_a_crash(line, tmp_path):
 
 
 def _monitor_that_saw_the_stop(bus: LineBus, tmp_path: Path, *extra) -> subprocess.Popen:
-    """A monitor (with --json m.json and `extra`) on the line, once the stop and its echo passed."""
+    """A monitor (with --json m.json and `extra`) on the line, once the stop and its echo passed.
+    The test answers for the robot (Master's `robot`): a `uitamr emulate` process the host
+    stalled past the 500 ms reply time-out would make the echo late, a finding, and no pass."""
     monitor = monitor_on(bus, tmp_path, *extra)
-    master = Master(bus)
+    master = Master(bus, Robot(SETTINGS))
     try:
         master.send(STOP)
     finally:
@@ -909,8 +912,8 @@ def _monitor_that_saw_the_stop(bus: LineBus, tmp_path: Path, *extra) -> subproce
 
 
 @pytest.mark.serial
-def test_ctrl_c_stops_the_monitor_and_the_reports_are_written(line, tmp_path):
-    monitor = _monitor_that_saw_the_stop(line, tmp_path, "--capture", tmp_path / "c.txt")
+def test_ctrl_c_stops_the_monitor_and_the_reports_are_written(bare_line, tmp_path):
+    monitor = _monitor_that_saw_the_stop(bare_line, tmp_path, "--capture", tmp_path / "c.txt")
     monitor.send_signal(signal.SIGINT)
     out, err = monitor.communicate(timeout=WAIT_S)
     assert monitor.returncode == 0, out + err
@@ -920,14 +923,14 @@ def test_ctrl_c_stops_the_monitor_and_the_reports_are_written(line, tmp_path):
 
 
 @pytest.mark.serial
-def test_a_second_ctrl_c_while_the_reports_are_written_loses_none_of_them(line, tmp_path):
+def test_a_second_ctrl_c_while_the_reports_are_written_loses_none_of_them(bare_line, tmp_path):
     """Pressed again because the monitor seemed slow to stop, Ctrl-C met the default handler
     (it was put back once the port was closed): a KeyboardInterrupt while the reports were
     written, "Aborted!", an exit status of 1 or death by SIGINT rather than the session's 0,
     and of the five files only the capture. Here Ctrl-C is pressed until the capture is there."""
     files = {"--junit": "m.xml", "--html": "m.html", "--trace": "m.jsonl", "--capture": "c.txt"}
-    monitor = _monitor_that_saw_the_stop(line, tmp_path, *[a for option, name in files.items()
-                                                           for a in (option, tmp_path / name)])
+    monitor = _monitor_that_saw_the_stop(bare_line, tmp_path, *[a for option, name in files.items()
+                                                                for a in (option, tmp_path / name)])
     while monitor.poll() is None and not (tmp_path / "c.txt").exists():
         monitor.send_signal(signal.SIGINT)
         time.sleep(0.005)
