@@ -793,14 +793,22 @@ def test_a_request_left_unanswered_on_a_real_line_replays_from_the_trace_as_judg
 
 @pytest.mark.serial
 def test_mbpoll_and_the_emulator_seen_by_the_monitor(line, tmp_path):
-    monitor = monitor_on(line, tmp_path, "--duration", "4s")
+    """Three mbpoll runs, 400 ms or more apart (the pacing), answered by `uitamr emulate`:
+    the monitor sees them all and passes. It is stopped with Ctrl-C once it printed the
+    third reply: it listened 4 s, and on a loaded host three mbpoll processes and the
+    pauses between them may take longer than that (the last exchange would go unseen)."""
+    monitor = monitor_on(line, tmp_path, "--duration", "120s")
+    printed: list[str] = []
     for request in (protocol.command_from_words("stop"), protocol.command_from_words("read task"),
                     protocol.command_from_words("read battery")):
         done = subprocess.run(mbpoll_command(request, SETTINGS, line.plc), capture_output=True, text=True,
                               timeout=WAIT_S)
         assert done.returncode == 0, done.stdout + done.stderr
+        wait_for_line(monitor, "robot → PLC", seen=printed)  # its reply, on the tap
         time.sleep(0.4)
+    monitor.send_signal(signal.SIGINT)
     out, err = monitor.communicate(timeout=WAIT_S)
+    out = "".join(printed) + out
     assert monitor.returncode == 0, out + err
     assert "PLC → robot  01 06 01 A0 00 00 88 14    stop (01/A0)" in out
     assert "robot → PLC  01 06 01 A0 00 00 88 14    echo: stop (01/A0)" in out
