@@ -1282,12 +1282,37 @@ def test_a_tcp_stream_that_carries_nothing_is_no_traffic_not_a_pass(tmp_path):
     assert report["verdict"] == "no-traffic" and report["scenarios"][0]["verdict"] == "no-traffic"
     assert report["scenarios"][0]["no_traffic"] == verdict.removeprefix("NO TRAFFIC: ")
     assert report["summary"]["passed"] == 0 and report["summary"]["no_traffic"] == 1
-    assert report["scenarios"][0]["ended"] == pytest.approx(1.0, abs=0.5)
+    assert report["scenarios"][0]["ended"] == 1.0  # its --duration (test_a_host_stall_at_the_deadline_...)
     junit = (tmp_path / "m.xml").read_text()
     assert 'errors="1"' in junit and 'type="no-traffic"' in junit and "no bytes were seen" in junit
     html = (tmp_path / "m.html").read_text()
     assert '<span class="badge no-traffic" id="verdict">NO TRAFFIC</span>' in html and "<b>No traffic:</b>" in html
     assert (tmp_path / "m.jsonl").read_text() == ""
+
+
+def test_a_host_stall_at_the_deadline_is_not_time_listened(tmp_path):
+    """A monitor the host did not run when its --duration ran out (here stopped with
+    SIGSTOP for 1.5 s from its start, as a loaded PC does for a moment) noticed the deadline
+    late and said "no bytes were seen on ... in 1.5 s" for --duration 1s, and its report's
+    `ended` said 1.5 (so a NO TRAFFIC test expecting "in 1.0 s" could fail on a loaded
+    host). Ended by its duration, it listened its duration."""
+    server = socket.create_server(("127.0.0.1", 0))
+    port = server.getsockname()[1]
+    thread = threading.Thread(target=lambda: server.accept()[0].recv(1), daemon=True)  # connects, sends nothing
+    thread.start()
+    monitor = start("monitor", "--tcp", f"127.0.0.1:{port}", "--duration", "1s", "--json", tmp_path / "m.json")
+    wait_for_line(monitor, "reading, connected")
+    monitor.send_signal(signal.SIGSTOP)
+    time.sleep(1.5)  # the stall: past the deadline however late the SIGSTOP came
+    monitor.send_signal(signal.SIGCONT)
+    out, err = monitor.communicate(timeout=WAIT_S)
+    server.close()
+    assert monitor.returncode == 3, out + err
+    assert f"no bytes were seen on tcp 127.0.0.1:{port} in 1.0 s:" in out, out
+    assert json.loads((tmp_path / "m.json").read_text())["scenarios"][0]["ended"] == 1.0
+    # as commissioning.md's row on a stalled host says
+    assert "A stall when `--duration` runs out does not count as time listened" in \
+        (ROOT / "docs" / "commissioning.md").read_text(encoding="utf-8")
 
 
 @pytest.mark.serial
@@ -1473,20 +1498,25 @@ def test_a_capture_that_cannot_be_written_is_an_error_not_a_traceback(line, tmp_
 
 
 @pytest.mark.serial
-def test_the_capture_is_written_even_when_a_report_cannot_be(line, tmp_path):
+def test_the_capture_is_written_even_when_a_report_cannot_be(bare_line, tmp_path):
     """The line's bytes cannot be had again; a report can, from the capture (`uitamr
     replay`). A --json in a folder that exists but cannot be written used to end the
     command before the capture was written: the capture was lost."""
-    monitor = start("monitor", "--serial", line.tap, "--duration", "2s", "--json", "/proc/m.json",
+    monitor = start("monitor", "--serial", bare_line.tap, "--duration", "60s", "--json", "/proc/m.json",
                     "--capture", tmp_path / "c.txt")
     wait_for_line(monitor, "listening")
-    master = Master(line)
+    master = Master(bare_line, Robot(SETTINGS))
     master.send(STOP)
     master.close()
+    # stopped once it has the echo: with a 2 s --duration, a host that held the test back
+    # that long would leave the capture empty
+    wait_for_line(monitor, "echo: stop")
+    monitor.send_signal(signal.SIGINT)
     out, err = monitor.communicate(timeout=WAIT_S)
     assert monitor.returncode == 2 and "Traceback" not in err
     assert "cannot write /proc/m.json" in err
-    assert parse_plain((tmp_path / "c.txt").read_text(encoding="utf-8"))  # the capture holds the stop
+    chunks = parse_plain((tmp_path / "c.txt").read_text(encoding="utf-8"))
+    assert b"".join(c.data for c in chunks) == STOP + STOP  # the capture holds the stop and its echo
 
 
 def test_an_html_report_of_a_capture_spanning_years_stays_small(tmp_path):
