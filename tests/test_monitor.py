@@ -983,11 +983,12 @@ class BadMasterStream:
 
     The host cannot make another line of it: each frame goes in one send (the capture has
     each frame's first byte apart, and a stream thread the host stalled 30 ms between the
-    two sends cut the frame in two, CRC and FORMAT findings), and each waits its gap after
-    the previous one as it was really sent (on a schedule from the first, a late frame made
-    the gap to the next one shorter: the stop came 350 ms before the last read, with 120 ms
-    of margin against the pacing). A stall can still lengthen a gap: `stalls` says when the
-    stream woke late, `sent` when each frame went (monotonic seconds, bytes)."""
+    two sends would cut the frame in two, CRC and FORMAT findings), and each waits its gap
+    after the previous one as it was really sent (on a schedule from the first, a late frame
+    made the gap to the next one shorter: the stop comes 350 ms before the last read, 120 ms
+    of margin against the pacing; 4 UITAMR-PACING, not 3, were seen under load). A stall can
+    still lengthen a gap: `stalls` says when the stream woke late, `sent` when each frame
+    went (monotonic seconds, bytes)."""
 
     def __init__(self, linger_s: float = 0.3, lead_s: float = 0.0):
         (chunks,) = read_capture(CAPTURES / "bad-master.txt").values()
