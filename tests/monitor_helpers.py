@@ -31,14 +31,15 @@ def start(*args, **kw) -> subprocess.Popen:
     return subprocess.Popen(uitamr(*args), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kw)
 
 
-def wait_for_line(proc: subprocess.Popen, words: str, timeout_s: float = WAIT_S) -> str:
+def wait_for_line(proc: subprocess.Popen, words: str, timeout_s: float = WAIT_S, seen: list[str] | None = None) -> str:
     """Read the process's stdout until a line holds `words` (it has started, it has seen a
     frame). A process that shows no such line in `timeout_s` is killed, and the failure
-    says what it printed. (This waited with select() on the pipe: lines that came in one
-    write with the one read were already in the reader's buffer, not the pipe, and were
-    never looked at; and its failure then read stderr to the end, so a process that ran
-    on hung the test instead of failing it.)"""
-    seen = []
+    says what it printed. The lines read (the one found too) are added to `seen` if given.
+    (This waited with select() on the pipe: lines that came in one write with the one read
+    were already in the reader's buffer, not the pipe, and were never looked at; and its
+    failure then read stderr to the end, so a process that ran on hung the test instead
+    of failing it.)"""
+    seen = [] if seen is None else seen
     watchdog = threading.Timer(timeout_s, proc.kill)
     watchdog.start()
     try:

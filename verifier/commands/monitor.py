@@ -179,7 +179,13 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
             source.close()
         if lost:
             console.print(f"[yellow]stopped: {escape(lost)}[/]")
-        result = session.result(listened_us=round((time.monotonic() - started) * 1_000_000))
+        listened_us = round((time.monotonic() - started) * 1_000_000)
+        if deadline is not None and not stop.is_set() and not lost:
+            # ended by --duration: it listened that long. A host that ran the monitor late
+            # (a loaded PC) let it notice the deadline late; that delay was no listening, and
+            # "no bytes were seen in 1.1 s" for --duration 1s told the engineer otherwise
+            listened_us = duration
+        result = session.result(listened_us=listened_us)
         if lost:
             result.notes.append(f"the capture ended early: {lost}")
         failed: list[ReportError] = []
