@@ -206,6 +206,29 @@ def serve_serial(url: str, emulator: Emulator, stop: StopFlag, silence_us: int,
             emulator.note(f"serial {url} closed{left_behind}")
 
 
+#: the most one read of a client takes (a flood beyond it is read on the next round)
+READ_AT_ONCE = 1 << 20
+
+
+def _read_waiting(sock: socket.socket) -> bytes:
+    """Every byte a client's socket holds now (up to READ_AT_ONCE), in one piece; b"" when
+    the peer shut its side. Read 4096 bytes at a time, a flood that had already come was
+    framed in pieces, and a host that stalled the emulator between two of them for longer
+    than the frame gap made it take the stall for a silence: the flood was cut, its tail
+    taken for a new frame, and a request sent after the first "!!" line was glued to it
+    (no reply). Bytes that arrive while the emulator is stalled still get the later time."""
+    data = sock.recv(65536)
+    while data and len(data) < READ_AT_ONCE:
+        try:
+            more = sock.recv(65536)
+        except OSError:  # nothing more waits (or the connection failed: said on the next read)
+            break
+        if not more:  # the peer shut its side: said on the next read
+            break
+        data += more
+    return data
+
+
 def serve_tcp(host: str, port: int, emulator: Emulator, stop: StopFlag, silence_us: int,
               on_listening=None) -> None:
     """Run until ``stop`` is set: accept clients on host:port; each has its own framing,
@@ -251,7 +274,7 @@ def serve_tcp(host: str, port: int, emulator: Emulator, stop: StopFlag, silence_
                     continue
                 sock = key.fileobj
                 try:
-                    data = sock.recv(4096)
+                    data = _read_waiting(sock)
                 except (BlockingIOError, InterruptedError):
                     continue
                 except OSError as err:
