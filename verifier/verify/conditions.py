@@ -19,7 +19,7 @@ from typing import Callable, Mapping
 
 from verifier.digits import describe, foreign_digit
 from verifier.st.errors import TIME_LITERAL_HINT
-from verifier.st.parser import _time_ms_text
+from verifier.st.parser import time_literal_ms
 
 Value = bool | int | float
 
@@ -99,7 +99,7 @@ def _tokenize(text: str) -> list[_Token]:
 
 def _number(token: _Token) -> Value:
     if token.kind == "time":  # T#1s: a TIME label's value, in ms
-        return _time_ms_text(token.text)
+        return time_literal_ms(token.text)
     digits = token.text.replace("_", "")
     if len(digits) > 100:  # int() reads no more than 4300 digits; no label holds even 100
         raise ConditionError(f"a number of {len(digits)} digits: no PLC label holds one this long", token.column)
