@@ -98,11 +98,14 @@ def _tokenize(text: str) -> list[_Token]:
 
 
 def _number(token: _Token) -> Value:
+    digits = token.text.replace("_", "")
+    # int() reads no more than 4300 digits, a float of 310 is infinite (a TIME literal's value
+    # would be an OverflowError); no label holds even 100
+    size = sum(c.isdigit() for c in digits) if token.kind == "time" else len(digits)
+    if size > 100:
+        raise ConditionError(f"a number of {size} digits: no PLC label holds one this long", token.column)
     if token.kind == "time":  # T#1s: a TIME label's value, in ms
         return time_literal_ms(token.text)
-    digits = token.text.replace("_", "")
-    if len(digits) > 100:  # int() reads no more than 4300 digits; no label holds even 100
-        raise ConditionError(f"a number of {len(digits)} digits: no PLC label holds one this long", token.column)
     try:
         if "#" in digits:
             base, body = digits.split("#", 1)
