@@ -141,7 +141,10 @@ _TIME_PART = re.compile(r"([0-9][0-9_]*(?:\.[0-9]+)?)\s*([A-Za-z]+)")
 #: IEC elementary types a typed literal (INT#5) may be prefixed with
 _NUMBER_TYPES = {"BOOL", "INT", "DINT", "UINT", "UDINT", "SINT", "USINT", "LINT", "ULINT", "BYTE",
                  "WORD", "DWORD", "LWORD", "REAL", "LREAL"}
-_DATE_TYPES = {"D", "DATE", "TOD", "TIME_OF_DAY", "DT", "DATE_AND_TIME", "LTIME", "LT"}
+_DATE_TYPES = {"D", "DATE", "TOD", "TIME_OF_DAY", "DT", "DATE_AND_TIME"}
+#: the rest of a date or time-of-day literal after what _HASH_WORD reads (TOD#12 :30:00)
+_DATE_REST = re.compile(r"[-0-9:._]*")
+_LONG_TIME_TYPES = {"LTIME", "LT"}
 
 
 def _hash_literal(text: str, pos: int) -> tuple[int, int, str] | None:
@@ -173,8 +176,14 @@ def _hash_literal(text: str, pos: int) -> tuple[int, int, str] | None:
                                f"typed literals such as '{word}' are not supported (docs/st-dialect.md §3): "
                                "write the value alone")
         if prefix in _DATE_TYPES:
+            word += _DATE_REST.match(text, m.end()).group()
             return (line, col, f"'{word}': {prefix} literals are not supported; GX Works has no date or "
                                "time-of-day types (docs/st-dialect.md §6)")
+        if prefix in _LONG_TIME_TYPES:  # the checker: "unknown type 'LTIME'"
+            time = "T#" + word.split("#", 1)[1]
+            instead = f", {time}" if _TIME_WORD.fullmatch(time) else ""
+            return (line, col, f"'{word}': {prefix} literals are not supported (docs/st-dialect.md §6 has no LTIME "
+                               f"type): write a TIME literal{instead}")
         return None
     return None
 
