@@ -131,8 +131,10 @@ def _nested_comment(text: str, pos: int) -> tuple[int, int, str] | None:
 TIME_LITERAL_HINT = "give every number its unit, d, h, m, s or ms (T#2s, T#1m30s, T#500ms)"
 #: a word with '#' after a name: a time literal (T#2s) or a typed one (INT#5) as written
 _HASH_WORD = re.compile(r"(?<![A-Za-z0-9_#.])([A-Za-z_][A-Za-z0-9_]*)#[-+0-9A-Za-z_.#]*")
-#: the time literal st.lark reads (TIME_LIT), the whole word
-_TIME_WORD = re.compile(r"(T|TIME)#-?([0-9][0-9_]*(\.[0-9]+)?(ms|d|h|m|s)_?)+", re.IGNORECASE)
+#: the time literal st.lark reads (TIME_LIT), the whole word, case aside: for the ST checker
+#: and scenario conditions alike ('#' escaped, so that a verbose pattern takes it too)
+TIME_LITERAL = r"(?:TIME|T)\#-?(?:[0-9][0-9_]*(?:\.[0-9]+)?(?:ms|d|h|m|s)_?)+"
+_TIME_WORD = re.compile(TIME_LITERAL, re.IGNORECASE)
 #: units people write that TIME literals spell otherwise
 _TIME_UNITS = {"msec": "ms", "msecs": "ms", "sec": "s", "secs": "s", "second": "s", "seconds": "s",
                "min": "m", "mins": "m", "minute": "m", "minutes": "m", "hr": "h", "hrs": "h",

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from typing import Callable, Mapping
 
 from verifier.digits import describe, foreign_digit
-from verifier.st.errors import TIME_LITERAL_HINT
+from verifier.st.errors import TIME_LITERAL, TIME_LITERAL_HINT
 from verifier.st.parser import time_literal_ms
 
 Value = bool | int | float
@@ -34,7 +34,7 @@ class ConditionError(ValueError):
 _TOKEN = re.compile(
     r"""
     (?P<space>\s+)
-  | (?P<time>(?i:(?:TIME|T)\#-?(?:[0-9][0-9_]*(?:\.[0-9]+)?(?:ms|d|h|m|s)_?)+)(?![A-Za-z0-9_.\#]))
+  | (?P<time>(?i:""" + TIME_LITERAL + r""")(?![A-Za-z0-9_.\#]))
   | (?P<number>(?:2|8|16)\#[0-9A-Fa-f_]+|[0-9][0-9_]*(?:\.[0-9]+)?)
   | (?P<name>[A-Za-z_][A-Za-z0-9_]*(?:\[[0-9]+\])*(?:\.[A-Za-z_][A-Za-z0-9_]*(?:\[[0-9]+\])*)*)
   | (?P<op><>|<=|>=|=|<|>|&|\(|\)|-)
