@@ -51,6 +51,25 @@ def test_broken_file_gets_its_one_diagnostic(path):
     assert part in diags[0].message
 
 
+@pytest.mark.parametrize("literal, message", [
+    ("TOD#12:30:00", "'TOD#12:30:00': TOD literals are not supported; GX Works has no date or time-of-day types"),
+    ("DT#2024-01-01-12:00:00", "'DT#2024-01-01-12:00:00': DT literals are not supported; GX Works has no date"),
+    ("D#2024-01-01", "'D#2024-01-01': D literals are not supported; GX Works has no date"),
+    ("LTIME#5s", "'LTIME#5s': LTIME literals are not supported (docs/st-dialect.md §6 has no LTIME type): "
+                 "write a TIME literal, T#5s"),
+    ("LT#1m30s", "'LT#1m30s': LT literals are not supported (docs/st-dialect.md §6 has no LTIME type): "
+                 "write a TIME literal, T#1m30s"),
+])
+def test_a_date_or_long_time_literal_is_named_whole_and_for_what_it_is(tmp_path, literal, message):
+    """58cb9e5 names the literal whole at its first character; a time of day was cut at its
+    first ':' ('TOD#12'), and LTIME#5s was said to be a date or time-of-day type."""
+    path = tmp_path / "p.st"
+    path.write_text(f"PROGRAM P\nVAR\n    t : TIME;\nEND_VAR\nt := {literal};\nEND_PROGRAM\n", encoding="utf-8")
+    _, diags = diagnose(path)
+    assert [(d.line, d.col, d.severity) for d in diags] == [(5, 6, "error")], "\n".join(map(str, diags))
+    assert message in diags[0].message, diags[0].message
+
+
 def _opener_text(what: str) -> str:
     return what.strip("'")
 

@@ -125,9 +125,11 @@ def test_c_notation_in_a_condition_is_told_the_st_spelling(text, column, hint):
     assert info.value.column == column and hint in info.value.message, info.value.message
 
 
-@pytest.mark.parametrize("number", ["9" * 5000, "16#" + "F" * 5000, "1." + "9" * 5000])
+@pytest.mark.parametrize("number", ["9" * 5000, "16#" + "F" * 5000, "1." + "9" * 5000, "T#" + "9" * 400 + "s",
+                                    "TIME#1m" + "9" * 5000 + "ms"])
 def test_a_number_of_thousands_of_digits_in_a_condition_says_so(number):
-    # was "'99...9' is not a number" (int()'s 4300-digit limit), or read and judged as it was
+    # was "'99...9' is not a number" (int()'s 4300-digit limit), or read and judged as it was;
+    # a TIME literal of 400 digits ended the verify run in an OverflowError traceback
     with pytest.raises(ConditionError) as info:
         parse_condition(f"x = {number}")
     assert info.value.column == 5 and "digits: no PLC label holds one this long" in info.value.message

@@ -131,8 +131,10 @@ def _nested_comment(text: str, pos: int) -> tuple[int, int, str] | None:
 TIME_LITERAL_HINT = "give every number its unit, d, h, m, s or ms (T#2s, T#1m30s, T#500ms)"
 #: a word with '#' after a name: a time literal (T#2s) or a typed one (INT#5) as written
 _HASH_WORD = re.compile(r"(?<![A-Za-z0-9_#.])([A-Za-z_][A-Za-z0-9_]*)#[-+0-9A-Za-z_.#]*")
-#: the time literal st.lark reads (TIME_LIT), the whole word
-_TIME_WORD = re.compile(r"(T|TIME)#-?([0-9][0-9_]*(\.[0-9]+)?(ms|d|h|m|s)_?)+", re.IGNORECASE)
+#: the time literal st.lark reads (TIME_LIT), the whole word, case aside: for the ST checker
+#: and scenario conditions alike ('#' escaped, so that a verbose pattern takes it too)
+TIME_LITERAL = r"(?:TIME|T)\#-?(?:[0-9][0-9_]*(?:\.[0-9]+)?(?:ms|d|h|m|s)_?)+"
+_TIME_WORD = re.compile(TIME_LITERAL, re.IGNORECASE)
 #: units people write that TIME literals spell otherwise
 _TIME_UNITS = {"msec": "ms", "msecs": "ms", "sec": "s", "secs": "s", "second": "s", "seconds": "s",
                "min": "m", "mins": "m", "minute": "m", "minutes": "m", "hr": "h", "hrs": "h",
@@ -141,7 +143,10 @@ _TIME_PART = re.compile(r"([0-9][0-9_]*(?:\.[0-9]+)?)\s*([A-Za-z]+)")
 #: IEC elementary types a typed literal (INT#5) may be prefixed with
 _NUMBER_TYPES = {"BOOL", "INT", "DINT", "UINT", "UDINT", "SINT", "USINT", "LINT", "ULINT", "BYTE",
                  "WORD", "DWORD", "LWORD", "REAL", "LREAL"}
-_DATE_TYPES = {"D", "DATE", "TOD", "TIME_OF_DAY", "DT", "DATE_AND_TIME", "LTIME", "LT"}
+_DATE_TYPES = {"D", "DATE", "TOD", "TIME_OF_DAY", "DT", "DATE_AND_TIME"}
+#: the rest of a date or time-of-day literal after what _HASH_WORD reads (TOD#12 :30:00)
+_DATE_REST = re.compile(r"[-0-9:._]*")
+_LONG_TIME_TYPES = {"LTIME", "LT"}
 
 
 def _hash_literal(text: str, pos: int) -> tuple[int, int, str] | None:
@@ -173,8 +178,14 @@ def _hash_literal(text: str, pos: int) -> tuple[int, int, str] | None:
                                f"typed literals such as '{word}' are not supported (docs/st-dialect.md §3): "
                                "write the value alone")
         if prefix in _DATE_TYPES:
+            word += _DATE_REST.match(text, m.end()).group()
             return (line, col, f"'{word}': {prefix} literals are not supported; GX Works has no date or "
                                "time-of-day types (docs/st-dialect.md §6)")
+        if prefix in _LONG_TIME_TYPES:  # the checker: "unknown type 'LTIME'"
+            time = "T#" + word.split("#", 1)[1]
+            instead = f", {time}" if _TIME_WORD.fullmatch(time) else ""
+            return (line, col, f"'{word}': {prefix} literals are not supported (docs/st-dialect.md §6 has no LTIME "
+                               f"type): write a TIME literal{instead}")
         return None
     return None
 

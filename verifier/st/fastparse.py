@@ -38,7 +38,7 @@ from operator import sub
 
 from verifier.st import ast
 from verifier.st.devices import H_CONST_RE, K_CONST_RE, parse_device
-from verifier.st.parser import MAX_NUMBER_CHARS, _section, _time_ms_text, decode_escapes, number_too_long
+from verifier.st.parser import MAX_NUMBER_CHARS, _section, decode_escapes, number_too_long, time_literal_ms
 
 
 class Bail(Exception):
@@ -804,7 +804,7 @@ class Parser:
         if kind == "BASED_INT":
             return self.based_lit(i)
         if kind == "TIME_LIT":
-            return ast.TimeLiteral(_time_ms_text(V[i]), V[i], span=self.tok_span(i))
+            return ast.TimeLiteral(time_literal_ms(V[i]), V[i], span=self.tok_span(i))
         if kind == "STRING_LIT" or kind == "WSTRING_LIT":
             return ast.StringLiteral(_decode(V[i]), kind == "WSTRING_LIT", span=self.tok_span(i))
         raise Bail

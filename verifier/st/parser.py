@@ -109,10 +109,12 @@ def _decode_string(tok: Token) -> str:
 
 
 def _time_ms(tok: Token) -> int:
-    return _time_ms_text(tok.value)
+    return time_literal_ms(tok.value)
 
 
-def _time_ms_text(value: str) -> int:
+def time_literal_ms(value: str) -> int:
+    """The value in ms of a TIME literal as st.lark reads it (`T#1m30s`, `TIME#-5ms`), as
+    a TIME label holds it: for the ST readers and for scenario conditions alike."""
     text = value.split("#", 1)[1]
     negative = text.startswith("-")
     total = 0.0

@@ -18,8 +18,8 @@ from dataclasses import dataclass
 from typing import Callable, Mapping
 
 from verifier.digits import describe, foreign_digit
-from verifier.st.errors import TIME_LITERAL_HINT
-from verifier.st.parser import _time_ms_text
+from verifier.st.errors import TIME_LITERAL, TIME_LITERAL_HINT
+from verifier.st.parser import time_literal_ms
 
 Value = bool | int | float
 
@@ -34,7 +34,7 @@ class ConditionError(ValueError):
 _TOKEN = re.compile(
     r"""
     (?P<space>\s+)
-  | (?P<time>(?i:(?:TIME|T)\#-?(?:[0-9][0-9_]*(?:\.[0-9]+)?(?:ms|d|h|m|s)_?)+)(?![A-Za-z0-9_.\#]))
+  | (?P<time>(?i:""" + TIME_LITERAL + r""")(?![A-Za-z0-9_.\#]))
   | (?P<number>(?:2|8|16)\#[0-9A-Fa-f_]+|[0-9][0-9_]*(?:\.[0-9]+)?)
   | (?P<name>[A-Za-z_][A-Za-z0-9_]*(?:\[[0-9]+\])*(?:\.[A-Za-z_][A-Za-z0-9_]*(?:\[[0-9]+\])*)*)
   | (?P<op><>|<=|>=|=|<|>|&|\(|\)|-)
@@ -98,11 +98,14 @@ def _tokenize(text: str) -> list[_Token]:
 
 
 def _number(token: _Token) -> Value:
-    if token.kind == "time":  # T#1s: a TIME label's value, in ms
-        return _time_ms_text(token.text)
     digits = token.text.replace("_", "")
-    if len(digits) > 100:  # int() reads no more than 4300 digits; no label holds even 100
-        raise ConditionError(f"a number of {len(digits)} digits: no PLC label holds one this long", token.column)
+    # int() reads no more than 4300 digits, a float of 310 is infinite (a TIME literal's value
+    # would be an OverflowError); no label holds even 100
+    size = sum(c.isdigit() for c in digits) if token.kind == "time" else len(digits)
+    if size > 100:
+        raise ConditionError(f"a number of {size} digits: no PLC label holds one this long", token.column)
+    if token.kind == "time":  # T#1s: a TIME label's value, in ms
+        return time_literal_ms(token.text)
     try:
         if "#" in digits:
             base, body = digits.split("#", 1)
