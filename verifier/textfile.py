@@ -58,6 +58,25 @@ def real_path(path: Path | str) -> Path:
     return Path(os.path.realpath(path))
 
 
+def is_folder(path: Path | str) -> bool:
+    """`Path.is_dir()` for paths users give, False where the file system refuses the name
+    (one too long, a symlink loop), which Python 3.11's `is_dir` raises: whatever reads the
+    path then says what is wrong with it."""
+    try:
+        return Path(path).is_dir()
+    except OSError:
+        return False
+
+
+def is_char_device(path: Path | str) -> bool:
+    """`Path.is_char_device()` (a serial port: /dev/ttyUSB0) for paths users give, False
+    where it raises, as `is_folder`."""
+    try:
+        return Path(path).is_char_device()
+    except OSError:
+        return False
+
+
 def reached_path(path: Path | str, cwd: Path | str) -> Path:
     """`path` against the folder `cwd`, absolute but not resolved: the path the user reached
     the file by (through a symlinked `vendor/uitamr`, say), where `real_path` says where it

@@ -21,6 +21,7 @@ from verifier.commands.report_files import (JudgingCommand, ReportError, check_f
 from verifier.monitor.capture import CaptureError, read_capture
 from verifier.monitor.framer import DEFAULT_TOLERANCE_US
 from verifier.monitor.session import CaptureInfo, MonitorSession
+from verifier.textfile import is_char_device
 from verifier.verify.evidence import RuleOptions
 from verifier.verify.result import mistakes_of
 
@@ -47,7 +48,7 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
         try:
             loaded = read_capture(path)
         except CaptureError as exc:
-            if _is_char_device(path):  # `uitamr replay /dev/ttyUSB0`: the port, not what was captured on it
+            if is_char_device(path):  # `uitamr replay /dev/ttyUSB0`: the port, not what was captured on it
                 exc = CaptureError(exc.where, "", message=f"{exc}: a serial port, not a capture; `uitamr monitor --serial "
                                                      f"{name}` listens on it (replay reads the file its --capture wrote)")
             click.echo(f"uitamr replay: {exc}", err=True)
@@ -89,12 +90,3 @@ def _rule_options(chunks: list, reply_timeout_us: int | None) -> RuleOptions:
     if reply_timeout_us is not None:
         recorded["reply_timeout_us"] = reply_timeout_us
     return RuleOptions(**recorded)
-
-
-def _is_char_device(path: Path) -> bool:
-    """Path.is_char_device, False where it raises (a name too long for the file system,
-    Python 3.11): the capture's own "cannot read" then says what is wrong."""
-    try:
-        return path.is_char_device()
-    except OSError:
-        return False

@@ -30,12 +30,12 @@ from verifier.verify.events_shown import EVENTS_AT_MOST
 from verifier.verify.result import KEEP_ALL, Keep, ScenarioResult, UnusableInput, mistakes_of
 from verifier.bundled import plc_dir as bundled_plc_dir
 from verifier.digits import digit_problem
-from verifier.textfile import real_path
+from verifier.textfile import is_folder, real_path
 from verifier.verify.scenario import (
     CHANNELS, DEFAULT_DURATION_US, MAX_DURATION_US, PLATFORMS, TOLD_PLATFORMS, Scenario, ScenarioError, bundled_platforms,
     default_scenario, load_scenario,
 )
-from verifier.verify.sources import SourceError, expand, is_folder, st_files_in, unique
+from verifier.verify.sources import SourceError, expand, st_files_in, unique
 
 EXIT_PASS, EXIT_FAIL, EXIT_UNUSABLE = 0, 1, 2
 SHOW_PROGRESS_AFTER_S = 0.5

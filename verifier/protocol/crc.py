@@ -48,4 +48,3 @@ def frame_crc(frame: bytes) -> int:
 def crc_ok(frame: bytes) -> bool:
     """True when the last two bytes of ``frame`` are the CRC of the bytes before them."""
     return len(frame) >= 3 and crc16(frame[:-2]) == frame_crc(frame)
-

@@ -65,15 +65,6 @@ def _expand(name: str, base: Path) -> list[Path]:
     return [path]
 
 
-def is_folder(name: str | Path) -> bool:
-    """`Path(name).is_dir()`, False where the file system refuses the name (one too long,
-    a symlink loop), which Python 3.11's `is_dir` raises: what reads it then says so."""
-    try:
-        return Path(name).is_dir()
-    except OSError:
-        return False
-
-
 def st_files_in(path: Path) -> list[Path]:
     """The .st files below the folder `path`, recursively: `.ST` too (as Windows tools may
     name them), and never a folder whose name ends in .st."""
