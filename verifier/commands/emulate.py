@@ -16,10 +16,11 @@ from verifier.amr.schema import LARGEST
 from verifier.emulate.assembler import DEFAULT_SILENCE_US
 from verifier.emulate.core import Emulator
 from verifier.emulate.faultfile import FaultFileError, load_fault_file
-from verifier.emulate.ports import PortError, serial_url_problem, serve_serial, serve_tcp, t3_5_at
+from verifier.emulate.ports import PortError, serve_serial, serve_tcp, t3_5_at
 from verifier.commands.numbers import INT
 from verifier.commands.protocol_options import protocol_settings
 from verifier.digits import digit_problem
+from verifier.serialports import serial_url_problem
 from verifier.stopflag import StopFlag
 
 

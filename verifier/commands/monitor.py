@@ -25,12 +25,12 @@ from verifier.commands.report_files import (JudgingCommand, ReportError, ReportP
                                              check_not_inputs, mistakes_junit, refused_report_junit, report_options,
                                              text_console, usage_error_junit, write_reports)
 from verifier.commands.verify import _Duration
-from verifier.emulate.ports import serial_url_problem
 from verifier.monitor.capture import format_plain, tolerance_hides_pacing
 from verifier.monitor.framer import DEFAULT_TOLERANCE_US, LineTiming
 from verifier.monitor.session import CaptureInfo, MonitorSession
 from verifier.monitor.sources import SerialSource, SourceError, TcpSource, now_us
 from verifier.monitor.view import MonitorView
+from verifier.serialports import serial_url_problem
 from verifier.stopflag import StopFlag
 from verifier.verify.evidence import RuleOptions
 from verifier.verify.result import NO_TRAFFIC, Mistake, overall_verdict

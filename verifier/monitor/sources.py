@@ -41,7 +41,7 @@ class SerialSource:
     def __init__(self, port: str, baud: int, bytesize: int, parity: str, stopbits: float):
         import serial
 
-        from verifier.emulate.ports import why_not_opened
+        from verifier.serialports import why_not_opened
 
         try:
             # exclusive (Linux/macOS: flock; Windows ports always are): a second reader of the
