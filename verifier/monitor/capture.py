@@ -401,9 +401,7 @@ def read_capture(path: Path) -> dict[str, list[Chunk]]:
         raise CaptureError(where, "", message=f"{path}: {exc}") from None
     first = _first_line(text)
     try:
-        if first.startswith("{"):
-            return parse_trace(text, str(path))
-        return {path.stem: parse_plain(text, str(path))}
+        return _parse(text, str(path), path.stem)
     except CaptureError as exc:
         other = _other_kind(path, text, first)
         if other is None:
@@ -416,20 +414,27 @@ def _first_line(text: str) -> str:
     return next((line.lstrip() for line in text_lines(text) if line.strip() and not line.lstrip().startswith("#")), "")
 
 
+def _parse(text: str, file: str, name: str) -> dict[str, list[Chunk]]:
+    """A capture's text as chunks per capture name: our JSONL trace (its first line that is
+    not blank or a comment starts with '{'), else a plain capture, named `name`."""
+    if _first_line(text).startswith("{"):
+        return parse_trace(text, file)
+    return {name: parse_plain(text, file)}
+
+
 def capture_kind(text: str, name: str) -> str | None:
     """What `text` is when it reads as a capture that holds bytes: "a capture of `uitamr
     monitor --capture` (...)" or "a trace (JSON Lines) ..."; None for anything else (only
     comments or an `end` line tell nothing). For the commands that read other files: a
     capture given to them is named as such, not as a mistake at its first line."""
     text = lone_cr_as_line_feed(text)
-    trace = _first_line(text).startswith("{")
     try:
-        captures = parse_trace(text, name) if trace else {name: parse_plain(text, name)}
+        captures = _parse(text, name, name)
     except (CaptureError, RecursionError):
         return None
     if not any(chunk.data for chunks in captures.values() for chunk in chunks):
         return None
-    return ("a trace (JSON Lines) of `uitamr verify` or `uitamr monitor`" if trace
+    return ("a trace (JSON Lines) of `uitamr verify` or `uitamr monitor`" if _first_line(text).startswith("{")
             else "a capture of `uitamr monitor --capture` (times and bytes on the line)")
 
 
