@@ -390,6 +390,15 @@ def _run_batch(batch: list[Scenario], every_scan: bool, keep: Keep) -> list[Scen
     return [run_scenario(scenario, plain=every_scan, keep=keep) for scenario in batch]
 
 
+def _worker_started() -> None:
+    """In each --jobs worker: SIGTERM kills it, as the pool expects. A forked worker inherited
+    the command's own SIGTERM handler (`_terminate_as_exit`), which raises SystemExit; the pool
+    stops its workers with SIGTERM when one of them was killed, and a worker sending its
+    results at that moment caught the SystemExit and sent them again, into a pipe nobody
+    read any more: the command hung for ever instead of saying a worker was lost."""
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
 def _batches(scenarios: list[Scenario], jobs: int) -> list[list[int]]:
     """Scenarios (by index) grouped for the worker processes, longest batch first.
 
@@ -471,7 +480,7 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress,
         batches = _batches(scenarios, jobs)
         # a worker per batch at most: the pool forks all its workers at once, and --jobs 5000
         # forked 5000 processes for two scenarios (the run never ended)
-        with ProcessPoolExecutor(max_workers=min(jobs, len(batches))) as pool:
+        with ProcessPoolExecutor(max_workers=min(jobs, len(batches)), initializer=_worker_started) as pool:
             futures = {pool.submit(_run_batch, [scenarios[i] for i in batch], every_scan, keep): batch
                        for batch in batches}
             try:
