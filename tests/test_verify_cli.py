@@ -391,7 +391,7 @@ def test_jobs_beyond_the_batches_start_no_idle_workers(tmp_path, monkeypatch):
     asked = []
 
     class Pool(concurrent.futures.ThreadPoolExecutor):  # records the size, runs in threads
-        def __init__(self, max_workers):
+        def __init__(self, max_workers, initializer=None):  # a worker process's set-up: not for threads
             asked.append(max_workers)
             super().__init__(max_workers=min(max_workers, 4))
 
