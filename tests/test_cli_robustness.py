@@ -332,9 +332,32 @@ def test_export_of_a_pipe_or_a_device_is_refused_without_reading_it(tmp_path):
         done = subprocess.run([sys.executable, "-m", "verifier.cli", "export", "--target", "gxworks2", "--out",
                                str(tmp_path / "out"), str(source)], capture_output=True, text=True, timeout=60,
                               preexec_fn=at_most_a_gigabyte)
-        assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
-        assert f"{source}:0:0: error: is not a regular file ({kind}); give a .st file" in done.stderr
-        assert "uitamr export: nothing written" in done.stderr
+        assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+        assert f"uitamr export: {source}: is not a regular file ({kind}); give a .st file" in done.stderr
+        assert not (tmp_path / "out").exists()
+
+
+def test_export_refuses_unusable_input_as_check_does(tmp_path, monkeypatch):
+    """`uitamr export` of a pipe or a device said 'nothing written, 1 unreadable file(s)' and
+    exited 1, the code of a program with mistakes, where `uitamr check` of the same input
+    exits 2 (unusable input) with the file and what to give instead: both now refuse it
+    alike, with the same line; a file whose bytes are not text stays an error of the
+    sources (exit 1) in both, at its line and column."""
+    monkeypatch.chdir(tmp_path)
+    os.mkfifo("pipe.st")
+    (tmp_path / "bad.st").write_bytes(b"PROGRAM P\n\xff\nEND_PROGRAM\n")
+    for source, why in [("pipe.st", "is not a regular file (a pipe); give a .st file"),
+                        ("/dev/null", "is not a regular file (a character device); give a .st file")]:
+        checked = invoke("check", source)
+        exported = invoke("export", "--target", "gxworks2", "--out", "out", source)
+        assert checked.exit_code == exported.exit_code == 2, (checked.output, exported.output)
+        assert f"uitamr check: {source}: {why}" in checked.output
+        assert f"uitamr export: {source}: {why}" in exported.output, exported.output
+        assert "unreadable" not in exported.output and not (tmp_path / "out").exists()
+    checked = invoke("check", "bad.st")
+    exported = invoke("export", "--target", "gxworks2", "--out", "out", "bad.st")
+    assert checked.exit_code == exported.exit_code == 1, (checked.output, exported.output)
+    assert "bad.st:2:1: error: byte 0xFF" in exported.output
 
 
 def test_an_empty_fault_file_name_is_refused_not_taken_for_none():

@@ -111,9 +111,9 @@ def not_st(path: Path) -> str | None:
     return None if suffix in (".st", ".toml") else _capture_kind(path) or _scenario_kind(path)
 
 
-def _not_a_source(path: Path) -> str | None:
-    """Why `path` cannot be checked at all (missing, a device, a pipe, another kind of
-    the toolkit's files ...), or None. Files that exist but hold no text are diagnosed with
+def not_a_source(path: Path) -> str | None:
+    """Why `path` cannot be checked (or exported) at all (missing, a device, a pipe, another
+    kind of the toolkit's files ...), or None: a usage error (exit 2) of either command. Files that exist but hold no text are diagnosed with
     file:line:col instead."""
     from verifier.st import read_source
     from verifier.verify.sources import is_pattern
@@ -261,7 +261,7 @@ def command(sources: tuple[str, ...], target: str | None, platform: str | None, 
     target_given = target is not None
     target = platform_target(platform, target) if platform else target or "gxworks2"
     paths = expand_sources(sources)
-    unusable = [(p, _not_a_source(p)) for p in paths]
+    unusable = [(p, not_a_source(p)) for p in paths]
     unusable = [(p, why) for p, why in unusable if why]
     if unusable:
         for p, why in unusable:
