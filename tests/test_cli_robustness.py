@@ -368,3 +368,32 @@ def test_an_empty_fault_file_name_is_refused_not_taken_for_none():
     assert result.exit_code == 2, result.output
     assert "Invalid value for --faults: the file's name is empty" in result.output
     assert "stopped after" not in result.output
+
+
+def test_a_folder_that_vanishes_during_the_walk_is_passed_over(tmp_path, monkeypatch):
+    """`uitamr check /` and `uitamr verify /` stopped with exit 2 ('/proc/10441: No such file
+    or directory') when a process ended while its /proc folder was being walked: a folder
+    that vanishes between being listed and being read is not the user's file, and is
+    passed over; the others are read. Real folders; the scandir wrapper only times the
+    removal: the first folder read removes its sibling, listed but not yet read."""
+    import shutil
+
+    root = tmp_path / "tree"
+    for name in ("a", "b"):
+        (root / name).mkdir(parents=True)
+        (root / name / f"{name.upper()}.st").write_text(f"PROGRAM {name.upper()}\nVAR x : INT; END_VAR\n"
+                                                         "x := x + 1;\nEND_PROGRAM\n")
+    real_scandir = os.scandir
+    removed = []
+
+    def scandir(path="."):
+        if isinstance(path, (str, os.PathLike)) and Path(path).parent == root and not removed:
+            removed.extend(sibling for sibling in root.iterdir() if sibling != Path(path))
+            for sibling in removed:
+                shutil.rmtree(sibling)
+        return real_scandir(path)
+
+    monkeypatch.setattr(os, "scandir", scandir)
+    result = invoke("check", root)
+    assert removed and result.exit_code == 0, result.output
+    assert "1 file(s) checked" in result.output and "No such file" not in result.output

@@ -315,7 +315,9 @@ def _no_st_in(folder: Path) -> str:
     .toml files, or for check itself when they are named (check reads a folder for .st only)."""
     from collections import Counter
 
-    files = [p for p in folder.rglob("*") if p.is_file()]
+    from verifier.verify.sources import files_below
+
+    files = files_below(folder)
     if not files:
         return "no .st file in it: the folder is empty"
     kinds = Counter(p.suffix.lower() or "(no suffix)" for p in files).most_common()

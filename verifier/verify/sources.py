@@ -68,7 +68,31 @@ def _expand(name: str, base: Path) -> list[Path]:
 def st_files_in(path: Path) -> list[Path]:
     """The .st files below the folder `path`, recursively: `.ST` too (as Windows tools may
     name them), and never a folder whose name ends in .st."""
-    return sorted(p for p in path.rglob("*") if p.suffix.lower() == ".st" and p.is_file())
+    return sorted(p for p in files_below(path) if p.suffix.lower() == ".st")
+
+
+def files_below(folder: Path) -> list[Path]:
+    """The regular files below `folder`, recursively, as `folder.rglob("*")` finds them
+    (symlinked folders not entered, a folder that cannot be read passed over), and also
+    passing over a folder that vanishes between being listed and being read: `rglob` stopped
+    the walk there ("/proc/10441: No such file or directory" ended `uitamr check /`, exit 2),
+    though what vanished was no file of the user's."""
+    def skipped(exc: OSError) -> None:
+        if not isinstance(exc, (FileNotFoundError, NotADirectoryError, PermissionError)):
+            raise exc
+
+    found = []
+    for top, _, names in os.walk(folder, onerror=skipped):
+        found += [p for name in names if _is_file(p := Path(top, name))]
+    return found
+
+
+def _is_file(path: Path) -> bool:
+    """`path.is_file()`, False where even asking is refused (/proc/1/cwd: permission denied)."""
+    try:
+        return path.is_file()
+    except OSError:
+        return False
 
 
 def unique(paths: list[Path]) -> tuple[Path, ...]:
