@@ -397,3 +397,29 @@ def test_a_folder_that_vanishes_during_the_walk_is_passed_over(tmp_path, monkeyp
     result = invoke("check", root)
     assert removed and result.exit_code == 0, result.output
     assert "1 file(s) checked" in result.output and "No such file" not in result.output
+
+
+def test_a_file_name_with_a_newline_stays_on_its_message_line(tmp_path, monkeypatch):
+    """A file named with a line feed or a tab (`a<LF>b.st`) was printed as it is: the message
+    `a<LF>b.st:3:6: error: ...` broke into two lines, and the editor's or CI's
+    `file:line:col` reader saw `b.st:3:6`. Line-based messages (check, export, verify, their
+    usage errors) show such a name escaped as the console report does (`a\\x0ab.st`);
+    JSON keeps the name exact."""
+    monkeypatch.chdir(tmp_path)
+    bad = "a\nb.st"
+    Path(bad).write_text("PROGRAM P\nVAR x : INT; END_VAR\nx := ;\nEND_PROGRAM\n", encoding="utf-8")
+    os.mkfifo("p\tq.st")
+    shown = "a\\x0ab.st:3:6: error: expected an expression"
+    for args in (["check", bad], ["export", "--target", "gxworks2", "--out", "out", bad]):
+        result = invoke(*args)
+        assert result.exit_code == 1, result.output
+        assert result.output.splitlines()[0].startswith(shown), result.output
+        assert "\n" + "b.st:3:6" not in result.output
+    result = invoke("verify", bad)
+    assert result.exit_code == 2 and f"{tmp_path}/{shown}" in result.output, result.output
+    for command in (["check"], ["export", "--target", "gxworks2", "--out", "out"]):
+        result = invoke(*command, "p\tq.st")
+        assert result.exit_code == 2, result.output
+        assert f"uitamr {command[0]}: p\\x09q.st: is not a regular file (a pipe)" in result.output
+    (finding,) = json.loads(invoke("check", "--format", "json", bad).output)["diagnostics"]
+    assert finding["file"] == bad

@@ -25,7 +25,7 @@ from verifier.commands.check_formats import PLATFORM_RULES, RULES, Finding, to_g
 from verifier.sim.cpu import EDITOR_NAMES, PROFILES, TARGET_CPUS
 from verifier.st import TARGETS
 from verifier.st.ast import Diagnostic, SourceFile
-from verifier.textfile import real_path, text_lines
+from verifier.textfile import real_path, shown_name, text_lines
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
 
@@ -265,7 +265,7 @@ def command(sources: tuple[str, ...], target: str | None, platform: str | None, 
     unusable = [(p, why) for p, why in unusable if why]
     if unusable:
         for p, why in unusable:
-            click.echo(f"uitamr check: {p}: {why}", err=True)
+            click.echo(f"uitamr check: {shown_name(str(p))}: {why}", err=True)
         sys.exit(EXIT_USAGE)
     say_folders_without_st("uitamr check", sources, fatal=not paths)
     if not paths:

@@ -28,7 +28,7 @@ import click
 from verifier.bundled import PLC_DIR
 from verifier.commands.check import expand_sources, not_a_source, platform_target, say_folders_without_st
 from verifier.sim.cpu import PROFILES
-from verifier.textfile import real_path
+from verifier.textfile import real_path, shown_name
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
 #: the bundled folders each editor gets by default
@@ -90,7 +90,7 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
         missing = [s for s in sources if not Path(s).exists() and not is_pattern(s)]
         if unmatched or missing:
             said = [f"{s!r} matches no file" for s in unmatched]  # as check and verify say it
-            said += [f"no such file or folder: {', '.join(missing)}"] if missing else []
+            said += [f"no such file or folder: {', '.join(map(shown_name, missing))}"] if missing else []
             click.echo(f"uitamr export: {'; '.join(said)}", err=True)
             sys.exit(EXIT_USAGE)
         paths = expand_sources(sources)
@@ -105,7 +105,7 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
         unusable = [(p, why) for p in paths if (why := not_a_source(p))]
         if unusable:
             for p, why in unusable:
-                click.echo(f"uitamr export: {p}: {why}", err=True)
+                click.echo(f"uitamr export: {shown_name(str(p))}: {why}", err=True)
             sys.exit(EXIT_USAGE)
         say_folders_without_st("uitamr export", sources, fatal=not paths)
         if not paths:

@@ -7,7 +7,7 @@ import os
 from functools import lru_cache
 from pathlib import Path
 
-from verifier.textfile import file_kind, reached_path, real_path
+from verifier.textfile import file_kind, reached_path, real_path, shown_name
 
 GLOB_CHARACTERS = "*?["
 
@@ -22,7 +22,7 @@ def expand(name: str, base: Path) -> list[Path]:
     try:
         return _expand(name, base)
     except OSError as exc:  # a name too long for the file system, a folder that cannot be read ...
-        raise SourceError(f"{exc.filename or name}: {exc.strerror or exc}") from None
+        raise SourceError(f"{shown_name(str(exc.filename or name))}: {exc.strerror or exc}") from None
 
 
 def is_pattern(name: str, literal: Path | None = None) -> bool:
@@ -54,14 +54,14 @@ def _expand(name: str, base: Path) -> list[Path]:
     if path.is_dir():
         files = st_files_in(path)
         if not files:
-            raise SourceError(f"the folder {path} holds no .st file")
+            raise SourceError(f"the folder {shown_name(str(path))} holds no .st file")
         return files
     if not path.is_file():
         if path.exists():
-            raise SourceError(f"{path} is not a regular file ({file_kind(path.stat().st_mode)}); give .st files")
+            raise SourceError(f"{shown_name(str(path))} is not a regular file ({file_kind(path.stat().st_mode)}); give .st files")
         if path.is_symlink():
-            raise SourceError(f"{path} is a symbolic link to nothing (its target is missing, or a loop of links)")
-        raise SourceError(f"no such file or folder: {path}")
+            raise SourceError(f"{shown_name(str(path))} is a symbolic link to nothing (its target is missing, or a loop of links)")
+        raise SourceError(f"no such file or folder: {shown_name(str(path))}")
     return [path]
 
 
