@@ -345,9 +345,11 @@ def test_export_refuses_unusable_input_as_check_does(tmp_path, monkeypatch):
     sources (exit 1) in both, at its line and column."""
     monkeypatch.chdir(tmp_path)
     os.mkfifo("pipe.st")
+    os.symlink("gone.st", "link.st")
     (tmp_path / "bad.st").write_bytes(b"PROGRAM P\n\xff\nEND_PROGRAM\n")
     for source, why in [("pipe.st", "is not a regular file (a pipe); give a .st file"),
-                        ("/dev/null", "is not a regular file (a character device); give a .st file")]:
+                        ("/dev/null", "is not a regular file (a character device); give a .st file"),
+                        ("link.st", "is a symbolic link to nothing (its target is missing, or a loop of links)")]:
         checked = invoke("check", source)
         exported = invoke("export", "--target", "gxworks2", "--out", "out", source)
         assert checked.exit_code == exported.exit_code == 2, (checked.output, exported.output)

@@ -116,7 +116,7 @@ def not_a_source(path: Path) -> str | None:
     kind of the toolkit's files ...), or None: a usage error (exit 2) of either command. Files that exist but hold no text are diagnosed with
     file:line:col instead."""
     from verifier.st import read_source
-    from verifier.verify.sources import is_pattern
+    from verifier.verify.sources import DANGLING_LINK, is_pattern
 
     if path.is_file():
         return not_st(path)
@@ -124,6 +124,12 @@ def not_a_source(path: Path) -> str | None:
         return "matches no file"
     if not path.exists() and not path.is_symlink():
         return "no such file"
+    try:
+        path.stat()
+    except FileNotFoundError:  # a symbolic link whose target is missing (a loop: read_source names it)
+        return DANGLING_LINK
+    except OSError:
+        pass
     problems = read_source(path)[1]
     return problems[0].message if problems else None
 

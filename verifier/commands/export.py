@@ -87,7 +87,8 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
 
         # a pattern is expanded as `uitamr verify` expands it (cmd and PowerShell do not)
         unmatched = [s for s in sources if is_pattern(s) and not pattern_files(s)]
-        missing = [s for s in sources if not Path(s).exists() and not is_pattern(s)]
+        # a symbolic link to nothing is not missing: it is refused below, as check refuses it
+        missing = [s for s in sources if not Path(s).exists() and not Path(s).is_symlink() and not is_pattern(s)]
         if unmatched or missing:
             said = [f"{s!r} matches no file" for s in unmatched]  # as check and verify say it
             said += [f"no such file or folder: {', '.join(map(shown_name, missing))}"] if missing else []

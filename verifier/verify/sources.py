@@ -10,6 +10,8 @@ from pathlib import Path
 from verifier.textfile import file_kind, reached_path, real_path, shown_name
 
 GLOB_CHARACTERS = "*?["
+#: what a symbolic link whose target is missing is, in every command's message naming it
+DANGLING_LINK = "is a symbolic link to nothing (its target is missing, or a loop of links)"
 
 
 class SourceError(ValueError):
@@ -60,7 +62,7 @@ def _expand(name: str, base: Path) -> list[Path]:
         if path.exists():
             raise SourceError(f"{shown_name(str(path))} is not a regular file ({file_kind(path.stat().st_mode)}); give .st files")
         if path.is_symlink():
-            raise SourceError(f"{shown_name(str(path))} is a symbolic link to nothing (its target is missing, or a loop of links)")
+            raise SourceError(f"{shown_name(str(path))} {DANGLING_LINK}")
         raise SourceError(f"no such file or folder: {shown_name(str(path))}")
     return [path]
 
