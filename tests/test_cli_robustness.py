@@ -332,9 +332,34 @@ def test_export_of_a_pipe_or_a_device_is_refused_without_reading_it(tmp_path):
         done = subprocess.run([sys.executable, "-m", "verifier.cli", "export", "--target", "gxworks2", "--out",
                                str(tmp_path / "out"), str(source)], capture_output=True, text=True, timeout=60,
                               preexec_fn=at_most_a_gigabyte)
-        assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
-        assert f"{source}:0:0: error: is not a regular file ({kind}); give a .st file" in done.stderr
-        assert "uitamr export: nothing written" in done.stderr
+        assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+        assert f"uitamr export: {source}: is not a regular file ({kind}); give a .st file" in done.stderr
+        assert not (tmp_path / "out").exists()
+
+
+def test_export_refuses_unusable_input_as_check_does(tmp_path, monkeypatch):
+    """`uitamr export` of a pipe or a device said 'nothing written, 1 unreadable file(s)' and
+    exited 1, the code of a program with mistakes, where `uitamr check` of the same input
+    exits 2 (unusable input) with the file and what to give instead: both now refuse it
+    alike, with the same line; a file whose bytes are not text stays an error of the
+    sources (exit 1) in both, at its line and column."""
+    monkeypatch.chdir(tmp_path)
+    os.mkfifo("pipe.st")
+    os.symlink("gone.st", "link.st")
+    (tmp_path / "bad.st").write_bytes(b"PROGRAM P\n\xff\nEND_PROGRAM\n")
+    for source, why in [("pipe.st", "is not a regular file (a pipe); give a .st file"),
+                        ("/dev/null", "is not a regular file (a character device); give a .st file"),
+                        ("link.st", "is a symbolic link to nothing (its target is missing, or a loop of links)")]:
+        checked = invoke("check", source)
+        exported = invoke("export", "--target", "gxworks2", "--out", "out", source)
+        assert checked.exit_code == exported.exit_code == 2, (checked.output, exported.output)
+        assert f"uitamr check: {source}: {why}" in checked.output
+        assert f"uitamr export: {source}: {why}" in exported.output, exported.output
+        assert "unreadable" not in exported.output and not (tmp_path / "out").exists()
+    checked = invoke("check", "bad.st")
+    exported = invoke("export", "--target", "gxworks2", "--out", "out", "bad.st")
+    assert checked.exit_code == exported.exit_code == 1, (checked.output, exported.output)
+    assert "bad.st:2:1: error: byte 0xFF" in exported.output
 
 
 def test_an_empty_fault_file_name_is_refused_not_taken_for_none():
@@ -345,3 +370,58 @@ def test_an_empty_fault_file_name_is_refused_not_taken_for_none():
     assert result.exit_code == 2, result.output
     assert "Invalid value for --faults: the file's name is empty" in result.output
     assert "stopped after" not in result.output
+
+
+def test_a_folder_that_vanishes_during_the_walk_is_passed_over(tmp_path, monkeypatch):
+    """`uitamr check /` and `uitamr verify /` stopped with exit 2 ('/proc/10441: No such file
+    or directory') when a process ended while its /proc folder was being walked: a folder
+    that vanishes between being listed and being read is not the user's file, and is
+    passed over; the others are read. Real folders; the scandir wrapper only times the
+    removal: the first folder read removes its sibling, listed but not yet read."""
+    import shutil
+
+    root = tmp_path / "tree"
+    for name in ("a", "b"):
+        (root / name).mkdir(parents=True)
+        (root / name / f"{name.upper()}.st").write_text(f"PROGRAM {name.upper()}\nVAR x : INT; END_VAR\n"
+                                                         "x := x + 1;\nEND_PROGRAM\n")
+    real_scandir = os.scandir
+    removed = []
+
+    def scandir(path="."):
+        if isinstance(path, (str, os.PathLike)) and Path(path).parent == root and not removed:
+            removed.extend(sibling for sibling in root.iterdir() if sibling != Path(path))
+            for sibling in removed:
+                shutil.rmtree(sibling)
+        return real_scandir(path)
+
+    monkeypatch.setattr(os, "scandir", scandir)
+    result = invoke("check", root)
+    assert removed and result.exit_code == 0, result.output
+    assert "1 file(s) checked" in result.output and "No such file" not in result.output
+
+
+def test_a_file_name_with_a_newline_stays_on_its_message_line(tmp_path, monkeypatch):
+    """A file named with a line feed or a tab (`a<LF>b.st`) was printed as it is: the message
+    `a<LF>b.st:3:6: error: ...` broke into two lines, and the editor's or CI's
+    `file:line:col` reader saw `b.st:3:6`. Line-based messages (check, export, verify, their
+    usage errors) show such a name escaped as the console report does (`a\\x0ab.st`);
+    JSON keeps the name exact."""
+    monkeypatch.chdir(tmp_path)
+    bad = "a\nb.st"
+    Path(bad).write_text("PROGRAM P\nVAR x : INT; END_VAR\nx := ;\nEND_PROGRAM\n", encoding="utf-8")
+    os.mkfifo("p\tq.st")
+    shown = "a\\x0ab.st:3:6: error: expected an expression"
+    for args in (["check", bad], ["export", "--target", "gxworks2", "--out", "out", bad]):
+        result = invoke(*args)
+        assert result.exit_code == 1, result.output
+        assert result.output.splitlines()[0].startswith(shown), result.output
+        assert "\n" + "b.st:3:6" not in result.output
+    result = invoke("verify", bad)
+    assert result.exit_code == 2 and f"{tmp_path}/{shown}" in result.output, result.output
+    for command in (["check"], ["export", "--target", "gxworks2", "--out", "out"]):
+        result = invoke(*command, "p\tq.st")
+        assert result.exit_code == 2, result.output
+        assert f"uitamr {command[0]}: p\\x09q.st: is not a regular file (a pipe)" in result.output
+    (finding,) = json.loads(invoke("check", "--format", "json", bad).output)["diagnostics"]
+    assert finding["file"] == bad

@@ -180,6 +180,35 @@ def test_the_regeneration_command_reports_mistakes_without_a_traceback(tmp_path)
     assert ok.returncode == 0 and ok.stdout == (LADDER / "UITAMR_LadderFx3.csv").read_bytes()
 
 
+def test_the_regeneration_command_writes_its_file_only_when_the_il_converts(tmp_path):
+    """`python -m verifier.export.ladder X.il > X.csv` left an empty X.csv when the .il had a
+    mistake (the shell empties the file before the command runs), and GX Works2 then read a
+    program of nothing. `-o X.csv` writes the file only once the conversion succeeded, whole
+    (a temporary file renamed over it); on a mistake the CSV there stays as it was."""
+    import subprocess
+    import sys
+    root = Path(__file__).resolve().parents[1]
+    env = {"PYTHONPATH": str(root), "PATH": ""}
+    csv = tmp_path / "out.csv"
+    csv.write_bytes(b"the previous CSV\r\n")
+    bad = tmp_path / "bad.il"
+    bad.write_text("LD X0\nOUTT Y0\nEND\n", encoding="utf-8")
+    run = subprocess.run([sys.executable, "-m", "verifier.export.ladder", str(bad), "-o", str(csv)], cwd=root,
+                         capture_output=True, text=True, env=env)
+    assert run.returncode == 1 and "bad.il:2:1" in run.stderr and "Traceback" not in run.stderr, run.stderr
+    assert csv.read_bytes() == b"the previous CSV\r\n" and run.stdout == ""
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.il", "out.csv"]  # no temporary file left
+    ok = subprocess.run([sys.executable, "-m", "verifier.export.ladder", str(IL), "--out", str(csv)], cwd=root,
+                        capture_output=True, env=env)
+    assert ok.returncode == 0 and ok.stdout == b"", ok.stderr
+    assert csv.read_bytes() == (LADDER / "UITAMR_LadderFx3.csv").read_bytes()
+    # the .il itself as the output is refused: it would be overwritten by its own CSV
+    same = subprocess.run([sys.executable, "-m", "verifier.export.ladder", str(bad), "-o", str(bad)], cwd=root,
+                          capture_output=True, text=True, env=env)
+    assert same.returncode == 2 and "is the .il itself" in same.stderr
+    assert bad.read_text(encoding="utf-8") == "LD X0\nOUTT Y0\nEND\n"
+
+
 def test_frame_constants_match_the_protocol(program):
     """The words the ladder writes are the protocol's frames, two bytes per word, low first."""
     words = lambda frame: [frame[i] | frame[i + 1] << 8 for i in range(0, 6, 2)]

@@ -206,6 +206,20 @@ def test_matrix_runs_user_sources_under_the_bundled_robot_and_faults_of_their_pl
     assert "note: bundled scenario run against your sources" in result.output
 
 
+def test_matrix_notes_name_a_bundled_scenario_as_its_headline_does(monkeypatch):
+    """Under --matrix from the repository, a bundled scenario's headline named it
+    plc/scenarios/fx3u-garbage.toml but its notes /abs/.../plc/scenarios/fx3u-garbage.toml:34:1:
+    the notes now name the file as the headline does (relative inside the working folder)."""
+    monkeypatch.chdir(REPO)
+    sources = [str(p.relative_to(REPO)) for p in FX3_SOURCES]
+    result = invoke(*sources, "--matrix", "--platform", "fx3g", "--duration", "3s")
+    assert result.exit_code == 0, result.output
+    headlines = re.findall(r"^(?:PASS|FAIL) .* \((plc/scenarios/[^)]+\.toml)\): ", result.output, re.M)
+    placed = re.findall(r"^    note: (\S+\.toml):\d+:\d+: ", result.output, re.M)
+    assert headlines and placed, result.output
+    assert set(placed) <= set(headlines) and str(REPO) not in result.output
+
+
 def test_matrix_of_a_tcp_program_runs_the_converter_scenarios_only(tmp_path):
     """The FX5U TCP example (its library folder also holds the serial port FBs) runs under the
     bundled FX5U converter scenarios, not the serial ones; a converter refusing connections at

@@ -602,11 +602,12 @@ def _load_error(*diagnostics):
 def test_the_error_compared_across_platforms_is_the_first_diagnostics_whole_line():
     """infer_platform compares each platform's first diagnostic, read back from the message's
     second line: a file name that holds a line break gave only its head ('odd'), the same for
-    every mistake in that file. Now the diagnostic's own line, from the data."""
+    every mistake in that file. Now the diagnostic's own line, from the data (the name's
+    line break shown escaped, as every file:line:col line shows it: textfile.shown_name)."""
     from verifier.verify.platform import _first_error
 
     error = _load_error(("odd\nname.st", 5, 6, "error", "undefined label 'y'"))
-    assert _first_error(error) == "odd\nname.st:5:6: error: undefined label 'y'"
+    assert _first_error(error) == "odd\\x0aname.st:5:6: error: undefined label 'y'"
     assert _first_error(_load_error()) == str(_load_error())  # no diagnostic: the message
 
 

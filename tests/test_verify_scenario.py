@@ -94,6 +94,20 @@ def test_condition_errors_name_the_column(text, column):
     assert info.value.column == column
 
 
+def test_a_time_literal_with_a_space_in_a_condition_is_named_as_such():
+    """`that = "fbTimer.ET > T#1h 30m"` said "unexpected '30' at column 10": the literal is
+    named now, at its first character, with the spelling that reads (T#1h30m), as the ST
+    checker names it."""
+    for text, column, word, fixed in (("fbTimer.ET > T#1h 30m", 14, "T#1h 30m", "T#1h30m"),
+                                      ("(t#1m  5s < et)", 2, "t#1m  5s", "t#1m5s"),
+                                      ("et > TIME#2 s", 6, "TIME#2 s", "TIME#2s")):
+        with pytest.raises(ConditionError) as info:
+            parse_condition(text)
+        assert info.value.column == column, (text, info.value.message)
+        assert info.value.message == f"{word!r}: a TIME literal cannot hold a space: write {fixed}"
+    assert parse_condition("fbTimer.ET > T#1h30m").holds({"fbTimer.ET": 5_400_001})
+
+
 def test_a_time_literal_in_a_condition_reads_as_a_time_label_does():
     """An integrator's `that = "fbLampTmr.ET > T#1s"` on a TON of their own: the condition
     stopped at "unexpected character '#'", though TIME labels compare (in ms) and ST writes

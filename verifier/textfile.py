@@ -1,7 +1,8 @@
 """Reading the text files the tool takes (captures, fault files, scenarios; ST files go
 through verifier.st.source, which shares the helpers below), with one wording for what
 went wrong: the caller puts it in its own error with the file name. And the one way
-characters a report cannot hold are shown in it (`escape_chars`)."""
+characters a report cannot hold are shown in it (`escape_chars`), and file names in
+line-based messages (`shown_name`)."""
 from __future__ import annotations
 
 import os
@@ -160,6 +161,16 @@ def escape_chars(text: str, keep: Callable[[str], bool]) -> str:
         return text
     return "".join(c if keep(c) else f"\\x{ord(c):02x}" if ord(c) < 0x100 else f"\\u{ord(c):04x}"
                    for c in text)
+
+
+def shown_name(name: str) -> str:
+    """A file name as line-based messages show it (`file:line:col: ...` on the console, in
+    editors and CI logs, a verdict line): a character that is not printable (a line feed,
+    a tab, ESC, a byte that is not UTF-8) as \\xNN or \\uNNNN, as the console report
+    shows it, so that the name stays on its line and the reader of `file:line:col` finds
+    it; names of ordinary characters (spaces, any script) come back as they are. JSON,
+    JUnit and SARIF hold the name itself, escaped by their own rules."""
+    return escape_chars(name, str.isprintable)
 
 
 @contextmanager

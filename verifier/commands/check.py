@@ -25,7 +25,7 @@ from verifier.commands.check_formats import PLATFORM_RULES, RULES, Finding, to_g
 from verifier.sim.cpu import EDITOR_NAMES, PROFILES, TARGET_CPUS
 from verifier.st import TARGETS
 from verifier.st.ast import Diagnostic, SourceFile
-from verifier.textfile import real_path, text_lines
+from verifier.textfile import real_path, shown_name, text_lines
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
 
@@ -111,12 +111,12 @@ def not_st(path: Path) -> str | None:
     return None if suffix in (".st", ".toml") else _capture_kind(path) or _scenario_kind(path)
 
 
-def _not_a_source(path: Path) -> str | None:
-    """Why `path` cannot be checked at all (missing, a device, a pipe, another kind of
-    the toolkit's files ...), or None. Files that exist but hold no text are diagnosed with
+def not_a_source(path: Path) -> str | None:
+    """Why `path` cannot be checked (or exported) at all (missing, a device, a pipe, another
+    kind of the toolkit's files ...), or None: a usage error (exit 2) of either command. Files that exist but hold no text are diagnosed with
     file:line:col instead."""
     from verifier.st import read_source
-    from verifier.verify.sources import is_pattern
+    from verifier.verify.sources import DANGLING_LINK, is_pattern
 
     if path.is_file():
         return not_st(path)
@@ -124,6 +124,12 @@ def _not_a_source(path: Path) -> str | None:
         return "matches no file"
     if not path.exists() and not path.is_symlink():
         return "no such file"
+    try:
+        path.stat()
+    except FileNotFoundError:  # a symbolic link whose target is missing (a loop: read_source names it)
+        return DANGLING_LINK
+    except OSError:
+        pass
     problems = read_source(path)[1]
     return problems[0].message if problems else None
 
@@ -261,11 +267,11 @@ def command(sources: tuple[str, ...], target: str | None, platform: str | None, 
     target_given = target is not None
     target = platform_target(platform, target) if platform else target or "gxworks2"
     paths = expand_sources(sources)
-    unusable = [(p, _not_a_source(p)) for p in paths]
+    unusable = [(p, not_a_source(p)) for p in paths]
     unusable = [(p, why) for p, why in unusable if why]
     if unusable:
         for p, why in unusable:
-            click.echo(f"uitamr check: {p}: {why}", err=True)
+            click.echo(f"uitamr check: {shown_name(str(p))}: {why}", err=True)
         sys.exit(EXIT_USAGE)
     say_folders_without_st("uitamr check", sources, fatal=not paths)
     if not paths:
@@ -315,7 +321,9 @@ def _no_st_in(folder: Path) -> str:
     .toml files, or for check itself when they are named (check reads a folder for .st only)."""
     from collections import Counter
 
-    files = [p for p in folder.rglob("*") if p.is_file()]
+    from verifier.verify.sources import files_below
+
+    files = files_below(folder)
     if not files:
         return "no .st file in it: the folder is empty"
     kinds = Counter(p.suffix.lower() or "(no suffix)" for p in files).most_common()

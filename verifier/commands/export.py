@@ -3,7 +3,8 @@ and label tables for GX Works (docs/import-gxworks2.md, docs/import-gxworks3.md)
 
 With no SOURCES it exports the bundled library (plc/core, the platform ports and the
 examples of that editor's platforms). Exit status: 0 written, 1 the sources have errors
-(listed as file:line:col), 2 usage errors (no such file, a file with no POU in it).
+(listed as file:line:col), 2 usage errors (no such file, one that is no regular file: a
+pipe, a device; a file with no POU in it), as `uitamr check` has them.
 An initial value the target's label table cannot carry is never dropped silently: one
 note line per value (file:line:col) and DROPPED_INITIAL_VALUES.txt in the output folder.
 An --out folder inside a source folder is left out of the sources (an earlier export there
@@ -25,9 +26,9 @@ from pathlib import Path
 import click
 
 from verifier.bundled import PLC_DIR
-from verifier.commands.check import expand_sources, not_st, platform_target, say_folders_without_st
+from verifier.commands.check import expand_sources, not_a_source, platform_target, say_folders_without_st
 from verifier.sim.cpu import PROFILES
-from verifier.textfile import real_path
+from verifier.textfile import real_path, shown_name
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
 #: the bundled folders each editor gets by default
@@ -86,10 +87,11 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
 
         # a pattern is expanded as `uitamr verify` expands it (cmd and PowerShell do not)
         unmatched = [s for s in sources if is_pattern(s) and not pattern_files(s)]
-        missing = [s for s in sources if not Path(s).exists() and not is_pattern(s)]
+        # a symbolic link to nothing is not missing: it is refused below, as check refuses it
+        missing = [s for s in sources if not Path(s).exists() and not Path(s).is_symlink() and not is_pattern(s)]
         if unmatched or missing:
             said = [f"{s!r} matches no file" for s in unmatched]  # as check and verify say it
-            said += [f"no such file or folder: {', '.join(missing)}"] if missing else []
+            said += [f"no such file or folder: {', '.join(map(shown_name, missing))}"] if missing else []
             click.echo(f"uitamr export: {'; '.join(said)}", err=True)
             sys.exit(EXIT_USAGE)
         paths = expand_sources(sources)
@@ -99,10 +101,12 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
             click.echo(f"uitamr export: {', '.join(scenarios[:3])}{more}: a scenario (.toml), not ST source: "
                        "export writes the POUs of .st files; run scenarios with uitamr verify --scenario", err=True)
             sys.exit(EXIT_USAGE)
-        others = [(p, what) for p in paths if p.suffix.lower() != ".st" and (what := not_st(p))]
-        if others:  # read as ST, an .il was "1:1: unexpected ';'", a capture "'#' must follow a radix"
-            for p, what in others:
-                click.echo(f"uitamr export: {p}: {what}", err=True)
+        # refused as check refuses them: read as ST, an .il was "1:1: unexpected ';'", a capture
+        # "'#' must follow a radix"; a pipe or a device was "1 unreadable file(s)", exit 1
+        unusable = [(p, why) for p in paths if (why := not_a_source(p))]
+        if unusable:
+            for p, why in unusable:
+                click.echo(f"uitamr export: {shown_name(str(p))}: {why}", err=True)
             sys.exit(EXIT_USAGE)
         say_folders_without_st("uitamr export", sources, fatal=not paths)
         if not paths:

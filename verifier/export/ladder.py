@@ -7,7 +7,11 @@ The .il format is one instruction per line, operands separated by spaces; lines 
 with ';' are comments, a comment line starting with '; R' names the next rung and becomes
 its line statement.
 
-    python -m verifier.export.ladder plc/ladder/UITAMR_LadderFx3.il > plc/ladder/UITAMR_LadderFx3.csv
+    python -m verifier.export.ladder plc/ladder/UITAMR_LadderFx3.il -o plc/ladder/UITAMR_LadderFx3.csv
+
+`-o FILE` writes the CSV only when the conversion succeeds, whole (a temporary file
+renamed over FILE): `... X.il > X.csv` left an empty X.csv on a mistake in the .il, as
+the shell empties the file before the command runs. Without -o the CSV goes to stdout.
 """
 from __future__ import annotations
 
@@ -110,22 +114,66 @@ def to_csv(program: list[Instruction], program_name: str) -> str:
     return "\r\n".join(rows) + "\r\n"
 
 
+USAGE = "python -m verifier.export.ladder FILE.il [-o FILE.csv]"
+
+
 def main(argv: list[str]) -> int:
-    if len(argv) != 1:
-        print("usage: python -m verifier.export.ladder FILE.il > FILE.csv", file=sys.stderr)
+    import argparse
+
+    parser = argparse.ArgumentParser(prog="python -m verifier.export.ladder", usage=USAGE,
+                                     description="The GX Works2 CSV of an instruction list (.il).")
+    parser.add_argument("il", metavar="FILE.il")
+    parser.add_argument("-o", "--out", metavar="FILE.csv",
+                        help="write the CSV to this file, only when the .il converts (default: stdout)")
+    args = parser.parse_args(argv)  # a usage mistake: argparse's message, exit 2
+    path = Path(args.il)
+    if args.out is not None and Path(args.out).resolve() == path.resolve():
+        print(f"{args.out}: is the .il itself: name the .csv to write (-o {path.with_suffix('.csv')})",
+              file=sys.stderr)
         return 2
-    path = Path(argv[0])
     try:
         text = read_utf8(path)
     except UnreadableText as e:
         print(f"{path}: {e}", file=sys.stderr)
         return 1
     try:
-        sys.stdout.write(to_csv(parse_il(text, str(path)), path.stem))
+        csv = to_csv(parse_il(text, str(path)), path.stem)
     except IlError as e:
         print(e, file=sys.stderr)
         return 1
+    if args.out is None:
+        sys.stdout.write(csv)
+        return 0
+    try:
+        _write_whole(Path(args.out), csv)
+    except OSError as e:
+        print(f"{args.out}: cannot write: {e.strerror or e}", file=sys.stderr)
+        return 2
     return 0
+
+
+def _write_whole(out: Path, text: str) -> None:
+    """`text` into `out` at once: written beside it under a temporary name, then renamed over
+    it, so that `out` is the old file or the new one, never a part (the temporary file is
+    removed when writing fails)."""
+    import os
+    import tempfile
+
+    fd, temporary = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
+    try:
+        try:  # the file's own mode, else a new file's (mkstemp's 0600 would hide it from others)
+            mode = out.stat().st_mode & 0o7777
+        except OSError:
+            umask = os.umask(0)
+            os.umask(umask)
+            mode = 0o666 & ~umask
+        os.chmod(fd, mode)
+        with open(fd, "w", encoding="utf-8", newline="") as f:
+            f.write(text)
+        os.replace(temporary, out)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -24,7 +24,7 @@ from verifier.sim.cpu import CpuProfile
 from verifier.sim.reach import type_names
 from verifier.export.labels import LabelRow, initial_text, label_class, label_rows, rows_of
 from verifier.export.types import type_name
-from verifier.textfile import real_path, text_lines, whole_file
+from verifier.textfile import real_path, shown_name, text_lines, whole_file
 
 COLUMNS = {
     "gxworks2": ("Class", "Label Name", "Data Type", "Constant", "Comment"),
@@ -87,7 +87,7 @@ class DroppedValue:
 
     def __str__(self) -> str:
         where = f"'{self.label}'" if self.owner == "global" else f"'{self.owner}.{self.label}'"
-        return (f"{self.file}:{self.line}:{self.col}: note: {self.label_class} {where} := {self.value} "
+        return (f"{shown_name(self.file)}:{self.line}:{self.col}: note: {self.label_class} {where} := {self.value} "
                 f"not exported: the {EDITOR[self.target]} label table has no initial value for it, "
                 f"so it starts at 0; assign it in the program (first scan) - listed in {DROPPED_TABLE}")
 

@@ -57,7 +57,9 @@ def _format_diag(d) -> str:
     msg = getattr(d, "message", str(d))
     if file.startswith(OPTION_PLACE):  # a call's argument has no line and column
         return f"{file}: {sev}: {msg}"
-    return f"{file}:{line}:{col}: {sev}: {msg}"
+    from verifier.textfile import shown_name
+
+    return f"{shown_name(file)}:{line}:{col}: {sev}: {msg}"
 
 
 class SimulationError(Exception):

@@ -16,6 +16,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field, fields, is_dataclass
 from typing import Iterator
 
+from verifier.textfile import shown_name
+
 
 # ----------------------------------------------------------------------------- places
 @dataclass(frozen=True, slots=True)
@@ -30,7 +32,7 @@ class Span:
     end_col: int
 
     def __str__(self) -> str:
-        return f"{self.file}:{self.line}:{self.col}"
+        return f"{shown_name(self.file)}:{self.line}:{self.col}"
 
 
 NO_SPAN = Span("<none>", 0, 0, 0, 0)
@@ -75,7 +77,7 @@ class Diagnostic:
     end_col: int | None = None
 
     def __str__(self) -> str:
-        return f"{self.file}:{self.line}:{self.col}: {self.severity}: {self.message}"
+        return f"{shown_name(self.file)}:{self.line}:{self.col}: {self.severity}: {self.message}"
 
     @property
     def is_error(self) -> bool:

@@ -135,6 +135,29 @@ _HASH_WORD = re.compile(r"(?<![A-Za-z0-9_#.])([A-Za-z_][A-Za-z0-9_]*)#[-+0-9A-Za
 #: and scenario conditions alike ('#' escaped, so that a verbose pattern takes it too)
 TIME_LITERAL = r"(?:TIME|T)\#-?(?:[0-9][0-9_]*(?:\.[0-9]+)?(?:ms|d|h|m|s)_?)+"
 _TIME_WORD = re.compile(TIME_LITERAL, re.IGNORECASE)
+#: a TIME literal with blanks between its parts (T#1h 30m, T#5 s): read as T#1h and a word
+#: '30m', which was "a name must not start with a digit"
+_SPACED_TIME = re.compile(r"(?<![A-Za-z0-9_#.])(?:TIME|T)#[ \t]*-?(?:[ \t]*[0-9][0-9_]*(?:\.[0-9]+)?[ \t]*"
+                          r"(?:ms|d|h|m|s)(?![A-Za-z])_?)+", re.IGNORECASE)
+
+
+def spaced_time_literal(text: str, pos: int = -1) -> tuple[int, str] | None:
+    """The first TIME literal of `text` written with a space or tab inside (`T#1h 30m`) and
+    reaching past `pos` (any, for -1), as (its offset, the message naming it with the
+    spelling that reads: T#1h30m); None when there is none. For the ST checker and
+    scenario conditions alike."""
+    for m in _SPACED_TIME.finditer(text):
+        word = m.group()
+        if pos >= 0 and m.end() <= pos or not any(c in word for c in " \t"):
+            continue
+        if pos >= 0 and m.start() > pos:
+            return None
+        fixed = re.sub(r"[ \t]+", "", word)
+        if _TIME_WORD.fullmatch(fixed):
+            return m.start(), f"{word!r}: a TIME literal cannot hold a space: write {fixed}"
+    return None
+
+
 #: units people write that TIME literals spell otherwise
 _TIME_UNITS = {"msec": "ms", "msecs": "ms", "sec": "s", "secs": "s", "second": "s", "seconds": "s",
                "min": "m", "mins": "m", "minute": "m", "minutes": "m", "hr": "h", "hrs": "h",
@@ -195,6 +218,9 @@ def describe_syntax_error(exc: UnexpectedInput, text: str, parser: Lark) -> tupl
     nested = _nested_comment(text, _error_pos(exc, text))
     if nested is not None:
         return nested
+    spaced = spaced_time_literal(text, _error_pos(exc, text))
+    if spaced is not None:
+        return *place_of_char(text, spaced[0]), spaced[1]
     literal = _hash_literal(text, _error_pos(exc, text))
     if literal is not None:
         return literal

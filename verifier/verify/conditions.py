@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from typing import Callable, Mapping
 
 from verifier.digits import describe, foreign_digit
-from verifier.st.errors import TIME_LITERAL, TIME_LITERAL_HINT
+from verifier.st.errors import TIME_LITERAL, TIME_LITERAL_HINT, spaced_time_literal
 from verifier.st.parser import time_literal_ms
 
 Value = bool | int | float
@@ -76,6 +76,9 @@ def _tokenize(text: str) -> list[_Token]:
         raise ConditionError(describe(text[foreign]), foreign + 1)
     for index in range(len(text)):
         _c_notation(text, index)
+    spaced = spaced_time_literal(text)  # T#1h 30m: "unexpected '30'"
+    if spaced is not None:
+        raise ConditionError(spaced[1], spaced[0] + 1)
     position = 0
     while position < len(text):
         match = _TOKEN.match(text, position)

@@ -6,7 +6,7 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from verifier.textfile import escape_chars
+from verifier.textfile import escape_chars, shown_name
 
 from .durations import format_seconds
 from .result import NO_TRAFFIC, ScenarioResult, all_captured, overall_verdict
@@ -39,7 +39,7 @@ def render(results: list[ScenarioResult], console: Console, *, first: int = FIRS
 
 def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
     mark = {"pass": "[green]PASS[/]", "fail": "[red]FAIL[/]", NO_TRAFFIC: "[yellow]NO TRAFFIC[/]"}[result.verdict]
-    where = f" ({escape(escape_chars(result.file, str.isprintable))})" if result.file else ""
+    where = f" ({escape(shown_name(result.file))})" if result.file else ""
     tx = result.tx_count
     failed = len(result.failed_expectations)
     expectations = (

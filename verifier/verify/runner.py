@@ -781,6 +781,9 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         tx_count = sum(1 for frame in trace if frame.direction == "tx")
         rx_count = len(trace) - tx_count
     signal = scenario.options.response_signal
+    # the notes name the file as the headline does (`file`): a bundled scenario under --matrix
+    # is loaded by its absolute path, and its notes named that beside a relative headline
+    named = replace(scenario, path=Path(_display_path(scenario.path))) if scenario.path is not None else scenario
     return ScenarioResult(
         name=scenario.name,
         file=_display_path(scenario.path),
@@ -812,7 +815,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         aborted=aborted,
         ended_us=end,
         wall_s=time.perf_counter() - wall_start,
-        notes=list(scenario.notes) + plc.cpu_notes() + _c24_notes(scenario, plc, violations) + _missed_fault_notes(scenario, robot, end)
-        + overwritten_input_notes(scenario, plc.project.files, plc.name, _relative)
+        notes=list(scenario.notes) + plc.cpu_notes() + _c24_notes(named, plc, violations) + _missed_fault_notes(named, robot, end)
+        + overwritten_input_notes(named, plc.project.files, plc.name, _relative)
         + ([] if tx_count else [_silence_note(scenario, plc, converter)]),
     )

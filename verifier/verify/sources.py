@@ -7,9 +7,11 @@ import os
 from functools import lru_cache
 from pathlib import Path
 
-from verifier.textfile import file_kind, reached_path, real_path
+from verifier.textfile import file_kind, reached_path, real_path, shown_name
 
 GLOB_CHARACTERS = "*?["
+#: what a symbolic link whose target is missing is, in every command's message naming it
+DANGLING_LINK = "is a symbolic link to nothing (its target is missing, or a loop of links)"
 
 
 class SourceError(ValueError):
@@ -22,7 +24,7 @@ def expand(name: str, base: Path) -> list[Path]:
     try:
         return _expand(name, base)
     except OSError as exc:  # a name too long for the file system, a folder that cannot be read ...
-        raise SourceError(f"{exc.filename or name}: {exc.strerror or exc}") from None
+        raise SourceError(f"{shown_name(str(exc.filename or name))}: {exc.strerror or exc}") from None
 
 
 def is_pattern(name: str, literal: Path | None = None) -> bool:
@@ -54,21 +56,45 @@ def _expand(name: str, base: Path) -> list[Path]:
     if path.is_dir():
         files = st_files_in(path)
         if not files:
-            raise SourceError(f"the folder {path} holds no .st file")
+            raise SourceError(f"the folder {shown_name(str(path))} holds no .st file")
         return files
     if not path.is_file():
         if path.exists():
-            raise SourceError(f"{path} is not a regular file ({file_kind(path.stat().st_mode)}); give .st files")
+            raise SourceError(f"{shown_name(str(path))} is not a regular file ({file_kind(path.stat().st_mode)}); give .st files")
         if path.is_symlink():
-            raise SourceError(f"{path} is a symbolic link to nothing (its target is missing, or a loop of links)")
-        raise SourceError(f"no such file or folder: {path}")
+            raise SourceError(f"{shown_name(str(path))} {DANGLING_LINK}")
+        raise SourceError(f"no such file or folder: {shown_name(str(path))}")
     return [path]
 
 
 def st_files_in(path: Path) -> list[Path]:
     """The .st files below the folder `path`, recursively: `.ST` too (as Windows tools may
     name them), and never a folder whose name ends in .st."""
-    return sorted(p for p in path.rglob("*") if p.suffix.lower() == ".st" and p.is_file())
+    return sorted(p for p in files_below(path) if p.suffix.lower() == ".st")
+
+
+def files_below(folder: Path) -> list[Path]:
+    """The regular files below `folder`, recursively, as `folder.rglob("*")` finds them
+    (symlinked folders not entered, a folder that cannot be read passed over), and also
+    passing over a folder that vanishes between being listed and being read: `rglob` stopped
+    the walk there ("/proc/10441: No such file or directory" ended `uitamr check /`, exit 2),
+    though what vanished was no file of the user's."""
+    def skipped(exc: OSError) -> None:
+        if not isinstance(exc, (FileNotFoundError, NotADirectoryError, PermissionError)):
+            raise exc
+
+    found = []
+    for top, _, names in os.walk(folder, onerror=skipped):
+        found += [p for name in names if _is_file(p := Path(top, name))]
+    return found
+
+
+def _is_file(path: Path) -> bool:
+    """`path.is_file()`, False where even asking is refused (/proc/1/cwd: permission denied)."""
+    try:
+        return path.is_file()
+    except OSError:
+        return False
 
 
 def unique(paths: list[Path]) -> tuple[Path, ...]:
