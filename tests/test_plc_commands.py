@@ -172,6 +172,44 @@ def test_hold_to_jog_needs_a_second_instance_for_the_stop():
         assert "second instance" in text and "UITAMR_PanelFx3" in text
 
 
+def test_one_button_hold_to_jog_as_the_library_page_wires_it():
+    """A station with one hold-to-jog button (journey32b) wired the second instance's
+    execute as `NOT X3`, the obvious release: a rising edge in the first scan too, so a jog
+    stop went out after every power-on stop. plc-library.md now shows the wiring; its
+    snippet, run as printed on an FX3U with the button on X3: nothing but the stop and the
+    engine's reads until the press, then jog forward, and jog stop after the release, also
+    after a tap released while the forward command is still busy."""
+    import re
+
+    page = (PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8")
+    section = page.split("**Hold-to-jog with `UITAMR_Jog`**", 1)[1].split("### The port interface", 1)[0]
+    snippet = re.search(r"```iecst\n(.*?)```", section, re.S).group(1)
+    program = ("PROGRAM T_Jog\nVAR\n    fbPort : UITAMR_PortFx3;\n    fbEngine : UITAMR_Engine;\n"
+               "    fbJogFwd : UITAMR_Jog;\n    fbJogStop : UITAMR_Jog;\n    uMbx : ARRAY[0..15] OF WORD;\n"
+               "    uPort : ARRAY[0..39] OF WORD;\n    bJogged : BOOL;\nEND_VAR\n"
+               "fbPort(i_bEN := TRUE, i_wChannel := 1, i_bRs232 := FALSE, io_uPort := uPort);\n"
+               "fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);\n"
+               + snippet + "END_PROGRAM\n")
+    project = verifier.load(PLC / "core", PLC / "fx3", sources={"T_Jog.st": program})
+    line = Line(Robot())
+    project.attach_serial("fx3:1", line)
+    jog_forward = encode(ControlRequest(1, 5, 1), SETTINGS)
+    jog_stop = encode(ControlRequest(1, 5, 0), SETTINGS)
+
+    def controls():
+        return [f.data for f in line.trace if f.direction == "tx" and f.data[1] == 0x06]
+
+    project.run_programs(["T_Jog"], ms=3000)
+    assert controls() == [encode(ControlRequest(1, 1, 0xA0), SETTINGS)]        # the power-on stop only
+    for hold_ms in (1500, 100):                                              # a hold, then a tap
+        project.devices["X3"] = True
+        project.run_programs(["T_Jog"], ms=hold_ms)
+        project.devices["X3"] = False
+        project.run_programs(["T_Jog"], ms=3000)
+    assert controls()[1:] == [jog_forward, jog_stop, jog_forward, jog_stop]
+    assert not project.program("T_Jog").bJogged
+
+
 def post_once(cases):
     """One instance per (FB, its input assignments) with its own mailbox and no engine, all
     given one rising edge of i_bExecute: the program after that scan (fb<i>, uMbx<i>)."""

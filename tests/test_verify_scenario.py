@@ -122,6 +122,33 @@ def test_a_time_literal_in_a_condition_reads_as_a_time_label_does():
             "or ms" in info.value.message, (text, info.value.message)
 
 
+@pytest.mark.parametrize("text, column, literal", [
+    ("fbMoveTmr.ET > 500ms", 16, "T#500ms"),
+    ("et >= 1.5s AND Y0", 7, "T#1.5s"),
+    ("et < 2sec", 6, "T#2s"),
+])
+def test_a_duration_without_t_in_a_condition_is_told_the_time_literal(text, column, literal):
+    """Writing a station's scenario, `that = "fbMoveTmr.ET > 500ms"` (durations in the same
+    file are written "500ms") got "unexpected 'ms' at column 19": neither the number's place
+    nor that a condition writes a time T#500ms."""
+    with pytest.raises(ConditionError) as info:
+        parse_condition(text)
+    assert info.value.column == column and f"a TIME literal is written {literal}" in info.value.message, \
+        info.value.message
+
+
+def test_st_s_time_literal_as_a_scenario_duration_is_told_the_scenario_spelling():
+    """`within = "T#2s"` (the ST spelling, as in the program's TONs) was refused with the
+    general advice only; it now says what to write instead."""
+    from verifier.verify.durations import parse_duration_us
+
+    for text, meant in (("T#2s", '"2s"'), ("TIME#500ms", '"500ms"'), ("t#1m", '"1min"')):
+        with pytest.raises(ValueError) as info:
+            parse_duration_us(text)
+        assert f"T# belongs to ST and to conditions, not to a scenario's durations; did you mean {meant}?" in \
+            str(info.value), str(info.value)
+
+
 @pytest.mark.parametrize("text, column, hint", [
     ("Y4 AND D20 = 0x0201", 14, "write 16#0201"),
     ("w = 0b1010", 5, "write 2#1010"),

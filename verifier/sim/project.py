@@ -454,6 +454,12 @@ class Project:
         QJ71C24N channel the program drives holds as a message not yet ended."""
         return [(un, *waiting) for un, module in self._program_c24() for waiting in module.unfinished()]
 
+    def c24_joined(self) -> list[tuple[int, int, int, int, int]]:
+        """(start I/O, channel, since µs, bytes before the silence, silence µs) of the first
+        message a QJ71C24N channel the program drives completed across a silence, with no
+        no-reception monitoring time (timer 0) set."""
+        return [(un, *joined) for un, module in self._program_c24() for joined in module.joined_messages()]
+
     def c24_word_unit_sends(self) -> list[tuple[int, int, int, int]]:
         """(start I/O, channel, count, bytes sent) of the first G_OUTPUT a QJ71C24N channel
         the program drives sent in word units (buffer memory 96H / 136H = 0, the default)."""

@@ -84,6 +84,39 @@ _DIGIT_SPEC_RE = re.compile(r"[Kk][1-8]")
 _CONSTANT_RE = re.compile(r"[Kk][0-9]+|[Hh][0-9A-Fa-f]+")
 
 
+#: the type letters of Mitsubishi's FB-library label names (i_bEN, o_uErrId, i_udIpAddress)
+#: and the GX Works2 data type each stands for, as docs/plc-library.md lists them
+TYPE_LETTERS = {"b": "Bit", "w": "Word[Signed]", "u": "Word[Unsigned]", "ud": "Double Word[Unsigned]",
+                "e": "FLOAT", "s": "String", "t": "Time"}
+_LETTERED = re.compile(r"(?:i|o|io)_([a-z]+)[A-Z0-9]")
+
+
+def type_letters_problem(name: str, t: T.Type, target: str = "gxworks2") -> str | None:
+    """Why the type letters of an i_/o_/io_ label name (`o_uCount`) do not name its type
+    (an INT), or None: for labels in the convention's form whose letters it lists, of an
+    elementary type (an array's element type)."""
+    m = _LETTERED.match(name)
+    if m is None or m.group(1) not in TYPE_LETTERS:
+        return None
+    from verifier.export.types import TABLES  # the editor's type names (no import cycle at call time)
+
+    element = t.element if isinstance(t, T.ArrayOf) else t
+    if not isinstance(element, T.Elementary):
+        return None
+    editor = TABLES.get(target, TABLES["gxworks2"]).get(element.name)  # as the label editor names it
+    if editor is None:
+        return None
+    letters, shown = m.group(1), editor.replace(" ", "")
+    if shown.startswith(TYPE_LETTERS[letters].replace(" ", "")):
+        return None
+    right = [k for k, v in TYPE_LETTERS.items() if shown.startswith(v.replace(" ", ""))]
+    rename = (f": rename it {name[:m.start(1)]}{right[0]}{name[m.end(1):]}" if right else
+              ": give it the letters of its type, or another type")
+    return (f"label '{name}' is {element.name} ({editor}), but its type letter{'s' if len(letters) > 1 else ''} "
+            f"'{letters}' stand{'' if len(letters) > 1 else 's'} for {TYPE_LETTERS[letters]} in Mitsubishi's "
+            f"FB-library label names (docs/plc-library.md){rename}")
+
+
 @functools.lru_cache(maxsize=8192)
 def label_name_problem(name: str, families: tuple[str, ...] = ()) -> str | None:
     """Why GX Works refuses `name` as a label, or None. Rules: docs/st-dialect.md §4.
@@ -249,6 +282,9 @@ class Checker:
     def _declare(self, v: ast.VarDecl) -> T.Type:
         self._check_name(v, v.name, "label")
         t = self.resolve_type(v.type)
+        letters = type_letters_problem(v.name, t, self.target)
+        if letters:
+            self.rep.warning(v, letters)
         if v.constant and v.init is None:
             self.rep.error(v, f"constant '{v.name}' needs an initial value (':= value')")
         if v.section == "VAR_IN_OUT" and v.init is not None:
@@ -374,6 +410,7 @@ class Checker:
                                       "hundreds of levels deep); split it using intermediate labels")
             if complete:  # an unchecked statement may use any label
                 self._unused(info)
+                self._called_twice(info)
         self.pou = None
 
     def check_structure(self) -> None:
@@ -391,6 +428,31 @@ class Checker:
                 self.rep.diagnostics.append(ast.Diagnostic(
                     f.filename, 1, 1, "warning",
                     "no POU in file (it is empty or holds only comments); nothing to check or export"))
+
+    def _called_twice(self, info: PouInfo) -> None:
+        """An FB instance called twice in the same scan: both calls in the POU's own statement
+        list, outside any IF, CASE or loop (so that both run, every scan). The instance has one
+        memory: the second call sees the first one's edge memories and overwrites its outputs,
+        so a command FB started by the second call ignores the first's rising edges, and what
+        the program reads from it after the second call is the second use's. (Calls in
+        different branches may be one a scan, and are not judged.)"""
+        first: dict[str, ast.CallStmt] = {}
+        for s in info.pou.body:
+            if not isinstance(s, ast.CallStmt) or not isinstance(s.call.callee, ast.Name):
+                continue
+            target = s.call.resolved
+            if getattr(target, "kind", None) != "fb":
+                continue
+            key = s.call.callee.name.upper()
+            if key not in first:
+                first[key] = s
+                continue
+            earlier = first[key].span
+            name = s.call.callee.name
+            self.rep.warning(s, f"FB instance '{name}' is called a second time in every scan (first at "
+                                f"{earlier.line}:{earlier.col}): an instance has one memory, so this call "
+                                f"overwrites the edges and outputs of the first; give the second use its own "
+                                f"instance (e.g. {name}2 : {target.name})")
 
     def _unused(self, info: PouInfo) -> None:
         for decl, _t in info.labels.values():

@@ -172,6 +172,30 @@ _DATE_REST = re.compile(r"[-0-9:._]*")
 _LONG_TIME_TYPES = {"LTIME", "LT"}
 
 
+#: a number with a unit and no T# (500ms, 1.5s, 1m30s, 2sec), the whole word
+_BARE_TIME = re.compile(r"[0-9][0-9_]*(?:\.[0-9]+)?[A-Za-z]+(?:[0-9][0-9_]*(?:\.[0-9]+)?[A-Za-z]+)*")
+
+
+def bare_time(text: str, pos: int) -> tuple[int, str] | None:
+    """A duration written without its T# (`500ms`, `1.5s`, `2sec`) that `pos` falls in:
+    (its first character's offset, the message saying which TIME literal to write), or None.
+    For the ST checker and scenario conditions alike: people write a scenario's durations
+    ("500ms") and forget that ST and conditions spell them T#500ms."""
+    start = pos
+    while start > 0 and (text[start - 1].isdigit() or text[start - 1] in "._"):
+        start -= 1
+    if start > 0 and (text[start - 1].isalnum() or text[start - 1] in "_#"):
+        return None  # part of a name (D100), a radix or T# literal
+    m = _BARE_TIME.match(text, start)
+    if m is None or m.end() <= pos:
+        return None
+    word = m.group()
+    literal = "T#" + _TIME_PART.sub(lambda p: p.group(1) + _TIME_UNITS.get(p.group(2).lower(), p.group(2)), word)
+    if not _TIME_WORD.fullmatch(literal):
+        return None
+    return start, f"'{word}' is a duration without T#: a TIME literal is written {literal}"
+
+
 def _hash_literal(text: str, pos: int) -> tuple[int, int, str] | None:
     """A TIME literal with a unit GX Works does not know or none (`T#2sec`, `T#2`: lark read
     `T#2s` and stumbled on `ec`, or found no literal and blamed the '#') and a typed literal
@@ -224,6 +248,10 @@ def describe_syntax_error(exc: UnexpectedInput, text: str, parser: Lark) -> tupl
     literal = _hash_literal(text, _error_pos(exc, text))
     if literal is not None:
         return literal
+    bare = bare_time(text, _error_pos(exc, text))
+    if bare is not None:
+        line, col = place_of_char(text, bare[0])
+        return line, col, bare[1]
     if isinstance(exc, (UnexpectedToken, UnexpectedEOF)):
         exc = diagnose.earlier_keyword_error(parser, text, _error_pos(exc, text)) or exc
     if isinstance(exc, UnexpectedCharacters):

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from typing import Callable, Mapping
 
 from verifier.digits import describe, foreign_digit
-from verifier.st.errors import TIME_LITERAL, TIME_LITERAL_HINT, spaced_time_literal
+from verifier.st.errors import TIME_LITERAL, TIME_LITERAL_HINT, bare_time, spaced_time_literal
 from verifier.st.parser import time_literal_ms
 
 Value = bool | int | float
@@ -89,6 +89,10 @@ def _tokenize(text: str) -> list[_Token]:
         if not match:
             raise ConditionError(f"unexpected character {text[position]!r}", position + 1)
         kind = match.lastgroup
+        if kind == "number" and text[match.end():match.end() + 1].isalpha():
+            bare = bare_time(text, match.end())  # 500ms: a scenario's duration, not a TIME literal
+            if bare is not None:
+                raise ConditionError(bare[1], bare[0] + 1)
         if kind != "space":
             word = match.group()
             if kind == "name" and word.upper() in _KEYWORDS:

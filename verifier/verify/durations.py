@@ -69,6 +69,12 @@ def _meant(text: str) -> str:
     be negative' for "-1s"; '' when nothing better can be said."""
     match = _OTHER.match(text)
     if not match:
+        st_time = re.match(r"^\s*(?:T|TIME)#(.*)$", text, re.IGNORECASE)
+        if st_time:  # T#500ms: ST's TIME literal, where a scenario writes "500ms"
+            meant = _meant(st_time.group(1))
+            return (f"; T# belongs to ST and to conditions, not to a scenario's durations{meant}"
+                    if meant.startswith("; did you mean") else "; T# belongs to ST and to conditions, "
+                    "not to a scenario's durations")
         return ""
     sign, number, unit = match.groups()
     unit = _OTHER_UNITS.get(unit.lower(), unit.lower() if unit.lower() in _UNITS_US else None)

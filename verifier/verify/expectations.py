@@ -300,6 +300,17 @@ class _ReachedPoint(ExchangeWatch):
         if self.accepted_at is None or request.query != protocol.Query.TASK:
             return
         reply = protocol.decode_reply(exchange.reply.data, self.settings, request)
+        if not self.running_seen and reply.value != 1 and reply.error in TASK_STOPPING_ERRORS:
+            # the robot still holds an anti-collision / off-tape state: it accepts the point and
+            # does nothing until the stop command clears it (plc-library.md, error codes)
+            error, accepted = reply.error, self.accepted_at
+            self.progress = lambda start, end: (
+                f"run-point {point} accepted at {format_seconds(accepted)}, but the robot never reported the task "
+                f"running: its task status at {format_seconds(t)} carried error {int(error):02d} "
+                f"({protocol.catalogue.ERROR_TITLES[error]}), which the robot keeps until the stop command "
+                "(01/A0): send the stop (acknowledge the fault) before the next point")
+            self.accepted_at = None
+            return
         if reply.value == 1:
             self.running_seen = True
             since = self.accepted_at

@@ -542,6 +542,13 @@ def _c24_notes(scenario: Scenario, plc: _Plc, violations: dict | None = None) ->
                      f"FFFFH in the module's parameters, or in the first scan (U{un:X}\\G{words['recv_count']} := 8; "
                      f"U{un:X}\\G{words['end_code']} := 16#FFFF, as UITAMR_ExampleQ does); in a scenario, [[c24]] "
                      f"receive_count = 8, end_code = \"none\"")
+    for un, channel, since_us, before, gap_us in plc.project.c24_joined():
+        notes.append(f"QJ71C24N U{un:X} CH{channel}: {before} received byte(s) from {format_seconds(since_us)} waited "
+                     f"{gap_us / 1000:.0f} ms in the module for the received data count and were read as one message "
+                     f"with the bytes after them: no no-reception monitoring time (timer 0) is set, so a short reply "
+                     f"(an exception, 5 bytes; noise) puts every later reply out of step. Set timer 0 with format 1 "
+                     f"in GX Works (docs/plc-library.md, platform notes: QJ71C24N); in a scenario, [[c24]] "
+                     f"no_reception = \"5ms\"")
     if (violations or {}).get("UITAMR-FORMAT"):
         # frames of the wrong length from a channel in word units: the port counted bytes
         for un, channel, count, nbytes in plc.project.c24_word_unit_sends():

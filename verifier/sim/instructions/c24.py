@@ -54,6 +54,15 @@ class _Channel:
         # the first G_OUTPUT sent in word units: (count, bytes sent), for the report's note
         # when the frames it sent were not the robot's (a port that counts bytes)
         self.word_send: tuple[int, int] | None = None
+        # the first message completed across a silence, without timer 0: (when its first
+        # byte came in µs, bytes before the silence, the silence in µs), for the report's
+        # note (a short reply waited for the received data count: every later one out of step)
+        self.joined: tuple[int, int, int] | None = None
+
+
+#: a silence inside one received message this long is no gap between a reply's bytes (one
+#: byte is 1.04 ms at 9600 bit/s): two replies, or a reply and noise, joined into one message
+JOINED_GAP_US = 20_000
 
 
 class C24Module:
@@ -198,6 +207,11 @@ class C24Module:
         return [(ch, len(c.rx), c.rx_first_t, self._word(ch, "recv_count"), self._word(ch, "end_code"))
                 for ch, c in self.channels.items() if c.rx]
 
+    def joined_messages(self) -> list[tuple[int, int, int, int]]:
+        """(channel, when the first byte came in µs, bytes before the silence, silence in µs)
+        of the first message each channel completed across a silence, timer 0 being off."""
+        return [(ch, *c.joined) for ch, c in self.channels.items() if c.joined is not None]
+
     def word_unit_sends(self) -> list[tuple[int, int, int]]:
         """(channel, count, bytes sent) of the first G_OUTPUT each channel sent in word units."""
         return [(ch, *c.word_send) for ch, c in self.channels.items() if c.word_send is not None]
@@ -260,6 +274,9 @@ class C24Module:
         for value, t in chan.port.receive_until(now):
             if chan.rx and chan.no_reception_us is not None and t - chan.rx_last_t > chan.no_reception_us:
                 self._timed_out(chan)
+            if (chan.rx and chan.no_reception_us is None and chan.joined is None
+                    and t - chan.rx_last_t > JOINED_GAP_US):
+                chan.joined = (chan.rx_first_t, len(chan.rx), t - chan.rx_last_t)
             if not chan.rx:
                 chan.rx_first_t = t
             chan.rx.append(value)

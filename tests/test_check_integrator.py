@@ -1,0 +1,102 @@
+"""Mistakes an integrator makes in a program of their own around the library, that GX Works
+imports without a word and the PLC then runs wrong: `uitamr check` warns at the place.
+
+Found writing a station program (journey32b) from the docs alone: an FB instance called
+twice in a scan, and i_/o_ label names whose type letters name another type."""
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+from verifier import st
+
+ROOT = Path(__file__).resolve().parents[1]
+
+TWICE = """\
+PROGRAM Station
+VAR
+    fbBatt : UITAMR_ReadStatus;
+    fbTmr : TON;
+    uMbx : ARRAY[0..15] OF WORD;
+    bRead : BOOL;
+    bVehicle : BOOL;
+END_VAR
+fbBatt(i_bEN := TRUE, i_bExecute := bRead, i_wQuery := 3, io_uMbx := uMbx);
+fbBatt(i_bEN := TRUE, i_bExecute := bVehicle, i_wQuery := 1, io_uMbx := uMbx);
+IF bRead THEN
+    fbTmr(IN := TRUE, PT := T#1s);
+ELSE
+    fbTmr(IN := FALSE, PT := T#1s);
+END_IF;
+END_PROGRAM
+"""
+
+
+def _check(text: str, *more: Path, target: str = "gxworks3"):
+    files = [st.parse(text, "Station.st", target)]
+    files += [st.parse(p.read_text(encoding="utf-8"), str(p), target) for d in more for p in sorted(d.glob("*.st"))]
+    return [d for d in st.check(files, target) if d.file == "Station.st"]
+
+
+def test_an_fb_instance_called_twice_in_every_scan_is_warned_at_the_second_call():
+    """A second use of a command FB given to the same instance (fbBatt for the battery and
+    for the vehicle status) passed `uitamr check` at 0 warnings; under verify the station
+    never reached "at station" and raised no fault: the second call saw the first one's
+    edge and outputs. Calls in the branches of an IF (one a scan) are not warned."""
+    diags = _check(TWICE, ROOT / "plc" / "core")
+    assert [(d.line, d.col, d.severity) for d in diags] == [(10, 1, "warning")], [str(d) for d in diags]
+    assert "FB instance 'fbBatt' is called a second time in every scan (first at 9:1)" in diags[0].message
+    assert "(e.g. fbBatt2 : UITAMR_ReadStatus)" in diags[0].message
+
+
+def test_type_letters_that_name_another_type_are_warned_with_the_name_to_give():
+    """`i_bPoint : INT`, `o_uCount : INT`, `i_wSpeed : WORD` passed `uitamr check`, though
+    plc-library.md says the labels follow the convention's letters "which uitamr check
+    enforces" (it enforced GX Works' naming rules only)."""
+    text = """\
+FUNCTION_BLOCK FB_Helper
+VAR_INPUT
+    i_bPoint : INT;
+    i_wSpeed : WORD;
+    i_udIp : DWORD;
+    i_xOther : INT;
+    i_eRange : REAL;
+END_VAR
+VAR_IN_OUT
+    io_wMbx : ARRAY[0..15] OF WORD;
+END_VAR
+VAR_OUTPUT
+    o_uCount : INT;
+    o_wWide : DINT;
+END_VAR
+o_uCount := i_bPoint;
+END_FUNCTION_BLOCK
+"""
+    got = {(d.line, d.message.split("rename it ")[-1] if "rename it" in d.message else d.message)
+           for d in _check(text) if "type letter" in d.message}
+    assert got == {(3, "i_wPoint"), (4, "i_uSpeed"), (10, "io_uMbx"), (13, "o_wCount"),
+                   (14, "label 'o_wWide' is DINT (Double Word [Signed]), but its type letter 'w' stands for "
+                        "Word[Signed] in Mitsubishi's FB-library label names (docs/plc-library.md): give it the "
+                        "letters of its type, or another type")}, got
+
+
+def test_the_library_and_the_examples_stay_at_no_warning_on_each_platform():
+    for platform, folders in (("fx3u", ["plc/fx3", "plc/examples/fx3"]), ("fx5u", ["plc/fx5", "plc/examples/fx5"]),
+                              ("q", ["plc/q", "plc/examples/q"])):
+        out = subprocess.run([sys.executable, "-m", "verifier.cli", "check", "--platform", platform, "plc/core",
+                              "plc/examples/common", *folders], cwd=ROOT, capture_output=True, text=True)
+        assert out.returncode == 0 and out.stdout.strip().endswith("0 error(s), 0 warning(s)"), out.stdout
+
+
+def test_the_letters_check_judges_are_the_ones_the_library_page_lists():
+    """plc-library.md's list of type letters is what `uitamr check` warns by: a letter added
+    to one and not the other would warn at names the page allows, or let through one it
+    forbids."""
+    import re
+
+    from verifier.st.check import TYPE_LETTERS
+
+    text = " ".join((ROOT / "docs" / "plc-library.md").read_text(encoding="utf-8").split())
+    listed = re.search(r"\(`i_`/`o_`/`io_` \+ type letters: (.*?)\) and GX Works' naming rules", text).group(1)
+    assert dict(item.split(" ", 1) for item in listed.split(", ")) == TYPE_LETTERS
