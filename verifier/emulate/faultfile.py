@@ -74,4 +74,4 @@ def load_fault_file(path: str | Path, own_address: int | None = None) -> FaultFi
 
 
 def _where(path: Path, place: Place | None) -> str:
-    return f"{path}:{place}" if place is not None else str(path)
+    return str(place.in_file(str(path))) if place is not None else str(path)
