@@ -107,5 +107,5 @@ def test_a_scenario_string_with_another_script_s_digits_names_key_place_and_char
     with pytest.raises(ScenarioError) as caught:
         parse_scenario(text, Path("s.toml"))
     error = caught.value
-    assert (error.key, (error.line, error.col)) == (key, place), str(error)
+    assert (error.key, (error.place.line, error.place.col)) == (key, place), str(error)
     assert f"{char!r} (U+{ord(char):04X}" in error.message

@@ -288,7 +288,7 @@ def test_every_mistake_in_a_scenario_is_placed_on_a_line(edited, platform):
     try:
         parse_scenario(text, path, platform)
     except ScenarioError as error:
-        assert error.line is not None and error.line >= 1 and error.col >= 1, str(error)
+        assert error.place is not None and error.place.line >= 1 and error.place.col >= 1, str(error)
 
 
 DURATION_VALUE = re.compile(r'"[0-9.]+(?:us|ms|s|min|h)"')

@@ -38,7 +38,7 @@ def test_a_source_name_too_long_in_a_scenario_names_its_key_and_line(tmp_path):
     path.write_text(f'program = "Main"\nsources = ["{LONG}.st"]\n', encoding="utf-8")
     with pytest.raises(ScenarioError) as caught:
         load_scenario(path)
-    assert (caught.value.key, caught.value.line, caught.value.col) == ("sources[0]", 2, 12)
+    assert (caught.value.key, caught.value.place.line, caught.value.place.col) == ("sources[0]", 2, 12)
     assert "File name too long" in caught.value.message
 
 

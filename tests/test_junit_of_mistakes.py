@@ -10,6 +10,7 @@ from click.testing import CliRunner
 
 from file_helpers import write_files
 from verifier.cli import main
+from verifier.place import Place
 from verifier.verify.report_junit import unusable_element
 from verifier.verify.result import Mistake
 
@@ -74,7 +75,7 @@ def test_a_capture_name_too_long_for_the_file_system_is_the_junits_error(tmp_pat
 
 def test_the_place_is_the_mistakes_data_not_its_text():
     root = unusable_element([Mistake("no place, though it reads a:1:2: like one"),
-                             Mistake("the sources do not load: dir: x/M.st:3:4: error: bad", "dir: x/M.st", 3, 4)])
+                             Mistake("the sources do not load: dir: x/M.st:3:4: error: bad", Place("dir: x/M.st", 3, 4))])
     unplaced, placed = root.findall("./testsuite/testcase")
     assert (unplaced.get("name"), unplaced.get("file")) == ("input", None)
     assert unplaced.find("error").get("message") == "no place, though it reads a:1:2: like one"
@@ -96,7 +97,7 @@ def test_mistakes_of_one_file_are_test_cases_of_their_own_names(tmp_path):
         assert names == [f"{tmp_path / 'a.toml'}:2:12 #1", f"{tmp_path / 'a.toml'}:2:12 #2",
                          f"{tmp_path / 'b.toml'}:2:8"]
     assert [case.get("file") for case in cases(report)] == [str(tmp_path / "a.toml")] * 2 + [str(tmp_path / "b.toml")]
-    numbered = unusable_element([Mistake("x"), Mistake("y"), Mistake("s.toml:1:1: z", "s.toml", 1, 1)])
+    numbered = unusable_element([Mistake("x"), Mistake("y"), Mistake("s.toml:1:1: z", Place("s.toml", 1, 1))])
     assert [c.get("name") for c in numbered.findall("./testsuite/testcase")] == ["input #1", "input #2", "s.toml:1:1"]
 
 
@@ -199,11 +200,11 @@ def test_the_places_of_an_unusable_input_cross_worker_processes():
 
     from verifier.verify.result import UnusableInput, mistakes_of
 
-    each = [Mistake("M.st:1:2: error: a", "M.st", 1, 2), Mistake("M.st:3:4: error: b", "M.st", 3, 4)]
-    error = pickle.loads(pickle.dumps(UnusableInput("ST sources have errors: ...", at=("M.st", 1, 2), mistakes=each)))
-    assert (error.file, error.line, error.col, mistakes_of(error)) == ("M.st", 1, 2, each)
-    alone = pickle.loads(pickle.dumps(UnusableInput("s.toml:2:3: program: x", at=("s.toml", 2, 3))))
-    assert mistakes_of(alone) == [Mistake("s.toml:2:3: program: x", "s.toml", 2, 3)]
+    each = [Mistake("M.st:1:2: error: a", Place("M.st", 1, 2)), Mistake("M.st:3:4: error: b", Place("M.st", 3, 4))]
+    error = pickle.loads(pickle.dumps(UnusableInput("ST sources have errors: ...", at=Place("M.st", 1, 2), mistakes=each)))
+    assert (error.place, mistakes_of(error)) == (Place("M.st", 1, 2), each)
+    alone = pickle.loads(pickle.dumps(UnusableInput("s.toml:2:3: program: x", at=Place("s.toml", 2, 3))))
+    assert mistakes_of(alone) == [Mistake("s.toml:2:3: program: x", Place("s.toml", 2, 3))]
 
 
 def _monitor_of_a_closed_stream(tmp_path, *args):
@@ -259,18 +260,18 @@ def test_every_exception_of_placed_mistakes_keeps_them_through_pickle():
     import pickle
 
     from verifier.commands.verify import ScenarioMistakes
-    from verifier.monitor.capture import CaptureError, Where
+    from verifier.monitor.capture import CaptureError
     from verifier.verify.result import UnusableInput, mistakes_of
 
-    several = ScenarioMistakes([UnusableInput("a.toml:1:2: program: x", at=("a.toml", 1, 2)),
+    several = ScenarioMistakes([UnusableInput("a.toml:1:2: program: x", at=Place("a.toml", 1, 2)),
                                 UnusableInput("--scan 5s: longer than the run")])
-    capture = CaptureError(Where("c.txt", 2, 3), "'0G' is not a byte in hex")
-    unreadable = CaptureError(Where("c.txt", 2, 10), "", message="c.txt: line 2, column 10 (byte 21): not UTF-8")
+    capture = CaptureError(Place("c.txt", 2, 3), "'0G' is not a byte in hex")
+    unreadable = CaptureError(Place("c.txt", 2, 10), "", message="c.txt: line 2, column 10 (byte 21): not UTF-8")
     for error in (several, capture, unreadable, CaptureError(None, "c.txt: no such file")):
         again = pickle.loads(pickle.dumps(error))
         assert (type(again), str(again), mistakes_of(again)) == (type(error), str(error), mistakes_of(error))
     assert mistakes_of(pickle.loads(pickle.dumps(capture))) == [
-        Mistake("c.txt:2:3: '0G' is not a byte in hex", "c.txt", 2, 3)]
+        Mistake("c.txt:2:3: '0G' is not a byte in hex", Place("c.txt", 2, 3))]
 
 
 def test_a_monitor_whose_line_cannot_be_opened_writes_that_to_its_junit(tmp_path):
@@ -388,10 +389,10 @@ def test_a_scenario_error_keeps_its_parts_through_pickle(tmp_path):
     for error in (read, ScenarioError(None, "", "no sources"), ScenarioError(Path("b.toml"), "seed", "not a number")):
         again = pickle.loads(pickle.dumps(error))
         assert type(again) is ScenarioError
-        assert (str(again), again.file, again.key, again.message, again.line, again.col) == (
-            str(error), error.file, error.key, error.message, error.line, error.col)
+        assert (str(again), again.file, again.key, again.message, again.place) == (
+            str(error), error.file, error.key, error.message, error.place)
         assert mistakes_of(again) == mistakes_of(error)
-    assert (read.line, read.col) == (2, 8)
+    assert read.place == Place(str(tmp_path / "a.toml"), 2, 8)
 
 
 def test_a_name_too_long_beside_a_command_line_mistake_keeps_clicks_message(tmp_path):

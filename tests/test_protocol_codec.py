@@ -325,6 +325,20 @@ def test_any_body_with_good_crc_decodes_or_names_a_field(settings, body):
         assert encode(request, settings) == with_crc(body)
 
 
+@given(any_settings, st.one_of(st.binary(max_size=12), st.binary(min_size=2, max_size=10).map(with_crc)))
+def test_a_refused_request_says_why_a_slave_stays_silent(settings, data):
+    """`uitamr frame` read again from the bytes why the robot would stay silent (the CRC,
+    the function code), which the decoder knew when it refused them; now the decoder says
+    it (`silence`): for every request refused without an exception reply, and only then."""
+    try:
+        decode_request(data, settings)
+    except FrameError as err:
+        assert (err.silence is None) == (err.exception is not None)
+        unanswerable = err.kind == "function" and crc_ok(data) and not 1 <= data[1] < 0x80
+        assert (err.silence == "function") == unanswerable
+        assert err.silence in (None, "function", "broken")
+
+
 # --- bad replies ------------------------------------------------------------------------
 
 def test_reply_from_wrong_address():

@@ -8,8 +8,9 @@ import tomllib
 import pytest
 from hypothesis import given, settings, strategies as st
 
+from verifier.place import Place
 from verifier.textfile import text_lines
-from verifier.tomlpos import Place, decode_error_position, line_of_key, place_of_key
+from verifier.tomlpos import decode_error_position, line_of_key, place_of_key
 
 TEXT = """\
 name = "bench"
@@ -84,7 +85,7 @@ def test_places_point_at_the_value_the_item_or_the_key():
     assert str(place_of_key(lines, "name")) == "1:8"
     assert str(place_of_key(lines, "watch")) == "2:9"
     assert [str(place_of_key(lines, f"watch[{i}]")) for i in range(4)] == ["2:10", "2:15", "2:22", "2:30"]
-    assert place_of_key(lines, "watch[9]") == Place(2, 9)  # no such item: the array
+    assert place_of_key(lines, "watch[9]") == Place(None, 2, 9)  # no such item: the array
     assert str(place_of_key(lines, "robot.pacing")) == "5:12"
     assert str(place_of_key(lines, "robot.pacing", at_name=True)) == "5:3"
     assert str(place_of_key(lines, "inputs[0].set.D100")) == "8:27"
@@ -97,9 +98,9 @@ def test_quoted_table_names_and_literal_keys_are_found():
     # be quoted too. Both pointed at the table's header, or nowhere (0:0 in `uitamr check`).
     lines = ["[initial]", "D100 = 3", "'U0\\G164' = 8", "", '["robot"]', "turnaround_ms = 'x'",
              "", "[[ 'faults' ]]", "kind = 'x'"]
-    assert place_of_key(lines, "initial.U0\\G164") == Place(3, 13)
-    assert place_of_key(lines, "initial.U0\\G164", at_name=True) == Place(3, 1)
-    assert place_of_key(lines, "robot.turnaround_ms") == Place(6, 17)
+    assert place_of_key(lines, "initial.U0\\G164") == Place(None, 3, 13)
+    assert place_of_key(lines, "initial.U0\\G164", at_name=True) == Place(None, 3, 1)
+    assert place_of_key(lines, "robot.turnaround_ms") == Place(None, 6, 17)
     assert line_of_key(lines, "robot") == 5
     assert line_of_key(lines, "faults[0].kind") == 9
 
@@ -107,8 +108,8 @@ def test_quoted_table_names_and_literal_keys_are_found():
 def test_dotted_keys_are_found():
     # robot.turnaround_ms = "x" (a TOML dotted key) gave no place at all (0:0 in uitamr check)
     lines = ['name = "x"', 'robot.turnaround_ms = "x"', "a.b.c = 1"]
-    assert place_of_key(lines, "robot.turnaround_ms") == Place(2, 23)
-    assert place_of_key(lines, "a", at_name=True) == Place(3, 1)
+    assert place_of_key(lines, "robot.turnaround_ms") == Place(None, 2, 23)
+    assert place_of_key(lines, "a", at_name=True) == Place(None, 3, 1)
 
 
 def test_items_of_an_array_over_several_lines_are_found_on_their_line():
@@ -122,40 +123,40 @@ def test_items_of_an_array_over_several_lines_are_found_on_their_line():
             ']\n')
     lines = text.splitlines()
     assert tomllib.loads(text)["watch"][3] == "fbCycle.o_wNoSuch"
-    assert place_of_key(lines, "watch[0]") == Place(2, 5)
-    assert place_of_key(lines, "watch[1]") == Place(4, 5)
-    assert place_of_key(lines, "watch[2]") == Place(4, 17)
-    assert place_of_key(lines, "watch[3]") == Place(5, 5)
-    assert place_of_key(lines, "watch[4]") == Place(1, 9)  # no such item: the array
+    assert place_of_key(lines, "watch[0]") == Place(None, 2, 5)
+    assert place_of_key(lines, "watch[1]") == Place(None, 4, 5)
+    assert place_of_key(lines, "watch[2]") == Place(None, 4, 17)
+    assert place_of_key(lines, "watch[3]") == Place(None, 5, 5)
+    assert place_of_key(lines, "watch[4]") == Place(None, 1, 9)  # no such item: the array
 
 
 @pytest.mark.parametrize("text, key, place, name", [
     # a sub-table by a dotted header: was its parent's header, or nothing
     ("[robot]\npacing = 'answer'\n\n[robot.point_durations_s]\n3 = 2.0\n4 = 'x'\n", "robot.point_durations_s.4",
-     Place(6, 5), Place(6, 1)),
-    ("[robot.point_durations_s]\n3 = 2.0\n", "robot.point_durations_s.3", Place(2, 5), Place(2, 1)),
-    ("[robot.point_durations_s]\n3 = 2.0\n", "robot", Place(1, 1), Place(1, 1)),  # made on the way: that header
-    ("[robot.point_durations_s]\n3 = 2.0\n[robot]\npacing = 1\n", "robot", Place(3, 1), Place(3, 1)),
+     Place(None, 6, 5), Place(None, 6, 1)),
+    ("[robot.point_durations_s]\n3 = 2.0\n", "robot.point_durations_s.3", Place(None, 2, 5), Place(None, 2, 1)),
+    ("[robot.point_durations_s]\n3 = 2.0\n", "robot", Place(None, 1, 1), Place(None, 1, 1)),  # made on the way: that header
+    ("[robot.point_durations_s]\n3 = 2.0\n[robot]\npacing = 1\n", "robot", Place(None, 3, 1), Place(None, 3, 1)),
     # a sub-table of the last table of an array of tables: was the [[...]] header
     ("[[inputs]]\nat = '1s'\n[[inputs]]\nat = '2s'\n[inputs.set]\nX0 = true\nD100 = 1\n", "inputs[1].set.D100",
-     Place(7, 8), Place(7, 1)),
-    ("[[inputs]]\nat = '1s'\n[[inputs]]\nat = '2s'\n[inputs.set]\nX0 = true\n", "inputs[1].set", Place(5, 1),
-     Place(5, 1)),
+     Place(None, 7, 8), Place(None, 7, 1)),
+    ("[[inputs]]\nat = '1s'\n[[inputs]]\nat = '2s'\n[inputs.set]\nX0 = true\n", "inputs[1].set", Place(None, 5, 1),
+     Place(None, 5, 1)),
     ("[[faults]]\nkind = 'x'\n[faults.sub]\ny = 1\n[[faults]]\nkind = 'z'\n[faults.sub]\ny = 2\n", "faults[1].sub.y",
-     Place(8, 5), Place(8, 1)),
-    ("[[a]]\n[[a.b]]\nc = 1\n[[a.b]]\nc = 2\n[[a]]\n[[a.b]]\nc = 3\n", "a[1].b[0].c", Place(8, 5), Place(8, 1)),
+     Place(None, 8, 5), Place(None, 8, 1)),
+    ("[[a]]\n[[a.b]]\nc = 1\n[[a.b]]\nc = 2\n[[a]]\n[[a.b]]\nc = 3\n", "a[1].b[0].c", Place(None, 8, 5), Place(None, 8, 1)),
     # dotted keys in a table, quoted parts, spaces around the dots
-    ("[robot]\npoint_durations_s . \"4\" = 'x'\n", "robot.point_durations_s.4", Place(2, 27), Place(2, 21)),
+    ("[robot]\npoint_durations_s . \"4\" = 'x'\n", "robot.point_durations_s.4", Place(None, 2, 27), Place(None, 2, 21)),
     # inline tables and arrays: the key inside, on its own line
-    ("faults = [\n  { kind = 'a' },  # one\n  { kind = 'b', at_s = 1 },\n]\n", "faults[1].at_s", Place(3, 24),
-     Place(3, 17)),
-    ("set = { 'fbRobot.i_uPoint' = 3, X0 = true }\n", "set.fbRobot.i_uPoint", Place(1, 30), Place(1, 9)),
+    ("faults = [\n  { kind = 'a' },  # one\n  { kind = 'b', at_s = 1 },\n]\n", "faults[1].at_s", Place(None, 3, 24),
+     Place(None, 3, 17)),
+    ("set = { 'fbRobot.i_uPoint' = 3, X0 = true }\n", "set.fbRobot.i_uPoint", Place(None, 1, 30), Place(None, 1, 9)),
     # names in comments and strings are not keys or headers
     ("a = '''\n[robot]\nturnaround_ms = 1'''\n# [robot]\n[robot]  # [faults]\nturnaround_ms = 2\n",
-     "robot.turnaround_ms", Place(6, 17), Place(6, 1)),
-    ('s = "a \\" [robot] x = 1"\n[robot]\nx = 2\n', "robot.x", Place(3, 5), Place(3, 1)),
+     "robot.turnaround_ms", Place(None, 6, 17), Place(None, 6, 1)),
+    ('s = "a \\" [robot] x = 1"\n[robot]\nx = 2\n', "robot.x", Place(None, 3, 5), Place(None, 3, 1)),
     # missing: the deepest table it would be in
-    ("[[inputs]]\nat = '1s'\n[inputs.set]\nX0 = true\n", "inputs[0].set.D100", Place(3, 1), Place(3, 1)),
+    ("[[inputs]]\nat = '1s'\n[inputs.set]\nX0 = true\n", "inputs[0].set.D100", Place(None, 3, 1), Place(None, 3, 1)),
 ])
 def test_keys_of_sub_tables_dotted_keys_and_inline_tables_are_at_their_own_place(text, key, place, name):
     lines = text.splitlines()
@@ -292,8 +293,8 @@ def test_finding_a_key_looks_up_its_own_parts_not_every_key_of_the_document(monk
         monkeypatch.setattr(tomlpos, "_places", lambda _text, places=places: places)
         Counting.read = 0
         lines = text_lines(text)
-        assert place_of_key(lines, f"inputs[{count - 1}].set.fb.i_uPoint") == Place(3 * count, 36)
-        assert place_of_key(lines, f"inputs[{count - 1}].set.X0", at_name=True) == Place(3 * count, 9)
+        assert place_of_key(lines, f"inputs[{count - 1}].set.fb.i_uPoint") == Place(None, 3 * count, 36)
+        assert place_of_key(lines, f"inputs[{count - 1}].set.X0", at_name=True) == Place(None, 3 * count, 9)
         reads.append(Counting.read)
     assert reads[1] == reads[0] < 40, reads
 
@@ -307,10 +308,10 @@ def test_an_array_nested_deeper_than_the_walk_can_follow_is_no_crash():
 
     text = "name = 5\nwatch = " + "[" * 400 + "]" * 400 + "\n"
     assert tomllib.loads(text)["name"] == 5
-    assert place_of_key(text_lines(text), "name") == Place(1, 8)
+    assert place_of_key(text_lines(text), "name") == Place(None, 1, 8)
     with pytest.raises(ScenarioError) as error:
         parse_scenario(text)
-    assert error.value.line == 1 and "name" in str(error.value)
+    assert error.value.place.line == 1 and "name" in str(error.value)
 
 
 def check_scenario(path, text):
@@ -371,7 +372,7 @@ def test_values_nested_too_deep_for_tomllib_are_an_error_at_their_key(text, plac
 
     with pytest.raises(ScenarioError) as error:
         parse_scenario(text)
-    assert (error.value.line, error.value.col) == place
+    assert (error.value.place.line, error.value.place.col) == place
     assert error.value.message == ("not valid TOML: arrays or inline tables nested hundreds deep: too deep to "
                                    "read, and no setting takes them")
     path = tmp_path / "deep.toml"

@@ -481,13 +481,14 @@ def test_verifier_md_says_what_the_junit_of_a_run_that_cannot_start_holds():
     """The exit-code table said 'No report is written' for exit 2 after --junit came to
     list the mistakes; the --junit section is held to what report_junit writes, a mistake
     with a place and one without (`--program MIAN`: name `input`, no `file`)."""
+    from verifier.place import Place
     from verifier.verify.report_junit import unusable_element
     from verifier.verify.result import Mistake
 
     section = " ".join(VERIFIER_MD.split("### `--junit FILE`", 1)[1].split("\n### ", 1)[0].split())
     (row,) = [line for line in VERIFIER_MD.splitlines() if line.startswith("| 2 | unusable input")]
     assert "`--junit`" in row and "(#--junit-file)" in row
-    root = unusable_element([Mistake("s.toml:4:1: duraton: unknown key\nmore", "s.toml", 4, 1),
+    root = unusable_element([Mistake("s.toml:4:1: duraton: unknown key\nmore", Place("s.toml", 4, 1)),
                              Mistake("--program: no PROGRAM 'MIAN' in the sources")])
     placed, unplaced = root.findall("./testsuite/testcase")
     assert f"classname `{placed.get('classname')}`" in section
@@ -497,5 +498,5 @@ def test_verifier_md_says_what_the_junit_of_a_run_that_cannot_start_holds():
     assert placed.find("error").get("message") == "s.toml:4:1: duraton: unknown key"  # the first line
     assert unplaced.get("name") == "input" and unplaced.get("file") is None
     assert "name `input` and no `file`" in section and "`--program MIAN`" in section
-    replay = unusable_element([Mistake("c.txt:1:16: 'zz' is not a byte in hex", "c.txt", 1, 16)], "uitamr replay")
+    replay = unusable_element([Mistake("c.txt:1:16: 'zz' is not a byte in hex", Place("c.txt", 1, 16))], "uitamr replay")
     assert f"classname `{replay.find('./testsuite/testcase').get('classname')}`" in section

@@ -326,7 +326,7 @@ def test_plc_settings_mistakes_name_their_key(tmp_path, body, key, words):
     scenario.write_text('platform = "q"\n' + body, encoding="utf-8")
     with pytest.raises(ScenarioError) as info:
         load_scenario(scenario)
-    assert info.value.key == key and words in info.value.message and info.value.line is not None
+    assert info.value.key == key and words in info.value.message and info.value.place is not None
 
 
 def test_c24_settings_need_the_q_platform(tmp_path, program):
@@ -624,4 +624,4 @@ def test_a_warning_before_the_errors_is_still_the_one_compared(monkeypatch):
     with pytest.raises(platform_module.UnusableInput) as raised:
         platform_module.infer_platform((Path("M.st"),))
     assert str(raised.value) == "the sources do not load: M.st:5:6: error: a"
-    assert (raised.value.file, raised.value.line, raised.value.col) == ("M.st", 5, 6)
+    assert str(raised.value.place) == "M.st:5:6"

@@ -287,20 +287,20 @@ def test_toml_syntax_errors_give_the_line(tmp_path):
     path.write_text('name = "x"\nprogram "Main"\n')
     with pytest.raises(ScenarioError) as info:
         load_scenario(path)
-    assert (info.value.line, info.value.col) == (2, 9)
+    assert (info.value.place.line, info.value.place.col) == (2, 9)
     assert str(info.value).startswith(f"{path}:2:9: not valid TOML")
 
 
 def test_unknown_keys_are_errors_with_their_line():
     error = error_of('program = "Main"\n\n[[expect]]\nthat = "a"\nwithn = "5s"\n', Path("s.toml"))
-    assert error.key == "expect[0].withn" and (error.line, error.col) == (5, 1)
+    assert error.key == "expect[0].withn" and (error.place.line, error.place.col) == (5, 1)
     assert str(error).startswith("s.toml:5:1: expect[0].withn: unknown key")
 
 
 def test_the_nth_table_of_an_array_is_found():
     text = 'program = "M"\n[[expect]]\nthat = "a"\nwithin = "1s"\n[[expect]]\nthat = "b"\nwithin = "5"\n'
     error = error_of(text)
-    assert error.key == "expect[1].within" and (error.line, error.col) == (7, 10) and "not a duration" in error.message
+    assert error.key == "expect[1].within" and (error.place.line, error.place.col) == (7, 10) and "not a duration" in error.message
 
 
 @pytest.mark.parametrize("text, key, words", [
@@ -351,16 +351,17 @@ def test_every_mistake_names_its_key(text, key, words):
     error = error_of(source, Path("x.toml"))
     assert error.key == key
     assert words in error.message
-    assert error.line is not None and 2 <= error.line <= 2 + text.count("\n")
-    line = source.splitlines()[error.line - 1]
-    assert error.col is not None and 1 <= error.col <= len(line), "the column is on the line"
-    assert str(error).startswith(f"x.toml:{error.line}:{error.col}: {key}: ")
+    place = error.place
+    assert place is not None and 2 <= place.line <= 2 + text.count("\n")
+    line = source.splitlines()[place.line - 1]
+    assert 1 <= place.col <= len(line), "the column is on the line"
+    assert str(error).startswith(f"{place}: {key}: ") and place.file == "x.toml"
 
 
 def test_a_number_too_long_for_python_is_a_toml_error_at_its_place():
     # tomllib let int()'s ValueError (more than 4300 digits) through: a traceback
     error = error_of('program = "Main"\nseed = 1_' + "9" * 5000 + "\n", Path("x.toml"))
-    assert (error.line, error.col) == (2, 8)
+    assert (error.place.line, error.place.col) == (2, 8)
     assert str(error).startswith("x.toml:2:8: not valid TOML: a whole number of 5001 digits: too long to read")
 
 
@@ -413,7 +414,7 @@ def test_an_input_after_the_run_says_the_run_length_and_what_to_do():
 ])
 def test_a_condition_that_does_not_parse_is_placed_where_it_fails_in_the_file(text, place):
     error = error_of('program = "M"\n' + text, Path("x.toml"))
-    assert (error.line, error.col) == place, str(error)
+    assert (error.place.line, error.place.col) == place, str(error)
     assert "found ')'" in str(error)
 
 
@@ -814,7 +815,7 @@ def test_each_platforms_channels_are_its_simulated_cpus():
 ])
 def test_a_key_in_a_sub_table_is_placed_on_its_own_line(text, key, place):
     error = error_of(text, Path("s.toml"))
-    assert (error.key, (error.line, error.col)) == (key, place), str(error)
+    assert (error.key, (error.place.line, error.place.col)) == (key, place), str(error)
     assert str(error).startswith(f"s.toml:{place[0]}:{place[1]}: {key}: ")
 
 

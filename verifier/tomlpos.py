@@ -17,20 +17,9 @@ import bisect
 import functools
 import re
 import tomllib
-from dataclasses import dataclass
 
+from verifier.place import Place
 from verifier.textfile import has_lone_cr, place_of_char, text_lines
-
-
-@dataclass(frozen=True)
-class Place:
-    """A line and column (both 1-based) in a TOML file; prints as `line:col`."""
-
-    line: int
-    col: int
-
-    def __str__(self) -> str:
-        return f"{self.line}:{self.col}"
 
 
 _LONG_NUMBER = re.compile(r"(?<![\w.])[0-9][0-9_]{4300,}")
@@ -262,7 +251,7 @@ class _Walk:
     def place(self, offset: int) -> Place:
         """`textfile.place_of_char`, by bisection of the line starts: asked for every key"""
         line = bisect.bisect_right(self.line_starts, offset)
-        return Place(line, offset - self.line_starts[line - 1] + 1)
+        return Place(None, line, offset - self.line_starts[line - 1] + 1)
 
 
 def decode_error_position(error: ValueError | RecursionError, source: str = "") -> tuple[str, Place | None]:
@@ -286,10 +275,10 @@ def decode_error_position(error: ValueError | RecursionError, source: str = "") 
         if source and _DECODE_AT_END.search(text):
             # a file that ends inside a string, a key, a table header: tomllib names no line
             # (Python < 3.14); the place is just past the last character, as tomllib counts
-            place = Place(*place_of_char(source, len(source)))
+            place = Place(None, *place_of_char(source, len(source)))
             return _DECODE_AT_END.sub(" at the end of the file", text), place
         return text, None
-    place = Place(int(match.group(1)), int(match.group(2)))
+    place = Place(None, int(match.group(1)), int(match.group(2)))
     if text.startswith("Cannot overwrite a value") and source:
         return _given_twice(source, place)
     return _DECODE_POSITION.sub("", text), place
@@ -308,7 +297,7 @@ def _given_twice(source: str, place: Place) -> tuple[str, Place]:
     if key is None:
         return "Cannot overwrite a value: a key is given twice", place
     name = key.group(2)
-    at = Place(place.line, len(key.group(1)) + 1)
+    at = Place(None, place.line, len(key.group(1)) + 1)
     for number in range(place.line - 1, 0, -1):
         earlier = lines[number - 1]
         if earlier.lstrip().startswith("["):
@@ -336,7 +325,7 @@ def _too_many_digits(source: str) -> tuple[str, Place | None]:
     match = _LONG_NUMBER.search(source)
     if match is None:
         return "a number too long to read", None
-    place = Place(*place_of_char(source, match.start()))
+    place = Place(None, *place_of_char(source, match.start()))
     digits = sum(ch.isdigit() for ch in match.group())
     return f"a whole number of {digits} digits: too long to read (at most 4300), and no setting takes it", place
 

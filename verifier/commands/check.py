@@ -193,7 +193,8 @@ def check_scenario(path: Path, platform: str | None = None) -> list[Diagnostic]:
         scenario = load_scenario(path, platform)  # --platform: a CPU verify runs (PLATFORMS)
     except ScenarioError as exc:
         message = f"{exc.key}: {exc.message}" if exc.key else exc.message
-        return [Diagnostic(str(path), exc.line or 0, exc.col or 0, "error", message)]
+        place = exc.place
+        return [Diagnostic(str(path), place.line if place else 0, place.col if place else 0, "error", message)]
     found = []
     place = scenario.key_lines.get("channel")
     if platform is not None and scenario.channel is not None and place is not None:

@@ -19,7 +19,6 @@ from verifier.protocol import (
     StatusReply,
     StatusRequest,
     ExceptionReply,
-    answerable_function,
     command_from_words,
     decode_frame,
     decode_reply,
@@ -30,7 +29,6 @@ from verifier.protocol import (
     explain_table,
     hex_bytes,
 )
-from verifier.protocol.crc import crc_ok
 from verifier.protocol.describe import looks_like_reply, modbus_tcp_hint
 from verifier.protocol.names import USAGE
 from verifier.commands.protocol_options import protocol_settings
@@ -238,7 +236,7 @@ def _decode_and_print(data: bytes, settings: Settings, direction, request, show_
             click.echo(hint)
         guessed = direction or ("reply" if request is not None or looks_like_reply(data) else "request")
         if guessed == "request":
-            click.echo("the robot would " + _robot_answer(exc, settings, data))
+            click.echo("the robot would " + _robot_answer(exc, settings))
         if show_fields:
             click.echo(explain_table(explain(data, settings, guessed)))
         raise SystemExit(EXIT_BAD_FRAME)
@@ -251,14 +249,16 @@ def _decode_and_print(data: bytes, settings: Settings, direction, request, show_
         click.echo(explain_table(explain(data, settings, kind)))
 
 
-def _robot_answer(error: FrameError, settings: Settings, data: bytes) -> str:
+def _robot_answer(error: FrameError, settings: Settings) -> str:
+    """What the robot does with a request the decoder refused: its exception reply, or why
+    it stays silent (the decoder's `silence`, else the address's)."""
     reply = exception_reply_for(error, settings)
     if reply is not None:
         return f"answer with exception {int(reply.exception_code):02X}: {hex_bytes(encode(reply, settings))}"
+    if error.silence == "function":
+        return f"stay silent (no exception reply can answer function code 0x{error.function:02X})"
     if error.exception is not None and error.address == 0:
         return "stay silent (broadcast requests get no reply)"
     if error.exception is not None:
         return f"stay silent (address {error.address} is not this robot's {settings.address})"
-    if error.kind == "function" and crc_ok(data) and not answerable_function(data[1]):
-        return f"stay silent (no exception reply can answer function code 0x{data[1]:02X})"
     return "stay silent (Modbus RTU: a frame with a bad length or CRC is discarded)"

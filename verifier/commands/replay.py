@@ -49,7 +49,7 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
             loaded = read_capture(path)
         except CaptureError as exc:
             if is_char_device(path):  # `uitamr replay /dev/ttyUSB0`: the port, not what was captured on it
-                exc = CaptureError(exc.where, "", message=f"{exc}: a serial port, not a capture; `uitamr monitor --serial "
+                exc = CaptureError(exc.place, "", message=f"{exc}: a serial port, not a capture; `uitamr monitor --serial "
                                                      f"{name}` listens on it (replay reads the file its --capture wrote)")
             click.echo(f"uitamr replay: {exc}", err=True)
             mistakes_junit(junit_path, mistakes_of(exc), "uitamr replay")  # the CI server shows the mistake

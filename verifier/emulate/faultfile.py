@@ -20,8 +20,9 @@ from typing import Any
 
 from verifier.amr import ConfigError, Fault, RobotConfig, check_fault_addresses, faults_from_list
 from verifier.amr.schema import reject_unknown_keys
+from verifier.place import Place
 from verifier.textfile import UnreadableText, read_utf8, text_lines
-from verifier.tomlpos import Place, decode_error_position, place_of_key
+from verifier.tomlpos import decode_error_position, place_of_key
 
 FILE_KEYS = ("robot", "faults")
 
@@ -73,4 +74,4 @@ def load_fault_file(path: str | Path, own_address: int | None = None) -> FaultFi
 
 
 def _where(path: Path, place: Place | None) -> str:
-    return f"{path}:{place}" if place is not None else str(path)
+    return str(place.in_file(str(path))) if place is not None else str(path)

@@ -24,11 +24,12 @@ import math
 import re
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any
 
 from verifier import protocol
 from verifier.amr.schema import LARGEST  # the largest number of seconds any setting holds
 from verifier.digits import describe, foreign_digit
+from verifier.place import Place
 from verifier.textfile import UnreadableText, lone_cr_as_line_feed, read_utf8, text_lines
 from verifier.verify.conditions import ConditionError, parse_condition
 from verifier.verify.report_trace import RUN_SETTINGS
@@ -63,34 +64,21 @@ def tolerance_hides_pacing(tolerance_us: int) -> bool:
     return tolerance_us >= protocol.MIN_PERIOD_US
 
 
-class Where(NamedTuple):
-    """A place in a capture file; prints as `file:line:col`."""
-
-    file: str
-    line: int
-    col: int
-
-    def __str__(self) -> str:
-        return f"{self.file}:{self.line}:{self.col}"
-
-
 class CaptureError(Exception):
-    """A capture file that cannot be read; the message is `file:line:col: what`, and `file`,
-    `line`, `col` hold the place (`where`; None: a file that cannot be read at all, whose
-    message names it alone)."""
+    """A capture file that cannot be read; the message is `file:line:col: what`, and `place`
+    holds the place (None: a file that cannot be read at all, whose message names it alone)."""
 
-    def __init__(self, where: Where | None, text: str, *, message: str | None = None):
-        """`message`, when given, instead of `where: text` (a message that shows its place otherwise)."""
-        super().__init__(message if message is not None else text if where is None else f"{where}: {text}")
-        self.where = where
-        self.file, self.line, self.col = where if where is not None else (None, None, None)
+    def __init__(self, place: Place | None, text: str, *, message: str | None = None):
+        """`message`, when given, instead of `place: text` (a message that shows its place otherwise)."""
+        super().__init__(message if message is not None else text if place is None else f"{place}: {text}")
+        self.place = place
 
     def __reduce__(self):  # its place with it: the constructor takes it apart from the message
-        return _capture_error, (self.where, str(self))
+        return _capture_error, (self.place, str(self))
 
 
-def _capture_error(where: Where | None, message: str) -> CaptureError:
-    return CaptureError(where, "", message=message)
+def _capture_error(place: Place | None, message: str) -> CaptureError:
+    return CaptureError(place, "", message=message)
 
 
 _TIME = re.compile(r"\s*([0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?=\s|$)")
@@ -109,23 +97,23 @@ def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
             continue
         if end_line is not None:
             col = len(line) - len(line.lstrip()) + 1
-            raise CaptureError(Where(name, number, col), f"the capture ended at its `end` line ({name}:{end_line}); "
+            raise CaptureError(Place(name, number, col), f"the capture ended at its `end` line ({name}:{end_line}); "
                                "move this line before it, or remove the `end` line")
         foreign = foreign_digit(line)  # float() reads '٠.٥' as 0.5
         if foreign is not None:
-            raise CaptureError(Where(name, number, foreign + 1), f"{describe(line[foreign])}")
+            raise CaptureError(Place(name, number, foreign + 1), f"{describe(line[foreign])}")
         time_match = _TIME.match(line)
         if time_match is None:
             col = len(line) - len(line.lstrip()) + 1
-            raise CaptureError(Where(name, number, col), "expected a time in seconds (e.g. 0.250) "
+            raise CaptureError(Place(name, number, col), "expected a time in seconds (e.g. 0.250) "
                                "at the start of the line")
         seconds = float(time_match.group(1))
         if seconds > LARGEST:  # the same bound as a trace record's time; 1e400 would not even be a number
-            raise CaptureError(Where(name, number, time_match.start(1) + 1), f"time {time_match.group(1)} s is "
+            raise CaptureError(Place(name, number, time_match.start(1) + 1), f"time {time_match.group(1)} s is "
                                f"beyond {LARGEST:g} s; expected a time in seconds from 0 to {LARGEST:g}")
         t_us = round(seconds * 1_000_000)
         if last_t is not None and t_us < last_t:
-            raise CaptureError(Where(name, number, time_match.start(1) + 1), f"time {time_match.group(1)} s is "
+            raise CaptureError(Place(name, number, time_match.start(1) + 1), f"time {time_match.group(1)} s is "
                                f"earlier than the line before ({last_t / 1_000_000:.6f} s); a capture "
                                "is in time order")
         pos = time_match.end()
@@ -134,7 +122,7 @@ def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
             rest = line[pos + end.end():]
             if rest.strip():
                 col = pos + end.end() + len(rest) - len(rest.lstrip()) + 1
-                raise CaptureError(Where(name, number, col), "an `end` line holds no bytes (it says until when the "
+                raise CaptureError(Place(name, number, col), "an `end` line holds no bytes (it says until when the "
                                    "line was listened to); put the bytes on a line of their own before it")
             chunks.append(Chunk(t_us, b""))
             last_t, end_line = t_us, number
@@ -153,12 +141,12 @@ def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
                 continue
             pair = _HEX_PAIR.match(rest, i)
             if pair is None:
-                raise CaptureError(Where(name, number, pos + i + 1), f"{rest[i:i + 2]!r} is not a byte in "
+                raise CaptureError(Place(name, number, pos + i + 1), f"{rest[i:i + 2]!r} is not a byte in "
                                    "hex (two digits 0-9, A-F)")
             data.append(int(pair.group(), 16))
             i = pair.end()
         if not data:
-            raise CaptureError(Where(name, number, len(line) + 1), "the line has a time but no bytes")
+            raise CaptureError(Place(name, number, len(line) + 1), "the line has a time but no bytes")
         chunks.append(Chunk(t_us, bytes(data), direction))
         last_t = t_us
     return chunks
@@ -184,16 +172,16 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
         try:
             record = json.loads(raw)
         except json.JSONDecodeError as exc:
-            raise CaptureError(Where(name, number, exc.colno), f"not a JSON trace record: {exc.msg}") from None
+            raise CaptureError(Place(name, number, exc.colno), f"not a JSON trace record: {exc.msg}") from None
         except ValueError:  # int() of more than 4300 digits
-            raise CaptureError(Where(name, number, 1), "not a trace record: it holds a number too long to read "
+            raise CaptureError(Place(name, number, 1), "not a trace record: it holds a number too long to read "
                                "(more than 4300 digits)") from None
         except RecursionError:
-            raise CaptureError(Where(name, number, 1), "not a trace record: arrays or objects nested thousands "
+            raise CaptureError(Place(name, number, 1), "not a trace record: arrays or objects nested thousands "
                                "deep") from None
         if not isinstance(record, dict):
-            raise CaptureError(Where(name, number, 1), "a trace record is a JSON object")
-        where = Where(name, number, 1)
+            raise CaptureError(Place(name, number, 1), "a trace record is a JSON object")
+        where = Place(name, number, 1)
         scenario = str(record.get("scenario", name))
         if scenario in ended:
             raise CaptureError(where, f"the run {scenario!r} ended at its end record ({name}:{ended[scenario]}); "
@@ -202,7 +190,7 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
             chunks = scenarios.setdefault(scenario, [])
             end = _end_chunk(record, chunks, where)
             recorded = events.pop(scenario, [])
-            within = [(event.t_us, Where(name, line, 1), f"the event record at {event.t_us / 1e6:g} s")
+            within = [(event.t_us, Place(name, line, 1), f"the event record at {event.t_us / 1e6:g} s")
                       for event, line in recorded]
             for k, (began, stopped) in enumerate(end.signal_held or ()):
                 # a stretch still holding at the end (stopped null) began after it
@@ -219,7 +207,7 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
             continue
         for key in ("t", "dir", "hex"):
             if key not in record:
-                raise CaptureError(Where(name, number, 1), f"the record has no {key!r}")
+                raise CaptureError(Place(name, number, 1), f"the record has no {key!r}")
         if record["dir"] not in ("tx", "rx"):
             raise CaptureError(where, f"'dir' is {record['dir']!r}; expected \"tx\" or \"rx\"")
         hex_text = record["hex"]
@@ -246,12 +234,12 @@ def parse_trace(text: str, name: str = "<trace>") -> dict[str, list[Chunk]]:
         chunks.append(Chunk(round(t_end * 1_000_000), data, record["dir"], round(t_start * 1_000_000),
                             None if tolerance is None else round(tolerance * 1_000_000)))
     for scenario in events:  # what the end record would have carried to the replay
-        raise CaptureError(Where(name, first_event[scenario], 1), f"the run {scenario!r} has event records but no end "
+        raise CaptureError(Place(name, first_event[scenario], 1), f"the run {scenario!r} has event records but no end "
                            "record after them; a trace ends each run with its end record")
     return scenarios
 
 
-def _nothing_after_the_end(end_us: int, records: list[tuple[int, Where, str]], end_line: int, scenario: str) -> None:
+def _nothing_after_the_end(end_us: int, records: list[tuple[int, Place, str]], end_line: int, scenario: str) -> None:
     """Refuse the first of `records` ((µs, place, what)) that lies after the run's end
     (`end_us`, its end record on line `end_line`): a run's events and the stretches its signal
     held are within it, so one after its end is a damaged or hand-edited trace, not the run."""
@@ -262,7 +250,7 @@ def _nothing_after_the_end(end_us: int, records: list[tuple[int, Where, str]], e
                                "the time or the end record's 'end', or remove what comes after it")
 
 
-def _event(record: dict, where: Where) -> LineEvent:
+def _event(record: dict, where: Place) -> LineEvent:
     """An event record (`{"scenario": ..., "t": seconds, "event": kind, "message": text}`): a
     line event the rules read that the frames do not show (RULE_EVENTS)."""
     other = sorted(set(record) - {"scenario", "t", "event", "message"})
@@ -280,7 +268,7 @@ def _event(record: dict, where: Where) -> LineEvent:
     return LineEvent(round(_seconds(record["t"], "t", where) * 1_000_000), record["event"], message)
 
 
-def _end_chunk(record: dict, chunks: list[Chunk], where: Where) -> Chunk:
+def _end_chunk(record: dict, chunks: list[Chunk], where: Place) -> Chunk:
     """A trace's end record (`{"scenario": ..., "end": seconds, "reply_timeout": seconds, ...}`,
     which every trace ends each run with): until when the line was listened to, as a chunk
     with no bytes, as a plain capture's `end` line is read; and the rules' settings the run
@@ -308,7 +296,7 @@ def _end_chunk(record: dict, chunks: list[Chunk], where: Where) -> Chunk:
                  settings=settings)
 
 
-def _protocol(table, where: Where) -> protocol.Settings:
+def _protocol(table, where: Place) -> protocol.Settings:
     """An end record's protocol settings (`{"address": 1, "field_order": "code-high", ...}`)."""
     names = tuple(field.name for field in fields(protocol.Settings))
     if not isinstance(table, dict):
@@ -329,7 +317,7 @@ def _protocol(table, where: Where) -> protocol.Settings:
 _OUTPUTS = ("response_signal", "response_signal_hint", "response_signal_held")
 
 
-def _signal(record: dict, where: Where) -> tuple[tuple[str, Any], ...]:
+def _signal(record: dict, where: Place) -> tuple[tuple[str, Any], ...]:
     """The response signal an end record names (None: the run had none) and the hint that
     says what the program has instead, as RuleOptions fields."""
     text, hint = record["response_signal"], record.get("response_signal_hint", "")
@@ -344,7 +332,7 @@ def _signal(record: dict, where: Where) -> tuple[tuple[str, Any], ...]:
     return ("response_signal", signal), ("response_signal_hint", hint)
 
 
-def _held(record: dict, where: Where) -> tuple[tuple[int, int | None], ...]:
+def _held(record: dict, where: Place) -> tuple[tuple[int, int | None], ...]:
     """When the response signal held: [began, stopped] pairs in seconds, in time order,
     stopped null for the last when it still held at the end of the run."""
     held = record.get("response_signal_held", [])
@@ -371,7 +359,7 @@ def _held(record: dict, where: Where) -> tuple[tuple[int, int | None], ...]:
 _HEX_BYTES = re.compile(r"\s*(?:[0-9A-Fa-f]{2}\s*)*")
 
 
-def _seconds(value, key: str, where: Where) -> float:
+def _seconds(value, key: str, where: Place) -> float:
     """A trace record's time in seconds: a finite number (not true/false), not negative."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
             or not 0 <= value <= LARGEST:
@@ -380,7 +368,7 @@ def _seconds(value, key: str, where: Where) -> float:
     return float(value)
 
 
-def _positive_us(value, key: str, where: Where) -> int:
+def _positive_us(value, key: str, where: Place) -> int:
     """A rule's time in an end record, in µs: longer than 0, as a scenario's [rules] and
     --reply-timeout take it (a time-out of 0 took every reply as late)."""
     us = round(_seconds(value, key, where) * 1_000_000)
@@ -397,7 +385,7 @@ def read_capture(path: Path) -> dict[str, list[Chunk]]:
         text = lone_cr_as_line_feed(read_utf8(path))
     except UnreadableText as exc:
         # bytes that are not text: `file: line L, column C (byte N): ...`, placed at them
-        where = None if exc.line is None else Where(str(path), exc.line, exc.col)
+        where = None if exc.line is None else Place(str(path), exc.line, exc.col)
         raise CaptureError(where, "", message=f"{path}: {exc}") from None
     first = _first_line(text)
     try:
@@ -406,7 +394,7 @@ def read_capture(path: Path) -> dict[str, list[Chunk]]:
         other = _other_kind(path, text, first)
         if other is None:
             raise
-        raise CaptureError(exc.where, "", message=f"{exc}; {other}") from None
+        raise CaptureError(exc.place, "", message=f"{exc}; {other}") from None
 
 
 def _first_line(text: str) -> str:

@@ -156,12 +156,12 @@ def _check_length(data: bytes, expected: int, what: str, address: int, function:
     if n < expected:
         raise FrameError(
             f"too short for {what}: {n} bytes, expected {expected}",
-            n, kind="length", address=address, function=function,
+            n, kind="length", address=address, function=function, silence="broken",
         )
     if n > expected:
         raise FrameError(
             f"too long for {what}: {n} bytes, expected {expected}",
-            expected, kind="length", address=address, function=function,
+            expected, kind="length", address=address, function=function, silence="broken",
         )
 
 
@@ -172,7 +172,7 @@ def _check_crc(data: bytes, address: int, function: int) -> None:
         raise FrameError(
             f"bad CRC: expected {hex_bytes(crc_bytes(expected))} (CRC 0x{expected:04X}), "
             f"got {hex_bytes(crc_bytes(got))} (CRC 0x{got:04X})",
-            len(data) - 2, kind="crc", address=address, function=function,
+            len(data) - 2, kind="crc", address=address, function=function, silence="broken",
         )
 
 
@@ -180,7 +180,7 @@ def _head(data: bytes, what: str) -> tuple[int, int]:
     if len(data) < 2:
         raise FrameError(
             f"too short for {what}: {len(data)} bytes, need at least the address and function code",
-            len(data), kind="length", address=data[0] if data else None,
+            len(data), kind="length", address=data[0] if data else None, silence="broken",
         )
     return data[0], data[1]
 
@@ -255,6 +255,7 @@ def _unknown_function(data: bytes, address: int, function: int) -> None:
             raise FrameError(
                 f"function code 0x{function:02X} is not one a master sends (00 is not a Modbus function "
                 "code, 80-FF are exception replies)", 1, kind="function", address=address, function=function,
+                silence="function",
             )
         raise FrameError(
             f"unknown function code 0x{function:02X} ({known})", 1,
@@ -263,7 +264,7 @@ def _unknown_function(data: bytes, address: int, function: int) -> None:
     raise FrameError(
         f"unknown function code 0x{function:02X} ({known}); the CRC over the {len(data)} bytes "
         "does not match either, so a slave stays silent",
-        1, kind="function", address=address, function=function,
+        1, kind="function", address=address, function=function, silence="broken",
     )
 
 

@@ -110,6 +110,10 @@ class FrameError(ValueError):
     rules; it is meaningful for requests only.
     ``address``/``function`` are the frame's first two bytes when present, so a slave can
     build its exception reply without parsing again.
+    ``silence`` says why no slave answers this request whatever its address, as the decoder
+    found it: "broken" (a bad length or CRC: the frame is discarded), "function" (a
+    function code no exception reply can answer, 00 or 80-FF); None when ``exception`` and
+    the address decide (requests only, as ``exception``).
     """
 
     def __init__(
@@ -121,6 +125,7 @@ class FrameError(ValueError):
         exception: ExceptionCode | None = None,
         address: int | None = None,
         function: int | None = None,
+        silence: str | None = None,
     ) -> None:
         super().__init__(message, offset)
         self.message = message
@@ -129,6 +134,7 @@ class FrameError(ValueError):
         self.exception = exception
         self.address = address
         self.function = function
+        self.silence = silence
 
     def __str__(self) -> str:
         return f"byte {self.offset}: {self.message}"

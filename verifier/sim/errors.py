@@ -3,6 +3,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from verifier.place import Place
+
 
 class LoadError(Exception):
     """The ST sources could not be loaded: parse or check diagnostics (file:line:col)."""
@@ -21,16 +23,16 @@ class LoadError(Exception):
         shows it (`file:line:col: severity: message`)."""
         return [_format_diag(d) for d in self.diagnostics]
 
-    def place(self) -> tuple[str, int, int] | None:
-        """(file, line, column) of the first error that names a source's line (not an
-        option of verifier.load), as its line of the message shows it; None if none does."""
+    def place(self) -> Place | None:
+        """The place of the first error that names a source's line (not an option of
+        verifier.load), as its line of the message shows it; None if none does."""
         located = self.located()
-        return located[0][:3] if located else None
+        return located[0][0] if located else None
 
-    def located(self) -> list[tuple[str, int, int, str]]:
-        """(file, line, column, its line of the message) of each error that names a source's
-        line, in the message's order: the mistakes a report can place one by one."""
-        return [(d.file, getattr(d, "line", 0), getattr(d, "col", 0), _format_diag(d)) for d in self.diagnostics
+    def located(self) -> list[tuple[Place, str]]:
+        """The place and the line of the message of each error that names a source's line,
+        in the message's order: the mistakes a report can place one by one."""
+        return [(Place(d.file, getattr(d, "line", 0), getattr(d, "col", 0)), _format_diag(d)) for d in self.diagnostics
                 if not getattr(d, "file", "?").startswith(OPTION_PLACE)
                 and getattr(d, "severity", "error") == "error"]
 

@@ -62,9 +62,9 @@ def infer_platform(sources: tuple[Path, ...]) -> str:
             located = exc.located()
             if not located:
                 raise UnusableInput(f"the sources do not load: {_first_error(exc)}", at=exc.place())
-            each = [Mistake(f"the sources do not load: {text}", file, line, col) for file, line, col, text in located]
-            raise UnusableInput("the sources do not load: " + "\n  ".join(text for *_, text in located),
-                                at=located[0][:3], mistakes=each)
+            each = [Mistake(f"the sources do not load: {text}", place) for place, text in located]
+            raise UnusableInput("the sources do not load: " + "\n  ".join(text for _, text in located),
+                                at=located[0][0], mistakes=each)
         reasons = "; ".join(f"{platform}: {error}" for platform, error in first.items())
         raise UnusableInput(f"the sources load on no platform ({reasons})")
     # the platforms named only, never told (an FX3G), beside the one whose scenarios they run

@@ -116,7 +116,7 @@ def unusable_element(mistakes: list[Mistake], command: str = "uitamr verify",
     `<error type="unusable-input">` whose message is the mistake's line that names its place
     (file:line:col), from the place on, and whose text is the whole message, so that the CI
     server shows what to fix instead of a missing report (or the last run's). The places are
-    the mistakes' own (`Mistake.file`, `line`, `col`), never read back from their text.
+    the mistakes' own (`Mistake.place`), never read back from their text.
     `results`: the runs that were done before the mistake (another report that could not be
     written after them), kept as their own test suite before the mistakes' one."""
     suites = to_element(results, command) if results else ET.Element("testsuites", name=command, tests="0",
@@ -128,8 +128,8 @@ def unusable_element(mistakes: list[Mistake], command: str = "uitamr verify",
     for mistake, name in zip(mistakes, _mistake_names(mistakes)):
         case = ET.SubElement(suite, "testcase", classname=command.replace(" ", ".") + ".input",
                              name=name, time="0.000")
-        if mistake.file is not None:
-            case.set("file", mistake.file)
+        if mistake.place is not None:
+            case.set("file", mistake.place.file)
         element = ET.SubElement(case, "error", message=_headline(mistake), type="unusable-input")
         element.text = mistake.message
     return suites
@@ -140,7 +140,7 @@ def _mistake_names(mistakes: list[Mistake]) -> list[str]:
     so that two mistakes of one file are two test cases a CI summary keeps apart, each named
     the same from run to run while it stays; mistakes that share a place (or have none) are
     numbered in order, `input #1`, `input #2`."""
-    names = [f"{m.file}:{m.line}:{m.col}" if m.file is not None else "input" for m in mistakes]
+    names = [str(m.place) if m.place is not None else "input" for m in mistakes]
     count, seen = Counter(names), Counter()
     numbered = []
     for name in names:
@@ -152,8 +152,8 @@ def _mistake_names(mistakes: list[Mistake]) -> list[str]:
 def _headline(mistake: Mistake) -> str:
     """The line of the message that shows the mistake's place, from the place on (`  plc/MAIN.st:5:6:
     error: ...` under `ST sources have errors:`); the first line when it shows none."""
-    if mistake.file is not None:
-        shown = f"{mistake.file}:{mistake.line}:{mistake.col}: "
+    if mistake.place is not None:
+        shown = f"{mistake.place}: "
         at = mistake.message.find(shown)
         if at >= 0:
             return mistake.message[at:].splitlines()[0]

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from verifier import protocol
+from verifier.place import Place
 
 from .durations import format_seconds
 from .evidence import DEFAULT_RESPONSE_WITHIN_US, RuleOptions, Violation
@@ -55,46 +56,42 @@ LINE = "line"
 @dataclass(frozen=True)
 class Mistake:
     """One mistake of a run that cannot start (exit 2), as its JUnit report lists it: the
-    whole message, and the place in a file it names first (file, line, column), or none
-    when it names no file's line (`--program MIAN`, a source file that does not exist)."""
+    whole message, and the place in a file it names first, or none when it names no file's
+    line (`--program MIAN`, a source file that does not exist)."""
 
     message: str
-    file: str | None = None
-    line: int | None = None
-    col: int | None = None
+    place: Place | None = None
 
 
 def mistakes_of(error: Exception) -> list[Mistake]:
     """The mistakes an exception of unusable input stands for, with their places as the
-    exception holds them (`file`, `line`, `col`: ScenarioError, UnusableInput, CaptureError;
-    `mistakes` for several, ScenarioMistakes); never read back from the message."""
+    exception holds them (`place`: ScenarioError, UnusableInput, CaptureError; `mistakes`
+    for several, ScenarioMistakes); never read back from the message."""
     several = getattr(error, "mistakes", None)
     if several is not None:
         return list(several)
-    file, line, col = (getattr(error, name, None) for name in ("file", "line", "col"))
-    if file is None or line is None or col is None:
+    place = getattr(error, "place", None)
+    if place is None or place.file is None:
         return [Mistake(str(error))]
-    return [Mistake(str(error), str(file), line, col)]
+    return [Mistake(str(error), place)]
 
 
 class UnusableInput(Exception):
     """Input the verifier cannot run (bad scenario, ST that does not load, unknown program).
 
     The message is complete and meant for people; the command exits 2 with it. `at`: the
-    place in a file the message names first, (file, line, column), for the JUnit report;
-    `mistakes`: the several mistakes one message lists, each at its own place (the errors
-    of ST that does not load), for the JUnit report's test cases."""
+    place in a file the message names first, for the JUnit report (`place`); `mistakes`:
+    the several mistakes one message lists, each at its own place (the errors of ST that
+    does not load), for the JUnit report's test cases."""
 
-    def __init__(self, message: str, at: tuple[str, int, int] | None = None,
-                 mistakes: list[Mistake] | None = None):
+    def __init__(self, message: str, at: Place | None = None, mistakes: list[Mistake] | None = None):
         super().__init__(message)
-        self.file, self.line, self.col = at if at is not None else (None, None, None)
+        self.place = at
         if mistakes is not None:
             self.mistakes = list(mistakes)
 
     def __reduce__(self):  # across --jobs' worker processes with its places
-        at = None if self.file is None else (self.file, self.line, self.col)
-        return _unusable_input, (type(self), str(self), at, getattr(self, "mistakes", None))
+        return _unusable_input, (type(self), str(self), self.place, getattr(self, "mistakes", None))
 
 
 def _unusable_input(kind: type, message: str, at, mistakes) -> UnusableInput:

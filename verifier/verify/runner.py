@@ -20,9 +20,9 @@ from verifier.amr.robot import Robot
 from verifier.amr.schema import did_you_mean
 from verifier.link import Line
 from verifier.link.converter import Converter
+from verifier.place import Place
 from verifier.sim.values import InstanceProxy, read_together
 from verifier.textfile import shown_path
-from verifier.tomlpos import Place
 
 from .durations import format_seconds
 from .events_shown import thin_line_events
@@ -73,7 +73,7 @@ class _Plc:
         except LoadError as exc:
             hint = _platform_hint(scenario)
             # one JUnit test case per error, each at its place (the message lists them all)
-            each = [Mistake(text + hint, file, line, col) for file, line, col, text in exc.located()]
+            each = [Mistake(text + hint, place) for place, text in exc.located()]
             raise UnusableInput(str(exc) + hint, at=exc.place(), mistakes=each or None) from None
         try:
             if isinstance(line, Converter):
@@ -286,7 +286,7 @@ def _key_where(scenario: Scenario, key: str) -> str:
     return _key_place(scenario, key)[0]
 
 
-def _key_place(scenario: Scenario, key: str) -> tuple[str, tuple[str, int, int] | None]:
+def _key_place(scenario: Scenario, key: str) -> tuple[str, Place | None]:
     """`_key_where(scenario, key)`, and the place it names as data (UnusableInput's `at`):
     none for the SOURCES arguments or an option."""
     if key in scenario.key_lines:

@@ -17,9 +17,10 @@ from verifier.amr.config import RobotConfig
 from verifier.amr.faults import Fault, check_fault_addresses
 from verifier.amr.schema import ConfigError, unknown_key
 from verifier.digits import digit_problem
+from verifier.place import Place
 from verifier.plcfacts import BUFFER_WORDS, CHANNELS, channel_problem, serial_channels
 from verifier.textfile import UnreadableText, read_utf8, text_lines
-from verifier.tomlpos import Place, decode_error_position, place_of_key, shown
+from verifier.tomlpos import decode_error_position, place_of_key, shown
 
 from verifier.link.converter import ConverterConfig
 
@@ -99,17 +100,17 @@ class ScenarioError(Exception):
     """A scenario that cannot be used, with where: `file:line:col: key: message`."""
 
     def __init__(self, file: Path | str | None, key: str, message: str, place: Place | None = None):
+        """`place`: the line and column in `file` (its own `file` is not read); `self.place`
+        is that place in `file` (its `file` None when the scenario has no file)."""
         self.file, self.key, self.message = file, key, message
-        self.line = place.line if place is not None else None
-        self.col = place.col if place is not None else None
+        self.place = place if place is None or file is None else place.in_file(str(file))
         where = str(file) if file is not None else "scenario"
         if place is not None:
-            where += f":{place}"
+            where = str(place.in_file(where))
         super().__init__(f"{where}: {key + ': ' if key else ''}{message}")
 
     def __reduce__(self):  # across --jobs' worker processes, as UnusableInput: the constructor takes the parts
-        place = None if self.line is None else Place(self.line, self.col)
-        return type(self), (self.file, self.key, self.message, place)
+        return type(self), (self.file, self.key, self.message, self.place)
 
 
 @dataclass(frozen=True)
@@ -229,18 +230,19 @@ class Scenario:
         return uses
 
     def where(self, key: str = "", line: Place | None = None) -> str:
-        """`file:line:col: key` (as much of it as is known) for messages about this scenario."""
+        """`file:line:col: key` (as much of it as is known) for messages about this scenario;
+        `line`: a place in this scenario's file."""
         text = str(self.path) if self.path is not None else f"scenario {self.name!r}"
         if line is not None:
-            text += f":{line}"
+            text = str(line.in_file(text))
         return f"{text}: {key}" if key else text
 
-    def at(self, line: Place | None) -> tuple[str, int, int] | None:
-        """The place `where(key, line)` names, as data (UnusableInput's `at`): (file, line,
-        column), or None when it names no file's line."""
+    def at(self, line: Place | None) -> Place | None:
+        """The place `where(key, line)` names, in the file (UnusableInput's `at`), or None
+        when it names no file's line."""
         if self.path is None or line is None:
             return None
-        return str(self.path), line.line, line.col
+        return line.in_file(str(self.path))
 
     def key_where(self, key: str) -> str:
         """`file:line:col: key` for the scenario's top-level `key`: where the file sets it, or
@@ -248,14 +250,14 @@ class Scenario:
         belongs in, as a key missing from an [[inputs]] table is placed at its header."""
         return self.where(key, self._key_place(key))
 
-    def key_at(self, key: str) -> tuple[str, int, int] | None:
+    def key_at(self, key: str) -> Place | None:
         """The place `key_where(key)` names, as data."""
         return self.at(self._key_place(key))
 
     def _key_place(self, key: str) -> Place | None:
         place = self.key_lines.get(key)
         if place is None and self.path is not None:
-            place = Place(1, 1)
+            place = Place(None, 1, 1)
         return place
 
     def with_overrides(self, **changes: Any) -> "Scenario":
@@ -326,7 +328,7 @@ def load_scenario(path: Path | str, platform: str | None = None) -> Scenario:
         if exc.line is None:
             raise ScenarioError(path, "", str(exc)) from None
         raise ScenarioError(path, "", f"not UTF-8 text (byte {exc.byte}): save the file as UTF-8",
-                            Place(exc.line, exc.col)) from None
+                            Place(None, exc.line, exc.col)) from None
     return parse_scenario(text, path, platform)
 
 
@@ -376,7 +378,7 @@ class _Reader:
                 return place
             if line[start] == '"' and "\\" in line[start:]:
                 return place  # an escape: the value is shorter than its text in the file
-            return Place(place.line, place.col + offset)
+            return Place(None, place.line, place.col + offset)
         row, col = place.line, place.col + 3  # the 1-based column of the value's first character
         if col > len(line):  # a newline right after the opening quotes is not part of the value
             row, col = row + 1, 1
@@ -394,7 +396,7 @@ class _Reader:
         while row - 1 < len(self.lines):
             rest = len(self.lines[row - 1]) - (col - 1)
             if left <= rest:
-                return Place(row, col + left)
+                return Place(None, row, col + left)
             left -= rest + 1  # the line's characters and its newline
             row, col = row + 1, 1
         return place

@@ -1,0 +1,30 @@
+"""A place in a file: the one shape every message, JUnit test case and annotation that
+points into a file is made from (a capture's bad byte, a scenario's key, an ST error of
+sources that do not load, the mistakes of a run that cannot start).
+
+Kept free of the toolkit's other modules: the command line's exit-2 paths import it, and
+they must stay quick to start.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+
+@dataclass(frozen=True)
+class Place:
+    """Line and column (both 1-based) in `file`; `file` None for a place within a file its
+    holder knows (a key of the scenario that `Scenario.key_lines` belongs to). Prints as
+    `file:line:col` (`line:col` without a file). Pickles as it is: places cross `--jobs`'
+    worker processes inside the errors that hold them."""
+
+    file: str | None
+    line: int
+    col: int
+
+    def __str__(self) -> str:
+        where = f"{self.line}:{self.col}"
+        return where if self.file is None else f"{self.file}:{where}"
+
+    def in_file(self, file: str) -> "Place":
+        """This line and column in `file`."""
+        return replace(self, file=file)
