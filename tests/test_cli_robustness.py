@@ -425,3 +425,20 @@ def test_a_file_name_with_a_newline_stays_on_its_message_line(tmp_path, monkeypa
         assert f"uitamr {command[0]}: p\\x09q.st: is not a regular file (a pipe)" in result.output
     (finding,) = json.loads(invoke("check", "--format", "json", bad).output)["diagnostics"]
     assert finding["file"] == bad
+
+
+def test_a_scenario_or_capture_named_with_a_newline_stays_on_its_message_line(tmp_path, monkeypatch):
+    """The places of scenario and capture mistakes (verifier.place.Place) printed a file name
+    with a line feed as it is: `verify --scenario 's<LF>c.toml'` said 'error: s' and then
+    'c.toml:2:12: duration: ...' on the next line. They now show it escaped, as check's and
+    verify's ST messages do (`s\\x0ac.toml:2:12`)."""
+    monkeypatch.chdir(tmp_path)
+    Path("s\nc.toml").write_text('name = "x"\nduration = "5q"\n', encoding="utf-8")
+    result = invoke("verify", "--scenario", "s\nc.toml")
+    assert result.exit_code == 2, result.output
+    assert "s\\x0ac.toml:2:12: duration: '5q' is not a duration" in result.output, result.output
+    assert "\nc.toml:" not in result.output
+    Path("t\nc.txt").write_text("0.000 rx 01 05\nbogus\n", encoding="utf-8")
+    result = invoke("replay", "t\nc.txt")
+    assert result.exit_code == 2, result.output
+    assert "t\\x0ac.txt:" in result.output and "\nc.txt:" not in result.output, result.output

@@ -14,7 +14,9 @@ from dataclasses import dataclass, replace
 class Place:
     """Line and column (both 1-based) in `file`; `file` None for a place within a file its
     holder knows (a key of the scenario that `Scenario.key_lines` belongs to). Prints as
-    `file:line:col` (`line:col` without a file). Pickles as it is: places cross `--jobs`'
+    `file:line:col` (`line:col` without a file), a name with a line feed or another
+    character that is not printable escaped as every line-based message shows it
+    (textfile.shown_name). Pickles as it is: places cross `--jobs`'
     worker processes inside the errors that hold them."""
 
     file: str | None
@@ -23,7 +25,13 @@ class Place:
 
     def __str__(self) -> str:
         where = f"{self.line}:{self.col}"
-        return where if self.file is None else f"{self.file}:{where}"
+        if self.file is None:
+            return where
+        if self.file.isprintable():
+            return f"{self.file}:{where}"
+        from verifier.textfile import shown_name  # a line feed in the name: keep the message on its line
+
+        return f"{shown_name(self.file)}:{where}"
 
     def in_file(self, file: str) -> "Place":
         """This line and column in `file`."""
