@@ -304,6 +304,38 @@ def test_the_fault_file_error_emulator_md_quotes_is_what_its_bench_toml_gives(tm
     assert f"bench.toml:{quoted};" in str(raised.value)
 
 
+def test_the_port_messages_the_pages_quote_are_the_commands_own(tmp_path):
+    """emulator.md and commissioning.md quote what `uitamr emulate` and `uitamr monitor` say of
+    a port that cannot be opened; each quote is the command's own words, run on a real port
+    (a quote ending in "..." is their start)."""
+    import socket
+    import subprocess
+    import sys
+
+    def page(name: str) -> str:
+        return " ".join((ROOT / "docs" / name).read_text(encoding="utf-8").split())
+
+    def said(*args: str) -> subprocess.CompletedProcess:
+        return subprocess.run([sys.executable, "-m", "verifier.cli", *args], capture_output=True, text=True,
+                              timeout=30)
+
+    emulator, commissioning = page("emulator.md"), page("commissioning.md")
+    missing = said("emulate", "--serial", str(tmp_path / "ttyUSB9"))  # the page's /dev/ttyUSB9, surely absent
+    quote = re.search(r"`cannot open serial port /dev/ttyUSB9: ([^`]*) \.\.\.`", emulator).group(1)
+    assert missing.returncode == 2 and f"cannot open serial port {tmp_path / 'ttyUSB9'}: {quote}" in missing.stderr
+    with socket.create_server(("127.0.0.1", 0)) as taken:
+        port = taken.getsockname()[1]
+        in_use = said("emulate", "--tcp", f"127.0.0.1:{port}")
+    quote = re.search(r"`(cannot listen on 127\.0\.0\.1:4001: [^`]*)`", emulator).group(1)
+    assert in_use.returncode == 2 and quote.replace("4001", str(port)) in in_use.stderr, in_use.stderr
+    with socket.create_server(("127.0.0.1", 0)) as probe:  # closed again: nothing listens on it
+        free = probe.getsockname()[1]
+    refused = said("monitor", "--tcp", f"127.0.0.1:{free}")
+    quote = re.search(r"`(cannot connect to 192\.168\.0\.60:4001: [^`]*)`", commissioning).group(1)
+    assert refused.returncode == 2
+    assert quote.replace("192.168.0.60:4001", f"127.0.0.1:{free}") in refused.stderr, refused.stderr
+
+
 def _plc_arguments(command: str) -> list[str]:
     """The bundled files a command names (not a pattern: `plc/*.st` in ci.md is the
     integrator's own plc/ folder)."""

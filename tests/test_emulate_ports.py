@@ -659,6 +659,15 @@ def test_the_scripted_fault_line_says_count_duration_and_filter_together(tmp_pat
     (("--serial", "socket://127.0.0.1:" + "9" * 5000), "is not a number from 1 to 65535", 2),
     # `--serial "$PORT"` with PORT unset: was exit 1, "cannot open serial port : ... ''"
     (("--serial", ""), "the port name is empty: give the serial port", 2),
+    # was pyserial's "Could not configure port: (25, 'Inappropriate ioctl for device')"
+    (("--serial", "/dev/null"), "uitamr emulate: cannot open serial port /dev/null: not a serial port (a file or "
+     "another kind of device): give the adapter's port", 2),
+    # was "[Errno -2] Name or service not known (while attempting to bind on address ('nosuch.invalid', 4001))"
+    (("--tcp", "nosuch.invalid:4001"), "uitamr emulate: cannot listen on nosuch.invalid:4001: nosuch.invalid is not "
+     "an address, nor a name this PC can look up", 2),
+    # TEST-NET-1 (RFC 5737), on no PC: was "[Errno 99] Cannot assign requested address (while attempting ...)"
+    (("--tcp", "192.0.2.7:4001"), "uitamr emulate: cannot listen on 192.0.2.7:4001: 192.0.2.7 is not an address "
+     "of this PC: give one of its own", 2),
 ])
 def test_cli_mistakes_get_a_clear_message(args, message, code):
     result = run_cli(*args)
@@ -686,6 +695,28 @@ def test_a_port_that_cannot_be_opened_says_what_to_check_on_site():
                                              "group (`ls -l` names the group, dialout on Debian and Ubuntu")
     busy = serial.SerialException(16, "could not open port /dev/ttyUSB0: [Errno 16] Device or resource busy")
     assert why_not_opened(busy).startswith("the port is busy: another program has it open")
+
+
+def test_a_tcp_port_in_use_or_refused_says_what_to_do(start_emulator):
+    """The bench mistakes with TCP: an emulator started earlier still holds the port (Python
+    said "[Errno 98] Address already in use (while attempting to bind on address
+    ('127.0.0.1', 4001))"); a serial server (socket://) that refuses (pyserial said "Could
+    not open port socket://...: [Errno 111] Connection refused"). Both exit 2 and say what
+    to check."""
+    first, port = tcp_emulator(start_emulator)
+    taken = run_cli("--tcp", f"127.0.0.1:{port}")
+    assert taken.returncode == 2 and "stopped after" not in taken.stdout
+    assert taken.stderr.strip() == (f"uitamr emulate: cannot listen on 127.0.0.1:{port}: the port is in use: another "
+                                    f"program listens on {port} (an emulator started earlier?); stop it, or give "
+                                    "another port (--tcp 0 picks a free one)")
+    assert first.stop()[0] == 0
+    with socket.create_server(("127.0.0.1", 0)) as probe:  # a port nothing listens on once it is closed
+        free = probe.getsockname()[1]
+    refused = run_cli("--serial", f"socket://127.0.0.1:{free}")
+    assert refused.returncode == 2 and "Errno" not in refused.stderr
+    assert refused.stderr.startswith(f"uitamr emulate: cannot open serial port socket://127.0.0.1:{free}: refused: "
+                                     "nothing accepts connections on that port; check the address and port"), \
+        refused.stderr
 
 
 def test_an_ipv6_listener_is_logged_as_tcp_takes_it_back(start_emulator):

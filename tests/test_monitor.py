@@ -1357,6 +1357,9 @@ def test_a_port_that_cannot_be_opened_exits_2_with_its_name(tmp_path):
     done = subprocess.run(uitamr("monitor", "--tcp", "127.0.0.1:1"), capture_output=True, text=True,
                           timeout=WAIT_S)
     assert done.returncode == 2 and "127.0.0.1:1" in done.stderr
+    # a converter that refuses: was the socket's bare "Connection refused", nothing to check named
+    assert ("cannot connect to 127.0.0.1:1: refused: nothing accepts connections on that port; check the address "
+            "and port (the converter's web page), that it is set to TCP server and is on") in done.stderr, done.stderr
 
 
 @pytest.mark.serial

@@ -1,9 +1,11 @@
 """What is wrong with a serial port a user named, in words to act on: for the two commands
-that open one, `uitamr emulate` (the robot's end) and `uitamr monitor` (a tap on the line).
+that open one, `uitamr emulate` (the robot's end) and `uitamr monitor` (a tap on the line);
+and with the TCP server either dials (a pyserial socket:// URL, `monitor --tcp`).
 """
 from __future__ import annotations
 
 import errno
+import socket
 
 
 def serial_url_problem(url: str) -> str | None:
@@ -23,12 +25,28 @@ def serial_url_problem(url: str) -> str | None:
     return None
 
 
+def _cause(err: BaseException) -> BaseException:
+    """The error pyserial wrapped: for socket:// and rfc2217:// URLs it raises a
+    SerialException without an errno, "Could not open port socket://...: [Errno 111]
+    Connection refused", the socket's OSError only as the context."""
+    if getattr(err, "errno", None) is None and isinstance(err.__context__, (OSError, socket.gaierror)):
+        return err.__context__
+    return err
+
+
 def why_not_opened(err: Exception) -> str:
     """Why pyserial could not open a port, and what to do, for the mistakes made on site: a
     wrong name (or the adapter unplugged), a port the user may not open, one another program
-    holds. Anything else in pyserial's words ("[Errno 2] could not open port /dev/ttyUSB9:
+    holds, a file that is no serial port, a serial server (socket://) that cannot be reached.
+    Anything else in pyserial's words ("[Errno 2] could not open port /dev/ttyUSB9:
     [Errno 2] No such file or directory: '/dev/ttyUSB9'" said the first twice, and no more)."""
+    cause = _cause(err)
+    if cause is not err and isinstance(cause, OSError):
+        return why_not_connected(cause)
     number = getattr(err, "errno", None)
+    if number is None and getattr(err.__context__, "args", (None,))[0] == errno.ENOTTY:  # termios.error
+        return ("not a serial port (a file or another kind of device): give the adapter's port, e.g. "
+                "/dev/ttyUSB0 or COM3")
     if number == errno.ENOENT:
         return ("no such port: check its name and that the adapter is plugged in (Linux: `ls /dev/ttyUSB* "
                 "/dev/ttyACM* /dev/serial/by-id/` lists the USB adapters; Windows: Device Manager, Ports (COM & LPT))")
@@ -38,3 +56,24 @@ def why_not_opened(err: Exception) -> str:
     if number == errno.EBUSY:
         return "the port is busy: another program has it open (a terminal program, ModemManager); close that first"
     return str(err)
+
+
+def why_not_connected(err: OSError) -> str:
+    """Why a TCP server (a converter streaming the line, a serial device server) could not be
+    reached, and what to check: it refused, it did not answer, this PC has no route to it,
+    its name is unknown. Anything else in the socket's words."""
+    if isinstance(err, socket.gaierror):
+        return "not an address, nor a name this PC can look up: give the converter's IP address"
+    number = err.errno
+    if number == errno.ECONNREFUSED:
+        return ("refused: nothing accepts connections on that port; check the address and port (the converter's "
+                "web page), that it is set to TCP server and is on, and that no other client holds its one "
+                "connection")
+    if isinstance(err, TimeoutError) or number == errno.ETIMEDOUT:
+        return ("no answer: check the address, that the converter is on and on this PC's network "
+                "(`ping` it), and any firewall between them")
+    if number in (errno.EHOSTUNREACH, errno.ENETUNREACH):
+        return ("no route to it: this PC is not on the converter's network; give the PC an address in the "
+                "converter's subnet, or check the address")
+    return err.strerror or str(err)
+
