@@ -719,6 +719,36 @@ def test_a_tcp_port_in_use_or_refused_says_what_to_do(start_emulator):
         refused.stderr
 
 
+@pytest.mark.serial
+def test_a_reply_whose_drain_meets_an_unplugged_port_ends_the_run_not_in_a_traceback(tmp_path):
+    """An adapter pulled out between the reply's write and its drain (pyserial's flush(),
+    termios.tcdrain): termios.error, no OSError, went past the emulator's handler - a
+    traceback, exit 1 and no summary (seen 1 run in 3 with socat killed as the reply came,
+    on a loaded PC). Here that moment for sure: the reply's bytes written (none left), the
+    drain on the port gone."""
+    from verifier.emulate.ports import PortError, send_reply
+
+    robot, plc = tmp_path / "robot", tmp_path / "plc"
+    socat = subprocess.Popen(["socat", f"pty,raw,echo=0,link={robot}", f"pty,raw,echo=0,link={plc}"],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + WAIT_S
+        while not (robot.exists() and plc.exists()):
+            assert socat.poll() is None and time.monotonic() < deadline, "socat made no pty pair"
+            time.sleep(0.02)
+        with serial.Serial(str(robot), 9600, timeout=0) as port:
+            socat.terminate()
+            socat.wait(timeout=WAIT_S)
+            with pytest.raises(PortError) as raised:
+                send_reply(port, str(robot), b"")
+    finally:
+        if socat.poll() is None:
+            socat.kill()
+            socat.wait(timeout=WAIT_S)
+    assert raised.value.in_use  # said after the summary, exit 1
+    assert str(raised.value).startswith(f"serial port {robot} failed while writing: ")
+
+
 def test_an_ipv6_listener_is_logged_as_tcp_takes_it_back(start_emulator):
     """The log's address pastes back into --tcp: [::1]:PORT, not ::1:PORT."""
     emulator = start_emulator("--tcp", "[::1]:0")
