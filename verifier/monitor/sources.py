@@ -70,7 +70,7 @@ class SerialSource:
             data = self.port.read(self.port.in_waiting or 1)
             if data and self.port.in_waiting:
                 data += self.port.read(self.port.in_waiting)
-        except self._error as exc:
+        except (self._error, OSError) as exc:  # in_waiting's ioctl on a port gone: OSError (EIO)
             raise SourceError(f"{self.description}: {exc}") from None
         if not data:
             return None
