@@ -306,11 +306,15 @@ def test_the_fault_file_error_emulator_md_quotes_is_what_its_bench_toml_gives(tm
 
 def test_the_port_messages_the_pages_quote_are_the_commands_own(tmp_path):
     """emulator.md and commissioning.md quote what `uitamr emulate` and `uitamr monitor` say of
-    a port that cannot be opened; each quote is the command's own words, run on a real port
-    (a quote ending in "..." is their start)."""
+    a port that cannot be opened and of one that went away; each quote is the command's own
+    words, run on a real port where one can be had (a quote ending in "..." is their start)."""
     import socket
     import subprocess
     import sys
+
+    import serial
+
+    from verifier.serialports import why_it_failed
 
     def page(name: str) -> str:
         return " ".join((ROOT / "docs" / name).read_text(encoding="utf-8").split())
@@ -334,6 +338,13 @@ def test_the_port_messages_the_pages_quote_are_the_commands_own(tmp_path):
     quote = re.search(r"`(cannot connect to 192\.168\.0\.60:4001: [^`]*)`", commissioning).group(1)
     assert refused.returncode == 2
     assert quote.replace("192.168.0.60:4001", f"127.0.0.1:{free}") in refused.stderr, refused.stderr
+    # an unplugged adapter, in pyserial 3.5's words (run on a real pty by test_emulate_ports.py
+    # and test_monitor.py)
+    gone = why_it_failed(serial.SerialException("device reports readiness to read but returned no data (device "
+                                                "disconnected or multiple access on port?)"))
+    assert f"`serial port /dev/ttyUSB0 failed: {gone}`" in emulator
+    quote = re.search(r"`the capture ended early: /dev/ttyUSB0: ([^`]*) \.\.\.`", commissioning).group(1)
+    assert gone.startswith(quote)
 
 
 def _plc_arguments(command: str) -> list[str]:

@@ -1363,6 +1363,45 @@ def test_a_port_that_cannot_be_opened_exits_2_with_its_name(tmp_path):
 
 
 @pytest.mark.serial
+def test_an_adapter_unplugged_mid_session_is_named_and_the_reports_are_written(tmp_path):
+    """The tap's USB adapter unplugged (its socat pty pair ended) while the monitor listened:
+    the session ends, the reports and the capture are written, and the reason says what
+    happened, not pyserial's "device reports readiness to read but returned no data (device
+    disconnected or multiple access on port?)" (the port is locked: nobody else reads it).
+    The exit status is that of what was seen (commissioning.md §2)."""
+    tap, line = tmp_path / "tap", tmp_path / "line"
+    socat = subprocess.Popen(["socat", f"pty,raw,echo=0,link={tap}", f"pty,raw,echo=0,link={line}"],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    monitor = None
+    try:
+        deadline = time.monotonic() + WAIT_S
+        while not (tap.exists() and line.exists()):
+            assert socat.poll() is None and time.monotonic() < deadline, "socat made no pty pair"
+            time.sleep(0.02)
+        monitor = start("monitor", "--serial", tap, "--json", tmp_path / "m.json", "--capture", tmp_path / "c.txt")
+        wait_for_line(monitor, "listening")
+        with open(line, "wb", buffering=0) as plc:
+            plc.write(STOP)
+            wait_for_line(monitor, "PLC → robot")
+        socat.terminate()  # the adapter is pulled out
+        socat.wait(timeout=WAIT_S)
+        out, err = monitor.communicate(timeout=WAIT_S)
+    finally:
+        for process in (monitor, socat):
+            if process is not None and process.poll() is None:
+                process.kill()
+                process.wait(timeout=WAIT_S)
+    gone = (f"{tap}: the port went away: the USB adapter was unplugged or lost power (or the program that made the "
+            "pty ended); plug it back in and start again")
+    assert f"stopped: {gone}" in out, out + err
+    assert "multiple access" not in out + err and "Traceback" not in err
+    report = json.loads((tmp_path / "m.json").read_text())
+    assert f"the capture ended early: {gone}" in report["scenarios"][0]["notes"], report["scenarios"][0]["notes"]
+    assert f"# the capture ended early: {gone}" in (tmp_path / "c.txt").read_text()
+    assert monitor.returncode == 0  # the stop command was seen and broke no rule: a PASS, with its note
+
+
+@pytest.mark.serial
 def test_a_read_of_a_port_that_went_away_is_the_end_of_the_capture_not_a_traceback(tmp_path):
     """The tap's adapter unplugged between two reads: pyserial's in_waiting (an ioctl) raised
     OSError (EIO), which went past the monitor's handler - a traceback and no report, no
@@ -1388,7 +1427,8 @@ def test_a_read_of_a_port_that_went_away_is_the_end_of_the_capture_not_a_traceba
         if socat.poll() is None:
             socat.kill()
             socat.wait(timeout=WAIT_S)
-    assert str(raised.value).startswith(f"{tap}: ")  # ends the capture: the reports are written
+    assert str(raised.value) == (f"{tap}: the port went away: the USB adapter was unplugged or lost power (or the "
+                                 "program that made the pty ended); plug it back in and start again")
 
 
 @pytest.mark.serial

@@ -25,7 +25,7 @@ from verifier.emulate.assembler import RequestAssembler
 from verifier.emulate.core import Emulator, Outgoing, counted
 from verifier.link.line import LineConfig
 from verifier.protocol.codec import hex_bytes
-from verifier.serialports import why_not_opened
+from verifier.serialports import why_it_failed, why_not_opened
 from verifier.stopflag import StopFlag
 
 POLL_S = 0.005  # longest wait between looks at the clock (reply and silence deadlines)
@@ -156,7 +156,7 @@ def send_reply(port: serial.SerialBase, url: str, data: bytes) -> None:
         port.write(data)
         port.flush()
     except (serial.SerialException, OSError, _DrainError) as err:
-        raise PortError(f"serial port {url} failed while writing: {err}", in_use=True) from None
+        raise PortError(f"serial port {url} failed while writing: {why_it_failed(err)}", in_use=True) from None
 
 
 def t3_5_at(baudrate: int) -> int:
@@ -199,7 +199,7 @@ def serve_serial(url: str, emulator: Emulator, stop: StopFlag, silence_us: int,
                 if data and port.in_waiting:
                     data += port.read(port.in_waiting)
             except (serial.SerialException, OSError) as err:
-                raise PortError(f"serial port {url} failed: {err}", in_use=True) from None
+                raise PortError(f"serial port {url} failed: {why_it_failed(err)}", in_use=True) from None
             now = emulator.now_us()
             if data:
                 heard_before = echo.seen
@@ -211,7 +211,13 @@ def serve_serial(url: str, emulator: Emulator, stop: StopFlag, silence_us: int,
             emulator.tick()
             now = emulator.now_us()
             for reply in channel.due(now):
-                send_reply(port, url, reply.data)
+                try:
+                    send_reply(port, url, reply.data)
+                except PortError:
+                    # not seen to leave: the closing line names it and the summary counts it as
+                    # not sent (it was counted nowhere: frames in were more than the sum)
+                    channel.outgoing.insert(0, reply)
+                    raise
                 echo.sent(reply.data, emulator.now_us() + channel.line.offset_us(len(reply.data)) + ECHO_GRACE_US)
                 emulator.sent(reply, now)
     finally:

@@ -14,7 +14,7 @@ import socket
 import time
 from typing import Protocol
 
-from verifier.serialports import why_not_connected, why_not_opened
+from verifier.serialports import why_it_failed, why_not_connected, why_not_opened
 
 from .capture import Chunk
 
@@ -71,7 +71,7 @@ class SerialSource:
             if data and self.port.in_waiting:
                 data += self.port.read(self.port.in_waiting)
         except (self._error, OSError) as exc:  # in_waiting's ioctl on a port gone: OSError (EIO)
-            raise SourceError(f"{self.description}: {exc}") from None
+            raise SourceError(f"{self.description}: {why_it_failed(exc)}") from None
         if not data:
             return None
         return Chunk(now_us(), bytes(data))
