@@ -6,6 +6,7 @@ No wall-clock time is asserted: waits are bounded polls for what must appear.
 """
 from __future__ import annotations
 
+import errno
 import os
 import queue
 import random
@@ -695,6 +696,18 @@ def test_a_port_that_cannot_be_opened_says_what_to_check_on_site():
                                              "group (`ls -l` names the group, dialout on Debian and Ubuntu")
     busy = serial.SerialException(16, "could not open port /dev/ttyUSB0: [Errno 16] Device or resource busy")
     assert why_not_opened(busy).startswith("the port is busy: another program has it open")
+    # nor can this bench make a converter that does not answer, one on no route, or a port
+    # below 1024 refused (root binds any): the socket's own exceptions for them
+    from verifier.emulate.ports import why_not_listening
+    from verifier.serialports import why_not_connected
+
+    assert why_not_connected(TimeoutError("timed out")).startswith("no answer: check the address, that the "
+                                                                   "converter is on and on this PC's network")
+    unreachable = OSError(errno.EHOSTUNREACH, "No route to host")
+    assert why_not_connected(unreachable).startswith("no route to it: this PC is not on the converter's network")
+    denied = PermissionError(errno.EACCES, "Permission denied (while attempting to bind on address ('0.0.0.0', 502))")
+    assert why_not_listening(denied, "0.0.0.0", 502) == ("permission denied: ports below 1024 need root; give a "
+                                                          "port from 1024 up, e.g. 4001")
 
 
 def test_a_tcp_port_in_use_or_refused_says_what_to_do(start_emulator):
