@@ -182,8 +182,10 @@ def test_every_option_of_a_command_is_in_its_page(name):
 def test_emulator_bench_recipe(tmp_path):
     """emulator.md, "Testing without hardware", run as the page gives it (its /tmp links
     moved into the test's folder): socat's pty pair, the emulator on one end, the three
-    mbpoll commands on the other; the stop and the point command are written, and the
-    status read shows coil 17 = 1 (running), as the page says."""
+    mbpoll commands on the other; the stop and the point command are written, the
+    status read shows coil 17 = 1 (running), and `kill %2` (SIGTERM) ends the emulator with
+    its summary line and status 0, as the page says. (socat killed first: status 1,
+    test_emulate_ports.py's test_an_adapter_unplugged_mid_run_...)"""
     import os
     import subprocess
     import sys
@@ -215,6 +217,12 @@ def test_emulator_bench_recipe(tmp_path):
         assert "Written 1 references." in outputs[0] and "Written 1 references." in outputs[1]
         coils = dict(re.findall(r"^\[(\d+)\]:\s+(\d)", outputs[2], flags=re.M))
         assert len(coils) == 22 and coils["17"] == "1", outputs[2]  # running: point 3 was started
+        # "`kill %2` stops the emulator (it prints its summary line and exits with status 0)"
+        emulator.terminate()
+        out = emulator.communicate(timeout=15)[0]
+        assert emulator.returncode == 0, out
+        assert out.splitlines()[-1].startswith("uitamr emulate: stopped after "), out
+        assert "3 frames in, 3 replies out, 0 unanswered" in out.splitlines()[-1], out
     finally:
         for process in (emulator, socat):
             if process is not None and process.poll() is None:
