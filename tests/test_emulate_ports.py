@@ -538,6 +538,21 @@ def test_bad_fault_file_names_file_and_key(tmp_path, text, message):
     assert "Traceback" not in result.stderr
 
 
+def test_a_fault_file_that_is_not_utf8_is_named_at_its_byte_as_a_scenario_is(tmp_path):
+    """A fault file saved in Latin-1 or Shift-JIS on the bench PC (a comment "café"): the
+    message was "faults.toml: line 2, column 24 (byte 31): not UTF-8 text", where every other
+    mistake in it, and the same file as a scenario, is named `file:line:col:`."""
+    path = tmp_path / "faults.toml"
+    path.write_bytes(b"[robot]\nturnaround_ms = 8 # caf\xe9\n")
+    result = run_cli("--tcp", "0", "--faults", str(path))
+    assert result.returncode == 2 and "Traceback" not in result.stderr
+    assert f"{path}:2:24: not UTF-8 text (byte 31): save the file as UTF-8" in result.stderr, result.stderr
+    verify = subprocess.run([sys.executable, "-m", "verifier.cli", "verify", "--scenario", str(path)],
+                            capture_output=True, text=True, timeout=WAIT_S)
+    assert verify.returncode == 2
+    assert f"{path}:2:24: not UTF-8 text (byte 31): save the file as UTF-8" in verify.stdout + verify.stderr
+
+
 def test_a_wrong_address_fault_on_the_robots_own_address_is_refused(tmp_path):
     path = tmp_path / "faults.toml"
     path.write_text('[[faults]]\nkind = "wrong_address"\non_request = 1\naddress = 5\n')
