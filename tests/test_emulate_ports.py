@@ -25,7 +25,7 @@ import serial
 from pymodbus.client import ModbusTcpClient
 from pymodbus.framer import FramerType
 
-from linebus import LineBus
+from linebus import LineBus, pty_cable
 from verifier.protocol import STOP_FRAME, ControlRequest, Query, StatusRequest, encode, with_crc
 
 pytestmark = pytest.mark.serial
@@ -756,41 +756,33 @@ def test_an_adapter_unplugged_mid_run_ends_with_the_summary_and_what_happened(tm
     disconnected or multiple access on port?)" after "Error:" - the port is locked, so nobody
     else read it."""
     robot, plc = tmp_path / "robot", tmp_path / "plc"
-    socat = subprocess.Popen(["socat", f"pty,raw,echo=0,link={robot}", f"pty,raw,echo=0,link={plc}"],
-                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     emulator = None
-    try:
-        deadline = time.monotonic() + WAIT_S
-        while not (robot.exists() and plc.exists()):
-            assert socat.poll() is None and time.monotonic() < deadline, "socat made no pty pair"
-            time.sleep(0.02)
-        emulator = EmulatorProcess("--serial", str(robot), "--frame-gap-ms", "60000")  # the 3 bytes wait
-        emulator.wait_for("listening on")
-        with serial.Serial(str(plc), 9600, timeout=WAIT_S) as port:
-            # in one write: the stop is answered at once, the three bytes after it wait for more
-            # (the PLC's end stays open: closing it made socat end before passing them on)
-            port.write(STOP_FRAME + STOP_FRAME[:3])
-            assert port.read(8) == STOP_FRAME
-            socat.terminate()
-            socat.wait(timeout=WAIT_S)
-        assert emulator.proc.wait(timeout=WAIT_S) == 1
-        emulator.wait_for(f"-- serial {robot} closed; 3 received bytes that were not yet a whole request dropped "
-                          r"\(01 06 01\)")
-        # frames in = replies out + unanswered + not sent: a reply whose drain failed (the
-        # port gone while it was going out) was counted nowhere
-        emulator.wait_for(r"uitamr emulate: stopped after .* 1 frame in, (1 reply out, 0 unanswered|"
-                          r"0 replies out, 0 unanswered, 1 reply not sent), ")
-        # the port is gone at the next read, or (the emulator late) at the reply's drain
-        emulator.wait_for(re.escape(f"uitamr emulate: serial port {robot} failed") + "( while writing)?"
-                          + re.escape(": the port went away: the USB adapter was unplugged or lost power (or the "
-                                      "program that made the pty ended); plug it back in and start again"))
-        assert not any("multiple access" in line or line.startswith("Error:") for line in emulator.lines)
-    finally:
-        if emulator is not None:
-            emulator.kill()
-        if socat.poll() is None:
-            socat.kill()
-            socat.wait(timeout=WAIT_S)
+    with pty_cable(tmp_path, "robot", "plc") as socat:
+        try:
+            emulator = EmulatorProcess("--serial", str(robot), "--frame-gap-ms", "60000")  # the 3 bytes wait
+            emulator.wait_for("listening on")
+            with serial.Serial(str(plc), 9600, timeout=WAIT_S) as port:
+                # in one write: the stop is answered at once, the three bytes after it wait for
+                # more (the PLC's end stays open: closing it made socat end before passing them on)
+                port.write(STOP_FRAME + STOP_FRAME[:3])
+                assert port.read(8) == STOP_FRAME
+                socat.terminate()
+                socat.wait(timeout=WAIT_S)
+            assert emulator.proc.wait(timeout=WAIT_S) == 1
+        finally:
+            if emulator is not None:
+                emulator.kill()
+    emulator.wait_for(f"-- serial {robot} closed; 3 received bytes that were not yet a whole request dropped "
+                      r"\(01 06 01\)")
+    # frames in = replies out + unanswered + not sent: a reply whose drain failed (the port
+    # gone while it was going out) was counted nowhere
+    emulator.wait_for(r"uitamr emulate: stopped after .* 1 frame in, (1 reply out, 0 unanswered|"
+                      r"0 replies out, 0 unanswered, 1 reply not sent), ")
+    # the port is gone at the next read, or (the emulator late) at the reply's drain
+    emulator.wait_for(re.escape(f"uitamr emulate: serial port {robot} failed") + "( while writing)?"
+                      + re.escape(": the port went away: the USB adapter was unplugged or lost power (or the "
+                                  "program that made the pty ended); plug it back in and start again"))
+    assert not any("multiple access" in line or line.startswith("Error:") for line in emulator.lines)
 
 
 @pytest.mark.serial
@@ -802,23 +794,12 @@ def test_a_reply_whose_drain_meets_an_unplugged_port_ends_the_run_not_in_a_trace
     drain on the port gone."""
     from verifier.emulate.ports import PortError, send_reply
 
-    robot, plc = tmp_path / "robot", tmp_path / "plc"
-    socat = subprocess.Popen(["socat", f"pty,raw,echo=0,link={robot}", f"pty,raw,echo=0,link={plc}"],
-                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    try:
-        deadline = time.monotonic() + WAIT_S
-        while not (robot.exists() and plc.exists()):
-            assert socat.poll() is None and time.monotonic() < deadline, "socat made no pty pair"
-            time.sleep(0.02)
-        with serial.Serial(str(robot), 9600, timeout=0) as port:
-            socat.terminate()
-            socat.wait(timeout=WAIT_S)
-            with pytest.raises(PortError) as raised:
-                send_reply(port, str(robot), b"")
-    finally:
-        if socat.poll() is None:
-            socat.kill()
-            socat.wait(timeout=WAIT_S)
+    robot = tmp_path / "robot"
+    with pty_cable(tmp_path, "robot", "plc") as socat, serial.Serial(str(robot), 9600, timeout=0) as port:
+        socat.terminate()
+        socat.wait(timeout=WAIT_S)
+        with pytest.raises(PortError) as raised:
+            send_reply(port, str(robot), b"")
     assert raised.value.in_use  # said after the summary, exit 1
     assert str(raised.value) == (f"serial port {robot} failed while writing: the port went away: the USB adapter was "
                                  "unplugged or lost power (or the program that made the pty ended); plug it back in "

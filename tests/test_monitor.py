@@ -26,7 +26,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from linebus import LineBus
+from linebus import LineBus, pty_cable
 from monitor_helpers import (BAD_MASTER_FINDINGS, SETTINGS, WAIT_S, Master, bad_master, diagnosis, findings,
                              frame, start, uitamr, wait_for_line)
 from verifier import protocol
@@ -1370,27 +1370,22 @@ def test_an_adapter_unplugged_mid_session_is_named_and_the_reports_are_written(t
     disconnected or multiple access on port?)" (the port is locked: nobody else reads it).
     The exit status is that of what was seen (commissioning.md §2)."""
     tap, line = tmp_path / "tap", tmp_path / "line"
-    socat = subprocess.Popen(["socat", f"pty,raw,echo=0,link={tap}", f"pty,raw,echo=0,link={line}"],
-                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     monitor = None
-    try:
-        deadline = time.monotonic() + WAIT_S
-        while not (tap.exists() and line.exists()):
-            assert socat.poll() is None and time.monotonic() < deadline, "socat made no pty pair"
-            time.sleep(0.02)
-        monitor = start("monitor", "--serial", tap, "--json", tmp_path / "m.json", "--capture", tmp_path / "c.txt")
-        wait_for_line(monitor, "listening")
-        with open(line, "wb", buffering=0) as plc:
-            plc.write(STOP)
-            wait_for_line(monitor, "PLC → robot")
-        socat.terminate()  # the adapter is pulled out
-        socat.wait(timeout=WAIT_S)
-        out, err = monitor.communicate(timeout=WAIT_S)
-    finally:
-        for process in (monitor, socat):
-            if process is not None and process.poll() is None:
-                process.kill()
-                process.wait(timeout=WAIT_S)
+    with pty_cable(tmp_path, "tap", "line") as socat:
+        try:
+            monitor = start("monitor", "--serial", tap, "--json", tmp_path / "m.json", "--capture",
+                            tmp_path / "c.txt")
+            wait_for_line(monitor, "listening")
+            with open(line, "wb", buffering=0) as plc:
+                plc.write(STOP)
+                wait_for_line(monitor, "PLC → robot")
+                socat.terminate()  # the adapter is pulled out
+                socat.wait(timeout=WAIT_S)
+            out, err = monitor.communicate(timeout=WAIT_S)
+        finally:
+            if monitor is not None and monitor.poll() is None:
+                monitor.kill()
+                monitor.wait(timeout=WAIT_S)
     gone = (f"{tap}: the port went away: the USB adapter was unplugged or lost power (or the program that made the "
             "pty ended); plug it back in and start again")
     assert f"stopped: {gone}" in out, out + err
@@ -1409,24 +1404,14 @@ def test_a_read_of_a_port_that_went_away_is_the_end_of_the_capture_not_a_traceba
     that moment for sure: the port is open, its pty pair gone, and the next read comes."""
     from verifier.monitor.sources import SerialSource, SourceError
 
-    tap, line = tmp_path / "tap", tmp_path / "line"
-    socat = subprocess.Popen(["socat", f"pty,raw,echo=0,link={tap}", f"pty,raw,echo=0,link={line}"],
-                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    try:
-        deadline = time.monotonic() + WAIT_S
-        while not (tap.exists() and line.exists()):
-            assert socat.poll() is None and time.monotonic() < deadline, "socat made no pty pair"
-            time.sleep(0.02)
+    tap = tmp_path / "tap"
+    with pty_cable(tmp_path, "tap", "line") as socat:
         source = SerialSource(str(tap), 9600, 8, "N", 1)
         socat.terminate()
         socat.wait(timeout=WAIT_S)
         with pytest.raises(SourceError) as raised:
             source.read()
         source.close()
-    finally:
-        if socat.poll() is None:
-            socat.kill()
-            socat.wait(timeout=WAIT_S)
     assert str(raised.value) == (f"{tap}: the port went away: the USB adapter was unplugged or lost power (or the "
                                  "program that made the pty ended); plug it back in and start again")
 
