@@ -294,6 +294,16 @@ def test_the_fault_defaults_emulator_md_gives_are_the_codes():
     assert f"`code` (default {Fault('exception', on_request=1).code:02d})" in rows["`exception`"]
 
 
+def test_the_reply_lateness_emulator_md_gives_is_how_often_the_emulator_looks():
+    """emulator.md gave `--turnaround-ms` as the time to the reply; on the wall clock the
+    reply goes out when the serving loop next looks, up to ports.POLL_S later."""
+    from verifier.emulate.ports import POLL_S
+
+    text = " ".join((ROOT / "docs" / "emulator.md").read_text(encoding="utf-8").split())
+    assert (f"a reply goes out up to {POLL_S * 1000:g} ms after it falls due, as the emulator looks at its port "
+            f"and clock every {POLL_S * 1000:g} ms") in text
+
+
 def test_the_fault_file_error_emulator_md_quotes_is_what_its_bench_toml_gives(tmp_path):
     """emulator.md quotes a fault file mistake right before it prints `bench.toml`: that
     file with its first fault's kind misspelt 'x' gives the quoted place and message (the
