@@ -729,8 +729,9 @@ def test_a_tcp_port_in_use_or_refused_says_what_to_do(start_emulator):
     """The bench mistakes with TCP: an emulator started earlier still holds the port (Python
     said "[Errno 98] Address already in use (while attempting to bind on address
     ('127.0.0.1', 4001))"); a serial server (socket://) that refuses (pyserial said "Could
-    not open port socket://...: [Errno 111] Connection refused"). Both exit 2 and say what
-    to check."""
+    not open port socket://...: [Errno 111] Connection refused"); rfc2217:// to a converter
+    in raw mode (pyserial: "Remote does not seem to support RFC2217 or BINARY mode
+    [we-BINARY:False(INACTIVE), ...]"). Each exits 2 and says what to check."""
     first, port = tcp_emulator(start_emulator)
     taken = run_cli("--tcp", f"127.0.0.1:{port}")
     assert taken.returncode == 2 and "stopped after" not in taken.stdout
@@ -740,6 +741,11 @@ def test_a_tcp_port_in_use_or_refused_says_what_to_do(start_emulator):
     assert first.stop()[0] == 0
     with socket.create_server(("127.0.0.1", 0)) as probe:  # a port nothing listens on once it is closed
         free = probe.getsockname()[1]
+    with socket.create_server(("127.0.0.1", 0)) as raw:  # a converter in raw TCP mode: it never negotiates
+        rfc2217 = run_cli("--serial", f"rfc2217://127.0.0.1:{raw.getsockname()[1]}")
+    assert rfc2217.returncode == 2
+    assert ("the server does not speak RFC 2217 (telnet COM port control): for a converter or ser2net that passes "
+            "the bytes as they are (raw TCP), give socket://HOST:PORT") in rfc2217.stderr, rfc2217.stderr
     refused = run_cli("--serial", f"socket://127.0.0.1:{free}")
     assert refused.returncode == 2 and "Errno" not in refused.stderr
     assert refused.stderr.startswith(f"uitamr emulate: cannot open serial port socket://127.0.0.1:{free}: refused: "

@@ -47,6 +47,9 @@ def why_not_opened(err: Exception) -> str:
     if number is None and getattr(err.__context__, "args", (None,))[0] == errno.ENOTTY:  # termios.error
         return ("not a serial port (a file or another kind of device): give the adapter's port, e.g. "
                 "/dev/ttyUSB0 or COM3")
+    if "does not seem to support RFC2217" in str(err):  # pyserial's rfc2217:// after its negotiation failed
+        return ("the server does not speak RFC 2217 (telnet COM port control): for a converter or ser2net that "
+                "passes the bytes as they are (raw TCP), give socket://HOST:PORT")
     if number == errno.ENOENT:
         return ("no such port: check its name and that the adapter is plugged in (Linux: `ls /dev/ttyUSB* "
                 "/dev/ttyACM* /dev/serial/by-id/` lists the USB adapters; Windows: Device Manager, Ports (COM & LPT))")
