@@ -1658,3 +1658,32 @@ def test_replay_of_a_serial_port_points_to_the_monitor():
     assert done.returncode == 2 and "Traceback" not in done.stderr
     assert (f"uitamr replay: {port}: cannot read: not a regular file (a character device): a serial port, not a "
             f"capture; `uitamr monitor --serial {port}` listens on it") in done.stderr, done.stderr
+
+
+def test_a_converter_that_resets_the_stream_is_said_with_what_to_check(tmp_path):
+    """`monitor --tcp` to a converter that reset its connection (restarted, lost power, dropped
+    this client: a TCP RST) ended with the socket's own words, '...: Connection reset by
+    peer'; it now says what happened and what to check, and still writes its reports."""
+    import struct
+
+    server = socket.create_server(("127.0.0.1", 0))
+    port = server.getsockname()[1]
+
+    def reset_after_some_bytes():
+        connection, _ = server.accept()
+        connection.sendall(frame("read", "task"))  # a status request: something was seen
+        time.sleep(0.5)
+        connection.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+        connection.close()  # linger 0: the close sends RST, not FIN
+
+    thread = threading.Thread(target=reset_after_some_bytes, daemon=True)
+    thread.start()
+    done = subprocess.run(uitamr("monitor", "--tcp", f"127.0.0.1:{port}", "--duration", "30s",
+                                 "--json", tmp_path / "m.json"), capture_output=True, text=True, timeout=60)
+    thread.join(10)
+    server.close()
+    said = done.stdout + done.stderr
+    assert "Traceback" not in said and "Connection reset by peer" not in said, said
+    assert (f"tcp 127.0.0.1:{port}: the server reset the connection: the converter restarted, lost power or "
+            "dropped this client; check it and start again") in said, said
+    assert (tmp_path / "m.json").exists(), said

@@ -90,13 +90,17 @@ def why_it_failed(err: Exception) -> str:
     """Why a serial port that was open failed while in use, and what to do: an unplugged
     adapter gave pyserial's "device reports readiness to read but returned no data (device
     disconnected or multiple access on port?)" - the port is locked, so it is the first -
-    or "[Errno 5] Input/output error". Anything else in pyserial's words."""
+    or "[Errno 5] Input/output error"; a TCP stream (monitor --tcp) that the converter reset
+    gave "Connection reset by peer". Anything else in pyserial's or the socket's words."""
     number = getattr(_cause(err), "errno", None)
     if number is None and err.args and isinstance(err.args[0], int):  # termios.error(5, 'Input/output error')
         number = err.args[0]
     if _GONE in str(err) or number in (errno.EIO, errno.ENXIO, errno.ENODEV):
         return ("the port went away: the USB adapter was unplugged or lost power (or the program that made the "
                 "pty ended); plug it back in and start again")
+    if number in (errno.ECONNRESET, errno.ECONNABORTED):  # the converter's RST: "Connection reset by peer"
+        return ("the server reset the connection: the converter restarted, lost power or dropped this client; "
+                "check it and start again")
     if str(err).endswith("socket disconnected"):  # pyserial's socket:// URL: "read failed: socket disconnected"
         return "the serial server closed the connection"
     return str(err)

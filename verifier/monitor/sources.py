@@ -97,8 +97,8 @@ class TcpSource:
             data = self.sock.recv(4096)
         except (TimeoutError, socket.timeout):
             return None
-        except OSError as exc:
-            raise SourceError(f"{self.description}: {exc.strerror or exc}") from None
+        except OSError as exc:  # "Connection reset by peer": said with what to check
+            raise SourceError(f"{self.description}: {why_it_failed(exc)}") from None
         if not data:
             raise SourceError(f"{self.description}: the server closed the connection")
         return Chunk(now_us(), data)
