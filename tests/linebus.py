@@ -13,6 +13,7 @@ import subprocess
 import threading
 import time
 from pathlib import Path
+import procs
 
 OPEN_TIMEOUT_S = 10
 
@@ -30,7 +31,7 @@ class LineBus:
         self._fds: dict[str, int] = {}
         for name in ("plc", "robot", "tap"):
             device, bus = folder / name, folder / f"{name}-bus"
-            self._socats.append(subprocess.Popen(
+            self._socats.append(procs.spawn(
                 ["socat", f"pty,raw,echo=0,link={device}", f"pty,raw,echo=0,link={bus}"],
                 stdout=subprocess.DEVNULL, stderr=subprocess.PIPE))
             deadline = time.monotonic() + OPEN_TIMEOUT_S

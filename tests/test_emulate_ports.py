@@ -26,6 +26,7 @@ from pymodbus.framer import FramerType
 
 from linebus import LineBus
 from verifier.protocol import STOP_FRAME, ControlRequest, Query, StatusRequest, encode, with_crc
+import procs
 
 pytestmark = pytest.mark.serial
 
@@ -38,7 +39,7 @@ class EmulatorProcess:
     """``python -m verifier.cli emulate ...`` with its log lines collected as they come."""
 
     def __init__(self, *args: str) -> None:
-        self.proc = subprocess.Popen(
+        self.proc = procs.spawn(
             [sys.executable, "-m", "verifier.cli", "emulate", *args],
             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, bufsize=1,
             env={**os.environ, "PYTHONUNBUFFERED": "1"},
@@ -84,7 +85,7 @@ class EmulatorProcess:
 
     def kill(self) -> None:
         if self.proc.poll() is None:
-            self.proc.kill()
+            procs.kill_group(self.proc)
             self.proc.wait(timeout=WAIT_S)
 
 
@@ -108,7 +109,7 @@ def pty_pair(tmp_path: Path):
     """Two linked ptys from socat: (robot side, master side)."""
     assert shutil.which("socat"), "socat is required (apt-get install socat)"
     robot_end, master_end = tmp_path / "robot", tmp_path / "master"
-    proc = subprocess.Popen(
+    proc = procs.spawn(
         ["socat", f"pty,raw,echo=0,link={robot_end}", f"pty,raw,echo=0,link={master_end}"],
         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
     )
@@ -124,14 +125,14 @@ def pty_pair(tmp_path: Path):
         try:
             proc.wait(timeout=WAIT_S)
         except subprocess.TimeoutExpired:
-            proc.kill()
+            procs.kill_group(proc)
             proc.wait(timeout=WAIT_S)
 
 
 def mbpoll(port: str, *args: str, values: tuple[str, ...] = ()) -> subprocess.CompletedProcess:
     """mbpoll once against ``port``; written values come after the device name."""
     assert shutil.which("mbpoll"), "mbpoll is required (apt-get install mbpoll)"
-    return subprocess.run(
+    return procs.run(
         ["mbpoll", "-m", "rtu", "-b", "9600", "-P", "none", "-a", "1", "-o", "3", "-1", *args, port, *values],
         capture_output=True, text=True, timeout=WAIT_S,
     )
@@ -200,10 +201,10 @@ def test_a_port_a_monitor_holds_is_refused_naming_the_monitor(pty_pair):
     emulator would; the refusal used to ask only "another uitamr emulate?", sending the
     user to look for an emulator that was not running."""
     robot_end, _ = pty_pair
-    monitor = subprocess.Popen([sys.executable, "-m", "verifier.cli", "monitor", "--serial", robot_end,
+    monitor = procs.spawn([sys.executable, "-m", "verifier.cli", "monitor", "--serial", robot_end,
                                 "--duration", "60s", "--quiet"],
-                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                               env={**os.environ, "PYTHONUNBUFFERED": "1"})
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                          env={**os.environ, "PYTHONUNBUFFERED": "1"})
     try:
         assert "listening on" in monitor.stdout.readline()
         refused = run_cli("--serial", robot_end, "--exit-after", "5")
@@ -215,7 +216,7 @@ def test_a_port_a_monitor_holds_is_refused_naming_the_monitor(pty_pair):
         try:
             monitor.wait(timeout=WAIT_S)
         except subprocess.TimeoutExpired:
-            monitor.kill()
+            procs.kill_group(monitor)
             monitor.wait(timeout=WAIT_S)
 
 
@@ -474,7 +475,7 @@ def test_a_modbus_tcp_client_is_told_the_route_is_rtu_over_tcp(start_emulator):
     the log says so and what to set (tcp-converter.md), instead of only 'too long for an
     FC01 request' about a frame that is no FC01 request."""
     emulator, port = tcp_emulator(start_emulator)
-    done = subprocess.run(["mbpoll", "-m", "tcp", "-a", "1", "-t", "4", "-r", "417", "-1", "-o", "1",
+    done = procs.run(["mbpoll", "-m", "tcp", "-a", "1", "-t", "4", "-r", "417", "-1", "-o", "1",
                            "-p", str(port), "127.0.0.1", "0"], capture_output=True, text=True, timeout=WAIT_S)
     assert done.returncode != 0  # no reply: the robot stays silent
     line = emulator.wait_for(r"<- 00 01 00 00 00 06 01 06 01 A0 00 00 .*").group(0)
@@ -519,8 +520,8 @@ def test_quiet_still_says_which_port_it_listens_on(start_emulator):
 # ---- the command's own errors ------------------------------------------------------------------
 
 def run_cli(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "verifier.cli", "emulate", *args],
-                          capture_output=True, text=True, timeout=WAIT_S)
+    return procs.run([sys.executable, "-m", "verifier.cli", "emulate", *args],
+                     capture_output=True, text=True, timeout=WAIT_S)
 
 
 @pytest.mark.parametrize("text, message", [
@@ -675,7 +676,7 @@ def test_a_port_that_cannot_be_opened_says_what_to_check_on_site():
     exited 1 where monitor exited 2."""
     from verifier.emulate.ports import why_not_opened
 
-    monitor = subprocess.run([sys.executable, "-m", "verifier.cli", "monitor", "--serial", "/nonexistent/ttyUSB9",
+    monitor = procs.run([sys.executable, "-m", "verifier.cli", "monitor", "--serial", "/nonexistent/ttyUSB9",
                               "--duration", "1s"], capture_output=True, text=True, timeout=WAIT_S)
     assert monitor.returncode == 2
     assert "uitamr monitor: cannot open /nonexistent/ttyUSB9: no such port: check its name" in monitor.stderr
@@ -720,8 +721,8 @@ def test_a_log_reader_that_leaves_does_not_take_the_robot_off_the_line():
     The robot keeps answering (a bench test goes on), and at the stop the summary goes to
     stderr with status 0, instead of exit 1 and no summary at all."""
     read_end, write_end = os.pipe()
-    proc = subprocess.Popen([sys.executable, "-m", "verifier.cli", "emulate", "--tcp", "127.0.0.1:0"],
-                            stdout=write_end, stderr=subprocess.PIPE, text=True)
+    proc = procs.spawn([sys.executable, "-m", "verifier.cli", "emulate", "--tcp", "127.0.0.1:0"],
+                       stdout=write_end, stderr=subprocess.PIPE, text=True)
     os.close(write_end)
     try:
         with os.fdopen(read_end, "rb") as reader:  # the first line, then the reader is gone
@@ -732,10 +733,10 @@ def test_a_log_reader_that_leaves_does_not_take_the_robot_off_the_line():
                 assert exchange(sock, STOP_FRAME, 8) == STOP_FRAME
             assert exchange(sock, STATUS_TASK, 8) == with_crc(bytes.fromhex("010103000000"))
         proc.send_signal(signal.SIGTERM)
-        _, err = proc.communicate(timeout=WAIT_S)
+        _, err = procs.finish(proc, WAIT_S)
     finally:
         if proc.poll() is None:
-            proc.kill()
+            procs.kill_group(proc)
             proc.wait(timeout=WAIT_S)
     assert proc.returncode == 0, err
     assert "Traceback" not in err

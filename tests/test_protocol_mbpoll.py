@@ -24,6 +24,7 @@ from verifier.protocol import (
     command_from_words,
     encode,
 )
+import procs
 
 pytestmark = pytest.mark.serial
 
@@ -33,7 +34,7 @@ IO_TIMEOUT_S = 10  # generous upper bound for a loaded machine; not a timing ass
 @pytest.fixture
 def pty_pair(tmp_path: Path):
     master_end, robot_end = tmp_path / "master", tmp_path / "robot"
-    socat = subprocess.Popen(
+    socat = procs.spawn(
         ["socat", f"pty,raw,echo=0,link={master_end}", f"pty,raw,echo=0,link={robot_end}"],
         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
     )
@@ -62,14 +63,14 @@ def read_exactly(fd: int, count: int) -> bytes:
 
 
 def exchange(device_fd: int, argv: list[str], expected_request: bytes, reply: bytes) -> str:
-    process = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    process = procs.spawn(argv, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         request = read_exactly(device_fd, len(expected_request))
         os.write(device_fd, reply)
-        output, _ = process.communicate(timeout=IO_TIMEOUT_S)
+        output, _ = procs.finish(process, IO_TIMEOUT_S)
     finally:
         if process.poll() is None:
-            process.kill()
+            procs.kill_group(process)
             process.wait()
     assert request == expected_request, f"mbpoll sent {request.hex(' ')}, we encode {expected_request.hex(' ')}"
     assert process.returncode == 0, output

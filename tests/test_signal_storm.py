@@ -22,6 +22,7 @@ import sys
 import time
 
 from monitor_helpers import WAIT_S
+import procs
 
 ATTEMPTS = 3
 BURST_S = 0.5
@@ -41,11 +42,9 @@ def _burst_of_ctrl_c(process: subprocess.Popen) -> None:
 def _ended(process: subprocess.Popen) -> str:
     """The process's stderr once it ended; a hang fails the test after WAIT_S."""
     try:
-        _out, err = process.communicate(timeout=WAIT_S)
-    except subprocess.TimeoutExpired:
-        process.kill()
-        _out, err = process.communicate()
-        raise AssertionError(f"still running {WAIT_S} s after a burst of Ctrl-C: {err[-2000:]}") from None
+        _out, err = procs.finish(process, WAIT_S)
+    except subprocess.TimeoutExpired as hung:  # its process group is killed
+        raise AssertionError(f"still running {WAIT_S} s after a burst of Ctrl-C: {hung.stderr[-2000:]}") from None
     assert "RecursionError" not in err, err[-2000:]
     return err
 
@@ -56,7 +55,7 @@ def test_the_monitor_stops_under_a_burst_of_ctrl_c_and_writes_its_report(tmp_pat
         port = server.getsockname()[1]
         for attempt in range(ATTEMPTS):
             report = tmp_path / f"m{attempt}.json"
-            monitor = subprocess.Popen(
+            monitor = procs.spawn(
                 [sys.executable, "-m", "verifier.cli", "monitor", "--tcp", f"127.0.0.1:{port}", "--json", str(report)],
                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
             connection, _ = server.accept()
@@ -70,8 +69,8 @@ def test_the_monitor_stops_under_a_burst_of_ctrl_c_and_writes_its_report(tmp_pat
 
 def test_the_emulator_stops_under_a_burst_of_ctrl_c():
     for _attempt in range(ATTEMPTS):
-        emulator = subprocess.Popen([sys.executable, "-m", "verifier.cli", "emulate", "--tcp", "127.0.0.1:0"],
-                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        emulator = procs.spawn([sys.executable, "-m", "verifier.cli", "emulate", "--tcp", "127.0.0.1:0"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         assert "listening on tcp" in emulator.stdout.readline()  # its handlers are in place
         time.sleep(LISTENING_S)
         _burst_of_ctrl_c(emulator)
