@@ -735,6 +735,33 @@ def test_a_bad_master_on_a_real_line_gets_exactly_its_findings(tmp_path):
     assert differing == {"name", "file", "description", "channel"}, {k: (live_run[k], replayed[k]) for k in differing}
 
 
+class EmulatedLine:
+    """One real-time attempt's fresh line (LineBus) in `folder`, with `uitamr emulate` on its
+    robot end, listening; on leaving, the emulator is stopped (its log in `log`) and the
+    line closed."""
+
+    def __init__(self, folder: Path):
+        folder.mkdir()
+        self.folder, self.log = folder, ""
+        self.bus = LineBus(folder)
+        self.robot = start("emulate", "--serial", self.bus.robot)
+
+    def __enter__(self) -> "EmulatedLine":
+        try:
+            wait_for_line(self.robot, "listening")
+        except BaseException:
+            self.__exit__()
+            raise
+        return self
+
+    def __exit__(self, *_exc) -> None:
+        try:
+            self.robot.terminate()
+            self.log, _ = procs.finish(self.robot, WAIT_S)
+        finally:
+            self.bus.close()
+
+
 @pytest.mark.serial
 def test_the_emulator_answering_the_bad_master_is_seen_reply_for_reply(tmp_path):
     """`uitamr emulate` on the line answers the bad master, and the monitor on the tap sees
@@ -749,19 +776,12 @@ def test_the_emulator_answering_the_bad_master_is_seen_reply_for_reply(tmp_path)
     without a stall fails at once, and so do three stalled attempts."""
     stalled = []
     for attempt in range(3):
-        folder = tmp_path / f"attempt{attempt}"
-        folder.mkdir()
-        bus = LineBus(folder)
-        robot = start("emulate", "--serial", bus.robot)
-        try:
-            wait_for_line(robot, "listening")
+        with EmulatedLine(tmp_path / f"attempt{attempt}") as line:
+            folder, bus = line.folder, line.bus
             monitor = monitor_on(bus, folder, "--duration", "3s", "--trace", folder / "m.jsonl")
             master = bad_master(bus)
             out, err = procs.finish(monitor, WAIT_S)
-        finally:
-            robot.terminate()
-            log, _ = procs.finish(robot, WAIT_S)
-            bus.close()
+        log = line.log
         seen = diagnosis(out, err, master=master) + "\n--- emulator ---\n" + log
         try:
             _seen_reply_for_reply(monitor.returncode, folder, master, log, seen)
@@ -882,12 +902,8 @@ def test_the_simulated_plc_driving_the_emulator_is_compliant(tmp_path):
     assert len(requests) >= 8
     stalled = []
     for attempt in range(3):
-        folder = tmp_path / f"attempt{attempt}"
-        folder.mkdir()
-        bus = LineBus(folder)
-        robot = start("emulate", "--serial", bus.robot)
-        try:
-            wait_for_line(robot, "listening")
+        with EmulatedLine(tmp_path / f"attempt{attempt}") as line:
+            folder, bus = line.folder, line.bus
             monitor = monitor_on(bus, folder, "--duration", "5.5s", "--tolerance", "50ms",  # host scheduling
                                  "--trace", folder / "m.jsonl", "--capture", folder / "c.txt")
             master = Master(bus)
@@ -898,10 +914,6 @@ def test_the_simulated_plc_driving_the_emulator_is_compliant(tmp_path):
             finally:
                 master.close()
             out, err = procs.finish(monitor, WAIT_S)
-        finally:
-            robot.terminate()
-            procs.finish(robot, WAIT_S)
-            bus.close()
         seen = diagnosis(out, err, folder / "c.txt", master)
         assert (folder / "m.json").exists(), seen
         clean = monitor.returncode == 0 and findings(folder / "m.json") == Counter()
