@@ -3,7 +3,16 @@ from __future__ import annotations
 
 import pytest
 
+import procs
 import verifier.sim.project as project_module
+
+
+@pytest.fixture(autouse=True)
+def _no_process_left():
+    """What a test spawned through procs.spawn/run and did not wait for (it failed or hung
+    first) is killed with its whole process group after the test."""
+    yield
+    procs.end_all()
 
 
 @pytest.fixture

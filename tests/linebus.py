@@ -14,6 +14,7 @@ import subprocess
 import threading
 import time
 from pathlib import Path
+import procs
 
 OPEN_TIMEOUT_S = 10
 
@@ -31,7 +32,7 @@ class LineBus:
         self._fds: dict[str, int] = {}
         for name in ("plc", "robot", "tap"):
             device, bus = folder / name, folder / f"{name}-bus"
-            self._socats.append(subprocess.Popen(
+            self._socats.append(procs.spawn(
                 ["socat", f"pty,raw,echo=0,link={device}", f"pty,raw,echo=0,link={bus}"],
                 stdout=subprocess.DEVNULL, stderr=subprocess.PIPE))
             deadline = time.monotonic() + OPEN_TIMEOUT_S
@@ -112,8 +113,8 @@ def pty_cable(folder: Path, one: str, other: str):
     yields socat's process, so that a test can pull the cable out (terminate it) while a
     command has a port open; the process is ended at the end if it still runs."""
     ends = folder / one, folder / other
-    socat = subprocess.Popen(["socat", *(f"pty,raw,echo=0,link={end}" for end in ends)],
-                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    socat = procs.spawn(["socat", *(f"pty,raw,echo=0,link={end}" for end in ends)],
+                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         deadline = time.monotonic() + OPEN_TIMEOUT_S
         while not all(end.exists() for end in ends):

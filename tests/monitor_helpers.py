@@ -14,6 +14,7 @@ from pathlib import Path
 from linebus import LineBus
 from verifier import protocol
 from verifier.amr import Robot
+import procs
 
 SETTINGS = protocol.DEFAULT_SETTINGS
 WAIT_S = 20
@@ -28,7 +29,7 @@ def uitamr(*args) -> list[str]:
 
 
 def start(*args, **kw) -> subprocess.Popen:
-    return subprocess.Popen(uitamr(*args), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kw)
+    return procs.spawn(uitamr(*args), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kw)
 
 
 def wait_for_line(proc: subprocess.Popen, words: str, timeout_s: float = WAIT_S, seen: list[str] | None = None) -> str:
@@ -40,7 +41,7 @@ def wait_for_line(proc: subprocess.Popen, words: str, timeout_s: float = WAIT_S,
     failure then read stderr to the end, so a process that ran on hung the test instead
     of failing it.)"""
     seen = [] if seen is None else seen
-    watchdog = threading.Timer(timeout_s, proc.kill)
+    watchdog = threading.Timer(timeout_s, procs.kill_group, (proc,))
     watchdog.start()
     try:
         for line in iter(proc.stdout.readline, ""):

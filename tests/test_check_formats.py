@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import json
 import re
-import subprocess
 import sys
 from pathlib import Path
 
@@ -13,6 +12,7 @@ from click.testing import CliRunner
 from st_helpers import CORPUS, ROOT
 from verifier.cli import main
 from verifier.commands.check_formats import RULES
+import procs
 
 BAD = CORPUS / "invalid" / "int_from_word.st"
 WARN = CORPUS / "invalid" / "unused_warning.st"
@@ -20,8 +20,8 @@ BROKEN = CORPUS / "broken" / "if_else_not_closed.st"
 
 
 def run(*args, cwd: Path | None = None):
-    return subprocess.run([sys.executable, "-m", "verifier.cli", "check", *map(str, args)],
-                          capture_output=True, text=True, timeout=120, cwd=cwd)
+    return procs.run([sys.executable, "-m", "verifier.cli", "check", *map(str, args)],
+                     capture_output=True, text=True, timeout=120, cwd=cwd)
 
 
 def test_text_stays_the_editor_format():

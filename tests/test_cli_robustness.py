@@ -9,6 +9,7 @@ from click.testing import CliRunner
 
 from verifier.cli import main
 from verifier.verify.scenario import ScenarioError, load_scenario
+import procs
 
 #: longer than any file name a Linux or Windows file system takes (255 bytes)
 LONG = "a" * 300
@@ -212,7 +213,6 @@ def test_verify_reports_of_a_source_whose_name_is_not_utf8_are_whole(tmp_path):
 
 import resource  # noqa: E402
 import signal  # noqa: E402
-import subprocess  # noqa: E402
 import sys  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -224,8 +224,8 @@ def run_with_file_size_limit(limit: int, *args, cwd: Path):
     def limit_files():
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a failed write, not a killed process
         resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
-    return subprocess.run([sys.executable, "-m", "verifier.cli", *map(str, args)], cwd=cwd, capture_output=True,
-                          text=True, preexec_fn=limit_files, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=120)
+    return procs.run([sys.executable, "-m", "verifier.cli", *map(str, args)], cwd=cwd, capture_output=True,
+                     text=True, preexec_fn=limit_files, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=120)
 
 
 @pytest.mark.parametrize("option, name", [("--json", "r.json"), ("--junit", "r.xml"), ("--trace", "r.jsonl"),
@@ -319,7 +319,6 @@ def test_export_of_a_pipe_or_a_device_is_refused_without_reading_it(tmp_path):
     scenario read it whole, whatever it was. Only a regular file is read now; these are
     refused as `check` refuses them, naming what they are."""
     import resource
-    import subprocess
     import sys
 
     fifo = tmp_path / "pipe"
@@ -329,9 +328,9 @@ def test_export_of_a_pipe_or_a_device_is_refused_without_reading_it(tmp_path):
         resource.setrlimit(resource.RLIMIT_AS, (1 << 30, 1 << 30))
 
     for source, kind in [(fifo, "a pipe"), ("/dev/full", "a character device")]:
-        done = subprocess.run([sys.executable, "-m", "verifier.cli", "export", "--target", "gxworks2", "--out",
+        done = procs.run([sys.executable, "-m", "verifier.cli", "export", "--target", "gxworks2", "--out",
                                str(tmp_path / "out"), str(source)], capture_output=True, text=True, timeout=60,
-                              preexec_fn=at_most_a_gigabyte)
+                         preexec_fn=at_most_a_gigabyte)
         assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
         assert f"uitamr export: {source}: is not a regular file ({kind}); give a .st file" in done.stderr
         assert not (tmp_path / "out").exists()

@@ -20,6 +20,7 @@ import pytest
 
 from doc_helpers import code_blocks
 from verifier.cli import main
+import procs
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGES = ["README.md", "README.zh-TW.md", "docs/commissioning.md", "docs/emulator.md", "docs/wiring-rs485.md",
@@ -198,20 +199,20 @@ def test_emulator_bench_recipe(tmp_path):
     socat_line, emulate_line, *mbpoll_lines = lines
     assert socat_line.startswith("socat -d -d pty,raw,echo=0,") and emulate_line.startswith("uitamr emulate --serial")
     assert len(mbpoll_lines) == 3 and all(line.startswith("mbpoll ") for line in mbpoll_lines)
-    socat = subprocess.Popen(_words(socat_line), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    socat = procs.spawn(_words(socat_line), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     emulator = None
     try:
         deadline = time.monotonic() + 15
         while not ((tmp_path / "robot").exists() and (tmp_path / "plc").exists()):
             assert socat.poll() is None and time.monotonic() < deadline, "socat made no pty pair"
             time.sleep(0.02)
-        emulator = subprocess.Popen([sys.executable, "-m", "verifier.cli", *_argv(emulate_line)],
-                                    stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                                    env={**os.environ, "PYTHONUNBUFFERED": "1"})
+        emulator = procs.spawn([sys.executable, "-m", "verifier.cli", *_argv(emulate_line)],
+                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                               env={**os.environ, "PYTHONUNBUFFERED": "1"})
         assert "listening on serial" in emulator.stdout.readline()
         outputs = []
         for line in mbpoll_lines:
-            done = subprocess.run(_words(line), capture_output=True, text=True, timeout=30)
+            done = procs.run(_words(line), capture_output=True, text=True, timeout=30)
             assert done.returncode == 0, (line, done.stdout, done.stderr)
             outputs.append(done.stdout)
         assert "Written 1 references." in outputs[0] and "Written 1 references." in outputs[1]
@@ -338,8 +339,8 @@ def test_the_port_messages_the_pages_quote_are_the_commands_own(tmp_path):
         return " ".join((ROOT / "docs" / name).read_text(encoding="utf-8").split())
 
     def said(*args: str) -> subprocess.CompletedProcess:
-        return subprocess.run([sys.executable, "-m", "verifier.cli", *args], capture_output=True, text=True,
-                              timeout=30)
+        return procs.run([sys.executable, "-m", "verifier.cli", *args], capture_output=True, text=True,
+                         timeout=30)
 
     emulator, commissioning = page("emulator.md"), page("commissioning.md")
     missing = said("emulate", "--serial", str(tmp_path / "ttyUSB9"))  # the page's /dev/ttyUSB9, surely absent

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import shutil
-import subprocess
 
 import pytest
 from click.testing import CliRunner
@@ -12,6 +11,7 @@ from verifier.cli import main
 from verifier.commands.frame import parse_hex
 from verifier.protocol import encode, hex_bytes, with_crc, words_for
 from verifier.protocol.strategies import requests
+import procs
 
 
 def run(*args: str):
@@ -159,13 +159,13 @@ def test_parse_hex():
 def test_installed_entry_point_in_a_real_subprocess():
     uitamr = shutil.which("uitamr")
     assert uitamr, "the uitamr entry point is not installed (pip install -e '.[test]')"
-    done = subprocess.run([uitamr, "frame", "stop"], capture_output=True, text=True, timeout=60)
+    done = procs.run([uitamr, "frame", "stop"], capture_output=True, text=True, timeout=60)
     assert done.returncode == 0 and done.stdout.strip() == "01 06 01 A0 00 00 88 14"
-    bad = subprocess.run([uitamr, "frame", "move", "x", "30"], capture_output=True, text=True, timeout=60)
+    bad = procs.run([uitamr, "frame", "move", "x", "30"], capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and "one byte holds at most 255" in bad.stderr
     assert "Traceback" not in bad.stderr
-    decoded = subprocess.run([uitamr, "frame", "--decode", "01 06 01 A0 00 00 88 15"],
-                             capture_output=True, text=True, timeout=60)
+    decoded = procs.run([uitamr, "frame", "--decode", "01 06 01 A0 00 00 88 15"],
+                        capture_output=True, text=True, timeout=60)
     assert decoded.returncode == 1 and "bad CRC" in decoded.stdout
 
 

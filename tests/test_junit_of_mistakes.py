@@ -13,6 +13,7 @@ from verifier.cli import main
 from verifier.place import Place
 from verifier.verify.report_junit import unusable_element
 from verifier.verify.result import Mistake
+import procs
 
 BROKEN = "PROGRAM MAIN\nVAR\n    x : INT;\nEND_VAR\nx := ;\nEND_PROGRAM\n"
 GOOD = "PROGRAM GOOD\nVAR\n    x : INT;\nEND_VAR\nx := 1;\nEND_PROGRAM\n"
@@ -542,7 +543,6 @@ def test_a_junit_that_is_a_pipe_is_written_to_its_reader_not_read(tmp_path):
     waited for a writer that never came - the command hung, with the pipe's reader waiting
     too. A pipe is not read now; the report goes to its reader."""
     import os
-    import subprocess
     import sys
     import threading
 
@@ -557,7 +557,7 @@ def test_a_junit_that_is_a_pipe_is_written_to_its_reader_not_read(tmp_path):
     thread = threading.Thread(target=reader, daemon=True)
     thread.start()
     try:
-        done = subprocess.run([sys.executable, "-m", "verifier.cli", "replay", str(tmp_path / "gone.txt"),
+        done = procs.run([sys.executable, "-m", "verifier.cli", "replay", str(tmp_path / "gone.txt"),
                                "--junit", str(fifo)], capture_output=True, text=True, timeout=60)
     finally:
         if thread.is_alive():  # whatever happened, the reader is let go

@@ -3,7 +3,6 @@ are the code's, its example capture reads, its example view is what the monitor 
 from __future__ import annotations
 
 import re
-import subprocess
 from pathlib import Path
 
 from monitor_helpers import uitamr
@@ -12,14 +11,15 @@ from verifier.monitor.framer import DEFAULT_TOLERANCE_US, LineTiming
 from verifier.monitor.session import CaptureInfo, MonitorSession
 from verifier.monitor.view import finding_lines, frame_line
 from verifier import protocol
+import procs
 
 CAPTURES = Path(__file__).resolve().parent / "captures"
 DOC = (Path(__file__).resolve().parent.parent / "docs" / "commissioning.md").read_text(encoding="utf-8")
 
 
 def test_every_option_in_the_table_exists():
-    helps = subprocess.run(uitamr("monitor", "--help"), capture_output=True, text=True, timeout=60).stdout
-    helps += subprocess.run(uitamr("replay", "--help"), capture_output=True, text=True, timeout=60).stdout
+    helps = procs.run(uitamr("monitor", "--help"), capture_output=True, text=True, timeout=60).stdout
+    helps += procs.run(uitamr("replay", "--help"), capture_output=True, text=True, timeout=60).stdout
     options = set(re.findall(r"\| `(--[a-z-]+)`", DOC)) | set(re.findall(r"`(--[a-z-]+)`", DOC))
     assert {"--tolerance", "--joined", "--capture", "--duration", "--reply-timeout"} <= options
     for option in options:
@@ -77,15 +77,15 @@ def test_a_plc_at_19200_read_at_9600_is_said_to_be_on_another_speed(tmp_path):
     capture = tmp_path / "fast.txt"
     capture.write_text("0.3 28 08 08 68\n" + "".join(f"{0.3 * n:.1f} 18 08 68 AB\n" for n in range(2, 6))
                        + "2.5 end\n", encoding="utf-8")
-    done = subprocess.run(uitamr("replay", capture), capture_output=True, text=True, timeout=60)
+    done = procs.run(uitamr("replay", capture), capture_output=True, text=True, timeout=60)
     note = re.search(r"note: (not one of .*)", done.stdout)
     assert note, done.stdout + done.stderr
     quoted = re.search(r"`(not one of the .*?)`", " ".join(DOC.split()))
     assert quoted and quoted.group(1) == note.group(1)
-    good = subprocess.run(uitamr("replay", CAPTURES / "bad-master.txt"), capture_output=True, text=True, timeout=60)
+    good = procs.run(uitamr("replay", CAPTURES / "bad-master.txt"), capture_output=True, text=True, timeout=60)
     assert "not one of" not in good.stdout  # one bad CRC among good frames: the PLC's own
     capture.write_text("0.3 01 06 01 A0 00 00 14 88\n1.0 end\n", encoding="utf-8")  # CRC high byte first
-    swapped = subprocess.run(uitamr("replay", capture), capture_output=True, text=True, timeout=60)
+    swapped = procs.run(uitamr("replay", capture), capture_output=True, text=True, timeout=60)
     assert "UITAMR-CRC" in swapped.stdout and "not one of" not in swapped.stdout  # the PLC's CRC, not the line
 
 
@@ -113,12 +113,12 @@ def test_a_monitor_trace_replays_to_the_monitors_findings(tmp_path):
     trace = tmp_path / "site.jsonl"
     report_trace.write([live], trace)
     report = tmp_path / "replay.json"
-    done = subprocess.run(uitamr("replay", str(trace), "--json", str(report)), capture_output=True, text=True,
-                          timeout=60)
+    done = procs.run(uitamr("replay", str(trace), "--json", str(report)), capture_output=True, text=True,
+                     timeout=60)
     assert done.returncode == 0, done.stdout + done.stderr
     assert json.loads(report.read_text())["summary"]["violations"]["UITAMR-PACING"] == 0
-    exact = subprocess.run(uitamr("replay", str(trace), "--tolerance", "0"), capture_output=True, text=True,
-                           timeout=60)
+    exact = procs.run(uitamr("replay", str(trace), "--tolerance", "0"), capture_output=True, text=True,
+                      timeout=60)
     assert exact.returncode == 1 and "UITAMR-PACING ×2" in exact.stdout
     *frames, end = (json.loads(line) for line in trace.read_text().splitlines())
     assert all(record["tolerance"] == DEFAULT_TOLERANCE_US / 1e6 for record in frames)
@@ -136,8 +136,8 @@ def test_an_unreadable_capture_is_reported_as_section_6_quotes(tmp_path):
     import os
 
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
-    done = subprocess.run(uitamr("replay", "site.txt"), capture_output=True, text=True, timeout=60, cwd=tmp_path,
-                          env=env)
+    done = procs.run(uitamr("replay", "site.txt"), capture_output=True, text=True, timeout=60, cwd=tmp_path,
+                     env=env)
     assert done.returncode == 2
     assert done.stderr.strip() == quoted
 
@@ -148,11 +148,11 @@ def test_an_exactly_timed_capture_is_not_said_to_be_timed_by_the_host(tmp_path):
     capture = tmp_path / "exact.txt"
     capture.write_text("0.000000 tx 01 06 01 A0 00 00 88 14\n0.013333 rx 01 06 01 A0 00 00 88 14\n",
                        encoding="utf-8")
-    exact = subprocess.run(uitamr("replay", capture), capture_output=True, text=True, timeout=60)
+    exact = procs.run(uitamr("replay", capture), capture_output=True, text=True, timeout=60)
     assert exact.returncode == 0, exact.stdout + exact.stderr
     assert "timed by the host" not in exact.stdout
     assert "note: frames taken as exactly timed; timing rules allow 0 ms for latency (--tolerance)" in exact.stdout
-    host = subprocess.run(uitamr("replay", CAPTURES / "bad-master.txt"), capture_output=True, text=True, timeout=60)
+    host = procs.run(uitamr("replay", CAPTURES / "bad-master.txt"), capture_output=True, text=True, timeout=60)
     assert "note: frames timed by the host; timing rules allow 20 ms for the adapter's latency (--tolerance)" \
         in host.stdout
 

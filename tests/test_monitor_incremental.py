@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import json
 import socket
-import subprocess
 import threading
 from collections import Counter
 from dataclasses import replace
@@ -31,6 +30,7 @@ from verifier.verify import report_json, report_junit
 from verifier.verify.evidence import RuleOptions
 from verifier.verify.runner import run_scenario
 from verifier.verify.scenario import load_scenario
+import procs
 
 ROOT = Path(__file__).resolve().parent.parent
 CAPTURES = Path(__file__).resolve().parent / "captures"
@@ -232,17 +232,17 @@ def test_a_burst_over_tcp_is_judged_live_as_it_is_on_replay(tmp_path):
 
     thread = threading.Thread(target=stream, daemon=True)
     thread.start()
-    done = subprocess.run(uitamr("monitor", "--tcp", f"127.0.0.1:{server.getsockname()[1]}", "--duration", "240s",
+    done = procs.run(uitamr("monitor", "--tcp", f"127.0.0.1:{server.getsockname()[1]}", "--duration", "240s",
                                  "--quiet", "--json", tmp_path / "m.json", "--capture", tmp_path / "c.txt"),
-                          capture_output=True, text=True, timeout=300)
+                     capture_output=True, text=True, timeout=300)
     thread.join(timeout=5)
     server.close()
     assert done.returncode == 1, done.stdout + done.stderr  # a burst breaks the pacing
     assert "the server closed the connection" in done.stdout, done.stdout  # the whole burst was read
     monitored = json.loads((tmp_path / "m.json").read_text())["scenarios"][0]
     assert monitored["frames"] == {"tx": 4096, "rx": 4096}
-    done = subprocess.run(uitamr("replay", tmp_path / "c.txt", "--json", tmp_path / "r.json"),
-                          capture_output=True, text=True, timeout=WAIT_S)
+    done = procs.run(uitamr("replay", tmp_path / "c.txt", "--json", tmp_path / "r.json"),
+                     capture_output=True, text=True, timeout=WAIT_S)
     assert done.returncode == 1, done.stdout + done.stderr
     replayed = json.loads((tmp_path / "r.json").read_text())["scenarios"][0]
     assert replayed["violations"] == monitored["violations"] and replayed["rules"] == monitored["rules"]

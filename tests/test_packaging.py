@@ -3,12 +3,12 @@ bundled scenarios, and the commands find them there exactly as in a checkout."""
 from __future__ import annotations
 
 import os
-import subprocess
 import sys
 import zipfile
 from pathlib import Path
 
 import pytest
+import procs
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -16,7 +16,7 @@ ROOT = Path(__file__).resolve().parents[1]
 @pytest.fixture(scope="module")
 def wheel(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("wheel")
-    subprocess.run(
+    procs.run(
         [sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "--no-build-isolation", str(ROOT), "-w", str(out)],
         check=True, capture_output=True, text=True, timeout=300,
     )
@@ -38,7 +38,7 @@ def test_the_wheel_carries_every_file_of_plc(wheel):
 
 def test_an_installed_wheel_finds_the_bundled_library(wheel, tmp_path):
     site = tmp_path / "site"
-    subprocess.run(
+    procs.run(
         [sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", str(site), str(wheel)],
         check=True, capture_output=True, text=True, timeout=300,
     )
@@ -47,12 +47,12 @@ def test_an_installed_wheel_finds_the_bundled_library(wheel, tmp_path):
         "import verifier, verifier.commands.verify as v;"
         "print(verifier.__file__); print(len(v.bundled_scenarios()))"
     )
-    shown = subprocess.run([sys.executable, "-c", probe], env=env, cwd=tmp_path,
-                           capture_output=True, text=True, timeout=120, check=True).stdout.split()
+    shown = procs.run([sys.executable, "-c", probe], env=env, cwd=tmp_path,
+                      capture_output=True, text=True, timeout=120, check=True).stdout.split()
     assert shown[0].startswith(str(site)), "the probe imported the checkout, not the installed wheel"
     assert int(shown[1]) == len(list((ROOT / "plc" / "scenarios").glob("*.toml"))) > 0
 
-    exported = subprocess.run(
+    exported = procs.run(
         [sys.executable, "-m", "verifier.cli", "export", "--target", "gxworks2", "--out", str(tmp_path / "out")],
         env=env, cwd=tmp_path, capture_output=True, text=True, timeout=120,
     )

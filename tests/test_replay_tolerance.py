@@ -3,11 +3,11 @@ whose frames say their side (our JSONL traces, `tx`/`rx` lines), as `--help` say
 from __future__ import annotations
 
 import json
-import subprocess
 
 import pytest
 
 from monitor_helpers import WAIT_S, uitamr
+import procs
 
 CHUNKS = "0.001042 01\n0.001097 06 01 01 00 00 D9 F6\n0.012000 01 06 01 01 00 00 D9 F6\n"
 SIDED = "0.001097 tx 01 06 01 01 00 00 D9 F6\n0.006417 rx 01 06 01 01 00 00 D9 F6\n"
@@ -24,13 +24,13 @@ SIDED = "0.001097 tx 01 06 01 01 00 00 D9 F6\n0.006417 rx 01 06 01 01 00 00 D9 F
 def test_default_tolerance_follows_the_kind_of_capture(tmp_path, text, extra, allowed):
     capture = tmp_path / "c.txt"
     capture.write_text(text, encoding="utf-8")
-    done = subprocess.run(uitamr("replay", capture, *extra), capture_output=True, text=True, timeout=WAIT_S)
+    done = procs.run(uitamr("replay", capture, *extra), capture_output=True, text=True, timeout=WAIT_S)
     assert done.returncode in (0, 1), done.stdout + done.stderr
     assert f"timing rules allow {allowed} ms" in done.stdout, done.stdout
 
 
 def test_the_help_says_which_captures_get_no_tolerance():
-    done = subprocess.run(uitamr("replay", "--help"), capture_output=True, text=True, timeout=WAIT_S)
+    done = procs.run(uitamr("replay", "--help"), capture_output=True, text=True, timeout=WAIT_S)
     text = " ".join(done.stdout.split())
     assert "Default 20ms" in text and "tx/rx lines: 0" in text, text
 
@@ -43,8 +43,8 @@ def test_a_tolerance_that_no_pacing_violation_could_beat_is_refused(tmp_path, co
     capture = tmp_path / "c.txt"
     capture.write_text(CHUNKS, encoding="utf-8")
     where = [capture] if command == "replay" else ["--serial", tmp_path / "nope"]
-    done = subprocess.run(uitamr(command, "--tolerance", tolerance, *where), capture_output=True, text=True,
-                          timeout=WAIT_S)
+    done = procs.run(uitamr(command, "--tolerance", tolerance, *where), capture_output=True, text=True,
+                     timeout=WAIT_S)
     assert done.returncode == 2, done.stdout + done.stderr
     assert f"'{tolerance}' is not below the pacing period of 250 ms" in done.stderr
     assert "was the unit mistyped?" in done.stderr and "Traceback" not in done.stderr
@@ -53,8 +53,8 @@ def test_a_tolerance_that_no_pacing_violation_could_beat_is_refused(tmp_path, co
 def test_a_tolerance_just_below_the_period_is_taken(tmp_path):
     capture = tmp_path / "c.txt"
     capture.write_text(CHUNKS, encoding="utf-8")
-    done = subprocess.run(uitamr("replay", "--tolerance", "249ms", capture), capture_output=True, text=True,
-                          timeout=WAIT_S)
+    done = procs.run(uitamr("replay", "--tolerance", "249ms", capture), capture_output=True, text=True,
+                     timeout=WAIT_S)
     assert done.returncode in (0, 1) and "timing rules allow 249 ms" in done.stdout, done.stdout + done.stderr
 
 

@@ -12,12 +12,13 @@ import pytest
 from monitor_helpers import uitamr
 from test_verify_cli import PLC, back_to_back
 from verifier.commands.verify import bundled_scenarios
+import procs
 
 RUN_S = 120  # a whole command over every bundled scenario (about 6 s of CPU)
 
 
 def run(*args, expect=(0, 1)) -> subprocess.CompletedProcess:
-    done = subprocess.run(uitamr(*args), capture_output=True, text=True, timeout=RUN_S)
+    done = procs.run(uitamr(*args), capture_output=True, text=True, timeout=RUN_S)
     assert done.returncode in expect, done.stdout + done.stderr
     return done
 

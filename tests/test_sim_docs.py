@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import os
 import re
-import subprocess
 import sys
 from pathlib import Path
 
 from doc_helpers import code_blocks
+import procs
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "testing-st.md"
@@ -44,8 +44,8 @@ def test_quick_start_runs_outside_the_toolkit_with_the_library_named_by_plc_dir(
     script = tmp_path / "quick_start.py"
     script.write_text(code.replace(doc_path, documented), encoding="utf-8")
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    done = subprocess.run([sys.executable, str(script)], cwd=tmp_path, env=env,
-                          capture_output=True, text=True, timeout=120)
+    done = procs.run([sys.executable, str(script)], cwd=tmp_path, env=env,
+                     capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
 
 

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import json
-import subprocess
 import sys
 from pathlib import Path
 
@@ -11,6 +10,7 @@ from click.testing import CliRunner
 
 from st_helpers import CORPUS
 from verifier.cli import main
+import procs
 
 ROOT = Path(__file__).resolve().parent.parent
 GOOD = CORPUS / "valid" / "statements.st"
@@ -221,8 +221,8 @@ def test_shift_jis_file_is_read(tmp_path):
 
 
 def test_installed_command_runs():
-    proc = subprocess.run([sys.executable, "-m", "verifier.cli", "check", str(BAD)],
-                          capture_output=True, text=True, timeout=120)
+    proc = procs.run([sys.executable, "-m", "verifier.cli", "check", str(BAD)],
+                     capture_output=True, text=True, timeout=120)
     assert proc.returncode == 1
     assert f"{BAD}:5:7: error" in proc.stdout
 

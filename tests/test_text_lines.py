@@ -7,7 +7,6 @@ an ST line, as in every editor."""
 from __future__ import annotations
 
 import re
-import subprocess
 import sys
 from pathlib import Path
 
@@ -19,6 +18,7 @@ import verifier
 from verifier.cli import main
 from verifier.sim.errors import SimulationError
 from verifier.textfile import text_lines
+import procs
 
 ROOT = Path(__file__).resolve().parents[1]
 # characters str.splitlines breaks at that are not line feeds
@@ -96,11 +96,11 @@ def test_a_trace_whose_scenario_name_holds_a_line_separator_replays(tmp_path):
     scenario.write_text(source, encoding="utf-8")
     trace = tmp_path / "t.jsonl"
     uitamr = [sys.executable, "-m", "verifier.cli"]
-    done = subprocess.run([*uitamr, "verify", "--scenario", scenario, "--trace", trace],
-                          capture_output=True, text=True, timeout=120)
+    done = procs.run([*uitamr, "verify", "--scenario", scenario, "--trace", trace],
+                     capture_output=True, text=True, timeout=120)
     assert trace.exists(), done.stdout + done.stderr
     assert "\u2028" in trace.read_text(encoding="utf-8")
-    done = subprocess.run([*uitamr, "replay", trace], capture_output=True, text=True, timeout=120)
+    done = procs.run([*uitamr, "replay", trace], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stdout + done.stderr
     assert "not a JSON trace record" not in done.stdout + done.stderr
 
@@ -150,6 +150,6 @@ def test_a_toml_file_with_lone_cr_line_ends_is_told_to_be_saved_with_lf_or_crlf(
            "save it with LF or CRLF line ends" in out
     faults = tmp_path / "f.toml"
     faults.write_bytes(b"[robot]\rturnaround_ms = 5\r")
-    done = subprocess.run([sys.executable, "-m", "verifier.cli", "emulate", "--tcp", "0", "--faults", faults],
-                          capture_output=True, text=True, timeout=60)
+    done = procs.run([sys.executable, "-m", "verifier.cli", "emulate", "--tcp", "0", "--faults", faults],
+                     capture_output=True, text=True, timeout=60)
     assert done.returncode == 2 and "save it with LF or CRLF line ends" in done.stderr

@@ -15,6 +15,7 @@ from click.testing import CliRunner
 
 from file_helpers import write_files
 from verifier.commands.verify import bundled_scenarios, command
+import procs
 
 REPO = Path(__file__).resolve().parents[1]
 PLC = REPO / "plc"
@@ -68,8 +69,8 @@ def test_violations_exit_1(tmp_path):
 
 
 def _run_cli(*args) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "verifier.cli", "verify", *map(str, args)],
-                          capture_output=True, text=True, timeout=600, cwd=REPO)
+    return procs.run([sys.executable, "-m", "verifier.cli", "verify", *map(str, args)],
+                     capture_output=True, text=True, timeout=600, cwd=REPO)
 
 
 def test_bad_scenario_exits_2_with_file_line_and_key(tmp_path):
@@ -159,8 +160,8 @@ def test_the_bundled_scenarios_cover_every_fault_kind():
 def test_the_readme_command_verifies_the_bundled_examples_in_parallel(tmp_path):
     """`uitamr verify` with no arguments: every bundled scenario, every one compliant."""
     junit = tmp_path / "bundled.xml"
-    done = subprocess.run(["uitamr", "verify", "--jobs", "2", "--junit", str(junit)],
-                          capture_output=True, text=True, timeout=900, cwd=tmp_path)
+    done = procs.run(["uitamr", "verify", "--jobs", "2", "--junit", str(junit)],
+                     capture_output=True, text=True, timeout=900, cwd=tmp_path)
     assert done.returncode == 0, done.stdout + done.stderr
     cases = ET.parse(junit).getroot().findall("./testsuite/testcase")
     assert len(cases) == len(bundled_scenarios()) >= 10
@@ -707,11 +708,11 @@ def test_a_reader_that_goes_away_loses_no_report(tmp_path):
     the console text is dropped, the reports are still written and the exit status is the
     verdict's (before, the console library exited 1 at once and r.json was never written)."""
     report = tmp_path / "r.json"
-    proc = subprocess.Popen([sys.executable, "-m", "verifier.cli", "verify", "--scenario",
+    proc = procs.spawn([sys.executable, "-m", "verifier.cli", "verify", "--scenario",
                              str(PLC / "scenarios" / "q-bad-crc.toml"), "--duration", "5s", "--json", str(report)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+                       stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     proc.stdout.close()  # no reader: the first line printed meets a broken pipe
-    _, stderr = proc.communicate(timeout=120)
+    _, stderr = procs.finish(proc, 120)
     assert proc.returncode == 1, stderr.decode()  # q-bad-crc's verdict, not the pipe's
     assert b"Traceback" not in stderr and b"BrokenPipe" not in stderr
     assert json.loads(report.read_text(encoding="utf-8"))["verdict"] == "fail"

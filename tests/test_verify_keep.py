@@ -7,7 +7,6 @@ from __future__ import annotations
 import io
 import json
 import re
-import subprocess
 import sys
 from pathlib import Path
 
@@ -19,6 +18,7 @@ from verifier.verify.report_json import to_dict
 from verifier.verify.result import Keep
 from verifier.verify.runner import run_scenario
 from verifier.verify.scenario import load_scenario
+import procs
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIOS = sorted((ROOT / "plc" / "scenarios").glob("*.toml"))
@@ -67,8 +67,8 @@ def test_watched_changes_and_events_are_kept_without_the_frames():
 
 
 def _verify(*args, cwd):
-    return subprocess.run([sys.executable, "-m", "verifier.cli", "verify", *map(str, args)],
-                          capture_output=True, text=True, timeout=300, cwd=cwd)
+    return procs.run([sys.executable, "-m", "verifier.cli", "verify", *map(str, args)],
+                     capture_output=True, text=True, timeout=300, cwd=cwd)
 
 
 def test_the_command_keeps_what_its_reports_list(tmp_path):

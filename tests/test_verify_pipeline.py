@@ -10,7 +10,6 @@ the emulated robot, the rules and the expectations.
 from __future__ import annotations
 
 import shutil
-import subprocess
 import sys
 from dataclasses import replace
 from pathlib import Path
@@ -25,6 +24,7 @@ from verifier.verify.evidence import RuleOptions
 from verifier.verify.result import KEEP_ALL, Keep
 from verifier.verify.runner import run_scenario
 from verifier.verify.scenario import Scenario, parse_scenario
+import procs
 
 REPO = Path(__file__).resolve().parents[1]
 PLC = REPO / "plc"
@@ -424,8 +424,8 @@ def test_a_location_on_line_100_is_printed_as_it_is(tmp_path):
     (tmp_path / "P.st").write_text("\n".join(padded).replace("n >= 30", "n >= 5") + "\n", encoding="utf-8")
     (tmp_path / "s.toml").write_text('name = "fast"\nsources = ["P.st"]\nprogram = "P"\nplatform = "fx3u"\n'
                                      'duration = "2s"\n', encoding="utf-8")
-    done = subprocess.run([sys.executable, "-m", "verifier.cli", "verify", "--scenario", str(tmp_path / "s.toml")],
-                          capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    done = procs.run([sys.executable, "-m", "verifier.cli", "verify", "--scenario", str(tmp_path / "s.toml")],
+                     capture_output=True, text=True, timeout=120, cwd=tmp_path)
     assert done.returncode == 1, done.stdout + done.stderr
     assert "UITAMR-PACING" in done.stdout and "P.st:100:9" in done.stdout, done.stdout
     assert "\N{HUNDRED POINTS SYMBOL}" not in done.stdout

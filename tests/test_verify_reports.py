@@ -7,7 +7,6 @@ import io
 import json
 import re
 import shutil
-import subprocess
 import tempfile
 import xml.etree.ElementTree as ET
 from html.parser import HTMLParser
@@ -22,6 +21,7 @@ from verifier.verify.evidence import RunEvidence
 from verifier.verify.expectations import Expectation, ExpectationResult
 from verifier.verify.result import LineEvent, ScenarioResult, TraceRecord
 from verifier.verify.rules import RULES, check_all
+import procs
 
 S = protocol.Settings()
 STOP = protocol.ControlRequest(1, protocol.ControlCode.ROBOT, protocol.RobotCommand.STOP)
@@ -383,16 +383,16 @@ def test_html_screenshot_is_taken(tmp_path):
     report_html.write([bad_result()], page)
     shot = tmp_path / "shot.png"
     with tempfile.TemporaryDirectory() as profile:
-        subprocess.run([_chromium(), *_chromium_flags(profile), f"--screenshot={shot}", page.as_uri()],
-                       capture_output=True, timeout=120)
+        procs.run([_chromium(), *_chromium_flags(profile), f"--screenshot={shot}", page.as_uri()],
+                  capture_output=True, timeout=120)
     assert shot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and shot.stat().st_size > 10_000
 
 
 def _rendered(uri: str) -> ET.Element:
     """The page at `uri` as Chromium laid it out, its script run (--dump-dom)."""
     with tempfile.TemporaryDirectory() as profile:
-        dom = subprocess.run([_chromium(), *_chromium_flags(profile), "--dump-dom", uri],
-                             capture_output=True, text=True, timeout=120).stdout
+        dom = procs.run([_chromium(), *_chromium_flags(profile), "--dump-dom", uri],
+                        capture_output=True, text=True, timeout=120).stdout
     return _parse_dom(dom)
 
 

@@ -22,6 +22,7 @@ from verifier.verify import stream as stream_module
 from verifier.verify.result import KEEP_ALL, Keep
 from verifier.verify.runner import run_scenario
 from verifier.verify.scenario import load_scenario, parse_scenario
+import procs
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIOS = sorted((ROOT / "plc" / "scenarios").glob("*.toml"))
@@ -162,9 +163,9 @@ def _spawn_matrix(out: Path):
     import subprocess
     import sys
 
-    return subprocess.Popen([sys.executable, "-m", "verifier.cli", "verify", "--matrix", "--duration", "600s",
+    return procs.spawn([sys.executable, "-m", "verifier.cli", "verify", "--matrix", "--duration", "600s",
                              "--jobs", "2", "--trace", str(out / "t.jsonl")],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
+                       stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
 
 
 def _wait_for_spool(out: Path, proc) -> None:
@@ -187,7 +188,7 @@ def test_a_ci_time_out_stops_the_run_and_leaves_nothing(tmp_path):
     proc = _spawn_matrix(tmp_path)
     _wait_for_spool(tmp_path, proc)
     os.killpg(proc.pid, signal.SIGTERM)
-    _, stderr = proc.communicate(timeout=120)
+    _, stderr = procs.finish(proc, 120)
     assert proc.returncode == 143, stderr.decode()
     assert b"Traceback" not in stderr
     assert list(tmp_path.iterdir()) == []
@@ -204,7 +205,7 @@ def test_a_worker_killed_midway_is_said_and_leaves_nothing(tmp_path):
     children = Path(f"/proc/{proc.pid}/task/{proc.pid}/children").read_text().split()
     assert children, "the pool has no worker process"
     os.kill(int(children[0]), signal.SIGKILL)
-    _, stderr = proc.communicate(timeout=120)
+    _, stderr = procs.finish(proc, 120)
     assert proc.returncode == 2, stderr.decode()
     assert b"a worker process of --jobs 2 stopped without a word" in stderr and b"Traceback" not in stderr
     assert list(tmp_path.iterdir()) == []
@@ -223,7 +224,7 @@ def test_a_command_killed_outright_leaves_a_spool_the_next_one_removes(tmp_path)
     proc = _spawn_matrix(tmp_path)
     _wait_for_spool(tmp_path, proc)
     os.killpg(proc.pid, signal.SIGKILL)
-    proc.communicate(timeout=60)
+    procs.finish(proc, 60)
     (orphan,) = tmp_path.glob(f"{SPOOL_PREFIX}*")
     living = tmp_path / f"{SPOOL_PREFIX}{owner()}-{os.getpid()}-abc"  # this test's process lives
     elsewhere = tmp_path / f"{SPOOL_PREFIX}otherhost-{proc.pid}-abc"  # another machine's: not ours to judge

@@ -13,6 +13,7 @@ import sys
 import click
 
 from verifier import __version__
+from verifier.stopflag import AS_PROGRAM
 from verifier.textfile import UNENCODABLE
 
 SUBCOMMANDS = {
@@ -43,6 +44,12 @@ class UnusablePath(click.ClickException):
 
 
 class LazyGroup(click.Group):
+    def __call__(self, *args, **kwargs):
+        # `uitamr` as a program (its console script, python -m verifier.cli); click's CliRunner
+        # and other in-process callers call .main() and keep their own Ctrl-C handling
+        AS_PROGRAM.set()
+        return super().__call__(*args, **kwargs)
+
     def list_commands(self, ctx: click.Context) -> list[str]:
         return list(SUBCOMMANDS)
 

@@ -21,7 +21,7 @@ from verifier.commands.numbers import INT
 from verifier.commands.protocol_options import protocol_settings
 from verifier.digits import digit_problem
 from verifier.serialports import serial_url_problem
-from verifier.stopflag import StopFlag
+from verifier.stopflag import StopFlag, put_back
 
 
 def _tcp_endpoint(value: str) -> tuple[str, int]:
@@ -312,8 +312,7 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
     finally:
         if timer is not None:
             timer.cancel()
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+        put_back(previous)
     log_anyway(emulator.summary())
     if log_closed:
         click.echo(f"{emulator.summary()} (the log's reader closed stdout; the robot kept serving "

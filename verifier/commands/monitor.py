@@ -31,7 +31,7 @@ from verifier.monitor.session import CaptureInfo, MonitorSession
 from verifier.monitor.sources import SerialSource, SourceError, TcpSource, now_us
 from verifier.monitor.view import MonitorView
 from verifier.serialports import serial_url_problem
-from verifier.stopflag import StopFlag
+from verifier.stopflag import StopFlag, put_back
 from verifier.verify.evidence import RuleOptions
 from verifier.verify.result import NO_TRAFFIC, Mistake, overall_verdict
 
@@ -212,8 +212,7 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
             sys.exit(EXIT_UNUSABLE)
         sys.exit(exit_status([result]))
     finally:  # the handlers stay until the reports and the capture are written
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+        put_back(previous)
 
 
 def exit_status(results) -> int:
