@@ -395,3 +395,34 @@ def test_ladder_error_id_is_the_code_of_the_fault_it_shows(tmp_path, program):
     tx = [f for f in result.trace if f.direction == "tx"]
     assert len({f.data for f in tx if 8_000_000 < f.t_start_us < 15_000_000}) < len(
         [f for f in tx if 8_000_000 < f.t_start_us < 15_000_000]), "no retry was exercised"
+
+
+def test_the_regeneration_command_keeps_a_link_and_the_file_s_mode(tmp_path, monkeypatch):
+    """`-o X.csv` renamed its temporary file over X.csv: a link X.csv (to the CSV kept in the
+    project folder) became a file of its own and the project's CSV stayed old, where the
+    shell's `> X.csv` writes through the link. And it set the mode with os.chmod on a file
+    descriptor, which Windows' Python before 3.13 refuses (TypeError: a traceback, the
+    temporary file left open): here os.chmod refuses descriptors as it does there."""
+    import os
+    import stat
+
+    from verifier.export import ladder
+
+    real_chmod = os.chmod
+
+    def chmod_without_descriptors(path, mode, *args, **kwargs):
+        if isinstance(path, int):
+            raise TypeError("chmod: path should be string, bytes or os.PathLike, not int")
+        return real_chmod(path, mode, *args, **kwargs)
+
+    monkeypatch.setattr(os, "chmod", chmod_without_descriptors)
+    kept = tmp_path / "project" / "UITAMR_LadderFx3.csv"
+    kept.parent.mkdir()
+    kept.write_bytes(b"the previous CSV\r\n")
+    real_chmod(kept, 0o640)
+    link = tmp_path / "out.csv"
+    link.symlink_to(kept)
+    assert ladder.main([str(IL), "-o", str(link)]) == 0
+    assert link.is_symlink() and kept.read_bytes() == (LADDER / "UITAMR_LadderFx3.csv").read_bytes()
+    assert stat.S_IMODE(kept.stat().st_mode) == 0o640
+    assert sorted(p.name for p in kept.parent.iterdir()) == ["UITAMR_LadderFx3.csv"]  # no temporary file left

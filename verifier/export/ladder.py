@@ -155,21 +155,25 @@ def main(argv: list[str]) -> int:
 def _write_whole(out: Path, text: str) -> None:
     """`text` into `out` at once: written beside it under a temporary name, then renamed over
     it, so that `out` is the old file or the new one, never a part (the temporary file is
-    removed when writing fails)."""
+    removed when writing fails). A symbolic link is written through to its target, as the
+    shell's `> X.csv` did; the mode is set by path once the file is closed (Windows' os.chmod
+    takes no file descriptor before Python 3.13)."""
     import os
     import tempfile
 
+    if out.is_symlink():
+        out = Path(os.path.realpath(out))
     fd, temporary = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
     try:
+        with open(fd, "w", encoding="utf-8", newline="") as f:
+            f.write(text)
         try:  # the file's own mode, else a new file's (mkstemp's 0600 would hide it from others)
             mode = out.stat().st_mode & 0o7777
         except OSError:
             umask = os.umask(0)
             os.umask(umask)
             mode = 0o666 & ~umask
-        os.chmod(fd, mode)
-        with open(fd, "w", encoding="utf-8", newline="") as f:
-            f.write(text)
+        os.chmod(temporary, mode)
         os.replace(temporary, out)
     except BaseException:
         Path(temporary).unlink(missing_ok=True)
