@@ -426,3 +426,14 @@ def test_the_regeneration_command_keeps_a_link_and_the_file_s_mode(tmp_path, mon
     assert link.is_symlink() and kept.read_bytes() == (LADDER / "UITAMR_LadderFx3.csv").read_bytes()
     assert stat.S_IMODE(kept.stat().st_mode) == 0o640
     assert sorted(p.name for p in kept.parent.iterdir()) == ["UITAMR_LadderFx3.csv"]  # no temporary file left
+
+
+def test_an_il_named_with_a_newline_keeps_its_mistakes_on_one_line():
+    """The converter's mistakes built 'file:line:col' by hand from the raw name: `b<LF>ad.il`
+    broke each into two lines, where every other message shows the name escaped (Place)."""
+    for text, message in (("LD X0\nOUTT Y0\nEND\n", "b\\x0aad.il:2:1: 'OUTT' is not an instruction"),
+                          ("LD X0 X1\nEND\n", "b\\x0aad.il:1:1: LD takes 1 operand(s)"),
+                          ("LD X0\n", "b\\x0aad.il: the program must end with END")):
+        with pytest.raises(IlError) as caught:
+            parse_il(text, "b\nad.il")
+        assert str(caught.value).startswith(message), str(caught.value)

@@ -18,7 +18,8 @@ from __future__ import annotations
 import sys
 from dataclasses import dataclass
 from pathlib import Path
-from verifier.textfile import UnreadableText, read_utf8, text_lines
+from verifier.place import Place
+from verifier.textfile import UnreadableText, read_utf8, shown_name, text_lines
 
 HEADER = ("Step Number", "Line Statement", "Instruction", "I/O(Device)", "Blank", "PI Statement", "Note")
 PLC_TYPE = "FX3U/FX3UC"
@@ -75,15 +76,15 @@ def parse_il(text: str, name: str = "<il>") -> list[Instruction]:
                 wanted = 2
         else:
             known = ", ".join(sorted(INSTRUCTIONS)) + ", LD=/AND=/OR= and the other comparisons"
-            raise IlError(f"{name}:{number}:{col}: '{op}' is not an instruction this converter "
+            raise IlError(f"{Place(name, number, col)}: '{op}' is not an instruction this converter "
                           f"knows (it counts the steps of {known})")
         if len(operands) != wanted:
-            raise IlError(f"{name}:{number}:{col}: {upper} takes {wanted} operand(s), "
+            raise IlError(f"{Place(name, number, col)}: {upper} takes {wanted} operand(s), "
                           f"got {len(operands)}: '{line}'")
         program.append(Instruction(number, upper, tuple(operands), pending))
         pending = ""
     if not program or program[-1].op != "END":
-        raise IlError(f"{name}: the program must end with END")
+        raise IlError(f"{shown_name(name)}: the program must end with END")
     return program
 
 
