@@ -437,3 +437,24 @@ def test_an_il_named_with_a_newline_keeps_its_mistakes_on_one_line():
         with pytest.raises(IlError) as caught:
             parse_il(text, "b\nad.il")
         assert str(caught.value).startswith(message), str(caught.value)
+
+
+def test_the_regeneration_command_writes_into_a_pipe_and_leaves_it_one(tmp_path):
+    """`-o` renamed its temporary file over whatever the path named: `-o` a pipe (or, run as
+    root, `-o /dev/null`) replaced it with a regular file. A pipe or a device is now written
+    to, as `> FILE` writes to it."""
+    import os
+    import stat
+    import threading
+
+    from verifier.export import ladder
+
+    pipe = tmp_path / "csv.pipe"
+    os.mkfifo(pipe)
+    received = []
+    reader = threading.Thread(target=lambda: received.append(pipe.read_bytes()), daemon=True)
+    reader.start()
+    assert ladder.main([str(IL), "-o", str(pipe)]) == 0
+    assert stat.S_ISFIFO(pipe.stat().st_mode)  # (replaced, the reader waits on a pipe no one opens)
+    reader.join(10)
+    assert received == [(LADDER / "UITAMR_LadderFx3.csv").read_bytes()]

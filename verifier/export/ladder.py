@@ -156,14 +156,18 @@ def main(argv: list[str]) -> int:
 def _write_whole(out: Path, text: str) -> None:
     """`text` into `out` at once: written beside it under a temporary name, then renamed over
     it, so that `out` is the old file or the new one, never a part (the temporary file is
-    removed when writing fails). A symbolic link is written through to its target, as the
-    shell's `> X.csv` did; the mode is set by path once the file is closed (Windows' os.chmod
-    takes no file descriptor before Python 3.13)."""
+    removed when writing fails). A symbolic link is written through to its target, and a
+    pipe or a device is written to, as the shell's `> X.csv` did; the mode is set by path
+    once the file is closed (Windows' os.chmod takes no file descriptor before 3.13)."""
     import os
     import tempfile
 
     if out.is_symlink():
         out = Path(os.path.realpath(out))
+    if out.exists() and not out.is_file():  # a pipe, a device (/dev/stdout): not replaced by a file
+        with open(out, "w", encoding="utf-8", newline="") as f:
+            f.write(text)
+        return
     fd, temporary = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
     try:
         with open(fd, "w", encoding="utf-8", newline="") as f:
