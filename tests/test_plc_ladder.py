@@ -439,6 +439,22 @@ def test_an_il_named_with_a_newline_keeps_its_mistakes_on_one_line():
         assert str(caught.value).startswith(message), str(caught.value)
 
 
+def test_the_regeneration_command_s_own_messages_keep_a_name_with_a_newline_on_one_line(tmp_path, capsys):
+    """The command's messages about its files (a .il that cannot be read, a CSV that cannot be
+    written, -o naming the .il) printed the raw name: `b<LF>ad.il` broke each in two."""
+    from verifier.export import ladder
+
+    missing = tmp_path / "b\nad.il"
+    assert ladder.main([str(missing)]) == 1
+    assert capsys.readouterr().err.startswith(f"{tmp_path}/b\\x0aad.il: ")
+    assert ladder.main([str(IL), "-o", str(tmp_path / "no\nfolder" / "x.csv")]) == 2
+    assert capsys.readouterr().err.startswith(f"{tmp_path}/no\\x0afolder/x.csv: cannot write: ")
+    il = tmp_path / "c\nd.il"
+    il.write_text("END\n", encoding="utf-8")
+    assert ladder.main([str(il), "-o", str(il)]) == 2
+    assert capsys.readouterr().err == f"{tmp_path}/c\\x0ad.il: is the .il itself: name the .csv to write (-o {tmp_path}/c\\x0ad.csv)\n"
+
+
 def test_the_regeneration_command_writes_into_a_pipe_and_leaves_it_one(tmp_path):
     """`-o` renamed its temporary file over whatever the path named: `-o` a pipe (or, run as
     root, `-o /dev/null`) replaced it with a regular file. A pipe or a device is now written

@@ -129,13 +129,13 @@ def main(argv: list[str]) -> int:
     args = parser.parse_args(argv)  # a usage mistake: argparse's message, exit 2
     path = Path(args.il)
     if args.out is not None and Path(args.out).resolve() == path.resolve():
-        print(f"{args.out}: is the .il itself: name the .csv to write (-o {path.with_suffix('.csv')})",
-              file=sys.stderr)
+        csv_name = shown_name(str(path.with_suffix(".csv")))
+        print(f"{shown_name(args.out)}: is the .il itself: name the .csv to write (-o {csv_name})", file=sys.stderr)
         return 2
     try:
         text = read_utf8(path)
     except UnreadableText as e:
-        print(f"{path}: {e}", file=sys.stderr)
+        print(f"{shown_name(str(path))}: {e}", file=sys.stderr)
         return 1
     try:
         csv = to_csv(parse_il(text, str(path)), path.stem)
@@ -148,7 +148,7 @@ def main(argv: list[str]) -> int:
     try:
         _write_whole(Path(args.out), csv)
     except OSError as e:
-        print(f"{args.out}: cannot write: {e.strerror or e}", file=sys.stderr)
+        print(f"{shown_name(args.out)}: cannot write: {e.strerror or e}", file=sys.stderr)
         return 2
     return 0
 
