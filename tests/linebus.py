@@ -7,6 +7,7 @@ writes reaches the PLC end and the tap. `noise` puts bytes on the line from nowh
 """
 from __future__ import annotations
 
+import contextlib
 import os
 import select
 import subprocess
@@ -103,3 +104,23 @@ class LineBus:
         for socat in self._socats:
             socat.terminate()
             socat.wait(timeout=5)
+
+
+@contextlib.contextmanager
+def pty_cable(folder: Path, one: str, other: str):
+    """A socat pty pair, the cable between two ends named `folder/one` and `folder/other`:
+    yields socat's process, so that a test can pull the cable out (terminate it) while a
+    command has a port open; the process is ended at the end if it still runs."""
+    ends = folder / one, folder / other
+    socat = subprocess.Popen(["socat", *(f"pty,raw,echo=0,link={end}" for end in ends)],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + OPEN_TIMEOUT_S
+        while not all(end.exists() for end in ends):
+            assert socat.poll() is None and time.monotonic() < deadline, "socat made no pty pair"
+            time.sleep(0.02)
+        yield socat
+    finally:
+        if socat.poll() is None:
+            socat.kill()
+            socat.wait(timeout=OPEN_TIMEOUT_S)

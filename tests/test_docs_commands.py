@@ -182,8 +182,10 @@ def test_every_option_of_a_command_is_in_its_page(name):
 def test_emulator_bench_recipe(tmp_path):
     """emulator.md, "Testing without hardware", run as the page gives it (its /tmp links
     moved into the test's folder): socat's pty pair, the emulator on one end, the three
-    mbpoll commands on the other; the stop and the point command are written, and the
-    status read shows coil 17 = 1 (running), as the page says."""
+    mbpoll commands on the other; the stop and the point command are written, the
+    status read shows coil 17 = 1 (running), and `kill %2` (SIGTERM) ends the emulator with
+    its summary line and status 0, as the page says. (socat killed first: status 1,
+    test_emulate_ports.py's test_an_adapter_unplugged_mid_run_...)"""
     import os
     import subprocess
     import sys
@@ -215,6 +217,12 @@ def test_emulator_bench_recipe(tmp_path):
         assert "Written 1 references." in outputs[0] and "Written 1 references." in outputs[1]
         coils = dict(re.findall(r"^\[(\d+)\]:\s+(\d)", outputs[2], flags=re.M))
         assert len(coils) == 22 and coils["17"] == "1", outputs[2]  # running: point 3 was started
+        # "`kill %2` stops the emulator (it prints its summary line and exits with status 0)"
+        emulator.terminate()
+        out = emulator.communicate(timeout=15)[0]
+        assert emulator.returncode == 0, out
+        assert out.splitlines()[-1].startswith("uitamr emulate: stopped after "), out
+        assert "3 frames in, 3 replies out, 0 unanswered" in out.splitlines()[-1], out
     finally:
         for process in (emulator, socat):
             if process is not None and process.poll() is None:
@@ -286,6 +294,16 @@ def test_the_fault_defaults_emulator_md_gives_are_the_codes():
     assert f"`code` (default {Fault('exception', on_request=1).code:02d})" in rows["`exception`"]
 
 
+def test_the_reply_lateness_emulator_md_gives_is_how_often_the_emulator_looks():
+    """emulator.md gave `--turnaround-ms` as the time to the reply; on the wall clock the
+    reply goes out when the serving loop next looks, up to ports.POLL_S later."""
+    from verifier.emulate.ports import POLL_S
+
+    text = " ".join((ROOT / "docs" / "emulator.md").read_text(encoding="utf-8").split())
+    assert (f"a reply goes out up to {POLL_S * 1000:g} ms after it falls due, as the emulator looks at its port "
+            f"and clock every {POLL_S * 1000:g} ms") in text
+
+
 def test_the_fault_file_error_emulator_md_quotes_is_what_its_bench_toml_gives(tmp_path):
     """emulator.md quotes a fault file mistake right before it prints `bench.toml`: that
     file with its first fault's kind misspelt 'x' gives the quoted place and message (the
@@ -302,6 +320,49 @@ def test_the_fault_file_error_emulator_md_quotes_is_what_its_bench_toml_gives(tm
     with pytest.raises(FaultFileError) as raised:
         load_fault_file(tmp_path / "bench.toml")
     assert f"bench.toml:{quoted};" in str(raised.value)
+
+
+def test_the_port_messages_the_pages_quote_are_the_commands_own(tmp_path):
+    """emulator.md and commissioning.md quote what `uitamr emulate` and `uitamr monitor` say of
+    a port that cannot be opened and of one that went away; each quote is the command's own
+    words, run on a real port where one can be had (a quote ending in "..." is their start)."""
+    import socket
+    import subprocess
+    import sys
+
+    import serial
+
+    from verifier.serialports import why_it_failed
+
+    def page(name: str) -> str:
+        return " ".join((ROOT / "docs" / name).read_text(encoding="utf-8").split())
+
+    def said(*args: str) -> subprocess.CompletedProcess:
+        return subprocess.run([sys.executable, "-m", "verifier.cli", *args], capture_output=True, text=True,
+                              timeout=30)
+
+    emulator, commissioning = page("emulator.md"), page("commissioning.md")
+    missing = said("emulate", "--serial", str(tmp_path / "ttyUSB9"))  # the page's /dev/ttyUSB9, surely absent
+    quote = re.search(r"`cannot open serial port /dev/ttyUSB9: ([^`]*) \.\.\.`", emulator).group(1)
+    assert missing.returncode == 2 and f"cannot open serial port {tmp_path / 'ttyUSB9'}: {quote}" in missing.stderr
+    with socket.create_server(("127.0.0.1", 0)) as taken:
+        port = taken.getsockname()[1]
+        in_use = said("emulate", "--tcp", f"127.0.0.1:{port}")
+    quote = re.search(r"`(cannot listen on 127\.0\.0\.1:4001: [^`]*)`", emulator).group(1)
+    assert in_use.returncode == 2 and quote.replace("4001", str(port)) in in_use.stderr, in_use.stderr
+    with socket.create_server(("127.0.0.1", 0)) as probe:  # closed again: nothing listens on it
+        free = probe.getsockname()[1]
+    refused = said("monitor", "--tcp", f"127.0.0.1:{free}")
+    quote = re.search(r"`(cannot connect to 192\.168\.0\.60:4001: [^`]*)`", commissioning).group(1)
+    assert refused.returncode == 2
+    assert quote.replace("192.168.0.60:4001", f"127.0.0.1:{free}") in refused.stderr, refused.stderr
+    # an unplugged adapter, in pyserial 3.5's words (run on a real pty by test_emulate_ports.py
+    # and test_monitor.py)
+    gone = why_it_failed(serial.SerialException("device reports readiness to read but returned no data (device "
+                                                "disconnected or multiple access on port?)"))
+    assert f"`serial port /dev/ttyUSB0 failed: {gone}`" in emulator
+    quote = re.search(r"`the capture ended early: /dev/ttyUSB0: ([^`]*) \.\.\.`", commissioning).group(1)
+    assert gone.startswith(quote)
 
 
 def _plc_arguments(command: str) -> list[str]:

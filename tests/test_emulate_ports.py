@@ -6,6 +6,7 @@ No wall-clock time is asserted: waits are bounded polls for what must appear.
 """
 from __future__ import annotations
 
+import errno
 import os
 import queue
 import random
@@ -24,7 +25,7 @@ import serial
 from pymodbus.client import ModbusTcpClient
 from pymodbus.framer import FramerType
 
-from linebus import LineBus
+from linebus import LineBus, pty_cable
 from verifier.protocol import STOP_FRAME, ControlRequest, Query, StatusRequest, encode, with_crc
 
 pytestmark = pytest.mark.serial
@@ -537,6 +538,21 @@ def test_bad_fault_file_names_file_and_key(tmp_path, text, message):
     assert "Traceback" not in result.stderr
 
 
+def test_a_fault_file_that_is_not_utf8_is_named_at_its_byte_as_a_scenario_is(tmp_path):
+    """A fault file saved in Latin-1 or Shift-JIS on the bench PC (a comment "café"): the
+    message was "faults.toml: line 2, column 24 (byte 31): not UTF-8 text", where every other
+    mistake in it, and the same file as a scenario, is named `file:line:col:`."""
+    path = tmp_path / "faults.toml"
+    path.write_bytes(b"[robot]\nturnaround_ms = 8 # caf\xe9\n")
+    result = run_cli("--tcp", "0", "--faults", str(path))
+    assert result.returncode == 2 and "Traceback" not in result.stderr
+    assert f"{path}:2:24: not UTF-8 text (byte 31): save the file as UTF-8" in result.stderr, result.stderr
+    verify = subprocess.run([sys.executable, "-m", "verifier.cli", "verify", "--scenario", str(path)],
+                            capture_output=True, text=True, timeout=WAIT_S)
+    assert verify.returncode == 2
+    assert f"{path}:2:24: not UTF-8 text (byte 31): save the file as UTF-8" in verify.stdout + verify.stderr
+
+
 def test_a_wrong_address_fault_on_the_robots_own_address_is_refused(tmp_path):
     path = tmp_path / "faults.toml"
     path.write_text('[[faults]]\nkind = "wrong_address"\non_request = 1\naddress = 5\n')
@@ -659,6 +675,15 @@ def test_the_scripted_fault_line_says_count_duration_and_filter_together(tmp_pat
     (("--serial", "socket://127.0.0.1:" + "9" * 5000), "is not a number from 1 to 65535", 2),
     # `--serial "$PORT"` with PORT unset: was exit 1, "cannot open serial port : ... ''"
     (("--serial", ""), "the port name is empty: give the serial port", 2),
+    # was pyserial's "Could not configure port: (25, 'Inappropriate ioctl for device')"
+    (("--serial", "/dev/null"), "uitamr emulate: cannot open serial port /dev/null: not a serial port (a file or "
+     "another kind of device): give the adapter's port", 2),
+    # was "[Errno -2] Name or service not known (while attempting to bind on address ('nosuch.invalid', 4001))"
+    (("--tcp", "nosuch.invalid:4001"), "uitamr emulate: cannot listen on nosuch.invalid:4001: nosuch.invalid is not "
+     "an address, nor a name this PC can look up", 2),
+    # TEST-NET-1 (RFC 5737), on no PC: was "[Errno 99] Cannot assign requested address (while attempting ...)"
+    (("--tcp", "192.0.2.7:4001"), "uitamr emulate: cannot listen on 192.0.2.7:4001: 192.0.2.7 is not an address "
+     "of this PC: give one of its own", 2),
 ])
 def test_cli_mistakes_get_a_clear_message(args, message, code):
     result = run_cli(*args)
@@ -686,6 +711,105 @@ def test_a_port_that_cannot_be_opened_says_what_to_check_on_site():
                                              "group (`ls -l` names the group, dialout on Debian and Ubuntu")
     busy = serial.SerialException(16, "could not open port /dev/ttyUSB0: [Errno 16] Device or resource busy")
     assert why_not_opened(busy).startswith("the port is busy: another program has it open")
+    # nor can this bench make a converter that does not answer, one on no route, or a port
+    # below 1024 refused (root binds any): the socket's own exceptions for them
+    from verifier.emulate.ports import why_not_listening
+    from verifier.serialports import why_not_connected
+
+    assert why_not_connected(TimeoutError("timed out")).startswith("no answer: check the address, that the "
+                                                                   "converter is on and on this PC's network")
+    unreachable = OSError(errno.EHOSTUNREACH, "No route to host")
+    assert why_not_connected(unreachable).startswith("no route to it: this PC is not on the converter's network")
+    denied = PermissionError(errno.EACCES, "Permission denied (while attempting to bind on address ('0.0.0.0', 502))")
+    assert why_not_listening(denied, "0.0.0.0", 502) == ("permission denied: ports below 1024 need root; give a "
+                                                          "port from 1024 up, e.g. 4001")
+
+
+def test_a_tcp_port_in_use_or_refused_says_what_to_do(start_emulator):
+    """The bench mistakes with TCP: an emulator started earlier still holds the port (Python
+    said "[Errno 98] Address already in use (while attempting to bind on address
+    ('127.0.0.1', 4001))"); a serial server (socket://) that refuses (pyserial said "Could
+    not open port socket://...: [Errno 111] Connection refused"); rfc2217:// to a converter
+    in raw mode (pyserial: "Remote does not seem to support RFC2217 or BINARY mode
+    [we-BINARY:False(INACTIVE), ...]"). Each exits 2 and says what to check."""
+    first, port = tcp_emulator(start_emulator)
+    taken = run_cli("--tcp", f"127.0.0.1:{port}")
+    assert taken.returncode == 2 and "stopped after" not in taken.stdout
+    assert taken.stderr.strip() == (f"uitamr emulate: cannot listen on 127.0.0.1:{port}: the port is in use: another "
+                                    f"program listens on {port} (an emulator started earlier?); stop it, or give "
+                                    "another port (--tcp 0 picks a free one)")
+    assert first.stop()[0] == 0
+    with socket.create_server(("127.0.0.1", 0)) as probe:  # a port nothing listens on once it is closed
+        free = probe.getsockname()[1]
+    with socket.create_server(("127.0.0.1", 0)) as raw:  # a converter in raw TCP mode: it never negotiates
+        rfc2217 = run_cli("--serial", f"rfc2217://127.0.0.1:{raw.getsockname()[1]}")
+    assert rfc2217.returncode == 2
+    assert ("the server does not speak RFC 2217 (telnet COM port control): for a converter or ser2net that passes "
+            "the bytes as they are (raw TCP), give socket://HOST:PORT") in rfc2217.stderr, rfc2217.stderr
+    refused = run_cli("--serial", f"socket://127.0.0.1:{free}")
+    assert refused.returncode == 2 and "Errno" not in refused.stderr
+    assert refused.stderr.startswith(f"uitamr emulate: cannot open serial port socket://127.0.0.1:{free}: refused: "
+                                     "nothing accepts connections on that port; check the address and port"), \
+        refused.stderr
+
+
+@pytest.mark.serial
+def test_an_adapter_unplugged_mid_run_ends_with_the_summary_and_what_happened(tmp_path):
+    """The USB adapter pulled out (here: socat, which made the pty pair, ended) with three bytes
+    of a request still arriving: the emulator ends by itself with status 1 (emulator.md,
+    "Testing without hardware"), after saying what it dropped and its summary; the reason
+    was pyserial's "device reports readiness to read but returned no data (device
+    disconnected or multiple access on port?)" after "Error:" - the port is locked, so nobody
+    else read it."""
+    robot, plc = tmp_path / "robot", tmp_path / "plc"
+    emulator = None
+    with pty_cable(tmp_path, "robot", "plc") as socat:
+        try:
+            emulator = EmulatorProcess("--serial", str(robot), "--frame-gap-ms", "60000")  # the 3 bytes wait
+            emulator.wait_for("listening on")
+            with serial.Serial(str(plc), 9600, timeout=WAIT_S) as port:
+                # in one write: the stop is answered at once, the three bytes after it wait for
+                # more (the PLC's end stays open: closing it made socat end before passing them on)
+                port.write(STOP_FRAME + STOP_FRAME[:3])
+                assert port.read(8) == STOP_FRAME
+                socat.terminate()
+                socat.wait(timeout=WAIT_S)
+            assert emulator.proc.wait(timeout=WAIT_S) == 1
+        finally:
+            if emulator is not None:
+                emulator.kill()
+    emulator.wait_for(f"-- serial {robot} closed; 3 received bytes that were not yet a whole request dropped "
+                      r"\(01 06 01\)")
+    # frames in = replies out + unanswered + not sent: a reply whose drain failed (the port
+    # gone while it was going out) was counted nowhere
+    emulator.wait_for(r"uitamr emulate: stopped after .* 1 frame in, (1 reply out, 0 unanswered|"
+                      r"0 replies out, 0 unanswered, 1 reply not sent), ")
+    # the port is gone at the next read, or (the emulator late) at the reply's drain
+    emulator.wait_for(re.escape(f"uitamr emulate: serial port {robot} failed") + "( while writing)?"
+                      + re.escape(": the port went away: the USB adapter was unplugged or lost power (or the "
+                                  "program that made the pty ended); plug it back in and start again"))
+    assert not any("multiple access" in line or line.startswith("Error:") for line in emulator.lines)
+
+
+@pytest.mark.serial
+def test_a_reply_whose_drain_meets_an_unplugged_port_ends_the_run_not_in_a_traceback(tmp_path):
+    """An adapter pulled out between the reply's write and its drain (pyserial's flush(),
+    termios.tcdrain): termios.error, no OSError, went past the emulator's handler - a
+    traceback, exit 1 and no summary (seen 1 run in 3 with socat killed as the reply came,
+    on a loaded PC). Here that moment for sure: the reply's bytes written (none left), the
+    drain on the port gone."""
+    from verifier.emulate.ports import PortError, send_reply
+
+    robot = tmp_path / "robot"
+    with pty_cable(tmp_path, "robot", "plc") as socat, serial.Serial(str(robot), 9600, timeout=0) as port:
+        socat.terminate()
+        socat.wait(timeout=WAIT_S)
+        with pytest.raises(PortError) as raised:
+            send_reply(port, str(robot), b"")
+    assert raised.value.in_use  # said after the summary, exit 1
+    assert str(raised.value) == (f"serial port {robot} failed while writing: the port went away: the USB adapter was "
+                                 "unplugged or lost power (or the program that made the pty ended); plug it back in "
+                                 "and start again")  # not termios' "(5, 'Input/output error')"
 
 
 def test_an_ipv6_listener_is_logged_as_tcp_takes_it_back(start_emulator):
@@ -712,7 +836,7 @@ def test_serial_pyserial_socket_url_reaches_a_serial_server(start_emulator):
     # the serial server went away: the emulator says so, sums up and exits with status 1
     emulator.wait_for(r"uitamr emulate: stopped after .* 2 frames in, 2 replies out")
     assert emulator.proc.wait(timeout=WAIT_S) == 1
-    assert "socket disconnected" in emulator.wait_for(r"Error: serial port socket://\S+ failed").string
+    emulator.wait_for(r"uitamr emulate: serial port socket://\S+ failed: the serial server closed the connection$")
 
 
 def test_a_log_reader_that_leaves_does_not_take_the_robot_off_the_line():

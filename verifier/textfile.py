@@ -30,6 +30,13 @@ class UnreadableText(Exception):
         super().__init__(message)
         self.line, self.col, self.byte = line, col, byte
 
+    def after_place(self) -> str:
+        """The words to put after the file's `file:line:col: ` place (bytes that are not
+        text), or after `file: ` (a file that cannot be read at all)."""
+        if self.line is None:
+            return str(self)
+        return f"not UTF-8 text (byte {self.byte}): save the file as UTF-8"
+
 
 def read_utf8(path: Path) -> str:
     """The text of `path`. Only a regular file is read (a named pipe would block for ever);

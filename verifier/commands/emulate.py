@@ -303,11 +303,12 @@ def command(serial_url, tcp, baud, settings, faults_file, turnaround_ms, point_d
             serve_tcp(endpoint[0], endpoint[1], emulator, stop, silence_us,
                       on_listening=(lambda host, port: log_anyway(f"listening on tcp {host}:{port}")) if quiet else None)
     except PortError as err:
-        if not err.in_use:  # a mistake on the command line (the port's name, one in use): exit 2, as monitor's
-            click.echo(f"uitamr emulate: {err}", err=True)
-            sys.exit(2)
-        log_anyway(emulator.summary())  # what it did before the port failed
-        raise click.ClickException(str(err)) from None
+        if err.in_use:
+            log_anyway(emulator.summary())  # what it did before the port failed
+        click.echo(f"uitamr emulate: {err}", err=True)
+        # a mistake on the command line (the port's name, one in use): exit 2, as monitor's;
+        # a port that failed while serving (the adapter unplugged): 1
+        sys.exit(1 if err.in_use else 2)
     finally:
         if timer is not None:
             timer.cancel()

@@ -48,8 +48,9 @@ def load_fault_file(path: str | Path, own_address: int | None = None) -> FaultFi
     path = Path(path)
     try:
         text = read_utf8(path)
-    except UnreadableText as err:
-        raise FaultFileError(f"{path}: {err}") from None
+    except UnreadableText as err:  # file:line:col at bytes that are not text, as a scenario's
+        place = Place(None, err.line, err.col) if err.line is not None else None
+        raise FaultFileError(f"{_where(path, place)}: {err.after_place()}") from None
     try:
         data = tomllib.loads(text)
     except (ValueError, RecursionError) as err:

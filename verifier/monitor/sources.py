@@ -14,6 +14,8 @@ import socket
 import time
 from typing import Protocol
 
+from verifier.serialports import why_it_failed, why_not_connected, why_not_opened
+
 from .capture import Chunk
 
 #: how long one read waits for bytes before the monitor looks at the clock (silence)
@@ -40,8 +42,6 @@ class SourceError(Exception):
 class SerialSource:
     def __init__(self, port: str, baud: int, bytesize: int, parity: str, stopbits: float):
         import serial
-
-        from verifier.serialports import why_not_opened
 
         try:
             # exclusive (Linux/macOS: flock; Windows ports always are): a second reader of the
@@ -70,8 +70,8 @@ class SerialSource:
             data = self.port.read(self.port.in_waiting or 1)
             if data and self.port.in_waiting:
                 data += self.port.read(self.port.in_waiting)
-        except self._error as exc:
-            raise SourceError(f"{self.description}: {exc}") from None
+        except (self._error, OSError) as exc:  # in_waiting's ioctl on a port gone: OSError (EIO)
+            raise SourceError(f"{self.description}: {why_it_failed(exc)}") from None
         if not data:
             return None
         return Chunk(now_us(), bytes(data))
@@ -85,7 +85,7 @@ class TcpSource:
         try:
             self.sock = socket.create_connection((host, port), timeout=connect_timeout_s)
         except OSError as exc:
-            raise SourceError(f"cannot connect to {host}:{port}: {exc.strerror or exc}") from None
+            raise SourceError(f"cannot connect to {host}:{port}: {why_not_connected(exc)}") from None
         except UnicodeError:  # from the idna codec, before any lookup
             raise SourceError(f"cannot connect to {host}:{port}: not a host name (a part between dots is "
                               "empty or longer than 63 characters)") from None
@@ -97,8 +97,8 @@ class TcpSource:
             data = self.sock.recv(4096)
         except (TimeoutError, socket.timeout):
             return None
-        except OSError as exc:
-            raise SourceError(f"{self.description}: {exc.strerror or exc}") from None
+        except OSError as exc:  # "Connection reset by peer": said with what to check
+            raise SourceError(f"{self.description}: {why_it_failed(exc)}") from None
         if not data:
             raise SourceError(f"{self.description}: the server closed the connection")
         return Chunk(now_us(), data)

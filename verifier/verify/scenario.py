@@ -325,10 +325,8 @@ def load_scenario(path: Path | str, platform: str | None = None) -> Scenario:
     try:
         text = read_utf8(path)
     except UnreadableText as exc:
-        if exc.line is None:
-            raise ScenarioError(path, "", str(exc)) from None
-        raise ScenarioError(path, "", f"not UTF-8 text (byte {exc.byte}): save the file as UTF-8",
-                            Place(None, exc.line, exc.col)) from None
+        place = Place(None, exc.line, exc.col) if exc.line is not None else None
+        raise ScenarioError(path, "", exc.after_place(), place) from None
     return parse_scenario(text, path, platform)
 
 
