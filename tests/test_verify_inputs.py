@@ -578,18 +578,24 @@ def test_the_note_quotes_the_overwriting_statement_past_a_line_separator_in_a_co
     """A form feed or a Unicode line separator inside a comment is no new line for the ST
     parser (it counts line feeds, textfile.text_lines): the statement the note quotes is the
     one at the line it names, not the line after it (str.splitlines broke at them too)."""
-    (tmp_path / "Main.st").write_text(
-        f"PROGRAM Main\nVAR\n    b : BOOL;\n    n : INT;\nEND_VAR\n(* page{separator}break *)\nb := n > 0;\nn := n + 1;\n"
+    notes, output = _does_nothing_notes(tmp_path, monkeypatch, "Main.st", f"(* page{separator}break *)\n")
+    assert notes == ["s.toml:6:9: inputs[0].set: b = true does nothing: the program overwrites b in every scan "
+                     "before reading it, at Main.st:7:1 (b := n > 0;)"], output
+
+
+def _does_nothing_notes(tmp_path, monkeypatch, source: str, before: str = "") -> tuple[list[str], str]:
+    """The 'does nothing' notes (and the console) of a run that sets b, which the program
+    in `source` (`before` put ahead of its statements) overwrites before reading it."""
+    (tmp_path / source).write_text(
+        f"PROGRAM Main\nVAR\n    b : BOOL;\n    n : INT;\nEND_VAR\n{before}b := n > 0;\nn := n + 1;\n"
         "Y0 := b;\nEND_PROGRAM\n", encoding="utf-8")
     (tmp_path / "s.toml").write_text(
-        'sources = ["Main.st"]\nprogram = "Main"\nduration = "1s"\n'
+        f'sources = [{json.dumps(source)}]\nprogram = "Main"\nduration = "1s"\n'
         '[[inputs]]\nat = "100ms"\nset = { b = true }\n[[expect]]\nthat = "Y0"\n', encoding="utf-8")
     monkeypatch.chdir(tmp_path)
     result = invoke("--scenario", "s.toml", "--json", "r.json")
     (run,) = json.loads((tmp_path / "r.json").read_text())["scenarios"]
-    notes = [note for note in run["notes"] if "does nothing" in note]
-    assert notes == ["s.toml:6:9: inputs[0].set: b = true does nothing: the program overwrites b in every scan "
-                     "before reading it, at Main.st:7:1 (b := n > 0;)"], result.output
+    return [note for note in run["notes"] if "does nothing" in note], result.output
 
 
 def _load_error(*diagnostics):
@@ -631,18 +637,9 @@ def test_the_overwritten_input_note_shows_a_source_named_with_a_newline_on_its_l
     """The note's 'at file:line:col' was built by hand from the span's raw file name, so a
     source named `Ma<LF>in.st` broke the note into two lines where every other message shows
     the name escaped (textfile.shown_name, `Ma\\x0ain.st`)."""
-    (tmp_path / "Ma\nin.st").write_text(
-        "PROGRAM Main\nVAR\n    b : BOOL;\n    n : INT;\nEND_VAR\nb := n > 0;\nn := n + 1;\nY0 := b;\nEND_PROGRAM\n",
-        encoding="utf-8")
-    (tmp_path / "s.toml").write_text(
-        'sources = ["Ma\\nin.st"]\nprogram = "Main"\nduration = "1s"\n'
-        '[[inputs]]\nat = "100ms"\nset = { b = true }\n[[expect]]\nthat = "Y0"\n', encoding="utf-8")
-    monkeypatch.chdir(tmp_path)
-    result = invoke("--scenario", "s.toml", "--json", "r.json")
-    (run,) = json.loads((tmp_path / "r.json").read_text())["scenarios"]
-    notes = [note for note in run["notes"] if "does nothing" in note]
+    notes, output = _does_nothing_notes(tmp_path, monkeypatch, "Ma\nin.st")
     assert notes == ["s.toml:6:9: inputs[0].set: b = true does nothing: the program overwrites b in every scan "
-                     "before reading it, at Ma\\x0ain.st:6:1 (b := n > 0;)"], result.output
+                     "before reading it, at Ma\\x0ain.st:6:1 (b := n > 0;)"], output
 
 
 def test_the_cpu_note_shows_a_source_named_with_a_newline_on_its_line(tmp_path, monkeypatch):
