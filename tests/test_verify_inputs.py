@@ -651,3 +651,14 @@ def test_the_cpu_note_shows_a_source_named_with_a_newline_on_its_line(tmp_path, 
     result = invoke("Ma\nin.st", "--platform", "q", "--duration", "1s")
     assert "    note: Ma\\x0ain.st:2:4: M8002 is an ordinary internal relay on the q" in result.output, result.output
     assert "\nin.st:2:4" not in result.output
+
+
+def test_a_place_in_st_is_relative_in_a_folder_whose_name_holds_a_colon(tmp_path, monkeypatch):
+    """runner._relative split 'file:line:col' at the first ':', so in a working folder named
+    'x:y' (and on Windows, 'C:\\...', in every one) the note kept the ST file's absolute path
+    where it names it relative to the working folder: 'at /tmp/.../x:y/Main.st:6:1'."""
+    folder = tmp_path / "x:y"
+    folder.mkdir()
+    notes, output = _does_nothing_notes(folder, monkeypatch, "Main.st")
+    assert notes == ["s.toml:6:9: inputs[0].set: b = true does nothing: the program overwrites b in every scan "
+                     "before reading it, at Main.st:6:1 (b := n > 0;)"], output
