@@ -123,3 +123,18 @@ END_PROGRAM
     diags = _check(text)
     assert [(d.line, d.col, d.severity) for d in diags] == [(10, 1, "warning")], [str(d) for d in diags]
     assert "FB instance 'fbTmr' is called a second time in every scan (first at 8:1)" in diags[0].message
+    # FALSE to an input that does not start the work (an option) is a second use all the same
+    option = """\
+PROGRAM Station
+VAR
+    fbSpeed : UITAMR_SetSpeed;
+    uMbx : ARRAY[0..15] OF WORD;
+    bSlow : BOOL;
+    bFast : BOOL;
+END_VAR
+fbSpeed(i_bEN := TRUE, i_bExecute := bSlow, i_bMagnetic := FALSE, i_wStage := 1, io_uMbx := uMbx);
+fbSpeed(i_bEN := TRUE, i_bExecute := bFast, i_bMagnetic := FALSE, i_wStage := 3, io_uMbx := uMbx);
+END_PROGRAM
+"""
+    diags = _check(option, ROOT / "plc" / "core")
+    assert [(d.line, d.col) for d in diags] == [(9, 1)], [str(d) for d in diags]

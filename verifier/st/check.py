@@ -117,11 +117,17 @@ def type_letters_problem(name: str, t: T.Type, target: str = "gxworks2") -> str 
             f"FB-library label names (docs/plc-library.md){rename}")
 
 
+#: the inputs that start an FB's work (IEC timers' IN, an EN, the FB library's i_bEN and
+#: i_bExecute): given FALSE, the call resets the instance
+_START_INPUTS = {"IN", "EN", "EXECUTE", "I_BEN", "I_BEXECUTE"}
+
+
 def _resets(call: ast.Call) -> bool:
-    """Whether an FB call gives one of its inputs the constant FALSE (`fbTmr(IN := FALSE)`,
-    `fbCmd(i_bExecute := FALSE)`): a reset before the instance's next call, not a use."""
-    return any(not a.output and isinstance(a.value, ast.BoolLiteral) and a.value.value is False
-               for a in call.args)
+    """Whether an FB call gives the input that starts its work the constant FALSE
+    (`fbTmr(IN := FALSE)`, `fbCmd(i_bEN := TRUE, i_bExecute := FALSE)`): a reset before the
+    instance's next call, not a use. FALSE to another input (an option) is a use."""
+    return any(not a.output and a.name is not None and a.name.upper() in _START_INPUTS
+               and isinstance(a.value, ast.BoolLiteral) and a.value.value is False for a in call.args)
 
 
 @functools.lru_cache(maxsize=8192)
@@ -443,7 +449,7 @@ class Checker:
         so a command FB started by the second call ignores the first's rising edges, and what
         the program reads from it after the second call is the second use's. (Calls in
         different branches may be one a scan, and are not judged.) A call right after a
-        reset call of the same instance, one giving an input the constant FALSE
+        reset call of the same instance, one giving IN, EN, i_bEN or i_bExecute FALSE
         (`fbTmr(IN := FALSE); fbTmr(IN := bRun, PT := T#1s);`, the IEC idiom that restarts
         a timer or re-arms an execute edge in one scan), is that one use, and not judged."""
         first: dict[str, ast.CallStmt] = {}
