@@ -100,3 +100,41 @@ def test_the_letters_check_judges_are_the_ones_the_library_page_lists():
     text = " ".join((ROOT / "docs" / "plc-library.md").read_text(encoding="utf-8").split())
     listed = re.search(r"\(`i_`/`o_`/`io_` \+ type letters: (.*?)\) and GX Works' naming rules", text).group(1)
     assert dict(item.split(" ", 1) for item in listed.split(", ")) == TYPE_LETTERS
+
+
+def test_a_reset_call_before_the_use_of_the_same_instance_is_not_warned():
+    """`fbTmr(IN := FALSE); fbTmr(IN := bRun, PT := T#1s);` restarts a timer in one scan (the
+    IEC idiom; the same with i_bExecute := FALSE re-arms a command FB's edge): one use, not
+    two, and the warning's advice (a second instance) would break the restart. A third
+    call after the use is still a second use, named at the use after the reset."""
+    text = """\
+PROGRAM Station
+VAR
+    fbTmr : TON;
+    bRun : BOOL;
+    bOther : BOOL;
+END_VAR
+fbTmr(IN := FALSE, PT := T#1s);
+fbTmr(IN := bRun, PT := T#1s);
+bOther := fbTmr.Q;
+fbTmr(IN := bOther, PT := T#2s);
+END_PROGRAM
+"""
+    diags = _check(text)
+    assert [(d.line, d.col, d.severity) for d in diags] == [(10, 1, "warning")], [str(d) for d in diags]
+    assert "FB instance 'fbTmr' is called a second time in every scan (first at 8:1)" in diags[0].message
+    # FALSE to an input that does not start the work (an option) is a second use all the same
+    option = """\
+PROGRAM Station
+VAR
+    fbSpeed : UITAMR_SetSpeed;
+    uMbx : ARRAY[0..15] OF WORD;
+    bSlow : BOOL;
+    bFast : BOOL;
+END_VAR
+fbSpeed(i_bEN := TRUE, i_bExecute := bSlow, i_bMagnetic := FALSE, i_wStage := 1, io_uMbx := uMbx);
+fbSpeed(i_bEN := TRUE, i_bExecute := bFast, i_bMagnetic := FALSE, i_wStage := 3, io_uMbx := uMbx);
+END_PROGRAM
+"""
+    diags = _check(option, ROOT / "plc" / "core")
+    assert [(d.line, d.col) for d in diags] == [(9, 1)], [str(d) for d in diags]

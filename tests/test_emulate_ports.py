@@ -917,3 +917,19 @@ def test_the_same_command_sent_again_soon_after_a_late_reply_is_answered_not_tak
         assert port.read(8) == STOP_FRAME, "\n".join(emulator.lines)
     code, summary = emulator.stop()
     assert code == 0 and "2 frames in, 2 replies out, 0 unanswered" in summary, "\n".join(emulator.lines)
+
+
+def test_a_port_error_raised_while_handling_one_without_words_is_no_traceback():
+    """why_not_opened read the first argument of the error pyserial raised its own from
+    (termios.error(25, ...) for a file that is no serial port) as `args[0]`: an error raised
+    while handling one with no arguments (KeyError(), NotImplementedError()) ended emulate and
+    monitor in an IndexError traceback instead of pyserial's words."""
+    from verifier.serialports import why_not_opened
+
+    try:
+        try:
+            raise NotImplementedError()
+        except NotImplementedError:
+            raise serial.SerialException("could not open port /dev/ttyS9: no custom baud rate")
+    except serial.SerialException as err:
+        assert why_not_opened(err) == "could not open port /dev/ttyS9: no custom baud rate"

@@ -1710,6 +1710,14 @@ def test_replay_of_a_serial_port_points_to_the_monitor():
             f"capture; `uitamr monitor --serial {port}` listens on it") in done.stderr, done.stderr
 
 
+def test_a_capture_named_with_a_newline_keeps_its_end_line_message_on_one_line():
+    """The `end` line's message named the file a second time by hand, the raw name: a capture
+    named `t<LF>c.txt` broke it into two lines though its place (Place) showed the name escaped."""
+    with pytest.raises(CaptureError) as caught:
+        parse_plain("0.1 01\n0.2 end\n 0.3 02\n", "t\nc.txt")
+    assert str(caught.value).startswith("t\\x0ac.txt:3:2: the capture ended at its `end` line (t\\x0ac.txt:2)")
+
+
 def test_a_converter_that_resets_the_stream_is_said_with_what_to_check(tmp_path):
     """`monitor --tcp` to a converter that reset its connection (restarted, lost power, dropped
     this client: a TCP RST) ended with the socket's own words, '...: Connection reset by

@@ -395,3 +395,82 @@ def test_ladder_error_id_is_the_code_of_the_fault_it_shows(tmp_path, program):
     tx = [f for f in result.trace if f.direction == "tx"]
     assert len({f.data for f in tx if 8_000_000 < f.t_start_us < 15_000_000}) < len(
         [f for f in tx if 8_000_000 < f.t_start_us < 15_000_000]), "no retry was exercised"
+
+
+def test_the_regeneration_command_keeps_a_link_and_the_file_s_mode(tmp_path, monkeypatch):
+    """`-o X.csv` renamed its temporary file over X.csv: a link X.csv (to the CSV kept in the
+    project folder) became a file of its own and the project's CSV stayed old, where the
+    shell's `> X.csv` writes through the link. And it set the mode with os.chmod on a file
+    descriptor, which Windows' Python before 3.13 refuses (TypeError: a traceback, the
+    temporary file left open): here os.chmod refuses descriptors as it does there."""
+    import os
+    import stat
+
+    from verifier.export import ladder
+
+    real_chmod = os.chmod
+
+    def chmod_without_descriptors(path, mode, *args, **kwargs):
+        if isinstance(path, int):
+            raise TypeError("chmod: path should be string, bytes or os.PathLike, not int")
+        return real_chmod(path, mode, *args, **kwargs)
+
+    monkeypatch.setattr(os, "chmod", chmod_without_descriptors)
+    kept = tmp_path / "project" / "UITAMR_LadderFx3.csv"
+    kept.parent.mkdir()
+    kept.write_bytes(b"the previous CSV\r\n")
+    real_chmod(kept, 0o640)
+    link = tmp_path / "out.csv"
+    link.symlink_to(kept)
+    assert ladder.main([str(IL), "-o", str(link)]) == 0
+    assert link.is_symlink() and kept.read_bytes() == (LADDER / "UITAMR_LadderFx3.csv").read_bytes()
+    assert stat.S_IMODE(kept.stat().st_mode) == 0o640
+    assert sorted(p.name for p in kept.parent.iterdir()) == ["UITAMR_LadderFx3.csv"]  # no temporary file left
+
+
+def test_an_il_named_with_a_newline_keeps_its_mistakes_on_one_line():
+    """The converter's mistakes built 'file:line:col' by hand from the raw name: `b<LF>ad.il`
+    broke each into two lines, where every other message shows the name escaped (Place)."""
+    for text, message in (("LD X0\nOUTT Y0\nEND\n", "b\\x0aad.il:2:1: 'OUTT' is not an instruction"),
+                          ("LD X0 X1\nEND\n", "b\\x0aad.il:1:1: LD takes 1 operand(s)"),
+                          ("LD X0\n", "b\\x0aad.il: the program must end with END")):
+        with pytest.raises(IlError) as caught:
+            parse_il(text, "b\nad.il")
+        assert str(caught.value).startswith(message), str(caught.value)
+
+
+def test_the_regeneration_command_s_own_messages_keep_a_name_with_a_newline_on_one_line(tmp_path, capsys):
+    """The command's messages about its files (a .il that cannot be read, a CSV that cannot be
+    written, -o naming the .il) printed the raw name: `b<LF>ad.il` broke each in two."""
+    from verifier.export import ladder
+
+    missing = tmp_path / "b\nad.il"
+    assert ladder.main([str(missing)]) == 1
+    assert capsys.readouterr().err.startswith(f"{tmp_path}/b\\x0aad.il: ")
+    assert ladder.main([str(IL), "-o", str(tmp_path / "no\nfolder" / "x.csv")]) == 2
+    assert capsys.readouterr().err.startswith(f"{tmp_path}/no\\x0afolder/x.csv: cannot write: ")
+    il = tmp_path / "c\nd.il"
+    il.write_text("END\n", encoding="utf-8")
+    assert ladder.main([str(il), "-o", str(il)]) == 2
+    assert capsys.readouterr().err == f"{tmp_path}/c\\x0ad.il: is the .il itself: name the .csv to write (-o {tmp_path}/c\\x0ad.csv)\n"
+
+
+def test_the_regeneration_command_writes_into_a_pipe_and_leaves_it_one(tmp_path):
+    """`-o` renamed its temporary file over whatever the path named: `-o` a pipe (or, run as
+    root, `-o /dev/null`) replaced it with a regular file. A pipe or a device is now written
+    to, as `> FILE` writes to it."""
+    import os
+    import stat
+    import threading
+
+    from verifier.export import ladder
+
+    pipe = tmp_path / "csv.pipe"
+    os.mkfifo(pipe)
+    received = []
+    reader = threading.Thread(target=lambda: received.append(pipe.read_bytes()), daemon=True)
+    reader.start()
+    assert ladder.main([str(IL), "-o", str(pipe)]) == 0
+    assert stat.S_ISFIFO(pipe.stat().st_mode)  # (replaced, the reader waits on a pipe no one opens)
+    reader.join(10)
+    assert received == [(LADDER / "UITAMR_LadderFx3.csv").read_bytes()]

@@ -578,18 +578,24 @@ def test_the_note_quotes_the_overwriting_statement_past_a_line_separator_in_a_co
     """A form feed or a Unicode line separator inside a comment is no new line for the ST
     parser (it counts line feeds, textfile.text_lines): the statement the note quotes is the
     one at the line it names, not the line after it (str.splitlines broke at them too)."""
-    (tmp_path / "Main.st").write_text(
-        f"PROGRAM Main\nVAR\n    b : BOOL;\n    n : INT;\nEND_VAR\n(* page{separator}break *)\nb := n > 0;\nn := n + 1;\n"
+    notes, output = _does_nothing_notes(tmp_path, monkeypatch, "Main.st", f"(* page{separator}break *)\n")
+    assert notes == ["s.toml:6:9: inputs[0].set: b = true does nothing: the program overwrites b in every scan "
+                     "before reading it, at Main.st:7:1 (b := n > 0;)"], output
+
+
+def _does_nothing_notes(tmp_path, monkeypatch, source: str, before: str = "") -> tuple[list[str], str]:
+    """The 'does nothing' notes (and the console) of a run that sets b, which the program
+    in `source` (`before` put ahead of its statements) overwrites before reading it."""
+    (tmp_path / source).write_text(
+        f"PROGRAM Main\nVAR\n    b : BOOL;\n    n : INT;\nEND_VAR\n{before}b := n > 0;\nn := n + 1;\n"
         "Y0 := b;\nEND_PROGRAM\n", encoding="utf-8")
     (tmp_path / "s.toml").write_text(
-        'sources = ["Main.st"]\nprogram = "Main"\nduration = "1s"\n'
+        f'sources = [{json.dumps(source)}]\nprogram = "Main"\nduration = "1s"\n'
         '[[inputs]]\nat = "100ms"\nset = { b = true }\n[[expect]]\nthat = "Y0"\n', encoding="utf-8")
     monkeypatch.chdir(tmp_path)
     result = invoke("--scenario", "s.toml", "--json", "r.json")
     (run,) = json.loads((tmp_path / "r.json").read_text())["scenarios"]
-    notes = [note for note in run["notes"] if "does nothing" in note]
-    assert notes == ["s.toml:6:9: inputs[0].set: b = true does nothing: the program overwrites b in every scan "
-                     "before reading it, at Main.st:7:1 (b := n > 0;)"], result.output
+    return [note for note in run["notes"] if "does nothing" in note], result.output
 
 
 def _load_error(*diagnostics):
@@ -625,3 +631,34 @@ def test_a_warning_before_the_errors_is_still_the_one_compared(monkeypatch):
         platform_module.infer_platform((Path("M.st"),))
     assert str(raised.value) == "the sources do not load: M.st:5:6: error: a"
     assert str(raised.value.place) == "M.st:5:6"
+
+
+def test_the_overwritten_input_note_shows_a_source_named_with_a_newline_on_its_line(tmp_path, monkeypatch):
+    """The note's 'at file:line:col' was built by hand from the span's raw file name, so a
+    source named `Ma<LF>in.st` broke the note into two lines where every other message shows
+    the name escaped (textfile.shown_name, `Ma\\x0ain.st`)."""
+    notes, output = _does_nothing_notes(tmp_path, monkeypatch, "Ma\nin.st")
+    assert notes == ["s.toml:6:9: inputs[0].set: b = true does nothing: the program overwrites b in every scan "
+                     "before reading it, at Ma\\x0ain.st:6:1 (b := n > 0;)"], output
+
+
+def test_the_cpu_note_shows_a_source_named_with_a_newline_on_its_line(tmp_path, monkeypatch):
+    """The run's CPU notes (M8002 on a Q) built their 'file:line:col' by hand from the raw
+    file name: a source named `Ma<LF>in.st` broke the note into two lines."""
+    (tmp_path / "Ma\nin.st").write_text("PROGRAM MAIN\nIF M8002 THEN\n    Y0 := TRUE;\nEND_IF;\nEND_PROGRAM\n",
+                                        encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    result = invoke("Ma\nin.st", "--platform", "q", "--duration", "1s")
+    assert "    note: Ma\\x0ain.st:2:4: M8002 is an ordinary internal relay on the q" in result.output, result.output
+    assert "\nin.st:2:4" not in result.output
+
+
+def test_a_place_in_st_is_relative_in_a_folder_whose_name_holds_a_colon(tmp_path, monkeypatch):
+    """runner._relative split 'file:line:col' at the first ':', so in a working folder named
+    'x:y' (and on Windows, 'C:\\...', in every one) the note kept the ST file's absolute path
+    where it names it relative to the working folder: 'at /tmp/.../x:y/Main.st:6:1'."""
+    folder = tmp_path / "x:y"
+    folder.mkdir()
+    notes, output = _does_nothing_notes(folder, monkeypatch, "Main.st")
+    assert notes == ["s.toml:6:9: inputs[0].set: b = true does nothing: the program overwrites b in every scan "
+                     "before reading it, at Main.st:6:1 (b := n > 0;)"], output

@@ -844,3 +844,20 @@ def test_an_unknown_robot_or_fault_key_is_pointed_at_by_its_name(tmp_path, text,
     with pytest.raises(FaultFileError) as caught:
         load_fault_file(bench)
     assert str(caught.value).startswith(str(tmp_path / place)), str(caught.value)
+
+
+def test_a_time_literal_broken_across_lines_is_named_as_one_with_a_space():
+    """`T#1h` at a line's end and `30m` on the next (a long ST line or a multi-line condition
+    wrapped inside the literal) got "'30m' is a duration without T#: a TIME literal is written
+    T#30m", advice that gives T#1h T#30m, another error; it is named as the one literal with a
+    blank inside, at its first character, in ST and in a condition alike."""
+    from verifier import st
+
+    source = st.parse("PROGRAM P\nVAR\n    tDelay : TIME;\nEND_VAR\nIF tDelay > T#1h\n    30m THEN\n"
+                      "    tDelay := T#0s;\nEND_IF;\nEND_PROGRAM\n", "p.st", "gxworks2")
+    assert [(d.line, d.col, d.message) for d in source.diagnostics] == [
+        (5, 13, "'T#1h\\n    30m': a TIME literal cannot hold a space: write T#1h30m")]
+    with pytest.raises(ConditionError) as info:
+        parse_condition("Y0 AND\n  n > T#1h\n  30m")
+    assert (info.value.column, info.value.message) == (
+        14, "'T#1h\\n  30m': a TIME literal cannot hold a space: write T#1h30m")

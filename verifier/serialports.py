@@ -44,7 +44,7 @@ def why_not_opened(err: Exception) -> str:
     if cause is not err and isinstance(cause, OSError):
         return why_not_connected(cause)
     number = getattr(err, "errno", None)
-    if number is None and getattr(err.__context__, "args", (None,))[0] == errno.ENOTTY:  # termios.error
+    if number is None and getattr(err.__context__, "args", ())[:1] == (errno.ENOTTY,):  # termios.error
         return ("not a serial port (a file or another kind of device): give the adapter's port, e.g. "
                 "/dev/ttyUSB0 or COM3")
     if "does not seem to support RFC2217" in str(err):  # pyserial's rfc2217:// after its negotiation failed

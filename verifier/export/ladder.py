@@ -18,7 +18,8 @@ from __future__ import annotations
 import sys
 from dataclasses import dataclass
 from pathlib import Path
-from verifier.textfile import UnreadableText, read_utf8, text_lines
+from verifier.place import Place
+from verifier.textfile import UnreadableText, read_utf8, shown_name, text_lines
 
 HEADER = ("Step Number", "Line Statement", "Instruction", "I/O(Device)", "Blank", "PI Statement", "Note")
 PLC_TYPE = "FX3U/FX3UC"
@@ -75,15 +76,15 @@ def parse_il(text: str, name: str = "<il>") -> list[Instruction]:
                 wanted = 2
         else:
             known = ", ".join(sorted(INSTRUCTIONS)) + ", LD=/AND=/OR= and the other comparisons"
-            raise IlError(f"{name}:{number}:{col}: '{op}' is not an instruction this converter "
+            raise IlError(f"{Place(name, number, col)}: '{op}' is not an instruction this converter "
                           f"knows (it counts the steps of {known})")
         if len(operands) != wanted:
-            raise IlError(f"{name}:{number}:{col}: {upper} takes {wanted} operand(s), "
+            raise IlError(f"{Place(name, number, col)}: {upper} takes {wanted} operand(s), "
                           f"got {len(operands)}: '{line}'")
         program.append(Instruction(number, upper, tuple(operands), pending))
         pending = ""
     if not program or program[-1].op != "END":
-        raise IlError(f"{name}: the program must end with END")
+        raise IlError(f"{shown_name(name)}: the program must end with END")
     return program
 
 
@@ -128,13 +129,13 @@ def main(argv: list[str]) -> int:
     args = parser.parse_args(argv)  # a usage mistake: argparse's message, exit 2
     path = Path(args.il)
     if args.out is not None and Path(args.out).resolve() == path.resolve():
-        print(f"{args.out}: is the .il itself: name the .csv to write (-o {path.with_suffix('.csv')})",
-              file=sys.stderr)
+        csv_name = shown_name(str(path.with_suffix(".csv")))
+        print(f"{shown_name(args.out)}: is the .il itself: name the .csv to write (-o {csv_name})", file=sys.stderr)
         return 2
     try:
         text = read_utf8(path)
     except UnreadableText as e:
-        print(f"{path}: {e}", file=sys.stderr)
+        print(f"{shown_name(str(path))}: {e}", file=sys.stderr)
         return 1
     try:
         csv = to_csv(parse_il(text, str(path)), path.stem)
@@ -147,7 +148,7 @@ def main(argv: list[str]) -> int:
     try:
         _write_whole(Path(args.out), csv)
     except OSError as e:
-        print(f"{args.out}: cannot write: {e.strerror or e}", file=sys.stderr)
+        print(f"{shown_name(args.out)}: cannot write: {e.strerror or e}", file=sys.stderr)
         return 2
     return 0
 
@@ -155,21 +156,29 @@ def main(argv: list[str]) -> int:
 def _write_whole(out: Path, text: str) -> None:
     """`text` into `out` at once: written beside it under a temporary name, then renamed over
     it, so that `out` is the old file or the new one, never a part (the temporary file is
-    removed when writing fails)."""
+    removed when writing fails). A symbolic link is written through to its target, and a
+    pipe or a device is written to, as the shell's `> X.csv` did; the mode is set by path
+    once the file is closed (Windows' os.chmod takes no file descriptor before 3.13)."""
     import os
     import tempfile
 
+    if out.is_symlink():
+        out = Path(os.path.realpath(out))
+    if out.exists() and not out.is_file():  # a pipe, a device (/dev/stdout): not replaced by a file
+        with open(out, "w", encoding="utf-8", newline="") as f:
+            f.write(text)
+        return
     fd, temporary = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
     try:
+        with open(fd, "w", encoding="utf-8", newline="") as f:
+            f.write(text)
         try:  # the file's own mode, else a new file's (mkstemp's 0600 would hide it from others)
             mode = out.stat().st_mode & 0o7777
         except OSError:
             umask = os.umask(0)
             os.umask(umask)
             mode = 0o666 & ~umask
-        os.chmod(fd, mode)
-        with open(fd, "w", encoding="utf-8", newline="") as f:
-            f.write(text)
+        os.chmod(temporary, mode)
         os.replace(temporary, out)
     except BaseException:
         Path(temporary).unlink(missing_ok=True)

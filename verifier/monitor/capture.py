@@ -30,7 +30,7 @@ from verifier import protocol
 from verifier.amr.schema import LARGEST  # the largest number of seconds any setting holds
 from verifier.digits import describe, foreign_digit
 from verifier.place import Place
-from verifier.textfile import UnreadableText, lone_cr_as_line_feed, read_utf8, text_lines
+from verifier.textfile import UnreadableText, lone_cr_as_line_feed, read_utf8, shown_name, text_lines
 from verifier.verify.conditions import ConditionError, parse_condition
 from verifier.verify.report_trace import RUN_SETTINGS
 from verifier.verify.result import RULE_EVENTS, LineEvent
@@ -97,7 +97,7 @@ def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
             continue
         if end_line is not None:
             col = len(line) - len(line.lstrip()) + 1
-            raise CaptureError(Place(name, number, col), f"the capture ended at its `end` line ({name}:{end_line}); "
+            raise CaptureError(Place(name, number, col), f"the capture ended at its `end` line ({shown_name(name)}:{end_line}); "
                                "move this line before it, or remove the `end` line")
         foreign = foreign_digit(line)  # float() reads '٠.٥' as 0.5
         if foreign is not None:

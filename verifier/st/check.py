@@ -117,6 +117,19 @@ def type_letters_problem(name: str, t: T.Type, target: str = "gxworks2") -> str 
             f"FB-library label names (docs/plc-library.md){rename}")
 
 
+#: the inputs that start an FB's work (IEC timers' IN, an EN, the FB library's i_bEN and
+#: i_bExecute): given FALSE, the call resets the instance
+_START_INPUTS = {"IN", "EN", "EXECUTE", "I_BEN", "I_BEXECUTE"}
+
+
+def _resets(call: ast.Call) -> bool:
+    """Whether an FB call gives the input that starts its work the constant FALSE
+    (`fbTmr(IN := FALSE)`, `fbCmd(i_bEN := TRUE, i_bExecute := FALSE)`): a reset before the
+    instance's next call, not a use. FALSE to another input (an option) is a use."""
+    return any(not a.output and a.name is not None and a.name.upper() in _START_INPUTS
+               and isinstance(a.value, ast.BoolLiteral) and a.value.value is False for a in call.args)
+
+
 @functools.lru_cache(maxsize=8192)
 def label_name_problem(name: str, families: tuple[str, ...] = ()) -> str | None:
     """Why GX Works refuses `name` as a label, or None. Rules: docs/st-dialect.md §4.
@@ -435,8 +448,12 @@ class Checker:
         memory: the second call sees the first one's edge memories and overwrites its outputs,
         so a command FB started by the second call ignores the first's rising edges, and what
         the program reads from it after the second call is the second use's. (Calls in
-        different branches may be one a scan, and are not judged.)"""
+        different branches may be one a scan, and are not judged.) A call right after a
+        reset call of the same instance, one giving IN, EN, i_bEN or i_bExecute FALSE
+        (`fbTmr(IN := FALSE); fbTmr(IN := bRun, PT := T#1s);`, the IEC idiom that restarts
+        a timer or re-arms an execute edge in one scan), is that one use, and not judged."""
         first: dict[str, ast.CallStmt] = {}
+        last: dict[str, ast.CallStmt] = {}
         for s in info.pou.body:
             if not isinstance(s, ast.CallStmt) or not isinstance(s.call.callee, ast.Name):
                 continue
@@ -444,8 +461,13 @@ class Checker:
             if getattr(target, "kind", None) != "fb":
                 continue
             key = s.call.callee.name.upper()
+            previous = last.get(key)
+            last[key] = s
             if key not in first:
                 first[key] = s
+                continue
+            if _resets(previous.call):
+                first[key] = s  # the use a later second call overwrites
                 continue
             earlier = first[key].span
             name = s.call.callee.name

@@ -135,9 +135,10 @@ _HASH_WORD = re.compile(r"(?<![A-Za-z0-9_#.])([A-Za-z_][A-Za-z0-9_]*)#[-+0-9A-Za
 #: and scenario conditions alike ('#' escaped, so that a verbose pattern takes it too)
 TIME_LITERAL = r"(?:TIME|T)\#-?(?:[0-9][0-9_]*(?:\.[0-9]+)?(?:ms|d|h|m|s)_?)+"
 _TIME_WORD = re.compile(TIME_LITERAL, re.IGNORECASE)
-#: a TIME literal with blanks between its parts (T#1h 30m, T#5 s): read as T#1h and a word
-#: '30m', which was "a name must not start with a digit"
-_SPACED_TIME = re.compile(r"(?<![A-Za-z0-9_#.])(?:TIME|T)#[ \t]*-?(?:[ \t]*[0-9][0-9_]*(?:\.[0-9]+)?[ \t]*"
+#: a TIME literal with blanks between its parts (T#1h 30m, T#5 s, T#1h at a line's end and
+#: 30m on the next): read as T#1h and a word '30m', which was "a name must not start with a
+#: digit" (and, across lines, "'30m' is a duration without T#")
+_SPACED_TIME = re.compile(r"(?<![A-Za-z0-9_#.])(?:TIME|T)#\s*-?(?:\s*[0-9][0-9_]*(?:\.[0-9]+)?\s*"
                           r"(?:ms|d|h|m|s)(?![A-Za-z])_?)+", re.IGNORECASE)
 
 
@@ -148,11 +149,11 @@ def spaced_time_literal(text: str, pos: int = -1) -> tuple[int, str] | None:
     scenario conditions alike."""
     for m in _SPACED_TIME.finditer(text):
         word = m.group()
-        if pos >= 0 and m.end() <= pos or not any(c in word for c in " \t"):
+        if pos >= 0 and m.end() <= pos or not any(c.isspace() for c in word):
             continue
         if pos >= 0 and m.start() > pos:
             return None
-        fixed = re.sub(r"[ \t]+", "", word)
+        fixed = re.sub(r"\s+", "", word)
         if _TIME_WORD.fullmatch(fixed):
             return m.start(), f"{word!r}: a TIME literal cannot hold a space: write {fixed}"
     return None

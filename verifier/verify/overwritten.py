@@ -316,7 +316,7 @@ def overwritten_input_notes(scenario, files: list[ast.SourceFile], program: str,
             snippet = _snippet(texts.get(span.file, ""), span)
             shown = "true" if value is True else "false" if value is False else str(value)
             note = (f"{where}: {name} = {shown} does nothing: the program overwrites {name} in every scan before "
-                    f"reading it, at {relative(f'{span.file}:{span.line}:{span.col}', cwd)}")
+                    f"reading it, at {relative(str(span), cwd)}")
             if snippet:
                 note += f" ({snippet})"
             source = _source(found, files, program, texts)

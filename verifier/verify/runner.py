@@ -100,7 +100,7 @@ class _Plc:
             from verifier.sim.cpucheck import cpu_diagnostics
 
             found = cpu_diagnostics(project.files, project.cpu, pous=set(project.module.pous))
-            notes = [f"{_relative(f'{d.file}:{d.line}:{d.col}', cwd)}: {d.message}" for d in found if not d.is_error]
+            notes = [f"{_relative(str(Place(d.file, d.line, d.col)), cwd)}: {d.message}" for d in found if not d.is_error]
             if len(_CPU_NOTES) >= _CPU_NOTES_MAX:
                 del _CPU_NOTES[next(iter(_CPU_NOTES))]
             cached = _CPU_NOTES[key] = (project.files, notes)  # the files kept alive: their id is not reused
@@ -323,15 +323,19 @@ def _display_path(path: Path | None) -> str | None:
 
 @lru_cache(maxsize=1024)
 def _relative(origin: str | None, cwd: str) -> str | None:
-    """An ST location "file:line:col" with the file relative to the working folder `cwd`
-    when inside it, by the path the sources reached it (a toolkit vendored by a symlink
-    shows as vendor/uitamr/plc/..., not where the link leads; textfile.shown_path).
+    """An ST location "file:line:col" (the file's name may hold a ':', as a Windows path's
+    drive does) with the file relative to the working folder `cwd` when inside it, by the
+    path the sources reached it (a toolkit vendored by a symlink shows as
+    vendor/uitamr/plc/..., not where the link leads; textfile.shown_path).
     Worked out once per location: every frame of a long run names the ST line that sent
     it, and the frames then share one string."""
     if not origin:
         return origin
-    file, _, rest = origin.partition(":")
-    return f"{shown_path(file, cwd)}:{rest}"
+    file, _, place = origin.rpartition(":")  # the file's name may hold ':' (Windows: C:\...)
+    file, _, line = file.rpartition(":")
+    if not (file and line.isdigit() and place.isdigit()):
+        return origin
+    return f"{shown_path(file, cwd)}:{line}:{place}"
 
 
 def _trace_records(frames: list, end_us: int) -> list[TraceRecord]:
