@@ -1432,6 +1432,30 @@ def test_every_bad_scenario_file_is_named_in_one_run(tmp_path):
     assert "Traceback" not in done.stderr and done.stdout == ""
 
 
+@pytest.mark.parametrize("jobs", ["1", "2"])
+def test_every_scenario_naming_a_missing_label_is_named_in_one_run(tmp_path, jobs):
+    """Scenario files that read well but name labels the program does not have: each found
+    when its run is set up, and verify stopped at the first one, leaving the next for the
+    next run (journey32b, a folder of an integrator's scenarios). Every one is now named in
+    one run, each at its place, serially and across --jobs workers; the good one among
+    them is not reported."""
+    text = (PLC / "scenarios" / "fx3u-healthy.toml").read_text(encoding="utf-8").replace('"../', f'"{PLC}/')
+    good = text.replace('duration = "60s"', 'duration = "3s"')
+    assert good != text
+    files = []
+    for name, wrong in (("a", "fbEngin.o_bErr"), ("b", ""), ("c", "fbCycl.o_bErr")):
+        path = tmp_path / f"{name}.toml"
+        path.write_text(good.replace("fbEngine.o_bErr OR", f"{wrong} OR") if wrong else good, encoding="utf-8")
+        files += ["--scenario", path]
+    done = _run_cli(*files, "--jobs", jobs)
+    assert done.returncode == 2, done.stderr
+    errors = [line for line in done.stderr.splitlines() if line.startswith("error: ")]
+    assert [line.split(": ")[1] for line in errors] == [f"{tmp_path / 'a.toml'}:36:10", f"{tmp_path / 'c.toml'}:36:10"], \
+        done.stderr
+    assert "'fbEngin.o_bErr'" in errors[0] and "'fbCycl.o_bErr'" in errors[1]
+    assert "Traceback" not in done.stderr and done.stdout == ""
+
+
 def test_every_scenario_file_without_sources_is_named_in_one_run(tmp_path):
     """Two scenario files that name no ST sources (none given as arguments either): both
     named, each its own error line (verify named only the first and left the second for

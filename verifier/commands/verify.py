@@ -9,6 +9,7 @@ import signal
 import sys
 import time
 from contextlib import contextmanager
+from itertools import accumulate
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import replace
@@ -385,9 +386,43 @@ def _source_files(sources) -> tuple[Path, ...]:
 
 
 def _run_batch(batch: list[Scenario], every_scan: bool, keep: Keep) -> list[ScenarioResult]:
-    from verifier.verify.runner import run_scenario
+    return _run_each(batch, every_scan, keep)
 
-    return [run_scenario(scenario, plain=every_scan, keep=keep) for scenario in batch]
+
+def _run_each(scenarios: list[Scenario], every_scan: bool, keep: Keep, progress_of=None) -> list[ScenarioResult]:
+    """Each scenario run in turn (`progress_of(position)`: the run's progress callback).
+    Once one cannot run (a label it names that the program does not have), the others are
+    only set up, and the mistakes of all of them are raised together: one at a time, a
+    folder of scenarios took a run per mistake to clean up (as _read_scenarios says of the
+    files' own mistakes)."""
+    from verifier.verify.runner import run_scenario, scenario_mistake
+
+    results, mistakes = [], []
+    for position, scenario in enumerate(scenarios):
+        if mistakes:
+            mistakes.append(scenario_mistake(scenario))
+            continue
+        try:
+            results.append(run_scenario(scenario, progress_of(position) if progress_of else None,
+                                        plain=every_scan, keep=keep))
+        except (ScenarioError, UnusableInput) as exc:
+            mistakes.append(exc)
+    _raise_together(mistakes)
+    return results
+
+
+def _raise_together(mistakes: list[Exception | None]) -> None:
+    """Raise the mistakes found (None: a scenario without one), one as it is, several as
+    ScenarioMistakes; the same mistake twice (scenarios of the same sources that do not
+    load) said once."""
+    found = []
+    for mistake in mistakes:
+        if mistake is not None and all(str(mistake) != str(seen) for seen in found):
+            found.append(mistake)
+    if len(found) == 1:
+        raise found[0]
+    if found:
+        raise ScenarioMistakes(found)
 
 
 def _worker_started() -> None:
@@ -472,7 +507,7 @@ class _LazyProgress:
 
 def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress,
              every_scan: bool = False, keep: Keep = KEEP_ALL) -> list[ScenarioResult]:
-    from verifier.verify.runner import run_scenario
+    from verifier.verify.runner import scenario_mistake
 
     if jobs > 1 and len(scenarios) > 1:
         results: list[ScenarioResult | None] = [None] * len(scenarios)
@@ -480,12 +515,22 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress,
         batches = _batches(scenarios, jobs)
         # a worker per batch at most: the pool forks all its workers at once, and --jobs 5000
         # forked 5000 processes for two scenarios (the run never ended)
+        mistakes: dict[int, Exception | None] = {}  # by the scenario's index: said in the scenarios' order
         with ProcessPoolExecutor(max_workers=min(jobs, len(batches)), initializer=_worker_started) as pool:
             futures = {pool.submit(_run_batch, [scenarios[i] for i in batch], every_scan, keep): batch
                        for batch in batches}
             try:
                 for future in as_completed(futures):
-                    for index, result in zip(futures[future], future.result()):
+                    if future.cancelled():
+                        continue
+                    try:
+                        batch_results = future.result()
+                    except (ScenarioError, UnusableInput) as exc:
+                        mistakes[futures[future][0]] = exc
+                        for other in futures:  # the batches not started: only set up, below
+                            other.cancel()
+                        continue
+                    for index, result in zip(futures[future], batch_results):
                         results[index] = result
                         done += scenarios[index].duration_us
                     progress.update(done, f"{sum(r is not None for r in results)}/{len(scenarios)} scenarios")
@@ -496,15 +541,19 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress,
                 for future in futures:
                     future.cancel()  # the batches not started yet: the command is ending
                 raise
+        if mistakes:
+            for future, batch in futures.items():
+                if future.cancelled():
+                    mistakes.update((i, scenario_mistake(scenarios[i])) for i in batch)
+            _raise_together([mistakes[i] for i in sorted(mistakes)])
         return [r for r in results if r is not None]
-    results = []
-    offset = 0
-    for position, scenario in enumerate(scenarios):
-        label = f"[{position + 1}/{len(scenarios)}] {scenario.name}"
-        results.append(run_scenario(scenario, lambda now, end, o=offset, l=label: progress.update(o + now, l),
-                                    plain=every_scan, keep=keep))
-        offset += scenario.duration_us
-    return results
+    offsets = [0, *accumulate(s.duration_us for s in scenarios)]
+
+    def progress_of(position: int):
+        label = f"[{position + 1}/{len(scenarios)}] {scenarios[position].name}"
+        return lambda now, end: progress.update(offsets[position] + now, label)
+
+    return _run_each(scenarios, every_scan, keep, progress_of)
 
 
 def _spool_folder(report_path: str, report: str) -> str:

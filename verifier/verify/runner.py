@@ -32,7 +32,8 @@ from .overwritten import overwritten_input_notes
 from .result import (KEEP_ALL, RULE_EVENTS, Keep, LineEvent, Mistake, ScenarioResult, TraceRecord, UnusableInput,
                      judged_with, summarize_diagnostics)
 from .rules import check_all
-from .scenario import BUFFER_MEMORY, DEFAULT_PLATFORM, DEVICE_NAME, Scenario, bundled_platform, scenario_power_on_stop
+from .scenario import (BUFFER_MEMORY, DEFAULT_PLATFORM, DEVICE_NAME, Scenario, ScenarioError, bundled_platform,
+                       scenario_power_on_stop)
 from .stream import Stream
 from .traffic import analyse, converter_drops
 
@@ -674,6 +675,34 @@ def _judge_whole(scenario: Scenario, trace: list[TraceRecord], end_us: int, even
     return check_all(evidence, traffic), [judge(expectation, evidence, traffic) for expectation in scenario.expectations]
 
 
+def _set_up(scenario: Scenario) -> tuple[Scenario, Robot, Line, Converter | None, _Plc]:
+    """The robot, the line (and the converter of the TCP route) and the PLC a run of
+    `scenario` scans, with the labels the scenario names checked against the program and its
+    PLC settings applied; ScenarioError/UnusableInput for input that cannot run."""
+    scenario = _expecting_something(scenario)
+    robot = Robot(scenario.settings, scenario.robot, list(scenario.faults))
+    line = Line(robot)
+    # the TCP route: the PLC talks to a converter, the rules judge the line behind it
+    converter = Converter(line, scenario.converter) if scenario.converter is not None else None
+    plc = _Plc(scenario, converter or line)
+    plc.project.keep_serial_log(False)  # the line records every frame: the trace below
+    scenario = _check_labels(plc, scenario)
+    _apply_plc_settings(plc, scenario)
+    return scenario, robot, line, converter, plc
+
+
+def scenario_mistake(scenario: Scenario) -> ScenarioError | UnusableInput | None:
+    """Why `scenario` cannot run (a label it names that the program does not have, ST that
+    does not load, ...), found by setting the run up without scanning; None when it can.
+    For saying the mistakes of every scenario of a command together once one of them has
+    one: the runs would be of no use then."""
+    try:
+        _set_up(scenario)
+    except (ScenarioError, UnusableInput) as exc:
+        return exc
+    return None
+
+
 def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain: bool = False,
                  keep: Keep = KEEP_ALL) -> ScenarioResult:
     """Run `scenario` to its end and judge it. UnusableInput for input that cannot run.
@@ -687,15 +716,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     watched labels by their names on each, recording them all: the reference the fast
     path is tested against (same result, byte for byte; `uitamr verify --every-scan`)."""
     wall_start = time.perf_counter()
-    scenario = _expecting_something(scenario)
-    robot = Robot(scenario.settings, scenario.robot, list(scenario.faults))
-    line = Line(robot)
-    # the TCP route: the PLC talks to a converter, the rules judge the line behind it
-    converter = Converter(line, scenario.converter) if scenario.converter is not None else None
-    plc = _Plc(scenario, converter or line)
-    plc.project.keep_serial_log(False)  # the line records every frame: the trace below
-    scenario = _check_labels(plc, scenario)
-    _apply_plc_settings(plc, scenario)
+    scenario, robot, line, converter, plc = _set_up(scenario)
     # every label the scenario names is read on each scan (a change marks the scan busy for
     # the idle check, which then need not compare the whole state); the watched ones are
     # recorded only when a report lists them
