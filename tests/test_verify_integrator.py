@@ -105,3 +105,22 @@ def test_a_q_run_without_timer_0_whose_replies_go_out_of_step_is_told_to_set_it(
     assert len(notes) == 1 and note in notes[0] and notes[0].startswith("QJ71C24N U0 CH1: 5 received byte(s) from "), \
         notes
     assert notes[0].endswith('in a scenario, [[c24]] no_reception = "5ms"')
+
+
+def test_a_button_on_the_c24s_read_request_signal_is_told(tmp_path):
+    """A Q station with its jog button wired to X3, the QJ71C24N's CH1 reception data read
+    request that the program also gives the port (i_bReadReq := X3): the jog was never
+    sent, and nothing said why (journey32b). A scenario input on one of the module's
+    reception signals now gets a note at its place; one on a free input (X20) none."""
+    text = (ROOT / "plc" / "scenarios" / "q-healthy.toml").read_text(encoding="utf-8")
+    text = text.replace('"../', f'"{(ROOT / "plc").as_posix()}/').replace('duration = "60s"', 'duration = "5s"')
+    free = tmp_path / "free.toml"
+    free.write_text(text, encoding="utf-8")
+    assert not [n for n in run_scenario(load_scenario(free)).notes if "QJ71C24N" in n]
+    on_signal = tmp_path / "x3.toml"
+    on_signal.write_text(text.replace("set = { X20 = true }", "set = { X20 = true, X3 = true }"), encoding="utf-8")
+    notes = [n for n in run_scenario(load_scenario(on_signal)).notes if "QJ71C24N" in n]
+    assert notes[0] == (f"{on_signal}:23:21: inputs[0].set: X3 is the CH1 reception data read request of the "
+                        "QJ71C24N at U0 that the program drives: the module turns it on and off itself, so a button "
+                        "or sensor wired there fights the module (and the program reads the module's signal); wire "
+                        "it to an X input that is not one of the module's signals"), notes

@@ -511,6 +511,35 @@ def _apply_plc_settings(plc: _Plc, scenario: Scenario) -> None:
 UNREAD_NOTE_US = 1_000_000  # a message unread this long at the end of the run is not being read
 
 
+def _c24_signal_inputs(scenario: Scenario, modules: list[int]) -> list[str]:
+    """A note for each `[[inputs]]` entry that sets one of the input signals of a QJ71C24N
+    the program drives (its reception data read request or reception abnormal detection,
+    X3/X4 and XA/XB from the module's start I/O): the module turns those on and off itself,
+    so a button wired there fights it (journey32b: a jog button on X3 beside the port's
+    i_bReadReq := X3, and the jog was never sent)."""
+    from verifier.sim.instructions.c24 import ABNORMAL, READ_REQUEST
+
+    signals = {}
+    for un in modules:
+        for channel in (1, 2):
+            signals[un * 16 + READ_REQUEST[channel]] = (un, f"CH{channel} reception data read request")
+            signals[un * 16 + ABNORMAL[channel]] = (un, f"CH{channel} reception abnormal detection")
+    notes = []
+    for step in scenario.inputs:
+        key = f"{step.key}.set"
+        for name in step.values:
+            number = re.fullmatch(r"[Xx]([0-9A-Fa-f]+)", name)
+            if number is None or int(number.group(1), 16) not in signals:
+                continue
+            un, what = signals[int(number.group(1), 16)]
+            where = scenario.where(key, scenario.key_lines.get(f"{key}.{name}", scenario.key_lines.get(key)))
+            notes.append(f"{where}: {name} is the {what} of the QJ71C24N at U{un:X} that the program drives: the "
+                         f"module turns it on and off itself, so a button or sensor wired there fights the module "
+                         f"(and the program reads the module's signal); wire it to an X input that is not one of "
+                         f"the module's signals")
+    return notes
+
+
 def _c24_notes(scenario: Scenario, plc: _Plc, violations: dict | None = None) -> list[str]:
     """Replies left in the program's QJ71C24N (the port reads on another input signal than
     the module's read request: the run shows only repeated attempts), and a [[c24]] for a
@@ -526,7 +555,7 @@ def _c24_notes(scenario: Scenario, plc: _Plc, violations: dict | None = None) ->
     used = plc.project.c24_addressed()
     if not used:
         return []
-    notes = []
+    notes = _c24_signal_inputs(scenario, used)
     for un, channel, count, since_us in plc.project.c24_unread():
         if plc.now_us - since_us < UNREAD_NOTE_US:
             continue  # a reply that came in the last moments of the run
