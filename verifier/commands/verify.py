@@ -526,7 +526,7 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress,
                     try:
                         batch_results = future.result()
                     except (ScenarioError, UnusableInput) as exc:
-                        mistakes[futures[future][0]] = exc
+                        mistakes[min(futures[future])] = exc
                         for other in futures:  # the batches not started: only set up, below
                             other.cancel()
                         continue
