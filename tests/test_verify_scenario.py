@@ -126,6 +126,8 @@ def test_a_time_literal_in_a_condition_reads_as_a_time_label_does():
     ("fbMoveTmr.ET > 500ms", 16, "T#500ms"),
     ("et >= 1.5s AND Y0", 7, "T#1.5s"),
     ("et < 2sec", 6, "T#2s"),
+    ("et > 2 s", 6, "T#2s"),  # a blank between number and unit: was "unexpected 's'"
+    ("et > 1 h 30 m AND Y0", 6, "T#1h30m"),
 ])
 def test_a_duration_without_t_in_a_condition_is_told_the_time_literal(text, column, literal):
     """Writing a station's scenario, `that = "fbMoveTmr.ET > 500ms"` (durations in the same
@@ -135,6 +137,21 @@ def test_a_duration_without_t_in_a_condition_is_told_the_time_literal(text, colu
         parse_condition(text)
     assert info.value.column == column and f"a TIME literal is written {literal}" in info.value.message, \
         info.value.message
+
+
+def test_a_duration_with_a_blank_before_its_unit_in_st_is_told_the_time_literal(tmp_path):
+    """`PT := 2 s` in ST got lark's "unexpected 's'" and a list of tokens; it is the same
+    mistake as `PT := 500ms` and now gets the same message, at the number; ST that is
+    right (a FOR ... BY 2 DO, 2 MOD 3) is not taken for a duration."""
+    from verifier import st
+
+    bad = st.parse("PROGRAM P\nVAR\n    t : TON;\nEND_VAR\nt(IN := TRUE, PT := 2 s);\nEND_PROGRAM\n", "P.st")
+    (diagnostic,) = [d for d in bad.diagnostics if d.is_error]
+    assert (diagnostic.line, diagnostic.col) == (5, 21), diagnostic
+    assert diagnostic.message == "'2 s' is a duration without T#: a TIME literal is written T#2s"
+    good = st.parse("PROGRAM Q\nVAR\n    i : INT;\nEND_VAR\nFOR i := 1 TO 10 BY 2 DO\n    i := i;\n"
+                    "END_FOR;\ni := 2 MOD 3;\nEND_PROGRAM\n", "Q.st")
+    assert not [d for d in good.diagnostics + st.check([good]) if d.is_error]
 
 
 def test_st_s_time_literal_as_a_scenario_duration_is_told_the_scenario_spelling():

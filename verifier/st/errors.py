@@ -174,7 +174,8 @@ _LONG_TIME_TYPES = {"LTIME", "LT"}
 
 
 #: a number with a unit and no T# (500ms, 1.5s, 1m30s, 2sec), the whole word
-_BARE_TIME = re.compile(r"[0-9][0-9_]*(?:\.[0-9]+)?[A-Za-z]+(?:[0-9][0-9_]*(?:\.[0-9]+)?[A-Za-z]+)*")
+#: (blanks between a number and its unit too: `2 s`, `1 h 30 m`)
+_BARE_TIME = re.compile(r"[0-9][0-9_]*(?:\.[0-9]+)?[ \t]*[A-Za-z]+(?:[ \t]*[0-9][0-9_]*(?:\.[0-9]+)?[ \t]*[A-Za-z]+)*")
 
 
 def bare_time(text: str, pos: int) -> tuple[int, str] | None:
@@ -183,6 +184,8 @@ def bare_time(text: str, pos: int) -> tuple[int, str] | None:
     For the ST checker and scenario conditions alike: people write a scenario's durations
     ("500ms") and forget that ST and conditions spell them T#500ms."""
     start = pos
+    while start > 0 and text[start - 1] in " \t":  # the unit of `2 s`
+        start -= 1
     while start > 0 and (text[start - 1].isdigit() or text[start - 1] in "._"):
         start -= 1
     if start > 0 and (text[start - 1].isalnum() or text[start - 1] in "_#"):
@@ -191,7 +194,8 @@ def bare_time(text: str, pos: int) -> tuple[int, str] | None:
     if m is None or m.end() <= pos:
         return None
     word = m.group()
-    literal = "T#" + _TIME_PART.sub(lambda p: p.group(1) + _TIME_UNITS.get(p.group(2).lower(), p.group(2)), word)
+    literal = "T#" + re.sub(r"[ \t]+", "", _TIME_PART.sub(
+        lambda p: p.group(1) + _TIME_UNITS.get(p.group(2).lower(), p.group(2)), word))
     if not _TIME_WORD.fullmatch(literal):
         return None
     return start, f"'{word}' is a duration without T#: a TIME literal is written {literal}"

@@ -89,8 +89,9 @@ def _tokenize(text: str) -> list[_Token]:
         if not match:
             raise ConditionError(f"unexpected character {text[position]!r}", position + 1)
         kind = match.lastgroup
-        if kind == "number" and text[match.end():match.end() + 1].isalpha():
-            bare = bare_time(text, match.end())  # 500ms: a scenario's duration, not a TIME literal
+        unit_at = len(text) - len(text[match.end():].lstrip(" \t"))  # 500ms, and 2 s
+        if kind == "number" and text[unit_at:unit_at + 1].isalpha():
+            bare = bare_time(text, unit_at)  # a scenario's duration, not a TIME literal
             if bare is not None:
                 raise ConditionError(bare[1], bare[0] + 1)
         if kind != "space":
