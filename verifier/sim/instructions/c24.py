@@ -60,9 +60,10 @@ class _Channel:
         self.joined: tuple[int, int, int] | None = None
 
 
-#: a silence inside one received message this long is no gap between a reply's bytes (one
-#: byte is 1.04 ms at 9600 bit/s): two replies, or a reply and noise, joined into one message
-JOINED_GAP_US = 20_000
+#: a silence inside one received message this many character times long (20.8 ms at 9600
+#: 8N1) is no gap between a reply's bytes: two replies, or a reply and noise, joined into
+#: one message; measured in the channel's own line format, so that it holds at any speed
+JOINED_GAP_CHARS = 20
 
 
 class C24Module:
@@ -275,7 +276,7 @@ class C24Module:
             if chan.rx and chan.no_reception_us is not None and t - chan.rx_last_t > chan.no_reception_us:
                 self._timed_out(chan)
             if (chan.rx and chan.no_reception_us is None and chan.joined is None
-                    and t - chan.rx_last_t > JOINED_GAP_US):
+                    and t - chan.rx_last_t > JOINED_GAP_CHARS * chan.port.format.byte_time_us):
                 chan.joined = (chan.rx_first_t, len(chan.rx), t - chan.rx_last_t)
             if not chan.rx:
                 chan.rx_first_t = t
