@@ -511,7 +511,7 @@ def _apply_plc_settings(plc: _Plc, scenario: Scenario) -> None:
 UNREAD_NOTE_US = 1_000_000  # a message unread this long at the end of the run is not being read
 
 
-def _c24_signal_inputs(scenario: Scenario, modules: list[int]) -> list[str]:
+def _c24_signal_inputs(scenario: Scenario, plc: _Plc, modules: list[int]) -> list[str]:
     """A note for each `[[inputs]]` entry that sets one of the input signals of a QJ71C24N
     the program drives (its reception data read request or reception abnormal detection,
     X3/X4 and XA/XB from the module's start I/O): the module turns those on and off itself,
@@ -528,10 +528,13 @@ def _c24_signal_inputs(scenario: Scenario, modules: list[int]) -> list[str]:
     for step in scenario.inputs:
         key = f"{step.key}.set"
         for name in step.values:
-            number = re.fullmatch(r"[Xx]([0-9A-Fa-f]+)", name)
-            if number is None or int(number.group(1), 16) not in signals:
+            try:  # the CPU's own reading of the name (X3, x03: the Q numbers X in hex)
+                device = plc.project.devices.address(name)
+            except KeyError:
+                continue  # a label
+            if device.area != "X" or device.index not in signals:
                 continue
-            un, what = signals[int(number.group(1), 16)]
+            un, what = signals[device.index]
             where = scenario.where(key, scenario.key_lines.get(f"{key}.{name}", scenario.key_lines.get(key)))
             notes.append(f"{where}: {name} is the {what} of the QJ71C24N at U{un:X} that the program drives: the "
                          f"module turns it on and off itself, so a button or sensor wired there fights the module "
@@ -555,7 +558,7 @@ def _c24_notes(scenario: Scenario, plc: _Plc, violations: dict | None = None) ->
     used = plc.project.c24_addressed()
     if not used:
         return []
-    notes = _c24_signal_inputs(scenario, used)
+    notes = _c24_signal_inputs(scenario, plc, used)
     for un, channel, count, since_us in plc.project.c24_unread():
         if plc.now_us - since_us < UNREAD_NOTE_US:
             continue  # a reply that came in the last moments of the run
