@@ -142,10 +142,7 @@ def _read_scenarios(files, platform: str | None = None) -> list[Scenario]:
             read.append(load_scenario(f, platform))
         except ScenarioError as exc:
             mistakes.append(exc)
-    if len(mistakes) == 1:
-        raise mistakes[0]
-    if mistakes:
-        raise ScenarioMistakes(mistakes)
+    _raise_together(mistakes)
     return read
 
 
@@ -407,22 +404,28 @@ def _run_each(scenarios: list[Scenario], every_scan: bool, keep: Keep, progress_
                                         plain=every_scan, keep=keep))
         except (ScenarioError, UnusableInput) as exc:
             mistakes.append(exc)
-    _raise_together(mistakes)
+    _raise_together(_said_once(mistakes))
     return results
 
 
 def _raise_together(mistakes: list[Exception | None]) -> None:
     """Raise the mistakes found (None: a scenario without one), one as it is, several as
-    ScenarioMistakes; the same mistake twice (scenarios of the same sources that do not
-    load) said once."""
-    found = []
-    for mistake in mistakes:
-        if mistake is not None and all(str(mistake) != str(seen) for seen in found):
-            found.append(mistake)
+    ScenarioMistakes."""
+    found = [mistake for mistake in mistakes if mistake is not None]
     if len(found) == 1:
         raise found[0]
     if found:
         raise ScenarioMistakes(found)
+
+
+def _said_once(mistakes: list[Exception | None]) -> list[Exception | None]:
+    """The runs' mistakes with the same one of several scenarios (sources that do not load,
+    shared by them) kept once."""
+    kept = []
+    for mistake in mistakes:
+        if mistake is None or all(str(mistake) != str(seen) for seen in kept):
+            kept.append(mistake)
+    return kept
 
 
 def _worker_started() -> None:
@@ -545,7 +548,7 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress,
             for future, batch in futures.items():
                 if future.cancelled():
                     mistakes.update((i, scenario_mistake(scenarios[i])) for i in batch)
-            _raise_together([mistakes[i] for i in sorted(mistakes)])
+            _raise_together(_said_once([mistakes[i] for i in sorted(mistakes)]))
         return [r for r in results if r is not None]
     offsets = [0, *accumulate(s.duration_us for s in scenarios)]
 
