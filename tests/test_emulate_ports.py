@@ -50,6 +50,7 @@ class EmulatorProcess:
         self.lines: list[str] = []
         self.came_at: list[float] = []  # when each of `lines` reached this process (monotonic s)
         self.matched_came_at = 0.0  # when the line wait_for last found did
+        self.resent = 0  # status requests read_status sent again after a host stall
         self._queue: queue.Queue[tuple[float, str] | None] = queue.Queue()
         threading.Thread(target=self._pump, daemon=True).start()
 
@@ -80,6 +81,15 @@ class EmulatorProcess:
                 self.matched_came_at = item[0]
                 return m
         raise AssertionError(f"no log line matching {pattern!r}; log so far:\n" + "\n".join(self.lines))
+
+    def test_clock(self, dated_s: float) -> float:
+        """The test's clock (monotonic s) when the emulator's clock read `dated_s` (the time
+        its log lines begin with), by the line that reached the test soonest after the
+        emulator dated it: later by that line's trip through the pipe (ms), never earlier,
+        whatever stalled this test's process when other lines came."""
+        offsets = [came - float(m.group(1)) for line, came in zip(self.lines, self.came_at)
+                   if (m := re.match(r" *(\d+\.\d{3}) s  ", line))]
+        return dated_s + min(offsets)
 
     def stop(self, sig: int = signal.SIGTERM) -> tuple[int, str]:
         """Signal it, wait for it to exit; (exit code, last line)."""
@@ -159,31 +169,41 @@ def coils(result: subprocess.CompletedProcess, first: int) -> list[int]:
 MBPOLL_TIMEOUT_S = 3
 
 
-def read_status(port: str, query: int, emulator: EmulatorProcess | None = None) -> tuple[int, int]:
-    """(error, value) read by mbpoll: coils 9-16 of the 22 carry the error byte, 17-22 the value.
+def read_status(port: str, query: int, emulator: EmulatorProcess) -> tuple[int, int]:
+    """(error, value) read by mbpoll from the `emulator` that answers on `port`: coils 9-16
+    of the 22 carry the error byte, 17-22 the value.
 
     mbpoll's -r is 1-based, so query parameter P is ``-r P+1``.
 
-    With the `emulator` that answers, a read that timed out while the host demonstrably held
-    the emulator back runs again (3 reads at most): the emulator's log line of the request
-    reached the test more than mbpoll's time-out after mbpoll started. (Seen: the emulator
-    SIGSTOPped 3.5 s as the flood test read the status after the flood: 'Connection timed
-    out'.) A read it never logged, or logged in time, fails at once.
+    A read that timed out because the host held the emulator back runs again (3 reads at
+    most): the emulator's own log dates its reply to the request more than mbpoll's time-out
+    after mbpoll started (`EmulatorProcess.test_clock`, so a stall of this test's process
+    does not count). Such a late reply is then read off the line, or the next exchange would
+    take it for its own, and `emulator.resent` counts the request sent again. (Seen: the
+    emulator SIGSTOPped 3.5 s as a test read the status: 'Connection timed out'.) A request
+    the emulator did not answer, or answered in time, fails at once; so do three stalled
+    reads (a host too loaded, or an emulator that answers late every time).
     """
     stalled = []
-    for _attempt in range(3 if emulator is not None else 1):
+    for _attempt in range(3):
         started = time.monotonic()
         result = mbpoll(port, "-t", "0", "-r", str(query + 1), "-c", "22")
-        if result.returncode != 0 and emulator is not None and "timed out" in result.stderr:
-            emulator.wait_for(rf"<- {STATUS_REQUEST_HEAD}", since=started)
-            logged_s = emulator.matched_came_at - started
-            if logged_s > MBPOLL_TIMEOUT_S:
-                stalled.append(f"the emulator logged the request {logged_s * 1000:.0f} ms after mbpoll started")
-                continue
-        assert result.returncode == 0, result.stdout + result.stderr + "\n".join(stalled)
-        break
+        if result.returncode == 0:
+            break
+        assert "timed out" in result.stderr, result.stdout + result.stderr + "\n".join(stalled)
+        late = _late_reply(emulator, started)
+        if late is None:
+            break
+        late_s, reply = late
+        stalled.append(f"the emulator's reply is dated {late_s * 1000:.0f} ms after mbpoll started")
+        with serial.Serial(port, 9600, timeout=WAIT_S) as line:  # the late reply: not the next exchange's
+            line.read(len(reply))
+        emulator.resent += 1
     else:
-        pytest.fail("every status read timed out while the host held the emulator back: " + "; ".join(stalled))
+        pytest.fail("every status read timed out while the host held the emulator back (or the emulator "
+                    "answers late every time): " + "; ".join(stalled))
+    assert result.returncode == 0, (result.stdout + result.stderr + "\n".join(stalled) + "\nthe emulator's log:\n"
+                                    + "\n".join(emulator.lines[-12:]))
     if stalled:  # shown in the run's warnings summary: how often the host got in the way
         warnings.warn("host stalls before the status read: " + "; ".join(stalled))
     bits = coils(result, query + 1)
@@ -191,6 +211,24 @@ def read_status(port: str, query: int, emulator: EmulatorProcess | None = None) 
     error = sum(bits[8 + i] << i for i in range(8))
     value = sum(bits[16 + i] << i for i in range(6))
     return error, value
+
+
+def _late_reply(emulator: EmulatorProcess, started: float) -> tuple[float, bytes] | None:
+    """When (s after `started`, this test's clock) the emulator dated its reply to the status
+    request mbpoll sent at `started`, and the reply, if after mbpoll's time-out; None when it
+    read none, did not answer it or answered in time (a failure that is not the host's).
+    Waits for the emulator to have read the request and settled it: a stalled emulator reads
+    it late."""
+    try:
+        emulator.wait_for(rf"<- {STATUS_REQUEST_HEAD}", since=started)
+        answer = emulator.wait_for(r"^ *(\d+\.\d{3}) s  (-> ((?:[0-9A-F]{2} )+)|\*\* fault)",
+                                   since=emulator.matched_came_at)
+    except AssertionError:  # nothing read, or read and never settled: what the log says is the failure's
+        return None
+    if answer.group(3) is None:
+        return None
+    dated = emulator.test_clock(float(answer.group(1))) - started
+    return (dated, bytes.fromhex(answer.group(3))) if dated > MBPOLL_TIMEOUT_S else None
 
 
 def write_command(port: str, code: int, command: int) -> subprocess.CompletedProcess:
@@ -207,14 +245,15 @@ def test_mbpoll_writes_stop_and_reads_every_status(pty_pair, start_emulator):
     assert result.returncode == 0 and "Written 1 references" in result.stdout
     emulator.wait_for(r"<- 01 06 01 A0 00 00 88 14  stop \(01/A0\)")
     emulator.wait_for(r"-> 01 06 01 A0 00 00 88 14")
-    assert read_status(master_end, Query.TASK) == (0, 0)
+    assert read_status(master_end, Query.TASK, emulator) == (0, 0)
     emulator.wait_for(r"<- 01 01 00 00 00 16 BD C4  read task status")
-    assert read_status(master_end, Query.SPEED) == (0, 0)
+    assert read_status(master_end, Query.SPEED, emulator) == (0, 0)
     assert write_command(master_end, 0x02, 3).returncode == 0  # trackless speed stage 4
-    assert read_status(master_end, Query.SPEED) == (0, 3)
+    assert read_status(master_end, Query.SPEED, emulator) == (0, 3)
     code, summary = emulator.stop()
     assert code == 0
-    assert re.search(r"5 frames in, 5 replies out", summary)
+    frames = 5 + emulator.resent  # a status request the host stalled was sent again
+    assert f"{frames} frames in, {frames} replies out" in summary, summary
 
 
 def test_a_second_emulator_on_the_same_port_is_refused(pty_pair, start_emulator):
@@ -225,7 +264,7 @@ def test_a_second_emulator_on_the_same_port_is_refused(pty_pair, start_emulator)
     assert second.returncode == 2  # a mistake on the command line, as monitor's on a held port
     assert f"cannot open serial port {robot_end}: another program has it locked" in second.stderr
     assert "Traceback" not in second.stderr
-    assert read_status(master_end, Query.TASK) == (0, 0)  # the first still answers
+    assert read_status(master_end, Query.TASK, first) == (0, 0)  # the first still answers
     assert first.stop()[0] == 0
 
 
@@ -258,10 +297,10 @@ def test_mbpoll_sees_a_task_run_and_an_anti_collision_stop(pty_pair, start_emula
     emulator = start_emulator("--serial", robot_end, "--point-duration-s", "600")
     assert write_command(master_end, 0x01, 0xA0).returncode == 0
     assert write_command(master_end, 0x01, 3).returncode == 0
-    assert read_status(master_end, Query.TASK) == (0, 1)
+    assert read_status(master_end, Query.TASK, emulator) == (0, 1)
     emulator.stop()
     emulator = start_emulator("--serial", robot_end, "--anti-collision-at", "0")
-    assert read_status(master_end, Query.VEHICLE) == (1, 1)
+    assert read_status(master_end, Query.VEHICLE, emulator) == (1, 1)
     assert emulator.stop()[0] == 0
 
 
@@ -286,7 +325,7 @@ def test_mbpoll_gets_illegal_function_and_the_next_request_is_still_answered(pty
     result = mbpoll(master_end, "-t", "3", "-r", "1", "-c", "1")  # FC04: not the robot's
     assert "Illegal function" in result.stdout + result.stderr
     emulator.wait_for(r"-> 01 84 01 ")
-    assert read_status(master_end, Query.TASK) == (0, 0)
+    assert read_status(master_end, Query.TASK, emulator) == (0, 0)
 
 
 def test_mbpoll_times_out_on_a_scripted_no_reply_then_recovers(pty_pair, start_emulator):
@@ -295,7 +334,43 @@ def test_mbpoll_times_out_on_a_scripted_no_reply_then_recovers(pty_pair, start_e
     result = mbpoll(master_end, "-t", "0", "-r", "1", "-c", "22")
     assert "timed out" in (result.stdout + result.stderr).lower()
     emulator.wait_for(r"\*\* fault: request 1: no_reply")
-    assert read_status(master_end, Query.TASK) == (0, 0)
+    assert read_status(master_end, Query.TASK, emulator) == (0, 0)
+
+
+def test_a_status_read_the_host_stalls_past_mbpolls_time_out_is_read_again(pty_pair, start_emulator):
+    """The host stops the emulator (SIGSTOP) longer than mbpoll's 3 s time-out while mbpoll
+    reads the status: the read is the host's, not the emulator's, so it runs again; and the
+    reply the emulator then gives late is not taken by the next exchange (mbpoll read it:
+    the run command failed, and the status read after it got the command's echo)."""
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end, "--point-duration-s", "600")
+    assert write_command(master_end, 0x01, 0xA0).returncode == 0
+    os.kill(emulator.proc.pid, signal.SIGSTOP)
+    resume = threading.Timer(MBPOLL_TIMEOUT_S + 1, os.kill, (emulator.proc.pid, signal.SIGCONT))
+    resume.start()
+    try:
+        with pytest.warns(UserWarning, match="host stalls before the status read"):
+            assert read_status(master_end, Query.TASK, emulator) == (0, 0)
+    finally:
+        resume.cancel()
+        os.kill(emulator.proc.pid, signal.SIGCONT)
+    ran = write_command(master_end, 0x01, 3)
+    assert ran.returncode == 0, ran.stdout + ran.stderr
+    assert read_status(master_end, Query.TASK, emulator) == (0, 1)
+    assert emulator.resent == 1
+    code, summary = emulator.stop()
+    assert code == 0 and "5 frames in, 5 replies out" in summary, summary
+
+
+def test_a_status_read_the_emulator_leaves_unanswered_fails_though_reads_are_run_again(pty_pair, start_emulator):
+    """A read that timed out is run again only when the emulator's own log dates its reply
+    past mbpoll's time-out: a request it read in time and did not answer fails at once."""
+    robot_end, master_end = pty_pair
+    emulator = start_emulator("--serial", robot_end, "--no-reply-on", "1")
+    with pytest.raises(AssertionError, match="Connection timed out"):
+        read_status(master_end, Query.TASK, emulator)
+    assert emulator.resent == 0
+    emulator.wait_for(r"\*\* fault: request 1: no_reply")
 
 
 def test_serial_survives_noise_truncated_frames_and_floods(pty_pair, start_emulator):

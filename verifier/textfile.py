@@ -12,6 +12,8 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Callable, Iterator
 
+from verifier.place import Place
+
 BOM = b"\xef\xbb\xbf"  # a UTF-8 byte order mark, as Windows editors write it: skipped
 
 #: the error handler of every text the tool writes (reports, traces, the console): a file
@@ -23,17 +25,17 @@ UNENCODABLE = "backslashreplace"
 
 class UnreadableText(Exception):
     """Why a text file could not be read: `cannot read: ...` or `line L, column C (byte N):
-    not UTF-8 text`; `line` and `col` say where when the bytes are not text."""
+    not UTF-8 text`; `place` (in the file its caller read: `Place.file` None) says where
+    when the bytes are not text, `byte` which byte it is."""
 
-    def __init__(self, message: str, line: int | None = None, col: int | None = None,
-                 byte: int | None = None):
+    def __init__(self, message: str, place: Place | None = None, byte: int | None = None):
         super().__init__(message)
-        self.line, self.col, self.byte = line, col, byte
+        self.place, self.byte = place, byte
 
     def after_place(self) -> str:
         """The words to put after the file's `file:line:col: ` place (bytes that are not
         text), or after `file: ` (a file that cannot be read at all)."""
-        if self.line is None:
+        if self.place is None:
             return str(self)
         return f"not UTF-8 text (byte {self.byte}): save the file as UTF-8"
 
@@ -56,7 +58,8 @@ def read_utf8(path: Path) -> str:
     except UnicodeDecodeError as exc:
         bad = start + exc.start
         line, col = place_of_byte(data, bad)
-        raise UnreadableText(f"line {line}, column {col} (byte {bad}): not UTF-8 text", line, col, bad) from None
+        raise UnreadableText(f"line {line}, column {col} (byte {bad}): not UTF-8 text", Place(None, line, col),
+                             bad) from None
 
 
 def real_path(path: Path | str) -> Path:

@@ -49,8 +49,7 @@ def load_fault_file(path: str | Path, own_address: int | None = None) -> FaultFi
     try:
         text = read_utf8(path)
     except UnreadableText as err:  # file:line:col at bytes that are not text, as a scenario's
-        place = Place(None, err.line, err.col) if err.line is not None else None
-        raise FaultFileError(f"{_where(path, place)}: {err.after_place()}") from None
+        raise FaultFileError(f"{_where(path, err.place)}: {err.after_place()}") from None
     try:
         data = tomllib.loads(text)
     except (ValueError, RecursionError) as err:

@@ -385,7 +385,7 @@ def read_capture(path: Path) -> dict[str, list[Chunk]]:
         text = lone_cr_as_line_feed(read_utf8(path))
     except UnreadableText as exc:
         # bytes that are not text: `file: line L, column C (byte N): ...`, placed at them
-        where = None if exc.line is None else Place(str(path), exc.line, exc.col)
+        where = None if exc.place is None else exc.place.in_file(str(path))
         raise CaptureError(where, "", message=f"{path}: {exc}") from None
     first = _first_line(text)
     try:

@@ -71,4 +71,4 @@ def on_cpu(files: list[ast.SourceFile], cpu: CpuProfile, diagnostics: list[ast.D
 
 
 def _at(span: ast.Span, message: str, severity: str = "error") -> ast.Diagnostic:
-    return ast.Diagnostic(span.file, span.line, span.col, severity, message, span.end_line, span.end_col)
+    return ast.Diagnostic.of_span(span, severity, message)

@@ -32,9 +32,8 @@ class LoadError(Exception):
     def located(self) -> list[tuple[Place, str]]:
         """The place and the line of the message of each error that names a source's line,
         in the message's order: the mistakes a report can place one by one."""
-        return [(Place(d.file, getattr(d, "line", 0), getattr(d, "col", 0)), _format_diag(d)) for d in self.diagnostics
-                if not getattr(d, "file", "?").startswith(OPTION_PLACE)
-                and getattr(d, "severity", "error") == "error"]
+        return [(d.place, _format_diag(d)) for d in self.diagnostics
+                if not d.file.startswith(OPTION_PLACE) and d.is_error]
 
 
 #: the "file" of a diagnostic about an argument of verifier.load, not about a source:
@@ -52,16 +51,9 @@ def option_error(message: str, **given) -> "LoadError":
 
 
 def _format_diag(d) -> str:
-    file = getattr(d, "file", "?")
-    line = getattr(d, "line", 0)
-    col = getattr(d, "col", 0)
-    sev = getattr(d, "severity", "error")
-    msg = getattr(d, "message", str(d))
-    if file.startswith(OPTION_PLACE):  # a call's argument has no line and column
-        return f"{file}: {sev}: {msg}"
-    from verifier.textfile import shown_name
-
-    return f"{shown_name(file)}:{line}:{col}: {sev}: {msg}"
+    if d.file.startswith(OPTION_PLACE):  # a call's argument has no line and column
+        return f"{d.file}: {d.severity}: {d.message}"
+    return str(d)
 
 
 class SimulationError(Exception):

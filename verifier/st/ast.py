@@ -16,14 +16,18 @@ from __future__ import annotations
 from dataclasses import dataclass, field, fields, is_dataclass
 from typing import Iterator
 
-from verifier.textfile import shown_name
+from verifier.place import Place
 
 
 # ----------------------------------------------------------------------------- places
 @dataclass(frozen=True, slots=True)
 class Span:
     """Where a node sits: 1-based line and column of its first and last character
-    (end_col is one past the last character, as lark counts)."""
+    (end_col is one past the last character, as lark counts). Its start is a
+    verifier.place.Place (`place`); the end is kept beside it, not in a Place, for the
+    caret under a source line and SARIF's region: spans are made for every token the
+    parser reads (fastparse makes them without calling the constructor), so they stay
+    five flat fields."""
 
     file: str
     line: int
@@ -31,8 +35,13 @@ class Span:
     end_line: int
     end_col: int
 
+    @property
+    def place(self) -> Place:
+        """Where the node starts, as every message places it."""
+        return Place(self.file, self.line, self.col)
+
     def __str__(self) -> str:
-        return f"{shown_name(self.file)}:{self.line}:{self.col}"
+        return str(self.place)
 
 
 NO_SPAN = Span("<none>", 0, 0, 0, 0)
@@ -76,8 +85,18 @@ class Diagnostic:
     end_line: int | None = None
     end_col: int | None = None
 
+    @classmethod
+    def of_span(cls, span: Span, severity: str, message: str) -> "Diagnostic":
+        """A finding about the node at `span`, its end included."""
+        return cls(span.file, span.line, span.col, severity, message, span.end_line, span.end_col)
+
+    @property
+    def place(self) -> Place:
+        """Where the finding is (its start; `end_line`/`end_col` are SARIF's and the caret's)."""
+        return Place(self.file, self.line, self.col)
+
     def __str__(self) -> str:
-        return f"{shown_name(self.file)}:{self.line}:{self.col}: {self.severity}: {self.message}"
+        return f"{self.place}: {self.severity}: {self.message}"
 
     @property
     def is_error(self) -> bool:

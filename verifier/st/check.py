@@ -61,8 +61,7 @@ class _Reporter:
 
     def at(self, node, severity: str, message: str) -> None:
         span = getattr(node, "span", None) or ast.NO_SPAN
-        self.diagnostics.append(ast.Diagnostic(span.file, span.line, span.col, severity, message,
-                                               span.end_line, span.end_col))
+        self.diagnostics.append(ast.Diagnostic.of_span(span, severity, message))
 
     def error(self, node, message: str) -> None:
         self.at(node, "error", message)

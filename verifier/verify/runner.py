@@ -101,7 +101,7 @@ class _Plc:
             from verifier.sim.cpucheck import cpu_diagnostics
 
             found = cpu_diagnostics(project.files, project.cpu, pous=set(project.module.pous))
-            notes = [f"{_relative(str(Place(d.file, d.line, d.col)), cwd)}: {d.message}" for d in found if not d.is_error]
+            notes = [f"{_relative(str(d.place), cwd)}: {d.message}" for d in found if not d.is_error]
             if len(_CPU_NOTES) >= _CPU_NOTES_MAX:
                 del _CPU_NOTES[next(iter(_CPU_NOTES))]
             cached = _CPU_NOTES[key] = (project.files, notes)  # the files kept alive: their id is not reused

@@ -325,8 +325,7 @@ def load_scenario(path: Path | str, platform: str | None = None) -> Scenario:
     try:
         text = read_utf8(path)
     except UnreadableText as exc:
-        place = Place(None, exc.line, exc.col) if exc.line is not None else None
-        raise ScenarioError(path, "", exc.after_place(), place) from None
+        raise ScenarioError(path, "", exc.after_place(), exc.place) from None
     return parse_scenario(text, path, platform)
 
 
