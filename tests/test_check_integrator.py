@@ -159,3 +159,48 @@ def test_letters_the_page_marks_unconfirmed_are_not_judged():
     text = "FUNCTION_BLOCK FB_Helper\nVAR_INPUT\n" + "".join(f"    {n} : BOOL;\n" for n in names) + \
         "END_VAR\nVAR_OUTPUT\n    o_bDone : BOOL;\nEND_VAR\no_bDone := " + " OR ".join(names) + ";\nEND_FUNCTION_BLOCK\n"
     assert [str(d) for d in _check(text) if "type letter" in d.message] == []
+
+
+def test_a_second_call_after_an_early_return_is_warned_for_the_scans_that_pass_it():
+    """`fbTmr(...); IF bStop THEN RETURN; END_IF; fbTmr(...);` was warned 'called a second
+    time in every scan', though in the scans that take the RETURN only the first call runs.
+    The two calls still share the instance in every other scan, so it stays a warning, said
+    for those scans with the RETURN's place. After a RETURN of the statement list itself the
+    second call never runs: not judged."""
+    text = """\
+PROGRAM Station
+VAR
+    fbTmr : TON;
+    bRun : BOOL;
+    bStop : BOOL;
+    bFault : BOOL;
+END_VAR
+fbTmr(IN := bRun, PT := T#1s);
+IF bStop THEN
+    RETURN;
+END_IF;
+fbTmr(IN := bRun, PT := T#2s);
+CASE 1 OF
+    1: IF bFault THEN RETURN; END_IF;
+END_CASE;
+fbTmr(IN := bStop, PT := T#3s);
+END_PROGRAM
+"""
+    diags = _check(text)
+    assert [(d.line, d.col) for d in diags] == [(12, 1), (16, 1)], [str(d) for d in diags]
+    assert ("FB instance 'fbTmr' is called a second time in the same scan whenever the RETURN at 10:5 is "
+            "not taken (first at 8:1)") in diags[0].message, diags[0].message
+    assert ("called a second time in the same scan whenever the RETURNs at 10:5, 14:23 are not taken "
+            "(first at 8:1)") in diags[1].message, diags[1].message
+    dead = """\
+PROGRAM Station
+VAR
+    fbTmr : TON;
+    bRun : BOOL;
+END_VAR
+fbTmr(IN := bRun, PT := T#1s);
+RETURN;
+fbTmr(IN := bRun, PT := T#2s);
+END_PROGRAM
+"""
+    assert [str(d) for d in _check(dead) if "second time" in d.message] == []

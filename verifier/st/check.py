@@ -451,11 +451,23 @@ class Checker:
         different branches may be one a scan, and are not judged.) A call right after a
         reset call of the same instance, one giving IN, EN, i_bEN or i_bExecute FALSE
         (`fbTmr(IN := FALSE); fbTmr(IN := bRun, PT := T#1s);`, the IEC idiom that restarts
-        a timer or re-arms an execute edge in one scan), is that one use, and not judged."""
+        a timer or re-arms an execute edge in one scan), is that one use, and not judged.
+        A RETURN between the two calls: inside an IF, CASE or loop (`IF c THEN RETURN;
+        END_IF;`) the second call still runs with the first in every scan that does not take
+        it, and the warning names it; a RETURN of the statement list itself ends what runs, and
+        a call after it is not judged."""
         first: dict[str, ast.CallStmt] = {}
         last: dict[str, ast.CallStmt] = {}
+        returns: list[ast.Return] = []  # the conditional RETURNs met so far, in order
+        seen_at: dict[str, int] = {}  # how many of them came before first[key]
         for s in info.pou.body:
-            if not isinstance(s, ast.CallStmt) or not isinstance(s.call.callee, ast.Name):
+            if isinstance(s, ast.Return):
+                break  # nothing after it runs
+            if not isinstance(s, ast.CallStmt):
+                returns += sorted((n for n in ast.walk(s) if isinstance(n, ast.Return)),
+                                  key=lambda n: (n.span.line, n.span.col))
+                continue
+            if not isinstance(s.call.callee, ast.Name):
                 continue
             target = s.call.resolved
             if getattr(target, "kind", None) != "fb":
@@ -463,15 +475,18 @@ class Checker:
             key = s.call.callee.name.upper()
             previous = last.get(key)
             last[key] = s
-            if key not in first:
-                first[key] = s
-                continue
-            if _resets(previous.call):
-                first[key] = s  # the use a later second call overwrites
+            if key not in first or _resets(previous.call):
+                first[key] = s  # a first use, or the use a later second call overwrites
+                seen_at[key] = len(returns)
                 continue
             earlier = first[key].span
             name = s.call.callee.name
-            self.rep.warning(s, f"FB instance '{name}' is called a second time in every scan (first at "
+            between = returns[seen_at[key]:]
+            when = ("in every scan" if not between else
+                    "in the same scan whenever the RETURN" + ("s" if len(between) > 1 else "") + " at "
+                    + ", ".join(f"{r.span.line}:{r.span.col}" for r in between)
+                    + (" are" if len(between) > 1 else " is") + " not taken")
+            self.rep.warning(s, f"FB instance '{name}' is called a second time {when} (first at "
                                 f"{earlier.line}:{earlier.col}): an instance has one memory, so this call "
                                 f"overwrites the edges and outputs of the first; give the second use its own "
                                 f"instance (e.g. {name}2 : {target.name})")
