@@ -204,3 +204,49 @@ fbTmr(IN := bRun, PT := T#2s);
 END_PROGRAM
 """
     assert [str(d) for d in _check(dead) if "second time" in d.message] == []
+
+
+def test_an_iec_counters_reset_before_its_use_is_not_warned():
+    """`fbCnt(R := TRUE); fbCnt(CU := bPulse, R := FALSE, PV := 10);` (a counter cleared and
+    counted on in one scan, the counters' form of the timer restart) was warned as a second
+    use: only FALSE to IN/EN/i_bEN/i_bExecute counted as a reset. R or LD given TRUE sets the
+    count whatever the call's other inputs, so it is a reset too, when the use gives the
+    input back (an input keeps its value: left out, it holds the counter at 0 in the use,
+    still warned). A user FB's `i_bReset := TRUE` is a use: its body is its own."""
+    text = """\
+FUNCTION_BLOCK FB_Seq
+VAR_INPUT
+    i_bReset : BOOL;
+    i_bExecute : BOOL;
+END_VAR
+VAR_OUTPUT
+    o_bDone : BOOL;
+END_VAR
+o_bDone := i_bExecute AND NOT i_bReset;
+END_FUNCTION_BLOCK
+
+PROGRAM Station
+VAR
+    fbCnt : CTU;
+    fbDown : CTD;
+    fbBoth : CTUD;
+    fbHeld : CTU;
+    fbSeq : FB_Seq;
+    bPulse : BOOL;
+END_VAR
+fbCnt(R := TRUE);
+fbCnt(CU := bPulse, R := FALSE, PV := 10);
+fbDown(CD := FALSE, LD := TRUE, PV := 5);
+fbDown(CD := bPulse, LD := FALSE);
+fbBoth(LD := TRUE, PV := 3);
+fbBoth(CU := bPulse, CD := FALSE, LD := FALSE, R := FALSE);
+fbHeld(R := TRUE);
+fbHeld(CU := bPulse, PV := 10);
+fbSeq(i_bReset := TRUE);
+fbSeq(i_bReset := FALSE, i_bExecute := bPulse);
+END_PROGRAM
+"""
+    diags = _check(text)
+    assert [(d.line, d.col) for d in diags] == [(28, 1), (30, 1)], [str(d) for d in diags]
+    assert "FB instance 'fbHeld' is called a second time in every scan (first at 27:1)" in diags[0].message
+    assert "FB instance 'fbSeq' is called a second time in every scan (first at 29:1)" in diags[1].message
