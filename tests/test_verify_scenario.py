@@ -427,7 +427,12 @@ def test_an_input_after_the_run_says_the_run_length_and_what_to_do():
     ("[[expect]]\nthat = \'\'\'Y0 AND\n   (Y1 OR ) \'\'\'\n", (4, 11)),
     ('[[expect]]\nthat = "Y0 AND (Y1 OR )"\n', (3, 23)),
     ("[[expect]]\nthat = 'Y0 AND (Y1 OR )'\n", (3, 23)),
-    ('[[expect]]\nthat = "Y0 AND\\t(Y1 OR )"\n', (3, 8)),  # an escape: the value's own place
+    # an escape (one character of the value, several in the file) was placed at the string's
+    # start, 3:8: now at the character, whatever the escapes before it
+    ('[[expect]]\nthat = "Y0 AND\\t(Y1 OR )"\n', (3, 24)),
+    ('[[expect]]\nthat = "Y0\\u0020AND\\U00000020(Y1 OR )"\n', (3, 37)),
+    ('[[expect]]\nthat = """Y0 \\\n    AND\\t(Y1 OR )"""\n', (4, 17)),  # a line-ending backslash
+    ('[[expect]]\nthat = """Y0 \\   \n\n  AND (Y1\\tOR )"""\n', (5, 15)),  # ... trims blank lines too
 ])
 def test_a_condition_that_does_not_parse_is_placed_where_it_fails_in_the_file(text, place):
     error = error_of('program = "M"\n' + text, Path("x.toml"))
