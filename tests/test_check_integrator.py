@@ -204,6 +204,11 @@ fbTmr(IN := bRun, PT := T#2s);
 END_PROGRAM
 """
     assert [str(d) for d in _check(dead) if "second time" in d.message] == []
+    # an IF whose every branch returns is that RETURN too; one without an ELSE is not
+    both = dead.replace("RETURN;", "IF bRun THEN\n    RETURN;\nELSE\n    RETURN;\nEND_IF;")
+    assert [str(d) for d in _check(both) if "second time" in d.message] == []
+    one = dead.replace("RETURN;", "IF bRun THEN\n    RETURN;\nELSIF NOT bRun THEN\n    RETURN;\nEND_IF;")
+    assert [(d.line, d.col) for d in _check(one) if "second time" in d.message] == [(12, 1)]
 
 
 def test_an_iec_counters_reset_before_its_use_is_not_warned():

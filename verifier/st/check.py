@@ -146,6 +146,20 @@ def _resets(call: ast.Call, following: ast.Call) -> bool:
     return bool(held) and held <= again
 
 
+def _always_returns(s: ast.Stmt) -> bool:
+    """Whether a statement leaves the POU whichever way it runs: a RETURN, or an IF or CASE
+    with an ELSE whose every branch holds one at its own level (a loop may run no time)."""
+    if isinstance(s, ast.Return):
+        return True
+    if isinstance(s, ast.If):
+        bodies = [b.body for b in s.branches] + [s.else_body]
+    elif isinstance(s, ast.Case):
+        bodies = [c.body for c in s.clauses] + [s.else_body]
+    else:
+        return False
+    return all(body is not None and any(_always_returns(x) for x in body) for body in bodies)
+
+
 def _constant(value: ast.Expr | None) -> bool | None:
     """TRUE or FALSE written as a literal, else None."""
     return value.value if isinstance(value, ast.BoolLiteral) else None
@@ -476,14 +490,15 @@ class Checker:
         and given back by the use) is that one use, and not judged.
         A RETURN between the two calls: inside an IF, CASE or loop (`IF c THEN RETURN;
         END_IF;`) the second call still runs with the first in every scan that does not take
-        it, and the warning names it; a RETURN of the statement list itself ends what runs, and
-        a call after it is not judged."""
+        it, and the warning names it; a RETURN of the statement list itself (or an IF or CASE
+        whose every branch, ELSE included, returns) ends what runs, and a call after it is not
+        judged."""
         first: dict[str, ast.CallStmt] = {}
         last: dict[str, ast.CallStmt] = {}
         returns: list[ast.Return] = []  # the conditional RETURNs met so far, in order
         seen_at: dict[str, int] = {}  # how many of them came before first[key]
         for s in info.pou.body:
-            if isinstance(s, ast.Return):
+            if _always_returns(s):
                 break  # nothing after it runs
             if not isinstance(s, ast.CallStmt):
                 returns += sorted((n for n in ast.walk(s) if isinstance(n, ast.Return)),
