@@ -138,3 +138,120 @@ END_PROGRAM
 """
     diags = _check(option, ROOT / "plc" / "core")
     assert [(d.line, d.col) for d in diags] == [(9, 1)], [str(d) for d in diags]
+
+
+def test_letters_the_page_marks_unconfirmed_are_not_judged():
+    """Mitsubishi's manuals use more letters than the judged list (`pb_dPositAdr`, a signed
+    position, in the FX5 Simple Motion examples), but no Mitsubishi page states their data
+    types: plc-library.md names them UNCONFIRMED and not judged, and check gives no warning
+    at them whatever the type (a warning it could not cite would be a guess)."""
+    import re
+
+    from verifier.st.check import TYPE_LETTERS
+
+    text = " ".join((ROOT / "docs" / "plc-library.md").read_text(encoding="utf-8").split())
+    said = re.search(r"\*\*UNCONFIRMED\*\*, not judged: (.*?) a warning on them could not be cited", text)
+    assert said is not None, "plc-library.md no longer says which letters are not judged"
+    letters = set(re.findall(r"`([a-z]+)`", re.sub(r"\(`pb_.*?\)|`[a-z]+[A-Z]\w*`", "", said.group(1))))
+    assert {"d", "dw", "lr", "le", "bn", "un", "st", "stn"} <= letters, letters
+    assert not letters & set(TYPE_LETTERS), letters & set(TYPE_LETTERS)
+    names = [f"i_{letter}Value{n}" for n, letter in enumerate(sorted(letters))]
+    text = "FUNCTION_BLOCK FB_Helper\nVAR_INPUT\n" + "".join(f"    {n} : BOOL;\n" for n in names) + \
+        "END_VAR\nVAR_OUTPUT\n    o_bDone : BOOL;\nEND_VAR\no_bDone := " + " OR ".join(names) + ";\nEND_FUNCTION_BLOCK\n"
+    assert [str(d) for d in _check(text) if "type letter" in d.message] == []
+
+
+def test_a_second_call_after_an_early_return_is_warned_for_the_scans_that_pass_it():
+    """`fbTmr(...); IF bStop THEN RETURN; END_IF; fbTmr(...);` was warned 'called a second
+    time in every scan', though in the scans that take the RETURN only the first call runs.
+    The two calls still share the instance in every other scan, so it stays a warning, said
+    for those scans with the RETURN's place. After a RETURN of the statement list itself the
+    second call never runs: not judged."""
+    text = """\
+PROGRAM Station
+VAR
+    fbTmr : TON;
+    bRun : BOOL;
+    bStop : BOOL;
+    bFault : BOOL;
+END_VAR
+fbTmr(IN := bRun, PT := T#1s);
+IF bStop THEN
+    RETURN;
+END_IF;
+fbTmr(IN := bRun, PT := T#2s);
+CASE 1 OF
+    1: IF bFault THEN RETURN; END_IF;
+END_CASE;
+fbTmr(IN := bStop, PT := T#3s);
+END_PROGRAM
+"""
+    diags = _check(text)
+    assert [(d.line, d.col) for d in diags] == [(12, 1), (16, 1)], [str(d) for d in diags]
+    assert ("FB instance 'fbTmr' is called a second time in the same scan whenever the RETURN at 10:5 is "
+            "not taken (first at 8:1)") in diags[0].message, diags[0].message
+    assert ("called a second time in the same scan whenever the RETURNs at 10:5, 14:23 are not taken "
+            "(first at 8:1)") in diags[1].message, diags[1].message
+    dead = """\
+PROGRAM Station
+VAR
+    fbTmr : TON;
+    bRun : BOOL;
+END_VAR
+fbTmr(IN := bRun, PT := T#1s);
+RETURN;
+fbTmr(IN := bRun, PT := T#2s);
+END_PROGRAM
+"""
+    assert [str(d) for d in _check(dead) if "second time" in d.message] == []
+    # an IF whose every branch returns is that RETURN too; one without an ELSE is not
+    both = dead.replace("RETURN;", "IF bRun THEN\n    RETURN;\nELSE\n    RETURN;\nEND_IF;")
+    assert [str(d) for d in _check(both) if "second time" in d.message] == []
+    one = dead.replace("RETURN;", "IF bRun THEN\n    RETURN;\nELSIF NOT bRun THEN\n    RETURN;\nEND_IF;")
+    assert [(d.line, d.col) for d in _check(one) if "second time" in d.message] == [(12, 1)]
+
+
+def test_an_iec_counters_reset_before_its_use_is_not_warned():
+    """`fbCnt(R := TRUE); fbCnt(CU := bPulse, R := FALSE, PV := 10);` (a counter cleared and
+    counted on in one scan, the counters' form of the timer restart) was warned as a second
+    use: only FALSE to IN/EN/i_bEN/i_bExecute counted as a reset. R or LD given TRUE sets the
+    count whatever the call's other inputs, so it is a reset too, when the use gives the
+    input back (an input keeps its value: left out, it holds the counter at 0 in the use,
+    still warned). A user FB's `i_bReset := TRUE` is a use: its body is its own."""
+    text = """\
+FUNCTION_BLOCK FB_Seq
+VAR_INPUT
+    i_bReset : BOOL;
+    i_bExecute : BOOL;
+END_VAR
+VAR_OUTPUT
+    o_bDone : BOOL;
+END_VAR
+o_bDone := i_bExecute AND NOT i_bReset;
+END_FUNCTION_BLOCK
+
+PROGRAM Station
+VAR
+    fbCnt : CTU;
+    fbDown : CTD;
+    fbBoth : CTUD;
+    fbHeld : CTU;
+    fbSeq : FB_Seq;
+    bPulse : BOOL;
+END_VAR
+fbCnt(R := TRUE);
+fbCnt(CU := bPulse, R := FALSE, PV := 10);
+fbDown(CD := FALSE, LD := TRUE, PV := 5);
+fbDown(CD := bPulse, LD := FALSE);
+fbBoth(LD := TRUE, PV := 3);
+fbBoth(CU := bPulse, CD := FALSE, LD := FALSE, R := FALSE);
+fbHeld(R := TRUE);
+fbHeld(CU := bPulse, PV := 10);
+fbSeq(i_bReset := TRUE);
+fbSeq(i_bReset := FALSE, i_bExecute := bPulse);
+END_PROGRAM
+"""
+    diags = _check(text)
+    assert [(d.line, d.col) for d in diags] == [(28, 1), (30, 1)], [str(d) for d in diags]
+    assert "FB instance 'fbHeld' is called a second time in every scan (first at 27:1)" in diags[0].message
+    assert "FB instance 'fbSeq' is called a second time in every scan (first at 29:1)" in diags[1].message

@@ -821,8 +821,7 @@ def test_a_port_that_cannot_be_opened_says_what_to_check_on_site():
     assert why_not_opened(busy).startswith("the port is busy: another program has it open")
     # nor can this bench make a converter that does not answer, one on no route, or a port
     # below 1024 refused (root binds any): the socket's own exceptions for them
-    from verifier.emulate.ports import why_not_listening
-    from verifier.serialports import why_not_connected
+    from verifier.serialports import why_not_connected, why_not_listening  # the port advice in one module
 
     assert why_not_connected(TimeoutError("timed out")).startswith("no answer: check the address, that the "
                                                                    "converter is on and on this PC's network")

@@ -100,11 +100,13 @@ def test_a_time_literal_with_a_space_in_a_condition_is_named_as_such():
     checker names it."""
     for text, column, word, fixed in (("fbTimer.ET > T#1h 30m", 14, "T#1h 30m", "T#1h30m"),
                                       ("(t#1m  5s < et)", 2, "t#1m  5s", "t#1m5s"),
-                                      ("et > TIME#2 s", 6, "TIME#2 s", "TIME#2s")):
+                                      ("et > TIME#2 s", 6, "TIME#2 s", "TIME#2s"),
+                                      ("et > T#2\ts", 6, "T#2\ts", "T#2s")):
         with pytest.raises(ConditionError) as info:
             parse_condition(text)
         assert info.value.column == column, (text, info.value.message)
-        assert info.value.message == f"{word!r}: a TIME literal cannot hold a space: write {fixed}"
+        blank = "a tab" if "\t" in word else "a space"  # the blank it holds, by name
+        assert info.value.message == f"{word!r}: a TIME literal cannot hold {blank}: write {fixed}"
     assert parse_condition("fbTimer.ET > T#1h30m").holds({"fbTimer.ET": 5_400_001})
 
 
@@ -427,7 +429,12 @@ def test_an_input_after_the_run_says_the_run_length_and_what_to_do():
     ("[[expect]]\nthat = \'\'\'Y0 AND\n   (Y1 OR ) \'\'\'\n", (4, 11)),
     ('[[expect]]\nthat = "Y0 AND (Y1 OR )"\n', (3, 23)),
     ("[[expect]]\nthat = 'Y0 AND (Y1 OR )'\n", (3, 23)),
-    ('[[expect]]\nthat = "Y0 AND\\t(Y1 OR )"\n', (3, 8)),  # an escape: the value's own place
+    # an escape (one character of the value, several in the file) was placed at the string's
+    # start, 3:8: now at the character, whatever the escapes before it
+    ('[[expect]]\nthat = "Y0 AND\\t(Y1 OR )"\n', (3, 24)),
+    ('[[expect]]\nthat = "Y0\\u0020AND\\U00000020(Y1 OR )"\n', (3, 37)),
+    ('[[expect]]\nthat = """Y0 \\\n    AND\\t(Y1 OR )"""\n', (4, 17)),  # a line-ending backslash
+    ('[[expect]]\nthat = """Y0 \\   \n\n  AND (Y1\\tOR )"""\n', (5, 15)),  # ... trims blank lines too
 ])
 def test_a_condition_that_does_not_parse_is_placed_where_it_fails_in_the_file(text, place):
     error = error_of('program = "M"\n' + text, Path("x.toml"))
@@ -863,18 +870,19 @@ def test_an_unknown_robot_or_fault_key_is_pointed_at_by_its_name(tmp_path, text,
     assert str(caught.value).startswith(str(tmp_path / place)), str(caught.value)
 
 
-def test_a_time_literal_broken_across_lines_is_named_as_one_with_a_space():
+def test_a_time_literal_broken_across_lines_is_named_as_one_with_a_line_break():
     """`T#1h` at a line's end and `30m` on the next (a long ST line or a multi-line condition
     wrapped inside the literal) got "'30m' is a duration without T#: a TIME literal is written
     T#30m", advice that gives T#1h T#30m, another error; it is named as the one literal with a
-    blank inside, at its first character, in ST and in a condition alike."""
+    blank inside, at its first character, in ST and in a condition alike; the blank is named
+    a line break, not a space (session 32 said 'cannot hold a space' for it)."""
     from verifier import st
 
     source = st.parse("PROGRAM P\nVAR\n    tDelay : TIME;\nEND_VAR\nIF tDelay > T#1h\n    30m THEN\n"
                       "    tDelay := T#0s;\nEND_IF;\nEND_PROGRAM\n", "p.st", "gxworks2")
     assert [(d.line, d.col, d.message) for d in source.diagnostics] == [
-        (5, 13, "'T#1h\\n    30m': a TIME literal cannot hold a space: write T#1h30m")]
+        (5, 13, "'T#1h\\n    30m': a TIME literal cannot hold a line break: write T#1h30m")]
     with pytest.raises(ConditionError) as info:
         parse_condition("Y0 AND\n  n > T#1h\n  30m")
     assert (info.value.column, info.value.message) == (
-        14, "'T#1h\\n  30m': a TIME literal cannot hold a space: write T#1h30m")
+        14, "'T#1h\\n  30m': a TIME literal cannot hold a line break: write T#1h30m")

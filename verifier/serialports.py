@@ -1,6 +1,7 @@
 """What is wrong with a serial port a user named, in words to act on: for the two commands
 that open one, `uitamr emulate` (the robot's end) and `uitamr monitor` (a tap on the line);
-and with the TCP server either dials (a pyserial socket:// URL, `monitor --tcp`).
+with the TCP server either dials (a pyserial socket:// URL, `monitor --tcp`); and with the
+TCP port `uitamr emulate --tcp` listens on.
 """
 from __future__ import annotations
 
@@ -78,6 +79,23 @@ def why_not_connected(err: OSError) -> str:
     if number in (errno.EHOSTUNREACH, errno.ENETUNREACH):
         return ("no route to it: this PC is not on the converter's network; give the PC an address in the "
                 "converter's subnet, or check the address")
+    return err.strerror or str(err)
+
+
+def why_not_listening(err: OSError, host: str, port: int) -> str:
+    """Why --tcp cannot listen, and what to do: Python said "[Errno 98] Address already in
+    use (while attempting to bind on address ('0.0.0.0', 4001))" for the usual one, an
+    emulator started earlier still running."""
+    if isinstance(err, socket.gaierror) or (err.errno or 0) < 0:  # bind() says getaddrinfo's EAI_* as errno
+        return f"{host} is not an address, nor a name this PC can look up: give one of its own IP addresses"
+    if err.errno == errno.EADDRINUSE:
+        return (f"the port is in use: another program listens on {port} (an emulator started earlier?); stop "
+                "it, or give another port (--tcp 0 picks a free one)")
+    if err.errno == errno.EADDRNOTAVAIL:
+        return (f"{host} is not an address of this PC: give one of its own (Linux: `ip -brief address`, "
+                "Windows: `ipconfig`), 0.0.0.0 for all of them, or the port alone for 127.0.0.1")
+    if err.errno in (errno.EACCES, errno.EPERM) and 0 < port < 1024:
+        return "permission denied: ports below 1024 need root; give a port from 1024 up, e.g. 4001"
     return err.strerror or str(err)
 
 

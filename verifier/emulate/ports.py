@@ -25,7 +25,7 @@ from verifier.emulate.assembler import RequestAssembler
 from verifier.emulate.core import Emulator, Outgoing, counted
 from verifier.link.line import LineConfig
 from verifier.protocol.codec import hex_bytes
-from verifier.serialports import why_it_failed, why_not_opened
+from verifier.serialports import why_it_failed, why_not_listening, why_not_opened
 from verifier.stopflag import StopFlag
 
 POLL_S = 0.005  # longest wait between looks at the clock (reply and silence deadlines)
@@ -247,23 +247,6 @@ def _read_waiting(sock: socket.socket) -> bytes:
             break
         data += more
     return data
-
-
-def why_not_listening(err: OSError, host: str, port: int) -> str:
-    """Why --tcp cannot listen, and what to do: Python said "[Errno 98] Address already in
-    use (while attempting to bind on address ('0.0.0.0', 4001))" for the usual one, an
-    emulator started earlier still running."""
-    if isinstance(err, socket.gaierror) or (err.errno or 0) < 0:  # bind() says getaddrinfo's EAI_* as errno
-        return f"{host} is not an address, nor a name this PC can look up: give one of its own IP addresses"
-    if err.errno == errno.EADDRINUSE:
-        return (f"the port is in use: another program listens on {port} (an emulator started earlier?); stop "
-                "it, or give another port (--tcp 0 picks a free one)")
-    if err.errno == errno.EADDRNOTAVAIL:
-        return (f"{host} is not an address of this PC: give one of its own (Linux: `ip -brief address`, "
-                "Windows: `ipconfig`), 0.0.0.0 for all of them, or the port alone for 127.0.0.1")
-    if err.errno in (errno.EACCES, errno.EPERM) and 0 < port < 1024:
-        return "permission denied: ports below 1024 need root; give a port from 1024 up, e.g. 4001"
-    return err.strerror or str(err)
 
 
 def serve_tcp(host: str, port: int, emulator: Emulator, stop: StopFlag, silence_us: int,

@@ -121,12 +121,47 @@ def type_letters_problem(name: str, t: T.Type, target: str = "gxworks2") -> str 
 _START_INPUTS = {"IN", "EN", "EXECUTE", "I_BEN", "I_BEXECUTE"}
 
 
-def _resets(call: ast.Call) -> bool:
-    """Whether an FB call gives the input that starts its work the constant FALSE
-    (`fbTmr(IN := FALSE)`, `fbCmd(i_bEN := TRUE, i_bExecute := FALSE)`): a reset before the
-    instance's next call, not a use. FALSE to another input (an option) is a use."""
-    return any(not a.output and a.name is not None and a.name.upper() in _START_INPUTS
-               and isinstance(a.value, ast.BoolLiteral) and a.value.value is False for a in call.args)
+#: the IEC counters' inputs that, given TRUE, set the count whatever the call's other
+#: inputs hold: R (CTU, CTUD: to 0, before any count) and LD (CTD, CTUD: to PV)
+_COUNTER_RESETS = {"CTU": {"R"}, "CTD": {"LD"}, "CTUD": {"R", "LD"}}
+
+
+def _resets(call: ast.Call, following: ast.Call) -> bool:
+    """Whether an FB call resets the instance before its `following` call, and is not a use:
+    it gives the input that starts the FB's work the constant FALSE (`fbTmr(IN := FALSE)`,
+    `fbCmd(i_bEN := TRUE, i_bExecute := FALSE)`), or it is an IEC counter's reset or preset,
+    the constant TRUE to R or LD (`fbCnt(R := TRUE)`), that the following call gives back (an
+    input keeps its value into the next call: one not given again would hold the counter at
+    its reset in the use). FALSE to another input (an option) is a use, and so is TRUE to an
+    input of a user FB named like a reset (`i_bReset`): what its body does in that call,
+    outputs included, is the FB's own."""
+    given = {a.name.upper(): a.value for a in call.args if not a.output and a.name is not None}
+    if any(name in _START_INPUTS and _constant(value) is False for name, value in given.items()):
+        return True
+    fb = getattr(call.resolved, "fb_type", None)
+    counter = _COUNTER_RESETS.get(fb.name.upper(), set()) if fb is not None and fb.standard else set()
+    held = {name for name in counter if _constant(given.get(name)) is True}
+    again = {a.name.upper() for a in following.args if not a.output and a.name is not None}
+    return bool(held) and held <= again
+
+
+def _always_returns(s: ast.Stmt) -> bool:
+    """Whether a statement leaves the POU whichever way it runs: a RETURN, or an IF or CASE
+    with an ELSE whose every branch holds one at its own level (a loop may run no time)."""
+    if isinstance(s, ast.Return):
+        return True
+    if isinstance(s, ast.If):
+        bodies = [b.body for b in s.branches] + [s.else_body]
+    elif isinstance(s, ast.Case):
+        bodies = [c.body for c in s.clauses] + [s.else_body]
+    else:
+        return False
+    return all(body is not None and any(_always_returns(x) for x in body) for body in bodies)
+
+
+def _constant(value: ast.Expr | None) -> bool | None:
+    """TRUE or FALSE written as a literal, else None."""
+    return value.value if isinstance(value, ast.BoolLiteral) else None
 
 
 @functools.lru_cache(maxsize=8192)
@@ -448,13 +483,27 @@ class Checker:
         so a command FB started by the second call ignores the first's rising edges, and what
         the program reads from it after the second call is the second use's. (Calls in
         different branches may be one a scan, and are not judged.) A call right after a
-        reset call of the same instance, one giving IN, EN, i_bEN or i_bExecute FALSE
-        (`fbTmr(IN := FALSE); fbTmr(IN := bRun, PT := T#1s);`, the IEC idiom that restarts
-        a timer or re-arms an execute edge in one scan), is that one use, and not judged."""
+        reset call of the same instance (`_resets`: IN, EN, i_bEN or i_bExecute given FALSE,
+        `fbTmr(IN := FALSE); fbTmr(IN := bRun, PT := T#1s);`, the IEC idiom that restarts
+        a timer or re-arms an execute edge in one scan; an IEC counter's R or LD given TRUE
+        and given back by the use) is that one use, and not judged.
+        A RETURN between the two calls: inside an IF, CASE or loop (`IF c THEN RETURN;
+        END_IF;`) the second call still runs with the first in every scan that does not take
+        it, and the warning names it; a RETURN of the statement list itself (or an IF or CASE
+        whose every branch, ELSE included, returns) ends what runs, and a call after it is not
+        judged."""
         first: dict[str, ast.CallStmt] = {}
         last: dict[str, ast.CallStmt] = {}
+        returns: list[ast.Return] = []  # the conditional RETURNs met so far, in order
+        seen_at: dict[str, int] = {}  # how many of them came before first[key]
         for s in info.pou.body:
-            if not isinstance(s, ast.CallStmt) or not isinstance(s.call.callee, ast.Name):
+            if _always_returns(s):
+                break  # nothing after it runs
+            if not isinstance(s, ast.CallStmt):
+                returns += sorted((n for n in ast.walk(s) if isinstance(n, ast.Return)),
+                                  key=lambda n: (n.span.line, n.span.col))
+                continue
+            if not isinstance(s.call.callee, ast.Name):
                 continue
             target = s.call.resolved
             if getattr(target, "kind", None) != "fb":
@@ -462,15 +511,18 @@ class Checker:
             key = s.call.callee.name.upper()
             previous = last.get(key)
             last[key] = s
-            if key not in first:
-                first[key] = s
-                continue
-            if _resets(previous.call):
-                first[key] = s  # the use a later second call overwrites
+            if key not in first or _resets(previous.call, s.call):
+                first[key] = s  # a first use, or the use a later second call overwrites
+                seen_at[key] = len(returns)
                 continue
             earlier = first[key].span
             name = s.call.callee.name
-            self.rep.warning(s, f"FB instance '{name}' is called a second time in every scan (first at "
+            between = returns[seen_at[key]:]
+            when = ("in every scan" if not between else
+                    "in the same scan whenever the RETURN" + ("s" if len(between) > 1 else "") + " at "
+                    + ", ".join(f"{r.span.line}:{r.span.col}" for r in between)
+                    + (" are" if len(between) > 1 else " is") + " not taken")
+            self.rep.warning(s, f"FB instance '{name}' is called a second time {when} (first at "
                                 f"{earlier.line}:{earlier.col}): an instance has one memory, so this call "
                                 f"overwrites the edges and outputs of the first; give the second use its own "
                                 f"instance (e.g. {name}2 : {target.name})")

@@ -143,10 +143,10 @@ _SPACED_TIME = re.compile(r"(?<![A-Za-z0-9_#.])(?:TIME|T)#\s*-?(?:\s*[0-9][0-9_]
 
 
 def spaced_time_literal(text: str, pos: int = -1) -> tuple[int, str] | None:
-    """The first TIME literal of `text` written with a space or tab inside (`T#1h 30m`) and
-    reaching past `pos` (any, for -1), as (its offset, the message naming it with the
-    spelling that reads: T#1h30m); None when there is none. For the ST checker and
-    scenario conditions alike."""
+    """The first TIME literal of `text` written with a space, tab or line break inside
+    (`T#1h 30m`) and reaching past `pos` (any, for -1), as (its offset, the message naming it
+    and the blank it holds, with the spelling that reads: T#1h30m); None when there is none.
+    For the ST checker and scenario conditions alike."""
     for m in _SPACED_TIME.finditer(text):
         word = m.group()
         if pos >= 0 and m.end() <= pos or not any(c.isspace() for c in word):
@@ -155,7 +155,9 @@ def spaced_time_literal(text: str, pos: int = -1) -> tuple[int, str] | None:
             return None
         fixed = re.sub(r"\s+", "", word)
         if _TIME_WORD.fullmatch(fixed):
-            return m.start(), f"{word!r}: a TIME literal cannot hold a space: write {fixed}"
+            blank = ("a line break" if "\n" in word or "\r" in word  # lines end at line feeds (lone CRs read so)
+                     else "a space" if " " in word else "a tab" if "\t" in word else "a blank")
+            return m.start(), f"{word!r}: a TIME literal cannot hold {blank}: write {fixed}"
     return None
 
 

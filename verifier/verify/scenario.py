@@ -10,7 +10,7 @@ import re
 import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 from verifier import protocol
 from verifier.amr.config import RobotConfig
@@ -341,6 +341,46 @@ def parse_scenario(text: str, path: Path | None = None, platform: str | None = N
     return _Reader(text, path, platform).read(data)
 
 
+#: how many characters follow the backslash of a TOML basic string's escape (`\t`: 1,
+#: `\u0041`: 5, `\U0001F600`: 9, TOML 1.1's `\x41`: 3)
+_ESCAPE_LENGTH = {"u": 5, "U": 9, "x": 3}
+
+
+def _string_characters(lines: list[str], row: int, col: int, delimiter: str) -> Iterator[tuple[int, int]]:
+    """The (line, column) in the file of each character of the TOML string value whose first
+    character is at `row`, `col` and that ends at `delimiter` (a quote, or three), then the
+    closing delimiter's own place. An escape of a basic string is one character, at its
+    backslash; a line-ending backslash of a multi-line basic string takes no character, nor the
+    blanks and line breaks after it; a line break in a multi-line string is one."""
+    basic, multi = delimiter[0] == '"', len(delimiter) == 3
+    trimming = False
+    while row - 1 < len(lines):
+        text, i = lines[row - 1], col - 1
+        while i < len(text):
+            if trimming and text[i] in " \t":
+                i += 1
+                continue
+            trimming = False
+            if text.startswith(delimiter, i):
+                yield row, i + 1
+                return
+            if basic and text[i] == "\\":
+                if multi and not text[i + 1:].strip(" \t"):
+                    trimming = True  # a line-ending backslash
+                    break
+                yield row, i + 1
+                i += 1 + _ESCAPE_LENGTH.get(text[i + 1:i + 2], 1)
+                continue
+            yield row, i + 1
+            i += 1
+        else:
+            if not multi:
+                return
+            if not trimming:
+                yield row, len(text) + 1  # the line break, a character of the value
+        row, col = row + 1, 1
+
+
 class _Reader:
     """Turns the parsed TOML into a Scenario; every error names its key and line."""
 
@@ -363,39 +403,26 @@ class _Reader:
         return ScenarioError(self.path, key, message, place)
 
     def _inside_string(self, place: Place, offset: int) -> Place:
-        """The place of character `offset` (1-based) of the string value that starts at
-        `place`: past a one-line string's quote, or inside a multi-line string, line by line
-        (a condition written over several lines with three quotes). Where the text cannot be
-        followed back to the file (an escape in a basic string), the value's own place."""
+        """The place of character `offset` (1-based; one past the last: the closing quote) of
+        the string value that starts at `place`, followed back through the file: past the
+        quote, line by line inside a multi-line string (a condition written over several lines
+        with three quotes), an escape of a basic string (`\\t`, `\\u0041`) at its backslash, and
+        a line-ending backslash with the blanks it trims taking no character. The value's own
+        place when it is not a string."""
         line = self.lines[place.line - 1]
         start = place.col - 1
-        quote = line[start:start + 3]
-        if quote not in ('"""', "\'\'\'"):
-            if line[start:start + 1] not in ("'", '"'):
-                return place
-            if line[start] == '"' and "\\" in line[start:]:
-                return place  # an escape: the value is shorter than its text in the file
-            return Place(None, place.line, place.col + offset)
-        row, col = place.line, place.col + 3  # the 1-based column of the value's first character
-        if col > len(line):  # a newline right after the opening quotes is not part of the value
-            row, col = row + 1, 1
-        if quote == '"""':
-            body, end = [], row
-            while end - 1 < len(self.lines):
-                text = self.lines[end - 1][(col - 1) if end == row else 0:]
-                body.append(text.split('"""')[0])
-                if '"""' in text:
-                    break
-                end += 1
-            if any("\\" in text for text in body):
-                return place
-        left = offset - 1  # characters to step over
-        while row - 1 < len(self.lines):
-            rest = len(self.lines[row - 1]) - (col - 1)
-            if left <= rest:
-                return Place(None, row, col + left)
-            left -= rest + 1  # the line's characters and its newline
-            row, col = row + 1, 1
+        delimiter = line[start:start + 3]
+        if delimiter in ('"""', "\'\'\'"):
+            row, col = place.line, place.col + 3  # the 1-based column of the value's first character
+            if col > len(line):  # a newline right after the opening quotes is not part of the value
+                row, col = row + 1, 1
+        elif line[start:start + 1] in ("'", '"'):
+            delimiter, row, col = line[start], place.line, place.col + 1
+        else:
+            return place
+        for n, (at_row, at_col) in enumerate(_string_characters(self.lines, row, col, delimiter), 1):
+            if n == offset:
+                return Place(None, at_row, at_col)
         return place
 
     def line_of(self, key: str) -> Place | None:
