@@ -235,9 +235,11 @@ def test_a_trace_without_its_end_record_still_replays(tmp_path):
 
 @pytest.mark.parametrize("lines, message", [
     (['{"scenario": "a", "end": 0.5, "t": 0.1}'],
-     "t.jsonl:2:1: an end record holds only 'scenario', 'end' (until when the line was listened to) and the run's "
+     "t.jsonl:2:1: an end record holds only 'scenario', 'end' (until when the line was listened to), the run's "
      "settings (reply_timeout, min_period, response_within, protocol, response_signal, response_signal_hint, "
-     "response_signal_held); it has 't'"),
+     "response_signal_held) and 'cut_short' (the monitor's port went away); it has 't'"),
+    (['{"scenario": "a", "end": 0.5, "cut_short": true}'],
+     "t.jsonl:2:1: 'cut_short' is true; expected the sentence the monitor said when its port went away"),
     (['{"scenario": "a", "end": 0.05}'], "t.jsonl:2:1: 'end' (0.05 s) is before the start of the record before (0.1 s)"),
     (['{"scenario": "a", "end": -1}'], "t.jsonl:2:1: 'end' is -1; expected a time in seconds"),
     (['{"scenario": "a", "end": 0.5}', '{"scenario": "a", "t": 0.6, "dir": "tx", "hex": "01"}'],
@@ -1289,11 +1291,13 @@ def test_a_converter_that_drops_the_connection_inside_a_frame_is_not_the_plcs_sh
         server.close()
         if done.returncode == 1 and gap and gap[0] > 0.02:
             continue  # the server thread stalled between the bytes and the shutdown
-        assert done.returncode == 0, done.stdout + done.stderr
+        # no finding; the closed connection made it a session cut short (exit 4), not a pass
+        assert done.returncode == 4, done.stdout + done.stderr
         note = "the capture ended inside a frame: its first 5 byte(s) (01 01 00 00 00) were not judged"
         assert "the server closed the connection" in done.stdout and note in done.stdout
         report = json.loads((folder / "m.json").read_text())
-        assert report["verdict"] == "pass" and note in report["scenarios"][0]["notes"]
+        assert report["verdict"] == "cut-short" and note in report["scenarios"][0]["notes"]
+        # the plain capture does not carry the cut (commissioning.md §6): its frames pass
         replayed = procs.run(uitamr("replay", folder / "c.txt"), capture_output=True, text=True,
                              timeout=WAIT_S)
         assert replayed.returncode == 0 and note in replayed.stdout, replayed.stdout + replayed.stderr
@@ -1412,23 +1416,63 @@ def test_a_port_that_cannot_be_opened_exits_2_with_its_name(tmp_path):
             "and port (the converter's web page), that it is set to TCP server and is on") in done.stderr, done.stderr
 
 
-@pytest.mark.serial
-def test_an_adapter_unplugged_mid_session_is_named_and_the_reports_are_written(tmp_path):
-    """The tap's USB adapter unplugged (its socat pty pair ended) while the monitor listened:
-    the session ends, the reports and the capture are written, and the reason says what
-    happened, not pyserial's "device reports readiness to read but returned no data (device
-    disconnected or multiple access on port?)" (the port is locked: nobody else reads it).
-    The exit status is that of what was seen (commissioning.md §2)."""
-    tap, line = tmp_path / "tap", tmp_path / "line"
+# --------------------------------------------------------------------- a port that went away: cut short
+def _every_report(folder: Path) -> list:
+    return ["--json", folder / "m.json", "--junit", folder / "m.xml", "--html", folder / "m.html",
+            "--trace", folder / "m.jsonl", "--capture", folder / "c.txt"]
+
+
+def assert_every_report_says_cut_short(folder: Path, out: str, source: str, asked: str, frames: int) -> str:
+    """A session whose port went away after `frames` frame(s) that broke no rule: its
+    console's verdict line says CUT SHORT, how long it ran of the `asked` --duration and
+    what to check, and every report written by `_every_report` says the same; the sentence."""
+    (verdict,) = [line for line in out.splitlines() if line.startswith("CUT SHORT:")]
+    said = verdict.removeprefix("CUT SHORT: ")
+    assert re.fullmatch(rf"{re.escape(str(source))} went away after \d+\.\d s of the {asked} s asked: the {frames} "
+                        r"frame\(s\) before it were verified, but the run is not the whole session; check .+, then "
+                        "monitor the whole session again", said), said
+    assert "PASS" not in out
+    report = json.loads((folder / "m.json").read_text())
+    assert report["verdict"] == report["scenarios"][0]["verdict"] == "cut-short"
+    assert report["scenarios"][0]["cut_short"] == said and report["scenarios"][0]["no_traffic"] is None
+    assert {key: report["summary"][key] for key in ("passed", "failed", "no_traffic", "cut_short")} == {
+        "passed": 0, "failed": 0, "no_traffic": 0, "cut_short": 1}
+    junit = ET.parse(folder / "m.xml").getroot()
+    (error,) = junit.iter("error")  # CI shows the session as not passed, with the sentence
+    assert (error.get("type"), error.get("message"), error.text) == ("cut-short", f"cut short: {said}", said)
+    assert junit.get("errors") == "1" and junit.get("failures") == "0"
+    html = (folder / "m.html").read_text()
+    assert '<span class="badge cut-short" id="verdict">CUT SHORT</span>' in html and "<b>Cut short:</b>" in html
+    assert json.loads((folder / "m.jsonl").read_text().splitlines()[-1])["cut_short"] == said  # the end record
+    return said
+
+
+def assert_the_replay_of_the_trace_is_cut_short(folder: Path, said: str) -> None:
+    """`uitamr replay` of the session's trace: its end record says the port went away, so
+    the replay is cut short too (exit 4, the same sentence); the plain capture cannot say it
+    (commissioning.md §6): its replay judges the frames alone."""
+    replayed = procs.run(uitamr("replay", folder / "m.jsonl", "--json", folder / "r.json"), capture_output=True,
+                         text=True, timeout=WAIT_S)
+    assert replayed.returncode == 4, replayed.stdout + replayed.stderr
+    assert f"CUT SHORT: {said}" in replayed.stdout
+    assert json.loads((folder / "r.json").read_text())["scenarios"][0]["cut_short"] == said
+    plain = procs.run(uitamr("replay", folder / "c.txt"), capture_output=True, text=True, timeout=WAIT_S)
+    assert plain.returncode == 0, plain.stdout + plain.stderr
+
+
+def _unplugged(folder: Path, sent: bytes, *options) -> tuple[int, str, str]:
+    """`uitamr monitor --serial` with `options` on the tap of a socat pty pair in `folder`
+    (folder/tap): `sent` written from the line's end (and shown by the monitor), then the
+    tap's adapter pulled out (socat ended); the monitor's exit status, stdout and stderr."""
     monitor = None
-    with pty_cable(tmp_path, "tap", "line") as socat:
+    with pty_cable(folder, "tap", "line") as socat:
         try:
-            monitor = start("monitor", "--serial", tap, "--json", tmp_path / "m.json", "--capture",
-                            tmp_path / "c.txt")
+            monitor = start("monitor", "--serial", folder / "tap", *options)
             wait_for_line(monitor, "listening")
-            with open(line, "wb", buffering=0) as plc:
-                plc.write(STOP)
-                wait_for_line(monitor, "PLC → robot")
+            with open(folder / "line", "wb", buffering=0) as plc:
+                if sent:
+                    plc.write(sent)
+                    wait_for_line(monitor, "PLC → robot")
                 socat.terminate()  # the adapter is pulled out
                 socat.wait(timeout=WAIT_S)
             out, err = monitor.communicate(timeout=WAIT_S)
@@ -1436,6 +1480,20 @@ def test_an_adapter_unplugged_mid_session_is_named_and_the_reports_are_written(t
             if monitor is not None and monitor.poll() is None:
                 monitor.kill()
                 monitor.wait(timeout=WAIT_S)
+    return monitor.returncode, out, err
+
+
+@pytest.mark.serial
+def test_an_adapter_unplugged_mid_session_is_cut_short_not_a_pass(tmp_path):
+    """The tap's USB adapter unplugged (its socat pty pair ended) while the monitor listened:
+    the session ends, the reports and the capture are written, and the reason says what
+    happened, not pyserial's "device reports readiness to read but returned no data (device
+    disconnected or multiple access on port?)" (the port is locked: nobody else reads it).
+    The stop command seen broke no rule, and the session exited 0, a PASS: a scripted
+    `monitor --duration 60s ... && echo accepted` accepted a few seconds of the minute.
+    It is cut short now: exit 4, and every report says so (commissioning.md §2)."""
+    tap = tmp_path / "tap"
+    returncode, out, err = _unplugged(tmp_path, STOP, "--duration", "60s", *_every_report(tmp_path))
     gone = (f"{tap}: the port went away: the USB adapter was unplugged or lost power (or the program that made the "
             "pty ended); plug it back in and start again")
     assert f"stopped: {gone}" in out, out + err
@@ -1443,7 +1501,90 @@ def test_an_adapter_unplugged_mid_session_is_named_and_the_reports_are_written(t
     report = json.loads((tmp_path / "m.json").read_text())
     assert f"the capture ended early: {gone}" in report["scenarios"][0]["notes"], report["scenarios"][0]["notes"]
     assert f"# the capture ended early: {gone}" in (tmp_path / "c.txt").read_text()
-    assert monitor.returncode == 0  # the stop command was seen and broke no rule: a PASS, with its note
+    assert returncode == 4, out + err
+    said = assert_every_report_says_cut_short(tmp_path, out, tap, "60", 1)
+    assert "check the USB adapter's cable and power" in said
+    assert_the_replay_of_the_trace_is_cut_short(tmp_path, said)
+
+
+@pytest.mark.serial
+def test_an_adapter_unplugged_before_a_byte_came_is_no_traffic_that_says_so(tmp_path):
+    """Unplugged before the line sent anything: nothing was verified (exit 3, as a silent
+    session), and the sentence says the port went away - it was "no bytes were seen ...:
+    check the wiring" alone, as if the monitor had listened all along."""
+    tap = tmp_path / "tap"
+    returncode, out, err = _unplugged(tmp_path, b"", "--duration", "60s", "--json", tmp_path / "m.json")
+    assert returncode == 3, out + err
+    assert re.search(rf"NO TRAFFIC: no bytes were seen on {re.escape(str(tap))} in \d+\.\d s, before it went away: "
+                     r"check the wiring \(A, B, GND\)", out), out
+    report = json.loads((tmp_path / "m.json").read_text())
+    assert report["verdict"] == "no-traffic" and report["scenarios"][0]["cut_short"] is None
+    assert report["summary"]["cut_short"] == 0
+
+
+def _converter(*frames: bytes, reset: bool = False):
+    """A TCP server on 127.0.0.1 that streams `frames` 20 ms apart to the one client it
+    accepts, waits 0.3 s and closes the connection (`reset`: with a TCP RST): (port,
+    server, thread)."""
+    import struct
+
+    server = socket.create_server(("127.0.0.1", 0))
+
+    def stream():
+        connection, _ = server.accept()
+        for data in frames:
+            connection.sendall(data)
+            time.sleep(0.02)
+        time.sleep(0.3)
+        if reset:
+            connection.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+        connection.close()
+
+    thread = threading.Thread(target=stream, daemon=True)
+    thread.start()
+    return server.getsockname()[1], server, thread
+
+
+@pytest.mark.parametrize("reset", [False, True], ids=["closed", "reset"])
+def test_a_converter_that_ends_the_stream_with_clean_frames_is_cut_short(tmp_path, reset):
+    """The converter closed (or reset) the connection 0.4 s into a --duration 10min session
+    whose frames broke no rule: it exited 0, a PASS of a session that was not listened to.
+    Cut short now: exit 4, with how long it ran of the 600 s asked, in every report, and in
+    the replay of its trace."""
+    port, server, thread = _converter(STOP, STOP, reset=reset)
+    done = procs.run(uitamr("monitor", "--tcp", f"127.0.0.1:{port}", "--duration", "10min",
+                            *_every_report(tmp_path)), capture_output=True, text=True, timeout=60)
+    thread.join(timeout=5)
+    server.close()
+    assert done.returncode == 4, done.stdout + done.stderr
+    said = assert_every_report_says_cut_short(tmp_path, done.stdout, f"tcp 127.0.0.1:{port}", "600", 2)
+    assert "check the converter (its power, its network" in said
+    assert_the_replay_of_the_trace_is_cut_short(tmp_path, said)
+
+
+def test_findings_before_the_converter_closed_still_fail(tmp_path):
+    """Findings win over the cut: a run point before the stop (UITAMR-POWERON-STOP), then the
+    converter closed the connection: exit 1, FAIL; the reports still say the run was cut
+    short (the JSON's cut_short, an error beside the rule's failure in the JUnit), and
+    without --duration the sentence says it went away before Ctrl-C."""
+    run_point = frame("run-point", "1")
+    port, server, thread = _converter(run_point, run_point)
+    done = procs.run(uitamr("monitor", "--tcp", f"127.0.0.1:{port}", *_every_report(tmp_path)),
+                     capture_output=True, text=True, timeout=60)
+    thread.join(timeout=5)
+    server.close()
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert "FAIL: 1 of 1 capture(s) failed" in done.stdout and "CUT SHORT:" not in done.stdout
+    report = json.loads((tmp_path / "m.json").read_text())
+    assert report["verdict"] == report["scenarios"][0]["verdict"] == "fail"
+    assert report["summary"]["cut_short"] == 0 and report["summary"]["failed"] == 1
+    said = report["scenarios"][0]["cut_short"]
+    assert said.startswith(f"tcp 127.0.0.1:{port} went away after ") and " s before Ctrl-C: the 2 frame(s)" in said
+    junit = ET.parse(tmp_path / "m.xml").getroot()
+    assert [(e.tag, e.get("type")) for e in junit.find(".//testcase") if e.tag in ("failure", "error")] == [
+        ("error", "cut-short"), ("failure", "UITAMR-POWERON-STOP")]
+    replayed = procs.run(uitamr("replay", tmp_path / "m.jsonl"), capture_output=True, text=True, timeout=WAIT_S)
+    assert replayed.returncode == 1, replayed.stdout + replayed.stderr
 
 
 @pytest.mark.serial

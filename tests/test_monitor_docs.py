@@ -69,6 +69,33 @@ def test_the_no_traffic_verdict_is_what_the_monitor_says():
     assert f"```\nNO TRAFFIC: {result.no_traffic}\n```" in DOC
 
 
+def test_the_cut_short_verdict_and_the_exit_table_are_the_monitors():
+    """§2 quotes the last line of a session whose port went away after 5.2 s of 10 min with
+    12 frames seen, and the start of the one that saw none, and its exit table lists each
+    of the monitor's exit statuses."""
+    from verifier.commands import monitor
+    from verifier.monitor.capture import Chunk
+
+    stop = protocol.encode(protocol.command_from_words(["stop"]), protocol.DEFAULT_SETTINGS)
+    session = MonitorSession(CaptureInfo("doc", "/dev/ttyUSB0"))
+    for k in range(12):
+        session.feed(Chunk(300_000 * k + 8_400, stop))
+    session.close()
+    session.went_away(5_200_000, 600_000_000)
+    assert f"```\nCUT SHORT: {session.result().cut_short}\n```" in DOC
+    silent = MonitorSession(CaptureInfo("doc", "/dev/ttyUSB0"))
+    silent.close()
+    silent.went_away(5_200_000, 600_000_000)  # before one byte came: no traffic that says so
+    quoted = re.search(r"`(no bytes were seen on /dev/ttyUSB0 in 5\.2 s, [^`]*) \.\.\.`", " ".join(DOC.split()))
+    assert quoted and silent.result(listened_us=5_200_000).no_traffic.startswith(quoted.group(1))
+    statuses = {monitor.EXIT_CLEAN: "frames were seen and no rule was broken", monitor.EXIT_FINDINGS: "findings",
+                monitor.EXIT_UNUSABLE: "the port cannot be opened", monitor.EXIT_NO_TRAFFIC: "**no traffic**",
+                monitor.EXIT_CUT_SHORT: "**cut short**"}
+    table = DOC.split("| exit status | meaning |\n|---|---|\n", 1)[1].split("\n\n", 1)[0].splitlines()
+    assert [row.split(" | ", 1)[0] for row in table] == [f"| {status}" for status in statuses]
+    assert all(row.split(" | ", 1)[1].startswith(meaning) for row, meaning in zip(table, statuses.values()))
+
+
 def test_a_plc_at_19200_read_at_9600_is_said_to_be_on_another_speed(tmp_path):
     """§2: a PLC at 19200 into a 9600 monitor gave only CRC and FORMAT findings ("unknown
     function code 0x08"), which §5's table sends to the PLC's CRC routine and frame builder;

@@ -192,6 +192,36 @@ def test_a_capture_with_no_traffic_neither_passes_nor_fails():
     assert [s["no_traffic"] for s in data["scenarios"]] == [None, silent.no_traffic]
 
 
+def test_a_capture_cut_short_neither_passes_nor_outranks_a_failure():
+    """A capture whose port went away (`uitamr monitor`) was verified only in part: with
+    frames that broke no rule its verdict is "cut-short", not "pass"; a rule its frames broke
+    still fails it, and a capture with nothing at all ranks first among the rest. Each
+    report counts it: passed + failed + no_traffic + cut_short = scenarios."""
+    from dataclasses import replace
+
+    from verifier.verify.result import CUT_SHORT, NO_TRAFFIC, overall_verdict
+
+    said = "COM5 went away after 5.2 s of the 600 s asked: the 12 frame(s) before it were verified, but ..."
+    cut = replace(good_result(), cut_short=said)
+    silent = replace(_result("silent", [], 0), no_traffic="no bytes were seen on COM6 in 20.0 s: check the wiring")
+    failed = replace(bad_result(), cut_short=said)
+    assert cut.verdict == CUT_SHORT == "cut-short" and not cut.passed
+    assert failed.verdict == "fail" and failed.unverified == [(CUT_SHORT, said)]
+    assert overall_verdict([good_result(), cut]) == CUT_SHORT and overall_verdict([cut, silent]) == NO_TRAFFIC
+    assert overall_verdict([cut, bad_result()]) == "fail"
+    out = io.StringIO()
+    report_console.render([good_result(), cut], Console(file=out, width=400, color_system=None))
+    assert "CUT SHORT" in out.getvalue() and out.getvalue().rstrip().endswith(f"CUT SHORT: {said}")
+    out = io.StringIO()
+    report_console.render([cut, silent, failed], Console(file=out, width=400, color_system=None))
+    assert out.getvalue().rstrip().endswith("FAIL: 1 of 3 scenario(s) failed, 1 saw no traffic, 1 cut short")
+    data = report_json.to_dict([good_result(), cut, silent, failed])
+    assert [s["verdict"] for s in data["scenarios"]] == ["pass", "cut-short", "no-traffic", "fail"]
+    assert [s["cut_short"] for s in data["scenarios"]] == [None, said, None, said]
+    assert {key: data["summary"][key] for key in ("scenarios", "passed", "failed", "no_traffic", "cut_short")} == {
+        "scenarios": 4, "passed": 1, "failed": 1, "no_traffic": 1, "cut_short": 1}
+
+
 def test_captures_are_counted_as_captures_without_expectations():
     """`uitamr replay` of a capture said "PASS: 1 scenario(s) compliant, every expectation met"
     and "0 expectation(s) met" for a run that was no scenario and could have no expectation;

@@ -4,7 +4,8 @@ Listens (never transmits), splits the bytes into RTU frames, tells requests from
 decodes them and applies the eight rules of `uitamr verify` while the line runs; Ctrl-C
 or `--duration` stops it and writes the same reports as `verify` (and `--capture FILE`,
 the plain capture `uitamr replay` reads). Exit status: 0 no finding, 1 findings, 2 the
-port or an option is unusable, 3 no traffic: not a byte was seen, so nothing was verified.
+port or an option is unusable, 3 no traffic: not a byte was seen, so nothing was verified,
+4 cut short: the port went away before the session's end, and its frames broke no rule.
 docs/commissioning.md.
 """
 from __future__ import annotations
@@ -33,9 +34,9 @@ from verifier.monitor.view import MonitorView
 from verifier.serialports import serial_url_problem
 from verifier.stopflag import StopFlag, put_back
 from verifier.verify.evidence import RuleOptions
-from verifier.verify.result import NO_TRAFFIC, Mistake, overall_verdict
+from verifier.verify.result import CUT_SHORT, NO_TRAFFIC, Mistake, overall_verdict
 
-EXIT_CLEAN, EXIT_FINDINGS, EXIT_UNUSABLE, EXIT_NO_TRAFFIC = 0, 1, 2, 3
+EXIT_CLEAN, EXIT_FINDINGS, EXIT_UNUSABLE, EXIT_NO_TRAFFIC, EXIT_CUT_SHORT = 0, 1, 2, 3, 4
 #: how often the rules judge what the line has settled since the last time
 CHECK_EVERY_S = 0.5
 
@@ -185,6 +186,8 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
             # (a loaded PC) let it notice the deadline late; that delay was no listening, and
             # "no bytes were seen in 1.1 s" for --duration 1s told the engineer otherwise
             listened_us = duration
+        if lost:
+            session.went_away(listened_us, duration)
         result = session.result(listened_us=listened_us)
         if lost:
             result.notes.append(f"the capture ended early: {lost}")
@@ -217,8 +220,9 @@ def command(serial_url, tcp, baud, line_format, tolerance, joined, reply_timeout
 
 def exit_status(results) -> int:
     """The exit status of the overall verdict: findings first (1); else a capture that saw
-    nothing (3): it verified nothing; else 0."""
-    return {"fail": EXIT_FINDINGS, NO_TRAFFIC: EXIT_NO_TRAFFIC, "pass": EXIT_CLEAN}[overall_verdict(results)]
+    nothing (3): it verified nothing; else one cut short (4): not the whole session; else 0."""
+    return {"fail": EXIT_FINDINGS, NO_TRAFFIC: EXIT_NO_TRAFFIC, CUT_SHORT: EXIT_CUT_SHORT,
+            "pass": EXIT_CLEAN}[overall_verdict(results)]
 
 
 def _finish(results, console: Console, json_path, junit_path, trace_path, html_path, command: str,

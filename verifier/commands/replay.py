@@ -4,7 +4,8 @@ Reads our JSONL trace (`uitamr verify --trace`, `uitamr monitor --trace`) or a p
 capture (timestamped hex lines, docs/commissioning.md), runs it through the monitor's
 framing and the eight rules, and writes the same reports. Exit status: 0 no finding,
 1 findings, 2 a capture that cannot be read (named with file, line and column), 3 a
-capture that holds no bytes (nothing was verified).
+capture that holds no bytes (nothing was verified), 4 a monitor's trace whose end record
+says its port went away (cut short: not the whole session).
 """
 from __future__ import annotations
 
@@ -75,7 +76,7 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
             for chunk in chunks:
                 session.feed(chunk)
             if chunks and not chunks[-1].data:  # an end record, or a capture's `end` line: the run's end
-                session.end_at(chunks[-1].t_us)
+                session.end_at(chunks[-1].t_us, chunks[-1].cut_short)
             session.close()
             results.append(session.result())
     _finish(results, console, json_path, junit_path, trace_path, html_path, "uitamr replay", captures)

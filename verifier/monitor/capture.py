@@ -55,6 +55,7 @@ class Chunk:
     signal_held: tuple[tuple[int, int | None], ...] | None = None
     events: tuple[LineEvent, ...] = ()  # the run's event records (RULE_EVENTS), on its end record's chunk
     settings: protocol.Settings | None = None  # the end record's protocol settings
+    cut_short: str | None = None  # the end record's: the monitor's port went away (ScenarioResult.cut_short)
 
 
 def tolerance_hides_pacing(tolerance_us: int) -> bool:
@@ -271,14 +272,15 @@ def _event(record: dict, where: Place) -> LineEvent:
 def _end_chunk(record: dict, chunks: list[Chunk], where: Place) -> Chunk:
     """A trace's end record (`{"scenario": ..., "end": seconds, "reply_timeout": seconds, ...}`,
     which every trace ends each run with): until when the line was listened to, as a chunk
-    with no bytes, as a plain capture's `end` line is read; and the rules' settings the run
-    was judged with (`report_trace.RUN_SETTINGS`; a trace written before them has none)."""
-    known = {"scenario", "end", *RUN_SETTINGS, "protocol", *_OUTPUTS}
+    with no bytes, as a plain capture's `end` line is read; the rules' settings the run
+    was judged with (`report_trace.RUN_SETTINGS`; a trace written before them has none); and
+    a monitor's `cut_short`, when its port went away."""
+    known = {"scenario", "end", *RUN_SETTINGS, "protocol", "cut_short", *_OUTPUTS}
     other = sorted(set(record) - known)
     if other:
         raise CaptureError(where, "an end record holds only 'scenario', 'end' (until when the line was listened "
-                           f"to) and the run's settings ({', '.join((*RUN_SETTINGS, 'protocol', *_OUTPUTS))}); it has "
-                           f"{', '.join(map(repr, other))}")
+                           f"to), the run's settings ({', '.join((*RUN_SETTINGS, 'protocol', *_OUTPUTS))}) and "
+                           f"'cut_short' (the monitor's port went away); it has {', '.join(map(repr, other))}")
     end_us = round(_seconds(record["end"], "end", where) * 1_000_000)
     # a run may end while its last frame is still on the line (verify --duration cut it)
     if chunks and end_us < chunks[-1].t_start_us:
@@ -286,14 +288,18 @@ def _end_chunk(record: dict, chunks: list[Chunk], where: Place) -> Chunk:
                            f"({chunks[-1].t_start_us / 1_000_000:g} s); a trace is in time order")
     rules = tuple((field, _positive_us(record[key], key, where)) for key, field in RUN_SETTINGS.items() if key in record)
     settings = _protocol(record["protocol"], where) if "protocol" in record else None
+    cut_short = record.get("cut_short")
+    if cut_short is not None and not isinstance(cut_short, str):
+        raise CaptureError(where, f"'cut_short' is {json.dumps(cut_short)}; expected the sentence the monitor said "
+                           "when its port went away")
     if "response_signal" not in record:  # a line's run: the program's outputs were not seen
         stray = sorted(set(_OUTPUTS) & set(record))
         if stray:
             raise CaptureError(where, f"{stray[0]!r} without 'response_signal'; an end record that says the "
                                "program's outputs gives the signal (null: the run had none)")
-        return Chunk(end_us, b"", rules=rules, settings=settings)
+        return Chunk(end_us, b"", rules=rules, settings=settings, cut_short=cut_short)
     return Chunk(end_us, b"", rules=rules + _signal(record, where), signal_held=_held(record, where),
-                 settings=settings)
+                 settings=settings, cut_short=cut_short)
 
 
 def _protocol(table, where: Place) -> protocol.Settings:

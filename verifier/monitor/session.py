@@ -71,6 +71,8 @@ class MonitorSession:
         self._origin_us: int | None = None  # host time of the first byte: t = 0 in reports
         self.last_us = 0
         self._ended_us: int | None = None  # the run's end as a trace's end record gives it (`end_at`)
+        self._gone = False  # the port went away (`went_away`)
+        self.cut_short: str | None = None  # what the result says of a run its port cut short
         # the live judgement: frames go to the pairing once no frame still to come can sort
         # before them (they start before the end of the latest frame), the rules judge what
         # the pairing has settled
@@ -111,13 +113,30 @@ class MonitorSession:
         self.last_us = max(self.last_us, now)
         return self._take(self.framer.poll(now))
 
-    def end_at(self, host_us: int) -> None:
+    def end_at(self, host_us: int, cut_short: str | None = None) -> None:
         """The run ended at host time `host_us` (a trace's end record): its length and the
         end the rules judge to, also when a frame that began before it was still on the line
         then (`uitamr verify --duration` cut it; the trace holds it whole), as the run was
-        judged; the latest byte or poll otherwise."""
+        judged; the latest byte or poll otherwise. `cut_short`: what the end record says of
+        a monitor whose port went away (`went_away`): the replay is not the whole session either."""
         if self._origin_us is not None:
             self._ended_us = host_us - self._origin_us
+        self.cut_short = cut_short
+
+    def went_away(self, listened_us: int, asked_us: int | None) -> None:
+        """The port went away (unplugged, the converter closed or reset the connection) after
+        `listened_us` of a session asked to last `asked_us` (None: until Ctrl-C), after the
+        `close`. With frames seen the run is cut short: not the whole session, so frames that
+        broke no rule do not pass it; with none, the silence says the port went away."""
+        self._gone = True
+        if not self.frames:
+            return
+        asked = "before Ctrl-C" if asked_us is None else f"of the {asked_us / 1_000_000:g} s asked"
+        check = ("the converter (its power, its network, that no other client took its one connection)"
+                 if self.info.channel == "tcp" else "the USB adapter's cable and power")
+        self.cut_short = (f"{self.info.source} went away after {listened_us / 1_000_000:.1f} s {asked}: the "
+                          f"{len(self.frames)} frame(s) before it were verified, but the run is not the whole "
+                          f"session; check {check}, then monitor the whole session again")
 
     @property
     def run_end_us(self) -> int:
@@ -307,6 +326,7 @@ class MonitorSession:
             notes=notes,
             no_traffic=no_traffic,
             timing_tolerance_us=self.timing.tolerance_us,
+            cut_short=self.cut_short,
         )
 
     def _silence(self, listened_us: int | None) -> str:
@@ -317,6 +337,8 @@ class MonitorSession:
             return (f"{source} holds no bytes, so nothing was verified: capture the line again once "
                     f"the monitor shows frames (check the wiring, the port name and {line})")
         during = "" if listened_us is None else f" in {listened_us / 1_000_000:.1f} s"
+        if self._gone:
+            during += ", before it went away"
         if self.info.channel == "tcp":
             return (f"no bytes were seen on {source}{during}: check that the converter streams the line "
                     f"to this port, its wiring to the line and its serial settings ({line})")

@@ -9,11 +9,19 @@ from rich.table import Table
 from verifier.textfile import escape_chars, shown_name
 
 from .durations import format_seconds
-from .result import NO_TRAFFIC, ScenarioResult, all_captured, overall_verdict
+from .result import CUT_SHORT, NO_TRAFFIC, UNVERIFIED, ScenarioResult, all_captured, overall_verdict
 from .rules import RULES
 
 FIRST_VIOLATIONS = 3  # times listed per broken rule and scenario
 SIMULATOR_NOTES = 5  # kinds of simulator note listed per scenario (the JSON and HTML list every one)
+#: how the last line counts the captures of each UNVERIFIED verdict: after FAIL, and after the
+#: first one's sentence
+_COUNTED = {NO_TRAFFIC: ("saw no traffic", "capture(s) with no bytes"), CUT_SHORT: ("cut short", "cut short")}
+
+
+def verdict_mark(verdict: str) -> str:
+    """A verdict as the console and the page show it: PASS, FAIL, NO TRAFFIC, CUT SHORT."""
+    return verdict.replace("-", " ").upper()
 
 
 def render(results: list[ScenarioResult], console: Console, *, first: int = FIRST_VIOLATIONS) -> None:
@@ -22,23 +30,25 @@ def render(results: list[ScenarioResult], console: Console, *, first: int = FIRS
     verdict = overall_verdict(results)
     if len(results) > 1 or verdict == "fail":
         console.print(_rule_table(results))
-    silent = [r.no_traffic for r in results if r.no_traffic is not None]
     # captures (`uitamr monitor`, `uitamr replay`) are no scenarios and hold no expectations
     runs = "capture(s)" if all_captured(results) else "scenario(s)"
     if verdict == "pass":
         met = ", every expectation met" if any(r.expectations for r in results) or runs == "scenario(s)" else ""
         console.print(f"[bold green]PASS[/]: {len(results)} {runs} compliant{met}")
-    elif verdict == NO_TRAFFIC:
-        more = f" (and {len(silent) - 1} more capture(s) with no bytes)" if len(silent) > 1 else ""
-        console.print(f"[bold yellow]NO TRAFFIC[/]: {escape(silent[0])}{more}")
+    elif verdict in UNVERIFIED:
+        said = [dict(r.unverified)[verdict] for r in results if r.verdict == verdict]
+        more = f" (and {len(said) - 1} more {_COUNTED[verdict][1]})" if len(said) > 1 else ""
+        console.print(f"[bold yellow]{verdict_mark(verdict)}[/]: {escape(said[0])}{more}")
     else:
         failed = sum(r.verdict == "fail" for r in results)
-        also = f", {len(silent)} saw no traffic" if silent else ""
+        also = "".join(f", {count} {_COUNTED[kind][0]}" for kind in UNVERIFIED
+                       if (count := sum(r.verdict == kind for r in results)))
         console.print(f"[bold red]FAIL[/]: {failed} of {len(results)} {runs} failed{also}")
 
 
 def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
-    mark = {"pass": "[green]PASS[/]", "fail": "[red]FAIL[/]", NO_TRAFFIC: "[yellow]NO TRAFFIC[/]"}[result.verdict]
+    color = {"pass": "green", "fail": "red"}.get(result.verdict, "yellow")  # yellow: UNVERIFIED
+    mark = f"[{color}]{verdict_mark(result.verdict)}[/]"
     where = f" ({escape(shown_name(result.file))})" if result.file else ""
     tx = result.tx_count
     failed = len(result.failed_expectations)

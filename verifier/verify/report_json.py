@@ -1,5 +1,6 @@
 """`--json FILE`: the whole verdict for machines, with a top-level "verdict": "pass"|"fail"
-("no-traffic" for a monitor or replay capture that saw no bytes)."""
+("no-traffic" for a monitor or replay capture that saw no bytes, "cut-short" for one whose
+port went away and whose frames broke no rule)."""
 from __future__ import annotations
 
 import json
@@ -12,7 +13,7 @@ from verifier.textfile import UNENCODABLE, whole_file
 
 from .evidence import Violation
 from .expectations import ExpectationResult
-from .result import ScenarioResult, overall_verdict
+from .result import UNVERIFIED, ScenarioResult, overall_verdict
 from .rules import RULES
 
 #: the report's "schema": raised when a field's place or meaning changes (docs/verifier.md).
@@ -90,6 +91,7 @@ def scenario_dict(result: ScenarioResult) -> dict[str, Any]:
         },
         "aborted": result.aborted,
         "no_traffic": result.no_traffic,
+        "cut_short": result.cut_short,
         "notes": list(result.notes),
         "simulator_diagnostics": result.diagnostics,
         "line_events": [{"t": _seconds(e.t_us), "kind": e.kind, "message": e.message} for e in result.events],
@@ -105,8 +107,9 @@ def to_dict(results: list[ScenarioResult], command: str = "uitamr verify") -> di
         "summary": {
             "scenarios": len(results),
             "passed": sum(r.passed for r in results),
-            "failed": sum(r.verdict == "fail" for r in results),  # passed + failed + no_traffic = scenarios
-            "no_traffic": sum(r.no_traffic is not None for r in results),
+            # passed + failed + no_traffic + cut_short = scenarios
+            "failed": sum(r.verdict == "fail" for r in results),
+            **{verdict.replace("-", "_"): sum(r.verdict == verdict for r in results) for verdict in UNVERIFIED},
             "violations": {
                 rule.id: sum(len(r.violations.get(rule.id, [])) for r in results) for rule in RULES
             },

@@ -2,7 +2,8 @@
 
 One <testcase> per scenario; one <failure> per broken rule (type = the rule id) and per
 failed expectation (type = "expectation"); an <error> when the simulation stopped, or when
-a monitored line or a capture had no bytes (type = "no-traffic"). A run that could not
+a monitored line or a capture had no bytes (type = "no-traffic") or its port went away
+(type = "cut-short"; with the rules' failures when its frames broke some). A run that could not
 start (exit 2) gets one <error type="unusable-input"> per mistake instead.
 """
 from __future__ import annotations
@@ -62,10 +63,10 @@ def to_element(results: list[ScenarioResult], command: str = "uitamr verify") ->
             first = result.aborted.splitlines()[0]
             element = ET.SubElement(case, "error", message=f"simulation stopped: {first}", type="simulation")
             element.text = result.aborted
-        if result.no_traffic:
-            errors += 1  # nothing was verified: not a pass, and not a rule the PLC broke
-            element = ET.SubElement(case, "error", message=f"no traffic: {result.no_traffic}", type="no-traffic")
-            element.text = result.no_traffic
+        for kind, said in result.unverified:
+            errors += 1  # nothing, or not the whole session, was verified: not a pass, and not a rule broken
+            element = ET.SubElement(case, "error", message=f"{kind.replace('-', ' ')}: {said}", type=kind)
+            element.text = said
         for rule_id, found in result.violations.items():
             if found:
                 failures += 1

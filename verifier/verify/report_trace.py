@@ -11,8 +11,9 @@ PLC frame, a TCP converter that dropped the connection after forwarding a reques
 end record (`end_record`): when the run ended - until when the line was listened to, a
 simulated run's end in virtual time - so that a replay judges the silence after the last
 frame as the run did (a reply still due, the run's length), as a plain capture's `end` line
-does; the rules' and the protocol's settings the run was judged with; and, for a run that saw
-the program's outputs (`uitamr verify`), its response signal and when it held. With them
+does; the rules' and the protocol's settings the run was judged with; for a monitor whose
+port went away, its `cut_short` sentence; and, for a run that saw the program's outputs
+(`uitamr verify`), its response signal and when it held. With them
 `uitamr replay` of the trace reaches the run's own rule findings
 (tests/test_replay_verify_trace.py).
 
@@ -191,7 +192,8 @@ def end_record(result: ScenarioResult, name: str) -> dict | None:
     the line was listened to; a simulated run's end in virtual time, which may be well after
     its last frame (a reply time-out still running, a silence) - and the rules' settings it
     was judged with (`RUN_SETTINGS`, and the protocol settings: the address, the manual's
-    choices), so that `uitamr replay` judges the trace as the run was.
+    choices), and a monitor's `cut_short` (its port went away), so that `uitamr replay`
+    judges the trace as the run was.
     A run that saw the program's outputs (`uitamr verify`) adds its response signal and when
     it held: UITAMR-RESPONSE-HANDLING judges by them, and a line does not show them."""
     if not frame_count(result):
@@ -199,6 +201,8 @@ def end_record(result: ScenarioResult, name: str) -> dict | None:
     record = {"scenario": name, "end": result.ended_us / 1_000_000,
               **{key: getattr(result, field) / 1_000_000 for key, field in RUN_SETTINGS.items()},
               "protocol": asdict(result.settings)}
+    if result.cut_short is not None:  # the port went away: a replay is not the whole session either
+        record["cut_short"] = result.cut_short
     if result.signal_held is not None:
         record["response_signal"] = result.response_signal
         if result.response_signal is None:

@@ -47,6 +47,11 @@ KEEP_ALL = Keep()
 
 #: the verdict of a capture that saw no bytes (`uitamr monitor`, `uitamr replay`)
 NO_TRAFFIC = "no-traffic"
+#: the verdict of a capture whose port went away before the session's end (`uitamr monitor`,
+#: `uitamr replay` of its trace) and whose frames broke no rule: not the whole session
+CUT_SHORT = "cut-short"
+#: the verdicts of a capture that neither passes nor fails, as they rank after "fail"
+UNVERIFIED = (NO_TRAFFIC, CUT_SHORT)
 
 #: the `platform` of a capture's result (`uitamr monitor`, `uitamr replay`): a real line,
 #: no simulated CPU, program, scan or seed
@@ -186,6 +191,9 @@ class ScenarioResult:
     # a capture that saw no bytes (`uitamr monitor`, `uitamr replay`): nothing was verified;
     # what was silent and what to check
     no_traffic: str | None = None
+    # a capture whose port went away while it had frames (`uitamr monitor`, and a replay of
+    # its trace, whose end record keeps this): how long it ran of what was asked, what to check
+    cut_short: str | None = None
     # frames timed by the host (`uitamr monitor`, `uitamr replay`): how far their times may
     # be off; the trace records it so that a replay of the trace judges with it too
     timing_tolerance_us: int = 0
@@ -213,9 +221,20 @@ class ScenarioResult:
         return [result for result in self.expectations if not result.passed]
 
     @property
+    def broke_nothing(self) -> bool:
+        """No rule broken, no expectation failed, no stop of the CPU."""
+        return self.aborted is None and self.violation_count == 0 and not self.failed_expectations
+
+    @property
     def passed(self) -> bool:
-        return (self.no_traffic is None and self.aborted is None and self.violation_count == 0
-                and not self.failed_expectations)
+        return not self.unverified and self.broke_nothing
+
+    @property
+    def unverified(self) -> list[tuple[str, str]]:
+        """(UNVERIFIED verdict, its sentence) for what a capture did not verify: no bytes at
+        all, a port that went away; what every report says of each."""
+        return [(kind, said) for kind, said in ((NO_TRAFFIC, self.no_traffic), (CUT_SHORT, self.cut_short))
+                if said is not None]
 
     @property
     def captured(self) -> bool:
@@ -235,10 +254,13 @@ class ScenarioResult:
 
     @property
     def verdict(self) -> str:
-        """"pass", "fail", or NO_TRAFFIC: a capture with nothing on it neither passes nor fails."""
+        """"pass", "fail", or an UNVERIFIED one: a capture with nothing on it neither passes nor
+        fails (NO_TRAFFIC); one cut short fails on a rule its frames broke, else is CUT_SHORT."""
         if self.no_traffic is not None:
             return NO_TRAFFIC
-        return "pass" if self.passed else "fail"
+        if not self.broke_nothing:
+            return "fail"
+        return CUT_SHORT if self.cut_short is not None else "pass"
 
     def all_violations(self) -> list[Violation]:
         return sorted((v for found in self.violations.values() for v in found), key=lambda v: (v.t_us, v.rule))
@@ -271,11 +293,11 @@ def run_names(results: list[ScenarioResult]) -> list[str]:
 
 def overall_verdict(results: list[ScenarioResult]) -> str:
     """"fail" when any result failed (or there are none), else NO_TRAFFIC when any capture
-    saw nothing, else "pass"."""
+    saw nothing, else CUT_SHORT when any was cut short, else "pass"."""
     verdicts = {result.verdict for result in results}
     if not results or "fail" in verdicts:
         return "fail"
-    return NO_TRAFFIC if NO_TRAFFIC in verdicts else "pass"
+    return next((verdict for verdict in UNVERIFIED if verdict in verdicts), "pass")
 
 
 def all_captured(results: list[ScenarioResult]) -> bool:
