@@ -590,3 +590,21 @@ def test_an_empty_report_name_is_a_command_line_mistake(tmp_path, monkeypatch):
     result = invoke("monitor", "--tcp", "127.0.0.1:1", "--capture", "--json", "r.json")
     assert result.exit_code == 2 and "Invalid value for '--capture': '--json' is an option, not a file" in result.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["j.xml", "site.txt"]
+
+
+def test_st_that_does_not_load_is_named_as_the_command_line_reaches_it(tmp_path, monkeypatch):
+    """`uitamr verify plc/*.st` in the repository named a syntax error
+    `/home/runner/work/.../plc/MAIN.st:5:6` on the console and in the JUnit test case's name
+    and `file`, while `uitamr check`, the frames' "sent by" and every scenario mistake name
+    it from the working folder: `plc/MAIN.st:5:6`. The ST's own path now, with the platform
+    given and told from the sources alike."""
+    (tmp_path / "plc").mkdir()
+    write_files(tmp_path, {"plc/MAIN.st": BROKEN})
+    monkeypatch.chdir(tmp_path)
+    for platform in (["--platform", "fx3u"], ["--matrix"]):
+        result = invoke("verify", "plc/MAIN.st", *platform, "--junit", "v.xml")
+        assert result.exit_code == 2, result.output
+        assert "plc/MAIN.st:5:6: error: expected an expression" in result.output
+        assert str(tmp_path) not in result.output, result.output
+        (case,) = cases(tmp_path / "v.xml")
+        assert (case.get("name"), case.get("file")) == ("plc/MAIN.st:5:6", "plc/MAIN.st")

@@ -72,6 +72,7 @@ class _Plc:
                 programs=None if scenario.program is None else [scenario.program],
             )
         except LoadError as exc:
+            exc = exc.shown_from(os.getcwd())  # plc/MAIN.st:7:1, as `uitamr check` and "sent by" name it
             hint = _platform_hint(scenario)
             # one JUnit test case per error, each at its place (the message lists them all)
             each = [Mistake(text + hint, place) for place, text in exc.located()]
