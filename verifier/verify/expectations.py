@@ -16,9 +16,10 @@ The window is [after, after + within] (`after` defaults to 0, `within` to the en
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from verifier import protocol
+from verifier.place import Place
 
 from .conditions import Condition
 from .durations import format_seconds
@@ -41,6 +42,9 @@ class Expectation:
     request: protocol.ControlRequest | protocol.StatusRequest | None = None
     point: int | None = None
     key: str = ""  # where the scenario states it, e.g. "expect[2]"
+    # the line and column of its kind's key in the scenario file (`that = ...`), for the
+    # reports of a failed expectation (ScenarioResult.place_of); None: no file states it
+    line: Place | None = field(default=None, compare=False)
 
     def window(self, end_us: int) -> tuple[int, int]:
         if self.within_us is None:
