@@ -608,3 +608,18 @@ def test_st_that_does_not_load_is_named_as_the_command_line_reaches_it(tmp_path,
         assert str(tmp_path) not in result.output, result.output
         (case,) = cases(tmp_path / "v.xml")
         assert (case.get("name"), case.get("file")) == ("plc/MAIN.st:5:6", "plc/MAIN.st")
+
+
+def test_a_mistake_test_case_carries_its_line_for_the_annotation(tmp_path):
+    """A typo in a scenario key (`duraton`) was the test case `x.toml:4:1` with `file` but
+    no `line`: GitHub's JUnit actions read `file` and `line` and put the annotation on
+    line 1 of the file. The line is now the mistake's own; a file that cannot be read at
+    all (its place 0:0) gets none."""
+    write_files(tmp_path, {"GOOD.st": GOOD, "x.toml": 'name = "x"\nprogram = "GOOD"\n\nduraton = "30s"\n'})
+    result = invoke("verify", tmp_path / "GOOD.st", "--scenario", tmp_path / "x.toml", "--junit", tmp_path / "v.xml")
+    assert result.exit_code == 2, result.output
+    (case,) = cases(tmp_path / "v.xml")
+    assert (case.get("file"), case.get("line")) == (str(tmp_path / "x.toml"), "4")
+    result = invoke("verify", tmp_path / "MISSING.st", tmp_path / "GOOD.st", "--junit", tmp_path / "v.xml")
+    assert result.exit_code == 2, result.output
+    assert all(case.get("line") is None for case in cases(tmp_path / "v.xml"))

@@ -493,8 +493,8 @@ def test_verifier_md_says_what_the_junit_of_a_run_that_cannot_start_holds():
     placed, unplaced = root.findall("./testsuite/testcase")
     assert f"classname `{placed.get('classname')}`" in section
     assert f'<error type="{placed.find("error").get("type")}">' in section
-    assert (placed.get("name"), placed.get("file")) == ("s.toml:4:1", "s.toml")
-    assert "name = its place `file:line:col` and `file` = the file it names" in section
+    assert (placed.get("name"), placed.get("file"), placed.get("line")) == ("s.toml:4:1", "s.toml", "4")
+    assert "name = its place `file:line:col`, `file` = the file it names and `line` its line" in section
     assert placed.find("error").get("message") == "s.toml:4:1: duraton: unknown key"  # the first line
     assert unplaced.get("name") == "input" and unplaced.get("file") is None
     assert "name `input` and no `file`" in section and "`--program MIAN`" in section

@@ -136,6 +136,8 @@ def unusable_element(mistakes: list[Mistake], command: str = "uitamr verify",
                              name=name, time="0.000")
         if mistake.place is not None:
             case.set("file", mistake.place.file)
+            if mistake.place.line > 0:  # where a JUnit reader (GitHub's actions) annotates the file
+                case.set("line", str(mistake.place.line))
         element = ET.SubElement(case, "error", message=_headline(mistake), type="unusable-input")
         element.text = mistake.message
     return suites
