@@ -140,3 +140,15 @@ def test_the_st_state_reaches_the_junit_xml_a_ci_server_shows(pytester):
         assert delay.count("ST state 1") == 1 and "o_bDone = False  (FB_DELAY.st:3:12)" in delay, delay
         assert "virtual time 1.000000 s after 100 scans" in delay
         assert "ST location" in oob and "FB_OOB.st:4:3: index 2 is outside a[0..1]" in oob, oob
+
+
+def test_st_project_without_its_mark_says_what_to_add_at_the_test(pytester):
+    """A test that asks for st_project without @pytest.mark.st got the plugin's fixture
+    source and `pytest.UsageError` (a command-line error's class) as its report. It now
+    gets the test's place and what to write, without the plugin's traceback."""
+    pytester.makepyfile(test_nomark="def test_nomark(st_project):\n    pass\n")
+    result = pytester.runpytest_subprocess("-p", "no:cacheprovider")
+    result.assert_outcomes(errors=1)
+    out = result.stdout.str()
+    assert "test_nomark.py:1: test_nomark uses the st_project fixture but has no @pytest.mark.st(" in out, out
+    assert "pytest_plugin.py" not in out and "UsageError" not in out, out

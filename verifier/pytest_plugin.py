@@ -48,7 +48,11 @@ def st_load(request):
 def st_project(request, st_load):
     marker = request.node.get_closest_marker("st")
     if marker is None:
-        raise pytest.UsageError("st_project needs @pytest.mark.st('file.st', ..., target=...)")
+        # the test's mistake, not the plugin's: its place and what to write, no traceback of the plugin
+        fspath, lineno, name = request.node.location
+        pytest.fail(f"{fspath}:{(lineno or 0) + 1}: {name} uses the st_project fixture but has no "
+                    "@pytest.mark.st('file.st', ..., target=...) naming the ST to load; add one, or use "
+                    "st_load('file.st') in the test", pytrace=False)
     return st_load(*marker.args, **marker.kwargs)
 
 
