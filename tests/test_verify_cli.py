@@ -1482,3 +1482,22 @@ def test_a_channel_that_picked_a_cpu_the_sources_do_not_fit_is_blamed(tmp_path):
     assert "(the default)" not in result.output, result.output
     assert ("--channel fx5:1: a port of the fx5u, on which the sources do not load; they load on fx3u: give a "
             "port of the fx3u (fx3:1, fx3:2, adp:1) or leave --channel out") in " ".join(result.output.split())
+
+
+def test_a_channel_over_the_tcp_route_is_not_applied_silently(tmp_path):
+    """`--channel fx5:2` with a TCP scenario (a [converter]) ran as if the option were not
+    there, and said nothing: the integrator believed the robot on channel 2 was tested. A
+    run of TCP scenarios only refuses it (exit 2), as the file's own `channel` beside
+    [converter] is refused; beside a serial scenario, the TCP one's run says in a note."""
+    tcp, serial = PLC / "scenarios" / "fx5u-tcp-healthy.toml", PLC / "scenarios" / "fx5u-healthy.toml"
+    refused = invoke("--scenario", tcp, "--channel", "fx5:2", "--duration", "1s", "--junit", tmp_path / "v.xml")
+    assert refused.exit_code == 2, refused.output
+    assert "--channel fx5:2: names a serial port, and every scenario of this run reaches the robot over TCP" in (
+        " ".join(refused.output.split()))
+    report = tmp_path / "r.json"
+    both = invoke("--scenario", tcp, "--scenario", serial, "--channel", "fx5:1", "--duration", "1s", "--json", report)
+    assert both.exit_code == 1, both.output  # the examples' 40 s windows: the runs are cut short
+    over_tcp, on_serial = json.loads(report.read_text())["scenarios"]
+    note = "--channel fx5:1 not applied: this scenario reaches the robot over TCP through its converter, not a serial port"
+    assert note in over_tcp["notes"] and note not in on_serial["notes"]
+    assert on_serial["channel"] == "fx5:1"
