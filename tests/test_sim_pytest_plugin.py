@@ -9,6 +9,15 @@ from sim_helpers import FB_DELAY
 
 pytest_plugins = ["pytester"]
 
+# an index out of range in the third scan: a SimulationError at FB_OOB.st:4:3
+FB_OOB = textwrap.dedent("""
+    FUNCTION_BLOCK FB_OOB
+    VAR i : INT; a : ARRAY[0..1] OF INT; END_VAR
+    i := i + 1;
+    a[i] := 1;
+    END_FUNCTION_BLOCK
+""")
+
 
 
 def test_fixtures_run_st_and_failures_show_st_state(pytester):
@@ -40,13 +49,7 @@ def test_fixtures_run_st_and_failures_show_st_state(pytester):
 
 
 def test_simulation_error_location_is_reported(pytester):
-    pytester.makefile(".st", FB_OOB=textwrap.dedent("""
-        FUNCTION_BLOCK FB_OOB
-        VAR i : INT; a : ARRAY[0..1] OF INT; END_VAR
-        i := i + 1;
-        a[i] := 1;
-        END_FUNCTION_BLOCK
-    """))
+    pytester.makefile(".st", FB_OOB=FB_OOB)
     pytester.makepyfile(test_oob=textwrap.dedent("""
         def test_oob(st_load):
             st_load("FB_OOB.st").instance("FB_OOB").scan(3)
@@ -111,13 +114,7 @@ def test_the_st_state_reaches_the_junit_xml_a_ci_server_shows(pytester):
     held only `assert False` and the traceback: the ST state and the ST location went to the
     terminal alone (report sections --junitxml does not write). They are now in the
     failure's text, once, also from an xdist worker; the terminal shows them once, as before."""
-    pytester.makefile(".st", FB_DELAY=FB_DELAY, FB_OOB=textwrap.dedent("""
-        FUNCTION_BLOCK FB_OOB
-        VAR i : INT; a : ARRAY[0..1] OF INT; END_VAR
-        i := i + 1;
-        a[i] := 1;
-        END_FUNCTION_BLOCK
-    """))
+    pytester.makefile(".st", FB_DELAY=FB_DELAY, FB_OOB=FB_OOB)
     pytester.makepyfile(test_ci=textwrap.dedent("""
         def test_wrong_expectation(st_load):
             fb = st_load("FB_DELAY.st").instance("FB_DELAY")
