@@ -590,3 +590,36 @@ def test_an_empty_report_name_is_a_command_line_mistake(tmp_path, monkeypatch):
     result = invoke("monitor", "--tcp", "127.0.0.1:1", "--capture", "--json", "r.json")
     assert result.exit_code == 2 and "Invalid value for '--capture': '--json' is an option, not a file" in result.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["j.xml", "site.txt"]
+
+
+def test_st_that_does_not_load_is_named_as_the_command_line_reaches_it(tmp_path, monkeypatch):
+    """`uitamr verify plc/*.st` in the repository named a syntax error
+    `/home/runner/work/.../plc/MAIN.st:5:6` on the console and in the JUnit test case's name
+    and `file`, while `uitamr check`, the frames' "sent by" and every scenario mistake name
+    it from the working folder: `plc/MAIN.st:5:6`. The ST's own path now, with the platform
+    given and told from the sources alike."""
+    (tmp_path / "plc").mkdir()
+    write_files(tmp_path, {"plc/MAIN.st": BROKEN})
+    monkeypatch.chdir(tmp_path)
+    for platform in (["--platform", "fx3u"], ["--matrix"]):
+        result = invoke("verify", "plc/MAIN.st", *platform, "--junit", "v.xml")
+        assert result.exit_code == 2, result.output
+        assert "plc/MAIN.st:5:6: error: expected an expression" in result.output
+        assert str(tmp_path) not in result.output, result.output
+        (case,) = cases(tmp_path / "v.xml")
+        assert (case.get("name"), case.get("file")) == ("plc/MAIN.st:5:6", "plc/MAIN.st")
+
+
+def test_a_mistake_test_case_carries_its_line_for_the_annotation(tmp_path):
+    """A typo in a scenario key (`duraton`) was the test case `x.toml:4:1` with `file` but
+    no `line`: GitHub's JUnit actions read `file` and `line` and put the annotation on
+    line 1 of the file. The line is now the mistake's own; a file that cannot be read at
+    all (its place 0:0) gets none."""
+    write_files(tmp_path, {"GOOD.st": GOOD, "x.toml": 'name = "x"\nprogram = "GOOD"\n\nduraton = "30s"\n'})
+    result = invoke("verify", tmp_path / "GOOD.st", "--scenario", tmp_path / "x.toml", "--junit", tmp_path / "v.xml")
+    assert result.exit_code == 2, result.output
+    (case,) = cases(tmp_path / "v.xml")
+    assert (case.get("file"), case.get("line")) == (str(tmp_path / "x.toml"), "4")
+    result = invoke("verify", tmp_path / "MISSING.st", tmp_path / "GOOD.st", "--junit", tmp_path / "v.xml")
+    assert result.exit_code == 2, result.output
+    assert all(case.get("line") is None for case in cases(tmp_path / "v.xml"))

@@ -292,7 +292,7 @@ def test_a_scenario_on_the_wrong_platform_says_which_platform_to_set(tmp_path):
     unset.write_text(text, encoding="utf-8")
     result = invoke("--scenario", unset)
     assert result.exit_code == 2
-    assert str(PLC / "fx5" / "UITAMR_Port") in result.output  # the load errors stay
+    assert "fx5/UITAMR_Port" in result.output  # the load errors stay (named from the working folder)
     assert (f"{unset}:1:1: platform: the sources load on fx5u, not on fx3u (the default): set "
             'platform = "fx5u" in the scenario, or give --platform fx5u') in result.output
     wrong = tmp_path / "wrong.toml"
@@ -1469,3 +1469,35 @@ def test_every_scenario_file_without_sources_is_named_in_one_run(tmp_path):
     assert [line.split(": ")[1] for line in errors] == [f"{first}:1:1", f"{second}:1:1"]
     assert all("no ST sources" in line for line in errors)
     assert "Traceback" not in done.stderr and done.stdout == ""
+
+
+def test_a_channel_that_picked_a_cpu_the_sources_do_not_fit_is_blamed(tmp_path):
+    """`uitamr verify FX3-SOURCES --channel fx5:1` (no scenario file, no --platform: the
+    port picks its CPU) said "the sources load on fx3u, not on fx5u (the default): give
+    --platform fx3u", though nothing was a default and --platform fx3u beside --channel
+    fx5:1 is refused in turn. The option that picked the CPU is named, with the ports of
+    the CPU the sources fit."""
+    result = invoke(*FX3_SOURCES, "--program", "UITAMR_ExampleFx3", "--channel", "fx5:1", "--duration", "1s")
+    assert result.exit_code == 2, result.output
+    assert "(the default)" not in result.output, result.output
+    assert ("--channel fx5:1: a port of the fx5u, on which the sources do not load; they load on fx3u: give a "
+            "port of the fx3u (fx3:1, fx3:2, adp:1) or leave --channel out") in " ".join(result.output.split())
+
+
+def test_a_channel_over_the_tcp_route_is_not_applied_silently(tmp_path):
+    """`--channel fx5:2` with a TCP scenario (a [converter]) ran as if the option were not
+    there, and said nothing: the integrator believed the robot on channel 2 was tested. A
+    run of TCP scenarios only refuses it (exit 2), as the file's own `channel` beside
+    [converter] is refused; beside a serial scenario, the TCP one's run says in a note."""
+    tcp, serial = PLC / "scenarios" / "fx5u-tcp-healthy.toml", PLC / "scenarios" / "fx5u-healthy.toml"
+    refused = invoke("--scenario", tcp, "--channel", "fx5:2", "--duration", "1s", "--junit", tmp_path / "v.xml")
+    assert refused.exit_code == 2, refused.output
+    assert "--channel fx5:2: names a serial port, and every scenario of this run reaches the robot over TCP" in (
+        " ".join(refused.output.split()))
+    report = tmp_path / "r.json"
+    both = invoke("--scenario", tcp, "--scenario", serial, "--channel", "fx5:1", "--duration", "1s", "--json", report)
+    assert both.exit_code == 1, both.output  # the examples' 40 s windows: the runs are cut short
+    over_tcp, on_serial = json.loads(report.read_text())["scenarios"]
+    note = "--channel fx5:1 not applied: this scenario reaches the robot over TCP through its converter, not a serial port"
+    assert note in over_tcp["notes"] and note not in on_serial["notes"]
+    assert on_serial["channel"] == "fx5:1"

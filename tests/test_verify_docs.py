@@ -493,10 +493,30 @@ def test_verifier_md_says_what_the_junit_of_a_run_that_cannot_start_holds():
     placed, unplaced = root.findall("./testsuite/testcase")
     assert f"classname `{placed.get('classname')}`" in section
     assert f'<error type="{placed.find("error").get("type")}">' in section
-    assert (placed.get("name"), placed.get("file")) == ("s.toml:4:1", "s.toml")
-    assert "name = its place `file:line:col` and `file` = the file it names" in section
+    assert (placed.get("name"), placed.get("file"), placed.get("line")) == ("s.toml:4:1", "s.toml", "4")
+    assert "name = its place `file:line:col`, `file` = the file it names and `line` its line" in section
     assert placed.find("error").get("message") == "s.toml:4:1: duraton: unknown key"  # the first line
     assert unplaced.get("name") == "input" and unplaced.get("file") is None
     assert "name `input` and no `file`" in section and "`--program MIAN`" in section
     replay = unusable_element([Mistake("c.txt:1:16: 'zz' is not a byte in hex", Place("c.txt", 1, 16))], "uitamr replay")
     assert f"classname `{replay.find('./testsuite/testcase').get('classname')}`" in section
+
+
+def test_ci_md_github_job_publishes_every_junit_file_its_steps_write():
+    """ci.md's GitHub job published `report_paths: verify.xml` while its --matrix step wrote
+    verify-matrix.xml: the fault sets' results never reached the check run; and the matrix
+    step, after a failed verify step, was skipped. Every --junit file of the GitHub section
+    is matched by the report step's report_paths, and every step that writes one runs
+    after a failure too."""
+    from fnmatch import fnmatch
+
+    text = (DOCS / "ci.md").read_text(encoding="utf-8")
+    github = text.split("## GitHub Actions", 1)[1].split("\n## ", 1)[0]
+    (paths,) = re.findall(r'^\s+report_paths: "?([^"\s]+)"?', github, re.M)
+    written = re.findall(r"--junit (\S+)", github)
+    assert {"verify.xml", "verify-matrix.xml"} <= set(written), written
+    assert all(fnmatch(name, paths) for name in written), (paths, written)
+    steps = [step for step in re.split(r"\n\s*- (?:name|uses|run):", github)
+             if "--junit" in step or "report_paths" in step]
+    for step in steps[1:]:  # each after the first verify step, which may fail
+        assert re.search(r"if: (always\(\)|success\(\) \|\| failure\(\))", step), step

@@ -441,3 +441,33 @@ def test_a_program_that_stops_the_cpu_names_its_st_file_as_the_frames_do(tmp_pat
     monkeypatch.chdir(tmp_path)
     result = run_scenario(replace(default_scenario(duration_us=1_000_000), sources=(crash,), program="Crash"))
     assert result.aborted.startswith("Crash.st:7:"), result.aborted
+
+
+@pytest.mark.parametrize("keep", [KEEP_ALL, Keep(frames=False, details=False)], ids=["whole", "as-it-goes"])
+def test_an_expectation_met_before_the_cpu_stopped_is_met(tmp_path, keep):
+    """The program stopped the CPU at 3 s (an index out of range); its stop command had
+    been sent and answered at 0.23 s, yet `sent = "stop"` within 5 s failed with "the
+    simulation stopped at 3.000 s, before the window closed at 5.000 s": a second failure
+    that was none, beside the real one. What came before the stop is met; what had not
+    come, and `never`, which needs the whole window, still fail and say why."""
+    example = (PLC / "examples" / "fx3" / "UITAMR_ExampleFx3.st").read_text(encoding="utf-8")
+    crash = tmp_path / "Crash.st"
+    crash.write_text(example.replace("PROGRAM UITAMR_ExampleFx3", "PROGRAM Crash")
+                     + "IF X5 THEN uMbx[D200] := 1; END_IF;\n", encoding="utf-8")
+    sources = [*sorted((PLC / "core").glob("*.st")), *sorted((PLC / "fx3").glob("*.st")),
+               *sorted((PLC / "examples" / "common").glob("*.st")), crash]
+    listed = ", ".join(f'"{p.as_posix()}"' for p in sources)
+    scenario = parse_scenario(
+        f'name = "crash"\nsources = [{listed}]\nprogram = "Crash"\nduration = "10s"\n'
+        '[initial]\nD200 = 99\n[[inputs]]\nat = "3s"\nset = { X5 = true }\n'
+        '[[expect]]\nsent = "stop"\nwithin = "5s"\n'
+        '[[expect]]\nthat = "fbEngine.o_bInitDone"\nwithin = "5s"\n'
+        '[[expect]]\nthat = "fbCycle.o_bCycle"\nwithin = "5s"\n'
+        '[[expect]]\nnever = "fbEngine.o_bErr"\nwithin = "5s"\n', tmp_path / "s.toml")
+    result = run_scenario(scenario, keep=keep)
+    assert "Crash.st" in result.aborted and result.ended_us == 3_000_000
+    stop, init, cycle, never = result.expectations
+    assert stop.passed and init.passed, (stop.detail, init.detail)
+    for failed in (cycle, never):
+        assert not failed.passed
+        assert failed.detail == "the simulation stopped at 3.000 s, before the window closed at 5.000 s"

@@ -48,7 +48,11 @@ def st_load(request):
 def st_project(request, st_load):
     marker = request.node.get_closest_marker("st")
     if marker is None:
-        raise pytest.UsageError("st_project needs @pytest.mark.st('file.st', ..., target=...)")
+        # the test's mistake, not the plugin's: its place and what to write, no traceback of the plugin
+        fspath, lineno, name = request.node.location
+        pytest.fail(f"{fspath}:{(lineno or 0) + 1}: {name} uses the st_project fixture but has no "
+                    "@pytest.mark.st('file.st', ..., target=...) naming the ST to load; add one, or use "
+                    "st_load('file.st') in the test", pytrace=False)
     return st_load(*marker.args, **marker.kwargs)
 
 
@@ -137,9 +141,16 @@ def pytest_runtest_makereport(item, call):
     project_module = sys.modules.get("verifier.sim.project")
     if not projects and project_module is not None:
         projects = [p for p in project_module.live_projects() if p.touched]
-    for i, project in enumerate(projects[-3:]):
-        report.sections.append((f"ST state {i + 1}", describe_project(project)))
+    sections = [(f"ST state {i + 1}", describe_project(project)) for i, project in enumerate(projects[-3:])]
     err = getattr(call.excinfo, "value", None) if call.excinfo else None
     location = getattr(err, "location", None)
     if location:
-        report.sections.append(("ST location", f"{location}: {getattr(err, 'message', err)}"))
+        sections.append(("ST location", f"{location}: {getattr(err, 'message', err)}"))
+    add = getattr(report.longrepr, "addsection", None)
+    for name, text in sections:
+        # in the failure's own text: what --junitxml writes into <failure> (a CI server shows
+        # it); report.sections reach only the terminal. The terminal shows them alike.
+        if add is not None:
+            add(name, text)
+        else:
+            report.sections.append((name, text))

@@ -217,6 +217,8 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
     scenarios = [replace(s, platform_from_option=platform_given, program_from_option=program is not None,
                          channel_from_option=channel is not None, duration_from_option=duration is not None)
                  for s in scenarios]
+    if channel is not None:
+        scenarios = _channel_over_tcp(scenarios, channel)
     if scan is not None and duration is not None and scan > duration:
         # both values are the options': no file's line is to blame
         raise UnusableInput(f"--scan {format_duration(scan)}: the scan time is longer than the whole run "
@@ -270,6 +272,19 @@ def _check_options(scenario: Scenario, scan: int | None, duration: int | None) -
             f"{scenario.key_where('scan_jitter')}: must be shorter than "
             f"the scan time ({format_duration(scenario.scan_us)})"
             + (f" with --scan {format_duration(scan)}" if scan is not None else ""), at=scenario.key_at("scan_jitter"))
+
+
+def _channel_over_tcp(scenarios: list[Scenario], channel: str) -> list[Scenario]:
+    """`--channel` names a serial port; a scenario whose robot is reached over TCP
+    ([converter]) has none, and ran as if the option were not there. Such a run says so in
+    a note; when no run has a serial port at all, the option is a mistake (exit 2)."""
+    if all(s.converter is not None for s in scenarios):
+        raise UnusableInput(f"--channel {channel}: names a serial port, and every scenario of this run reaches the "
+                            "robot over TCP through a converter ([converter], or a program that uses the Ethernet "
+                            "instructions): it has no serial port to replace; leave --channel out")
+    note = (f"--channel {channel} not applied: this scenario reaches the robot over TCP through its converter, "
+            "not a serial port")
+    return [replace(s, notes=s.notes + (note,)) if s.converter is not None else s for s in scenarios]
 
 
 def _cut_short(scenario: Scenario) -> Scenario:

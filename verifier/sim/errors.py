@@ -23,6 +23,23 @@ class LoadError(Exception):
         shows it (`file:line:col: severity: message`)."""
         return [_format_diag(d) for d in self.diagnostics]
 
+    def shown_from(self, cwd: str) -> "LoadError":
+        """The same diagnostics, each source's path as reports show it from the working
+        folder `cwd` (relative when inside it, by the path the sources reach it:
+        textfile.shown_path): `uitamr verify` names ST errors as `uitamr check` and the
+        frames' ST places do (`plc/MAIN.st:7:1`), not by the absolute path it loaded."""
+        from dataclasses import is_dataclass, replace
+
+        from verifier.textfile import shown_path
+
+        def shown(d):
+            file = getattr(d, "file", None)
+            if not is_dataclass(d) or not isinstance(file, str) or file.startswith(OPTION_PLACE):
+                return d
+            return replace(d, file=shown_path(file, cwd))
+
+        return type(self)([shown(d) for d in self.diagnostics])
+
     def place(self) -> Place | None:
         """The place of the first error that names a source's line (not an option of
         verifier.load), as its line of the message shows it; None if none does."""

@@ -9,6 +9,7 @@ from the sources (scenario.TOLD_PLATFORMS): what loads on it loads on the FX3U t
 """
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -35,7 +36,7 @@ def platforms_that_load(sources: tuple[Path, ...]) -> tuple[list[str], dict[str,
         try:
             verifier.load(*[str(p) for p in sources], target=PLATFORMS[platform][0], cpu=platform)
         except LoadError as exc:
-            errors[platform] = exc
+            errors[platform] = exc.shown_from(os.getcwd())  # the paths as the reports show them
             continue
         fits.append(platform)
     return fits, errors

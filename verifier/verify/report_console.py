@@ -77,7 +77,9 @@ def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
     for found in broken:
         _rule_block(found, console, first)
     for outcome in result.failed_expectations:
-        console.print(f"    [red]expected[/] {escape(outcome.expectation.label)}: {escape(outcome.detail)}")
+        place = result.place_of(outcome.expectation)
+        at = f"  [dim]at {escape(str(place))}[/]" if place is not None else ""
+        console.print(f"    [red]expected[/] {escape(outcome.expectation.label)}: {escape(outcome.detail)}{at}")
 
 
 def _rule_block(found: list, console: Console, first: int) -> None:

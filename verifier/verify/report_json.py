@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from verifier import __version__
+from verifier.place import Place
 from verifier.textfile import UNENCODABLE, whole_file
 
 from .evidence import Violation
@@ -45,13 +46,15 @@ def violation_dict(violation: Violation) -> dict[str, Any]:
     }
 
 
-def expectation_dict(outcome: ExpectationResult) -> dict[str, Any]:
+def expectation_dict(outcome: ExpectationResult, place: Place | None = None) -> dict[str, Any]:
+    """`place`: where the scenario file states it (ScenarioResult.place_of)."""
     return {
         "expectation": outcome.expectation.label,
         "kind": outcome.expectation.kind,
         "passed": outcome.passed,
         "detail": outcome.detail,
         "t": _seconds(outcome.t_us),
+        "place": None if place is None else str(place),
     }
 
 
@@ -85,7 +88,7 @@ def scenario_dict(result: ScenarioResult) -> dict[str, Any]:
             for rule in RULES
         },
         "violations": [violation_dict(v) for v in result.all_violations()],
-        "expectations": [expectation_dict(e) for e in result.expectations],
+        "expectations": [expectation_dict(e, result.place_of(e.expectation)) for e in result.expectations],
         "watched": {
             name: [[_seconds(t), value] for t, value in changes] for name, changes in result.watched.items()
         },

@@ -77,7 +77,13 @@ def to_element(results: list[ScenarioResult], command: str = "uitamr verify") ->
                 )
         for outcome in result.failed_expectations:
             failures += 1
-            _failure(case, "expectation", f"expected {outcome.expectation.label}: {outcome.detail}", outcome.detail)
+            place = result.place_of(outcome.expectation)
+            at = f"  at {place}" if place is not None else ""
+            # the text starts at the scenario's line, as a compiler's message does
+            text = f"{place}: {outcome.expectation.key}: {outcome.detail}" if place is not None else outcome.detail
+            _failure(case, "expectation", f"expected {outcome.expectation.label}: {outcome.detail}{at}", text)
+            if place is not None and case.get("line") is None:
+                case.set("line", str(place.line))  # a JUnit reader's annotation: the first failed [[expect]]
         out = ET.SubElement(case, "system-out")
         tx, rx = result.tx_count, result.rx_count
         out.text = "\n".join(
@@ -131,6 +137,8 @@ def unusable_element(mistakes: list[Mistake], command: str = "uitamr verify",
                              name=name, time="0.000")
         if mistake.place is not None:
             case.set("file", mistake.place.file)
+            if mistake.place.line > 0:  # where a JUnit reader (GitHub's actions) annotates the file
+                case.set("line", str(mistake.place.line))
         element = ET.SubElement(case, "error", message=_headline(mistake), type="unusable-input")
         element.text = mistake.message
     return suites

@@ -15,7 +15,7 @@ from verifier.place import Place
 
 from .durations import format_seconds
 from .evidence import DEFAULT_RESPONSE_WITHIN_US, RuleOptions, Violation
-from .expectations import ExpectationResult
+from .expectations import Expectation, ExpectationResult
 
 
 @dataclass(frozen=True)
@@ -219,6 +219,15 @@ class ScenarioResult:
     @property
     def failed_expectations(self) -> list[ExpectationResult]:
         return [result for result in self.expectations if not result.passed]
+
+    def place_of(self, expectation: Expectation) -> Place | None:
+        """Where the scenario file states `expectation` (`verify/no-reply.toml:21:1`, its
+        kind's key, the file as the reports name it), so that a failed one says which table
+        to look at; None for one no file states (the answered power-on stop a scenario
+        without [[expect]], or a run without a file, expects)."""
+        if self.file is None or expectation.line is None:
+            return None
+        return expectation.line.in_file(self.file)
 
     @property
     def broke_nothing(self) -> bool:

@@ -72,6 +72,7 @@ class _Plc:
                 programs=None if scenario.program is None else [scenario.program],
             )
         except LoadError as exc:
+            exc = exc.shown_from(os.getcwd())  # plc/MAIN.st:7:1, as `uitamr check` and "sent by" name it
             hint = _platform_hint(scenario)
             # one JUnit test case per error, each at its place (the message lists them all)
             each = [Mistake(text + hint, place) for place, text in exc.located()]
@@ -270,6 +271,13 @@ def _platform_hint(scenario: Scenario) -> str:
     if scenario.platform_from_option:  # the option is to blame, not a file's key
         return (f"\n--platform {scenario.platform}: the sources load on {', '.join(fits)}, not on "
                 f"{scenario.platform}: give --platform {fits[0]}")
+    if scenario.path is None and scenario.channel_from_option:
+        # --channel fx5:1 picked the CPU its port belongs to: the option is to blame, not a default
+        from verifier.plcfacts import serial_channels
+
+        return (f"\n--channel {scenario.channel}: a port of the {scenario.platform}, on which the sources do not "
+                f"load; they load on {', '.join(fits)}: give a port of the {fits[0]} "
+                f"({', '.join(serial_channels(fits[0]))}) or leave --channel out")
     if scenario.path is None:  # no file's key to point at
         return (f"\nthe sources load on {', '.join(fits)}, not on {scenario.platform} (the default): "
                 f"give --platform {fits[0]}")

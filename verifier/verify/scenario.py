@@ -820,7 +820,8 @@ class _Reader:
                 raise self.fail(f"{key}.reached_point", f"expected a point number 1-21, got {shown(value)}")
             fields["point"] = value
             what = f"robot reached point {value}"
-        expectation = Expectation(kind=kind, label="", after_us=after, within_us=within, key=key, **fields)
+        expectation = Expectation(kind=kind, label="", after_us=after, within_us=within, key=key,
+                                  line=self.line_of(f"{key}.{kind}"), **fields)
         label = item.get("name")
         if label is None:
             label = f"{what} {describe_window(expectation)}".strip()
