@@ -407,3 +407,37 @@ def test_pause_and_resume_of_a_running_point_as_the_library_page_wires_it():
     _press(project, run, "X1", 100)                            # the stop clears it
     run(2000)
     assert not h.bObstacle and h.fbStop.o_uErrId == 0
+
+
+def test_a_stop_during_a_point_lights_no_lamp_wired_as_the_page_shows():
+    """journey33b: a cell's error lamp latched every o_bErr of its command FBs, as
+    UITAMR_PanelFx3's fault lamp does; the operator's stop during a point lit it (the run
+    ended with 16#0305), and no page said that a stop ends the command it overtakes with an
+    error. The page's lamp, run as printed: the run ends with 16#0305, the lamp stays off;
+    a robot that stops answering lights it with 16#0101, and X2 clears it."""
+    import re
+
+    from verifier.amr.faults import Fault
+
+    page = (PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8")
+    section = page.split("**A stop is not a fault of the command it ends.**", 1)[1].split("\n### ", 1)[0]
+    snippet = re.search(r"```iecst\n(.*?)```", section, re.S).group(1)
+    body = ("fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);\n"
+            "fbRun(i_bEN := TRUE, i_bExecute := X0, i_wPoint := 3, io_uMbx := uMbx);\n"
+            "fbStop(i_bEN := TRUE, i_bExecute := X1, io_uMbx := uMbx);\n" + snippet
+            + "IF fbRun.o_bErr THEN\n    bNaive := TRUE;\nEND_IF;\n")          # a lamp of every o_bErr
+    project, robot, line, run = _cell(
+        "    fbRun : UITAMR_RunPoint;\n    fbStop : UITAMR_Stop;\n    bLamp : BOOL;\n    uLampErr : WORD;\n"
+        "    bNaive : BOOL;\n",
+        body, faults=[Fault(kind="no_reply", at_s=12.0, duration_s=5.0)])
+    h = project.program("T_Cell")
+    _press(project, run, "X0", 2000)
+    _press(project, run, "X1", 2000)                          # the stop during the move, at 4 s
+    run(2000)
+    assert h.fbRun.o_uErrId == 0x0305 and h.fbStop.o_uErrId == 0 and robot.mode == "idle"  # kept after o_bErr
+    assert not h.bLamp and h.uLampErr == 0 and h.bNaive       # the page's lamp stays off, a naive one lit
+    _press(project, run, "X0", 4000)                          # again at ~10.3 s; silent from 12 s
+    run(6000)
+    assert h.bLamp and h.uLampErr == 0x0101
+    _press(project, run, "X2", 1000)
+    assert not h.bLamp and h.uLampErr == 0
