@@ -255,3 +255,44 @@ END_PROGRAM
     assert [(d.line, d.col) for d in diags] == [(28, 1), (30, 1)], [str(d) for d in diags]
     assert "FB instance 'fbHeld' is called a second time in every scan (first at 27:1)" in diags[0].message
     assert "FB instance 'fbSeq' is called a second time in every scan (first at 29:1)" in diags[1].message
+
+
+ONLY_UNDER_IF = """\
+PROGRAM Cell
+VAR
+    fbStop : UITAMR_Stop;
+    fbRun : UITAMR_RunPoint;
+    fbPause : UITAMR_Pause;
+    uMbx : ARRAY[0..15] OF WORD;
+    bStop : BOOL;
+    bGo : BOOL;
+    bHold : BOOL;
+END_VAR
+IF bStop THEN
+    fbStop(i_bEN := TRUE, i_bExecute := TRUE, io_uMbx := uMbx);
+END_IF;
+IF bGo THEN
+    fbRun(i_bEN := TRUE, i_bExecute := TRUE, i_wPoint := 3, io_uMbx := uMbx);
+ELSE
+    fbRun(i_bEN := TRUE, i_bExecute := FALSE, i_wPoint := 3, io_uMbx := uMbx);
+END_IF;
+fbPause(i_bEN := bHold, i_bExecute := TRUE, io_uMbx := uMbx);
+END_PROGRAM
+"""
+
+
+def test_a_command_fb_called_only_under_a_condition_or_on_a_constant_true_is_warned():
+    """journey33b: `IF X1 THEN fbStop(i_bEN := TRUE, i_bExecute := TRUE, ...)` passed `uitamr
+    check` at 0 warnings, stopped the robot once under verify and never again (the second
+    press was no rising edge: the instance had not run while X1 was off), and verify said
+    only that the stop was not sent. `i_bEN := X3, i_bExecute := TRUE` (the button on the
+    wrong input) sent nothing at all. A call in every branch of an IF with an ELSE is a call
+    on every scan, and TRUE there is the edge the ELSE's FALSE makes: not warned."""
+    diags = _check(ONLY_UNDER_IF, ROOT / "plc" / "core")
+    assert [(d.line, d.col, d.severity) for d in diags] == [(12, 5, "warning"), (19, 39, "warning")], \
+        [str(d) for d in diags]
+    assert "FB instance 'fbStop' is called only under a condition" in diags[0].message
+    assert "a second press sends nothing" in diags[0].message
+    assert "call it on every scan, outside the IF, and give the condition to i_bExecute" in diags[0].message
+    assert diags[1].message.startswith("i_bExecute := TRUE on every scan: 'fbPause' starts on a rising edge")
+    assert "TRUE to i_bEN" in diags[1].message

@@ -314,3 +314,130 @@ def test_a_relative_move_is_accepted_while_it_rounds_into_the_command_byte():
             assert (fb.o_bErr, mbx[0], mbx[2], mbx[3]) == (False, 1, code, units), (axis, value)
     header = " ".join((PLC / "core" / "UITAMR_MoveRelative.st").read_text(encoding="utf-8").split("*)", 1)[0].split())
     assert "25.54 m sends 255; at 255.5 or more (25.56 m, 2.556 rad) 16#0301, nothing sent" in header
+
+
+PAUSE_FRAME = encode(ControlRequest(1, 1, 0x80), SETTINGS)
+POINT_3 = encode(ControlRequest(1, 1, 3), SETTINGS)
+
+
+def _cell(declarations: str, body: str, point_duration_s: float = 8.0, faults=()):
+    """A cell program on an FX3U (RS2 ch1) around `body`, the robot's point run taking
+    `point_duration_s`: (project, robot, line, run(ms))."""
+    program = ("PROGRAM T_Cell\nVAR\n    fbPort : UITAMR_PortFx3;\n    fbEngine : UITAMR_Engine;\n"
+               "    uMbx : ARRAY[0..15] OF WORD;\n    uPort : ARRAY[0..39] OF WORD;\n" + declarations + "END_VAR\n"
+               "fbPort(i_bEN := TRUE, i_wChannel := 1, i_bRs232 := FALSE, io_uPort := uPort);\n" + body + "END_PROGRAM\n")
+    project = verifier.load(PLC / "core", PLC / "fx3", sources={"T_Cell.st": program})
+    robot = Robot(config=RobotConfig(point_duration_s=point_duration_s), faults=faults)
+    line = Line(robot)
+    project.attach_serial("fx3:1", line)
+    return project, robot, line, lambda ms: project.run_programs(["T_Cell"], ms=ms)
+
+
+def _press(project, run, device, at_ms_from_now):
+    run(at_ms_from_now)
+    project.devices[device] = True
+    run(300)
+    project.devices[device] = False
+
+
+def _controls_at(line):
+    return [(round(f.t_start_us / 1e6, 2), f.data) for f in line.trace if f.direction == "tx" and f.data[1] == 0x06]
+
+
+def test_a_pause_waits_behind_a_run_point_until_its_point_ended():
+    """journey33b: a cell wired from the page (start X0 -> UITAMR_RunPoint, pause X3 ->
+    UITAMR_Pause, resume X4 -> a second UITAMR_RunPoint of the same point) paused nothing:
+    the pause pressed 3 s into an 8 s point went out after the point had ended, and the
+    resume ran the point a second time. plc-library.md now says so and shows the wiring
+    that pauses (next test)."""
+    project, robot, line, run = _cell(
+        "    fbRun : UITAMR_RunPoint;\n    fbPause : UITAMR_Pause;\n    fbResume : UITAMR_RunPoint;\n",
+        "fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);\n"
+        "fbRun(i_bEN := TRUE, i_bExecute := X0, i_wPoint := 3, io_uMbx := uMbx);\n"
+        "fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);\n"
+        "fbResume(i_bEN := TRUE, i_bExecute := X4, i_wPoint := 3, io_uMbx := uMbx);\n")
+    _press(project, run, "X0", 2000)                          # point 3 from ~2.3 s, 8 s long
+    _press(project, run, "X3", 2700)                          # pause at 5 s
+    _press(project, run, "X4", 2700)                          # resume at 8 s
+    run(20_000)
+    sent = _controls_at(line)
+    (run_at, _), (pause_at, pause), (again_at, again) = [c for c in sent if c[1] != sent[0][1]]
+    point_end = run_at + 8.0
+    assert pause == PAUSE_FRAME and pause_at > point_end      # the point had ended: nothing paused
+    assert again == POINT_3 and again_at > pause_at           # and the "resume" runs it again
+    page = (PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8")
+    assert "test_a_pause_waits_behind_a_run_point_until_its_point_ended" in page
+
+
+def test_pause_and_resume_of_a_running_point_as_the_library_page_wires_it():
+    """The page's wiring (plc-library.md, 'Pause and resume while a point runs'), run as
+    printed: the pause goes out while the point runs and the task stays reported running,
+    the resume sends the point again, the robot finishes it (paused time not counted), and
+    the point's end is o_bTaskRunning falling; an obstacle during a run shows on the
+    monitor's o_wRobotErr, not on the engine's o_bErr, and the stop clears it."""
+    import re
+
+    from verifier.amr.faults import Fault
+
+    page = (PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8")
+    section = page.split("### Pause and resume while a point runs", 1)[1].split("\n## ", 1)[0]
+    snippet = re.search(r"```iecst\n(.*?)```", section, re.S).group(1)
+    declarations = ("    fbGo : UITAMR_Command;\n    fbPause : UITAMR_Pause;\n    fbResume : UITAMR_Command;\n"
+                    "    fbStop : UITAMR_Stop;\n    bMoving : BOOL;\n    bObstacle : BOOL;\n")
+    project, robot, line, run = _cell(declarations, snippet, faults=[Fault(kind="anti_collision", at_s=24.0)])
+    h = project.program("T_Cell")
+    _press(project, run, "X0", 2000)                          # point 3 from ~2.4 s, 8 s long
+    run(700)
+    assert h.bMoving and robot.mode == "running"
+    _press(project, run, "X3", 2000)                          # pause ~3 s into the run
+    run(700)
+    assert robot.mode == "paused" and h.bMoving                 # paused, still reported running
+    _press(project, run, "X4", 5000)                           # resume after 5 s of pause (11 s)
+    run(700)
+    assert robot.mode == "running"
+    assert [c[1] for c in _controls_at(line)][1:] == [POINT_3, PAUSE_FRAME, POINT_3]
+    run(3000)                                                   # 15 s: unpaused it would have ended at ~10.4 s
+    assert robot.mode == "running" and h.bMoving
+    run(5000)                                                   # 20 s
+    assert robot.mode == "idle" and not h.bMoving and not h.bObstacle and not h.fbEngine.o_bErr
+    _press(project, run, "X0", 2000)                           # again at 22 s; an obstacle at 24 s
+    run(4000)
+    assert h.bObstacle and not h.bMoving and robot.mode != "running"
+    assert not h.fbEngine.o_bErr and h.fbEngine.o_uErrId == 0  # not the engine's error: the monitor's byte
+    _press(project, run, "X1", 100)                            # the stop clears it
+    run(2000)
+    assert not h.bObstacle and h.fbStop.o_uErrId == 0
+
+
+def test_a_stop_during_a_point_lights_no_lamp_wired_as_the_page_shows():
+    """journey33b: a cell's error lamp latched every o_bErr of its command FBs, as
+    UITAMR_PanelFx3's fault lamp does; the operator's stop during a point lit it (the run
+    ended with 16#0305), and no page said that a stop ends the command it overtakes with an
+    error. The page's lamp, run as printed: the run ends with 16#0305, the lamp stays off;
+    a robot that stops answering lights it with 16#0101, and X2 clears it."""
+    import re
+
+    from verifier.amr.faults import Fault
+
+    page = (PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8")
+    section = page.split("**A stop is not a fault of the command it ends.**", 1)[1].split("\n### ", 1)[0]
+    snippet = re.search(r"```iecst\n(.*?)```", section, re.S).group(1)
+    body = ("fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);\n"
+            "fbRun(i_bEN := TRUE, i_bExecute := X0, i_wPoint := 3, io_uMbx := uMbx);\n"
+            "fbStop(i_bEN := TRUE, i_bExecute := X1, io_uMbx := uMbx);\n" + snippet
+            + "IF fbRun.o_bErr THEN\n    bNaive := TRUE;\nEND_IF;\n")          # a lamp of every o_bErr
+    project, robot, line, run = _cell(
+        "    fbRun : UITAMR_RunPoint;\n    fbStop : UITAMR_Stop;\n    bLamp : BOOL;\n    uLampErr : WORD;\n"
+        "    bNaive : BOOL;\n",
+        body, faults=[Fault(kind="no_reply", at_s=12.0, duration_s=5.0)])
+    h = project.program("T_Cell")
+    _press(project, run, "X0", 2000)
+    _press(project, run, "X1", 2000)                          # the stop during the move, at 4 s
+    run(2000)
+    assert h.fbRun.o_uErrId == 0x0305 and h.fbStop.o_uErrId == 0 and robot.mode == "idle"  # kept after o_bErr
+    assert not h.bLamp and h.uLampErr == 0 and h.bNaive       # the page's lamp stays off, a naive one lit
+    _press(project, run, "X0", 4000)                          # again at ~10.3 s; silent from 12 s
+    run(6000)
+    assert h.bLamp and h.uLampErr == 0x0101
+    _press(project, run, "X2", 1000)
+    assert not h.bLamp and h.uLampErr == 0

@@ -414,7 +414,7 @@ def test_import_gxworks2_registers_every_program_it_exports():
                          if p.kind == "PROGRAM"}
     text = " ".join((ROOT / "docs" / "import-gxworks2.md").read_text(encoding="utf-8").split())
     step = text.split("## 4. Programs and tasks", 1)[1].split("## 5.", 1)[0]
-    assert len(programs) == 5 and set(re.findall(r"`(UITAMR_\w+)`", step)) == programs
+    assert len(programs) == 6 and set(re.findall(r"`(UITAMR_\w+)`", step)) == programs
 
 
 def test_the_label_prefixes_are_the_type_letters_the_library_page_lists():

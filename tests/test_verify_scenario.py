@@ -673,6 +673,20 @@ def test_a_control_command_not_sent_names_what_was_sent_instead():
     assert "instead" not in results[2].detail  # the other reads would be noise
 
 
+def test_a_request_sent_outside_the_window_says_when_it_went_out():
+    """journey33b: a pause pressed while UITAMR_RunPoint waited for its point went out 5.8 s
+    late, after the point had ended (it queued behind the run); the finding said only 'was
+    not sent between 5.000 s and 6.000 s', as for a pause never sent at all."""
+    PAUSE = protocol.ControlRequest(1, protocol.ControlCode.ROBOT, protocol.RobotCommand.PAUSE)
+    trace = _control(0, STOP) + _control(600, POINT3) + _read(900, 1) + _read(1200, 0) + _control(1500, PAUSE)
+    late, early = _judge('[[expect]]\nsent = "pause"\nafter = "0.7s"\nwithin = "0.5s"\n'
+                         '[[expect]]\nsent = "stop"\nafter = "0.5s"\nwithin = "0.5s"\n', _evidence({}, trace))
+    assert not late.passed and late.detail.endswith(
+        "was not sent between 0.700 s and 1.200 s; it went out later, at 1.500 s (0.800 s after the window opened)")
+    assert not early.passed and early.detail.endswith(
+        "; sent instead: run point/script 3 (01/03) at 0.600 s; it went out before the window, last at 0.000 s")
+
+
 def test_a_command_answered_with_an_exception_says_so():
     # 'was sent at 0.600 s but never answered' for a command the robot refused with an
     # exception: the user looked for a silent robot

@@ -164,6 +164,32 @@ def _constant(value: ast.Expr | None) -> bool | None:
     return value.value if isinstance(value, ast.BoolLiteral) else None
 
 
+def _execute_input(call: ast.Call) -> str | None:
+    """The name of the edge input that starts an FB instance's command (i_bExecute, or
+    PLCopen's Execute), as its type declares it, or None for an FB without one (a timer,
+    the engine, a port)."""
+    target = call.resolved
+    if getattr(target, "kind", None) != "fb" or target.fb_type is None or target.fb_type.standard:
+        return None
+    return next((n for n, _t in target.fb_type.inputs if n.upper() in ("I_BEXECUTE", "EXECUTE")), None)
+
+
+def _always_calls(body: list[ast.Stmt], key: str) -> bool:
+    """Whether `body` calls the FB instance `key` on every run of it: a call in the body
+    itself, or in every branch of an IF or CASE that has an ELSE (a loop may run no time)."""
+    for s in body:
+        if (isinstance(s, ast.CallStmt) and isinstance(s.call.callee, ast.Name)
+                and s.call.callee.name.upper() == key):
+            return True
+        if isinstance(s, ast.If) and s.else_body is not None:
+            if all(_always_calls(b.body, key) for b in s.branches) and _always_calls(s.else_body, key):
+                return True
+        if isinstance(s, ast.Case) and s.else_body is not None:
+            if all(_always_calls(c.body, key) for c in s.clauses) and _always_calls(s.else_body, key):
+                return True
+    return False
+
+
 @functools.lru_cache(maxsize=8192)
 def label_name_problem(name: str, families: tuple[str, ...] = ()) -> str | None:
     """Why GX Works refuses `name` as a label, or None. Rules: docs/st-dialect.md §4.
@@ -458,6 +484,7 @@ class Checker:
             if complete:  # an unchecked statement may use any label
                 self._unused(info)
                 self._called_twice(info)
+                self._execute_calls(info)
         self.pou = None
 
     def check_structure(self) -> None:
@@ -526,6 +553,54 @@ class Checker:
                                 f"{earlier.line}:{earlier.col}): an instance has one memory, so this call "
                                 f"overwrites the edges and outputs of the first; give the second use its own "
                                 f"instance (e.g. {name}2 : {target.name})")
+
+    def _execute_calls(self, info: PouInfo) -> None:
+        """FB instances started by a rising edge of i_bExecute (or Execute), the library's
+        command FBs and PLCopen-style blocks of one's own, called in a way that cannot give
+        them an edge, which GX Works imports without a word:
+        - called only under a condition (inside an IF, CASE or loop, on no path of every
+          scan): the instance sees its inputs, the falling edge among them, and hands its
+          result back only in the scans it runs, so `IF X1 THEN fbStop(i_bExecute := TRUE`
+          stops the robot once and a second press sends nothing (no falling edge was seen);
+        - given the constant TRUE on every scan: one rising edge, in the first scan, and
+          never another."""
+        calls: dict[str, list[tuple[ast.CallStmt, int]]] = {}
+
+        def walk(body: list[ast.Stmt], depth: int) -> None:
+            for s in body:
+                if isinstance(s, ast.CallStmt):
+                    if isinstance(s.call.callee, ast.Name) and _execute_input(s.call) is not None:
+                        calls.setdefault(s.call.callee.name.upper(), []).append((s, depth))
+                elif isinstance(s, ast.If):
+                    for b in s.branches:
+                        walk(b.body, depth + 1)
+                    walk(s.else_body or [], depth + 1)
+                elif isinstance(s, ast.Case):
+                    for c in s.clauses:
+                        walk(c.body, depth + 1)
+                    walk(s.else_body or [], depth + 1)
+                elif isinstance(s, (ast.For, ast.While, ast.Repeat)):
+                    walk(s.body, depth + 1)
+
+        walk(info.pou.body, 0)
+        for key, found in calls.items():
+            first, _depth = found[0]
+            name, execute = first.call.callee.name, _execute_input(first.call)
+            if not _always_calls(info.pou.body, key):
+                self.rep.warning(first, (
+                    f"FB instance '{name}' is called only under a condition: it sees {execute}, its "
+                    f"falling edge included, and hands its result back only in the scans it is called, "
+                    f"so after one command a new one gets no rising edge (a second press sends nothing); "
+                    f"call it on every scan, outside the IF, and give the condition to {execute} "
+                    f"({execute} := <button>) (docs/plc-library.md: call every FB on every scan)"))
+                continue
+            for s, depth in found:
+                value = next((a.value for a in s.call.args if not a.output and a.key == execute.upper()), None)
+                if depth == 0 and isinstance(value, ast.BoolLiteral) and value.value is True:
+                    self.rep.warning(value, (
+                        f"{execute} := TRUE on every scan: '{name}' starts on a rising edge of {execute}, "
+                        f"and a constant TRUE gives one, in its first scan, and never another; give "
+                        f"{execute} the button or condition that starts the command, and TRUE to i_bEN"))
 
     def _unused(self, info: PouInfo) -> None:
         for decl, _t in info.labels.values():

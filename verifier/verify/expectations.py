@@ -208,6 +208,12 @@ class ExchangeWatch(ABC):
         t = exchange.request.t_start_us
         if self.first_us <= t <= self.last_us:
             self.in_window(exchange, t)
+        else:
+            self.outside(exchange, t)
+
+    def outside(self, exchange, t: int) -> None:
+        """Take `exchange`, whose request started at `t`, before or after the window (for the
+        words of a failure; nothing by default)."""
 
     @abstractmethod
     def in_window(self, exchange, t: int) -> None:
@@ -231,6 +237,18 @@ class _Sent(ExchangeWatch):
         # sent), the first few distinct ones (meaning, time)
         self.instead: dict[str, int] = {}
         self.instead_other: dict[str, int] = {}
+        # the request itself outside the window: the last time before it, the first after
+        # it (a command that waited behind another one goes out late: say when it did)
+        self.before: int | None = None
+        self.later: int | None = None
+
+    def outside(self, exchange, t: int) -> None:
+        if bytes(exchange.request.data) != self.wanted:
+            return
+        if t < self.first_us:
+            self.before = t
+        elif self.later is None:
+            self.later = t
 
     def in_window(self, exchange, t: int) -> None:
         if self.answered is not None:
@@ -267,6 +285,11 @@ class _Sent(ExchangeWatch):
                 f"{other} at {format_seconds(t)}" for other, t in list(instead.items())[:SENT_INSTEAD])
             if len(instead) > SENT_INSTEAD:
                 sent += ", ..."
+        if self.later is not None:
+            sent += (f"; it went out later, at {format_seconds(self.later)} "
+                     f"({format_seconds(self.later - start)} after the window opened)")
+        elif self.before is not None:
+            sent += f"; it went out before the window, last at {format_seconds(self.before)}"
         return ExpectationResult(
             expectation, False,
             f"{meaning} ({protocol.hex_bytes(self.wanted)}) was not sent {_span(start, end)}{sent}",
