@@ -296,3 +296,29 @@ def test_a_command_fb_called_only_under_a_condition_or_on_a_constant_true_is_war
     assert "call it on every scan, outside the IF, and give the condition to i_bExecute" in diags[0].message
     assert diags[1].message.startswith("i_bExecute := TRUE on every scan: 'fbPause' starts on a rising edge")
     assert "TRUE to i_bEN" in diags[1].message
+
+
+
+def test_a_return_in_a_repeat_loop_ends_what_runs():
+    """A REPEAT's body runs once at least, so 'REPEAT RETURN; UNTIL TRUE END_REPEAT;' between
+    two calls of an instance always leaves the POU: the second call was warned 'whenever the
+    RETURN at 8:5 is not taken', of a RETURN that is always taken. It now ends what runs, as a
+    plain RETURN does; an EXIT before the RETURN leaves the loop first, and the RETURN stays
+    one the scan may pass."""
+    text = """\
+PROGRAM Station
+VAR
+    fbTmr : TON;
+    bRun : BOOL;
+END_VAR
+fbTmr(IN := bRun, PT := T#1s);
+REPEAT
+    RETURN;
+UNTIL bRun END_REPEAT;
+fbTmr(IN := bRun, PT := T#2s);
+END_PROGRAM
+"""
+    assert [str(d) for d in _check(text) if "second time" in d.message] == []
+    exits = text.replace("    RETURN;", "    IF bRun THEN\n        EXIT;\n    END_IF;\n    RETURN;")
+    assert [(d.line, d.col) for d in _check(exits) if "second time" in d.message] == [(13, 1)]
+    assert "whenever the RETURN at 11:5 is not taken" in [d.message for d in _check(exits)][-1]

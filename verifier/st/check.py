@@ -146,10 +146,18 @@ def _resets(call: ast.Call, following: ast.Call) -> bool:
 
 
 def _always_returns(s: ast.Stmt) -> bool:
-    """Whether a statement leaves the POU whichever way it runs: a RETURN, or an IF or CASE
-    with an ELSE whose every branch holds one at its own level (a loop may run no time)."""
+    """Whether a statement leaves the POU whichever way it runs: a RETURN, an IF or CASE
+    with an ELSE whose every branch holds one at its own level, or a REPEAT whose body holds
+    one before any EXIT (its body runs once at least; a FOR or WHILE may run no time)."""
     if isinstance(s, ast.Return):
         return True
+    if isinstance(s, ast.Repeat):
+        for x in s.body:
+            if any(isinstance(n, ast.Exit) for n in ast.walk(x)):
+                return False  # the loop may be left before the RETURN
+            if _always_returns(x):
+                return True
+        return False
     if isinstance(s, ast.If):
         bodies = [b.body for b in s.branches] + [s.else_body]
     elif isinstance(s, ast.Case):
