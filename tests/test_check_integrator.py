@@ -298,6 +298,43 @@ def test_a_command_fb_called_only_under_a_condition_or_on_a_constant_true_is_war
     assert "TRUE to i_bEN" in diags[1].message
 
 
+def test_a_command_fb_called_after_an_early_return_is_warned_as_one_under_a_condition():
+    """`IF NOT X1 THEN RETURN; END_IF; fbStop(i_bEN := TRUE, i_bExecute := TRUE, ...);` is the
+    IF of the test above written as a guard: fbStop runs only in the scans that pass the
+    RETURN, sees no falling edge and stops the robot once. It was taken for a call on every
+    scan and warned 'i_bExecute := TRUE on every scan' (the advice, i_bExecute := X1 behind the
+    same RETURN, left the instance seeing TRUE alone), and with the button on i_bExecute not
+    at all. Both are warned now as called only in the scans that do not take the RETURN, with
+    its place; a call before the RETURN, or in every branch before one, stays a call on every
+    scan, and a call after a RETURN of the statement list never runs and is not judged."""
+    guarded = ONLY_UNDER_IF.replace("""IF bStop THEN
+    fbStop(i_bEN := TRUE, i_bExecute := TRUE, io_uMbx := uMbx);
+END_IF;""", """IF NOT bStop THEN
+    RETURN;
+END_IF;
+fbStop(i_bEN := TRUE, i_bExecute := TRUE, io_uMbx := uMbx);""")
+    diags = _check(guarded, ROOT / "plc" / "core")
+    stop = [d for d in diags if "'fbStop'" in d.message]
+    assert [(d.line, d.col) for d in stop] == [(14, 1)], [str(d) for d in diags]
+    assert stop[0].message.startswith("FB instance 'fbStop' is called only in the scans that do not take the "
+                                      "RETURN at 12:5: it sees i_bExecute"), stop[0].message
+    assert "call it on every scan, before the RETURN, and give the condition to i_bExecute" in stop[0].message
+    button = guarded.replace("fbStop(i_bEN := TRUE, i_bExecute := TRUE", "fbStop(i_bEN := TRUE, i_bExecute := bStop")
+    assert [(d.line, d.col) for d in _check(button, ROOT / "plc" / "core") if "'fbStop'" in d.message] == [(14, 1)]
+    # the call before the RETURN runs in every scan; so does one in every branch before a RETURN
+    before = button.replace("IF NOT bStop THEN\n    RETURN;\nEND_IF;\nfbStop(i_bEN := TRUE, i_bExecute := bStop, "
+                            "io_uMbx := uMbx);", "fbStop(i_bEN := TRUE, i_bExecute := bStop, io_uMbx := uMbx);\n"
+                            "IF NOT bStop THEN\n    RETURN;\nEND_IF;")
+    assert before != button and [str(d) for d in _check(before, ROOT / "plc" / "core") if "'fbStop'" in d.message] == []
+    branches = button.replace("IF NOT bStop THEN\n    RETURN;\nEND_IF;\nfbStop(i_bEN := TRUE, i_bExecute := bStop, "
+                              "io_uMbx := uMbx);", "IF NOT bStop THEN\n    fbStop(i_bEN := TRUE, i_bExecute := bStop, "
+                              "io_uMbx := uMbx);\n    RETURN;\nELSE\n    fbStop(i_bEN := TRUE, i_bExecute := bStop, "
+                              "io_uMbx := uMbx);\nEND_IF;")
+    assert branches != button
+    assert [str(d) for d in _check(branches, ROOT / "plc" / "core") if "'fbStop'" in d.message] == []
+    dead = button.replace("IF NOT bStop THEN\n    RETURN;\nEND_IF;", "RETURN;")
+    assert dead != button and [str(d) for d in _check(dead, ROOT / "plc" / "core") if "'fbStop'" in d.message] == []
+
 
 def test_a_return_in_a_repeat_loop_ends_what_runs():
     """A REPEAT's body runs once at least, so 'REPEAT RETURN; UNTIL TRUE END_REPEAT;' between
