@@ -161,6 +161,20 @@ def test_letters_the_page_marks_unconfirmed_are_not_judged():
     assert [str(d) for d in _check(text) if "type letter" in d.message] == []
 
 
+#: two calls of a timer with a RETURN of the statement list between them
+AFTER_RETURN = """\
+PROGRAM Station
+VAR
+    fbTmr : TON;
+    bRun : BOOL;
+END_VAR
+fbTmr(IN := bRun, PT := T#1s);
+RETURN;
+fbTmr(IN := bRun, PT := T#2s);
+END_PROGRAM
+"""
+
+
 def test_a_second_call_after_an_early_return_is_warned_for_the_scans_that_pass_it():
     """`fbTmr(...); IF bStop THEN RETURN; END_IF; fbTmr(...);` was warned 'called a second
     time in every scan', though in the scans that take the RETURN only the first call runs.
@@ -192,17 +206,7 @@ END_PROGRAM
             "not taken (first at 8:1)") in diags[0].message, diags[0].message
     assert ("called a second time in the same scan whenever the RETURNs at 10:5, 14:23 are not taken "
             "(first at 8:1)") in diags[1].message, diags[1].message
-    dead = """\
-PROGRAM Station
-VAR
-    fbTmr : TON;
-    bRun : BOOL;
-END_VAR
-fbTmr(IN := bRun, PT := T#1s);
-RETURN;
-fbTmr(IN := bRun, PT := T#2s);
-END_PROGRAM
-"""
+    dead = AFTER_RETURN
     assert [str(d) for d in _check(dead) if "second time" in d.message] == []
     # an IF whose every branch returns is that RETURN too; one without an ELSE is not
     both = dead.replace("RETURN;", "IF bRun THEN\n    RETURN;\nELSE\n    RETURN;\nEND_IF;")
@@ -342,19 +346,7 @@ def test_a_return_in_a_repeat_loop_ends_what_runs():
     RETURN at 8:5 is not taken', of a RETURN that is always taken. It now ends what runs, as a
     plain RETURN does; an EXIT before the RETURN leaves the loop first, and the RETURN stays
     one the scan may pass."""
-    text = """\
-PROGRAM Station
-VAR
-    fbTmr : TON;
-    bRun : BOOL;
-END_VAR
-fbTmr(IN := bRun, PT := T#1s);
-REPEAT
-    RETURN;
-UNTIL bRun END_REPEAT;
-fbTmr(IN := bRun, PT := T#2s);
-END_PROGRAM
-"""
+    text = AFTER_RETURN.replace("RETURN;", "REPEAT\n    RETURN;\nUNTIL bRun END_REPEAT;")
     assert [str(d) for d in _check(text) if "second time" in d.message] == []
     exits = text.replace("    RETURN;", "    IF bRun THEN\n        EXIT;\n    END_IF;\n    RETURN;")
     assert [(d.line, d.col) for d in _check(exits) if "second time" in d.message] == [(13, 1)]
