@@ -161,6 +161,20 @@ def test_letters_the_page_marks_unconfirmed_are_not_judged():
     assert [str(d) for d in _check(text) if "type letter" in d.message] == []
 
 
+#: two calls of a timer with a RETURN of the statement list between them
+AFTER_RETURN = """\
+PROGRAM Station
+VAR
+    fbTmr : TON;
+    bRun : BOOL;
+END_VAR
+fbTmr(IN := bRun, PT := T#1s);
+RETURN;
+fbTmr(IN := bRun, PT := T#2s);
+END_PROGRAM
+"""
+
+
 def test_a_second_call_after_an_early_return_is_warned_for_the_scans_that_pass_it():
     """`fbTmr(...); IF bStop THEN RETURN; END_IF; fbTmr(...);` was warned 'called a second
     time in every scan', though in the scans that take the RETURN only the first call runs.
@@ -192,17 +206,7 @@ END_PROGRAM
             "not taken (first at 8:1)") in diags[0].message, diags[0].message
     assert ("called a second time in the same scan whenever the RETURNs at 10:5, 14:23 are not taken "
             "(first at 8:1)") in diags[1].message, diags[1].message
-    dead = """\
-PROGRAM Station
-VAR
-    fbTmr : TON;
-    bRun : BOOL;
-END_VAR
-fbTmr(IN := bRun, PT := T#1s);
-RETURN;
-fbTmr(IN := bRun, PT := T#2s);
-END_PROGRAM
-"""
+    dead = AFTER_RETURN
     assert [str(d) for d in _check(dead) if "second time" in d.message] == []
     # an IF whose every branch returns is that RETURN too; one without an ELSE is not
     both = dead.replace("RETURN;", "IF bRun THEN\n    RETURN;\nELSE\n    RETURN;\nEND_IF;")
@@ -296,3 +300,54 @@ def test_a_command_fb_called_only_under_a_condition_or_on_a_constant_true_is_war
     assert "call it on every scan, outside the IF, and give the condition to i_bExecute" in diags[0].message
     assert diags[1].message.startswith("i_bExecute := TRUE on every scan: 'fbPause' starts on a rising edge")
     assert "TRUE to i_bEN" in diags[1].message
+
+
+def test_a_command_fb_called_after_an_early_return_is_warned_as_one_under_a_condition():
+    """`IF NOT X1 THEN RETURN; END_IF; fbStop(i_bEN := TRUE, i_bExecute := TRUE, ...);` is the
+    IF of the test above written as a guard: fbStop runs only in the scans that pass the
+    RETURN, sees no falling edge and stops the robot once. It was taken for a call on every
+    scan and warned 'i_bExecute := TRUE on every scan' (the advice, i_bExecute := X1 behind the
+    same RETURN, left the instance seeing TRUE alone), and with the button on i_bExecute not
+    at all. Both are warned now as called only in the scans that do not take the RETURN, with
+    its place; a call before the RETURN, or in every branch before one, stays a call on every
+    scan, and a call after a RETURN of the statement list never runs and is not judged."""
+    guarded = ONLY_UNDER_IF.replace("""IF bStop THEN
+    fbStop(i_bEN := TRUE, i_bExecute := TRUE, io_uMbx := uMbx);
+END_IF;""", """IF NOT bStop THEN
+    RETURN;
+END_IF;
+fbStop(i_bEN := TRUE, i_bExecute := TRUE, io_uMbx := uMbx);""")
+    diags = _check(guarded, ROOT / "plc" / "core")
+    stop = [d for d in diags if "'fbStop'" in d.message]
+    assert [(d.line, d.col) for d in stop] == [(14, 1)], [str(d) for d in diags]
+    assert stop[0].message.startswith("FB instance 'fbStop' is called only in the scans that do not take the "
+                                      "RETURN at 12:5: it sees i_bExecute"), stop[0].message
+    assert "call it on every scan, before the RETURN, and give the condition to i_bExecute" in stop[0].message
+    button = guarded.replace("fbStop(i_bEN := TRUE, i_bExecute := TRUE", "fbStop(i_bEN := TRUE, i_bExecute := bStop")
+    assert [(d.line, d.col) for d in _check(button, ROOT / "plc" / "core") if "'fbStop'" in d.message] == [(14, 1)]
+    # the call before the RETURN runs in every scan; so does one in every branch before a RETURN
+    before = button.replace("IF NOT bStop THEN\n    RETURN;\nEND_IF;\nfbStop(i_bEN := TRUE, i_bExecute := bStop, "
+                            "io_uMbx := uMbx);", "fbStop(i_bEN := TRUE, i_bExecute := bStop, io_uMbx := uMbx);\n"
+                            "IF NOT bStop THEN\n    RETURN;\nEND_IF;")
+    assert before != button and [str(d) for d in _check(before, ROOT / "plc" / "core") if "'fbStop'" in d.message] == []
+    branches = button.replace("IF NOT bStop THEN\n    RETURN;\nEND_IF;\nfbStop(i_bEN := TRUE, i_bExecute := bStop, "
+                              "io_uMbx := uMbx);", "IF NOT bStop THEN\n    fbStop(i_bEN := TRUE, i_bExecute := bStop, "
+                              "io_uMbx := uMbx);\n    RETURN;\nELSE\n    fbStop(i_bEN := TRUE, i_bExecute := bStop, "
+                              "io_uMbx := uMbx);\nEND_IF;")
+    assert branches != button
+    assert [str(d) for d in _check(branches, ROOT / "plc" / "core") if "'fbStop'" in d.message] == []
+    dead = button.replace("IF NOT bStop THEN\n    RETURN;\nEND_IF;", "RETURN;")
+    assert dead != button and [str(d) for d in _check(dead, ROOT / "plc" / "core") if "'fbStop'" in d.message] == []
+
+
+def test_a_return_in_a_repeat_loop_ends_what_runs():
+    """A REPEAT's body runs once at least, so 'REPEAT RETURN; UNTIL TRUE END_REPEAT;' between
+    two calls of an instance always leaves the POU: the second call was warned 'whenever the
+    RETURN at 8:5 is not taken', of a RETURN that is always taken. It now ends what runs, as a
+    plain RETURN does; an EXIT before the RETURN leaves the loop first, and the RETURN stays
+    one the scan may pass."""
+    text = AFTER_RETURN.replace("RETURN;", "REPEAT\n    RETURN;\nUNTIL bRun END_REPEAT;")
+    assert [str(d) for d in _check(text) if "second time" in d.message] == []
+    exits = text.replace("    RETURN;", "    IF bRun THEN\n        EXIT;\n    END_IF;\n    RETURN;")
+    assert [(d.line, d.col) for d in _check(exits) if "second time" in d.message] == [(13, 1)]
+    assert "whenever the RETURN at 11:5 is not taken" in [d.message for d in _check(exits)][-1]

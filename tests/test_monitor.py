@@ -233,6 +233,24 @@ def test_a_trace_without_its_end_record_still_replays(tmp_path):
     assert replayed["duration"] == pytest.approx(0.498333) and replayed["violations"] == []
 
 
+
+def test_an_end_record_cut_short_with_no_frame_before_it_is_no_traffic_alone(tmp_path):
+    """A trace whose end record says the port went away but that holds no frame (written by
+    hand: the monitor writes no end record without frames, and a port gone before one byte is
+    NO TRAFFIC) replayed NO TRAFFIC, yet its JSON kept `cut_short` ('the 2 frame(s) before it
+    were verified') and its JUnit two errors, no traffic and cut short, of one capture: the
+    reports said both that nothing and that frames were verified. Nothing was: no traffic alone."""
+    trace = tmp_path / "t.jsonl"
+    said = ("tcp 127.0.0.1:4001 went away after 0.5 s of the 600 s asked: the 2 frame(s) before it were verified, "
+            "but the run is not the whole session; check the converter")
+    trace.write_text(json.dumps({"scenario": "m", "end": 0.5, "cut_short": said}) + "\n", encoding="utf-8")
+    done = procs.run(uitamr("replay", trace, "--json", tmp_path / "r.json", "--junit", tmp_path / "r.xml"),
+                     capture_output=True, text=True, timeout=WAIT_S)
+    assert done.returncode == 3, done.stdout + done.stderr
+    replayed = json.loads((tmp_path / "r.json").read_text())["scenarios"][0]
+    assert replayed["verdict"] == "no-traffic" and replayed["cut_short"] is None, replayed
+    assert [e.get("type") for e in ET.parse(tmp_path / "r.xml").getroot().iter("error")] == ["no-traffic"]
+
 @pytest.mark.parametrize("lines, message", [
     (['{"scenario": "a", "end": 0.5, "t": 0.1}'],
      "t.jsonl:2:1: an end record holds only 'scenario', 'end' (until when the line was listened to), the run's "

@@ -222,6 +222,26 @@ def test_a_capture_cut_short_neither_passes_nor_outranks_a_failure():
         "scenarios": 4, "passed": 1, "failed": 1, "no_traffic": 1, "cut_short": 1}
 
 
+def test_the_last_line_of_a_capture_with_no_traffic_counts_the_ones_cut_short_too():
+    """`uitamr replay` of a cut-short monitor trace and an empty capture exits 3 (no traffic
+    ranks first), and its last line said the empty one's sentence alone: the session cut
+    short was not named where the verdict is read, though the FAIL line counts both. It now
+    counts them after the sentence (verifier.md: the console's last line counts them)."""
+    from dataclasses import replace
+
+    said = "COM5 went away after 5.2 s of the 600 s asked: the 12 frame(s) before it were verified, but ..."
+    cut = replace(good_result(), cut_short=said)
+    silent = replace(_result("silent", [], 0), no_traffic="no bytes were seen on COM6 in 20.0 s: check the wiring")
+    out = io.StringIO()
+    report_console.render([cut, silent, silent], Console(file=out, width=400, color_system=None))
+    assert out.getvalue().rstrip().endswith(
+        "NO TRAFFIC: no bytes were seen on COM6 in 20.0 s: check the wiring (and 1 more capture(s) with no bytes); "
+        "1 cut short"), out.getvalue()
+    out = io.StringIO()
+    report_console.render([silent, good_result()], Console(file=out, width=400, color_system=None))
+    assert out.getvalue().rstrip().endswith("NO TRAFFIC: no bytes were seen on COM6 in 20.0 s: check the wiring")
+
+
 def test_captures_are_counted_as_captures_without_expectations():
     """`uitamr replay` of a capture said "PASS: 1 scenario(s) compliant, every expectation met"
     and "0 expectation(s) met" for a run that was no scenario and could have no expectation;

@@ -121,7 +121,8 @@ class MonitorSession:
         a monitor whose port went away (`went_away`): the replay is not the whole session either."""
         if self._origin_us is not None:
             self._ended_us = host_us - self._origin_us
-        self.cut_short = cut_short
+        # with no byte before it nothing was verified: no traffic alone, as `went_away` says
+        self.cut_short = cut_short if self._origin_us is not None else None
 
     def went_away(self, listened_us: int, asked_us: int | None) -> None:
         """The port went away (unplugged, the converter closed or reset the connection) after

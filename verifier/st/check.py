@@ -146,10 +146,18 @@ def _resets(call: ast.Call, following: ast.Call) -> bool:
 
 
 def _always_returns(s: ast.Stmt) -> bool:
-    """Whether a statement leaves the POU whichever way it runs: a RETURN, or an IF or CASE
-    with an ELSE whose every branch holds one at its own level (a loop may run no time)."""
+    """Whether a statement leaves the POU whichever way it runs: a RETURN, an IF or CASE
+    with an ELSE whose every branch holds one at its own level, or a REPEAT whose body holds
+    one before any EXIT (its body runs once at least; a FOR or WHILE may run no time)."""
     if isinstance(s, ast.Return):
         return True
+    if isinstance(s, ast.Repeat):
+        for x in s.body:
+            if any(isinstance(n, ast.Exit) for n in ast.walk(x)):
+                return False  # the loop may be left before the RETURN
+            if _always_returns(x):
+                return True
+        return False
     if isinstance(s, ast.If):
         bodies = [b.body for b in s.branches] + [s.else_body]
     elif isinstance(s, ast.Case):
@@ -176,7 +184,8 @@ def _execute_input(call: ast.Call) -> str | None:
 
 def _always_calls(body: list[ast.Stmt], key: str) -> bool:
     """Whether `body` calls the FB instance `key` on every run of it: a call in the body
-    itself, or in every branch of an IF or CASE that has an ELSE (a loop may run no time)."""
+    itself, or in every branch of an IF or CASE that has an ELSE (a loop may run no time),
+    before any statement that may RETURN (the scans that take it do not reach the call)."""
     for s in body:
         if (isinstance(s, ast.CallStmt) and isinstance(s.call.callee, ast.Name)
                 and s.call.callee.name.upper() == key):
@@ -187,7 +196,14 @@ def _always_calls(body: list[ast.Stmt], key: str) -> bool:
         if isinstance(s, ast.Case) and s.else_body is not None:
             if all(_always_calls(c.body, key) for c in s.clauses) and _always_calls(s.else_body, key):
                 return True
+        if _returns_in(s):
+            return False
     return False
+
+
+def _returns_in(s: ast.Stmt) -> list[ast.Return]:
+    """The RETURNs a statement holds, in the order of the text."""
+    return sorted((n for n in ast.walk(s) if isinstance(n, ast.Return)), key=lambda n: (n.span.line, n.span.col))
 
 
 @functools.lru_cache(maxsize=8192)
@@ -527,8 +543,7 @@ class Checker:
             if _always_returns(s):
                 break  # nothing after it runs
             if not isinstance(s, ast.CallStmt):
-                returns += sorted((n for n in ast.walk(s) if isinstance(n, ast.Return)),
-                                  key=lambda n: (n.span.line, n.span.col))
+                returns += _returns_in(s)
                 continue
             if not isinstance(s.call.callee, ast.Name):
                 continue
@@ -584,14 +599,23 @@ class Checker:
 
         walk(info.pou.body, 0)
         for key, found in calls.items():
-            first, _depth = found[0]
+            first, depth = found[0]
             name, execute = first.call.callee.name, _execute_input(first.call)
             if not _always_calls(info.pou.body, key):
+                # a call of the statement list itself that a RETURN before it may skip: the IF
+                # written as a guard (`IF NOT X1 THEN RETURN; END_IF; fbStop(...)`)
+                before = info.pou.body[:next(i for i, s in enumerate(info.pou.body) if s is first)] if depth == 0 else []
+                if any(_always_returns(s) for s in before):
+                    continue  # it never runs: not judged
+                guard = next((r for s in before for r in _returns_in(s)), None)
+                when, where = (("under a condition", "outside the IF") if guard is None else
+                               (f"in the scans that do not take the RETURN at {guard.span.line}:{guard.span.col}",
+                                "before the RETURN"))
                 self.rep.warning(first, (
-                    f"FB instance '{name}' is called only under a condition: it sees {execute}, its "
+                    f"FB instance '{name}' is called only {when}: it sees {execute}, its "
                     f"falling edge included, and hands its result back only in the scans it is called, "
                     f"so after one command a new one gets no rising edge (a second press sends nothing); "
-                    f"call it on every scan, outside the IF, and give the condition to {execute} "
+                    f"call it on every scan, {where}, and give the condition to {execute} "
                     f"({execute} := <button>) (docs/plc-library.md: call every FB on every scan)"))
                 continue
             for s, depth in found:

@@ -38,6 +38,9 @@ def render(results: list[ScenarioResult], console: Console, *, first: int = FIRS
     elif verdict in UNVERIFIED:
         said = [dict(r.unverified)[verdict] for r in results if r.verdict == verdict]
         more = f" (and {len(said) - 1} more {_COUNTED[verdict][1]})" if len(said) > 1 else ""
+        # the kinds it outranks (a capture cut short beside one with no bytes): counted here too
+        more += "".join(f"; {count} {_COUNTED[kind][0]}" for kind in UNVERIFIED[UNVERIFIED.index(verdict) + 1:]
+                        if (count := sum(r.verdict == kind for r in results)))
         console.print(f"[bold yellow]{verdict_mark(verdict)}[/]: {escape(said[0])}{more}")
     else:
         failed = sum(r.verdict == "fail" for r in results)
