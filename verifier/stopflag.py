@@ -39,7 +39,7 @@ def put_back(previous: dict) -> None:
     KeyboardInterrupt while the command exited ("Exception ignored in atexit callback",
     "lost sys.stderr") or, once the interpreter had reset it to the default, ended the
     process by SIGINT (status 130), so the exit status that says the verdict (`monitor`'s
-    1 or 3, `emulate`'s 0) was lost though nothing was left to stop. SIGTERM is put back as
+    0, 1, 3 or 4, `emulate`'s 0) was lost though nothing was left to stop. SIGTERM is put back as
     it was: it still ends a process that would not exit.
 
     Ctrl-C is blocked while its handler becomes SIG_IGN: one that came between
