@@ -91,6 +91,28 @@ def test_a_run_without_a_scenario_file_names_the_programs_st_file(tmp_path, monk
     assert (case.get("file"), case.get("line")) == ("plc/examples/fx3/UITAMR_ExampleFx3.st", None)
 
 
+def test_the_json_names_its_sources_as_it_names_every_other_path(tmp_path, monkeypatch):
+    """Before, `sources` were absolute (a scenario's are found from its folder) while `file`,
+    the origins and the places were relative to the working folder."""
+    _project(tmp_path, monkeypatch)
+    (tmp_path / "verify" / "x.toml").write_text(
+        TOO_FAST.format(sources='"../plc/fx3/*.st", "../plc/core", "../plc/examples/common/*.st", '
+                                '"../plc/examples/fx3/UITAMR_ExampleFx3.st"'), encoding="utf-8")
+    outside = tmp_path.parent / f"{tmp_path.name}-outside.st"  # a source beyond the working folder stays whole
+    shutil.copy(PLC / "examples" / "fx3" / "UITAMR_ExampleFx3.st", outside)
+    try:
+        assert invoke("--scenario", "verify/x.toml", "--json", "v.json").exit_code == 1
+        sources = json.loads((tmp_path / "v.json").read_text(encoding="utf-8"))["scenarios"][0]["sources"]
+        assert "plc/fx3/UITAMR_PortFx3.st" in sources and "plc/examples/fx3/UITAMR_ExampleFx3.st" in sources
+        assert all(not Path(s).is_absolute() and (tmp_path / s).is_file() for s in sources), sources
+        given = [*FX3[:3], outside]
+        assert invoke(*given, "--program", "UITAMR_ExampleFx3", "--duration", "200ms", "--json", "w.json").exit_code == 1
+        sources = json.loads((tmp_path / "w.json").read_text(encoding="utf-8"))["scenarios"][0]["sources"]
+        assert str(outside) in sources and "plc/core/UITAMR_Engine.st" in sources
+    finally:
+        outside.unlink()
+
+
 def test_verifier_md_says_where_each_finding_places_the_test_case(tmp_path, monkeypatch):
     """verifier.md, `--junit FILE`: the three places it lists, in its order, are what the
     JUnit test case carries for each kind of finding: the stopped CPU, the console example's
