@@ -113,6 +113,26 @@ def test_the_json_names_its_sources_as_it_names_every_other_path(tmp_path, monke
         outside.unlink()
 
 
+def test_the_hint_of_a_scenario_without_sources_is_right_from_its_folder(tmp_path, monkeypatch):
+    """Before, it said `sources = ["plc/*.st"], relative to it` for verify/x.toml too, where
+    the right value is "../plc/*.st"."""
+    _project(tmp_path, monkeypatch)
+    (tmp_path / "plc" / "MAIN.st").write_text("PROGRAM MAIN\nVAR x : INT; END_VAR\nx := 1;\nEND_PROGRAM\n",
+                                             encoding="utf-8")
+    (tmp_path / "verify" / "x.toml").write_text('program = "MAIN"\n', encoding="utf-8")
+    result = invoke("--scenario", "verify/x.toml")
+    assert result.exit_code == 2
+    shown = " ".join(result.output.split())
+    assert 'list them in the file (sources = ["../plc/*.st"] for the .st files in plc/: paths relative' in shown
+    (tmp_path / "plc" / "MAIN.st").unlink()  # no .st file right inside a folder: a plc/ said as an example
+    shutil.rmtree(tmp_path / "plc" / "core")
+    result = invoke("--scenario", "verify/x.toml")
+    assert 'sources = ["../plc/*.st"] for .st files in plc/ of the working folder' in " ".join(result.output.split())
+    (tmp_path / "x.toml").write_text('program = "MAIN"\n', encoding="utf-8")
+    result = invoke("--scenario", "x.toml")
+    assert 'sources = ["plc/*.st"] for .st files in plc/ of the working folder' in " ".join(result.output.split())
+
+
 def test_verifier_md_says_where_each_finding_places_the_test_case(tmp_path, monkeypatch):
     """verifier.md, `--junit FILE`: the three places it lists, in its order, are what the
     JUnit test case carries for each kind of finding: the stopped CPU, the console example's
