@@ -113,6 +113,22 @@ def test_the_json_names_its_sources_as_it_names_every_other_path(tmp_path, monke
         outside.unlink()
 
 
+def test_list_rules_refuses_a_report_it_would_not_write(tmp_path, monkeypatch):
+    """Before, `uitamr verify --list-rules --junit r.xml` printed the rules, exited 0 and
+    wrote no r.xml: a CI job read an earlier run's file, or none."""
+    monkeypatch.chdir(tmp_path)
+    result = CliRunner().invoke(command, ["--list-rules", "--junit", "r.xml"])
+    assert result.exit_code == 2
+    said = "--list-rules prints the rules and exits: it runs nothing and writes no report, so --junit would do nothing"
+    assert said in " ".join(result.output.split())
+    (error,) = ET.parse(tmp_path / "r.xml").getroot().iter("error")  # the mistake, as for any usage mistake
+    assert error.get("message").startswith(said)
+    result = CliRunner().invoke(command, ["--list-rules", "plc", "--html", "r.html"])
+    assert result.exit_code == 2 and "so SOURCES, --html would do nothing; leave them out" in result.output
+    assert not (tmp_path / "r.html").exists()
+    assert CliRunner().invoke(command, ["--list-rules"]).exit_code == 0
+
+
 def test_the_hint_of_a_scenario_without_sources_is_right_from_its_folder(tmp_path, monkeypatch):
     """Before, it said `sources = ["plc/*.st"], relative to it` for verify/x.toml too, where
     the right value is "../plc/*.st"."""

@@ -25,7 +25,7 @@ from verifier.commands.check import not_st
 from verifier.commands.numbers import INT, IntRange
 from verifier.commands.report_files import (JudgingCommand, ReportError, check_folders, check_not_inputs,
                                              junit_of_mistakes, junit_of_refused_report, report_options, text_console,
-                                             write_reports)
+                                             usage_error_junit, write_reports)
 from verifier.verify.durations import format_duration, format_seconds, parse_duration_us
 from verifier.verify import spool
 from verifier.verify.events_shown import EVENTS_AT_MOST
@@ -349,6 +349,18 @@ def _with_signal(scenario: Scenario, text: str) -> Scenario:
     return replace(scenario, options=options, response_signal_given=True, response_signal_key="--response-signal")
 
 
+def _given_beside_list_rules(ctx: click.Context) -> list[str]:
+    """The options (and SOURCES) the command line gives beside --list-rules, which only
+    prints the rules: each would do nothing."""
+    given = []
+    for param in ctx.command.params:
+        if param.name == "list_rules" or ctx.get_parameter_source(param.name) in (
+                None, click.core.ParameterSource.DEFAULT):
+            continue
+        given.append(param.opts[0] if isinstance(param, click.Option) else param.human_readable_name)
+    return given
+
+
 def _scenario_files(names) -> list[Path]:
     """--scenario values: files, and folders standing for their *.toml files."""
     files: list[Path] = []
@@ -666,6 +678,15 @@ def command(sources, program, platform, channel, response_signal, scenario_files
     console = text_console()
     if list_rules:
         from verifier.verify.rules import RULES
+
+        ctx = click.get_current_context()
+        if given := _given_beside_list_rules(ctx):
+            # `--list-rules --junit r.xml` wrote no report and said nothing: a CI job then read
+            # an earlier run's file, or none. Refused as a usage mistake, as click refuses one
+            mistake = click.UsageError(f"--list-rules prints the rules and exits: it runs nothing and writes no "
+                                       f"report, so {', '.join(given)} would do nothing; leave "
+                                       f"{'it' if len(given) == 1 else 'them'} out", ctx)
+            raise usage_error_junit(junit_path, mistake, "uitamr verify", _inputs_given(ctx.params))
 
         for rule in RULES:
             console.print(f"[bold]{rule.id}[/] — {rule.title}\n    {rule.explanation}")
