@@ -1228,8 +1228,9 @@ def test_a_scenario_without_sources_says_the_file_can_list_them(tmp_path, monkey
     monkeypatch.chdir(tmp_path)
     result = invoke("--scenario", "s.toml")
     assert result.exit_code == 2
-    assert ('error: s.toml:1:1: sources: no ST sources: list them in the file (sources = ["plc/*.st"], relative to it) or give '
-            "them as arguments (uitamr verify FILE.st ...)") in " ".join(result.output.split())
+    assert ('error: s.toml:1:1: sources: no ST sources: list them in the file (sources = ["plc/*.st"] for .st files in '
+            "plc/ of the working folder: paths relative to the file's folder) or give them as arguments (uitamr verify "
+            "FILE.st ...)") in " ".join(result.output.split())
 
 
 def test_a_key_the_scenario_leaves_out_is_placed_at_the_start_of_the_file(tmp_path, monkeypatch):

@@ -100,7 +100,9 @@ def test_junit_has_one_testcase_per_scenario_and_a_failure_per_broken_rule(tmp_p
     pacing = next(f for f in cases[1].findall("failure") if f.get("type") == "UITAMR-PACING")
     assert pacing.get("message").startswith("UITAMR-PACING: 9 violation(s); first at 0.200 s")
     assert "01 01 00 00 00 16 BD C4" in pacing.text
-    assert cases[1].get("file") == "plc/scenarios/broken.toml"
+    # the annotation's place: the ST statement that sent the first broken rule's first frame
+    assert (cases[1].get("file"), cases[1].get("line")) == ("UITAMR_Engine.st", "210")
+    assert (cases[0].get("file"), cases[0].get("line")) == ("plc/scenarios/healthy.toml", None)
 
 
 def test_junit_keeps_runs_that_share_a_name_apart(tmp_path):

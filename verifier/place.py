@@ -36,3 +36,14 @@ class Place:
     def in_file(self, file: str) -> "Place":
         """This line and column in `file`."""
         return replace(self, file=file)
+
+    @classmethod
+    def of_location(cls, location: str | None) -> "Place | None":
+        """An ST location as the simulator names it, "file:line:col" (a frame's origin, where
+        the program stopped the CPU; the file's name may hold a ':', as a Windows drive
+        does), as a Place; None for anything else."""
+        file, _, col = (location or "").rpartition(":")
+        file, _, line = file.rpartition(":")
+        if not (file and line.isdigit() and col.isdigit()):
+            return None
+        return cls(file, int(line), int(col))

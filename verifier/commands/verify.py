@@ -4,6 +4,7 @@ Exit codes: 0 compliant, 1 violations or failed expectations, 2 unusable input.
 """
 from __future__ import annotations
 
+import os
 import shutil
 import signal
 import sys
@@ -24,14 +25,14 @@ from verifier.commands.check import not_st
 from verifier.commands.numbers import INT, IntRange
 from verifier.commands.report_files import (JudgingCommand, ReportError, check_folders, check_not_inputs,
                                              junit_of_mistakes, junit_of_refused_report, report_options, text_console,
-                                             write_reports)
+                                             usage_error_junit, write_reports)
 from verifier.verify.durations import format_duration, format_seconds, parse_duration_us
 from verifier.verify import spool
 from verifier.verify.events_shown import EVENTS_AT_MOST
 from verifier.verify.result import KEEP_ALL, Keep, ScenarioResult, UnusableInput, mistakes_of
 from verifier.bundled import plc_dir as bundled_plc_dir
 from verifier.digits import digit_problem
-from verifier.textfile import is_folder, real_path
+from verifier.textfile import is_folder, real_path, shown_path
 from verifier.verify.scenario import (
     CHANNELS, DEFAULT_DURATION_US, MAX_DURATION_US, PLATFORMS, TOLD_PLATFORMS, Scenario, ScenarioError, bundled_platforms,
     default_scenario, load_scenario,
@@ -250,7 +251,33 @@ def _no_sources(scenario: Scenario) -> str:
     if scenario.path is None:
         return "the default scenario: no ST sources: give them as arguments (uitamr verify FILE.st ...)"
     return (f"{scenario.key_where('sources')}: no ST sources: list them in the file "
-            "(sources = [\"plc/*.st\"], relative to it) or give them as arguments (uitamr verify FILE.st ...)")
+            f"({_sources_example(scenario.path)}) or give them as arguments (uitamr verify FILE.st ...)")
+
+
+def _sources_example(scenario_file: Path) -> str:
+    """A `sources` line for `scenario_file`, whose paths are relative to its folder: the .st
+    files of the working folder, or of a folder in it, that hold some (`verify/x.toml` and
+    plc/MAIN.st: "../plc/*.st"); else those of a plc/ folder of the working folder, said so."""
+    cwd = Path.cwd()
+    here = real_path(scenario_file).parent
+
+    def pattern(folder: Path) -> str:
+        try:
+            return Path(os.path.relpath(folder / "*.st", here)).as_posix()
+        except ValueError:  # another drive (Windows): no relative path leads there
+            return (folder / "*.st").as_posix()
+
+    try:
+        folders = [cwd, *sorted(f for f in cwd.iterdir() if f.is_dir() and not f.name.startswith("."))]
+        found = [folder for folder in folders if any(folder.glob("*.st"))][:3]
+    except OSError:
+        found = []
+    if found:
+        return " or ".join(f'sources = ["{pattern(folder)}"] for the .st files in '
+                           + ("the working folder" if folder == cwd else f"{shown_path(folder, cwd)}/")
+                           for folder in found) + ": paths relative to the file's folder"
+    return (f'sources = ["{pattern(cwd / "plc")}"] for .st files in plc/ of the working folder: paths relative '
+            "to the file's folder")
 
 
 def _check_options(scenario: Scenario, scan: int | None, duration: int | None) -> None:
@@ -320,6 +347,18 @@ def _with_signal(scenario: Scenario, text: str) -> Scenario:
         raise UnusableInput(f"--response-signal: {problem}")
     options = replace(scenario.options, response_signal=signal)
     return replace(scenario, options=options, response_signal_given=True, response_signal_key="--response-signal")
+
+
+def _given_beside_list_rules(ctx: click.Context) -> list[str]:
+    """The options (and SOURCES) the command line gives beside --list-rules, which only
+    prints the rules: each would do nothing."""
+    given = []
+    for param in ctx.command.params:
+        if param.name == "list_rules" or ctx.get_parameter_source(param.name) in (
+                None, click.core.ParameterSource.DEFAULT):
+            continue
+        given.append(param.opts[0] if isinstance(param, click.Option) else param.human_readable_name)
+    return given
 
 
 def _scenario_files(names) -> list[Path]:
@@ -639,6 +678,15 @@ def command(sources, program, platform, channel, response_signal, scenario_files
     console = text_console()
     if list_rules:
         from verifier.verify.rules import RULES
+
+        ctx = click.get_current_context()
+        if given := _given_beside_list_rules(ctx):
+            # `--list-rules --junit r.xml` wrote no report and said nothing: a CI job then read
+            # an earlier run's file, or none. Refused as a usage mistake, as click refuses one
+            mistake = click.UsageError(f"--list-rules prints the rules and exits: it runs nothing and writes no "
+                                       f"report, so {', '.join(given)} would do nothing; leave "
+                                       f"{'it' if len(given) == 1 else 'them'} out", ctx)
+            raise usage_error_junit(junit_path, mistake, "uitamr verify", _inputs_given(ctx.params))
 
         for rule in RULES:
             console.print(f"[bold]{rule.id}[/] — {rule.title}\n    {rule.explanation}")

@@ -76,8 +76,7 @@ def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
     if len(result.diagnostic_summary) > len(shown):
         console.print(f"    [yellow]simulator[/] and {len(result.diagnostic_summary) - len(shown)} more kind(s) of note "
                       "(see --json or --html)")
-    broken = sorted((found for found in result.violations.values() if found), key=lambda found: found[0].t_us)
-    for found in broken:
+    for found in result.broken_rules():
         _rule_block(found, console, first)
     for outcome in result.failed_expectations:
         place = result.place_of(outcome.expectation)

@@ -64,6 +64,8 @@ def scenario_dict(result: ScenarioResult) -> dict[str, Any]:
         "file": result.file,
         "description": result.description,
         "verdict": result.verdict,
+        # where a CI annotation belongs, as the JUnit test case's file and line (first_place)
+        "place": None if (place := result.first_place) is None else str(place),
         "program": result.program,
         "platform": result.platform,
         "channel": result.channel,

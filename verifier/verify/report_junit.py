@@ -1,6 +1,8 @@
 """`--junit FILE`: JUnit XML as GitHub, GitLab and Jenkins read it.
 
-One <testcase> per scenario; one <failure> per broken rule (type = the rule id) and per
+One <testcase> per scenario, its `file` and `line` where its first finding is (the ST
+statement that sent a broken rule's frame, a failed expectation's line: ScenarioResult.
+first_place); one <failure> per broken rule (type = the rule id) and per
 failed expectation (type = "expectation"); an <error> when the simulation stopped, or when
 a monitored line or a capture had no bytes (type = "no-traffic") or its port went away
 (type = "cut-short"; with the rules' failures when its frames broke some). A run that could not
@@ -55,8 +57,14 @@ def to_element(results: list[ScenarioResult], command: str = "uitamr verify") ->
             name=name,
             time=f"{result.wall_s:.3f}",
         )
-        if result.file:
-            case.set("file", result.file)
+        # one place a JUnit reader (GitHub's actions) annotates: the first finding's that has
+        # one (ScenarioResult.first_place), else the scenario file, or the program's ST file
+        place = result.first_place
+        if place is not None:
+            case.set("file", place.file)
+            case.set("line", str(place.line))
+        elif result.file or result.program_file:
+            case.set("file", result.file or result.program_file)
         if result.aborted:
             errors += 1
             # the message is what a CI server lists: the ST place and the reason, as for a rule
@@ -67,14 +75,14 @@ def to_element(results: list[ScenarioResult], command: str = "uitamr verify") ->
             errors += 1  # nothing, or not the whole session, was verified: not a pass, and not a rule broken
             element = ET.SubElement(case, "error", message=f"{kind.replace('-', ' ')}: {said}", type=kind)
             element.text = said
-        for rule_id, found in result.violations.items():
-            if found:
-                failures += 1
-                _failure(
-                    case, rule_id,
-                    f"{rule_id}: {len(found)} violation(s); first at {format_seconds(found[0].t_us)}: {found[0].message}",
-                    _rule_failure_text(rule_id, result),
-                )
+        for found in result.broken_rules():  # as the console lists them: the first one first
+            rule_id = found[0].rule
+            failures += 1
+            _failure(
+                case, rule_id,
+                f"{rule_id}: {len(found)} violation(s); first at {format_seconds(found[0].t_us)}: {found[0].message}",
+                _rule_failure_text(rule_id, result),
+            )
         for outcome in result.failed_expectations:
             failures += 1
             place = result.place_of(outcome.expectation)
@@ -82,8 +90,6 @@ def to_element(results: list[ScenarioResult], command: str = "uitamr verify") ->
             # the text starts at the scenario's line, as a compiler's message does
             text = f"{place}: {outcome.expectation.key}: {outcome.detail}" if place is not None else outcome.detail
             _failure(case, "expectation", f"expected {outcome.expectation.label}: {outcome.detail}{at}", text)
-            if place is not None and case.get("line") is None:
-                case.set("line", str(place.line))  # a JUnit reader's annotation: the first failed [[expect]]
         out = ET.SubElement(case, "system-out")
         tx, rx = result.tx_count, result.rx_count
         out.text = "\n".join(

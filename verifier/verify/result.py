@@ -141,7 +141,7 @@ def judged_with(options: RuleOptions) -> dict[str, Any]:
 @dataclass
 class ScenarioResult:
     name: str
-    file: str | None
+    file: str | None  # the scenario file (a capture's for monitor and replay), as the reports name it
     description: str
     program: str | None
     platform: str
@@ -180,6 +180,8 @@ class ScenarioResult:
     diagnostic_summary: list[str] = field(default_factory=list)
     watched: dict[str, list[tuple[int, Any]]] = field(default_factory=dict)
     aborted: str | None = None  # the program stopped the simulation (ST location inside)
+    # where it stopped: the ST location "file:line:col", the file as the reports name ST files
+    aborted_at: str | None = None
     ended_us: int = 0
     wall_s: float = 0.0  # real time the run took (for people; nothing judges it)
     notes: list[str] = field(default_factory=list)  # how the run differs from its scenario file
@@ -197,6 +199,9 @@ class ScenarioResult:
     # frames timed by the host (`uitamr monitor`, `uitamr replay`): how far their times may
     # be off; the trace records it so that a replay of the trace judges with it too
     timing_tolerance_us: int = 0
+    # the ST file that defines the PROGRAM that ran, as the reports name ST files (None for
+    # a capture): what a JUnit test case names when the run has no scenario file
+    program_file: str | None = None
 
     @property
     def tx_count(self) -> int:
@@ -228,6 +233,33 @@ class ScenarioResult:
         if self.file is None or expectation.line is None:
             return None
         return expectation.line.in_file(self.file)
+
+    def broken_rules(self) -> list[list[Violation]]:
+        """The violations of each broken rule, the rules in the order of their first
+        violation (the rules' own order among those of the same time): as the console and
+        the JUnit report list them."""
+        return sorted((found for found in self.violations.values() if found), key=lambda found: found[0].t_us)
+
+    @property
+    def first_place(self) -> Place | None:
+        """Where a CI annotation of this run belongs (the JUnit test case's `file` and
+        `line`, the JSON's `place`): the place of its first finding, as the reports list
+        them, that has one. The ST statement where the program stopped the CPU; else the
+        one that sent the frame of the first broken rule's first violation (`sent by`),
+        which is what to fix; else the line of the first failed expectation in the
+        scenario file (`place_of`). None when no finding has a place (a pass, a capture)."""
+        stopped = Place.of_location(self.aborted_at)
+        if stopped is not None:
+            return stopped
+        for found in self.broken_rules():
+            sent_by = Place.of_location(found[0].origin)
+            if sent_by is not None:
+                return sent_by
+        for outcome in self.failed_expectations:
+            place = self.place_of(outcome.expectation)
+            if place is not None:
+                return place
+        return None
 
     @property
     def broke_nothing(self) -> bool:

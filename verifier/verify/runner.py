@@ -136,6 +136,11 @@ class _Plc:
         raise _key_mistake(scenario, "program", f"no PROGRAM {scenario.program!r} in the sources; "
                            f"they define: {listing}")
 
+    def program_file(self) -> Path | None:
+        """The ST file that defines the PROGRAM that runs."""
+        return next((Path(f.filename) for f in self.project.files for pou in f.pous
+                     if pou.key == self.name.upper() and pou.kind == "PROGRAM"), None)
+
     @property
     def now_us(self) -> int:
         return self.project.now_us
@@ -766,7 +771,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
     recorded_names = frozenset(recorded)
     picked = [k for k, name in enumerate(names) if name in recorded_names]
     schedule = _input_schedule(scenario)
-    aborted = None
+    aborted = aborted_at = None
     end = scenario.duration_us
     from verifier.sim.errors import SimulationError
 
@@ -831,7 +836,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
                 progress(plc.now_us, end)
     except SimulationError as exc:
         exc.location = _relative(exc.location, os.getcwd())  # as the frames' origins name ST files
-        aborted = str(exc)
+        aborted, aborted_at = str(exc), exc.location
         end = min(end, plc.now_us)
     finally:
         if freeze:
@@ -863,7 +868,7 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         program=plc.name,
         platform=scenario.platform,
         channel=scenario.serial_channel,
-        sources=[str(p) for p in scenario.sources],
+        sources=[_display_path(p) for p in scenario.sources],  # as `file`: relative when inside the working folder
         duration_us=scenario.duration_us,
         scan_us=scenario.scan_us,
         scan_jitter_us=scenario.scan_jitter_us,
@@ -885,6 +890,8 @@ def run_scenario(scenario: Scenario, progress: Progress | None = None, *, plain:
         diagnostic_summary=plc.diagnostic_summary(),
         watched={name: list(samples.changes.get(name, [])) for name in scenario.watch} if keep.details and keep.watched else {},
         aborted=aborted,
+        aborted_at=aborted_at,
+        program_file=_display_path(plc.program_file()),
         ended_us=end,
         wall_s=time.perf_counter() - wall_start,
         notes=list(scenario.notes) + plc.cpu_notes() + _c24_notes(named, plc, violations) + _missed_fault_notes(named, robot, end)
