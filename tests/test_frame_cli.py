@@ -287,3 +287,54 @@ def test_an_rtu_frame_with_a_bad_crc_is_never_called_modbus_tcp():
         assert done.exit_code == 1 and "bad CRC" in done.output
         assert "Modbus TCP" not in done.output, done.output
     assert modbus_tcp_hint(bytes.fromhex("00 01 00 00 00 03 01 81 02"))  # the shortest: an exception reply
+
+
+@pytest.mark.parametrize("hex_text, said", [
+    # a broadcast or a reserved address was decoded with "(a normal reply echoes these 8
+    # bytes)": no slave answers either (protocol.md §8)
+    ("00 06 01 A0 00 00 89 C5", "(broadcast: every robot on the line acts on it, none replies)"),
+    ("00 01 00 00 00 16 BC 15", "(broadcast: every robot on the line acts on it, none replies)"),
+    ("F8 06 01 A0 00 00 9C 7D", "(address 248 is reserved: Modbus slave addresses are 1-247, so no robot "
+                                "replies; the robot's default is 1)"),
+])
+def test_a_request_no_robot_answers_is_not_said_to_be_echoed(hex_text, said):
+    result = run("--decode", hex_text)
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    assert lines[2] == said and "echoes" not in result.output
+
+
+def test_a_request_to_the_robot_still_says_the_echo():
+    assert run("--decode", "F7 06 01 A0 00 00 9C 82").output.splitlines()[2] == "(a normal reply echoes these 8 bytes)"
+
+
+@pytest.mark.parametrize("args, hint", [
+    # the CRC word sent high byte first: only "bad CRC: expected 88 14 ..., got 14 88"
+    (["--decode", "01 06 01 A0 00 00 14 88"],
+     "the CRC bytes are swapped: Modbus RTU sends the CRC low byte first (88 14), not 14 88; a send buffer "
+     "that holds the CRC word high byte first sends them this way"),
+    (["read", "task", "--decode", "01 01 03 00 00 01 8E FD"],
+     "the CRC bytes are swapped: Modbus RTU sends the CRC low byte first (FD 8E), not 8E FD; a send buffer "
+     "that holds the CRC word high byte first sends them this way"),
+    # a whole frame and a stray byte, as a terminal shows them: only "too long ... 9 bytes"
+    (["--decode", "01 06 01 A0 00 00 88 14 00"],
+     "bytes 0-7 are a whole frame, FC06 request: stop (01/A0), CRC ok; 00 after it (byte 8) is extra: "
+     "a second frame run together with it, or a stray byte of the line"),
+    (["--decode", "00 01 06 01 A0 00 00 88 14"],
+     "bytes 1-8 are a whole frame, FC06 request: stop (01/A0), CRC ok; 00 before it (byte 0) is extra: "
+     "a second frame run together with it, or a stray byte of the line"),
+    (["read", "task", "--decode", "01 01 03 00 00 01 FD 8E 01 01"],
+     "bytes 0-7 are a whole frame, FC01 reply: task status: running (1), error 00 normal, CRC ok; 01 01 after "
+     "it (byte 8 on) is extra: a second frame run together with it, or a stray byte of the line"),
+])
+def test_a_pasted_frame_says_what_went_wrong_with_it(args, hint):
+    result = run(*args)
+    assert result.exit_code == 1, result.output
+    assert result.output.splitlines()[2] == hint
+
+
+@pytest.mark.parametrize("hex_text", ["01 06 01 A0 00 00 88 15", "01 06 01 A0 00 00 88 15 00",
+                                      "01 06 01 A0 00 00 00 00", "01 06 01 A0 00 00 88"])
+def test_no_paste_hint_where_none_fits(hex_text):
+    out = run("--decode", hex_text).output
+    assert "swapped" not in out and "whole frame" not in out

@@ -29,6 +29,7 @@ from verifier.protocol import (
     explain_table,
     hex_bytes,
 )
+from verifier.protocol.crc import crc16, crc_bytes
 from verifier.protocol.describe import looks_like_reply, modbus_tcp_hint
 from verifier.protocol.names import USAGE
 from verifier.commands.protocol_options import protocol_settings
@@ -231,7 +232,7 @@ def _decode_and_print(data: bytes, settings: Settings, direction, request, show_
             frame = decode_frame(data, settings, direction)
     except FrameError as exc:
         click.echo(f"invalid frame: {exc}")
-        hint = modbus_tcp_hint(data, settings)
+        hint = modbus_tcp_hint(data, settings) or _paste_hint(data, exc, settings, direction, request)
         if hint:
             click.echo(hint)
         guessed = direction or ("reply" if request is not None or looks_like_reply(data) else "request")
@@ -241,12 +242,53 @@ def _decode_and_print(data: bytes, settings: Settings, direction, request, show_
             click.echo(explain_table(explain(data, settings, guessed)))
         raise SystemExit(EXIT_BAD_FRAME)
     click.echo(f"{_kind(frame)}: {describe(frame, settings)}")
-    if isinstance(frame, ControlRequest):
-        click.echo("(a normal reply echoes these 8 bytes)")
+    if isinstance(frame, (ControlRequest, StatusRequest)):
+        said = _who_answers(frame, settings)
+        if said:
+            click.echo(said)
     click.echo(f"CRC {hex_bytes(data[-2:])} ok")
     if show_fields:
         kind = "request" if isinstance(frame, (ControlRequest, StatusRequest)) else "reply"
         click.echo(explain_table(explain(data, settings, kind)))
+
+
+def _who_answers(request, settings: Settings) -> str | None:
+    """Who answers a valid request: a broadcast (address 0) or a reserved address (248-255)
+    gets no reply from any slave; said "(a normal reply echoes these 8 bytes)" for both."""
+    if request.address == 0:
+        return "(broadcast: every robot on the line acts on it, none replies)"
+    if request.address > 247:
+        return (f"(address {request.address} is reserved: Modbus slave addresses are 1-247, so no robot "
+                "replies; the robot's default is 1)")
+    if isinstance(request, ControlRequest):
+        return "(a normal reply echoes these 8 bytes)"
+    return None
+
+
+def _paste_hint(data: bytes, error: FrameError, settings: Settings, direction, request) -> str | None:
+    """What a frame copied from a terminal or a logic analyser most likely went through: its
+    CRC bytes swapped (high byte first), or a whole frame with one stray byte before or
+    after it. Each said only "bad CRC" or "too long" without the fix."""
+    if error.kind == "crc" and len(data) >= 4:
+        expected = crc16(data[:-2])
+        if data[-2:] == bytes(reversed(crc_bytes(expected))) and data[-2] != data[-1]:
+            return (f"the CRC bytes are swapped: Modbus RTU sends the CRC low byte first "
+                    f"({hex_bytes(crc_bytes(expected))}), not {hex_bytes(data[-2:])}; a send buffer that "
+                    "holds the CRC word high byte first sends them this way")
+    if error.kind == "length" and error.offset < len(data):  # too long
+        for start, end, where in ((0, error.offset, "after"), (1, len(data), "before")):
+            part = data[start:end]
+            try:
+                frame = decode_reply(part, settings, request) if request is not None \
+                    else decode_frame(part, settings, direction)
+            except FrameError:
+                continue
+            stray = data[end:] if where == "after" else data[:1]
+            at = f"byte {end}" if where == "after" else "byte 0"
+            return (f"bytes {start}-{end - 1} are a whole frame, {_kind(frame)}: {describe(frame, settings)}, "
+                    f"CRC ok; {hex_bytes(stray)} {where} it ({at}{' on' if len(stray) > 1 else ''}) is extra: "
+                    "a second frame run together with it, or a stray byte of the line")
+    return None
 
 
 def _robot_answer(error: FrameError, settings: Settings) -> str:
