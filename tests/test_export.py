@@ -156,9 +156,13 @@ def test_exporting_a_folder_into_a_folder_inside_it_runs_twice(tmp_path):
     assert second.exit_code == 0, second.output
     assert f"1 file(s) in the --out folder {src / 'gx2'} left out of the sources (an earlier export)" in second.output
     assert (src / "gx2" / "Main.st").read_text() == "wX := wX + 1;\n"
-    # the output folder named as the source is read: it is what was asked for
+    # the output folder named as the source: its bodies are said to be an export's, not ST
+    # sources (was exit 1, 'a statement outside a POU' at src/gx2/Main.st:1:1)
     third = CliRunner().invoke(command, ["--target", "gxworks2", "--out", str(tmp_path / "o"), str(src / "gx2")])
-    assert third.exit_code == 1 and "outside a POU" in third.output
+    assert third.exit_code == 2 and "outside a POU" not in third.output
+    assert third.output == (f"uitamr export: {src / 'gx2' / 'Main.st'}: a body written by `uitamr export` (its "
+                            "declarations are in Main.labels.tsv), not ST source: check the .st files it was "
+                            "exported from, with the same --platform\n")
 
 
 def test_a_pattern_is_read_as_the_folders_and_files_it_matches(tmp_path, monkeypatch):
@@ -799,3 +803,22 @@ def test_the_import_steps_say_what_to_do_with_every_file_the_export_writes(tmp_p
     for kind in kinds:
         named = kind.replace("NAME", "")
         assert re.search(rf"`[^`]*{re.escape(named)}`", steps), (page, kind)
+
+
+def test_checking_an_export_folder_says_to_check_its_sources(tmp_path):
+    """`uitamr check --platform fx3u gx2/` on what export wrote printed, per body, 'a statement
+    ('o_bENO') outside a POU' (28 errors, exit 1): the bodies have no declarations. Now each
+    is named an export's body (exit 2), as check names the toolkit's other files."""
+    from verifier.cli import main
+
+    out = tmp_path / "gx 2 ü"  # a folder name with a space and a non-ASCII letter
+    assert run("--platform", "fx3u", "--out", str(out)).exit_code == 0
+    result = CliRunner().invoke(main, ["check", "--platform", "fx3u", str(out)])
+    assert result.exit_code == 2, result.output
+    assert "outside a POU" not in result.output
+    assert (f"uitamr check: {out / 'UITAMR_CRC16.st'}: a body written by `uitamr export` (its declarations are in "
+            "UITAMR_CRC16.labels.tsv), not ST source: check the .st files it was exported from, with the same "
+            "--platform") in result.output.splitlines()
+    # the same file alone, without IMPORT_ORDER.txt beside it, is read as ST again
+    (out / "IMPORT_ORDER.txt").unlink()
+    assert "outside a POU" in CliRunner().invoke(main, ["check", str(out / "UITAMR_CRC16.st")]).output

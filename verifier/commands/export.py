@@ -101,16 +101,6 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
             click.echo(f"uitamr export: {', '.join(scenarios[:3])}{more}: a scenario (.toml), not ST source: "
                        "export writes the POUs of .st files; run scenarios with uitamr verify --scenario", err=True)
             sys.exit(EXIT_USAGE)
-        # refused as check refuses them: read as ST, an .il was "1:1: unexpected ';'", a capture
-        # "'#' must follow a radix"; a pipe or a device was "1 unreadable file(s)", exit 1
-        unusable = [(p, why) for p in paths if (why := not_a_source(p))]
-        if unusable:
-            for p, why in unusable:
-                click.echo(f"uitamr export: {shown_name(str(p))}: {why}", err=True)
-            sys.exit(EXIT_USAGE)
-        say_folders_without_st("uitamr export", sources, fatal=not paths)
-        if not paths:
-            sys.exit(EXIT_USAGE)
         # a folder that holds --out: the files of an earlier export there are not sources (bodies
         # without declarations: the second run of the same command failed on them)
         out = real_path(out_dir)
@@ -122,6 +112,16 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
             click.echo(f"uitamr export: {len(earlier)} file(s) in the --out folder {out_dir} left out of the "
                        "sources (an earlier export)", err=True)
             paths = [p for p in paths if p not in earlier]
+        # refused as check refuses them: read as ST, an .il was "1:1: unexpected ';'", a capture
+        # "'#' must follow a radix"; a pipe or a device was "1 unreadable file(s)", exit 1
+        unusable = [(p, why) for p in paths if (why := not_a_source(p))]
+        if unusable:
+            for p, why in unusable:
+                click.echo(f"uitamr export: {shown_name(str(p))}: {why}", err=True)
+            sys.exit(EXIT_USAGE)
+        say_folders_without_st("uitamr export", sources, fatal=not paths)
+        if not paths:
+            sys.exit(EXIT_USAGE)
     else:
         paths = bundled_sources(target, platform)
     if not paths:
