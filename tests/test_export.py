@@ -822,3 +822,27 @@ def test_checking_an_export_folder_says_to_check_its_sources(tmp_path):
     # the same file alone, without IMPORT_ORDER.txt beside it, is read as ST again
     (out / "IMPORT_ORDER.txt").unlink()
     assert "outside a POU" in CliRunner().invoke(main, ["check", str(out / "UITAMR_CRC16.st")]).output
+
+
+def test_an_export_into_the_folder_of_an_earlier_one_leaves_none_of_its_files(tmp_path):
+    """Exporting again into the same --out (fewer POUs, the other editor) left the earlier
+    files beside the new ones, unlisted: a GlobalLabels.labels.tsv the import guides say to
+    paste when it is there, GX Works2 tables among GX Works3 ones. Now they are removed and
+    named; a file no export wrote stays."""
+    src = tmp_path / "src"
+    src.mkdir()
+    (src / "Cell.st").write_text("VAR_GLOBAL\n    gwMode : INT;\nEND_VAR\nPROGRAM Cell\ngwMode := 1;\nEND_PROGRAM\n"
+                                 "FUNCTION_BLOCK FB_Old\nVAR\n    wX : INT;\nEND_VAR\nwX := 1;\nEND_FUNCTION_BLOCK\n")
+    (src / "Main.st").write_text("PROGRAM Main\nVAR\n    wX : INT;\nEND_VAR\nwX := wX + 1;\nEND_PROGRAM\n")
+    out = tmp_path / "gx"
+    assert run("--target", "gxworks2", "--out", str(out), str(src)).exit_code == 0
+    assert (out / "GlobalLabels.labels.tsv").is_file() and (out / "FB_Old.st").is_file()
+    (out / "my notes.txt").write_text("mine\n")
+    result = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(out), str(src / "Main.st")])
+    assert result.exit_code == 0, result.output
+    assert sorted(p.name for p in out.iterdir()) == ["IMPORT_ORDER.txt", "Main.labels.tsv", "Main.st", "my notes.txt"]
+    assert (f"uitamr export: note: removed 5 file(s) of an earlier export into {out} that this one does not hold: "
+            "FB_Old.st, FB_Old.labels.tsv, Cell.st, Cell.labels.tsv and 1 more") in result.output.splitlines()
+    # again: nothing of an earlier export left to remove, nothing said
+    again = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(out), str(src / "Main.st")])
+    assert again.exit_code == 0 and "removed" not in again.output

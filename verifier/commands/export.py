@@ -140,9 +140,11 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
         sys.exit(EXIT_ERRORS)
     notes: list = []
     warnings: list = []  # the CPU's (--platform), printed before whatever follows
+    removed: list[Path] = []
     try:
         written = export_sources(paths, target, Path(out_dir), texts, notes=notes, programs=list(programs),
-                                 cpu=PROFILES[platform] if platform else None, warnings=warnings)
+                                 cpu=PROFILES[platform] if platform else None, warnings=warnings,
+                                 removed=removed)
     except NothingToExport as e:
         for d in e.diagnostics:
             click.echo(str(d), err=True)
@@ -164,6 +166,10 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
         click.echo(str(note), err=True)
     if sources:
         _warn_of_another_editor(tuple(paths), target)
+    if removed:
+        names = ", ".join(p.name for p in removed[:4]) + (f" and {len(removed) - 4} more" if len(removed) > 4 else "")
+        click.echo(f"uitamr export: note: removed {len(removed)} file(s) of an earlier export into {out_dir} "
+                   f"that this one does not hold: {names}", err=True)
     pous = sum(1 for p in written if p.suffix == ".st")
     click.echo(f"{pous} POU(s) exported for {target} into {out_dir} (import order: "
                f"{Path(out_dir) / IMPORT_ORDER})")
