@@ -338,3 +338,14 @@ def test_a_pasted_frame_says_what_went_wrong_with_it(args, hint):
 def test_no_paste_hint_where_none_fits(hex_text):
     out = run("--decode", hex_text).output
     assert "swapped" not in out and "whole frame" not in out
+
+
+@pytest.mark.parametrize("args", [["01", "06", "01", "A0", "00", "00", "88", "14"], ["01 06 01 A0 00 00 88 14"],
+                                  ["010601A000008814"]])
+def test_bytes_given_without_decode_say_to_decode_them(args):
+    # was "unknown command '01'; one of: stop, pause, ..." (the whole command list)
+    result = run(*args)
+    assert result.exit_code == 2
+    assert result.output.splitlines()[-1] == (
+        f"Error: {' '.join(args)!r} is bytes, not a command: to decode them, uitamr frame --decode "
+        f"\"{' '.join(' '.join(args).split())}\"")

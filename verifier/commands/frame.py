@@ -186,6 +186,11 @@ def _request_from(words: tuple[str, ...], address: int):
     try:
         return command_from_words(list(words), address=address)
     except CommandError as exc:
+        # `uitamr frame 01 06 01 A0 00 00 88 14`, --decode forgotten: "unknown command '01'; one of ..."
+        tokens = " ".join(words).split()
+        if (len(tokens) > 1 or len("".join(tokens)) >= 8) and all(_HEX_WORD.fullmatch(t) for t in tokens):
+            raise click.UsageError(f"{' '.join(words)!r} is bytes, not a command: to decode them, "
+                                   f"uitamr frame --decode \"{' '.join(tokens)}\"") from None
         raise click.UsageError(str(exc)) from None
 
 
