@@ -349,3 +349,9 @@ def test_bytes_given_without_decode_say_to_decode_them(args):
     assert result.output.splitlines()[-1] == (
         f"Error: {' '.join(args)!r} is bytes, not a command: to decode them, uitamr frame --decode "
         f"\"{' '.join(' '.join(args).split())}\"")
+
+
+def test_the_usage_line_names_the_command_the_help_text_speaks_of():
+    # 'Usage: uitamr frame [OPTIONS] [WORDS]...' over a text about COMMAND and its list "Commands:"
+    usage = CliRunner().invoke(main, ["frame", "--help"], prog_name="uitamr").output.splitlines()[0]
+    assert usage == "Usage: uitamr frame [OPTIONS] [COMMAND]..."

@@ -97,7 +97,7 @@ def _device(ctx, param, value: str | None) -> str | None:
     epilog=_EPILOG,
     context_settings={"ignore_unknown_options": True, "help_option_names": ["-h", "--help"]},
 )
-@click.argument("words", nargs=-1, type=click.UNPROCESSED)
+@click.argument("words", nargs=-1, type=click.UNPROCESSED, metavar="[COMMAND]...")
 @protocol_settings
 @click.option("--decode", "decode_hex", metavar="HEX",
               help="Decode these bytes instead (with COMMAND: as the reply to that command, "
