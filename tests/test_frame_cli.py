@@ -355,3 +355,41 @@ def test_the_usage_line_names_the_command_the_help_text_speaks_of():
     # 'Usage: uitamr frame [OPTIONS] [WORDS]...' over a text about COMMAND and its list "Commands:"
     usage = CliRunner().invoke(main, ["frame", "--help"], prog_name="uitamr").output.splitlines()[0]
     assert usage == "Usage: uitamr frame [OPTIONS] [COMMAND]..."
+
+
+@pytest.mark.parametrize("words, frame", [
+    # what `--words` prints and a GX Works monitor shows for the send buffer: was
+    # "not a hex digit: 'H' in 'H0601'"
+    ("H0601 HA001 H0000 H1488", "01 06 01 A0 00 00 88 14"),
+    ("h601,ha001,h0,h1488", "01 06 01 A0 00 00 88 14"),
+    ("H0101 H0000 H1600 HC4BD", "01 01 00 00 00 16 BD C4"),
+])
+def test_the_words_of_a_plc_buffer_decode(words, frame):
+    for args in (["--decode", words], ["--decode", *words.split()]):  # quoted, or not
+        result = run(*args)
+        assert result.exit_code == 0, result.output
+        assert result.output.splitlines()[0] == frame
+
+
+def test_the_padding_of_an_odd_count_in_words_is_left_out():
+    result = run("--decode", "H8601 H0203 H0061")
+    assert result.exit_code == 0, result.output
+    assert result.output.splitlines()[:3] == [
+        "01 86 03 02 61", "(the last word's high byte 00 is the padding after an odd byte count: left out)",
+        "exception reply: exception 03 (illegal data value) to function 06"]
+
+
+def test_words_and_bytes_mixed_are_refused_with_why():
+    result = run("--decode", "H0601 A0 01 00 00 88 14")
+    assert result.exit_code == 2
+    assert result.output.splitlines()[-1] == ("Error: Invalid value for --decode: H words (H0601: two bytes, low byte "
+                                              "first) and bytes mixed: give all of them one way")
+
+
+def test_register_values_without_h_are_said_to_be_words():
+    # `0601 A001 0000 1488` read off a monitor: only "bad CRC: expected 4E 7D"
+    result = run("--decode", "0601 A001 0000 1488")
+    assert result.exit_code == 1
+    assert result.output.splitlines()[2] == (
+        "read as 16-bit words, low byte first (as RS2 and the QJ71C24N hold a frame), these are FC06 request: "
+        "stop (01/A0): give them as H0601 HA001 H0000 H1488, or as the bytes 01 06 01 A0 00 00 88 14")
