@@ -293,7 +293,8 @@ def test_an_rtu_frame_with_a_bad_crc_is_never_called_modbus_tcp():
     # a broadcast or a reserved address was decoded with "(a normal reply echoes these 8
     # bytes)": no slave answers either (protocol.md §8)
     ("00 06 01 A0 00 00 89 C5", "(broadcast: every robot on the line acts on it, none replies)"),
-    ("00 01 00 00 00 16 BC 15", "(broadcast: every robot on the line acts on it, none replies)"),
+    ("00 01 00 00 00 16 BC 15", "(broadcast: no robot replies, so a read to address 0 returns nothing; Modbus "
+                                "broadcasts only writes)"),
     ("F8 06 01 A0 00 00 9C 7D", "(address 248 is reserved: Modbus slave addresses are 1-247, so no robot "
                                 "replies; the robot's default is 1)"),
 ])

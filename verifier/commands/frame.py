@@ -285,6 +285,9 @@ def _decode_and_print(data: bytes, settings: Settings, direction, request, show_
 def _who_answers(request, settings: Settings) -> str | None:
     """Who answers a valid request: a broadcast (address 0) or a reserved address (248-255)
     gets no reply from any slave; said "(a normal reply echoes these 8 bytes)" for both."""
+    if request.address == 0 and isinstance(request, StatusRequest):
+        # Modbus over Serial Line V1.02 §2.1: "broadcast requests are necessarily writing commands"
+        return "(broadcast: no robot replies, so a read to address 0 returns nothing; Modbus broadcasts only writes)"
     if request.address == 0:
         return "(broadcast: every robot on the line acts on it, none replies)"
     if request.address > 247:
