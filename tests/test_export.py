@@ -846,3 +846,14 @@ def test_an_export_into_the_folder_of_an_earlier_one_leaves_none_of_its_files(tm
     # again: nothing of an earlier export left to remove, nothing said
     again = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(out), str(src / "Main.st")])
     assert again.exit_code == 0 and "removed" not in again.output
+
+
+@pytest.mark.parametrize("blank", ["", " "])
+def test_a_blank_out_folder_is_refused(tmp_path, monkeypatch, blank):
+    """`--out "$OUT"` with OUT unset wrote the whole library into the current folder."""
+    monkeypatch.chdir(tmp_path)
+    result = CliRunner().invoke(command, ["--platform", "q", "--out", blank])
+    assert result.exit_code == 2
+    assert result.output.splitlines()[-1] == ("Error: Invalid value for '--out': the folder is empty: give the folder "
+                                              "to write into, e.g. --out gx2")
+    assert list(tmp_path.iterdir()) == []

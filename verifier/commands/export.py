@@ -48,12 +48,20 @@ def bundled_sources(target: str, platform: str | None = None) -> list[Path]:
     return [p for folder in folders for p in sorted((PLC_DIR / folder).glob("*.st"))]
 
 
+def _folder(ctx, param, value: str) -> str:
+    """--out's folder: a blank one (`--out "$OUT"` with OUT unset) wrote the export into the
+    current folder, among whatever is there."""
+    if not value.strip():
+        raise click.BadParameter("the folder is empty: give the folder to write into, e.g. --out gx2")
+    return value
+
+
 @click.command(name="export")
 @click.argument("sources", nargs=-1, type=click.Path())
 @click.option("--target", type=click.Choice(["gxworks2", "gxworks3"]), default=None,
               help="The engineering tool that will import the files. Required, unless --platform "
                    "names the CPU (its editor: gxworks3 for fx5u, gxworks2 for the others).")
-@click.option("--out", "out_dir", type=click.Path(file_okay=False), required=True,
+@click.option("--out", "out_dir", type=click.Path(file_okay=False), required=True, callback=_folder,
               help="Folder for <POU>.st, <POU>.labels.tsv, GlobalLabels.labels.tsv, <Type>.struct.tsv and IMPORT_ORDER.txt.")
 @click.option("--program", "programs", multiple=True, metavar="NAME",
               help="Write only this POU (usually your PROGRAM) and every function block, function and "
