@@ -156,9 +156,13 @@ def test_exporting_a_folder_into_a_folder_inside_it_runs_twice(tmp_path):
     assert second.exit_code == 0, second.output
     assert f"1 file(s) in the --out folder {src / 'gx2'} left out of the sources (an earlier export)" in second.output
     assert (src / "gx2" / "Main.st").read_text() == "wX := wX + 1;\n"
-    # the output folder named as the source is read: it is what was asked for
+    # the output folder named as the source: its bodies are said to be an export's, not ST
+    # sources (was exit 1, 'a statement outside a POU' at src/gx2/Main.st:1:1)
     third = CliRunner().invoke(command, ["--target", "gxworks2", "--out", str(tmp_path / "o"), str(src / "gx2")])
-    assert third.exit_code == 1 and "outside a POU" in third.output
+    assert third.exit_code == 2 and "outside a POU" not in third.output
+    assert third.output == (f"uitamr export: {src / 'gx2' / 'Main.st'}: a body written by `uitamr export` (its "
+                            "declarations are in Main.labels.tsv), not ST source: check the .st files it was "
+                            "exported from, with the same --platform\n")
 
 
 def test_a_pattern_is_read_as_the_folders_and_files_it_matches(tmp_path, monkeypatch):
@@ -799,3 +803,57 @@ def test_the_import_steps_say_what_to_do_with_every_file_the_export_writes(tmp_p
     for kind in kinds:
         named = kind.replace("NAME", "")
         assert re.search(rf"`[^`]*{re.escape(named)}`", steps), (page, kind)
+
+
+def test_checking_an_export_folder_says_to_check_its_sources(tmp_path):
+    """`uitamr check --platform fx3u gx2/` on what export wrote printed, per body, 'a statement
+    ('o_bENO') outside a POU' (28 errors, exit 1): the bodies have no declarations. Now each
+    is named an export's body (exit 2), as check names the toolkit's other files."""
+    from verifier.cli import main
+
+    out = tmp_path / "gx 2 ü"  # a folder name with a space and a non-ASCII letter
+    assert run("--platform", "fx3u", "--out", str(out)).exit_code == 0
+    result = CliRunner().invoke(main, ["check", "--platform", "fx3u", str(out)])
+    assert result.exit_code == 2, result.output
+    assert "outside a POU" not in result.output
+    assert (f"uitamr check: {out / 'UITAMR_CRC16.st'}: a body written by `uitamr export` (its declarations are in "
+            "UITAMR_CRC16.labels.tsv), not ST source: check the .st files it was exported from, with the same "
+            "--platform") in result.output.splitlines()
+    # the same file alone, without IMPORT_ORDER.txt beside it, is read as ST again
+    (out / "IMPORT_ORDER.txt").unlink()
+    assert "outside a POU" in CliRunner().invoke(main, ["check", str(out / "UITAMR_CRC16.st")]).output
+
+
+def test_an_export_into_the_folder_of_an_earlier_one_leaves_none_of_its_files(tmp_path):
+    """Exporting again into the same --out (fewer POUs, the other editor) left the earlier
+    files beside the new ones, unlisted: a GlobalLabels.labels.tsv the import guides say to
+    paste when it is there, GX Works2 tables among GX Works3 ones. Now they are removed and
+    named; a file no export wrote stays."""
+    src = tmp_path / "src"
+    src.mkdir()
+    (src / "Cell.st").write_text("VAR_GLOBAL\n    gwMode : INT;\nEND_VAR\nPROGRAM Cell\ngwMode := 1;\nEND_PROGRAM\n"
+                                 "FUNCTION_BLOCK FB_Old\nVAR\n    wX : INT;\nEND_VAR\nwX := 1;\nEND_FUNCTION_BLOCK\n")
+    (src / "Main.st").write_text("PROGRAM Main\nVAR\n    wX : INT;\nEND_VAR\nwX := wX + 1;\nEND_PROGRAM\n")
+    out = tmp_path / "gx"
+    assert run("--target", "gxworks2", "--out", str(out), str(src)).exit_code == 0
+    assert (out / "GlobalLabels.labels.tsv").is_file() and (out / "FB_Old.st").is_file()
+    (out / "my notes.txt").write_text("mine\n")
+    result = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(out), str(src / "Main.st")])
+    assert result.exit_code == 0, result.output
+    assert sorted(p.name for p in out.iterdir()) == ["IMPORT_ORDER.txt", "Main.labels.tsv", "Main.st", "my notes.txt"]
+    assert (f"uitamr export: note: removed 5 file(s) of an earlier export into {out} that this one does not hold: "
+            "FB_Old.st, FB_Old.labels.tsv, Cell.st, Cell.labels.tsv and 1 more") in result.output.splitlines()
+    # again: nothing of an earlier export left to remove, nothing said
+    again = CliRunner().invoke(command, ["--target", "gxworks3", "--out", str(out), str(src / "Main.st")])
+    assert again.exit_code == 0 and "removed" not in again.output
+
+
+@pytest.mark.parametrize("blank", ["", " "])
+def test_a_blank_out_folder_is_refused(tmp_path, monkeypatch, blank):
+    """`--out "$OUT"` with OUT unset wrote the whole library into the current folder."""
+    monkeypatch.chdir(tmp_path)
+    result = CliRunner().invoke(command, ["--platform", "q", "--out", blank])
+    assert result.exit_code == 2
+    assert result.output.splitlines()[-1] == ("Error: Invalid value for '--out': the folder is empty: give the folder "
+                                              "to write into, e.g. --out gx2")
+    assert list(tmp_path.iterdir()) == []

@@ -287,3 +287,110 @@ def test_an_rtu_frame_with_a_bad_crc_is_never_called_modbus_tcp():
         assert done.exit_code == 1 and "bad CRC" in done.output
         assert "Modbus TCP" not in done.output, done.output
     assert modbus_tcp_hint(bytes.fromhex("00 01 00 00 00 03 01 81 02"))  # the shortest: an exception reply
+
+
+@pytest.mark.parametrize("hex_text, said", [
+    # a broadcast or a reserved address was decoded with "(a normal reply echoes these 8
+    # bytes)": no slave answers either (protocol.md §8)
+    ("00 06 01 A0 00 00 89 C5", "(broadcast: every robot on the line acts on it, none replies)"),
+    ("00 01 00 00 00 16 BC 15", "(broadcast: no robot replies, so a read to address 0 returns nothing; Modbus "
+                                "broadcasts only writes)"),
+    ("F8 06 01 A0 00 00 9C 7D", "(address 248 is reserved: Modbus slave addresses are 1-247, so no robot "
+                                "replies; the robot's default is 1)"),
+])
+def test_a_request_no_robot_answers_is_not_said_to_be_echoed(hex_text, said):
+    result = run("--decode", hex_text)
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    assert lines[2] == said and "echoes" not in result.output
+
+
+def test_a_request_to_the_robot_still_says_the_echo():
+    assert run("--decode", "F7 06 01 A0 00 00 9C 82").output.splitlines()[2] == "(a normal reply echoes these 8 bytes)"
+
+
+@pytest.mark.parametrize("args, hint", [
+    # the CRC word sent high byte first: only "bad CRC: expected 88 14 ..., got 14 88"
+    (["--decode", "01 06 01 A0 00 00 14 88"],
+     "the CRC bytes are swapped: Modbus RTU sends the CRC low byte first (88 14), not 14 88; a send buffer "
+     "that holds the CRC word high byte first sends them this way"),
+    (["read", "task", "--decode", "01 01 03 00 00 01 8E FD"],
+     "the CRC bytes are swapped: Modbus RTU sends the CRC low byte first (FD 8E), not 8E FD; a send buffer "
+     "that holds the CRC word high byte first sends them this way"),
+    # a whole frame and a stray byte, as a terminal shows them: only "too long ... 9 bytes"
+    (["--decode", "01 06 01 A0 00 00 88 14 00"],
+     "bytes 0-7 are a whole frame, FC06 request: stop (01/A0), CRC ok; 00 after it (byte 8) is extra: "
+     "a second frame run together with it, or a stray byte of the line"),
+    (["--decode", "00 01 06 01 A0 00 00 88 14"],
+     "bytes 1-8 are a whole frame, FC06 request: stop (01/A0), CRC ok; 00 before it (byte 0) is extra: "
+     "a second frame run together with it, or a stray byte of the line"),
+    (["read", "task", "--decode", "01 01 03 00 00 01 FD 8E 01 01"],
+     "bytes 0-7 are a whole frame, FC01 reply: task status: running (1), error 00 normal, CRC ok; 01 01 after "
+     "it (byte 8 on) is extra: a second frame run together with it, or a stray byte of the line"),
+])
+def test_a_pasted_frame_says_what_went_wrong_with_it(args, hint):
+    result = run(*args)
+    assert result.exit_code == 1, result.output
+    assert result.output.splitlines()[2] == hint
+
+
+@pytest.mark.parametrize("hex_text", ["01 06 01 A0 00 00 88 15", "01 06 01 A0 00 00 88 15 00",
+                                      "01 06 01 A0 00 00 00 00", "01 06 01 A0 00 00 88"])
+def test_no_paste_hint_where_none_fits(hex_text):
+    out = run("--decode", hex_text).output
+    assert "swapped" not in out and "whole frame" not in out
+
+
+@pytest.mark.parametrize("args", [["01", "06", "01", "A0", "00", "00", "88", "14"], ["01 06 01 A0 00 00 88 14"],
+                                  ["010601A000008814"]])
+def test_bytes_given_without_decode_say_to_decode_them(args):
+    # was "unknown command '01'; one of: stop, pause, ..." (the whole command list)
+    result = run(*args)
+    assert result.exit_code == 2
+    assert result.output.splitlines()[-1] == (
+        f"Error: {' '.join(args)!r} is bytes, not a command: to decode them, uitamr frame --decode "
+        f"\"{' '.join(' '.join(args).split())}\"")
+
+
+def test_the_usage_line_names_the_command_the_help_text_speaks_of():
+    # 'Usage: uitamr frame [OPTIONS] [WORDS]...' over a text about COMMAND and its list "Commands:"
+    usage = CliRunner().invoke(main, ["frame", "--help"], prog_name="uitamr").output.splitlines()[0]
+    assert usage == "Usage: uitamr frame [OPTIONS] [COMMAND]..."
+
+
+@pytest.mark.parametrize("words, frame", [
+    # what `--words` prints and a GX Works monitor shows for the send buffer: was
+    # "not a hex digit: 'H' in 'H0601'"
+    ("H0601 HA001 H0000 H1488", "01 06 01 A0 00 00 88 14"),
+    ("h601,ha001,h0,h1488", "01 06 01 A0 00 00 88 14"),
+    ("H0101 H0000 H1600 HC4BD", "01 01 00 00 00 16 BD C4"),
+])
+def test_the_words_of_a_plc_buffer_decode(words, frame):
+    for args in (["--decode", words], ["--decode", *words.split()]):  # quoted, or not
+        result = run(*args)
+        assert result.exit_code == 0, result.output
+        assert result.output.splitlines()[0] == frame
+
+
+def test_the_padding_of_an_odd_count_in_words_is_left_out():
+    result = run("--decode", "H8601 H0203 H0061")
+    assert result.exit_code == 0, result.output
+    assert result.output.splitlines()[:3] == [
+        "01 86 03 02 61", "(the last word's high byte 00 is the padding after an odd byte count: left out)",
+        "exception reply: exception 03 (illegal data value) to function 06"]
+
+
+def test_words_and_bytes_mixed_are_refused_with_why():
+    result = run("--decode", "H0601 A0 01 00 00 88 14")
+    assert result.exit_code == 2
+    assert result.output.splitlines()[-1] == ("Error: Invalid value for --decode: H words (H0601: two bytes, low byte "
+                                              "first) and bytes mixed: give all of them one way")
+
+
+def test_register_values_without_h_are_said_to_be_words():
+    # `0601 A001 0000 1488` read off a monitor: only "bad CRC: expected 4E 7D"
+    result = run("--decode", "0601 A001 0000 1488")
+    assert result.exit_code == 1
+    assert result.output.splitlines()[2] == (
+        "read as 16-bit words, low byte first (as RS2 and the QJ71C24N hold a frame), these are FC06 request: "
+        "stop (01/A0): give them as H0601 HA001 H0000 H1488, or as the bytes 01 06 01 A0 00 00 88 14")

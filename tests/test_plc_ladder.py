@@ -151,6 +151,14 @@ def test_bad_il_names_its_line():
     ("LD X0\nOUT T200\nEND\n", r"x.il:2:1: OUT takes 2 operand\(s\), got 1"),
     ("LD X0\n  MOVV D0 D1\nEND\n", r"x.il:2:3: 'MOVV' is not an instruction this converter knows"),
     ("LD= D0\nEND\n", r"x.il:1:1: LD= takes 2 operand\(s\), got 1"),
+    # each was "x.il: the program must end with END", with no line or what to do
+    ("LD X0\nOUT Y0\n", r"^x.il:2:1: the program must end with END: add END after this line \(OUT Y0\)$"),
+    ("LD X0\nOUT Y0\nEND\nLD X1\n", r"^x.il:4:1: LD after END \(line 3\): END must be the last instruction, "
+                                     r"the CPU runs nothing after it$"),
+    ("; R1 nothing yet\n", r"^x.il: no instruction in it: an .il holds one instruction a line, the last one END$"),
+    # was "got 3: 'OUT Y0 ; lamp'" without why
+    ("LD X0\nOUT Y0 ; lamp\nEND\n", r"x.il:2:1: OUT takes 1 operand\(s\), got 3: 'OUT Y0 ; lamp' \(a comment "
+                                    r"goes on a line of its own, starting with ';'\)$"),
 ])
 def test_il_mistakes_are_named_with_line_and_column(text, message):
     """A mistyped instruction used to become a CSV row GX Works2 would refuse (with a step
@@ -433,7 +441,7 @@ def test_an_il_named_with_a_newline_keeps_its_mistakes_on_one_line():
     broke each into two lines, where every other message shows the name escaped (Place)."""
     for text, message in (("LD X0\nOUTT Y0\nEND\n", "b\\x0aad.il:2:1: 'OUTT' is not an instruction"),
                           ("LD X0 X1\nEND\n", "b\\x0aad.il:1:1: LD takes 1 operand(s)"),
-                          ("LD X0\n", "b\\x0aad.il: the program must end with END")):
+                          ("LD X0\n", "b\\x0aad.il:1:1: the program must end with END")):
         with pytest.raises(IlError) as caught:
             parse_il(text, "b\nad.il")
         assert str(caught.value).startswith(message), str(caught.value)
@@ -474,3 +482,13 @@ def test_the_regeneration_command_writes_into_a_pipe_and_leaves_it_one(tmp_path)
     assert stat.S_ISFIFO(pipe.stat().st_mode)  # (replaced, the reader waits on a pipe no one opens)
     reader.join(10)
     assert received == [(LADDER / "UITAMR_LadderFx3.csv").read_bytes()]
+
+
+def test_devices_written_in_lower_case_reach_the_csv_in_upper_case():
+    """`ld x0` gave the CSV row "LD" "x0": the instruction was upper-cased, its device not;
+    GX Works2 writes devices in upper case in its own CSV (ASSUMPTION: that its reader wants
+    them so is not confirmed; upper case is what it writes)."""
+    csv = to_csv(parse_il("ld x0\nout t200 k30\nmov h1c81 d8400\nend\n", "x.il"), "x")
+    rows = [line.split("\t")[2:4] for line in csv.splitlines()[3:]]
+    assert rows == [['"LD"', '"X0"'], ['"OUT"', '"T200"'], ['""', '"K30"'], ['"MOV"', '"H1C81"'], ['""', '"D8400"'],
+                    ['"END"', '""']]

@@ -108,7 +108,22 @@ def not_st(path: Path) -> str | None:
     suffix = path.suffix.lower()
     if suffix in _OTHER_KINDS:
         return _OTHER_KINDS[suffix]
-    return None if suffix in (".st", ".toml") else _capture_kind(path) or _scenario_kind(path)
+    if suffix == ".st":
+        return _exported_body(path)
+    return None if suffix == ".toml" else _capture_kind(path) or _scenario_kind(path)
+
+
+def _exported_body(path: Path) -> str | None:
+    """What `path` is when `uitamr export` wrote it: a body without its declarations, beside
+    its label table and the folder's IMPORT_ORDER.txt. Checked, each such file was 'a
+    statement outside a POU' at its first statement."""
+    from verifier.export.writer import IMPORT_ORDER
+
+    table = path.with_name(path.stem + ".labels.tsv")
+    if not (table.is_file() and (path.parent / IMPORT_ORDER).is_file()):
+        return None
+    return (f"a body written by `uitamr export` (its declarations are in {table.name}), not ST source: "
+            "check the .st files it was exported from, with the same --platform")
 
 
 def not_a_source(path: Path) -> str | None:

@@ -48,12 +48,20 @@ def bundled_sources(target: str, platform: str | None = None) -> list[Path]:
     return [p for folder in folders for p in sorted((PLC_DIR / folder).glob("*.st"))]
 
 
+def _folder(ctx, param, value: str) -> str:
+    """--out's folder: a blank one (`--out "$OUT"` with OUT unset) wrote the export into the
+    current folder, among whatever is there."""
+    if not value.strip():
+        raise click.BadParameter("the folder is empty: give the folder to write into, e.g. --out gx2")
+    return value
+
+
 @click.command(name="export")
 @click.argument("sources", nargs=-1, type=click.Path())
 @click.option("--target", type=click.Choice(["gxworks2", "gxworks3"]), default=None,
               help="The engineering tool that will import the files. Required, unless --platform "
                    "names the CPU (its editor: gxworks3 for fx5u, gxworks2 for the others).")
-@click.option("--out", "out_dir", type=click.Path(file_okay=False), required=True,
+@click.option("--out", "out_dir", type=click.Path(file_okay=False), required=True, callback=_folder,
               help="Folder for <POU>.st, <POU>.labels.tsv, GlobalLabels.labels.tsv, <Type>.struct.tsv and IMPORT_ORDER.txt.")
 @click.option("--program", "programs", multiple=True, metavar="NAME",
               help="Write only this POU (usually your PROGRAM) and every function block, function and "
@@ -101,16 +109,6 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
             click.echo(f"uitamr export: {', '.join(scenarios[:3])}{more}: a scenario (.toml), not ST source: "
                        "export writes the POUs of .st files; run scenarios with uitamr verify --scenario", err=True)
             sys.exit(EXIT_USAGE)
-        # refused as check refuses them: read as ST, an .il was "1:1: unexpected ';'", a capture
-        # "'#' must follow a radix"; a pipe or a device was "1 unreadable file(s)", exit 1
-        unusable = [(p, why) for p in paths if (why := not_a_source(p))]
-        if unusable:
-            for p, why in unusable:
-                click.echo(f"uitamr export: {shown_name(str(p))}: {why}", err=True)
-            sys.exit(EXIT_USAGE)
-        say_folders_without_st("uitamr export", sources, fatal=not paths)
-        if not paths:
-            sys.exit(EXIT_USAGE)
         # a folder that holds --out: the files of an earlier export there are not sources (bodies
         # without declarations: the second run of the same command failed on them)
         out = real_path(out_dir)
@@ -122,6 +120,16 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
             click.echo(f"uitamr export: {len(earlier)} file(s) in the --out folder {out_dir} left out of the "
                        "sources (an earlier export)", err=True)
             paths = [p for p in paths if p not in earlier]
+        # refused as check refuses them: read as ST, an .il was "1:1: unexpected ';'", a capture
+        # "'#' must follow a radix"; a pipe or a device was "1 unreadable file(s)", exit 1
+        unusable = [(p, why) for p in paths if (why := not_a_source(p))]
+        if unusable:
+            for p, why in unusable:
+                click.echo(f"uitamr export: {shown_name(str(p))}: {why}", err=True)
+            sys.exit(EXIT_USAGE)
+        say_folders_without_st("uitamr export", sources, fatal=not paths)
+        if not paths:
+            sys.exit(EXIT_USAGE)
     else:
         paths = bundled_sources(target, platform)
     if not paths:
@@ -140,9 +148,11 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
         sys.exit(EXIT_ERRORS)
     notes: list = []
     warnings: list = []  # the CPU's (--platform), printed before whatever follows
+    removed: list[Path] = []
     try:
         written = export_sources(paths, target, Path(out_dir), texts, notes=notes, programs=list(programs),
-                                 cpu=PROFILES[platform] if platform else None, warnings=warnings)
+                                 cpu=PROFILES[platform] if platform else None, warnings=warnings,
+                                 removed=removed)
     except NothingToExport as e:
         for d in e.diagnostics:
             click.echo(str(d), err=True)
@@ -164,6 +174,10 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
         click.echo(str(note), err=True)
     if sources:
         _warn_of_another_editor(tuple(paths), target)
+    if removed:
+        names = ", ".join(p.name for p in removed[:4]) + (f" and {len(removed) - 4} more" if len(removed) > 4 else "")
+        click.echo(f"uitamr export: note: removed {len(removed)} file(s) of an earlier export into {out_dir} "
+                   f"that this one does not hold: {names}", err=True)
     pous = sum(1 for p in written if p.suffix == ".st")
     click.echo(f"{pous} POU(s) exported for {target} into {out_dir} (import order: "
                f"{Path(out_dir) / IMPORT_ORDER})")

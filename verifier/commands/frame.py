@@ -29,13 +29,18 @@ from verifier.protocol import (
     explain_table,
     hex_bytes,
 )
+from verifier.protocol.crc import crc16, crc_bytes
+from verifier.protocol.stream import frame_length_either_side
 from verifier.protocol.describe import looks_like_reply, modbus_tcp_hint
 from verifier.protocol.names import USAGE
 from verifier.commands.protocol_options import protocol_settings
 from verifier.digits import digit_problem
 
 EXIT_BAD_FRAME = 1
-_HEX_WORD = re.compile(r"(0[xX])?[0-9a-fA-F]+,?")
+_HEX_WORD = re.compile(r"(0[xX]|[hH](?=[0-9a-fA-F]{1,4},?$))?[0-9a-fA-F]+,?")
+#: a 16-bit word in MELSEC's hex constant notation, as `--words` prints it and a GX Works
+#: device monitor shows a send buffer register: H0601 = bytes 01 06 (low byte first)
+_MELSEC_WORD = re.compile(r"[hH]([0-9a-fA-F]{1,4})")
 
 _EPILOG = "\b\nCommands:\n" + "\n".join(f"  {line}" for line in USAGE) + """
 
@@ -51,7 +56,13 @@ Examples:
 
 
 def parse_hex(text: str) -> bytes:
-    """Bytes from hex text: "01 06 01 A0", "0106 01a0", "0x01,0x06" and the like."""
+    """Bytes from hex text: "01 06 01 A0", "0106 01a0", "0x01,0x06" and the like, or 16-bit
+    words in MELSEC notation, low byte first: "H0601 HA001 H0000 H1488" (a PLC send buffer)."""
+    words = [t for t in re.split(r"[\s,;]+", text) if t]
+    if words and all(_MELSEC_WORD.fullmatch(w) for w in words):
+        return bytes(b for w in words for b in int(w[1:], 16).to_bytes(2, "little"))
+    if any(_MELSEC_WORD.fullmatch(w) for w in words):
+        raise ValueError("H words (H0601: two bytes, low byte first) and bytes mixed: give all of them one way")
     cleaned = re.sub(r"0[xX]", " ", text)
     tokens = [t for t in re.split(r"[\s,;:\-]+", cleaned) if t]
     if not tokens:
@@ -67,6 +78,14 @@ def parse_hex(text: str) -> bytes:
             raise ValueError(f"odd number of hex digits in {token!r}: write bytes as pairs like 0A")
         out += bytes.fromhex(token.zfill(2))
     return bytes(out)
+
+
+def _padded_words(text: str, data: bytes) -> bool:
+    """H words of a frame with an odd byte count (a 5-byte exception reply): the last word's
+    high byte is the 00 a send or receive buffer pads with, not a byte of the frame."""
+    words = [t for t in re.split(r"[\s,;]+", text) if t]
+    return (bool(words) and all(_MELSEC_WORD.fullmatch(w) for w in words) and data[-1:] == b"\x00"
+            and frame_length_either_side(data[:2]) == len(data) - 1)
 
 
 def _kind(frame) -> str:
@@ -96,11 +115,12 @@ def _device(ctx, param, value: str | None) -> str | None:
     epilog=_EPILOG,
     context_settings={"ignore_unknown_options": True, "help_option_names": ["-h", "--help"]},
 )
-@click.argument("words", nargs=-1, type=click.UNPROCESSED)
+@click.argument("words", nargs=-1, type=click.UNPROCESSED, metavar="[COMMAND]...")
 @protocol_settings
 @click.option("--decode", "decode_hex", metavar="HEX",
-              help="Decode these bytes instead (with COMMAND: as the reply to that command, "
-                   "or with --as request as that command's request).")
+              help="Decode these bytes instead: hex bytes (01 06 01 A0 ...), or a PLC buffer's 16-bit "
+                   "words low byte first as --words prints them (H0601 HA001 ...). With COMMAND: as the "
+                   "reply to that command, or with --as request as that command's request.")
 @click.option("--as", "direction", type=click.Choice(["auto", "request", "reply"]), default="auto",
               show_default=True,
               help="With --decode: read the bytes as a request or a reply. With a COMMAND too, "
@@ -139,13 +159,16 @@ def command(words, settings, decode_hex, direction, explain_fields,
         data = parse_hex(decode_hex)
     except ValueError as exc:
         raise click.BadParameter(str(exc), param_hint="--decode") from None
+    note = None
+    if _padded_words(decode_hex, data):
+        data, note = data[:-1], "(the last word's high byte 00 is the padding after an odd byte count: left out)"
     if request is not None and direction == "request":
-        _decode_and_print(data, settings, "request", None, explain_fields)
+        _decode_and_print(data, settings, "request", None, explain_fields, note)
         _compare_with_command(data, request, settings, words)
         return
     if request is not None:
         direction = "reply"
-    _decode_and_print(data, settings, None if direction == "auto" else direction, request, explain_fields)
+    _decode_and_print(data, settings, None if direction == "auto" else direction, request, explain_fields, note)
 
 
 def _compare_with_command(data: bytes, request, settings: Settings, words: tuple[str, ...]) -> None:
@@ -185,6 +208,11 @@ def _request_from(words: tuple[str, ...], address: int):
     try:
         return command_from_words(list(words), address=address)
     except CommandError as exc:
+        # `uitamr frame 01 06 01 A0 00 00 88 14`, --decode forgotten: "unknown command '01'; one of ..."
+        tokens = " ".join(words).split()
+        if (len(tokens) > 1 or len("".join(tokens)) >= 8) and all(_HEX_WORD.fullmatch(t) for t in tokens):
+            raise click.UsageError(f"{' '.join(words)!r} is bytes, not a command: to decode them, "
+                                   f"uitamr frame --decode \"{' '.join(tokens)}\"") from None
         raise click.UsageError(str(exc)) from None
 
 
@@ -222,8 +250,11 @@ def _print_request(request, settings: Settings, show_fields: bool, as_words: boo
         click.echo(explain_table(explain(data, settings, "request")))
 
 
-def _decode_and_print(data: bytes, settings: Settings, direction, request, show_fields: bool) -> None:
+def _decode_and_print(data: bytes, settings: Settings, direction, request, show_fields: bool,
+                      note: str | None = None) -> None:
     click.echo(hex_bytes(data))
+    if note:
+        click.echo(note)
     try:
         if request is not None:
             frame = decode_reply(data, settings, request)
@@ -231,7 +262,7 @@ def _decode_and_print(data: bytes, settings: Settings, direction, request, show_
             frame = decode_frame(data, settings, direction)
     except FrameError as exc:
         click.echo(f"invalid frame: {exc}")
-        hint = modbus_tcp_hint(data, settings)
+        hint = modbus_tcp_hint(data, settings) or _paste_hint(data, exc, settings, direction, request)
         if hint:
             click.echo(hint)
         guessed = direction or ("reply" if request is not None or looks_like_reply(data) else "request")
@@ -241,12 +272,70 @@ def _decode_and_print(data: bytes, settings: Settings, direction, request, show_
             click.echo(explain_table(explain(data, settings, guessed)))
         raise SystemExit(EXIT_BAD_FRAME)
     click.echo(f"{_kind(frame)}: {describe(frame, settings)}")
-    if isinstance(frame, ControlRequest):
-        click.echo("(a normal reply echoes these 8 bytes)")
+    if isinstance(frame, (ControlRequest, StatusRequest)):
+        said = _who_answers(frame, settings)
+        if said:
+            click.echo(said)
     click.echo(f"CRC {hex_bytes(data[-2:])} ok")
     if show_fields:
         kind = "request" if isinstance(frame, (ControlRequest, StatusRequest)) else "reply"
         click.echo(explain_table(explain(data, settings, kind)))
+
+
+def _who_answers(request, settings: Settings) -> str | None:
+    """Who answers a valid request: a broadcast (address 0) or a reserved address (248-255)
+    gets no reply from any slave; said "(a normal reply echoes these 8 bytes)" for both."""
+    if request.address == 0 and isinstance(request, StatusRequest):
+        # Modbus over Serial Line V1.02 §2.1: "broadcast requests are necessarily writing commands"
+        return "(broadcast: no robot replies, so a read to address 0 returns nothing; Modbus broadcasts only writes)"
+    if request.address == 0:
+        return "(broadcast: every robot on the line acts on it, none replies)"
+    if request.address > 247:
+        return (f"(address {request.address} is reserved: Modbus slave addresses are 1-247, so no robot "
+                "replies; the robot's default is 1)")
+    if isinstance(request, ControlRequest):
+        return "(a normal reply echoes these 8 bytes)"
+    return None
+
+
+def _paste_hint(data: bytes, error: FrameError, settings: Settings, direction, request) -> str | None:
+    """What a frame copied from a terminal or a logic analyser most likely went through: its
+    CRC bytes swapped (high byte first), or a whole frame with one stray byte before or
+    after it. Each said only "bad CRC" or "too long" without the fix."""
+    if error.kind == "crc" and len(data) >= 4:
+        expected = crc16(data[:-2])
+        if data[-2:] == bytes(reversed(crc_bytes(expected))) and data[-2] != data[-1]:
+            return (f"the CRC bytes are swapped: Modbus RTU sends the CRC low byte first "
+                    f"({hex_bytes(crc_bytes(expected))}), not {hex_bytes(data[-2:])}; a send buffer that "
+                    "holds the CRC word high byte first sends them this way")
+    if len(data) % 2 == 0 and len(data) >= 4:
+        # `0601 A001 0000 1488`: a send buffer's registers read off a monitor, each word high
+        # byte first as a number is written; the frame is their bytes low byte first
+        swapped = bytes(b for i in range(0, len(data), 2) for b in (data[i + 1], data[i]))
+        try:
+            frame = decode_frame(swapped, settings, direction) if request is None \
+                else decode_reply(swapped, settings, request)
+        except FrameError:
+            frame = None
+        if frame is not None:
+            words = " ".join(f"H{swapped[i + 1]:02X}{swapped[i]:02X}" for i in range(0, len(swapped), 2))
+            return (f"read as 16-bit words, low byte first (as RS2 and the QJ71C24N hold a frame), these are "
+                    f"{_kind(frame)}: {describe(frame, settings)}: give them as {words}, or as the bytes "
+                    f"{hex_bytes(swapped)}")
+    if error.kind == "length" and error.offset < len(data):  # too long
+        for start, end, where in ((0, error.offset, "after"), (1, len(data), "before")):
+            part = data[start:end]
+            try:
+                frame = decode_reply(part, settings, request) if request is not None \
+                    else decode_frame(part, settings, direction)
+            except FrameError:
+                continue
+            stray = data[end:] if where == "after" else data[:1]
+            at = f"byte {end}" if where == "after" else "byte 0"
+            return (f"bytes {start}-{end - 1} are a whole frame, {_kind(frame)}: {describe(frame, settings)}, "
+                    f"CRC ok; {hex_bytes(stray)} {where} it ({at}{' on' if len(stray) > 1 else ''}) is extra: "
+                    "a second frame run together with it, or a stray byte of the line")
+    return None
 
 
 def _robot_answer(error: FrameError, settings: Settings) -> str:

@@ -79,12 +79,24 @@ def parse_il(text: str, name: str = "<il>") -> list[Instruction]:
             raise IlError(f"{Place(name, number, col)}: '{op}' is not an instruction this converter "
                           f"knows (it counts the steps of {known})")
         if len(operands) != wanted:
+            # `OUT Y0 ; lamp` counted the comment's words as operands, without a word of why
+            why = (" (a comment goes on a line of its own, starting with ';')"
+                   if any(o.startswith(";") for o in operands) else "")
             raise IlError(f"{Place(name, number, col)}: {upper} takes {wanted} operand(s), "
-                          f"got {len(operands)}: '{line}'")
-        program.append(Instruction(number, upper, tuple(operands), pending))
+                          f"got {len(operands)}: '{line}'{why}")
+        if program and program[-1].op == "END":
+            raise IlError(f"{Place(name, number, col)}: {upper} after END (line {program[-1].line}): END must be "
+                          "the last instruction, the CPU runs nothing after it")
+        # devices upper case, as GX Works2 writes them in its CSV (`ld x0` gave the operand "x0")
+        program.append(Instruction(number, upper, tuple(o.upper() for o in operands), pending))
         pending = ""
-    if not program or program[-1].op != "END":
-        raise IlError(f"{shown_name(name)}: the program must end with END")
+    if not program:
+        raise IlError(f"{shown_name(name)}: no instruction in it: an .il holds one instruction a line, "
+                      "the last one END")
+    if program[-1].op != "END":
+        last = program[-1]
+        raise IlError(f"{Place(name, last.line, 1)}: the program must end with END: add END after this "
+                      f"line ({' '.join((last.op, *last.operands))})")
     return program
 
 

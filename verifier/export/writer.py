@@ -253,7 +253,8 @@ def _on_cpu(files: list[ast.SourceFile], cpu: CpuProfile, problems: list[ast.Dia
 
 def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, str] | None = None,
                    notes: list[DroppedValue] | None = None, programs: list[str] | None = None,
-                   cpu: CpuProfile | None = None, warnings: list[ast.Diagnostic] | None = None) -> list[Path]:
+                   cpu: CpuProfile | None = None, warnings: list[ast.Diagnostic] | None = None,
+                   removed: list[Path] | None = None) -> list[Path]:
     """Parse and check `paths`, write the export into `out`; returns the files written.
     Raises ExportError (with file:line:col diagnostics) when a source has errors, and
     NothingToExport when a file has nothing in it to export. Initial values the target
@@ -262,7 +263,9 @@ def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, 
     (`needed.needed`; UnknownProgram for a name the sources do not define); every file
     is still checked. With `cpu` (a CPU profile), what is written is also checked against
     that CPU as `uitamr check --platform` checks it (`_on_cpu`): its errors refuse the
-    export like the check's, its warnings are appended to `warnings`."""
+    export like the check's, its warnings are appended to `warnings`. The files of an
+    earlier export into `out` that this one does not write are removed (`_earlier_export`)
+    and appended to `removed`."""
     if target not in COLUMNS:
         raise ValueError(f"unknown target {target!r}; expected gxworks2 or gxworks3")
     texts = texts or {}
@@ -286,6 +289,7 @@ def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, 
     known = {p.key for f in files for p in f.pous}
     structs = {t.key for f in files for t in f.types}
     exported: list[ExportedPou] = []
+    earlier = _earlier_export(out)
     out.mkdir(parents=True, exist_ok=True)
     written: list[Path] = []
     for f in files:
@@ -324,7 +328,28 @@ def export_sources(paths: list[Path], target: str, out: Path, texts: dict[Path, 
     rows = [(name, by_name[name].kind, by_name[name].result) for name in import_order(exported)]
     _write(order, "".join("\t".join(filter(None, row)) + "\n" for row in rows))
     written.append(order)
+    kept = {real_path(p) for p in written} | {real_path(p) for p in paths}
+    for path in earlier:
+        if real_path(path) not in kept:
+            path.unlink()
+            if removed is not None:
+                removed.append(path)
     return written
+
+
+def _earlier_export(out: Path) -> list[Path]:
+    """The files an earlier export wrote into `out`, as its IMPORT_ORDER.txt lists them (and
+    its global label table). Left behind by an export of fewer POUs or for the other editor,
+    they sat beside the new files unlisted: a stale GlobalLabels.labels.tsv, which the import
+    guides say to paste when it is there, or GX Works2 type names among GX Works3 tables."""
+    try:
+        lines = (out / IMPORT_ORDER).read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError):
+        return []
+    names = [line.split("\t")[0].strip() for line in lines if line.strip()]
+    files = [out / f"{name}{suffix}" for name in names if name and "/" not in name and "\\" not in name
+             for suffix in (".st", ".labels.tsv", ".struct.tsv")]
+    return [path for path in files + [out / GLOBAL_TABLE] if path.is_file()]
 
 
 def _write(path: Path, text: str) -> None:
