@@ -283,15 +283,7 @@ def command(sources: tuple[str, ...], target: str | None, platform: str | None, 
     target_given = target is not None
     target = platform_target(platform, target) if platform else target or "gxworks2"
     paths = expand_sources(sources)
-    unusable = [(p, not_a_source(p)) for p in paths]
-    unusable = [(p, why) for p, why in unusable if why]
-    if unusable:
-        for p, why in unusable:
-            click.echo(f"uitamr check: {shown_name(str(p))}: {why}", err=True)
-        sys.exit(EXIT_USAGE)
-    say_folders_without_st("uitamr check", sources, fatal=not paths)
-    if not paths:
-        sys.exit(EXIT_USAGE)
+    refuse_what_is_not_st("uitamr check", sources, paths)
     files, findings = check_findings(paths, target, platform)
     diagnostics = [f.diagnostic for f in findings]
     errors = sum(d.is_error for d in diagnostics)
@@ -318,6 +310,20 @@ def command(sources: tuple[str, ...], target: str | None, platform: str | None, 
         click.echo(f"{_summary(paths, target, target_given, platform)}: {errors} error(s), "
                    f"{warnings} warning(s)")
     sys.exit(EXIT_ERRORS if errors else EXIT_OK)
+
+
+def refuse_what_is_not_st(command: str, sources, paths: list[Path]) -> None:
+    """Exit 2 when a path is no ST source (`not_a_source`: an .il, a capture, a pipe, an
+    exported body, each named with why) or when the sources hold none: what `uitamr check`
+    and `uitamr export` refuse alike."""
+    unusable = [(p, why) for p in paths if (why := not_a_source(p))]
+    if unusable:
+        for p, why in unusable:
+            click.echo(f"{command}: {shown_name(str(p))}: {why}", err=True)
+        sys.exit(EXIT_USAGE)
+    say_folders_without_st(command, sources, fatal=not paths)
+    if not paths:
+        sys.exit(EXIT_USAGE)
 
 
 def say_folders_without_st(command: str, sources, fatal: bool) -> None:

@@ -26,7 +26,7 @@ from pathlib import Path
 import click
 
 from verifier.bundled import PLC_DIR
-from verifier.commands.check import expand_sources, not_a_source, platform_target, say_folders_without_st
+from verifier.commands.check import expand_sources, platform_target, refuse_what_is_not_st
 from verifier.sim.cpu import PROFILES
 from verifier.textfile import real_path, shown_name
 
@@ -122,14 +122,7 @@ def command(sources: tuple[str, ...], target: str | None, out_dir: str, programs
             paths = [p for p in paths if p not in earlier]
         # refused as check refuses them: read as ST, an .il was "1:1: unexpected ';'", a capture
         # "'#' must follow a radix"; a pipe or a device was "1 unreadable file(s)", exit 1
-        unusable = [(p, why) for p in paths if (why := not_a_source(p))]
-        if unusable:
-            for p, why in unusable:
-                click.echo(f"uitamr export: {shown_name(str(p))}: {why}", err=True)
-            sys.exit(EXIT_USAGE)
-        say_folders_without_st("uitamr export", sources, fatal=not paths)
-        if not paths:
-            sys.exit(EXIT_USAGE)
+        refuse_what_is_not_st("uitamr export", sources, paths)
     else:
         paths = bundled_sources(target, platform)
     if not paths:
