@@ -173,7 +173,7 @@ def test_words_pack_two_bytes_per_register_low_byte_first():
     result = run("stop", "--words")
     assert result.exit_code == 0
     assert result.output.splitlines()[1] == "words (low byte first): H0601 HA001 H0000 H1488"
-    from verifier.commands.frame import packed_words
+    from verifier.protocol.codec import packed_words
     assert packed_words(b"\x01\x86\x03\x02\x61") == [0x8601, 0x0203, 0x0061]
 
 

@@ -12,13 +12,10 @@ import click
 
 from verifier.protocol import (
     CommandError,
-    ControlReply,
     ControlRequest,
     FrameError,
     Settings,
-    StatusReply,
     StatusRequest,
-    ExceptionReply,
     command_from_words,
     decode_frame,
     decode_reply,
@@ -29,9 +26,9 @@ from verifier.protocol import (
     explain_table,
     hex_bytes,
 )
-from verifier.protocol.crc import crc16, crc_bytes
+from verifier.protocol.codec import hex_words
 from verifier.protocol.stream import frame_length_either_side
-from verifier.protocol.describe import looks_like_reply, modbus_tcp_hint
+from verifier.protocol.describe import frame_kind, looks_like_reply, modbus_tcp_hint, paste_hint, who_answers
 from verifier.protocol.names import USAGE
 from verifier.commands.protocol_options import protocol_settings
 from verifier.digits import digit_problem
@@ -86,20 +83,6 @@ def _padded_words(text: str, data: bytes) -> bool:
     words = [t for t in re.split(r"[\s,;]+", text) if t]
     return (bool(words) and all(_MELSEC_WORD.fullmatch(w) for w in words) and data[-1:] == b"\x00"
             and frame_length_either_side(data[:2]) == len(data) - 1)
-
-
-def _kind(frame) -> str:
-    if isinstance(frame, ControlRequest):
-        return "FC06 request"
-    if isinstance(frame, StatusRequest):
-        return "FC01 request"
-    if isinstance(frame, ControlReply):
-        return "FC06 reply"
-    if isinstance(frame, StatusReply):
-        return "FC01 reply"
-    if isinstance(frame, ExceptionReply):
-        return "exception reply"
-    return "frame"
 
 
 def _device(ctx, param, value: str | None) -> str | None:
@@ -232,11 +215,6 @@ def mbpoll_command(request, settings: Settings, device: str) -> list[str]:
     return common + ["-t", "0", "-r", str(reference), "-c", str(request.quantity), device]
 
 
-def packed_words(data: bytes) -> list[int]:
-    """Two bytes per 16-bit word, low byte first; an odd last byte gets a 00 high byte."""
-    return [data[i] | (data[i + 1] << 8 if i + 1 < len(data) else 0) for i in range(0, len(data), 2)]
-
-
 def _print_request(request, settings: Settings, show_fields: bool, as_words: bool = False) -> None:
     try:
         data = encode(request, settings)
@@ -244,7 +222,7 @@ def _print_request(request, settings: Settings, show_fields: bool, as_words: boo
         raise click.UsageError(str(exc)) from None
     click.echo(hex_bytes(data))
     if as_words:
-        click.echo("words (low byte first): " + " ".join(f"H{w:04X}" for w in packed_words(data)))
+        click.echo("words (low byte first): " + hex_words(data))
     if show_fields:
         click.echo(describe(request, settings))
         click.echo(explain_table(explain(data, settings, "request")))
@@ -262,7 +240,7 @@ def _decode_and_print(data: bytes, settings: Settings, direction, request, show_
             frame = decode_frame(data, settings, direction)
     except FrameError as exc:
         click.echo(f"invalid frame: {exc}")
-        hint = modbus_tcp_hint(data, settings) or _paste_hint(data, exc, settings, direction, request)
+        hint = modbus_tcp_hint(data, settings) or paste_hint(data, exc, settings, direction, request)
         if hint:
             click.echo(hint)
         guessed = direction or ("reply" if request is not None or looks_like_reply(data) else "request")
@@ -271,71 +249,15 @@ def _decode_and_print(data: bytes, settings: Settings, direction, request, show_
         if show_fields:
             click.echo(explain_table(explain(data, settings, guessed)))
         raise SystemExit(EXIT_BAD_FRAME)
-    click.echo(f"{_kind(frame)}: {describe(frame, settings)}")
+    click.echo(f"{frame_kind(frame)}: {describe(frame, settings)}")
     if isinstance(frame, (ControlRequest, StatusRequest)):
-        said = _who_answers(frame, settings)
+        said = who_answers(frame)
         if said:
             click.echo(said)
     click.echo(f"CRC {hex_bytes(data[-2:])} ok")
     if show_fields:
         kind = "request" if isinstance(frame, (ControlRequest, StatusRequest)) else "reply"
         click.echo(explain_table(explain(data, settings, kind)))
-
-
-def _who_answers(request, settings: Settings) -> str | None:
-    """Who answers a valid request: a broadcast (address 0) or a reserved address (248-255)
-    gets no reply from any slave; said "(a normal reply echoes these 8 bytes)" for both."""
-    if request.address == 0 and isinstance(request, StatusRequest):
-        # Modbus over Serial Line V1.02 §2.1: "broadcast requests are necessarily writing commands"
-        return "(broadcast: no robot replies, so a read to address 0 returns nothing; Modbus broadcasts only writes)"
-    if request.address == 0:
-        return "(broadcast: every robot on the line acts on it, none replies)"
-    if request.address > 247:
-        return (f"(address {request.address} is reserved: Modbus slave addresses are 1-247, so no robot "
-                "replies; the robot's default is 1)")
-    if isinstance(request, ControlRequest):
-        return "(a normal reply echoes these 8 bytes)"
-    return None
-
-
-def _paste_hint(data: bytes, error: FrameError, settings: Settings, direction, request) -> str | None:
-    """What a frame copied from a terminal or a logic analyser most likely went through: its
-    CRC bytes swapped (high byte first), or a whole frame with one stray byte before or
-    after it. Each said only "bad CRC" or "too long" without the fix."""
-    if error.kind == "crc" and len(data) >= 4:
-        expected = crc16(data[:-2])
-        if data[-2:] == bytes(reversed(crc_bytes(expected))) and data[-2] != data[-1]:
-            return (f"the CRC bytes are swapped: Modbus RTU sends the CRC low byte first "
-                    f"({hex_bytes(crc_bytes(expected))}), not {hex_bytes(data[-2:])}; a send buffer that "
-                    "holds the CRC word high byte first sends them this way")
-    if len(data) % 2 == 0 and len(data) >= 4:
-        # `0601 A001 0000 1488`: a send buffer's registers read off a monitor, each word high
-        # byte first as a number is written; the frame is their bytes low byte first
-        swapped = bytes(b for i in range(0, len(data), 2) for b in (data[i + 1], data[i]))
-        try:
-            frame = decode_frame(swapped, settings, direction) if request is None \
-                else decode_reply(swapped, settings, request)
-        except FrameError:
-            frame = None
-        if frame is not None:
-            words = " ".join(f"H{swapped[i + 1]:02X}{swapped[i]:02X}" for i in range(0, len(swapped), 2))
-            return (f"read as 16-bit words, low byte first (as RS2 and the QJ71C24N hold a frame), these are "
-                    f"{_kind(frame)}: {describe(frame, settings)}: give them as {words}, or as the bytes "
-                    f"{hex_bytes(swapped)}")
-    if error.kind == "length" and error.offset < len(data):  # too long
-        for start, end, where in ((0, error.offset, "after"), (1, len(data), "before")):
-            part = data[start:end]
-            try:
-                frame = decode_reply(part, settings, request) if request is not None \
-                    else decode_frame(part, settings, direction)
-            except FrameError:
-                continue
-            stray = data[end:] if where == "after" else data[:1]
-            at = f"byte {end}" if where == "after" else "byte 0"
-            return (f"bytes {start}-{end - 1} are a whole frame, {_kind(frame)}: {describe(frame, settings)}, "
-                    f"CRC ok; {hex_bytes(stray)} {where} it ({at}{' on' if len(stray) > 1 else ''}) is extra: "
-                    "a second frame run together with it, or a stray byte of the line")
-    return None
 
 
 def _robot_answer(error: FrameError, settings: Settings) -> str:

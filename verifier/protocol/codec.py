@@ -64,6 +64,18 @@ def hex_bytes(data: bytes) -> str:
     return " ".join(f"{b:02X}" for b in data)
 
 
+def packed_words(data: bytes) -> list[int]:
+    """Two bytes per 16-bit word, low byte first, as RS2 and the QJ71C24N hold a frame in
+    their buffers; an odd last byte gets a 00 high byte."""
+    return [data[i] | (data[i + 1] << 8 if i + 1 < len(data) else 0) for i in range(0, len(data), 2)]
+
+
+def hex_words(data: bytes) -> str:
+    """``b'\x01\x06\x01\xa0'`` -> ``'H0601 HA001'``: a frame as a PLC buffer's words,
+    written as a GX Works device monitor shows them (`uitamr frame --words`)."""
+    return " ".join(f"H{word:04X}" for word in packed_words(data))
+
+
 def function_of(frame: Frame) -> int:
     """The function code byte a frame carries (0x81/0x86 for exception replies)."""
     if isinstance(frame, (ControlRequest, ControlReply)):

@@ -15,7 +15,9 @@ from verifier.protocol.catalogue import (
     wire_code,
     wire_query,
 )
-from verifier.protocol.codec import EXCEPTION_REPLY_LENGTH, REQUEST_LENGTH, decode_reply, decode_request
+from verifier.protocol.codec import (EXCEPTION_REPLY_LENGTH, REQUEST_LENGTH, decode_reply, decode_request, hex_bytes,
+                                     hex_words)
+from verifier.protocol.crc import crc16, crc_bytes
 from verifier.protocol.frames import (
     ControlReply,
     ControlRequest,
@@ -25,7 +27,7 @@ from verifier.protocol.frames import (
     StatusReply,
     StatusRequest,
 )
-from verifier.protocol.settings import DEFAULT_SETTINGS, Settings
+from verifier.protocol.settings import DEFAULT_SETTINGS, SLAVE_ADDRESSES, Settings
 from verifier.protocol.stream import Direction
 
 
@@ -66,6 +68,79 @@ def modbus_tcp_hint(data: bytes, settings: Settings = DEFAULT_SETTINGS) -> str:
     return (f"this is a Modbus TCP frame (MBAP header {data[:6].hex(' ').upper()}, unit {data[6]}{meaning}): "
             "the robot's route carries Modbus RTU frames with their CRC inside TCP: set the master or the "
             "converter to RTU over TCP (transparent mode), not Modbus TCP (docs/tcp-converter.md)")
+
+
+def frame_kind(frame: Frame) -> str:
+    """"FC06 request", "FC01 reply", "exception reply", ...: what a decoded frame is."""
+    if isinstance(frame, ControlRequest):
+        return "FC06 request"
+    if isinstance(frame, StatusRequest):
+        return "FC01 request"
+    if isinstance(frame, ControlReply):
+        return "FC06 reply"
+    if isinstance(frame, StatusReply):
+        return "FC01 reply"
+    if isinstance(frame, ExceptionReply):
+        return "exception reply"
+    return "frame"
+
+
+def who_answers(request: ControlRequest | StatusRequest) -> str | None:
+    """Who answers a valid request: a broadcast (address 0) or a reserved address (248-255)
+    gets no reply from any slave; an FC06 request's normal reply echoes it."""
+    if request.address == 0 and isinstance(request, StatusRequest):
+        # Modbus over Serial Line V1.02 §2.1: "broadcast requests are necessarily writing commands"
+        return "(broadcast: no robot replies, so a read to address 0 returns nothing; Modbus broadcasts only writes)"
+    if request.address == 0:
+        return "(broadcast: every robot on the line acts on it, none replies)"
+    if request.address not in SLAVE_ADDRESSES:
+        return (f"(address {request.address} is reserved: Modbus slave addresses are "
+                f"{SLAVE_ADDRESSES.start}-{SLAVE_ADDRESSES.stop - 1}, so no robot replies; the robot's default is 1)")
+    if isinstance(request, ControlRequest):
+        return "(a normal reply echoes these 8 bytes)"
+    return None
+
+
+def paste_hint(data: bytes, error: FrameError, settings: Settings = DEFAULT_SETTINGS,
+               direction: Direction | None = None,
+               request: ControlRequest | StatusRequest | None = None) -> str | None:
+    """What a frame copied from a terminal or a logic analyser most likely went through: its
+    CRC bytes swapped (high byte first), a PLC buffer's words read high byte first, or a
+    whole frame with one stray byte before or after it. Each said only "bad CRC" or "too
+    long" without the fix. `request`: the bytes are its reply."""
+    def decoded(part: bytes) -> Frame:
+        return decode_reply(part, settings, request) if request is not None else decode_frame(part, settings, direction)
+
+    if error.kind == "crc" and len(data) >= 4:
+        expected = crc_bytes(crc16(data[:-2]))
+        if data[-2:] == expected[::-1] and data[-2] != data[-1]:
+            return (f"the CRC bytes are swapped: Modbus RTU sends the CRC low byte first "
+                    f"({hex_bytes(expected)}), not {hex_bytes(data[-2:])}; a send buffer that "
+                    "holds the CRC word high byte first sends them this way")
+    if len(data) % 2 == 0 and len(data) >= 4:
+        # `0601 A001 0000 1488`: a send buffer's registers read off a monitor, each word high
+        # byte first as a number is written; the frame is their bytes low byte first
+        swapped = bytes(b for i in range(0, len(data), 2) for b in (data[i + 1], data[i]))
+        try:
+            frame = decoded(swapped)
+        except FrameError:
+            frame = None
+        if frame is not None:
+            return (f"read as 16-bit words, low byte first (as RS2 and the QJ71C24N hold a frame), these are "
+                    f"{frame_kind(frame)}: {describe(frame, settings)}: give them as {hex_words(swapped)}, or as "
+                    f"the bytes {hex_bytes(swapped)}")
+    if error.kind == "length" and error.offset < len(data):  # too long
+        for start, end, where in ((0, error.offset, "after"), (1, len(data), "before")):
+            try:
+                frame = decoded(data[start:end])
+            except FrameError:
+                continue
+            stray = data[end:] if where == "after" else data[:1]
+            at = f"byte {end}" if where == "after" else "byte 0"
+            return (f"bytes {start}-{end - 1} are a whole frame, {frame_kind(frame)}: {describe(frame, settings)}, "
+                    f"CRC ok; {hex_bytes(stray)} {where} it ({at}{' on' if len(stray) > 1 else ''}) is extra: "
+                    "a second frame run together with it, or a stray byte of the line")
+    return None
 
 
 def decode_frame(data: bytes, settings: Settings = DEFAULT_SETTINGS, direction: Direction | None = None) -> Frame:
