@@ -28,17 +28,12 @@ class LoadError(Exception):
         folder `cwd` (relative when inside it, by the path the sources reach it:
         textfile.shown_path): `uitamr verify` names ST errors as `uitamr check` and the
         frames' ST places do (`plc/MAIN.st:7:1`), not by the absolute path it loaded."""
-        from dataclasses import is_dataclass, replace
+        from dataclasses import replace
 
         from verifier.textfile import shown_path
 
-        def shown(d):
-            file = getattr(d, "file", None)
-            if not is_dataclass(d) or not isinstance(file, str) or file.startswith(OPTION_PLACE):
-                return d
-            return replace(d, file=shown_path(file, cwd))
-
-        return type(self)([shown(d) for d in self.diagnostics])
+        return type(self)([d if d.file.startswith(OPTION_PLACE) else replace(d, file=shown_path(d.file, cwd))
+                           for d in self.diagnostics])
 
     def place(self) -> Place | None:
         """The place of the first error that names a source's line (not an option of

@@ -343,13 +343,10 @@ def _relative(origin: str | None, cwd: str) -> str | None:
     vendor/uitamr/plc/..., not where the link leads; textfile.shown_path).
     Worked out once per location: every frame of a long run names the ST line that sent
     it, and the frames then share one string."""
-    if not origin:
+    place = Place.of_location(origin)
+    if place is None:
         return origin
-    file, _, place = origin.rpartition(":")  # the file's name may hold ':' (Windows: C:\...)
-    file, _, line = file.rpartition(":")
-    if not (file and line.isdigit() and place.isdigit()):
-        return origin
-    return f"{shown_path(file, cwd)}:{line}:{place}"
+    return f"{shown_path(place.file, cwd)}:{place.line}:{place.col}"
 
 
 def _trace_records(frames: list, end_us: int) -> list[TraceRecord]:
