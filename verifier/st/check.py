@@ -118,7 +118,9 @@ def type_letters_problem(name: str, t: T.Type, target: str = "gxworks2") -> str 
 
 #: the inputs that start an FB's work (IEC timers' IN, an EN, the FB library's i_bEN and
 #: i_bExecute): given FALSE, the call resets the instance
-_START_INPUTS = {"IN", "EN", "EXECUTE", "I_BEN", "I_BEXECUTE"}
+#: the edge inputs that start a command FB (the library's i_bExecute, PLCopen's Execute)
+_EXECUTE_INPUTS = ("I_BEXECUTE", "EXECUTE")
+_START_INPUTS = {"IN", "EN", "I_BEN", *_EXECUTE_INPUTS}
 
 
 #: the IEC counters' inputs that, given TRUE, set the count whatever the call's other
@@ -179,7 +181,7 @@ def _execute_input(call: ast.Call) -> str | None:
     target = call.resolved
     if getattr(target, "kind", None) != "fb" or target.fb_type is None or target.fb_type.standard:
         return None
-    return next((n for n, _t in target.fb_type.inputs if n.upper() in ("I_BEXECUTE", "EXECUTE")), None)
+    return next((n for n, _t in target.fb_type.inputs if n.upper() in _EXECUTE_INPUTS), None)
 
 
 def _always_calls(body: list[ast.Stmt], key: str) -> bool:

@@ -48,7 +48,7 @@ class Expectation:
     key: str = ""  # where the scenario states it, e.g. "expect[2]"
     # the line and column of its kind's key in the scenario file (`that = ...`), for the
     # reports of a failed expectation (ScenarioResult.place_of); None: no file states it
-    line: Place | None = field(default=None, compare=False)
+    place: Place | None = field(default=None, compare=False)
 
     def window(self, end_us: int) -> tuple[int, int]:
         if self.within_us is None:

@@ -230,9 +230,9 @@ class ScenarioResult:
         kind's key, the file as the reports name it), so that a failed one says which table
         to look at; None for one no file states (the answered power-on stop a scenario
         without [[expect]], or a run without a file, expects)."""
-        if self.file is None or expectation.line is None:
+        if self.file is None or expectation.place is None:
             return None
-        return expectation.line.in_file(self.file)
+        return expectation.place.in_file(self.file)
 
     def broken_rules(self) -> list[list[Violation]]:
         """The violations of each broken rule, the rules in the order of their first

@@ -821,7 +821,7 @@ class _Reader:
             fields["point"] = value
             what = f"robot reached point {value}"
         expectation = Expectation(kind=kind, label="", after_us=after, within_us=within, key=key,
-                                  line=self.line_of(f"{key}.{kind}"), **fields)
+                                  place=self.line_of(f"{key}.{kind}"), **fields)
         label = item.get("name")
         if label is None:
             label = f"{what} {describe_window(expectation)}".strip()
