@@ -351,3 +351,32 @@ def test_a_return_in_a_repeat_loop_ends_what_runs():
     exits = text.replace("    RETURN;", "    IF bRun THEN\n        EXIT;\n    END_IF;\n    RETURN;")
     assert [(d.line, d.col) for d in _check(exits) if "second time" in d.message] == [(13, 1)]
     assert "whenever the RETURN at 11:5 is not taken" in [d.message for d in _check(exits)][-1]
+
+
+def test_reading_an_fb_s_internal_instance_or_label_says_it_is_internal_and_what_to_read():
+    """`fbRun.fbCmd.o_uErrDetail` (UITAMR_RunPoint's internal UITAMR_Command) was refused as
+    "has no input or output 'fbCmd'", as if the name were a typo: the message now says it is an
+    internal instance (VAR), which GX Works does not let a program read either, lists the
+    outputs to read instead, and that a scenario may watch it (the verifier reads internals)."""
+    text = """\
+PROGRAM Station
+VAR
+    fbRun : UITAMR_RunPoint;
+    uMbx : ARRAY[0..15] OF WORD;
+    uDetail : WORD;
+    bBad : BOOL;
+END_VAR
+fbRun(i_bEN := TRUE, i_bExecute := TRUE, i_wPoint := 3, io_uMbx := uMbx);
+uDetail := fbRun.fbCmd.o_uErrDetail;
+bBad := fbRun.bParamErr;
+uDetail := fbRun.o_uNope;
+END_PROGRAM
+"""
+    found = {d.line: d.message for d in _check(text, ROOT / "plc" / "core")}
+    outputs = "read its outputs instead (o_bENO, o_bBusy, o_bOK, o_bErr, o_uErrId)"
+    assert found[9].startswith("UITAMR_RunPoint has no input or output 'fbCmd': 'fbCmd' is an internal "
+                               "instance of UITAMR_Command (VAR) of UITAMR_RunPoint"), found
+    assert outputs in found[9] and "call UITAMR_Command in the program itself" in found[9]
+    assert "as GX Works does" in found[9] and "A scenario's watch and conditions may read" in found[9]
+    assert "'bParamErr' is an internal label (VAR) of UITAMR_RunPoint" in found[10] and outputs in found[10]
+    assert found[11] == "UITAMR_RunPoint has no input or output 'o_uNope'"  # a typo stays a typo

@@ -910,7 +910,7 @@ class Checker:
         if isinstance(bt, T.FbType):
             p = bt.param(e.member)
             if p is None:
-                self.rep.error(e, f"{bt} has no input or output '{e.member}'")
+                self.rep.error(e, f"{bt} has no input or output '{e.member}'{self._internal_label(bt, e.member)}")
                 return T.ANY
             if p[0] == "in_out":
                 self.rep.error(e, f"'{e.member}' is a VAR_IN_OUT of {bt}; it cannot be read from outside")
@@ -920,6 +920,25 @@ class Checker:
             return T.BOOL
         self.rep.error(e, f"'.{e.member}' needs a structure or FB instance; this is {bt}")
         return T.ANY
+
+    def _internal_label(self, fb: T.FbType, member: str) -> str:
+        """When `member` is a label of `fb`'s own VAR (`fbRun.fbCmd`: the UITAMR_Command instance
+        inside UITAMR_RunPoint), the words that say so and what to read instead; else "".
+        GX Works does not let a program read an FB's internal labels either (only its inputs
+        and outputs); a scenario's `watch` and conditions may, as a monitor looks inside."""
+        info = None if fb.standard else self.table.pous.get(fb.name.upper())
+        label = info.labels.get(member.upper()) if info is not None else None
+        if label is None or label[0].section not in ("VAR", "VAR_TEMP"):
+            return ""
+        v, t = label
+        what = f"an internal instance of {t.name}" if isinstance(t, T.FbType) else "an internal label"
+        outputs = ", ".join(n for n, _ in fb.outputs)
+        instead = f"read its outputs instead ({outputs})" if outputs else "it has no outputs to read"
+        if isinstance(t, T.FbType):
+            instead += f", or call {t.name} in the program itself where it must act on {t.name}'s outputs"
+        return (f": '{v.name}' is {what} (VAR) of {fb.name}, and a program reads only an FB's inputs "
+                f"and outputs, as GX Works does; {instead}. A scenario's watch and conditions may read "
+                "internal labels (the verifier looks inside the instance, as a monitor does)")
 
     def _convert(self, source: T.Type, target: T.Type, advice: str) -> str:
         """`advice` with the editor's conversion from `source` to `target` in its {}, or ""
