@@ -921,6 +921,18 @@ class Checker:
         self.rep.error(e, f"'.{e.member}' needs a structure or FB instance; this is {bt}")
         return T.ANY
 
+    def _library_range(self, a: ast.Arg, fb: T.FbType) -> None:
+        """A constant outside the range a UITAMR library FB checks its input against
+        (library.LIBRARY_INPUT_RANGES): the FB would end with its error code at run time."""
+        limits = library.LIBRARY_INPUT_RANGES.get((fb.name.upper(), a.key))
+        value = _const_int(a.value) if limits is not None else None
+        if value is None or limits[0] <= value <= limits[1]:
+            return
+        lo, hi, code = limits
+        self.rep.warning(a.value, f"{a.name} := {value} is outside {lo}..{hi}, the range {fb.name} accepts: "
+                                  f"it ends with o_bErr and o_uErrId 16#{code:04X} instead of running "
+                                  f"(see its header); give a value in {lo}..{hi}")
+
     def _internal_label(self, fb: T.FbType, member: str) -> str:
         """When `member` is a label of `fb`'s own VAR (`fbRun.fbCmd`: the UITAMR_Command instance
         inside UITAMR_RunPoint), the words that say so and what to read instead; else "".
@@ -1120,6 +1132,8 @@ class Checker:
                     vt = self.expr(a.value)
                 if vt is not None:
                     self._assign_compat(a.value, pt, vt, f"input {a.name}")
+                if kind == "input" and not fb.standard:
+                    self._library_range(a, fb)
         for n, _t in fb.in_outs:
             if n.upper() not in seen:
                 self.rep.error(c, f"VAR_IN_OUT '{n}' of {fb} must be connected in every call")
