@@ -351,3 +351,102 @@ def test_a_return_in_a_repeat_loop_ends_what_runs():
     exits = text.replace("    RETURN;", "    IF bRun THEN\n        EXIT;\n    END_IF;\n    RETURN;")
     assert [(d.line, d.col) for d in _check(exits) if "second time" in d.message] == [(13, 1)]
     assert "whenever the RETURN at 11:5 is not taken" in [d.message for d in _check(exits)][-1]
+
+
+def test_reading_an_fb_s_internal_instance_or_label_says_it_is_internal_and_what_to_read():
+    """`fbRun.fbCmd.o_uErrDetail` (UITAMR_RunPoint's internal UITAMR_Command) was refused as
+    "has no input or output 'fbCmd'", as if the name were a typo: the message now says it is an
+    internal instance (VAR), which GX Works does not let a program read either, lists the
+    outputs to read instead, and that a scenario may watch it (the verifier reads internals)."""
+    text = """\
+PROGRAM Station
+VAR
+    fbRun : UITAMR_RunPoint;
+    uMbx : ARRAY[0..15] OF WORD;
+    uDetail : WORD;
+    bBad : BOOL;
+END_VAR
+fbRun(i_bEN := TRUE, i_bExecute := TRUE, i_wPoint := 3, io_uMbx := uMbx);
+uDetail := fbRun.fbCmd.o_uErrDetail;
+bBad := fbRun.bParamErr;
+uDetail := fbRun.o_uNope;
+END_PROGRAM
+"""
+    found = {d.line: d.message for d in _check(text, ROOT / "plc" / "core")}
+    outputs = "read its outputs instead (o_bENO, o_bBusy, o_bOK, o_bErr, o_uErrId)"
+    assert found[9].startswith("UITAMR_RunPoint has no input or output 'fbCmd': 'fbCmd' is an internal "
+                               "instance of UITAMR_Command (VAR) of UITAMR_RunPoint"), found
+    assert outputs in found[9] and "call UITAMR_Command in the program itself" in found[9]
+    assert "as GX Works does" in found[9] and "A scenario's watch and conditions may read" in found[9]
+    assert "'bParamErr' is an internal label (VAR) of UITAMR_RunPoint" in found[10] and outputs in found[10]
+    assert found[11] == "UITAMR_RunPoint has no input or output 'o_uNope'"  # a typo stays a typo
+
+
+def _ranges_the_library_checks() -> dict[tuple[str, str], tuple[int, int, int]]:
+    """(FB, input) -> (lo, hi, code), read from plc/: each FB's own range check of an input
+    (`bParamErr := (i_wPoint < POINT_MIN) OR (i_wPoint > POINT_MAX);`, `(i_wConnection >=
+    CONN_MIN) AND (i_wConnection <= CONN_MAX)`, `(i_wChannel = CH1) OR (i_wChannel = CH2)`),
+    its constants resolved, and the error code its header gives for a parameter out of range
+    (16#0301) or an invalid channel / connection number (16#0304)."""
+    import re
+
+    forms = [r"\((i_\w+) < (\w+)\) OR \(\1 > (\w+)\)", r"\((i_\w+) >= (\w+)\) AND \(\1 <= (\w+)\)",
+             r"\((i_\w+) = (\w+)\) OR \(\1 = (\w+)\)"]
+    found = {}
+    for path in sorted((ROOT / "plc").glob("*/*.st")):
+        text = path.read_text(encoding="utf-8")
+        fb = re.search(r"^FUNCTION_BLOCK (\w+)", text, re.M)
+        if fb is None:
+            continue
+        constants = {n: int(v) for n, v in re.findall(r"^\s*(\w+) : INT := (-?\d+);", text, re.M)}
+        header = text[:text.index("*)")]
+        for form in forms:
+            for name, lo, hi in re.findall(form, text):
+                if name.startswith("i_e"):  # a REAL (UITAMR_SetCollisionRange): 4 values, no range to warn
+                    continue
+                lo, hi = constants[lo], constants[hi]
+                if "=" in form and "<" not in form:  # two values: a range only when they are adjacent
+                    assert hi == lo + 1, (path, name)
+                codes = [c for c in (0x0301, 0x0304) if f"16#{c:04X}" in header]
+                if not codes:  # no parameter check: UITAMR_ParseReply's received length (16#0105)
+                    continue
+                assert len(codes) == 1, (path, name, codes)
+                code = codes[0]
+                found[(fb.group(1).upper(), name.upper())] = (lo, hi, code)
+    return found
+
+
+def test_the_input_ranges_check_warns_on_are_the_ones_the_library_s_st_checks():
+    """The table `uitamr check` warns from is held to plc/: a range changed in an FB (or a new
+    FB that checks one) without the table fails here."""
+    from verifier.st.library import LIBRARY_INPUT_RANGES
+
+    assert LIBRARY_INPUT_RANGES == _ranges_the_library_checks()
+
+
+def test_a_constant_out_of_the_range_a_library_fb_checks_is_warned():
+    """`i_wPoint := 25` on UITAMR_RunPoint (points 1..21) or `i_wChannel := 3` on UITAMR_PortFx3
+    passed `uitamr check` without a word and ended at run time with o_bErr (16#0301 / 16#0304):
+    a constant outside the FB's range is now warned at the value; one inside is not."""
+    text = """\
+PROGRAM Station
+VAR
+    fbRun : UITAMR_RunPoint;
+    fbPort : UITAMR_PortFx3;
+    uMbx : ARRAY[0..15] OF WORD;
+    uPort : ARRAY[0..39] OF WORD;
+    bGo : BOOL;
+END_VAR
+fbPort(i_bEN := TRUE, i_wChannel := 3, i_bRs232 := FALSE, io_uPort := uPort);
+fbRun(i_bEN := TRUE, i_bExecute := bGo, i_wPoint := 25, io_uMbx := uMbx);
+fbRun(i_bEN := TRUE, i_bExecute := bGo, i_wPoint := 21, io_uMbx := uMbx);
+END_PROGRAM
+"""
+    found = [(d.line, d.col, d.message) for d in _check(text, ROOT / "plc" / "core", ROOT / "plc" / "fx3",
+                                                          target="gxworks2")
+             if "is outside" in d.message]
+    assert found == [
+        (9, 37, "i_wChannel := 3 is outside 1..2, the range UITAMR_PortFx3 accepts: it ends with o_bErr and "
+                "o_uErrId 16#0304 instead of running (see its header); give a value in 1..2"),
+        (10, 53, "i_wPoint := 25 is outside 1..21, the range UITAMR_RunPoint accepts: it ends with o_bErr and "
+                 "o_uErrId 16#0301 instead of running (see its header); give a value in 1..21")], found

@@ -175,7 +175,7 @@ def test_the_regeneration_command_reports_mistakes_without_a_traceback(tmp_path)
     root = Path(__file__).resolve().parents[1]
     bad = tmp_path / "bad.il"
     bad.write_bytes(b"LD X0\nOUT Y0\xff\nEND\n")
-    cases = [([str(tmp_path / "missing.il")], 1, "missing.il: cannot read"),
+    cases = [([str(tmp_path / "missing.il")], 2, "missing.il: cannot read"),
              ([str(bad)], 1, "bad.il: line 2, column 7 (byte 12): not UTF-8 text"),
              ([], 2, "usage: python -m verifier.export.ladder FILE.il")]
     for args, status, message in cases:
@@ -453,7 +453,7 @@ def test_the_regeneration_command_s_own_messages_keep_a_name_with_a_newline_on_o
     from verifier.export import ladder
 
     missing = tmp_path / "b\nad.il"
-    assert ladder.main([str(missing)]) == 1
+    assert ladder.main([str(missing)]) == 2
     assert capsys.readouterr().err.startswith(f"{tmp_path}/b\\x0aad.il: ")
     assert ladder.main([str(IL), "-o", str(tmp_path / "no\nfolder" / "x.csv")]) == 2
     assert capsys.readouterr().err.startswith(f"{tmp_path}/no\\x0afolder/x.csv: cannot write: ")
@@ -492,3 +492,25 @@ def test_devices_written_in_lower_case_reach_the_csv_in_upper_case():
     rows = [line.split("\t")[2:4] for line in csv.splitlines()[3:]]
     assert rows == [['"LD"', '"X0"'], ['"OUT"', '"T200"'], ['""', '"K30"'], ['"MOV"', '"H1C81"'], ['""', '"D8400"'],
                     ['"END"', '""']]
+
+
+@pytest.mark.parametrize("name, text", [
+    ("UITAMR_Command.st", "LD X0\nEND\n"),  # named .st: whatever it holds
+    ("fb.txt", "(* UITAMR_Command *)\nFUNCTION_BLOCK UITAMR_Command\nEND_FUNCTION_BLOCK\n"),
+    ("main.il", "\ufeff  program Main\nVAR x : BOOL; END_VAR\nEND_PROGRAM\n"),
+    ("fb.il", "FUNCTION_BLOCK Fb\nEND_FUNCTION_BLOCK\n"),
+])
+def test_the_regeneration_command_names_an_st_file_as_one(tmp_path, capsys, name, text):
+    """Given an ST file, the converter said "'(*' is not an instruction this converter knows"
+    (exit 1), as if an .il had a typo: it now says the file is structured text and what reads
+    it, with the exit status of other unusable input (2), and writes no CSV."""
+    from verifier.export import ladder
+
+    source = tmp_path / name
+    source.write_text(text, encoding="utf-8")
+    csv = tmp_path / "out.csv"
+    assert ladder.main([str(source), "-o", str(csv)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"{source}: is structured text (ST), not an instruction list"), err
+    assert "`uitamr check`" in err and "`uitamr export`" in err and "not an instruction this" not in err
+    assert not csv.exists()

@@ -129,6 +129,21 @@ def to_csv(program: list[Instruction], program_name: str) -> str:
 
 USAGE = "python -m verifier.export.ladder FILE.il [-o FILE.csv]"
 
+ST_OPENINGS = ("PROGRAM", "FUNCTION_BLOCK", "FUNCTION")
+
+
+def structured_text(path: Path, text: str) -> str | None:
+    """Why `path` is structured text rather than an instruction list (a .st file, or text that
+    opens with a comment `(*`, PROGRAM or FUNCTION_BLOCK), or None: given one, the converter
+    said "'(*' is not an instruction", as if the ST had a typo in it."""
+    words = text.lstrip().split(None, 1)
+    first = words[0].upper() if words else ""
+    if path.suffix.lower() != ".st" and not first.startswith("(*") and first not in ST_OPENINGS:
+        return None
+    return ("is structured text (ST), not an instruction list: this converter reads .il files "
+            "(one instruction a line, ending with END); ST is read by `uitamr check` (to check it) "
+            "and `uitamr export` (to import it into GX Works)")
+
 
 def main(argv: list[str]) -> int:
     import argparse
@@ -147,8 +162,13 @@ def main(argv: list[str]) -> int:
     try:
         text = read_utf8(path)
     except UnreadableText as e:
+        # a file that cannot be read at all is unusable input (2), as for `uitamr check`;
+        # bytes that are not UTF-8 are a mistake at a line of it, as any other (1)
         print(f"{shown_name(str(path))}: {e}", file=sys.stderr)
-        return 1
+        return 1 if e.place is not None else 2
+    if (why := structured_text(path, text)) is not None:
+        print(f"{shown_name(str(path))}: {why}", file=sys.stderr)
+        return 2
     try:
         csv = to_csv(parse_il(text, str(path)), path.stem)
     except IlError as e:

@@ -912,7 +912,7 @@ class Checker:
         if isinstance(bt, T.FbType):
             p = bt.param(e.member)
             if p is None:
-                self.rep.error(e, f"{bt} has no input or output '{e.member}'")
+                self.rep.error(e, f"{bt} has no input or output '{e.member}'{self._internal_label(bt, e.member)}")
                 return T.ANY
             if p[0] == "in_out":
                 self.rep.error(e, f"'{e.member}' is a VAR_IN_OUT of {bt}; it cannot be read from outside")
@@ -922,6 +922,37 @@ class Checker:
             return T.BOOL
         self.rep.error(e, f"'.{e.member}' needs a structure or FB instance; this is {bt}")
         return T.ANY
+
+    def _library_range(self, a: ast.Arg, fb: T.FbType) -> None:
+        """A constant outside the range a UITAMR library FB checks its input against
+        (library.LIBRARY_INPUT_RANGES): the FB would end with its error code at run time."""
+        limits = library.LIBRARY_INPUT_RANGES.get((fb.name.upper(), a.key))
+        value = _const_int(a.value) if limits is not None else None
+        if value is None or limits[0] <= value <= limits[1]:
+            return
+        lo, hi, code = limits
+        self.rep.warning(a.value, f"{a.name} := {value} is outside {lo}..{hi}, the range {fb.name} accepts: "
+                                  f"it ends with o_bErr and o_uErrId 16#{code:04X} instead of running "
+                                  f"(see its header); give a value in {lo}..{hi}")
+
+    def _internal_label(self, fb: T.FbType, member: str) -> str:
+        """When `member` is a label of `fb`'s own VAR (`fbRun.fbCmd`: the UITAMR_Command instance
+        inside UITAMR_RunPoint), the words that say so and what to read instead; else "".
+        GX Works does not let a program read an FB's internal labels either (only its inputs
+        and outputs); a scenario's `watch` and conditions may, as a monitor looks inside."""
+        info = None if fb.standard else self.table.pous.get(fb.name.upper())
+        label = info.labels.get(member.upper()) if info is not None else None
+        if label is None or label[0].section not in ("VAR", "VAR_TEMP"):
+            return ""
+        v, t = label
+        what = f"an internal instance of {t.name}" if isinstance(t, T.FbType) else "an internal label"
+        outputs = ", ".join(n for n, _ in fb.outputs)
+        instead = f"read its outputs instead ({outputs})" if outputs else "it has no outputs to read"
+        if isinstance(t, T.FbType):
+            instead += f", or call {t.name} in the program itself where it must act on {t.name}'s outputs"
+        return (f": '{v.name}' is {what} (VAR) of {fb.name}, and a program reads only an FB's inputs "
+                f"and outputs, as GX Works does; {instead}. A scenario's watch and conditions may read "
+                "internal labels (the verifier looks inside the instance, as a monitor does)")
 
     def _convert(self, source: T.Type, target: T.Type, advice: str) -> str:
         """`advice` with the editor's conversion from `source` to `target` in its {}, or ""
@@ -1103,6 +1134,8 @@ class Checker:
                     vt = self.expr(a.value)
                 if vt is not None:
                     self._assign_compat(a.value, pt, vt, f"input {a.name}")
+                if kind == "input" and not fb.standard:
+                    self._library_range(a, fb)
         for n, _t in fb.in_outs:
             if n.upper() not in seen:
                 self.rep.error(c, f"VAR_IN_OUT '{n}' of {fb} must be connected in every call")

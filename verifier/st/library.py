@@ -232,3 +232,26 @@ def reserved_reason(name: str, families: tuple[str, ...] = ()) -> str | None:
     if key in RESERVED_DEVICE_WORDS:
         return "is a reserved device name of the operating system"
     return None
+
+
+# The inputs of the UITAMR library's FBs that the FBs themselves check against a range, with
+# the error code they end with outside it (`uitamr check` warns at a constant out of range:
+# `i_wPoint := 25` imported without a word and failed at the first command). Each range is
+# the one the FB's ST checks and each code is in its header; tests/test_check_integrator.py
+# derives them from plc/ and compares, so the table cannot drift from the ST.
+LIBRARY_INPUT_RANGES: dict[tuple[str, str], tuple[int, int, int]] = {
+    ("UITAMR_BUILDCONTROL", "I_WADDRESS"): (1, 247, 0x0301),
+    ("UITAMR_BUILDCONTROL", "I_WCODE"): (1, 13, 0x0301),
+    ("UITAMR_BUILDCONTROL", "I_WCOMMAND"): (0, 255, 0x0301),
+    ("UITAMR_BUILDSTATUS", "I_WADDRESS"): (1, 247, 0x0301),
+    ("UITAMR_BUILDSTATUS", "I_WQUERY"): (0, 3, 0x0301),
+    ("UITAMR_RUNPOINT", "I_WPOINT"): (1, 21, 0x0301),
+    ("UITAMR_SETSPEED", "I_WSTAGE"): (1, 4, 0x0301),
+    ("UITAMR_READSTATUS", "I_WQUERY"): (0, 3, 0x0301),
+    ("UITAMR_JOG", "I_WDIRECTION"): (0, 6, 0x0301),
+    ("UITAMR_PORTFX3", "I_WCHANNEL"): (1, 2, 0x0304),
+    ("UITAMR_PORTFX5", "I_WCHANNEL"): (1, 2, 0x0304),
+    ("UITAMR_PORTQC24", "I_WCHANNEL"): (1, 2, 0x0304),
+    ("UITAMR_PORTTCPFX5", "I_WCONNECTION"): (1, 8, 0x0304),
+    ("UITAMR_PORTE71", "I_WCONNECTION"): (1, 7, 0x0304),
+}
