@@ -12,11 +12,16 @@ its line statement.
 `-o FILE` writes the CSV only when the conversion succeeds, whole (a temporary file
 renamed over FILE): `... X.il > X.csv` left an empty X.csv on a mistake in the .il, as
 the shell empties the file before the command runs. Without -o the CSV goes to stdout.
+
+`--encoding` (utf-8 default, utf-16 = UTF-16 LE with BOM, cp950, cp932, shift_jis): which
+one GX Works2 reads is UNCONFIRMED (docs/plc-library.md, "Which encoding"); a rung comment
+the chosen one cannot hold is named at its .il line and column.
 """
 from __future__ import annotations
 
 import sys
 from dataclasses import dataclass
+from typing import Callable
 from pathlib import Path
 from verifier.place import Place
 from verifier.textfile import UnreadableText, read_utf8, shown_name, text_lines
@@ -51,11 +56,13 @@ class Instruction:
     op: str
     operands: tuple[str, ...]
     statement: str = ""        # the rung comment that precedes it, on a rung's first instruction
+    statement_at: tuple[int, int] = (0, 0)   # the .il line and column where that comment's text starts
+    operand_cols: tuple[int, ...] = ()       # the .il column of each operand, on `line`
 
 
 def parse_il(text: str, name: str = "<il>") -> list[Instruction]:
     program: list[Instruction] = []
-    pending = ""
+    pending, pending_at = "", (0, 0)
     for number, raw in enumerate(text_lines(text), 1):
         line = raw.strip()
         if not line:
@@ -63,7 +70,7 @@ def parse_il(text: str, name: str = "<il>") -> list[Instruction]:
         if line.startswith(";"):
             comment = line[1:].strip()
             if comment[:1] == "R" and comment[1:2].isdigit():
-                pending = comment
+                pending, pending_at = comment, (number, raw.index(comment) + 1)
             continue
         op, *operands = line.split()
         col = raw.index(op) + 1
@@ -88,8 +95,14 @@ def parse_il(text: str, name: str = "<il>") -> list[Instruction]:
             raise IlError(f"{Place(name, number, col)}: {upper} after END (line {program[-1].line}): END must be "
                           "the last instruction, the CPU runs nothing after it")
         # devices upper case, as GX Works2 writes them in its CSV (`ld x0` gave the operand "x0")
-        program.append(Instruction(number, upper, tuple(o.upper() for o in operands), pending))
-        pending = ""
+        cols, at = [], raw.index(op) + len(op)
+        for o in operands:
+            at = raw.index(o, at)
+            cols.append(at + 1)
+            at += len(o)
+        program.append(Instruction(number, upper, tuple(o.upper() for o in operands), pending, pending_at,
+                                   tuple(cols)))
+        pending, pending_at = "", (0, 0)
     if not program:
         raise IlError(f"{shown_name(name)}: no instruction in it: an .il holds one instruction a line, "
                       "the last one END")
@@ -127,7 +140,40 @@ def to_csv(program: list[Instruction], program_name: str) -> str:
     return "\r\n".join(rows) + "\r\n"
 
 
-USAGE = "python -m verifier.export.ladder FILE.il [-o FILE.csv]"
+#: --encoding -> (Python codec, bytes put first). ASSUMPTION (docs/plc-library.md, "Which
+#: encoding"): no Mitsubishi page found says which one "Read from CSV File" takes; utf-8 stays
+#: the default, utf-16 is the form a third-party generator says GX Works2 writes, cp950 / cp932 /
+#: shift_jis the code pages of a Traditional Chinese / Japanese Windows.
+ENCODINGS = {"utf-8": ("utf-8", b""), "utf-16": ("utf-16-le", b"\xff\xfe"), "cp950": ("cp950", b""),
+             "cp932": ("cp932", b""), "shift_jis": ("shift_jis", b"")}
+
+
+def encode_csv(program: list[Instruction], program_name: str, encoding: str = "utf-8",
+               name: str = "<il>") -> bytes:
+    """to_csv() as the bytes of `encoding` (a key of ENCODINGS). A rung comment or operand
+    with a character the encoding has no code for is an IlError at its .il line and column
+    (the .il file name for the program name, which is the file's stem)."""
+    codec, bom = ENCODINGS[encoding]
+
+    def refuse(text: str, where: Callable[[int], object], what: str) -> None:
+        try:
+            text.encode(codec)
+        except UnicodeEncodeError as e:
+            char = text[e.start]
+            raise IlError(f"{where(e.start)}: {what} has '{char}' (U+{ord(char):04X}), which {encoding} cannot "
+                          f"encode: write it in another --encoding (utf-16 holds every character) or "
+                          f"replace it") from None
+
+    refuse(program_name, lambda i: shown_name(name), "the file name (the CSV's program name)")
+    for ins in program:
+        if ins.statement:
+            refuse(ins.statement, lambda i: Place(name, ins.statement_at[0], ins.statement_at[1] + i), "the comment")
+        for operand, col in zip(ins.operands, ins.operand_cols or (1,) * len(ins.operands)):
+            refuse(operand, lambda i: Place(name, ins.line, col + i), "the operand")
+    return bom + to_csv(program, program_name).encode(codec)
+
+
+USAGE = "python -m verifier.export.ladder FILE.il [-o FILE.csv] [--encoding ENC]"
 
 ST_OPENINGS = ("PROGRAM", "FUNCTION_BLOCK", "FUNCTION")
 
@@ -153,6 +199,10 @@ def main(argv: list[str]) -> int:
     parser.add_argument("il", metavar="FILE.il")
     parser.add_argument("-o", "--out", metavar="FILE.csv",
                         help="write the CSV to this file, only when the .il converts (default: stdout)")
+    parser.add_argument("--encoding", choices=list(ENCODINGS), default="utf-8",
+                        help="the CSV's encoding (default utf-8; utf-16 = UTF-16 LE with BOM; cp950 Traditional "
+                             "Chinese, cp932/shift_jis Japanese Windows). Which one GX Works2 expects is "
+                             "UNCONFIRMED: see docs/plc-library.md")
     args = parser.parse_args(argv)  # a usage mistake: argparse's message, exit 2
     path = Path(args.il)
     if args.out is not None and Path(args.out).resolve() == path.resolve():
@@ -170,12 +220,14 @@ def main(argv: list[str]) -> int:
         print(f"{shown_name(str(path))}: {why}", file=sys.stderr)
         return 2
     try:
-        csv = to_csv(parse_il(text, str(path)), path.stem)
+        csv = encode_csv(parse_il(text, str(path)), path.stem, args.encoding, str(path))
     except IlError as e:
         print(e, file=sys.stderr)
         return 1
     if args.out is None:
-        sys.stdout.write(csv)
+        sys.stdout.flush()
+        sys.stdout.buffer.write(csv)
+        sys.stdout.buffer.flush()
         return 0
     try:
         _write_whole(Path(args.out), csv)
@@ -185,8 +237,8 @@ def main(argv: list[str]) -> int:
     return 0
 
 
-def _write_whole(out: Path, text: str) -> None:
-    """`text` into `out` at once: written beside it under a temporary name, then renamed over
+def _write_whole(out: Path, data: bytes) -> None:
+    """`data` into `out` at once: written beside it under a temporary name, then renamed over
     it, so that `out` is the old file or the new one, never a part (the temporary file is
     removed when writing fails). A symbolic link is written through to its target, and a
     pipe or a device is written to, as the shell's `> X.csv` did; the mode is set by path
@@ -197,13 +249,13 @@ def _write_whole(out: Path, text: str) -> None:
     if out.is_symlink():
         out = Path(os.path.realpath(out))
     if out.exists() and not out.is_file():  # a pipe, a device (/dev/stdout): not replaced by a file
-        with open(out, "w", encoding="utf-8", newline="") as f:
-            f.write(text)
+        with open(out, "wb") as f:
+            f.write(data)
         return
     fd, temporary = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
     try:
-        with open(fd, "w", encoding="utf-8", newline="") as f:
-            f.write(text)
+        with open(fd, "wb") as f:
+            f.write(data)
         try:  # the file's own mode, else a new file's (mkstemp's 0600 would hide it from others)
             mode = out.stat().st_mode & 0o7777
         except OSError:
