@@ -927,11 +927,19 @@ class Checker:
         """A constant outside the range a UITAMR library FB checks its input against
         (library.LIBRARY_INPUT_RANGES): the FB would end with its error code at run time."""
         limits = library.LIBRARY_INPUT_RANGES.get((fb.name.upper(), a.key))
-        value = _const_int(a.value) if limits is not None else None
+        if limits is None:
+            return
+        value, given = _const_int(a.value), None
+        decl = getattr(a.value, "symbol", None) if isinstance(a.value, ast.Name) else None
+        if value is None and isinstance(decl, ast.VarDecl) and decl.constant and decl.init is not None:
+            # the usual form: a named constant (`RS2_CHANNEL : INT := 3;` in VAR CONSTANT)
+            value = _const_int(decl.init)
+            where = decl.span.place if decl.span.file != a.value.span.file else f"{decl.span.line}:{decl.span.col}"
+            given = f"{a.value.name} ({value}, the VAR CONSTANT at {where})"
         if value is None or limits[0] <= value <= limits[1]:
             return
         lo, hi, code = limits
-        self.rep.warning(a.value, f"{a.name} := {value} is outside {lo}..{hi}, the range {fb.name} accepts: "
+        self.rep.warning(a.value, f"{a.name} := {given or value} is outside {lo}..{hi}, the range {fb.name} accepts: "
                                   f"it ends with o_bErr and o_uErrId 16#{code:04X} instead of running "
                                   f"(see its header); give a value in {lo}..{hi}")
 
