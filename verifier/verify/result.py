@@ -243,22 +243,30 @@ class ScenarioResult:
     @property
     def first_place(self) -> Place | None:
         """Where a CI annotation of this run belongs (the JUnit test case's `file` and
-        `line`, the JSON's `place`): the place of its first finding, as the reports list
-        them, that has one. The ST statement where the program stopped the CPU; else the
-        one that sent the frame of the first broken rule's first violation (`sent by`),
-        which is what to fix; else the line of the first failed expectation in the
-        scenario file (`place_of`). None when no finding has a place (a pass, a capture)."""
+        `line`, the JSON's `place`, the HTML's "look first at"): the place of its first
+        finding, as the reports list them, that has one (`first_finding`). None when no
+        finding has a place (a pass, a capture)."""
+        found = self.first_finding
+        return None if found is None else found[0]
+
+    @property
+    def first_finding(self) -> tuple[Place, str] | None:
+        """The place of the first finding that has one, and what was found there, for
+        people: the ST statement where the program stopped the CPU; else the one that sent
+        the frame of the first broken rule's first violation (`sent by`), which is what to
+        fix; else the line of the first failed expectation in the scenario file
+        (`place_of`). None when no finding has a place."""
         stopped = Place.of_location(self.aborted_at)
         if stopped is not None:
-            return stopped
+            return stopped, "the program stopped the CPU here"
         for found in self.broken_rules():
             sent_by = Place.of_location(found[0].origin)
             if sent_by is not None:
-                return sent_by
+                return sent_by, f"sent the frame of the first {found[0].rule} violation"
         for outcome in self.failed_expectations:
             place = self.place_of(outcome.expectation)
             if place is not None:
-                return place
+                return place, f"expected {outcome.expectation.label}"
         return None
 
     @property
