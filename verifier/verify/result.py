@@ -56,6 +56,9 @@ UNVERIFIED = (NO_TRAFFIC, CUT_SHORT)
 #: the `platform` of a capture's result (`uitamr monitor`, `uitamr replay`): a real line,
 #: no simulated CPU, program, scan or seed
 LINE = "line"
+#: the `channel` of a capture read from a file (`uitamr replay`); a line listened to live
+#: (`uitamr monitor`) has its port's kind: rs485, tcp
+CAPTURED_FROM_FILE = "capture"
 
 
 @dataclass(frozen=True)
@@ -268,6 +271,17 @@ class ScenarioResult:
             if place is not None:
                 return place, f"expected {outcome.expectation.label}"
         return None
+
+    @property
+    def file_to_annotate(self) -> str | None:
+        """The file a CI annotation of this run names when no finding has a place (the JUnit
+        test case's `file` without `line`): the scenario file, else the ST file of its
+        PROGRAM; for `uitamr replay` the capture file. None for a line `uitamr monitor`
+        listened to: its port (`/dev/ttyUSB0`, `tcp 192.168.0.50:4001`) is no file of the
+        repository a CI server could open."""
+        if self.captured and self.channel != CAPTURED_FROM_FILE:
+            return None
+        return self.file or self.program_file
 
     @property
     def broke_nothing(self) -> bool:
