@@ -231,6 +231,22 @@ def test_raw_and_negative_numbers_need_no_double_dash():
     assert result.exit_code == 2 and "unknown robot command 0x20" in result.output
 
 
+def test_a_command_byte_in_hex_without_0x_is_told_how_to_write_it():
+    """The decoder prints the stop as "stop (01/A0)", protocol.md's table its byte as A0:
+    `uitamr frame raw 1 A0` was refused with "must be a whole number (decimal, or hex as
+    0x..)", which did not say what to type. It names it now, for GX Works' ways of writing
+    hex too; a hex number without letters (16) stays decimal, as --help and protocol.md say."""
+    for written in ("A0", "a0", "HA0", "16#A0", "A0h"):
+        result = run("raw", "1", written)
+        assert result.exit_code == 2, result.output
+        assert (f"command {written!r} is hex: write it 0xA0 (or 160 in decimal); a number without 0x is read as "
+                "decimal") in " ".join(result.output.split()), result.output
+    stop = run("stop").output.strip()
+    assert run("raw", "1", "0xA0").output.strip() == run("raw", "1", "160").output.strip() == stop
+    assert "stop is raw 1 0xA0" in " ".join(run("--help").output.split())
+    assert run("raw", "1", "16").output.strip() == run("run-point", "16").output.strip()
+
+
 def test_help_lists_every_command_form():
     result = run("--help")
     assert result.exit_code == 0

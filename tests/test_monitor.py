@@ -1273,14 +1273,14 @@ def test_on_a_terminal_a_rich_panel_counts_frames_and_findings_under_the_lines(t
     assert "0.000 s  UITAMR-POWERON-STOP: the first control command" in text  # a finding line above it
 
 
-def test_a_converter_that_drops_the_connection_inside_a_frame_is_not_the_plcs_short_frame(tmp_path):
-    """Seen on the converter route: the converter closed the connection five bytes into a
-    status read. Those bytes were cut by the end of the capture, not sent short by the
-    PLC: no CRC and FORMAT findings (exit 1) against a healthy PLC, but a note, live and in
-    the replay of the capture. The cut bytes go out with the connection's end in one
-    segment (MSG_MORE, then the shutdown): a host stall before the shutdown could let the
-    monitor see them end by silence instead - measured, and such an attempt runs again."""
-    partial = READ[:5]
+def _dropped_inside_a_frame(tmp_path: Path, partial: bytes, *before: bytes, stalled_if=lambda done: True):
+    """`uitamr monitor --tcp` (with --json, --junit and --capture in an attempt's folder) on
+    a converter that streams `before` (6 ms apart) and, 0.3 s on, closes the connection
+    `partial` bytes into a frame: (the monitor's run, the attempt's folder, the port). The
+    cut bytes go out with the connection's end in one segment (MSG_MORE, then the
+    shutdown): a host stall before the shutdown could let the monitor see them end by
+    silence instead - measured, and an attempt where it came and `stalled_if` the run
+    runs again."""
     for attempt in range(3):
         server = socket.create_server(("127.0.0.1", 0))
         port = server.getsockname()[1]
@@ -1289,9 +1289,9 @@ def test_a_converter_that_drops_the_connection_inside_a_frame_is_not_the_plcs_sh
         def stream():
             connection, _ = server.accept()
             with connection:
-                connection.sendall(STOP)
-                time.sleep(0.006)
-                connection.sendall(STOP)  # the echo
+                for data in before:
+                    connection.sendall(data)
+                    time.sleep(0.006)
                 time.sleep(0.3)
                 sent = time.monotonic()
                 connection.send(partial, socket.MSG_MORE)
@@ -1303,24 +1303,76 @@ def test_a_converter_that_drops_the_connection_inside_a_frame_is_not_the_plcs_sh
         folder = tmp_path / f"attempt{attempt}"
         folder.mkdir()
         done = procs.run(uitamr("monitor", "--tcp", f"127.0.0.1:{port}", "--duration", "10s",
-                                     "--json", folder / "m.json", "--capture", folder / "c.txt"),
+                                "--json", folder / "m.json", "--junit", folder / "m.xml", "--capture", folder / "c.txt"),
                          capture_output=True, text=True, timeout=60)
         thread.join(timeout=5)
         server.close()
-        if done.returncode == 1 and gap and gap[0] > 0.02:
+        if gap and gap[0] > 0.02 and stalled_if(done):
             continue  # the server thread stalled between the bytes and the shutdown
-        # no finding; the closed connection made it a session cut short (exit 4), not a pass
-        assert done.returncode == 4, done.stdout + done.stderr
-        note = "the capture ended inside a frame: its first 5 byte(s) (01 01 00 00 00) were not judged"
-        assert "the server closed the connection" in done.stdout and note in done.stdout
-        report = json.loads((folder / "m.json").read_text())
-        assert report["verdict"] == "cut-short" and note in report["scenarios"][0]["notes"]
-        # the plain capture does not carry the cut (commissioning.md §6): its frames pass
-        replayed = procs.run(uitamr("replay", folder / "c.txt"), capture_output=True, text=True,
-                             timeout=WAIT_S)
-        assert replayed.returncode == 0 and note in replayed.stdout, replayed.stdout + replayed.stderr
-        return
+        return done, folder, port
     pytest.fail("the stream's server thread stalled in every attempt")
+
+
+def test_a_converter_that_drops_the_connection_inside_a_frame_is_not_the_plcs_short_frame(tmp_path):
+    """Seen on the converter route: the converter closed the connection five bytes into a
+    status read. Those bytes were cut by the end of the capture, not sent short by the
+    PLC: no CRC and FORMAT findings (exit 1) against a healthy PLC, but a note, live and in
+    the replay of the capture."""
+    done, folder, _ = _dropped_inside_a_frame(tmp_path, READ[:5], STOP, STOP,  # the stop and its echo
+                                              stalled_if=lambda done: done.returncode == 1)
+    # no finding; the closed connection made it a session cut short (exit 4), not a pass
+    assert done.returncode == 4, done.stdout + done.stderr
+    note = "the capture ended inside a frame: its first 5 byte(s) (01 01 00 00 00) were not judged"
+    assert "the server closed the connection" in done.stdout and note in done.stdout
+    report = json.loads((folder / "m.json").read_text())
+    assert report["verdict"] == "cut-short" and note in report["scenarios"][0]["notes"]
+    # the plain capture does not carry the cut (commissioning.md §6): its frames pass
+    replayed = procs.run(uitamr("replay", folder / "c.txt"), capture_output=True, text=True,
+                         timeout=WAIT_S)
+    assert replayed.returncode == 0 and note in replayed.stdout, replayed.stdout + replayed.stderr
+
+
+def test_a_port_that_went_away_after_a_few_bytes_and_no_frame_says_it_saw_them(tmp_path):
+    """The converter closed the connection five bytes into the first frame: nothing was
+    verified (exit 3), but the headline said 'no bytes were seen on ... before it went
+    away' while the note beside it named the five bytes cut. It says what came now, live
+    and in the replay of the capture that holds them."""
+    done, folder, port = _dropped_inside_a_frame(tmp_path, READ[:5], stalled_if=lambda done: done.returncode != 3)
+    assert done.returncode == 3, done.stdout + done.stderr
+    assert re.search(rf"^NO TRAFFIC: only 5 byte\(s\) \(01 01 00 00 00\), no whole frame, were seen on tcp "
+                     rf"127\.0\.0\.1:{port} in \d+\.\d s, before it went away: check that the converter streams",
+                     done.stdout, re.M), done.stdout
+    assert "no bytes were seen" not in done.stdout
+    assert "its first 5 byte(s) (01 01 00 00 00) were not judged" in done.stdout  # the note, as before
+    report = json.loads((folder / "m.json").read_text())
+    assert report["verdict"] == "no-traffic" and report["scenarios"][0]["no_traffic"].startswith("only 5 byte(s)")
+    replayed = procs.run(uitamr("replay", folder / "c.txt"), capture_output=True, text=True, timeout=WAIT_S)
+    assert replayed.returncode == 3, replayed.stdout + replayed.stderr
+    assert (f"NO TRAFFIC: {folder / 'c.txt'} holds only 5 byte(s) (01 01 00 00 00), no whole frame, so nothing "
+            "was verified") in replayed.stdout, replayed.stdout
+
+
+def test_a_monitor_test_case_names_no_port_as_its_file(tmp_path):
+    """A monitor's JUnit test case had file="tcp 127.0.0.1:PORT" (or "/dev/ttyUSB0"): no
+    file of the repository, which a JUnit action (GitHub, GitLab) annotates or links as
+    one. It has no `file` now (the port is in its name); a replay's names its capture file."""
+    server = socket.create_server(("127.0.0.1", 0))
+    port = server.getsockname()[1]
+    thread = threading.Thread(target=lambda: server.accept()[0].recv(1), daemon=True)  # connects, sends nothing
+    thread.start()
+    done = procs.run(uitamr("monitor", "--tcp", f"127.0.0.1:{port}", "--duration", "1s", "--junit", tmp_path / "m.xml"),
+                     capture_output=True, text=True, timeout=WAIT_S)
+    server.close()
+    assert done.returncode == 3, done.stdout + done.stderr
+    (case,) = ET.parse(tmp_path / "m.xml").getroot().iter("testcase")
+    assert (case.get("name"), case.get("file"), case.get("line")) == (f"monitor tcp 127.0.0.1:{port}", None, None)
+    capture = tmp_path / "c.txt"
+    capture.write_text(f"0.1 {protocol.hex_bytes(STOP)}\n0.106 {protocol.hex_bytes(STOP)}\n", encoding="utf-8")
+    done = procs.run(uitamr("replay", capture, "--junit", tmp_path / "r.xml"), capture_output=True, text=True,
+                     timeout=WAIT_S)
+    assert done.returncode == 0, done.stdout + done.stderr
+    (case,) = ET.parse(tmp_path / "r.xml").getroot().iter("testcase")
+    assert case.get("file") == str(capture)
 
 
 def test_a_capture_that_ends_inside_a_frame_leaves_that_frame_unjudged():

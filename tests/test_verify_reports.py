@@ -509,3 +509,33 @@ def test_a_page_of_no_run_does_not_say_its_times_came_from_a_line():
 
     page = report_html.render([])
     assert "virtual time · bytes at 9600 8N1" in page and "times from the line" not in page
+
+
+def test_html_lists_the_rules_and_the_first_place_as_the_other_reports_do(tmp_path):
+    """Before, the page's rule tiles came in the rules' own order (UITAMR-PACING before
+    UITAMR-POWERON-STOP, which broke first and which the console and the JUnit list first),
+    and a failed run said nowhere where to look first, while the JSON's `place` and the
+    JUnit test case's file/line name its first finding's place."""
+    bad = bad_result()
+    page = tmp_path / "report.html"
+    report_html.write([good_result(), bad], page)
+    root = _rendered(page.as_uri())
+    good_section, bad_section = [s for s in root.iter("section") if "scenario" in (s.get("class") or "")]
+    tiles = [d.get("data-rule") for d in bad_section.iter("div") if "rule" in (d.get("class") or "").split()]
+    (case,) = [c for c in report_junit.to_element([bad]).iter("testcase")]
+    broken = [f.get("type") for f in case.findall("failure") if f.get("type") != "expectation"]
+    assert broken == ["UITAMR-POWERON-STOP", "UITAMR-PACING"]
+    assert tiles[:2] == broken  # as the JUnit (and the console) list them
+    assert tiles[2:] == [r.id for r in RULES if r.id not in broken]
+    out = io.StringIO()
+    report_console.render([bad], Console(file=out, width=200, color_system=None))
+    shown = [line.split()[0].rstrip(",") for line in out.getvalue().splitlines() if line.startswith("    UITAMR-")]
+    assert shown == broken
+    place = report_json.to_dict([bad])["scenarios"][0]["place"]
+    assert place == "UITAMR_Engine.st:210:9" and (case.get("file"), case.get("line")) == ("UITAMR_Engine.st", "210")
+    (said,) = [p for p in bad_section.iter("p") if p.get("class") == "first-finding"]
+    assert said.find("code").text == place
+    assert "UITAMR-POWERON-STOP" in "".join(said.itertext())
+    assert not [p for p in good_section.iter("p") if p.get("class") == "first-finding"]  # a pass has none
+    index = root.find(".//*[@id='index']")
+    assert [(td.text or "") for td in index.iter("td") if "place" in (td.get("class") or "").split()] == ["", place]

@@ -24,7 +24,7 @@ from verifier.monitor.framer import DEFAULT_TOLERANCE_US
 from verifier.monitor.session import CaptureInfo, MonitorSession
 from verifier.textfile import is_char_device
 from verifier.verify.evidence import RuleOptions
-from verifier.verify.result import mistakes_of
+from verifier.verify.result import CAPTURED_FROM_FILE, mistakes_of
 
 
 @click.command("replay", cls=JudgingCommand, maker="uitamr replay",
@@ -66,7 +66,7 @@ def command(captures, baud, line_format, tolerance, joined, reply_timeout, setti
         for capture_name, chunks in loaded.items():
             # a verify trace names its one run as its JUnit did, after the scenario; a monitor's
             # trace and a plain capture are named after their file
-            info = CaptureInfo(capture_name if len(loaded) > 1 or verify_trace else path.name, str(path), "capture",
+            info = CaptureInfo(capture_name if len(loaded) > 1 or verify_trace else path.name, str(path), CAPTURED_FROM_FILE,
                                line=f"{baud} {line_format}")
             recorded = chunks[-1].settings if chunks else None  # the end record's: overridden by options given
             run_settings = settings if recorded is None else replace(recorded, **given_settings(settings))

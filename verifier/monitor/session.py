@@ -19,7 +19,7 @@ from verifier import protocol
 from verifier.protocol.codec import MAX_FRAME
 from verifier.protocol.stream import ROBOT_LINE, garbled, garbled_note
 from verifier.verify.evidence import RuleOptions, RunEvidence, Samples, Violation
-from verifier.verify.result import LINE, LineEvent, ScenarioResult, TraceRecord, judged_with
+from verifier.verify.result import CAPTURED_FROM_FILE, LINE, LineEvent, ScenarioResult, TraceRecord, judged_with
 from verifier.verify.rules import Judgement, check_all
 from verifier.verify.traffic import Exchange, Pairing, analyse, converter_drops
 
@@ -37,7 +37,7 @@ class CaptureInfo:
 
     name: str
     source: str  # "/dev/ttyUSB0", "tcp 192.168.0.50:4001", "capture.txt"
-    channel: str = "rs485"  # rs485 / tcp / capture
+    channel: str = "rs485"  # rs485 / tcp / capture (CAPTURED_FROM_FILE)
     line: str = ROBOT_LINE  # the line's speed and framing, as the monitor was told them
     notes: list[str] = field(default_factory=list)
 
@@ -334,13 +334,17 @@ class MonitorSession:
         """What a session that saw no bytes says: nothing was verified, and what to check
         (on site it is almost always the wiring, the port or the line's settings)."""
         source, line = self.info.source, self.info.line
-        if self.info.channel == "capture":
-            return (f"{source} holds no bytes, so nothing was verified: capture the line again once "
+        # the start of a frame the end cut (`cut_off`, the note names it) is all there was
+        some = f"only {len(self.cut_off)} byte(s) ({protocol.hex_bytes(self.cut_off)}), no whole frame,"
+        if self.info.channel == CAPTURED_FROM_FILE:
+            holds = f"{source} holds {some}" if self.cut_off else f"{source} holds no bytes,"
+            return (f"{holds} so nothing was verified: capture the line again once "
                     f"the monitor shows frames (check the wiring, the port name and {line})")
         during = "" if listened_us is None else f" in {listened_us / 1_000_000:.1f} s"
         if self._gone:
             during += ", before it went away"
+        seen = f"{some} were seen" if self.cut_off else "no bytes were seen"
         if self.info.channel == "tcp":
-            return (f"no bytes were seen on {source}{during}: check that the converter streams the line "
+            return (f"{seen} on {source}{during}: check that the converter streams the line "
                     f"to this port, its wiring to the line and its serial settings ({line})")
-        return f"no bytes were seen on {source}{during}: check the wiring (A, B, GND), the port name and {line}"
+        return f"{seen} on {source}{during}: check the wiring (A, B, GND), the port name and {line}"

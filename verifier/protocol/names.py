@@ -5,6 +5,7 @@
 """
 from __future__ import annotations
 
+import re
 from decimal import Decimal, InvalidOperation
 
 from verifier.digits import digit_problem
@@ -77,7 +78,7 @@ USAGE = (
     "move x|front|rear|y ±METRES      (0-25.5 m in 0.1 m steps)",
     "rotate ±VALUE                    (0-2.55 in 0.01 steps)",
     "read task|vehicle|speed|battery",
-    "raw CODE CMD                     (control code 1-13, command byte; 0x.. for hex)",
+    "raw CODE CMD                     (control code 1-13, command byte; decimal, 0x.. for hex: stop is raw 1 0xA0)",
 )
 
 
@@ -170,7 +171,14 @@ def _integer(text: str, what: str) -> int:
     try:
         return int(text, 16) if text.lower().startswith("0x") else int(text, 10)
     except ValueError:
-        raise CommandError(f"{what} must be a whole number (decimal, or hex as 0x..), got {text!r}") from None
+        pass
+    # hex as the decoder prints it ("stop (01/A0)"), as GX Works writes it (HA0, 16#A0), or A0h
+    written = re.fullmatch(r"(?:16#|[hH])?([0-9a-fA-F]+)[hH]?", text)
+    if written is not None:
+        digits = written.group(1).upper()
+        raise CommandError(f"{what} {text!r} is hex: write it 0x{digits} (or {int(digits, 16)} in decimal); a "
+                           f"number without 0x is read as decimal")
+    raise CommandError(f"{what} must be a whole number (decimal, or hex as 0x..), got {text!r}")
 
 
 def _stage(text: str, what: str) -> int:

@@ -20,7 +20,7 @@ from .durations import format_seconds
 from .events_shown import EVENTS_AT_MOST, event_class
 from .report_trace import LineTimes, blamed_frames, frame_count, records
 from .result import ScenarioResult, all_captured, overall_verdict
-from .rules import RULES
+from .rules import RULES, RULES_BY_ID
 
 DEFAULT_PX_PER_MS = 0.5
 MINOR_TICKS_UP_TO_MS = 120_000
@@ -186,15 +186,24 @@ def scenario_view(index: int, result: ScenarioResult, frames_at_most: int = FRAM
         "minor_ticks": minor,
         "end_ms": round(end_ms, 3),
         "period_ms": period_ms,
+        # the broken rules first, in the order of their first violation as the console and
+        # the JUnit list them, then the others in the rules' own order
         "rules": [
             {"id": rule.id, "title": rule.title, "explanation": rule.explanation,
              "count": len(result.violations.get(rule.id, []))}
-            for rule in RULES
+            for rule in _rules_in_order(result)
         ],
+        "first_finding": result.first_finding,
         "tx": requests,
         "rx": len(line) - requests,
         "ended": format_seconds(result.ended_us),
     }
+
+
+def _rules_in_order(result: ScenarioResult) -> list:
+    """Every rule, the broken ones first as ScenarioResult.broken_rules lists them."""
+    broken = [found[0].rule for found in result.broken_rules()]
+    return [RULES_BY_ID[rule] for rule in broken] + [rule for rule in RULES if rule.id not in broken]
 
 
 def _pieces(results: list[ScenarioResult], command: str) -> Iterator[str]:

@@ -58,13 +58,14 @@ def to_element(results: list[ScenarioResult], command: str = "uitamr verify") ->
             time=f"{result.wall_s:.3f}",
         )
         # one place a JUnit reader (GitHub's actions) annotates: the first finding's that has
-        # one (ScenarioResult.first_place), else the scenario file, or the program's ST file
+        # one (ScenarioResult.first_place), else the scenario file, the program's ST file or
+        # the capture file; no port a monitor listened to (file_to_annotate)
         place = result.first_place
         if place is not None:
             case.set("file", place.file)
             case.set("line", str(place.line))
-        elif result.file or result.program_file:
-            case.set("file", result.file or result.program_file)
+        elif result.file_to_annotate is not None:
+            case.set("file", result.file_to_annotate)
         if result.aborted:
             errors += 1
             # the message is what a CI server lists: the ST place and the reason, as for a rule

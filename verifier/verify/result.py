@@ -56,6 +56,9 @@ UNVERIFIED = (NO_TRAFFIC, CUT_SHORT)
 #: the `platform` of a capture's result (`uitamr monitor`, `uitamr replay`): a real line,
 #: no simulated CPU, program, scan or seed
 LINE = "line"
+#: the `channel` of a capture read from a file (`uitamr replay`); a line listened to live
+#: (`uitamr monitor`) has its port's kind: rs485, tcp
+CAPTURED_FROM_FILE = "capture"
 
 
 @dataclass(frozen=True)
@@ -243,23 +246,42 @@ class ScenarioResult:
     @property
     def first_place(self) -> Place | None:
         """Where a CI annotation of this run belongs (the JUnit test case's `file` and
-        `line`, the JSON's `place`): the place of its first finding, as the reports list
-        them, that has one. The ST statement where the program stopped the CPU; else the
-        one that sent the frame of the first broken rule's first violation (`sent by`),
-        which is what to fix; else the line of the first failed expectation in the
-        scenario file (`place_of`). None when no finding has a place (a pass, a capture)."""
+        `line`, the JSON's `place`, the HTML's "look first at"): the place of its first
+        finding, as the reports list them, that has one (`first_finding`). None when no
+        finding has a place (a pass, a capture)."""
+        found = self.first_finding
+        return None if found is None else found[0]
+
+    @property
+    def first_finding(self) -> tuple[Place, str] | None:
+        """The place of the first finding that has one, and what was found there, for
+        people: the ST statement where the program stopped the CPU; else the one that sent
+        the frame of the first broken rule's first violation (`sent by`), which is what to
+        fix; else the line of the first failed expectation in the scenario file
+        (`place_of`). None when no finding has a place."""
         stopped = Place.of_location(self.aborted_at)
         if stopped is not None:
-            return stopped
+            return stopped, "the program stopped the CPU here"
         for found in self.broken_rules():
             sent_by = Place.of_location(found[0].origin)
             if sent_by is not None:
-                return sent_by
+                return sent_by, f"sent the frame of the first {found[0].rule} violation"
         for outcome in self.failed_expectations:
             place = self.place_of(outcome.expectation)
             if place is not None:
-                return place
+                return place, f"expected {outcome.expectation.label}"
         return None
+
+    @property
+    def file_to_annotate(self) -> str | None:
+        """The file a CI annotation of this run names when no finding has a place (the JUnit
+        test case's `file` without `line`): the scenario file, else the ST file of its
+        PROGRAM; for `uitamr replay` the capture file. None for a line `uitamr monitor`
+        listened to: its port (`/dev/ttyUSB0`, `tcp 192.168.0.50:4001`) is no file of the
+        repository a CI server could open."""
+        if self.captured and self.channel != CAPTURED_FROM_FILE:
+            return None
+        return self.file or self.program_file
 
     @property
     def broke_nothing(self) -> bool:
