@@ -85,6 +85,8 @@ def test_plain_capture_reads_chunks_and_frames_with_directions():
     ("0.1 01\n0.2 end 02\n", "c.txt:2:9: an `end` line holds no bytes"),
     ("0.1 01\n0.2 end\n# after\n 0.3 02\n", "c.txt:4:2: the capture ended at its `end` line (c.txt:2)"),
     ("0.2 01\n0.1 end\n", "c.txt:2:1: time 0.1 s is earlier than the line before"),
+    ("0.1 01\n0.2 silence 02\n", "c.txt:2:13: a `silence` line holds no bytes"),
+    ("0.2 01\n0.1 silence\n", "c.txt:2:1: time 0.1 s is earlier than the line before"),
 ])
 def test_a_bad_capture_is_named_with_file_line_and_column(text, where):
     with pytest.raises(CaptureError) as caught:
