@@ -121,25 +121,22 @@ def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
                                f"earlier than the line before ({last_t / 1_000_000:.6f} s); a capture "
                                "is in time order")
         pos = time_match.end()
-        end = re.match(r"\s+end\b", line[pos:], re.IGNORECASE)
-        if end is not None:
-            rest = line[pos + end.end():]
+        # `end`: listened to until then, and nothing follows; `silence`: the live session saw
+        # the line silent until then and ended a frame there. Neither holds bytes
+        keyword = re.match(r"\s+(end|silence)\b", line[pos:], re.IGNORECASE)
+        if keyword is not None:
+            rest = line[pos + keyword.end():]
             if rest.strip():
-                col = pos + end.end() + len(rest) - len(rest.lstrip()) + 1
-                raise CaptureError(Place(name, number, col), "an `end` line holds no bytes (it says until when the "
-                                   "line was listened to); put the bytes on a line of their own before it")
-            chunks.append(Chunk(t_us, b""))
-            last_t, end_line = t_us, number
-            continue
-        silence = re.match(r"\s+silence\b", line[pos:], re.IGNORECASE)
-        if silence is not None:
-            rest = line[pos + silence.end():]
-            if rest.strip():
-                col = pos + silence.end() + len(rest) - len(rest.lstrip()) + 1
-                raise CaptureError(Place(name, number, col), "a `silence` line holds no bytes (it says the line "
-                                   "was silent until then); put the bytes on a line of their own after it")
+                col = pos + keyword.end() + len(rest) - len(rest.lstrip()) + 1
+                what = ("an `end` line holds no bytes (it says until when the line was listened to); put the bytes "
+                        "on a line of their own before it") if keyword.group(1).lower() == "end" else \
+                    ("a `silence` line holds no bytes (it says the line was silent until then); put the bytes on a "
+                     "line of their own after it")
+                raise CaptureError(Place(name, number, col), what)
             chunks.append(Chunk(t_us, b""))
             last_t = t_us
+            if keyword.group(1).lower() == "end":
+                end_line = number
             continue
         direction = None
         word = re.match(r"\s+(tx|rx|TX|RX)\b", line[pos:])
