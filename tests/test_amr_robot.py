@@ -385,6 +385,20 @@ def test_pacing_ignore_drops_the_fast_request():
     assert robot.mode == "idle"
 
 
+def test_pacing_ignore_still_marks_a_request_answered_after_dropped_ones():
+    """A master at 100 ms with pacing "ignore": the second and third requests were dropped
+    and logged, the fourth (300 ms after the first, the last one answered) was answered
+    with no `pacing` line, though it too came 100 ms after the one before."""
+    robot = Robot(config=RobotConfig(pacing="ignore"))
+    frame = status(Query.TASK)
+    replies = [robot.on_request(frame, t_us) for t_us in (100_000, 200_000, 300_000, 400_000)]
+    assert [reply is not None for reply in replies] == [True, False, False, True]
+    messages = [e.message for e in robot.events if e.kind == "pacing"]
+    assert len(messages) == 3, messages
+    assert messages[-1] == ("request 4 came 100.0 ms after the previous one (must be > 250 ms): answered, as more "
+                            "than 250 ms after the last one answered")
+
+
 def test_pacing_late_answers_when_the_period_is_over():
     robot = Robot(config=RobotConfig(pacing="late"))
     frame = status(Query.TASK)

@@ -442,3 +442,33 @@ def test_a_scenario_or_capture_named_with_a_newline_stays_on_its_message_line(tm
     result = invoke("replay", "t\nc.txt")
     assert result.exit_code == 2, result.output
     assert "t\\x0ac.txt:" in result.output and "\nc.txt:" not in result.output, result.output
+
+
+#: `uitamr` as a program whose lazy import of the sub-command's module gets a real SIGINT
+#: (Ctrl-C pressed in the first tenth of a second, while a loaded bench PC still imports
+#: pyserial and the robot model): the signal is sent from inside that import, so the test
+#: does not depend on when the host runs it
+CTRL_C_WHILE_IMPORTING = """
+import importlib, os, signal, sys
+real = importlib.import_module
+def import_module(name, *args):
+    if name.startswith("verifier.commands."):
+        os.kill(os.getpid(), signal.SIGINT)
+    return real(name, *args)
+importlib.import_module = import_module
+from verifier.cli import main
+sys.argv[0] = "uitamr"
+main()
+"""
+
+
+@pytest.mark.parametrize("command", [["emulate", "--tcp", "0"], ["monitor", "--tcp", "4001"], ["frame", "stop"]])
+def test_ctrl_c_while_the_command_is_being_loaded_names_the_command(command):
+    """It said `uitamr None: interrupted (Ctrl-C) ...`: the command's name is known only
+    once its module is imported, and the message was made from that."""
+    import sys
+    result = procs.run([sys.executable, "-c", CTRL_C_WHILE_IMPORTING, *command], timeout=60, capture_output=True,
+                         text=True)
+    assert result.returncode == 130, (result.returncode, result.stderr)
+    assert result.stderr.endswith(f"\nuitamr {command[0]}: interrupted (Ctrl-C) before it finished: no verdict\n"), result.stderr
+    assert "Traceback" not in result.stderr

@@ -786,6 +786,10 @@ def test_the_scripted_fault_line_says_count_duration_and_filter_together(tmp_pat
     # was pyserial's "Could not configure port: (25, 'Inappropriate ioctl for device')"
     (("--serial", "/dev/null"), "uitamr emulate: cannot open serial port /dev/null: not a serial port (a file or "
      "another kind of device): give the adapter's port", 2),
+    # a folder (Tab completion stops at /dev/serial/by-id/): was pyserial's "[Errno 21] could not
+    # open port /tmp: [Errno 21] Is a directory: '/tmp'"
+    (("--serial", "/tmp"), "uitamr emulate: cannot open serial port /tmp: a folder, not a serial port: give the "
+     "adapter's port, e.g. /dev/ttyUSB0 or a name in /dev/serial/by-id/", 2),
     # was "[Errno -2] Name or service not known (while attempting to bind on address ('nosuch.invalid', 4001))"
     (("--tcp", "nosuch.invalid:4001"), "uitamr emulate: cannot listen on nosuch.invalid:4001: nosuch.invalid is not "
      "an address, nor a name this PC can look up", 2),
@@ -813,6 +817,10 @@ def test_a_port_that_cannot_be_opened_says_what_to_check_on_site():
     assert monitor.returncode == 2
     assert "uitamr monitor: cannot open /nonexistent/ttyUSB9: no such port: check its name" in monitor.stderr
     assert "Errno" not in monitor.stderr
+    folder = procs.run([sys.executable, "-m", "verifier.cli", "monitor", "--serial", "/tmp", "--duration", "1s"],
+                       capture_output=True, text=True, timeout=WAIT_S)
+    assert folder.returncode == 2 and "uitamr monitor: cannot open /tmp: a folder, not a serial port" in folder.stderr
+    assert "Errno" not in folder.stderr
     # root (the test runner) opens any port: pyserial's own exceptions for the other two
     denied = serial.SerialException(13, "could not open port /dev/ttyUSB0: [Errno 13] Permission denied")
     assert why_not_opened(denied).startswith("permission denied: your user may not open it; add it to the port's "

@@ -85,6 +85,8 @@ def test_plain_capture_reads_chunks_and_frames_with_directions():
     ("0.1 01\n0.2 end 02\n", "c.txt:2:9: an `end` line holds no bytes"),
     ("0.1 01\n0.2 end\n# after\n 0.3 02\n", "c.txt:4:2: the capture ended at its `end` line (c.txt:2)"),
     ("0.2 01\n0.1 end\n", "c.txt:2:1: time 0.1 s is earlier than the line before"),
+    ("0.1 01\n0.2 silence 02\n", "c.txt:2:13: a `silence` line holds no bytes"),
+    ("0.2 01\n0.1 silence\n", "c.txt:2:1: time 0.1 s is earlier than the line before"),
 ])
 def test_a_bad_capture_is_named_with_file_line_and_column(text, where):
     with pytest.raises(CaptureError) as caught:
@@ -122,6 +124,46 @@ def test_a_replay_of_the_monitors_capture_judges_as_the_live_session_did(pieces,
     text = format_plain(live.chunks, "site", end_us=live.last_us)
     replayed = session_of(parse_plain(text), tolerance_us)
     assert _judged(replayed) == _judged(live)
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(st.tuples(st.integers(1, 60_000), st.binary(min_size=1, max_size=12), st.integers(0, 100)),
+                min_size=1, max_size=12), st.integers(0, 30_000))
+def test_a_replay_of_the_monitors_capture_cuts_where_the_live_session_saw_silence(pieces, tolerance_us):
+    """Live, the monitor polls between reads (every 2 ms) and a poll that finds the line
+    silent for t3.5 ends the frame; a replay of the capture dates each chunk's bytes back to
+    back before its arrival. A pty or a TCP converter hands bytes over faster than the
+    line, so a chunk that came after the silence was dated back into it, and the replay
+    joined it to the frame before: an FC03 request and its exception reply 8 ms later were
+    two frames live, one garbled frame (an extra UITAMR-CRC) in the replay. Each piece:
+    the gap before a chunk, the chunk, and where in that gap (percent) the live session
+    polled."""
+    t, live = 0, MonitorSession(CaptureInfo("test", "test"), timing=LineTiming(tolerance_us=tolerance_us))
+    for gap, data, polled_at in pieces:
+        live.poll(t + gap * polled_at // 100)
+        t += gap
+        live.feed(Chunk(t, data))
+    live.poll(t + 50_000)
+    live.close()
+    text = format_plain(live.chunks, "site", end_us=live.last_us)
+    assert _judged(session_of(parse_plain(text), tolerance_us)) == _judged(live), text
+
+
+def test_an_fc03_request_and_its_exception_reply_over_a_pty_replay_as_two_frames():
+    """The case seen on the bench: the emulator's exception reply came over the pty 8 ms
+    after the FC03 request's last byte; the monitor had polled in between."""
+    request, reply = bytes.fromhex("01 03 00 00 00 01 84 0A"), bytes.fromhex("01 83 01 80 F0")
+    live = MonitorSession(CaptureInfo("test", "test"), timing=LineTiming())
+    live.feed(Chunk(1_000_000, request))
+    live.poll(1_004_200)
+    live.feed(Chunk(1_008_100, reply))
+    live.poll(1_500_000)
+    live.close()
+    text = format_plain(live.chunks, "site", end_us=live.last_us)
+    assert text.splitlines()[2:] == ["0.012533 silence", "0.016433 01 83 01 80 F0", "0.508333 end"]
+    replayed = session_of(parse_plain(text))
+    assert [f.data for f in replayed.result().trace] == [request, reply]
+    assert rules_of(replayed) == rules_of(live) == Counter({"UITAMR-FORMAT": 1})
 
 
 def test_a_capture_with_its_end_line_replays_the_silence_after_the_last_bytes(tmp_path):
@@ -867,6 +909,26 @@ def test_a_request_left_unanswered_on_a_real_line_replays_from_the_trace_as_judg
     live_run, replayed = (json.loads((tmp_path / name).read_text())["scenarios"][0] for name in ("m.json", "r.json"))
     differing = {key for key in live_run if live_run[key] != replayed[key]}
     assert differing == {"name", "file", "description", "channel"}, {k: (live_run[k], replayed[k]) for k in differing}
+
+
+@pytest.mark.serial
+def test_a_capture_of_a_real_line_replays_to_the_live_findings_when_bytes_come_faster_than_the_line(bare_line, tmp_path):
+    """Over ptys bytes arrive faster than at 9600 bit/s: an FC03 request and its exception
+    reply 8 ms later (as `uitamr emulate` answers it) were two frames live, the monitor
+    having seen the silence between them, and one garbled frame in the replay of its
+    --capture (an extra UITAMR-CRC). A host that stalls the monitor over the 8 ms hands it
+    both in one read, which live and replay then judge alike: the test holds either way."""
+    monitor = monitor_on(bare_line, tmp_path, "--duration", "3s", "--joined", "--capture", tmp_path / "m.txt")
+    bare_line.from_plc(bytes.fromhex("01 03 00 00 00 01 84 0A"))
+    time.sleep(0.008)
+    bare_line.from_robot(bytes.fromhex("01 83 01 80 F0"))
+    out, err = procs.finish(monitor, WAIT_S)
+    seen = diagnosis(out, err, capture=tmp_path / "m.txt")
+    assert monitor.returncode == 1 and (tmp_path / "m.json").exists(), seen
+    done = procs.run(uitamr("replay", tmp_path / "m.txt", "--json", tmp_path / "r.json"),
+                     capture_output=True, text=True, timeout=WAIT_S)
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert findings(tmp_path / "r.json") == findings(tmp_path / "m.json"), seen + done.stdout
 
 
 @pytest.mark.serial

@@ -69,6 +69,10 @@ class LazyGroup(click.Group):
             raise
 
     def resolve_command(self, ctx: click.Context, args: list[str]):
+        # the name as typed, for the Ctrl-C message of `invoke`: `ctx.invoked_subcommand` is
+        # set only once the command's module is imported (`get_command`), and Ctrl-C in that
+        # import (a loaded PC takes a second or more) said `uitamr None: interrupted`
+        ctx.meta["uitamr.command"] = args[0] if args else None
         try:
             return super().resolve_command(ctx, args)
         except click.UsageError as error:  # `uitamr verfy --junit report.xml`
@@ -113,7 +117,8 @@ class LazyGroup(click.Group):
             # and exit 1, which these commands' callers read as "findings". 130 = 128 + SIGINT,
             # as the shell reports a program that Ctrl-C stopped. (monitor and emulate take
             # Ctrl-C as their stop and finish their reports or summary.)
-            click.echo(f"\nuitamr {ctx.invoked_subcommand}: interrupted (Ctrl-C) before it finished: "
+            name = ctx.invoked_subcommand or ctx.meta.get("uitamr.command")
+            click.echo(f"\nuitamr{' ' + name if name else ''}: interrupted (Ctrl-C) before it finished: "
                        "no verdict", err=True)
             sys.exit(EXIT_INTERRUPTED)
         except OSError as exc:

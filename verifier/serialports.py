@@ -54,6 +54,9 @@ def why_not_opened(err: Exception) -> str:
     if number == errno.ENOENT:
         return ("no such port: check its name and that the adapter is plugged in (Linux: `ls /dev/ttyUSB* "
                 "/dev/ttyACM* /dev/serial/by-id/` lists the USB adapters; Windows: Device Manager, Ports (COM & LPT))")
+    if number == errno.EISDIR:  # Tab completion stops at /dev/serial/by-id/
+        return ("a folder, not a serial port: give the adapter's port, e.g. /dev/ttyUSB0 or a name in "
+                "/dev/serial/by-id/ (Linux: `ls /dev/ttyUSB* /dev/ttyACM* /dev/serial/by-id/` lists the USB adapters)")
     if number in (errno.EACCES, errno.EPERM):
         return ("permission denied: your user may not open it; add it to the port's group (`ls -l` names "
                 "the group, dialout on Debian and Ubuntu: `sudo usermod -aG dialout $USER`, then log in again)")

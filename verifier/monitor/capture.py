@@ -14,6 +14,9 @@ frames by silence and content as it does live. A last line `<time> end` says the
 listened to, silent, until then (`uitamr monitor --capture` writes it): a replay judges
 the capture as the live session did, up to its end - a reply still due, the bytes of a
 frame left short by the silence - rather than as if listening stopped at the last byte.
+A line `<time> silence` says the live session saw the line silent until then and ended a
+frame there (bytes a pty or a converter hands over faster than the line would otherwise
+be dated back into that silence and joined to the frame before).
 A capture that cannot be read is an error naming file, line and column; nothing in it is
 skipped silently.
 """
@@ -118,15 +121,22 @@ def parse_plain(text: str, name: str = "<capture>") -> list[Chunk]:
                                f"earlier than the line before ({last_t / 1_000_000:.6f} s); a capture "
                                "is in time order")
         pos = time_match.end()
-        end = re.match(r"\s+end\b", line[pos:], re.IGNORECASE)
-        if end is not None:
-            rest = line[pos + end.end():]
+        # `end`: listened to until then, and nothing follows; `silence`: the live session saw
+        # the line silent until then and ended a frame there. Neither holds bytes
+        keyword = re.match(r"\s+(end|silence)\b", line[pos:], re.IGNORECASE)
+        if keyword is not None:
+            rest = line[pos + keyword.end():]
             if rest.strip():
-                col = pos + end.end() + len(rest) - len(rest.lstrip()) + 1
-                raise CaptureError(Place(name, number, col), "an `end` line holds no bytes (it says until when the "
-                                   "line was listened to); put the bytes on a line of their own before it")
+                col = pos + keyword.end() + len(rest) - len(rest.lstrip()) + 1
+                what = ("an `end` line holds no bytes (it says until when the line was listened to); put the bytes "
+                        "on a line of their own before it") if keyword.group(1).lower() == "end" else \
+                    ("a `silence` line holds no bytes (it says the line was silent until then); put the bytes on a "
+                     "line of their own after it")
+                raise CaptureError(Place(name, number, col), what)
             chunks.append(Chunk(t_us, b""))
-            last_t, end_line = t_us, number
+            last_t = t_us
+            if keyword.group(1).lower() == "end":
+                end_line = number
             continue
         direction = None
         word = re.match(r"\s+(tx|rx|TX|RX)\b", line[pos:])
@@ -468,8 +478,10 @@ def format_plain(chunks: list[Chunk], comment: str = "", end_us: int | None = No
     `end` line at `end_us` when given (until when the line was listened to)."""
     lines = [f"# {line}" for line in comment.splitlines()]
     for chunk in chunks:
-        if not chunk.data:
-            continue  # nothing came: only the `end` line says so
+        if not chunk.data:  # the live session saw the line silent until then, and cut a frame there
+            if end_us is None or chunk.t_us < end_us:  # (the `end` line says it of its own time)
+                lines.append(f"{chunk.t_us / 1_000_000:.6f} silence")
+            continue
         direction = f" {chunk.direction}" if chunk.direction else ""
         lines.append(f"{chunk.t_us / 1_000_000:.6f}{direction} {protocol.hex_bytes(chunk.data)}")
     if end_us is not None:

@@ -111,7 +111,15 @@ class MonitorSession:
             return []
         now = host_us - self._origin_us
         self.last_us = max(self.last_us, now)
-        return self._take(self.framer.poll(now))
+        frames = self.framer.poll(now)
+        if frames and self.info.channel != "capture":
+            # the line was seen silent until now, and that ended a frame: the capture keeps it
+            # (a `silence` line, `format_plain`), or its replay, which dates each chunk's bytes
+            # back to back before its arrival, joined bytes that a pty or a TCP converter had
+            # handed over faster than the line: a request and a reply 8 ms later were one
+            # garbled frame in the replay and two frames live
+            self.chunks.append(Chunk(now, b""))
+        return self._take(frames)
 
     def end_at(self, host_us: int, cut_short: str | None = None) -> None:
         """The run ended at host time `host_us` (a trace's end record): its length and the
