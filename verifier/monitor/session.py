@@ -112,7 +112,7 @@ class MonitorSession:
         now = host_us - self._origin_us
         self.last_us = max(self.last_us, now)
         frames = self.framer.poll(now)
-        if frames and self.info.channel != "capture":
+        if frames and self.info.channel != CAPTURED_FROM_FILE:
             # the line was seen silent until now, and that ended a frame: the capture keeps it
             # (a `silence` line, `format_plain`), or its replay, which dates each chunk's bytes
             # back to back before its arrival, joined bytes that a pty or a TCP converter had
