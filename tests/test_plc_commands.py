@@ -471,3 +471,47 @@ def test_a_paused_point_outlasts_the_task_timeout_and_ends_ok_after_the_resume()
     _press(project, run, "X4", 0)
     run(8000)
     assert robot.mode == "idle" and h.bDone and not h.fbRun.o_bErr and not h.fbEngine.o_bPaused
+
+
+def test_a_pause_pressed_with_the_start_goes_after_the_point_and_pauses_it():
+    """A pause asked in the scan the point is asked (start and pause buttons together, or the
+    pause while the run still waits in the mailbox) went out first, the priority slot being
+    served first: it paused nothing and the point then ran unpaused. The point's control
+    command now goes first and the pause right after it, pausing the point."""
+    project, robot, line, run = _cell(
+        "    fbRun : UITAMR_RunPoint;\n    fbPause : UITAMR_Pause;\n",
+        "fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);\n"
+        "fbRun(i_bEN := TRUE, i_bExecute := X0, i_wPoint := 3, io_uMbx := uMbx);\n"
+        "fbPause(i_bEN := TRUE, i_bExecute := X0, io_uMbx := uMbx);\n")
+    h = project.program("T_Cell")
+    _press(project, run, "X0", 2000)
+    run(1000)
+    assert [c[1] for c in _controls_at(line)][1:] == [POINT_3, PAUSE_FRAME]
+    assert robot.mode == "paused" and h.fbEngine.o_bPaused and h.fbRun.o_bBusy
+
+
+def test_a_stop_pressed_while_a_pause_is_served_goes_out_right_after_it():
+    """The pause holds the priority slot while it is served (its control command and its
+    status read): a stop pressed 20 ms after the pause is the next control command after
+    it, one pace after the pause's status read (plc-library.md: about 600 ms after the
+    pause), and ends the paused run with 16#0305."""
+    project, robot, line, run = _cell(
+        "    fbRun : UITAMR_RunPoint;\n    fbPause : UITAMR_Pause;\n    fbStop : UITAMR_Stop;\n",
+        "fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);\n"
+        "fbRun(i_bEN := TRUE, i_bExecute := X0, i_wPoint := 3, io_uMbx := uMbx);\n"
+        "fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);\n"
+        "fbStop(i_bEN := TRUE, i_bExecute := X1, io_uMbx := uMbx);\n")
+    h = project.program("T_Cell")
+    _press(project, run, "X0", 2000)
+    run(2700)
+    project.devices["X3"] = True
+    run(20)
+    _press(project, run, "X1", 0)
+    project.devices["X3"] = False
+    run(2000)
+    (pause_at, pause), (stop_at, stop) = _controls_at(line)[2:]
+    assert pause == PAUSE_FRAME and stop == encode(ControlRequest(1, 1, 0xA0), SETTINGS)
+    assert 0.55 <= stop_at - pause_at <= 0.7
+    assert robot.mode == "idle" and h.fbRun.o_uErrId == 0x0305 and h.fbPause.o_uErrId == 0
+    page = " ".join((PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8").split())
+    assert "(the pause's control command and status read: about 600 ms)" in page
