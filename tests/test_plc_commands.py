@@ -344,6 +344,14 @@ def _controls_at(line):
     return [(round(f.t_start_us / 1e6, 2), f.data) for f in line.trace if f.direction == "tx" and f.data[1] == 0x06]
 
 
+def _run_point_cell(declarations: str, body: str):
+    """_cell with the engine (monitor on) and fbRun : UITAMR_RunPoint of point 3 on X0, a
+    fbPause : UITAMR_Pause declared, and `body` after them."""
+    return _cell("    fbRun : UITAMR_RunPoint;\n    fbPause : UITAMR_Pause;\n" + declarations,
+                 "fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);\n"
+                 "fbRun(i_bEN := TRUE, i_bExecute := X0, i_wPoint := 3, io_uMbx := uMbx);\n" + body)
+
+
 def test_a_pause_overtakes_a_run_point_and_a_second_run_point_is_no_resume():
     """journey33b: a cell wired from the page (start X0 -> UITAMR_RunPoint, pause X3 ->
     UITAMR_Pause) paused nothing: the pause pressed 3 s into an 8 s point went out after
@@ -351,11 +359,9 @@ def test_a_pause_overtakes_a_run_point_and_a_second_run_point_is_no_resume():
     the next frame the pace allows, the robot pauses and the run stays busy without error.
     A second UITAMR_RunPoint of the same point is still no resume (kind 1: it queues behind
     the paused run); the stop ends both."""
-    project, robot, line, run = _cell(
-        "    fbRun : UITAMR_RunPoint;\n    fbPause : UITAMR_Pause;\n    fbResume : UITAMR_RunPoint;\n"
+    project, robot, line, run = _run_point_cell(
+        "    fbResume : UITAMR_RunPoint;\n"
         "    fbStop : UITAMR_Stop;\n",
-        "fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);\n"
-        "fbRun(i_bEN := TRUE, i_bExecute := X0, i_wPoint := 3, io_uMbx := uMbx);\n"
         "fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);\n"
         "fbResume(i_bEN := TRUE, i_bExecute := X4, i_wPoint := 3, io_uMbx := uMbx);\n"
         "fbStop(i_bEN := TRUE, i_bExecute := X1, io_uMbx := uMbx);\n")
@@ -453,11 +459,9 @@ def test_a_paused_point_outlasts_the_task_timeout_and_ends_ok_after_the_resume()
     """TASK_TIMEOUT (10 min) bounds a run's travel, not an operator's pause: a point paused
     for 11 min is still busy, without 16#0106, and after the resume the timer starts from 0:
     the run ends with o_bOK when the robot has finished the point."""
-    project, robot, line, run = _cell(
-        "    fbRun : UITAMR_RunPoint;\n    fbPause : UITAMR_Pause;\n    fbResume : UITAMR_Command;\n"
+    project, robot, line, run = _run_point_cell(
+        "    fbResume : UITAMR_Command;\n"
         "    bDone : BOOL;\n",
-        "fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);\n"
-        "fbRun(i_bEN := TRUE, i_bExecute := X0, i_wPoint := 3, io_uMbx := uMbx);\n"
         "fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);\n"
         "fbResume(i_bEN := TRUE, i_bExecute := X4, i_wKind := 2, i_wCode := 1, i_wCommand := 3,\n"
         "         i_bParamErr := FALSE, i_bPriority := FALSE, io_uMbx := uMbx);\n"
@@ -478,10 +482,8 @@ def test_a_pause_pressed_with_the_start_goes_after_the_point_and_pauses_it():
     pause while the run still waits in the mailbox) went out first, the priority slot being
     served first: it paused nothing and the point then ran unpaused. The point's control
     command now goes first and the pause right after it, pausing the point."""
-    project, robot, line, run = _cell(
-        "    fbRun : UITAMR_RunPoint;\n    fbPause : UITAMR_Pause;\n",
-        "fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);\n"
-        "fbRun(i_bEN := TRUE, i_bExecute := X0, i_wPoint := 3, io_uMbx := uMbx);\n"
+    project, robot, line, run = _run_point_cell(
+        "",
         "fbPause(i_bEN := TRUE, i_bExecute := X0, io_uMbx := uMbx);\n")
     h = project.program("T_Cell")
     _press(project, run, "X0", 2000)
@@ -495,10 +497,8 @@ def test_a_stop_pressed_while_a_pause_is_served_goes_out_right_after_it():
     status read): a stop pressed 20 ms after the pause is the next control command after
     it, one pace after the pause's status read (plc-library.md: about 600 ms after the
     pause), and ends the paused run with 16#0305."""
-    project, robot, line, run = _cell(
-        "    fbRun : UITAMR_RunPoint;\n    fbPause : UITAMR_Pause;\n    fbStop : UITAMR_Stop;\n",
-        "fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);\n"
-        "fbRun(i_bEN := TRUE, i_bExecute := X0, i_wPoint := 3, io_uMbx := uMbx);\n"
+    project, robot, line, run = _run_point_cell(
+        "    fbStop : UITAMR_Stop;\n",
         "fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);\n"
         "fbStop(i_bEN := TRUE, i_bExecute := X1, io_uMbx := uMbx);\n")
     h = project.program("T_Cell")
