@@ -344,69 +344,81 @@ def _controls_at(line):
     return [(round(f.t_start_us / 1e6, 2), f.data) for f in line.trace if f.direction == "tx" and f.data[1] == 0x06]
 
 
-def test_a_pause_waits_behind_a_run_point_until_its_point_ended():
+def _run_point_cell(declarations: str, body: str):
+    """_cell with the engine (monitor on) and fbRun : UITAMR_RunPoint of point 3 on X0, a
+    fbPause : UITAMR_Pause declared, and `body` after them."""
+    return _cell("    fbRun : UITAMR_RunPoint;\n    fbPause : UITAMR_Pause;\n" + declarations,
+                 "fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);\n"
+                 "fbRun(i_bEN := TRUE, i_bExecute := X0, i_wPoint := 3, io_uMbx := uMbx);\n" + body)
+
+
+def test_a_pause_overtakes_a_run_point_and_a_second_run_point_is_no_resume():
     """journey33b: a cell wired from the page (start X0 -> UITAMR_RunPoint, pause X3 ->
-    UITAMR_Pause, resume X4 -> a second UITAMR_RunPoint of the same point) paused nothing:
-    the pause pressed 3 s into an 8 s point went out after the point had ended, and the
-    resume ran the point a second time. plc-library.md now says so and shows the wiring
-    that pauses (next test)."""
-    project, robot, line, run = _cell(
-        "    fbRun : UITAMR_RunPoint;\n    fbPause : UITAMR_Pause;\n    fbResume : UITAMR_RunPoint;\n",
-        "fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);\n"
-        "fbRun(i_bEN := TRUE, i_bExecute := X0, i_wPoint := 3, io_uMbx := uMbx);\n"
+    UITAMR_Pause) paused nothing: the pause pressed 3 s into an 8 s point went out after
+    the point had ended (the run held the engine). The pause now overtakes the run: it is
+    the next frame the pace allows, the robot pauses and the run stays busy without error.
+    A second UITAMR_RunPoint of the same point is still no resume (kind 1: it queues behind
+    the paused run); the stop ends both."""
+    project, robot, line, run = _run_point_cell(
+        "    fbResume : UITAMR_RunPoint;\n"
+        "    fbStop : UITAMR_Stop;\n",
         "fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);\n"
-        "fbResume(i_bEN := TRUE, i_bExecute := X4, i_wPoint := 3, io_uMbx := uMbx);\n")
-    _press(project, run, "X0", 2000)                          # point 3 from ~2.3 s, 8 s long
-    _press(project, run, "X3", 2700)                          # pause at 5 s
-    _press(project, run, "X4", 2700)                          # resume at 8 s
-    run(20_000)
-    sent = _controls_at(line)
-    (run_at, _), (pause_at, pause), (again_at, again) = [c for c in sent if c[1] != sent[0][1]]
-    point_end = run_at + 8.0
-    assert pause == PAUSE_FRAME and pause_at > point_end      # the point had ended: nothing paused
-    assert again == POINT_3 and again_at > pause_at           # and the "resume" runs it again
+        "fbResume(i_bEN := TRUE, i_bExecute := X4, i_wPoint := 3, io_uMbx := uMbx);\n"
+        "fbStop(i_bEN := TRUE, i_bExecute := X1, io_uMbx := uMbx);\n")
+    h = project.program("T_Cell")
+    _press(project, run, "X0", 2000)                          # point 3 from ~2.4 s, 8 s long
+    run(2700)                                                 # 5.0 s
+    pressed_at = project.now_us / 1e6
+    _press(project, run, "X3", 0)                             # pause at 5 s
+    run(500)
+    (run_at, _), (pause_at, pause) = [c for c in _controls_at(line) if c[1] != _controls_at(line)[0][1]]
+    assert pause == PAUSE_FRAME and pause_at < pressed_at + 0.35   # within one pace of the button
+    assert robot.mode == "paused" and h.fbEngine.o_bPaused
+    assert h.fbRun.o_bBusy and not h.fbRun.o_bOK and not h.fbRun.o_bErr
+    _press(project, run, "X4", 2000)                          # "resume" with a second RunPoint at ~8 s
+    run(8000)                                                 # 16 s: the point would long have ended
+    assert robot.mode == "paused" and h.fbRun.o_bBusy and h.fbResume.o_bBusy
+    assert [c[1] for c in _controls_at(line)][1:] == [POINT_3, PAUSE_FRAME]    # nothing else sent
+    _press(project, run, "X1", 0)
+    run(1000)
+    assert robot.mode == "idle" and not h.fbRun.o_bBusy and h.fbRun.o_uErrId == 0x0305
+    assert not h.fbResume.o_bBusy and h.fbResume.o_uErrId == 0x0305 and not h.fbEngine.o_bPaused
+    assert [c[1] for c in _controls_at(line)][-1] == encode(ControlRequest(1, 1, 0xA0), SETTINGS)
     page = (PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8")
-    assert "test_a_pause_waits_behind_a_run_point_until_its_point_ended" in page
+    assert "A second `UITAMR_RunPoint` of\nthe same point is no resume" in page
 
 
 def test_pause_and_resume_of_a_running_point_as_the_library_page_wires_it():
     """The page's wiring (plc-library.md, 'Pause and resume while a point runs'), run as
-    printed: the pause goes out while the point runs and the task stays reported running,
-    the resume sends the point again, the robot finishes it (paused time not counted), and
-    the point's end is o_bTaskRunning falling; an obstacle during a run shows on the
-    monitor's o_wRobotErr, not on the engine's o_bErr, and the stop clears it."""
+    printed: UITAMR_RunPoint runs the point, the pause overtakes it and the robot pauses,
+    the run stays busy (no o_bOK, no o_bErr) and o_bPaused is on while paused, the resume
+    (UITAMR_Command kind 2 of the same point) overtakes it too, the robot finishes the
+    point (paused time not counted) and the run ends with o_bOK."""
     import re
-
-    from verifier.amr.faults import Fault
 
     page = (PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8")
     section = page.split("### Pause and resume while a point runs", 1)[1].split("\n## ", 1)[0]
     snippet = re.search(r"```iecst\n(.*?)```", section, re.S).group(1)
-    declarations = ("    fbGo : UITAMR_Command;\n    fbPause : UITAMR_Pause;\n    fbResume : UITAMR_Command;\n"
-                    "    fbStop : UITAMR_Stop;\n    bMoving : BOOL;\n    bObstacle : BOOL;\n")
-    project, robot, line, run = _cell(declarations, snippet, faults=[Fault(kind="anti_collision", at_s=24.0)])
+    declarations = ("    fbRun : UITAMR_RunPoint;\n    fbPause : UITAMR_Pause;\n    fbResume : UITAMR_Command;\n"
+                    "    fbStop : UITAMR_Stop;\n    bPaused : BOOL;\n    bDone : BOOL;\n")
+    project, robot, line, run = _cell(declarations, snippet + "IF fbRun.o_bOK THEN\n    bDone := TRUE;\nEND_IF;\n")
     h = project.program("T_Cell")
     _press(project, run, "X0", 2000)                          # point 3 from ~2.4 s, 8 s long
     run(700)
-    assert h.bMoving and robot.mode == "running"
+    assert robot.mode == "running" and h.fbRun.o_bBusy and not h.bPaused
     _press(project, run, "X3", 2000)                          # pause ~3 s into the run
     run(700)
-    assert robot.mode == "paused" and h.bMoving                 # paused, still reported running
+    assert robot.mode == "paused" and h.bPaused and h.fbEngine.o_bTaskRunning   # paused, still reported running
+    assert h.fbRun.o_bBusy and not h.fbRun.o_bErr and not h.bDone
     _press(project, run, "X4", 5000)                           # resume after 5 s of pause (11 s)
     run(700)
-    assert robot.mode == "running"
+    assert robot.mode == "running" and not h.bPaused and h.fbRun.o_bBusy
     assert [c[1] for c in _controls_at(line)][1:] == [POINT_3, PAUSE_FRAME, POINT_3]
     run(3000)                                                   # 15 s: unpaused it would have ended at ~10.4 s
-    assert robot.mode == "running" and h.bMoving
+    assert robot.mode == "running" and h.fbRun.o_bBusy and not h.bDone
     run(5000)                                                   # 20 s
-    assert robot.mode == "idle" and not h.bMoving and not h.bObstacle and not h.fbEngine.o_bErr
-    _press(project, run, "X0", 2000)                           # again at 22 s; an obstacle at 24 s
-    run(4000)
-    assert h.bObstacle and not h.bMoving and robot.mode != "running"
-    assert not h.fbEngine.o_bErr and h.fbEngine.o_uErrId == 0  # not the engine's error: the monitor's byte
-    _press(project, run, "X1", 100)                            # the stop clears it
-    run(2000)
-    assert not h.bObstacle and h.fbStop.o_uErrId == 0
+    assert robot.mode == "idle" and h.bDone and not h.fbRun.o_bBusy and not h.fbRun.o_bErr
+    assert not h.fbEngine.o_bErr and not h.bPaused
 
 
 def test_a_stop_during_a_point_lights_no_lamp_wired_as_the_page_shows():
@@ -441,3 +453,65 @@ def test_a_stop_during_a_point_lights_no_lamp_wired_as_the_page_shows():
     assert h.bLamp and h.uLampErr == 0x0101
     _press(project, run, "X2", 1000)
     assert not h.bLamp and h.uLampErr == 0
+
+
+def test_a_paused_point_outlasts_the_task_timeout_and_ends_ok_after_the_resume():
+    """TASK_TIMEOUT (10 min) bounds a run's travel, not an operator's pause: a point paused
+    for 11 min is still busy, without 16#0106, and after the resume the timer starts from 0:
+    the run ends with o_bOK when the robot has finished the point."""
+    project, robot, line, run = _run_point_cell(
+        "    fbResume : UITAMR_Command;\n"
+        "    bDone : BOOL;\n",
+        "fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);\n"
+        "fbResume(i_bEN := TRUE, i_bExecute := X4, i_wKind := 2, i_wCode := 1, i_wCommand := 3,\n"
+        "         i_bParamErr := FALSE, i_bPriority := FALSE, io_uMbx := uMbx);\n"
+        "IF fbRun.o_bOK THEN\n    bDone := TRUE;\nEND_IF;\n")
+    h = project.program("T_Cell")
+    _press(project, run, "X0", 2000)
+    _press(project, run, "X3", 2000)                          # paused ~2 s into the 8 s point
+    run(11 * 60_000)
+    assert robot.mode == "paused" and h.fbEngine.o_bPaused
+    assert h.fbRun.o_bBusy and not h.fbRun.o_bErr and h.fbRun.o_uErrId == 0
+    _press(project, run, "X4", 0)
+    run(8000)
+    assert robot.mode == "idle" and h.bDone and not h.fbRun.o_bErr and not h.fbEngine.o_bPaused
+
+
+def test_a_pause_pressed_with_the_start_goes_after_the_point_and_pauses_it():
+    """A pause asked in the scan the point is asked (start and pause buttons together, or the
+    pause while the run still waits in the mailbox) went out first, the priority slot being
+    served first: it paused nothing and the point then ran unpaused. The point's control
+    command now goes first and the pause right after it, pausing the point."""
+    project, robot, line, run = _run_point_cell(
+        "",
+        "fbPause(i_bEN := TRUE, i_bExecute := X0, io_uMbx := uMbx);\n")
+    h = project.program("T_Cell")
+    _press(project, run, "X0", 2000)
+    run(1000)
+    assert [c[1] for c in _controls_at(line)][1:] == [POINT_3, PAUSE_FRAME]
+    assert robot.mode == "paused" and h.fbEngine.o_bPaused and h.fbRun.o_bBusy
+
+
+def test_a_stop_pressed_while_a_pause_is_served_goes_out_right_after_it():
+    """The pause holds the priority slot while it is served (its control command and its
+    status read): a stop pressed 20 ms after the pause is the next control command after
+    it, one pace after the pause's status read (plc-library.md: about 600 ms after the
+    pause), and ends the paused run with 16#0305."""
+    project, robot, line, run = _run_point_cell(
+        "    fbStop : UITAMR_Stop;\n",
+        "fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);\n"
+        "fbStop(i_bEN := TRUE, i_bExecute := X1, io_uMbx := uMbx);\n")
+    h = project.program("T_Cell")
+    _press(project, run, "X0", 2000)
+    run(2700)
+    project.devices["X3"] = True
+    run(20)
+    _press(project, run, "X1", 0)
+    project.devices["X3"] = False
+    run(2000)
+    (pause_at, pause), (stop_at, stop) = _controls_at(line)[2:]
+    assert pause == PAUSE_FRAME and stop == encode(ControlRequest(1, 1, 0xA0), SETTINGS)
+    assert 0.55 <= stop_at - pause_at <= 0.7
+    assert robot.mode == "idle" and h.fbRun.o_uErrId == 0x0305 and h.fbPause.o_uErrId == 0
+    page = " ".join((PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8").split())
+    assert "(the pause's control command and status read: about 600 ms)" in page
