@@ -915,6 +915,33 @@ def test_a_misspelt_label_in_a_scenario_offers_the_label_meant(tmp_path):
         assert result.output.strip().endswith(f"expect[2].never: {message}"), result.output
 
 
+def test_every_label_mistake_of_a_scenario_is_reported_in_one_run(tmp_path):
+    """An integrator's scenario with a misspelt watch, a misspelt input label and a misspelt
+    condition label exited 2 naming one of them, and not the first in the file (the
+    condition's, at line 29): three CI runs to clean up one file. Now each is an error at its
+    own line and column, in the file's order, and a JUnit test case each."""
+    base = (PLC / "scenarios" / "fx5u-healthy.toml").read_text(encoding="utf-8").replace('"../', f'"{PLC.as_posix()}/')
+    text = (base.replace('watch = ["fbEngine.o_wTxCount"', 'watch = ["fbEngine.o_wTxCnt"')
+            .replace("set = { X0 = true }", "set = { bEngineOnn = true }")
+            .replace('never = "fbEngine.o_bErr OR fbCycle.o_bErr"', 'never = "fbEngin.o_bErr OR fbCycle.o_bErr"'))
+    path, xml = tmp_path / "s.toml", tmp_path / "r.xml"
+    path.write_text(text, encoding="utf-8")
+    lines = text.splitlines()
+    # a watch item at its string (its opening quote), an input at its label, a condition's label at itself
+    at = [(n + 1, line.index(word) + 1) for word in ('"fbEngine.o_wTxCnt', "bEngineOnn", "fbEngin.o_bErr")
+          for n, line in enumerate(lines) if word in line]
+    result = invoke("--scenario", path, "--duration", "2s", "--junit", xml)
+    assert result.exit_code == 2
+    errors = [line for line in result.output.splitlines() if line.startswith("error:")]
+    assert [re.match(r"error: .*s\.toml:(\d+):(\d+): ", e).groups() for e in errors] == \
+        [(str(line), str(col)) for line, col in at], result.output
+    assert "watch[0]: no label 'fbEngine.o_wTxCnt'" in errors[0]
+    assert "inputs[0].set: the program UITAMR_ExampleFx5 has no label 'bEngineOnn'; did you mean 'bEngineOn'?" in errors[1]
+    assert "expect[2].never: the program UITAMR_ExampleFx5 has no label 'fbEngin.o_bErr'" in errors[2]
+    cases = ET.parse(xml).getroot().findall(".//testcase")
+    assert [case.get("line") for case in cases] == [str(line) for line, _ in at]
+
+
 def test_a_renamed_instance_gets_no_guess_that_lacks_the_member(tmp_path):
     """ci.md: a renamed instance makes the job exit 2 with "no label ...". The FX3U example
     with its engine renamed fbRobot and `--response-signal fbEngine.o_bErr` was told "did

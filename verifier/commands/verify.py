@@ -29,7 +29,7 @@ from verifier.commands.report_files import (JudgingCommand, ReportError, check_f
 from verifier.verify.durations import format_duration, format_seconds, parse_duration_us
 from verifier.verify import spool
 from verifier.verify.events_shown import EVENTS_AT_MOST
-from verifier.verify.result import KEEP_ALL, Keep, ScenarioResult, UnusableInput, mistakes_of
+from verifier.verify.result import KEEP_ALL, Keep, ScenarioMistakes, ScenarioResult, UnusableInput, mistakes_of
 from verifier.bundled import plc_dir as bundled_plc_dir
 from verifier.digits import digit_problem
 from verifier.textfile import is_folder, real_path, shown_path
@@ -123,15 +123,6 @@ def _unusable_after(messages: list[str], junit: tuple[bool, str] | None) -> None
     if written:
         _unusable(*messages, done=said)
     _unusable(*messages, said)
-
-
-class ScenarioMistakes(UnusableInput):
-    """The mistakes of several scenario files, each its own message (file:line:col) and
-    place (`mistakes`)."""
-
-    def __init__(self, errors: list[Exception]):
-        self.mistakes = [mistake for error in errors for mistake in mistakes_of(error)]
-        super().__init__("\n".join(mistake.message for mistake in self.mistakes))
 
 
 def _read_scenarios(files, platform: str | None = None) -> list[Scenario]:
