@@ -34,8 +34,8 @@ from verifier.bundled import plc_dir as bundled_plc_dir
 from verifier.digits import digit_problem
 from verifier.textfile import is_folder, real_path, shown_path
 from verifier.verify.scenario import (
-    CHANNELS, DEFAULT_DURATION_US, MAX_DURATION_US, PLATFORMS, TOLD_PLATFORMS, Scenario, ScenarioError, bundled_platforms,
-    default_scenario, load_scenario,
+    CHANNELS, DEFAULT_DURATION_US, MAX_DURATION_US, PLATFORMS, TOLD_PLATFORMS, Scenario, ScenarioError, ScenarioErrors,
+    bundled_platforms, default_scenario, load_scenario,
 )
 from verifier.verify.sources import SourceError, expand, st_files_in, unique
 
@@ -103,7 +103,8 @@ def _unusable_input(junit_path: str | None, inputs, error: Exception) -> None:
     mistakes = mistakes_of(error)
     # the console shows each scenario file's mistake as its own error line, and ST that does
     # not load as one message listing its errors (the JUnit report has a test case for each)
-    messages = [mistake.message for mistake in mistakes] if isinstance(error, ScenarioMistakes) else [str(error)]
+    messages = ([mistake.message for mistake in mistakes] if isinstance(error, (ScenarioMistakes, ScenarioErrors))
+                else [str(error)])
     _unusable_after(messages, junit_of_mistakes(junit_path, mistakes, "uitamr verify", inputs) if junit_path else None)
 
 
