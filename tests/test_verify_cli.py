@@ -665,6 +665,9 @@ def test_the_fx5_second_port_can_carry_the_robot(tmp_path):
     failed = invoke("--scenario", copy, "--channel", "fx5:1")
     assert failed.exit_code == 1 and "the program sent nothing on fx5:1 in the whole run" in failed.output
     assert "frame(s) on fx5:2: the robot hangs on fx5:1 in this run: give --channel fx5:2" in failed.output
+    # the integrator's mistake may be the program's channel, not the scenario's: both fixes are named
+    assert ('or channel = "fx5:2" in the scenario; or, if the robot is wired to fx5:1, make the program drive fx5:1'
+            in " ".join(failed.output.split())), failed.output
 
 
 def test_a_silent_run_says_where_the_program_did_talk(tmp_path):
@@ -694,6 +697,8 @@ def test_a_silent_run_says_where_the_program_did_talk(tmp_path):
     assert ("nothing reached the robot's line through the converter: the PLC opens a connection to "
             "192.168.3.50:4001: nothing answers there (the converter is at 192.168.3.60:4001); set the "
             "scenario's [converter] ip and port to what the program opens") in result.output
+    assert ("to what the program opens, or, if the converter is at 192.168.3.60:4001, make the program open that "
+            "(its port FB's address and port inputs)") in " ".join(result.output.split())
     rs2 = (PLC / "scenarios" / "fx5u-healthy.toml").read_text(encoding="utf-8").replace('"../', f'"{PLC.as_posix()}/')
     behind = tmp_path / "rs2-behind-a-converter.toml"
     behind.write_text(rs2.replace("[robot]", "[converter]\n\n[robot]"), encoding="utf-8")

@@ -689,7 +689,10 @@ def _silence_note(scenario: Scenario, plc: _Plc, converter: Converter | None) ->
         if converter.open_count == 0:
             note += ": the program opened no connection to it"
         elif converter.first_failed_open is not None and converter.accepted_count == 0:
-            note += f": {converter.first_failed_open}; set the scenario's [converter] ip and port to what the program opens"
+            cfg = converter.config
+            note += (f": {converter.first_failed_open}; set the scenario's [converter] ip and port to what the program "
+                     f"opens, or, if the converter is at {cfg.ip}:{cfg.port}, make the program open that (its "
+                     "port FB's address and port inputs)")
         note += ")"
         from verifier.sim.instructions.tcp import FixedBufferPort
 
@@ -707,8 +710,10 @@ def _silence_note(scenario: Scenario, plc: _Plc, converter: Converter | None) ->
     opens = sum(poller.open_count for poller in rt.pollers if isinstance(poller, TcpPort))
     if sent:
         first = next(iter(other))
+        # either side may be wrong: the scenario's port, or the program's (its port FB's channel)
         note += (f"; {sent}: the robot hangs on {channel} in this run: give --channel {first}, "
-                 f'or channel = "{first}" in the scenario')
+                 f'or channel = "{first}" in the scenario; or, if the robot is wired to {channel}, make the '
+                 f"program drive {channel}")
     elif opens:
         note += (f"; it opened TCP connections ({opens} open(s)): the robot is behind a serial-to-TCP converter "
                  "on that route: add a [converter] table to the scenario (docs/scenarios.md)")
