@@ -1534,3 +1534,23 @@ def test_a_channel_over_the_tcp_route_is_not_applied_silently(tmp_path):
     note = "--channel fx5:1 not applied: this scenario reaches the robot over TCP through its converter, not a serial port"
     assert note in over_tcp["notes"] and note not in on_serial["notes"]
     assert on_serial["channel"] == "fx5:1"
+
+
+def test_st_errors_of_a_program_without_platform_are_the_ones_of_its_cpu(tmp_path):
+    """An FX5U integrator's program with a WORD array index (and an initial value, which GX
+    Works3 keeps) run with `uitamr verify SOURCES --program Main` and no --platform: it
+    loads on no CPU, and its errors were listed for the FX3U, led by GX Works2's "label
+    tables have no initial value column" - a mistake it does not have on the FX5U. Now the
+    errors are those of the CPU that finds fewest: the FX5U's."""
+    main = tmp_path / "Main.st"
+    main.write_text(
+        "PROGRAM Main\nVAR\n    fbPort : UITAMR_PortFx5;\n    fbEngine : UITAMR_Engine;\n"
+        "    uMbx : ARRAY[0..15] OF WORD;\n    uPort : ARRAY[0..39] OF WORD;\n"
+        "    wRoute : ARRAY[0..3] OF INT := [1, 2, 3, 4];\n    wIdx : WORD;\n    wPoint : INT;\nEND_VAR\n"
+        "fbPort(i_bEN := TRUE, i_wChannel := 1, io_uPort := uPort);\n"
+        "fbEngine(i_bEN := NOT SM402, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);\n"
+        "wPoint := wRoute[wIdx];\nEND_PROGRAM\n", encoding="utf-8")
+    result = invoke(PLC / "core", PLC / "fx5" / "UITAMR_PortFx5.st", main, "--program", "Main")
+    assert result.exit_code == 2
+    assert "array index must be INT or DINT, not WORD" in result.output, result.output
+    assert "initial value column" not in result.output, result.output

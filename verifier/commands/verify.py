@@ -192,8 +192,16 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
                 raise UnusableInput(f"no bundled scenario is written for the {platform}")
         if not own and not bundled:
             if resolved and platform is None:
-                fits, _ = platforms_that_load(resolved)
-                platform = fits[0] if len(fits) == 1 else None  # else the default, fx3u (ST errors show there)
+                fits, errors = platforms_that_load(resolved)
+                if len(fits) == 1:
+                    platform = fits[0]
+                elif not fits and errors:
+                    # ST errors on every CPU: shown for the one that finds fewest (ties: fx3u, fx5u, q),
+                    # not always the FX3U's - an FX5U program with an initial value was told GX Works2's
+                    # "label tables have no initial value column" beside its own mistakes
+                    platform = min(errors, key=lambda told: len(errors[told].located()))
+                else:
+                    platform = None  # loads on several: the default, fx3u
                 overrides["platform"] = platform
             own = [replace(default_scenario(duration_us=duration or DEFAULT_DURATION_US), sources=resolved)]
             if resolved and uses_tcp_route(resolved, program):
