@@ -297,3 +297,23 @@ def test_fx5u_sources_loaded_without_a_target_name_the_target_that_loads_them():
     assert not any("note:" in line for line in broken.value.lines())
     # and the sources load as the note says
     assert verifier.load(*paths, sources={"Main.st": main}, target="gxworks3").cpu.name == "fx5u"
+
+
+def test_a_misspelt_label_read_from_python_offers_the_label_meant():
+    """`main.fbEngin.o_bErr` in an integrator's pytest said only "Main has no label
+    'fbEngin'", where the same name in a scenario offers 'fbEngine': now the API guesses
+    too, for a label of one's own POU and for a standard FB's input/output."""
+    import pytest
+
+    project = verifier.load(sources={"d.st": FB_DELAY})
+    fb = project.instance("FB_Delay")
+    with pytest.raises(AttributeError) as caught:
+        fb.fbTimr
+    assert str(caught.value) == "FB_Delay has no label 'fbTimr'; did you mean 'fbTimer'?"
+    with pytest.raises(AttributeError) as caught:
+        fb.fbTimer.PTT
+    assert str(caught.value) == "FB_Delay.fbTimer (TON) has no input/output PTT; did you mean 'PT'?"
+    with pytest.raises(AttributeError) as caught:
+        fb.zzz
+    assert str(caught.value) == "FB_Delay has no label 'zzz'"
+    assert not hasattr(fb, "zzz")
