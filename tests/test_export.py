@@ -857,3 +857,37 @@ def test_a_blank_out_folder_is_refused(tmp_path, monkeypatch, blank):
     assert result.output.splitlines()[-1] == ("Error: Invalid value for '--out': the folder is empty: give the folder "
                                               "to write into, e.g. --out gx2")
     assert list(tmp_path.iterdir()) == []
+
+
+# ------------------------------------------------------- GX Works3 local label classes
+# MELSEC iQ-F FX5 Programming Manual (Program Design) §4.2 "Class" (p. 33,
+# https://www.easymanua.ls/mitsubishi-electric/melsec-iq-f-series/manual/744685?p=35): the
+# local label classes a GX Works3 POU can hold. There is no VAR_EXTERNAL: a POU uses a
+# global label by its name.
+GX3_LOCAL_CLASSES = {"VAR", "VAR_CONSTANT", "VAR_RETAIN", "VAR_INPUT", "VAR_OUTPUT", "VAR_OUTPUT_RETAIN",
+                     "VAR_IN_OUT", "VAR_PUBLIC", "VAR_PUBLIC_RETAIN"}
+
+
+def test_gxworks3_label_tables_hold_only_the_classes_gx_works3_has(tmp_path):
+    """An integrator's program that declares the global labels it uses in VAR_EXTERNAL (as
+    `uitamr check` accepts and IEC 61131-3 writes it) was exported with VAR_EXTERNAL rows in
+    its label table: GX Works3 has no such local label class, so the paste was refused. The
+    globals are in GlobalLabels.labels.tsv, and the POU uses them by name."""
+    (tmp_path / "Globals.st").write_text("VAR_GLOBAL\n    gbStart AT X10 : BOOL; (* start *)\nEND_VAR\n")
+    (tmp_path / "Main.st").write_text(
+        "PROGRAM Main\nVAR_EXTERNAL\n    gbStart : BOOL;\nEND_VAR\nVAR\n    bRun : BOOL;\nEND_VAR\n"
+        "bRun := gbStart;\nEND_PROGRAM\n")
+    out = tmp_path / "gx3"
+    result = run("--target", "gxworks3", "--out", str(out), str(tmp_path / "Globals.st"), str(tmp_path / "Main.st"))
+    assert result.exit_code == 0, result.output
+    rows = [line.split("\t") for line in (out / "Main.labels.tsv").read_text().splitlines()[1:]]
+    assert [(r[0], r[2]) for r in rows] == [("bRun", "VAR")]
+    assert "gbStart\tBit\tVAR_GLOBAL\tX10" in (out / "GlobalLabels.labels.tsv").read_text()
+    assert "gbStart := " not in (out / "Main.st").read_text() and "bRun := gbStart;" in (out / "Main.st").read_text()
+
+
+def test_the_bundled_gxworks3_export_uses_only_gx_works3_label_classes(tmp_path):
+    assert run("--target", "gxworks3", "--out", str(tmp_path)).exit_code == 0
+    for table in tmp_path.glob("*.labels.tsv"):
+        classes = {line.split("\t")[2] for line in table.read_text().splitlines()[1:]}
+        assert classes <= GX3_LOCAL_CLASSES, (table.name, classes - GX3_LOCAL_CLASSES)

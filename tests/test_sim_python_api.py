@@ -264,3 +264,56 @@ def test_an_array_slice_counts_in_st_indexes_as_an_index_does():
     err = _error(lambda: fb.a["1":])
     assert isinstance(err, TypeError)
     assert str(err) == "FB_A.a is sliced by whole numbers within its ST bounds [1..4]; got '1'"
+
+
+def test_fx5u_sources_loaded_without_a_target_name_the_target_that_loads_them():
+    """An FX5U integrator's `st_load("vendor/uitamr/plc/core", ".../UITAMR_PortFx5.st",
+    "src")` (testing-st.md, no target: GX Works2 and the FX3U) failed with errors inside the
+    library's port FB (`device SM8561: the fx3u has no SM devices ...`) and nothing about the
+    target to give. Now the errors end with a note naming target='gxworks3'; with a target
+    given, the errors are the target's alone."""
+    from pathlib import Path
+
+    import pytest
+    from verifier.sim.errors import LoadError
+
+    plc = Path(__file__).resolve().parents[1] / "plc"
+    main = ("PROGRAM Main\nVAR\n    fbPort : UITAMR_PortFx5;\n    uPort : ARRAY[0..39] OF WORD;\nEND_VAR\n"
+            "fbPort(i_bEN := NOT SM402, i_wChannel := 1, io_uPort := uPort);\nEND_PROGRAM\n")
+    paths = [plc / "core", plc / "fx5" / "UITAMR_PortFx5.st"]
+    with pytest.raises(LoadError) as caught:
+        verifier.load(*paths, sources={"Main.st": main})
+    lines = caught.value.lines()
+    assert any("SM8561" in line for line in lines[:-1])
+    assert lines[-1] == ("verifier.load(target='gxworks2'): note: the sources load with target='gxworks3' "
+                         "(the fx5u CPU): give target='gxworks3'")
+    assert caught.value.place() is not None and "SM" in str(caught.value)  # still placed by its first ST error
+    with pytest.raises(LoadError) as told:
+        verifier.load(*paths, sources={"Main.st": main}, target="gxworks2")
+    assert not any("note:" in line for line in told.value.lines())
+    # a program with an error on every CPU gets no note
+    with pytest.raises(LoadError) as broken:
+        verifier.load(*paths, sources={"Main.st": main.replace("uPort);", "uPortt);")})
+    assert not any("note:" in line for line in broken.value.lines())
+    # and the sources load as the note says
+    assert verifier.load(*paths, sources={"Main.st": main}, target="gxworks3").cpu.name == "fx5u"
+
+
+def test_a_misspelt_label_read_from_python_offers_the_label_meant():
+    """`main.fbEngin.o_bErr` in an integrator's pytest said only "Main has no label
+    'fbEngin'", where the same name in a scenario offers 'fbEngine': now the API guesses
+    too, for a label of one's own POU and for a standard FB's input/output."""
+    import pytest
+
+    project = verifier.load(sources={"d.st": FB_DELAY})
+    fb = project.instance("FB_Delay")
+    with pytest.raises(AttributeError) as caught:
+        fb.fbTimr
+    assert str(caught.value) == "FB_Delay has no label 'fbTimr'; did you mean 'fbTimer'?"
+    with pytest.raises(AttributeError) as caught:
+        fb.fbTimer.PTT
+    assert str(caught.value) == "FB_Delay.fbTimer (TON) has no input/output PTT; did you mean 'PT'?"
+    with pytest.raises(AttributeError) as caught:
+        fb.zzz
+    assert str(caught.value) == "FB_Delay has no label 'zzz'"
+    assert not hasattr(fb, "zzz")

@@ -380,3 +380,15 @@ def test_values_nested_too_deep_for_tomllib_are_an_error_at_their_key(text, plac
     assert result.output.startswith(f"{path}:{place[0]}:{place[1]}: error: not valid TOML: arrays")
     with pytest.raises(FaultFileError, match=rf"^{path}:{place[0]}:{place[1]}: not valid TOML: arrays or inline tables"):
         load_fault_file(path)
+
+
+def test_a_value_nested_hundreds_deep_is_shown_without_a_recursion_error():
+    """A scenario's deeply nested `watch` item, told now beside the file's other mistakes,
+    reached `shown` and ended in a RecursionError instead of the file's errors."""
+    from verifier.tomlpos import shown
+
+    deep: list = []
+    for _ in range(400):
+        deep = [deep]
+    assert shown(deep).startswith("[[[[") and shown(deep).endswith("...")
+    assert shown([1, [True, "a"]]) == "[1, [true, 'a']]"

@@ -665,6 +665,9 @@ def test_the_fx5_second_port_can_carry_the_robot(tmp_path):
     failed = invoke("--scenario", copy, "--channel", "fx5:1")
     assert failed.exit_code == 1 and "the program sent nothing on fx5:1 in the whole run" in failed.output
     assert "frame(s) on fx5:2: the robot hangs on fx5:1 in this run: give --channel fx5:2" in failed.output
+    # the integrator's mistake may be the program's channel, not the scenario's: both fixes are named
+    assert ('or channel = "fx5:2" in the scenario; or, if the robot is wired to fx5:1, make the program drive fx5:1'
+            in " ".join(failed.output.split())), failed.output
 
 
 def test_a_silent_run_says_where_the_program_did_talk(tmp_path):
@@ -694,6 +697,8 @@ def test_a_silent_run_says_where_the_program_did_talk(tmp_path):
     assert ("nothing reached the robot's line through the converter: the PLC opens a connection to "
             "192.168.3.50:4001: nothing answers there (the converter is at 192.168.3.60:4001); set the "
             "scenario's [converter] ip and port to what the program opens") in result.output
+    assert ("to what the program opens, or, if the converter is at 192.168.3.60:4001, make the program open that "
+            "(its port FB's address and port inputs)") in " ".join(result.output.split())
     rs2 = (PLC / "scenarios" / "fx5u-healthy.toml").read_text(encoding="utf-8").replace('"../', f'"{PLC.as_posix()}/')
     behind = tmp_path / "rs2-behind-a-converter.toml"
     behind.write_text(rs2.replace("[robot]", "[converter]\n\n[robot]"), encoding="utf-8")
@@ -913,6 +918,33 @@ def test_a_misspelt_label_in_a_scenario_offers_the_label_meant(tmp_path):
         result = invoke("--scenario", path, "--duration", "2s")
         assert result.exit_code == 2
         assert result.output.strip().endswith(f"expect[2].never: {message}"), result.output
+
+
+def test_every_label_mistake_of_a_scenario_is_reported_in_one_run(tmp_path):
+    """An integrator's scenario with a misspelt watch, a misspelt input label and a misspelt
+    condition label exited 2 naming one of them, and not the first in the file (the
+    condition's, at line 29): three CI runs to clean up one file. Now each is an error at its
+    own line and column, in the file's order, and a JUnit test case each."""
+    base = (PLC / "scenarios" / "fx5u-healthy.toml").read_text(encoding="utf-8").replace('"../', f'"{PLC.as_posix()}/')
+    text = (base.replace('watch = ["fbEngine.o_wTxCount"', 'watch = ["fbEngine.o_wTxCnt"')
+            .replace("set = { X0 = true }", "set = { bEngineOnn = true }")
+            .replace('never = "fbEngine.o_bErr OR fbCycle.o_bErr"', 'never = "fbEngin.o_bErr OR fbCycle.o_bErr"'))
+    path, xml = tmp_path / "s.toml", tmp_path / "r.xml"
+    path.write_text(text, encoding="utf-8")
+    lines = text.splitlines()
+    # a watch item at its string (its opening quote), an input at its label, a condition's label at itself
+    at = [(n + 1, line.index(word) + 1) for word in ('"fbEngine.o_wTxCnt', "bEngineOnn", "fbEngin.o_bErr")
+          for n, line in enumerate(lines) if word in line]
+    result = invoke("--scenario", path, "--duration", "2s", "--junit", xml)
+    assert result.exit_code == 2
+    errors = [line for line in result.output.splitlines() if line.startswith("error:")]
+    assert [re.match(r"error: .*s\.toml:(\d+):(\d+): ", e).groups() for e in errors] == \
+        [(str(line), str(col)) for line, col in at], result.output
+    assert "watch[0]: no label 'fbEngine.o_wTxCnt'" in errors[0]
+    assert "inputs[0].set: the program UITAMR_ExampleFx5 has no label 'bEngineOnn'; did you mean 'bEngineOn'?" in errors[1]
+    assert "expect[2].never: the program UITAMR_ExampleFx5 has no label 'fbEngin.o_bErr'" in errors[2]
+    cases = ET.parse(xml).getroot().findall(".//testcase")
+    assert [case.get("line") for case in cases] == [str(line) for line, _ in at]
 
 
 def test_a_renamed_instance_gets_no_guess_that_lacks_the_member(tmp_path):
@@ -1502,3 +1534,23 @@ def test_a_channel_over_the_tcp_route_is_not_applied_silently(tmp_path):
     note = "--channel fx5:1 not applied: this scenario reaches the robot over TCP through its converter, not a serial port"
     assert note in over_tcp["notes"] and note not in on_serial["notes"]
     assert on_serial["channel"] == "fx5:1"
+
+
+def test_st_errors_of_a_program_without_platform_are_the_ones_of_its_cpu(tmp_path):
+    """An FX5U integrator's program with a WORD array index (and an initial value, which GX
+    Works3 keeps) run with `uitamr verify SOURCES --program Main` and no --platform: it
+    loads on no CPU, and its errors were listed for the FX3U, led by GX Works2's "label
+    tables have no initial value column" - a mistake it does not have on the FX5U. Now the
+    errors are those of the CPU that finds fewest: the FX5U's."""
+    main = tmp_path / "Main.st"
+    main.write_text(
+        "PROGRAM Main\nVAR\n    fbPort : UITAMR_PortFx5;\n    fbEngine : UITAMR_Engine;\n"
+        "    uMbx : ARRAY[0..15] OF WORD;\n    uPort : ARRAY[0..39] OF WORD;\n"
+        "    wRoute : ARRAY[0..3] OF INT := [1, 2, 3, 4];\n    wIdx : WORD;\n    wPoint : INT;\nEND_VAR\n"
+        "fbPort(i_bEN := TRUE, i_wChannel := 1, io_uPort := uPort);\n"
+        "fbEngine(i_bEN := NOT SM402, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);\n"
+        "wPoint := wRoute[wIdx];\nEND_PROGRAM\n", encoding="utf-8")
+    result = invoke(PLC / "core", PLC / "fx5" / "UITAMR_PortFx5.st", main, "--program", "Main")
+    assert result.exit_code == 2
+    assert "array index must be INT or DINT, not WORD" in result.output, result.output
+    assert "initial value column" not in result.output, result.output

@@ -900,3 +900,73 @@ def test_a_time_literal_broken_across_lines_is_named_as_one_with_a_line_break():
         parse_condition("Y0 AND\n  n > T#1h\n  30m")
     assert (info.value.column, info.value.message) == (
         14, "'T#1h\\n  30m': a TIME literal cannot hold a line break: write T#1h30m")
+
+
+# --- every mistake of a file in one run ---------------------------------------------------------
+SEVERAL_MISTAKES = '''name = "cell"
+platform = "fx5u"
+channel = "fx3:1"
+duration = "20s"
+
+[[faults]]
+kind = "no-replies"
+at_s = 2.0
+
+[[inputs]]
+at = "1s"
+set = { X10 = "on" }
+
+[[expect]]
+that = "gbErrLamp"
+within = 5
+
+[[expect]]
+sent = "stop"
+within = "1s"
+'''
+
+
+def test_every_mistake_of_a_scenario_file_is_told_in_one_read(tmp_path):
+    """An integrator's FX5U scenario with four mistakes (an FX3 channel, a fault kind spelt
+    with a hyphen and plural, a string for a bit, a bare number for a duration) was refused
+    at the first alone: four runs of `uitamr check` or of the CI job to clean up one file.
+    Now each is told, at its line and column, in the file's order; the rest is read as before."""
+    path = tmp_path / "cell.toml"
+    path.write_text(SEVERAL_MISTAKES, encoding="utf-8")
+    with pytest.raises(ScenarioError) as caught:
+        load_scenario(path)
+    errors = caught.value.errors
+    assert [(e.key, e.place.line, e.place.col) for e in errors] == [
+        ("channel", 3, 11), ("faults[0].kind", 7, 8), ("inputs[0].set.X10", 12, 15), ("expect[0].within", 16, 10)]
+    assert "unknown fault 'no-replies'" in errors[1].message
+    assert str(caught.value).splitlines() == [str(e) for e in errors]
+    # the first is the error's own key and place, as for a file with one mistake
+    assert (caught.value.key, caught.value.place) == ("channel", errors[0].place)
+
+
+def test_uitamr_check_and_verify_list_every_mistake_of_a_scenario_file(tmp_path):
+    from click.testing import CliRunner
+    from verifier.commands.check import command as check
+    from verifier.commands.verify import command as verify
+
+    path = tmp_path / "cell.toml"
+    path.write_text(SEVERAL_MISTAKES, encoding="utf-8")
+    result = CliRunner().invoke(check, [str(path)])
+    assert result.exit_code == 1
+    places = [line.split(": error: ")[0].rsplit(":", 2)[1:] for line in result.output.splitlines() if ": error: " in line]
+    assert places == [["3", "11"], ["7", "8"], ["12", "15"], ["16", "10"]], result.output
+    assert "4 error(s)" in result.output
+    xml = tmp_path / "r.xml"
+    result = CliRunner().invoke(verify, ["--scenario", str(path), "--junit", str(xml)])
+    assert result.exit_code == 2
+    assert sum(line.startswith("error: ") for line in result.output.splitlines()) == 4, result.output
+    assert xml.read_text(encoding="utf-8").count("<testcase") == 4
+
+
+def test_a_duration_in_error_does_not_make_later_times_mistakes(tmp_path):
+    """The run's length unknown (a mistake of its own), an input at 90 s is no mistake too."""
+    path = tmp_path / "s.toml"
+    path.write_text('duration = "2 minutes"\n[[inputs]]\nat = "90s"\nset = { X0 = true }\n', encoding="utf-8")
+    with pytest.raises(ScenarioError) as caught:
+        load_scenario(path)
+    assert caught.value.key == "duration" and not hasattr(caught.value, "errors")

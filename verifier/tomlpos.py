@@ -330,11 +330,15 @@ def _too_many_digits(source: str) -> tuple[str, Place | None]:
     return f"a whole number of {digits} digits: too long to read (at most 4300), and no setting takes it", place
 
 
-def shown(value) -> str:
+def shown(value, depth: int = 0) -> str:
     """A TOML value for messages: `true`/`false` and arrays as the file writes them, a
-    date-time as one, a table as "a table"; text quoted as the other messages quote it."""
+    date-time as one, a table as "a table"; text quoted as the other messages quote it.
+    Arrays nested deeper than a message can show (tomllib reads 400 deep) end in `[...]`:
+    their items were shown one frame deeper each, to a RecursionError."""
     import datetime
 
+    if isinstance(value, list) and depth >= 30:  # past the 60 characters shown in any case
+        return "[...]"
     if isinstance(value, bool):
         text = "true" if value else "false"
     elif isinstance(value, (datetime.datetime, datetime.date, datetime.time)):
@@ -342,7 +346,7 @@ def shown(value) -> str:
     elif isinstance(value, dict):
         text = "a table"
     elif isinstance(value, list):
-        text = "[" + ", ".join(shown(item) for item in value) + "]"
+        text = "[" + ", ".join(shown(item, depth + 1) for item in value) + "]"
     else:
         text = repr(value)
     return text if len(text) <= 60 else text[:57] + "..."

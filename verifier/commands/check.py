@@ -206,10 +206,10 @@ def check_scenario(path: Path, platform: str | None = None) -> list[Diagnostic]:
 
     try:
         scenario = load_scenario(path, platform)  # --platform: a CPU verify runs (PLATFORMS)
-    except ScenarioError as exc:
-        message = f"{exc.key}: {exc.message}" if exc.key else exc.message
-        place = exc.place
-        return [Diagnostic(str(path), place.line if place else 0, place.col if place else 0, "error", message)]
+    except ScenarioError as exc:  # every mistake of the file, each at its place (ScenarioErrors: several)
+        return [Diagnostic(str(path), error.place.line if error.place else 0, error.place.col if error.place else 0,
+                           "error", f"{error.key}: {error.message}" if error.key else error.message)
+                for error in getattr(exc, "errors", [exc])]
     found = []
     place = scenario.key_lines.get("channel")
     if platform is not None and scenario.channel is not None and place is not None:

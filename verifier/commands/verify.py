@@ -29,13 +29,13 @@ from verifier.commands.report_files import (JudgingCommand, ReportError, check_f
 from verifier.verify.durations import format_duration, format_seconds, parse_duration_us
 from verifier.verify import spool
 from verifier.verify.events_shown import EVENTS_AT_MOST
-from verifier.verify.result import KEEP_ALL, Keep, ScenarioResult, UnusableInput, mistakes_of
+from verifier.verify.result import KEEP_ALL, Keep, ScenarioMistakes, ScenarioResult, UnusableInput, mistakes_of
 from verifier.bundled import plc_dir as bundled_plc_dir
 from verifier.digits import digit_problem
 from verifier.textfile import is_folder, real_path, shown_path
 from verifier.verify.scenario import (
-    CHANNELS, DEFAULT_DURATION_US, MAX_DURATION_US, PLATFORMS, TOLD_PLATFORMS, Scenario, ScenarioError, bundled_platforms,
-    default_scenario, load_scenario,
+    CHANNELS, DEFAULT_DURATION_US, MAX_DURATION_US, PLATFORMS, TOLD_PLATFORMS, Scenario, ScenarioError, ScenarioErrors,
+    bundled_platforms, default_scenario, load_scenario,
 )
 from verifier.verify.sources import SourceError, expand, st_files_in, unique
 
@@ -103,7 +103,8 @@ def _unusable_input(junit_path: str | None, inputs, error: Exception) -> None:
     mistakes = mistakes_of(error)
     # the console shows each scenario file's mistake as its own error line, and ST that does
     # not load as one message listing its errors (the JUnit report has a test case for each)
-    messages = [mistake.message for mistake in mistakes] if isinstance(error, ScenarioMistakes) else [str(error)]
+    messages = ([mistake.message for mistake in mistakes] if isinstance(error, (ScenarioMistakes, ScenarioErrors))
+                else [str(error)])
     _unusable_after(messages, junit_of_mistakes(junit_path, mistakes, "uitamr verify", inputs) if junit_path else None)
 
 
@@ -123,15 +124,6 @@ def _unusable_after(messages: list[str], junit: tuple[bool, str] | None) -> None
     if written:
         _unusable(*messages, done=said)
     _unusable(*messages, said)
-
-
-class ScenarioMistakes(UnusableInput):
-    """The mistakes of several scenario files, each its own message (file:line:col) and
-    place (`mistakes`)."""
-
-    def __init__(self, errors: list[Exception]):
-        self.mistakes = [mistake for error in errors for mistake in mistakes_of(error)]
-        super().__init__("\n".join(mistake.message for mistake in self.mistakes))
 
 
 def _read_scenarios(files, platform: str | None = None) -> list[Scenario]:
@@ -200,8 +192,16 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
                 raise UnusableInput(f"no bundled scenario is written for the {platform}")
         if not own and not bundled:
             if resolved and platform is None:
-                fits, _ = platforms_that_load(resolved)
-                platform = fits[0] if len(fits) == 1 else None  # else the default, fx3u (ST errors show there)
+                fits, errors = platforms_that_load(resolved)
+                if len(fits) == 1:
+                    platform = fits[0]
+                elif not fits and errors:
+                    # ST errors on every CPU: shown for the one that finds fewest (ties: fx3u, fx5u, q),
+                    # not always the FX3U's - an FX5U program with an initial value was told GX Works2's
+                    # "label tables have no initial value column" beside its own mistakes
+                    platform = min(errors, key=lambda told: len(errors[told].located()))
+                else:
+                    platform = None  # loads on several: the default, fx3u
                 overrides["platform"] = platform
             own = [replace(default_scenario(duration_us=duration or DEFAULT_DURATION_US), sources=resolved)]
             if resolved and uses_tcp_route(resolved, program):

@@ -62,7 +62,14 @@ def initial_text(source_text: str, lines: list[str], decl: ast.VarDecl) -> str:
 
 
 def label_rows(pou: ast.Pou, source_text: str, target: str) -> list[LabelRow]:
-    return rows_of(pou.variables, source_text, target)
+    """The rows of a POU's label table. GX Works3 has no VAR_EXTERNAL class (MELSEC iQ-F FX5
+    Programming Manual (Program Design) §4.2: a POU uses a global label by its name), so a
+    POU's VAR_EXTERNAL declarations, which the check matched against the VAR_GLOBAL blocks,
+    are no rows of it there: the globals are in the global label table."""
+    decls = pou.variables
+    if target == "gxworks3":
+        decls = [d for d in decls if d.section != "VAR_EXTERNAL"]
+    return rows_of(decls, source_text, target)
 
 
 def rows_of(decls: list[ast.VarDecl], source_text: str, target: str) -> list[LabelRow]:

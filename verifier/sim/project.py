@@ -15,14 +15,22 @@ from verifier.textfile import text_lines
 
 from .compiler import GENERATED_FILE, CompiledModule, compile_files, default_code
 from .cpu import profile_for
-from .errors import LoadError, SimulationError, option_error
+from .errors import OPTION_PLACE, LoadError, SimulationError, option_error
 from .instructions import InstructionSet
 from .runtime import Runtime
 from .typesys import ArrayT, CompileError, StringT, StructT
 from .values import InstanceProxy, to_st, to_st_list, wrap
 
 
-def load(*paths, target: str = "gxworks2", cpu: str | None = None, scan_ms: float = 10,
+class _NotGiven(str):
+    """The default of `load`'s target, "gxworks2", told apart from the same name given."""
+
+
+#: the editor `load` reads for when given no target (and so the FX3U, its default CPU)
+DEFAULT_TARGET = _NotGiven("gxworks2")
+
+
+def load(*paths, target: str = DEFAULT_TARGET, cpu: str | None = None, scan_ms: float = 10,
          jitter_ms: float = 0, seed: int = 0, stop_on_operation_error: bool | None = None,
          sources: dict[str, str] | None = None, timer_resolution_ms: int = 1,
          programs: Iterable[str] | None = None) -> "Project":
@@ -34,7 +42,9 @@ def load(*paths, target: str = "gxworks2", cpu: str | None = None, scan_ms: floa
     ("fx3u", "fx3g", "fx5u", "q").  `programs` (PROGRAM names) makes the simulator compile
     only those programs and what they use, which loads a large library faster; every file
     is parsed and checked all the same. Names that are not all PROGRAMs of the files are
-    ignored (everything is compiled). Raises LoadError listing file:line:col diagnostics."""
+    ignored (everything is compiled). Raises LoadError listing file:line:col diagnostics;
+    with neither `target` nor `cpu` given ("gxworks2", the FX3U), sources that load on the
+    FX5U or a Q instead get a last line naming the target to give."""
     texts: dict[str, str] = {}
     problems = []
     if sources is not None and not isinstance(sources, dict):
@@ -55,9 +65,32 @@ def load(*paths, target: str = "gxworks2", cpu: str | None = None, scan_ms: floa
     texts.update(sources or {})
     if problems:
         raise LoadError(problems)
-    return Project(texts, target=target, cpu=cpu, scan_ms=scan_ms, jitter_ms=jitter_ms, seed=seed,
-                   stop_on_operation_error=stop_on_operation_error, timer_resolution_ms=timer_resolution_ms,
-                   programs=programs)
+    try:
+        return Project(texts, target=str(target) if target is DEFAULT_TARGET else target, cpu=cpu, scan_ms=scan_ms, jitter_ms=jitter_ms,
+                       seed=seed, stop_on_operation_error=stop_on_operation_error,
+                       timer_resolution_ms=timer_resolution_ms, programs=programs)
+    except LoadError as exc:
+        note = _target_note(texts) if target is DEFAULT_TARGET and cpu is None and exc.located() else None
+        if note is None:
+            raise
+        raise LoadError(exc.diagnostics + [note]) from None
+
+
+def _target_note(texts: dict[str, str]) -> ast.Diagnostic | None:
+    """For sources that failed to load for the default target: a note naming the target
+    whose CPU loads them (the FX5U's GX Works3, a Q), None when none does. An FX5U
+    integrator who left out target= otherwise read only errors inside the library's port FB
+    (`device SM8561: the fx3u has no SM devices`)."""
+    for target, cpu in (("gxworks3", "fx5u"), ("gxworks2:q", "q")):
+        profile = profile_for(target, cpu)
+        try:  # as Project loads them, without making one (the pytest plugin would show it)
+            files, _ = _parsed_and_checked(texts, target.split(":")[0], profile.name)
+            compile_files(files, Runtime(profile), profile)
+        except (LoadError, CompileError):
+            continue
+        return ast.Diagnostic(f"{OPTION_PLACE}target={str(DEFAULT_TARGET)!r})", 0, 0, "note",
+                              f"the sources load with target={target!r} (the {cpu} CPU): give target={target!r}")
+    return None
 
 
 def _empty_folder(path: Path) -> ast.Diagnostic:

@@ -106,11 +106,14 @@ class InstanceProxy:
         if isinstance(self._obj, StdFB):
             t = FB_PARAM_TYPES[self._obj.TYPE_NAME].get(key)
             if t is None:
-                raise AttributeError(f"{self._label} ({self._obj.TYPE_NAME}) has no input/output {name}")
+                raise AttributeError(f"{self._label} ({self._obj.TYPE_NAME}) has no input/output {name}"
+                                     + _guess(name, FB_PARAM_TYPES[self._obj.TYPE_NAME]))
             return key, t, None
-        sym = self._symbols().get(key)
-        if sym is None:
-            raise AttributeError(f"{self._label} has no label {name!r}")
+        symbols = self._symbols()
+        sym = symbols.get(key)
+        if sym is None:  # the guess a scenario's misspelt label gets, for a test's too
+            raise AttributeError(f"{self._label} has no label {name!r}"
+                                 + _guess(name, [s.name for s in symbols.values()]))
         from .codegen import attr_name
 
         return attr_name(sym.name), sym.type, sym
@@ -368,3 +371,10 @@ def read_together(readers: list) -> Callable[[], tuple]:
     source = "def read_all():\n    return (" + "".join(p + ", " for p in parts) + ")\n"
     exec(compile(source, "<watched-labels>", "exec"), env)
     return env["read_all"]
+
+
+def _guess(name: str, names) -> str:
+    """"; did you mean 'fbEngine'?" for a label spelt nearly as one of `names`, else ""."""
+    from verifier.amr.schema import did_you_mean
+
+    return did_you_mean(name, names)

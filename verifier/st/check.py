@@ -315,7 +315,8 @@ class Checker:
                 if v.section == "VAR_EXTERNAL":
                     g = self.table.globals.get(v.key)
                     if g is None:
-                        self.rep.error(v, f"VAR_EXTERNAL '{v.name}' has no VAR_GLOBAL declaration in the files checked")
+                        self.rep.error(v, f"VAR_EXTERNAL '{v.name}' has no VAR_GLOBAL declaration in the files checked: "
+                                          "add the file that declares it in a VAR_GLOBAL block to the sources")
                     elif g[1] != t:
                         self.rep.error(v, f"VAR_EXTERNAL '{v.name}' is {t} but the global is {g[1]}")
                 if v.key in info.labels:

@@ -207,6 +207,9 @@ def assignable(target: Type, source: Type, target_name: str = "gxworks2") -> str
             return f"an integer constant cannot be stored in {target}; write it as a REAL constant (e.g. 1.0)"
         if target == BOOL:
             return "an integer constant cannot be stored in BOOL; write TRUE or FALSE"
+        if target == TIME:
+            return ("an integer constant cannot be stored in TIME; write a TIME literal, T# and a number with its "
+                    "unit, e.g. T#500ms or T#1s")
         return f"an integer constant cannot be stored in {target}"
     if is_group(source, "real-literal"):
         if isinstance(target, Elementary) and target.group == "real":

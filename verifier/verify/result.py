@@ -110,6 +110,15 @@ def _unusable_input(kind: type, message: str, at, mistakes) -> UnusableInput:
     return error
 
 
+class ScenarioMistakes(UnusableInput):
+    """The mistakes of several scenario files, or several of one (its labels), each its own
+    message (file:line:col) and place (`mistakes`)."""
+
+    def __init__(self, errors: list[Exception]):
+        self.mistakes = [mistake for error in errors for mistake in mistakes_of(error)]
+        super().__init__("\n".join(mistake.message for mistake in self.mistakes))
+
+
 @dataclass(frozen=True, slots=True)
 class TraceRecord:
     t_start_us: int

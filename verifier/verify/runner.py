@@ -29,8 +29,8 @@ from .events_shown import thin_line_events
 from .evidence import RunEvidence, Samples
 from .expectations import judge
 from .overwritten import overwritten_input_notes
-from .result import (KEEP_ALL, RULE_EVENTS, Keep, LineEvent, Mistake, ScenarioResult, TraceRecord, UnusableInput,
-                     judged_with, summarize_diagnostics)
+from .result import (KEEP_ALL, RULE_EVENTS, Keep, LineEvent, Mistake, ScenarioMistakes, ScenarioResult, TraceRecord,
+                     UnusableInput, judged_with, summarize_diagnostics)
 from .rules import check_all
 from .scenario import (BUFFER_MEMORY, DEFAULT_PLATFORM, DEVICE_NAME, Scenario, ScenarioError, bundled_platform,
                        scenario_power_on_stop)
@@ -411,6 +411,7 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
     a BOOL where a condition is expected, a value that fits the label an input writes. A
     missing default response signal is dropped. Errors name the file, line and key."""
     kinds: dict[str, str] = {}
+    mistakes: list[UnusableInput] = []  # every one, in the file's order: not a run per misspelt label
     for use in scenario.label_uses():
         missing, line = None, use.line
         for name in use.names:
@@ -421,7 +422,8 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
             scenario = _without_default_signal(plc, scenario)
             continue
         if missing is not None:
-            raise _line_mistake(scenario, use.key, line, missing)
+            mistakes.append(_line_mistake(scenario, use.key, line, missing))
+            continue
         for name in use.names:
             value = _plain(plc.read(name))
             kinds[name] = "bool" if isinstance(value, bool) else "STRING" if isinstance(value, str) else "number"
@@ -431,7 +433,12 @@ def _check_labels(plc: _Plc, scenario: Scenario) -> Scenario:
         if problem and use.optional:  # the default signal: an o_bErr that is not a BOOL is not it
             scenario = _without_default_signal(plc, scenario)
         elif problem:
-            raise _line_mistake(scenario, use.key, use.line, problem)
+            mistakes.append(_line_mistake(scenario, use.key, use.line, problem))
+    mistakes.sort(key=lambda m: (m.place is None, m.place.line if m.place else 0, m.place.col if m.place else 0))
+    if len(mistakes) == 1:
+        raise mistakes[0]
+    if mistakes:
+        raise ScenarioMistakes(mistakes)
     return scenario
 
 
@@ -682,7 +689,10 @@ def _silence_note(scenario: Scenario, plc: _Plc, converter: Converter | None) ->
         if converter.open_count == 0:
             note += ": the program opened no connection to it"
         elif converter.first_failed_open is not None and converter.accepted_count == 0:
-            note += f": {converter.first_failed_open}; set the scenario's [converter] ip and port to what the program opens"
+            cfg = converter.config
+            note += (f": {converter.first_failed_open}; set the scenario's [converter] ip and port to what the program "
+                     f"opens, or, if the converter is at {cfg.ip}:{cfg.port}, make the program open that (its "
+                     "port FB's address and port inputs)")
         note += ")"
         from verifier.sim.instructions.tcp import FixedBufferPort
 
@@ -700,8 +710,10 @@ def _silence_note(scenario: Scenario, plc: _Plc, converter: Converter | None) ->
     opens = sum(poller.open_count for poller in rt.pollers if isinstance(poller, TcpPort))
     if sent:
         first = next(iter(other))
+        # either side may be wrong: the scenario's port, or the program's (its port FB's channel)
         note += (f"; {sent}: the robot hangs on {channel} in this run: give --channel {first}, "
-                 f'or channel = "{first}" in the scenario')
+                 f'or channel = "{first}" in the scenario; or, if the robot is wired to {channel}, make the '
+                 f"program drive {channel}")
     elif opens:
         note += (f"; it opened TCP connections ({opens} open(s)): the robot is behind a serial-to-TCP converter "
                  "on that route: add a [converter] table to the scenario (docs/scenarios.md)")

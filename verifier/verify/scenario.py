@@ -10,7 +10,7 @@ import re
 import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any, Callable, Iterator
 
 from verifier import protocol
 from verifier.amr.config import RobotConfig
@@ -111,6 +111,35 @@ class ScenarioError(Exception):
 
     def __reduce__(self):  # across --jobs' worker processes, as UnusableInput: the constructor takes the parts
         return type(self), (self.file, self.key, self.message, self.place)
+
+    @staticmethod
+    def together(errors: list["ScenarioError"]) -> "ScenarioError":
+        """One error as it is; several (the mistakes of one file) as ScenarioErrors, in the
+        file's order."""
+        if len(errors) == 1:
+            return errors[0]
+        return ScenarioErrors(sorted(errors, key=lambda e: (e.place is None, e.place.line if e.place else 0,
+                                                            e.place.col if e.place else 0)))
+
+
+class ScenarioErrors(ScenarioError):
+    """Several mistakes of one scenario file: `errors`, each a ScenarioError with its place;
+    the first's key, message and place are this one's, its text every one's, a line each.
+    `mistakes`: each as the JUnit report lists it (result.mistakes_of)."""
+
+    def __init__(self, errors: list[ScenarioError]):
+        first = errors[0]
+        self.errors = list(errors)
+        self.file, self.key, self.message, self.place = first.file, first.key, first.message, first.place
+        Exception.__init__(self, "\n".join(str(error) for error in errors))
+
+    @property
+    def mistakes(self) -> list:
+        from .result import mistakes_of
+        return [mistake for error in self.errors for mistake in mistakes_of(error)]
+
+    def __reduce__(self):
+        return type(self), (self.errors,)
 
 
 @dataclass(frozen=True)
@@ -490,100 +519,158 @@ class _Reader:
 
     # --- the document ----------------------------------------------------------------------
 
+    def attempt(self, read: Callable[[], Any], default: Any = None) -> Any:
+        """What `read` gives, or `default` after noting its ScenarioError in `self.errors`: the
+        file's other keys are read on, so that every mistake of it is told in one run."""
+        try:
+            return read()
+        except ScenarioError as exc:
+            self.errors.append(exc)
+            return default
+
     def read(self, data: dict) -> Scenario:
-        self.only(data, TOP_KEYS, "")
-        name = self.string(data.get("name", self.path.stem if self.path else "scenario"), "name")
-        if not name.strip():  # every report names the run by it: a JUnit test case with no name
-            raise self.fail("name", "is empty: give the scenario a name, or leave 'name' out to use the file name")
-        description = self.string(data.get("description", ""), "description")
-        sources = tuple(self.sources(data["sources"])) if "sources" in data else ()
-        program = self.string(data["program"], "program") if "program" in data else None
-        if program is not None and not program.strip():  # was "no PROGRAM '' in the sources", without a line
-            raise self.fail("program", "is empty: give the name of the PROGRAM to run, or leave 'program' out "
-                                       "when the sources hold only one")
-        platform = self.string(data.get("platform", self.default_platform), "platform").lower()
-        if platform not in PLATFORMS:
-            raise self.fail("platform", f"unknown platform {platform!r}; expected one of {', '.join(PLATFORMS)}")
-        channel = None
-        if "channel" in data:
+        self.errors: list[ScenarioError] = []
+        attempt = self.attempt
+        attempt(lambda: self.only(data, TOP_KEYS, ""))
+
+        def read_name() -> str:
+            name = self.string(data.get("name", self.path.stem if self.path else "scenario"), "name")
+            if not name.strip():  # every report names the run by it: a JUnit test case with no name
+                raise self.fail("name", "is empty: give the scenario a name, or leave 'name' out to use the file name")
+            return name
+        name = attempt(read_name, "scenario")
+        description = attempt(lambda: self.string(data.get("description", ""), "description"), "")
+        sources = attempt(lambda: tuple(self.sources(data["sources"])) if "sources" in data else (), ())
+
+        def read_program() -> str | None:
+            program = self.string(data["program"], "program") if "program" in data else None
+            if program is not None and not program.strip():  # was "no PROGRAM '' in the sources", without a line
+                raise self.fail("program", "is empty: give the name of the PROGRAM to run, or leave 'program' out "
+                                           "when the sources hold only one")
+            return program
+        program = attempt(read_program)
+
+        def read_platform() -> str | None:
+            platform = self.string(data.get("platform", self.default_platform), "platform").lower()
+            if platform not in PLATFORMS:
+                raise self.fail("platform", f"unknown platform {platform!r}; expected one of {', '.join(PLATFORMS)}")
+            return platform
+        platform = attempt(read_platform)  # None: a mistake, and nothing is judged against it
+
+        def read_channel() -> str | None:
+            if "channel" not in data:
+                return None
             channel = self.string(data["channel"], "channel")
             if channel not in CHANNELS:
                 raise self.fail("channel", f"unknown channel {channel!r}; expected one of {', '.join(CHANNELS)}")
-            problem = channel_problem(channel, platform)  # as verify's load would refuse it
+            problem = channel_problem(channel, platform) if platform is not None else None  # as verify's load would
             if problem is not None:
                 owner = next((p for p in TOLD_PLATFORMS if channel in serial_channels(p)), None)
                 if "platform" not in data and owner is not None:  # the platform is the default (or --platform's)
                     given = "--platform's" if self.platform_option else "the default platform"
                     problem += f" ({platform} is {given}: set platform = \"{owner}\", the CPU that has {channel})"
                 raise self.fail("channel", problem)
-        duration = self.duration(data.get("duration", "60s"), "duration")
-        if duration > MAX_DURATION_US:
-            raise self.fail("duration", f"longer than the limit of {format_duration(MAX_DURATION_US)} of virtual time; "
-                                        "split a longer soak test into several scenarios")
-        scan = self.duration(data.get("scan", "10ms"), "scan")
-        if scan > duration:
-            raise self.fail("scan", "the scan time is longer than the whole run")
-        jitter = self.duration(data["scan_jitter"], "scan_jitter", positive=False) if "scan_jitter" in data else 0
-        if jitter >= scan:
-            raise self.fail("scan_jitter", "must be shorter than the scan time")
-        seed = data.get("seed", 0)
-        if isinstance(seed, bool) or not isinstance(seed, int):
-            raise self.fail("seed", f"expected a whole number, got {shown(seed)}")
-        watch = data.get("watch", [])
-        if not isinstance(watch, list):
-            raise self.fail("watch", "expected a list of label paths")
-        watch = tuple(self.label(item, f"watch[{i}]") for i, item in enumerate(watch))
-        settings = self.settings(data.get("protocol", {}))
-        robot = self.robot(data.get("robot", {}))
-        faults = self.faults(data.get("faults", []))
-        try:
-            check_fault_addresses(faults, settings.address)
-        except ConfigError as exc:
-            raise self.fail(exc.path, exc.message) from None
+            return channel
+        channel = attempt(read_channel)
+
+        def read_duration() -> int:
+            duration = self.duration(data.get("duration", "60s"), "duration")
+            if duration > MAX_DURATION_US:
+                raise self.fail("duration", f"longer than the limit of {format_duration(MAX_DURATION_US)} of virtual "
+                                            "time; split a longer soak test into several scenarios")
+            return duration
+        # a duration in error judges nothing else: the longest run, so no time is "after its end"
+        duration = attempt(read_duration, None)
+        duration_known = duration is not None
+        duration = duration if duration_known else MAX_DURATION_US
+
+        def read_scan() -> int:
+            scan = self.duration(data.get("scan", "10ms"), "scan")
+            if duration_known and scan > duration:
+                raise self.fail("scan", "the scan time is longer than the whole run")
+            return scan
+        scan = attempt(read_scan, None)
+
+        def read_jitter() -> int:
+            jitter = self.duration(data["scan_jitter"], "scan_jitter", positive=False) if "scan_jitter" in data else 0
+            if scan is not None and jitter >= scan:
+                raise self.fail("scan_jitter", "must be shorter than the scan time")
+            return jitter
+        jitter = attempt(read_jitter, 0)
+
+        def read_seed() -> int:
+            seed = data.get("seed", 0)
+            if isinstance(seed, bool) or not isinstance(seed, int):
+                raise self.fail("seed", f"expected a whole number, got {shown(seed)}")
+            return seed
+        seed = attempt(read_seed, 0)
+
+        def read_watch() -> tuple[str, ...]:
+            watch = data.get("watch", [])
+            if not isinstance(watch, list):
+                raise self.fail("watch", "expected a list of label paths")
+            return tuple(label for label in (attempt(lambda i=i, item=item: self.label(item, f"watch[{i}]"))
+                                             for i, item in enumerate(watch)) if label is not None)
+        watch = attempt(read_watch, ())
+        settings = attempt(lambda: self.settings(data.get("protocol", {})), None)
+        robot = attempt(lambda: self.robot(data.get("robot", {})), None)
+        faults = attempt(lambda: self.faults(data.get("faults", [])), ())
+        if settings is not None:
+            try:
+                check_fault_addresses(faults, settings.address)
+            except ConfigError as exc:
+                self.errors.append(self.fail(exc.path, exc.message))
         for i, fault in enumerate(faults):
-            if fault.at_s is not None and fault.at_s * 1_000_000 >= duration:
-                raise self.fail(f"faults[{i}].at_s", f"is at or after the end of the run "
-                                                     f"({format_duration(duration)}): the fault would never happen")
-        inputs = tuple(
-            self.input_step(item, f"inputs[{i}]", duration)
-            for i, item in enumerate(self.array_of_tables(data.get("inputs", []), "inputs"))
-        )
-        expectations = tuple(
-            self.expectation(item, f"expect[{i}]", settings)
-            for i, item in enumerate(self.array_of_tables(data.get("expect", []), "expect"))
-        )
-        for expectation in expectations:
+            if duration_known and fault.at_s is not None and fault.at_s * 1_000_000 >= duration:
+                self.errors.append(self.fail(f"faults[{i}].at_s", f"is at or after the end of the run "
+                                                                  f"({format_duration(duration)}): the fault would "
+                                                                  "never happen"))
+        inputs = tuple(step for step in (
+            attempt(lambda i=i, item=item: self.input_step(item, f"inputs[{i}]", duration))
+            for i, item in enumerate(attempt(lambda: self.array_of_tables(data.get("inputs", []), "inputs"), [])))
+            if step is not None)
+        expectations = tuple(expectation for expectation in (
+            attempt(lambda i=i, item=item: self.expectation(item, f"expect[{i}]", settings or protocol.Settings()))
+            for i, item in enumerate(attempt(lambda: self.array_of_tables(data.get("expect", []), "expect"), [])))
+            if expectation is not None)
+        for expectation in expectations if robot is not None else ():
             if (expectation.kind == "reached_point" and expectation.within_us is not None and robot.is_taught(
                     expectation.point) and expectation.within_us < robot.point_duration_us(expectation.point)):
                 takes = format_duration(robot.point_duration_us(expectation.point))
-                raise self.fail(f"{expectation.key}.within",
-                                f"point {expectation.point} takes the robot {takes} ([robot] point_duration_s / "
-                                f"point_durations_s), longer than this window of "
-                                f"{format_duration(expectation.within_us)}: it can never be reached in it; make "
-                                "'within' longer")
+                self.errors.append(self.fail(
+                    f"{expectation.key}.within",
+                    f"point {expectation.point} takes the robot {takes} ([robot] point_duration_s / "
+                    f"point_durations_s), longer than this window of "
+                    f"{format_duration(expectation.within_us)}: it can never be reached in it; make 'within' longer"))
             if expectation.kind == "reached_point" and not robot.is_taught(expectation.point):
-                raise self.fail(f"{expectation.key}.reached_point",
-                                f"point {expectation.point} is not among the robot's taught_points "
-                                f"{list(robot.taught_points)}: the robot accepts run-point {expectation.point} and "
-                                "does nothing, so it is never reached; add it to [robot] taught_points")
-        options, signal_given = self.options(data.get("rules", {}), data.get("response_handling", None))
-        initial = self.initial(data.get("initial", {}))
-        c24 = tuple(
-            self.c24(item, f"c24[{i}]", platform)
-            for i, item in enumerate(self.array_of_tables(data.get("c24", []), "c24"))
-        )
+                self.errors.append(self.fail(
+                    f"{expectation.key}.reached_point",
+                    f"point {expectation.point} is not among the robot's taught_points "
+                    f"{list(robot.taught_points)}: the robot accepts run-point {expectation.point} and "
+                    "does nothing, so it is never reached; add it to [robot] taught_points"))
+        options, signal_given = attempt(lambda: self.options(data.get("rules", {}), data.get("response_handling", None)),
+                                        (None, False))
+        initial = attempt(lambda: self.initial(data.get("initial", {})), ())
+        c24 = tuple(setting for setting in (
+            attempt(lambda i=i, item=item: self.c24(item, f"c24[{i}]", platform))
+            for i, item in enumerate(attempt(lambda: self.array_of_tables(data.get("c24", []), "c24"), [])))
+            if setting is not None) if platform is not None else ()
         seen_c24: dict[tuple[int, int], str] = {}
         for setting in c24:
             first = seen_c24.setdefault((setting.unit, setting.channel), setting.key)
             if first != setting.key:
-                raise self.fail(setting.key, f"U{setting.unit:X} channel {setting.channel} is already set in "
-                                             f"{first}: one [[c24]] table per module channel", at_name=True)
-        converter = (self.converter(data["converter"], platform, duration,
-                                    "file" if "platform" in data else "option" if self.platform_option else "")
-                     if "converter" in data else None)
-        if converter is not None and channel is not None:
-            raise self.fail("channel", "a scenario with [converter] reaches the robot over TCP: "
-                                       "it has no serial channel; remove 'channel'")
+                self.errors.append(self.fail(setting.key, f"U{setting.unit:X} channel {setting.channel} is already "
+                                                          f"set in {first}: one [[c24]] table per module channel",
+                                             at_name=True))
+        converter = (attempt(lambda: self.converter(data["converter"], platform, duration,
+                                                    "file" if "platform" in data
+                                                    else "option" if self.platform_option else ""))
+                     if "converter" in data and platform is not None else None)
+        if "converter" in data and channel is not None:
+            self.errors.append(self.fail("channel", "a scenario with [converter] reaches the robot over TCP: "
+                                                    "it has no serial channel; remove 'channel'"))
+        if self.errors:
+            raise ScenarioError.together(self.errors)
         keys = [key for key in ("duration", "scan", "scan_jitter") if key in data]
         keys += [f"initial.{name}" for name, _ in initial] + [setting.key for setting in c24]
         keys += [f"faults[{i}]" for i in range(len(faults))]
@@ -757,9 +844,9 @@ class _Reader:
         for i, item in enumerate(items):
             try:
                 result.append(Fault.from_dict(item, f"faults[{i}]"))
-            except ConfigError as exc:
+            except ConfigError as exc:  # noted, and the next fault read: every mistake of the file in one run
                 path = exc.path if exc.path.startswith("faults[") else f"faults[{i}]"
-                raise self.fail(path, exc.message, at_name=exc.at_name) from None
+                self.errors.append(self.fail(path, exc.message, at_name=exc.at_name))
         return tuple(result)
 
     def input_step(self, item: dict, key: str, duration: int) -> InputStep:
