@@ -515,3 +515,38 @@ def test_a_stop_pressed_while_a_pause_is_served_goes_out_right_after_it():
     assert robot.mode == "idle" and h.fbRun.o_uErrId == 0x0305 and h.fbPause.o_uErrId == 0
     page = " ".join((PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8").split())
     assert "(the pause's control command and status read: about 600 ms)" in page
+
+
+def test_the_resume_button_moves_nothing_when_no_point_runs():
+    """review34: UITAMR_CellFx3's resume (X4: UITAMR_Command kind 2 of the point) and the
+    page's wiring sent the point whenever pressed: with nothing paused - before X0, or after
+    the operator's stop had ended the paused point - the robot drove to the point with fbGo
+    idle (nobody following it, no 'reached', no fault from the run). The resume is now
+    asked only while the point's run is busy; while it is, it resumes as before."""
+    import re
+
+    from verifier.amr.config import RobotConfig as Config
+
+    page = (PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8")
+    section = page.split("### Pause and resume while a point runs", 1)[1].split("\n## ", 1)[0]
+    snippet = re.search(r"```iecst\n(.*?)```", section, re.S).group(1)
+    page_project = _cell("    fbRun : UITAMR_RunPoint;\n    fbPause : UITAMR_Pause;\n    fbResume : UITAMR_Command;\n"
+                         "    fbStop : UITAMR_Stop;\n    bPaused : BOOL;\n", snippet)
+    cell = verifier.load(PLC / "core", PLC / "fx3", PLC / "examples" / "fx3" / "UITAMR_CellFx3.st")
+    robot = Robot(config=Config(point_duration_s=8.0))
+    line = Line(robot)
+    cell.attach_serial("fx3:1", line)
+    cell_project = (cell, robot, line, lambda ms: cell.run_programs(["UITAMR_CellFx3"], ms=ms))
+    for project, robot, line, run in (page_project, cell_project):
+        _press(project, run, "X4", 2000)                      # resume with nothing run yet
+        run(2000)
+        assert robot.mode == "idle" and len(_controls_at(line)) == 1      # the power-on stop only
+        _press(project, run, "X0", 0)                         # the point ...
+        _press(project, run, "X3", 2000)                      # ... paused ...
+        _press(project, run, "X1", 2000)                      # ... and stopped
+        run(1000)
+        assert robot.mode == "idle"
+        _press(project, run, "X4", 1000)                      # resume after the stop
+        run(2000)
+        assert robot.mode == "idle"
+        assert [c[1] for c in _controls_at(line)][1:] == [POINT_3, PAUSE_FRAME, encode(ControlRequest(1, 1, 0xA0), SETTINGS)]
