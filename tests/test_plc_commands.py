@@ -550,3 +550,29 @@ def test_the_resume_button_moves_nothing_when_no_point_runs():
         run(2000)
         assert robot.mode == "idle"
         assert [c[1] for c in _controls_at(line)][1:] == [POINT_3, PAUSE_FRAME, encode(ControlRequest(1, 1, 0xA0), SETTINGS)]
+
+
+def test_a_pause_that_comes_after_the_point_has_ended_waits_for_the_resume():
+    """review34: a pause pressed in the last 300 ms of a point reaches the robot after the
+    task has ended: the robot ignores it and reports idle, and the engine (which does not
+    let an 'idle' answer end a paused run, in case a robot reports a paused task idle)
+    keeps the run busy with o_bPaused on, TASK_TIMEOUT stopped. plc-library.md says so and
+    how it ends: the resume (the point again, already reached) ends it with o_bOK."""
+    project, robot, line, run = _run_point_cell(
+        "    fbResume : UITAMR_Command;\n    bDone : BOOL;\n",
+        "fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);\n"
+        "fbResume(i_bEN := TRUE, i_bExecute := X4 AND fbRun.o_bBusy, i_wKind := 2, i_wCode := 1, i_wCommand := 3,\n"
+        "         i_bParamErr := FALSE, i_bPriority := FALSE, io_uMbx := uMbx);\n"
+        "IF fbRun.o_bOK THEN\n    bDone := TRUE;\nEND_IF;\n")
+    h = project.program("T_Cell")
+    _press(project, run, "X0", 2000)                          # point 3 at 2.4 s, ends at ~10.4 s
+    _press(project, run, "X3", 8000)                          # pause at 10.3 s: sent at 10.46 s
+    run(20_000)
+    assert [c[1] for c in _controls_at(line)][1:] == [POINT_3, PAUSE_FRAME]
+    assert robot.mode == "idle" and h.fbEngine.o_bPaused and not h.fbEngine.o_bTaskRunning
+    assert h.fbRun.o_bBusy and not h.bDone and not h.fbRun.o_bErr
+    _press(project, run, "X4", 0)
+    run(10_000)
+    assert h.bDone and not h.fbRun.o_bBusy and not h.fbEngine.o_bPaused
+    page = " ".join((PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8").split())
+    assert "a pause that reaches the robot after the point has ended" in page
