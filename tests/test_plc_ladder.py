@@ -176,7 +176,7 @@ def test_the_regeneration_command_reports_mistakes_without_a_traceback(tmp_path)
     bad = tmp_path / "bad.il"
     bad.write_bytes(b"LD X0\nOUT Y0\xff\nEND\n")
     cases = [([str(tmp_path / "missing.il")], 2, "missing.il: cannot read"),
-             ([str(bad)], 1, "bad.il: line 2, column 7 (byte 12): not UTF-8 text"),
+             ([str(bad)], 1, "bad.il:2:7: not UTF-8 text (byte 12)"),
              ([], 2, "usage: python -m verifier.export.ladder FILE.il")]
     for args, status, message in cases:
         run = subprocess.run([sys.executable, "-m", "verifier.export.ladder", *args], cwd=root,

@@ -191,6 +191,19 @@ def structured_text(path: Path, text: str) -> str | None:
             "and `uitamr export` (to import it into GX Works)")
 
 
+def _not_utf8(path: Path, byte: int | None) -> str:
+    """What to do with an .il that is not UTF-8: a Traditional Chinese Windows editor's Big5,
+    or its "Unicode" (UTF-16, named by its byte order mark). `--encoding` is the CSV's, not
+    the .il's: the message says so, as it looks like the fix."""
+    with open(path, "rb") as f:
+        head = f.read(2)
+    if head in (b"\xff\xfe", b"\xfe\xff"):
+        order = "little" if head == b"\xff\xfe" else "big"
+        return (f"the file is UTF-16 ({order}-endian: it starts with the bytes {head[0]:02X} {head[1]:02X}, "
+                "UTF-16's byte order mark), not UTF-8; save it as UTF-8 (an editor's \"Unicode\" is UTF-16)")
+    return f"not UTF-8 text (byte {byte}): the .il is read as UTF-8 (--encoding is the CSV's); save it as UTF-8"
+
+
 def main(argv: list[str]) -> int:
     import argparse
 
@@ -214,8 +227,11 @@ def main(argv: list[str]) -> int:
     except UnreadableText as e:
         # a file that cannot be read at all is unusable input (2), as for `uitamr check`;
         # bytes that are not UTF-8 are a mistake at a line of it, as any other (1)
-        print(f"{shown_name(str(path))}: {e}", file=sys.stderr)
-        return 1 if e.place is not None else 2
+        if e.place is None:
+            print(f"{shown_name(str(path))}: {e}", file=sys.stderr)
+            return 2
+        print(f"{shown_name(str(path))}:{e.place.line}:{e.place.col}: {_not_utf8(path, e.byte)}", file=sys.stderr)
+        return 1
     if (why := structured_text(path, text)) is not None:
         print(f"{shown_name(str(path))}: {why}", file=sys.stderr)
         return 2
