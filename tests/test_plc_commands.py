@@ -576,3 +576,29 @@ def test_a_pause_that_comes_after_the_point_has_ended_waits_for_the_resume():
     assert h.bDone and not h.fbRun.o_bBusy and not h.fbEngine.o_bPaused
     page = " ".join((PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8").split())
     assert "a pause that reaches the robot after the point has ended" in page
+
+
+def test_a_pause_during_a_relative_move_is_a_pause_too():
+    """review34: the pause overtakes every command that waits for its task, and the robot
+    pauses a relative move as it pauses a point (UITAMR_PanelFx3: X15 then X21). But the
+    engine counted a pause only over a code-1 command: o_bPaused stayed FALSE while the
+    robot stood paused, and TASK_TIMEOUT ran on, so an operator's pause of 10 min ended the
+    move with 16#0106 (the fault lamp). Now it is paused as a point is: o_bPaused, no
+    TASK_TIMEOUT; the stop ends it with 16#0305."""
+    project, robot, line, run = _cell(
+        "    fbMove : UITAMR_MoveRelative;\n    fbPause : UITAMR_Pause;\n    fbStop : UITAMR_Stop;\n",
+        "fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);\n"
+        "fbMove(i_bEN := TRUE, i_bExecute := X0, i_wAxis := 1, i_eValue := 2.0, io_uMbx := uMbx);\n"
+        "fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);\n"
+        "fbStop(i_bEN := TRUE, i_bExecute := X1, io_uMbx := uMbx);\n")
+    h = project.program("T_Cell")
+    _press(project, run, "X0", 2000)
+    _press(project, run, "X3", 500)
+    run(1000)
+    assert robot.mode == "paused" and h.fbEngine.o_bPaused and h.fbMove.o_bBusy
+    run(11 * 60_000)
+    assert robot.mode == "paused" and h.fbMove.o_bBusy and h.fbMove.o_uErrId == 0 and not h.fbEngine.o_bErr
+    _press(project, run, "X1", 0)
+    run(1000)
+    assert robot.mode == "idle" and not h.fbMove.o_bBusy and h.fbMove.o_uErrId == 0x0305
+    assert not h.fbEngine.o_bPaused
