@@ -927,11 +927,19 @@ class Checker:
         """A constant outside the range a UITAMR library FB checks its input against
         (library.LIBRARY_INPUT_RANGES): the FB would end with its error code at run time."""
         limits = library.LIBRARY_INPUT_RANGES.get((fb.name.upper(), a.key))
-        value = _const_int(a.value) if limits is not None else None
+        if limits is None:
+            return
+        value, shown = _const_int(a.value), None
+        decl = getattr(a.value, "symbol", None)
+        if value is None and isinstance(decl, ast.VarDecl) and decl.constant and decl.init is not None:
+            # `i_wChannel := C24_CHANNEL`, as UITAMR_ExampleQ passes it: the VAR CONSTANT's value
+            value = _const_int(decl.init)
+            if value is not None:
+                shown = f"{a.value.name} ({value}, the constant declared at {decl.span.line}:{decl.span.col})"
         if value is None or limits[0] <= value <= limits[1]:
             return
         lo, hi, code = limits
-        self.rep.warning(a.value, f"{a.name} := {value} is outside {lo}..{hi}, the range {fb.name} accepts: "
+        self.rep.warning(a.value, f"{a.name} := {shown or value} is outside {lo}..{hi}, the range {fb.name} accepts: "
                                   f"it ends with o_bErr and o_uErrId 16#{code:04X} instead of running "
                                   f"(see its header); give a value in {lo}..{hi}")
 
