@@ -14,6 +14,7 @@ import re
 from pathlib import Path
 from dataclasses import dataclass, field
 
+from verifier import plcfacts
 from verifier.bundled import PLC_DIR, library_file
 from verifier.textfile import real_path
 from verifier.st import ast, library, melsec, structure
@@ -503,6 +504,7 @@ class Checker:
                 self._unused(info)
                 self._called_twice(info)
                 self._execute_calls(info)
+                self._c24_wiring(info)
         self.pou = None
 
     def check_structure(self) -> None:
@@ -570,6 +572,61 @@ class Checker:
                                 f"{earlier.line}:{earlier.col}): an instance has one memory, so this call "
                                 f"overwrites the edges and outputs of the first; give the second use its own "
                                 f"instance (e.g. {name}2 : {target.name})")
+
+    def _c24_wiring(self, info: PouInfo) -> None:
+        """A UITAMR_PortQC24 call whose module (i_uUnit) and channel (i_wChannel) are constants
+        drives those: its i_bReadReq / i_bRecvErr given an X device of another channel or slot
+        (X3 kept from the example for CH2 of a module at X/Y020), and a write in this POU to a
+        receive-setting word (96H/A4H/A5H, 136H/144H/145H) of a module or channel no port here
+        drives (U2\\G150, CH1's, for a port on CH2), are the half-moved module that
+        docs/import-gxworks2.md section 5 lists the edits for: GX Works takes them, and on the
+        PLC the replies are never read or the frames go out in word units."""
+        driven: dict[tuple[int, int], ast.Call] = {}
+        for node in ast.walk(info.pou.body):
+            target = getattr(node, "resolved", None) if isinstance(node, ast.Call) else None
+            if getattr(target, "kind", None) != "fb" or target.name.upper() != "UITAMR_PORTQC24":
+                continue
+            args = {a.key: a for a in node.args if a.name is not None and not a.output}
+            unit = _constant_arg(args["I_UUNIT"].value)[0] if "I_UUNIT" in args else None
+            channel = _constant_arg(args["I_WCHANNEL"].value)[0] if "I_WCHANNEL" in args else None
+            if unit is None or channel not in plcfacts.C24_BUFFER:
+                continue
+            driven.setdefault((unit, channel), node)
+            for key, offsets, what in (("I_BREADREQ", plcfacts.C24_READ_REQUEST, "reception data read request"),
+                                       ("I_BRECVERR", plcfacts.C24_ABNORMAL, "reception abnormal detection")):
+                dev = args[key].value if key in args else None
+                if not (isinstance(dev, ast.Device) and dev.kind == "X" and dev.module is None
+                        and dev.bit is None and dev.digits is None and dev.index is None):
+                    continue
+                want = unit * 16 + offsets[channel]
+                if dev.number != want:
+                    right = f"X{want:X}"
+                    self.rep.warning(dev, (
+                        f"{args[key].name} := {dev.text or dev.key} is not the {what} of CH{channel} of the "
+                        f"QJ71C24N at U{unit:X} (X/Y{unit * 16:03X}, from i_uUnit and i_wChannel): that is "
+                        f"{right} (start + {offsets[channel]:X}H; C24 (Basic), docs/instructions.md §9); pass "
+                        f"{right}, or the port never reads what the module received"))
+        if len(driven) != 1:
+            return  # no port with constants here, or several: which one a word was meant for is not known
+        (port_unit, port_channel), call = next(iter(driven.items()))
+        words = {addr: (channel, name) for channel, names in plcfacts.C24_BUFFER.items()
+                 for name, addr in names.items()}
+        for node in ast.walk(info.pou.body):
+            dev = node.target if isinstance(node, ast.Assign) else None
+            if not (isinstance(dev, ast.Device) and dev.module is not None and dev.kind == "G"
+                    and dev.number in words and dev.index is None and dev.bit is None):
+                continue
+            unit = int(dev.module, 16)
+            if unit > 0xFF:
+                continue  # U3E0\G..: the CPU shared memory of a multiple CPU system, no module
+            channel, name = words[dev.number]
+            if (unit, channel) in driven:
+                continue
+            right = plcfacts.C24_BUFFER[port_channel][name]
+            self.rep.warning(dev, (
+                f"{dev.key} is the {_C24_SETTING[name]} ({dev.number:X}H) of CH{channel} of the QJ71C24N at "
+                f"U{unit:X}, but the port ({call.callee.name} at {call.span.line}:{call.span.col}) drives "
+                f"CH{port_channel} of U{port_unit:X}: write U{port_unit:X}\\G{right} ({right:X}H) instead"))
 
     def _execute_calls(self, info: PouInfo) -> None:
         """FB instances started by a rising edge of i_bExecute (or Execute), the library's
@@ -929,13 +986,7 @@ class Checker:
         limits = library.LIBRARY_INPUT_RANGES.get((fb.name.upper(), a.key))
         if limits is None:
             return
-        value, shown = _const_int(a.value), None
-        decl = getattr(a.value, "symbol", None)
-        if value is None and isinstance(decl, ast.VarDecl) and decl.constant and decl.init is not None:
-            # `i_wChannel := C24_CHANNEL`, as UITAMR_ExampleQ passes it: the VAR CONSTANT's value
-            value = _const_int(decl.init)
-            if value is not None:
-                shown = f"{a.value.name} ({value}, the constant declared at {decl.span.line}:{decl.span.col})"
+        value, shown = _constant_arg(a.value)
         if value is None or limits[0] <= value <= limits[1]:
             return
         lo, hi, code = limits
@@ -1477,6 +1528,25 @@ def _text(e) -> str:
 
 def _lit_text(e) -> str:
     return getattr(e, "text", "") or str(getattr(e, "value", "this constant"))
+
+
+#: the QJ71C24N receive settings' names in plcfacts.C24_BUFFER, in the manual's words
+_C24_SETTING = {"unit": "word/byte units", "recv_count": "received data count", "end_code": "receive end code"}
+
+
+def _constant_arg(e) -> tuple[int | None, str]:
+    """The integer an argument always has, and how to show it: a literal (`3`, "3"), or a VAR
+    CONSTANT label with a literal value (`i_wChannel := C24_CHANNEL`, as UITAMR_ExampleQ
+    passes it: "C24_CHANNEL (3, the constant declared at 17:5)"); (None, "") otherwise."""
+    value = _const_int(e)
+    if value is not None:
+        return value, str(value)
+    decl = getattr(e, "symbol", None)
+    if isinstance(decl, ast.VarDecl) and decl.constant and decl.init is not None:
+        value = _const_int(decl.init)
+        if value is not None:
+            return value, f"{e.name} ({value}, the constant declared at {decl.span.line}:{decl.span.col})"
+    return None, ""
 
 
 def _const_int(e) -> int | None:

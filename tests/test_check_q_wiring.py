@@ -1,0 +1,72 @@
+"""A Q program adapted from UITAMR_ExampleQ for a QJ71C24N elsewhere (another slot, CH2) must
+change the unit, the channel, the module's two input signals and the receive-setting words
+together (docs/import-gxworks2.md section 5). Half of it done passed `uitamr check --platform
+q` at 0 warnings; only `verify` showed it, as a frame 16 bytes long or replies never read.
+`check` now names the signal or buffer-memory word that does not belong to the module and
+channel the port drives, and the one to write."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from verifier import st
+
+ROOT = Path(__file__).resolve().parents[1]
+
+MAIN = """\
+PROGRAM Main
+VAR
+    fbPort : UITAMR_PortQC24;
+    uPort : ARRAY[0..39] OF WORD;
+END_VAR
+VAR CONSTANT
+    C24_UNIT : WORD := 16#2;
+    C24_CHANNEL : INT := 2;
+END_VAR
+IF SM402 THEN
+    {w1} := 1;
+    {w2} := 8;
+    {w3} := 16#FFFF;
+END_IF;
+fbPort(i_bEN := TRUE, i_uUnit := C24_UNIT, i_wChannel := C24_CHANNEL, i_bReadReq := {req},
+       i_bRecvErr := {err}, io_uPort := uPort);
+END_PROGRAM
+"""
+
+
+def _check(**devices: str) -> list[tuple[int, int, str]]:
+    text = MAIN.format(**{"w1": "U2\\G310", "w2": "U2\\G324", "w3": "U2\\G325", "req": "X2A", "err": "X2B",
+                          **devices})
+    files = [st.parse(text, "Main.st", "gxworks2")]
+    files += [st.parse(p.read_text(encoding="utf-8"), str(p), "gxworks2")
+              for d in ("core", "q") for p in sorted((ROOT / "plc" / d).glob("*.st"))]
+    return [(d.line, d.col, d.message) for d in st.check(files, "gxworks2") if d.file == "Main.st"]
+
+
+def test_the_module_s_signals_and_words_of_the_channel_the_port_drives_are_not_warned():
+    assert _check() == []
+
+
+def test_a_read_request_or_abnormal_detection_of_another_channel_or_slot_is_warned_with_the_right_one():
+    """X3 / X4 are CH1's signals of a module at X/Y000; the port drives CH2 of the module at
+    X/Y020, whose are X2A / X2B: with X3 the port waits for a signal that never comes and every
+    reply stays in the module."""
+    found = _check(req="X3", err="X24")
+    assert found == [
+        (15, 85, "i_bReadReq := X3 is not the reception data read request of CH2 of the QJ71C24N at U2 "
+                 "(X/Y020, from i_uUnit and i_wChannel): that is X2A (start + AH; C24 (Basic), "
+                 "docs/instructions.md §9); pass X2A, or the port never reads what the module received"),
+        (16, 22, "i_bRecvErr := X24 is not the reception abnormal detection of CH2 of the QJ71C24N at U2 "
+                 "(X/Y020, from i_uUnit and i_wChannel): that is X2B (start + BH; C24 (Basic), "
+                 "docs/instructions.md §9); pass X2B, or the port never reads what the module received")], found
+
+
+def test_a_receive_setting_written_for_the_other_channel_or_module_is_warned_with_the_word_to_write():
+    """CH1's words (G150 / G164 / G165) written for a port on CH2 leave CH2 in word units with the
+    default count: every frame went out 16 bytes long. U0\\G... while the port drives U2 sets a
+    module that is not there."""
+    found = _check(w1="U2\\G150", w2="U0\\G324")
+    assert found == [
+        (11, 5, "U2\\G150 is the word/byte units (96H) of CH1 of the QJ71C24N at U2, but the port (fbPort at "
+                "15:1) drives CH2 of U2: write U2\\G310 (136H) instead"),
+        (12, 5, "U0\\G324 is the received data count (144H) of CH2 of the QJ71C24N at U0, but the port (fbPort "
+                "at 15:1) drives CH2 of U2: write U2\\G324 (144H) instead")], found
