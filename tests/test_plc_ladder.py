@@ -514,3 +514,31 @@ def test_the_regeneration_command_names_an_st_file_as_one(tmp_path, capsys, name
     assert err.startswith(f"{source}: is structured text (ST), not an instruction list"), err
     assert "`uitamr check`" in err and "`uitamr export`" in err and "not an instruction this" not in err
     assert not csv.exists()
+
+
+@pytest.mark.parametrize("text, message", [
+    # each was converted without a word into a CSV GX Works2 refuses, or a program that does not run
+    ("LD X8\nOUT Y0\nEND\n", r"^x.il:1:4: device X8: X numbers are base 8 on the fx3u"),
+    ("LD X0\nOUT Y19\nEND\n", r"^x.il:2:5: device Y19: Y numbers are base 8 on the fx3u"),
+    ("LD X0\nMOV K1 D9000\nEND\n", r"^x.il:2:8: device D9000 does not exist on the fx3u: D runs D0..D8511"),
+    ("LD SM400\nOUT Y0\nEND\n", r"^x.il:1:4: device SM400: the fx3u has no SM devices; .* use M8000"),
+    ("LD X0\nOUT T600 K10\nEND\n", r"^x.il:2:5: device T600 does not exist on the FX3U: T runs T0..T511"),
+    ("LD X0\nOUT D0\nEND\n", r"^x.il:2:5: OUT takes a bit device \(Y, M, S\) or a timer or counter with its "
+                             r"preset; D0 is a word device"),
+    ("LD D0\nOUT Y0\nEND\n", r"^x.il:1:4: LD takes a bit device \(X, Y, M, S, T, C\); D0 is a word device: "
+                             r"compare a word with LD= D0 K\.\.\."),
+    ("LD X0\nMOV K1 K2\nEND\n", r"^x.il:2:8: MOV stores its result in K2, a constant: give a word device "
+                                r"\(D, R\) there"),
+    ("LD X0\nRS2 D200 K8 K0 K8 K1\nEND\n", r"^x.il:2:13: RS2 stores its result in K0, a constant"),
+])
+def test_an_operand_the_fx3u_does_not_have_or_of_the_wrong_kind_is_named_at_its_column(text, message):
+    """A technician who changed the example's devices (X8 for the ninth input, a D past
+    D8511, a word on OUT, a constant as MOV's destination) got a CSV without a word: the
+    converter only counted operands. The device rules are `uitamr check --platform fx3u`'s."""
+    with pytest.raises(IlError, match=message):
+        parse_il(text, "x.il")
+
+
+def test_the_operands_of_the_bundled_ladder_and_ordinary_ones_are_accepted(program):
+    parse_il("LD X0\nLDP X17\nORB\nOUT T0 K10\nOUT C255 K5\nRST D0\nRST T0\nMOV H1C81 D8400\nMOV K4M0 D0\n"
+             "LD= D0 K1\nMOV D0Z1 R100\nINC D0\nOUT M8000\nEND\n", "x.il")

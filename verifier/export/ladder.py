@@ -19,6 +19,7 @@ the chosen one cannot hold is named at its .il line and column.
 """
 from __future__ import annotations
 
+import re
 import sys
 from dataclasses import dataclass
 from typing import Callable
@@ -100,6 +101,10 @@ def parse_il(text: str, name: str = "<il>") -> list[Instruction]:
             at = raw.index(o, at)
             cols.append(at + 1)
             at += len(o)
+        for k, (o, c) in enumerate(zip(operands, cols)):
+            why = _operand_problem(upper, k, o.upper())
+            if why:
+                raise IlError(f"{Place(name, number, c)}: {why}")
         program.append(Instruction(number, upper, tuple(o.upper() for o in operands), pending, pending_at,
                                    tuple(cols)))
         pending, pending_at = "", (0, 0)
@@ -111,6 +116,52 @@ def parse_il(text: str, name: str = "<il>") -> list[Instruction]:
         raise IlError(f"{Place(name, last.line, 1)}: the program must end with END: add END after this "
                       f"line ({' '.join((last.op, *last.operands))})")
     return program
+
+
+#: contacts and coils: their first operand is a bit (a word device there is refused by GX Works2)
+_BIT_OPERAND = {"LD", "LDI", "AND", "ANI", "OR", "ORI", "LDP", "LDF", "OUT", "SET"}
+#: instruction -> the position of the operand it stores its result in (MOV S D, CRC S D n,
+#: RS2 S m D n n1: FX3 programming manual operand orders, as the bundled ladder uses them)
+_RESULT_OPERAND = {"MOV": 1, "ADD": 2, "SUB": 2, "MUL": 2, "DIV": 2, "WAND": 2, "INC": 0, "CRC": 1, "RS2": 2}
+_CONSTANT = re.compile(r"K-?[0-9]+|H[0-9A-F]+")
+_PLAIN_DEVICE = re.compile(r"([A-Z]+)([0-9]+)")
+#: FX3U timer and counter numbers. ASSUMPTION (as remembered from the FX3 programming
+#: manual's device list, no page read): T0..T511, C0..C255 (C200..C255 32-bit).
+_TIMERS_COUNTERS = {"T": 511, "C": 255}
+
+
+def _operand_problem(op: str, k: int, operand: str) -> str | None:
+    """Why the k-th operand of `op` cannot stand in an FX3U program, or None: a device the
+    FX3U does not have (X8: octal; D9000; SM400), judged as `uitamr check --platform fx3u`
+    judges ST's devices; a word device or constant where a contact or coil takes a bit; a
+    constant where the instruction stores its result. Operands of other forms (K4M0, D0Z1,
+    D0.F) are left to GX Works2."""
+    from verifier.sim.cpu import PROFILES
+    from verifier.sim.devices import device_problem
+
+    constant = _CONSTANT.fullmatch(operand) is not None
+    device = None if constant else _PLAIN_DEVICE.fullmatch(operand)
+    if device is not None:
+        letters, number = device.group(1), int(device.group(2))
+        if letters in _TIMERS_COUNTERS:
+            if number > _TIMERS_COUNTERS[letters]:
+                return (f"device {operand} does not exist on the FX3U: {letters} runs "
+                        f"{letters}0..{letters}{_TIMERS_COUNTERS[letters]}")
+        elif letters not in ("V", "P", "I", "N"):  # index V0-V7, pointers, nesting: not judged
+            why = device_problem(operand, PROFILES["fx3u"])
+            if why:
+                return why
+    if k == 0 and op in _BIT_OPERAND and (constant or (device is not None and device.group(1) in ("D", "R", "Z", "V"))):
+        kind = "a constant" if constant else "a word device"
+        if op == "OUT":
+            return f"OUT takes a bit device (Y, M, S) or a timer or counter with its preset; {operand} is {kind}"
+        if op == "SET":
+            return f"SET takes a bit device (Y, M, S); {operand} is {kind}"
+        return (f"{op} takes a bit device (X, Y, M, S, T, C); {operand} is {kind}: compare a word with "
+                f"{op}= {operand} K...")
+    if constant and _RESULT_OPERAND.get(op) == k:
+        return f"{op} stores its result in {operand}, a constant: give a word device (D, R) there"
+    return None
 
 
 def steps(ins: Instruction) -> int:
