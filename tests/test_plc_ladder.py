@@ -542,3 +542,24 @@ def test_an_operand_the_fx3u_does_not_have_or_of_the_wrong_kind_is_named_at_its_
 def test_the_operands_of_the_bundled_ladder_and_ordinary_ones_are_accepted(program):
     parse_il("LD X0\nLDP X17\nORB\nOUT T0 K10\nOUT C255 K5\nRST D0\nRST T0\nMOV H1C81 D8400\nMOV K4M0 D0\n"
              "LD= D0 K1\nMOV D0Z1 R100\nINC D0\nOUT M8000\nEND\n", "x.il")
+
+
+def test_a_comment_before_an_instruction_that_is_not_carried_into_the_csv_is_noted(tmp_path):
+    """`; 啟動按鈕` over a rung (no R and number) vanished from the CSV without a word: only
+    `; R5 ...` comments become line statements. The converter writes the CSV and says so at
+    the comment; comments that are not directly over an instruction (the file's header),
+    and one that continues an R comment, are not noted."""
+    import subprocess
+    import sys
+
+    il = tmp_path / "cell.il"
+    il.write_text("; my cell\n; devices: X10 start\n; R1 first scan\nLD M8002\nSET M100\n; 啟動按鈕\nLD X10\n"
+                  "SET M101\n; R2 停止\n; 第二行\nLD X11\nRST M101\nEND\n", encoding="utf-8")
+    notes: list[str] = []
+    program = parse_il(il.read_text(encoding="utf-8"), str(il), notes)
+    assert [i.statement for i in program if i.statement] == ["R1 first scan", "R2 停止"]
+    assert notes == [f"{il}:6:3: note: this comment is not carried into the CSV: only a comment that starts "
+                     f"with R and a number (; R5 ...) becomes the line statement of the instruction after it"]
+    run = subprocess.run([sys.executable, "-m", "verifier.export.ladder", str(il), "-o", str(tmp_path / "cell.csv")],
+                         cwd=Path(__file__).resolve().parents[1], capture_output=True, text=True, encoding="utf-8")
+    assert (run.returncode, run.stderr) == (0, notes[0] + "\n"), run

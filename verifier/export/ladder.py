@@ -61,18 +61,31 @@ class Instruction:
     operand_cols: tuple[int, ...] = ()       # the .il column of each operand, on `line`
 
 
-def parse_il(text: str, name: str = "<il>") -> list[Instruction]:
+def parse_il(text: str, name: str = "<il>", notes: list[str] | None = None) -> list[Instruction]:
+    """The instructions of an .il; an IlError at the first mistake. `notes` (when given)
+    gets a line for each comment directly over an instruction that the CSV will not hold
+    (`; 啟動按鈕` with no R and number: no line statement, the comment would vanish)."""
     program: list[Instruction] = []
     pending, pending_at = "", (0, 0)
+    loose: tuple[int, int] | None = None  # where the comment on the line before starts, if not an R one
     for number, raw in enumerate(text_lines(text), 1):
         line = raw.strip()
         if not line:
+            loose = None
             continue
         if line.startswith(";"):
             comment = line[1:].strip()
             if comment[:1] == "R" and comment[1:2].isdigit():
                 pending, pending_at = comment, (number, raw.index(comment) + 1)
+                loose = None
+            else:
+                loose = (number, raw.index(comment) + 1) if comment else None
             continue
+        if loose is not None and not pending and notes is not None:
+            notes.append(f"{Place(name, *loose)}: note: this comment is not carried into the CSV: only a comment "
+                         "that starts with R and a number (; R5 ...) becomes the line statement of the "
+                         "instruction after it")
+        loose = None
         op, *operands = line.split()
         col = raw.index(op) + 1
         upper = op.upper()
@@ -270,11 +283,14 @@ def main(argv: list[str]) -> int:
     if (why := structured_text(path, text)) is not None:
         print(f"{shown_name(str(path))}: {why}", file=sys.stderr)
         return 2
+    notes: list[str] = []
     try:
-        csv = encode_csv(parse_il(text, str(path)), path.stem, args.encoding, str(path))
+        csv = encode_csv(parse_il(text, str(path), notes), path.stem, args.encoding, str(path))
     except IlError as e:
         print(e, file=sys.stderr)
         return 1
+    for note in notes:
+        print(note, file=sys.stderr)
     if args.out is None:
         sys.stdout.flush()
         sys.stdout.buffer.write(csv)
