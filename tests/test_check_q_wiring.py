@@ -70,3 +70,41 @@ def test_a_receive_setting_written_for_the_other_channel_or_module_is_warned_wit
                 "15:1) drives CH2 of U2: write U2\\G310 (136H) instead"),
         (12, 5, "U0\\G324 is the received data count (144H) of CH2 of the QJ71C24N at U0, but the port (fbPort "
                 "at 15:1) drives CH2 of U2: write U2\\G324 (144H) instead")], found
+
+
+TCP = """\
+PROGRAM MainTcp
+VAR
+    fbPort : UITAMR_PortE71;
+    uPort : ARRAY[0..39] OF WORD;
+END_VAR
+VAR CONSTANT
+    E71_UNIT : STRING(4) := 'U2';
+END_VAR
+fbPort(i_bEN := TRUE, i_sUnit := E71_UNIT, i_wConnection := 1, i_udIpAddress := 16#C0A80332,
+       i_uTcpPort := 4001, i_uLocalPort := 4002,
+       i_uOpenSignal := {open}, i_uRecvSignal := {recv}, io_uPort := uPort);
+END_PROGRAM
+"""
+
+
+def _check_tcp(open_signal: str, recv_signal: str) -> list[tuple[int, int, str]]:
+    text = TCP.format(open=open_signal, recv=recv_signal)
+    files = [st.parse(text, "MainTcp.st", "gxworks2")]
+    files += [st.parse(p.read_text(encoding="utf-8"), str(p), "gxworks2")
+              for d in ("core", "q") for p in sorted((ROOT / "plc" / d).glob("*.st"))]
+    return [(d.line, d.col, d.message) for d in st.check(files, "gxworks2") if d.file == "MainTcp.st"]
+
+
+def test_the_e71_s_status_words_of_another_module_or_swapped_are_warned_with_the_word_to_pass():
+    """UITAMR_ExampleTcpQ moved to X/Y020 with E71_UNIT := 'U2' but U0\\G20480 kept: check said
+    0 warnings and verify showed a stop sent 32 s late with no word why."""
+    assert _check_tcp("U2\\G20480", "U2\\G20485") == []
+    found = _check_tcp("U0\\G20480", "U2\\G20480")
+    assert found == [
+        (11, 25, "i_uOpenSignal := U0\\G20480 is not the open completion signal (5000H) of the QJ71E71 at U2 "
+                 "(from i_sUnit := E71_UNIT, 'U2', the constant declared at 7:5): pass U2\\G20480 (the library's "
+                 "buffer addresses, docs/instructions.md §13)"),
+        (11, 53, "i_uRecvSignal := U2\\G20480 is not the fixed buffer reception status signal (5005H) of the "
+                 "QJ71E71 at U2 (from i_sUnit := E71_UNIT, 'U2', the constant declared at 7:5): pass U2\\G20485 "
+                 "(the library's buffer addresses, docs/instructions.md §13)")], found

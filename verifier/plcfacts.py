@@ -46,6 +46,12 @@ C24_BUFFER = MappingProxyType({
 C24_READ_REQUEST = MappingProxyType({1: 0x3, 2: 0xA})
 C24_ABNORMAL = MappingProxyType({1: 0x4, 2: 0xB})
 
+#: QJ71E71-100 buffer memory, bit n-1 for connection n: the open completion signal and the
+#: fixed buffer reception status signal (ASSUMPTION, docs/instructions.md §13). The
+#: simulator's module (verifier.sim.instructions.tcp) and `uitamr check` read them.
+E71_OPEN_SIGNAL = 0x5000
+E71_RECEIVE_SIGNAL = 0x5005
+
 
 def serial_channels(cpu_name: str) -> list[str]:
     """The serial channels of the CPU profile called `cpu_name` ("fx3u", "fx3g", "fx5u",

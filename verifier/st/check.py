@@ -505,6 +505,7 @@ class Checker:
                 self._called_twice(info)
                 self._execute_calls(info)
                 self._c24_wiring(info)
+                self._e71_wiring(info)
         self.pou = None
 
     def check_structure(self) -> None:
@@ -627,6 +628,35 @@ class Checker:
                 f"{dev.key} is the {_C24_SETTING[name]} ({dev.number:X}H) of CH{channel} of the QJ71C24N at "
                 f"U{unit:X}, but the port ({call.callee.name} at {call.span.line}:{call.span.col}) drives "
                 f"CH{port_channel} of U{port_unit:X}: write U{port_unit:X}\\G{right} ({right:X}H) instead"))
+
+    def _e71_wiring(self, info: PouInfo) -> None:
+        """A UITAMR_PortE71 call whose module (i_sUnit, `'U2'`) is a constant: a status word
+        passed that is not that module's open completion / reception status signal (U0\\G20480
+        kept when the module moved to U2, or the two words swapped) makes the port wait for a
+        connection or data another word shows; GX Works takes it without a word."""
+        for node in ast.walk(info.pou.body):
+            target = getattr(node, "resolved", None) if isinstance(node, ast.Call) else None
+            if getattr(target, "kind", None) != "fb" or target.name.upper() != "UITAMR_PORTE71":
+                continue
+            args = {a.key: a for a in node.args if a.name is not None and not a.output}
+            unit_arg = args.get("I_SUNIT")
+            text, shown = _constant_text(unit_arg.value) if unit_arg is not None else (None, "")
+            m = re.fullmatch(r"U([0-9A-F]{1,2})", (text or "").strip(), re.IGNORECASE)
+            if m is None:
+                continue
+            unit = int(m.group(1), 16)
+            for key, want, what in (("I_UOPENSIGNAL", plcfacts.E71_OPEN_SIGNAL, "open completion signal"),
+                                    ("I_URECVSIGNAL", plcfacts.E71_RECEIVE_SIGNAL,
+                                     "fixed buffer reception status signal")):
+                dev = args[key].value if key in args else None
+                if not (isinstance(dev, ast.Device) and dev.module is not None and dev.kind == "G"
+                        and dev.index is None and dev.bit is None):
+                    continue
+                if (int(dev.module, 16), dev.number) != (unit, want):
+                    self.rep.warning(dev, (
+                        f"{args[key].name} := {dev.key} is not the {what} ({want:X}H) of the QJ71E71 at "
+                        f"U{unit:X} (from {unit_arg.name} := {shown}): pass U{unit:X}\\G{want} (the library's "
+                        f"buffer addresses, docs/instructions.md §13)"))
 
     def _execute_calls(self, info: PouInfo) -> None:
         """FB instances started by a rising edge of i_bExecute (or Execute), the library's
@@ -1546,6 +1576,18 @@ def _constant_arg(e) -> tuple[int | None, str]:
         value = _const_int(decl.init)
         if value is not None:
             return value, f"{e.name} ({value}, the constant declared at {decl.span.line}:{decl.span.col})"
+    return None, ""
+
+
+def _constant_text(e) -> tuple[str | None, str]:
+    """The STRING an argument always has, and how to show it: a literal (`'U2'`), or a VAR
+    CONSTANT label with one (`E71_UNIT, 'U2', the constant declared at 7:5`); (None, "")."""
+    if isinstance(e, ast.StringLiteral):
+        return e.value, f"'{e.value}'"
+    decl = getattr(e, "symbol", None)
+    if isinstance(decl, ast.VarDecl) and decl.constant and isinstance(decl.init, ast.StringLiteral):
+        return decl.init.value, (f"{e.name}, '{decl.init.value}', the constant declared at "
+                                 f"{decl.span.line}:{decl.span.col}")
     return None, ""
 
 
