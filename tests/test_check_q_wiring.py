@@ -108,3 +108,38 @@ def test_the_e71_s_status_words_of_another_module_or_swapped_are_warned_with_the
         (11, 53, "i_uRecvSignal := U2\\G20480 is not the fixed buffer reception status signal (5005H) of the "
                  "QJ71E71 at U2 (from i_sUnit := E71_UNIT, 'U2', the constant declared at 7:5): pass U2\\G20485 "
                  "(the library's buffer addresses, docs/instructions.md §13)")], found
+
+
+RAW = """\
+PROGRAM Raw
+VAR
+    uCtl : ARRAY[0..2] OF WORD;
+    uSend : ARRAY[0..3] OF WORD;
+    bDone : ARRAY[0..1] OF BOOL;
+    bSend : BOOL;
+    bBusy : BOOL;
+END_VAR
+uCtl[0] := 1;
+uCtl[2] := 8;
+bSend := X20;
+bDone[1] := FALSE;
+G_OUTPUT(bSend, 16#0, uCtl[0], uSend[0], bDone[0]);
+{handling}
+END_PROGRAM
+"""
+
+
+def _check_raw(handling: str) -> list[tuple[int, int, str]]:
+    files = [st.parse(RAW.format(handling=handling), "Raw.st", "gxworks2")]
+    return [(d.line, d.col, d.message) for d in st.check(files, "gxworks2") if d.file == "Raw.st"]
+
+
+def test_completion_bits_of_a_dedicated_instruction_that_are_never_read_are_warned():
+    """A send of one's own with G_OUTPUT held on by a level and its completion bits never read
+    passed check at 0 warnings; on the PLC it sends again as soon as it completes (verify: one
+    3200-byte frame) and an error completion goes unseen. Writing a bit is no reading of it."""
+    assert _check_raw("bBusy := bSend;") == [
+        (13, 42, "G_OUTPUT's completion bits bDone (done, error) are never read in Raw: the program cannot tell "
+                 "when it has completed or whether it failed; wait for bDone[0] (done) before starting the next "
+                 "one, and act on bDone[1] (error)")]
+    assert _check_raw("bBusy := bSend AND NOT bDone[0];") == []

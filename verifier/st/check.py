@@ -506,6 +506,7 @@ class Checker:
                 self._execute_calls(info)
                 self._c24_wiring(info)
                 self._e71_wiring(info)
+                self._completion_unread(info)
         self.pou = None
 
     def check_structure(self) -> None:
@@ -657,6 +658,38 @@ class Checker:
                         f"{args[key].name} := {dev.key} is not the {what} ({want:X}H) of the QJ71E71 at "
                         f"U{unit:X} (from {unit_arg.name} := {shown}): pass U{unit:X}\\G{want} (the library's "
                         f"buffer addresses, docs/instructions.md §13)"))
+
+    def _completion_unread(self, info: PouInfo) -> None:
+        """The completion bits (done, error) of a dedicated instruction (G_OUTPUT, G_INPUT,
+        ZP_OPEN ... ADPRW on FX5: the BITS2 operands) given a label of this POU's own that
+        nothing in it reads: the program cannot know when the instruction completed, so a
+        send held on by a level starts again at each completion, and an error completion goes
+        unseen. A write to the label (`bDone[1] := FALSE`) is no reading of it."""
+        written = {id(n) for s in ast.walk(info.pou.body) if isinstance(s, ast.Assign) for n in ast.walk(s.target)}
+        operands: list[tuple[ast.Call, ast.Expr, ast.VarDecl]] = []
+        for node in ast.walk(info.pou.body):
+            target = getattr(node, "resolved", None) if isinstance(node, ast.Call) else None
+            if getattr(target, "kind", None) != "instruction" or target.signature is None:
+                continue
+            for p, a in zip(target.signature.params, node.args):
+                root = a.value.base if isinstance(a.value, ast.Index) else a.value
+                decl = getattr(root, "symbol", None)
+                if (p.accepts == "BITS2" and isinstance(root, ast.Name) and isinstance(decl, ast.VarDecl)
+                        and decl.section in ("VAR", "VAR_TEMP") and info.labels.get(decl.key, (None,))[0] is decl):
+                    operands.append((node, a.value, decl))
+        if not operands:
+            return
+        mine = {id(n) for _c, op, _d in operands for n in ast.walk(op)}
+        read = {id(n.symbol) for n in ast.walk(info.pou.body)
+                if isinstance(n, ast.Name) and id(n) not in written and id(n) not in mine}
+        for call, op, decl in operands:
+            if id(decl) in read:
+                continue
+            self.rep.warning(op, (
+                f"{call.name}'s completion bits {decl.name} (done, error) are never read in {info.pou.name}: the "
+                f"program cannot tell when it has completed or whether it failed; wait for {decl.name}[0] (done) "
+                f"before starting the next one, and act on {decl.name}[1] (error)"))
+            read.add(id(decl))  # one warning per label
 
     def _execute_calls(self, info: PouInfo) -> None:
         """FB instances started by a rising edge of i_bExecute (or Execute), the library's
