@@ -143,3 +143,16 @@ def test_completion_bits_of_a_dedicated_instruction_that_are_never_read_are_warn
                  "when it has completed or whether it failed; wait for bDone[0] (done) before starting the next "
                  "one, and act on bDone[1] (error)")]
     assert _check_raw("bBusy := bSend AND NOT bDone[0];") == []
+
+
+def test_a_module_written_as_in_ladder_says_how_st_writes_it():
+    """`G_OUTPUT(X20, U0, ...)` as the ladder writes the module said "undefined label 'U0';
+    declare it in a VAR block", and GX Works takes no label named U0 (a device letter)."""
+    text = RAW.format(handling="").replace("16#0, uCtl[0]", "U2, uCtl[0]").replace("bDone[1] := FALSE;",
+                                                                                  "bBusy := bDone[0];")
+    files = [st.parse(text, "Raw.st", "gxworks2")]
+    found = [(d.line, d.col, d.message) for d in st.check(files, "gxworks2") if d.file == "Raw.st"]
+    assert found == [
+        (13, 17, "undefined label 'U2'; ST does not write a module as U2 (ladder's Un): G_OUTPUT and G_INPUT "
+                 "take its start I/O number without the last digit (16#2 for the module at X/Y020), ZP_OPEN and "
+                 "the other ZP_ instructions the string 'U2'; U2\\G150 is its buffer memory")]

@@ -982,6 +982,13 @@ class Checker:
             return T.PouRef(info.pou.name)
         if re.fullmatch(r"E[0-9]+", e.name, re.IGNORECASE):
             self.rep.error(e, f"undefined label '{e.name}'; E constants are not read here: write the REAL as 1.5 or 1.0E3")
+        elif re.fullmatch(r"U[0-9A-F]{1,2}", e.name, re.IGNORECASE):
+            # G.OUTPUT U2 ... in ladder (docs/st-dialect.md: the ST operand forms of Un)
+            n = e.name[1:].upper()
+            self.rep.error(e, f"undefined label '{e.name}'; ST does not write a module as {e.name} (ladder's Un): "
+                              f"G_OUTPUT and G_INPUT take its start I/O number without the last digit (16#{n} for "
+                              f"the module at X/Y{int(n, 16) * 16:03X}), ZP_OPEN and the other ZP_ instructions the string '{e.name}'; "
+                              f"{e.name}\\G150 is its buffer memory")
         elif re.fullmatch(r"H[0-9A-F]+", e.name, re.IGNORECASE):
             self.rep.error(e, f"undefined label '{e.name}'; for the hex constant write 16#{e.name[1:]} (or H0{e.name[1:]})")
         else:
