@@ -176,7 +176,7 @@ def test_the_regeneration_command_reports_mistakes_without_a_traceback(tmp_path)
     bad = tmp_path / "bad.il"
     bad.write_bytes(b"LD X0\nOUT Y0\xff\nEND\n")
     cases = [([str(tmp_path / "missing.il")], 2, "missing.il: cannot read"),
-             ([str(bad)], 1, "bad.il: line 2, column 7 (byte 12): not UTF-8 text"),
+             ([str(bad)], 1, "bad.il:2:7: not UTF-8 text (byte 12): save the file as UTF-8"),
              ([], 2, "usage: python -m verifier.export.ladder FILE.il")]
     for args, status, message in cases:
         run = subprocess.run([sys.executable, "-m", "verifier.export.ladder", *args], cwd=root,
@@ -563,3 +563,20 @@ def test_a_comment_before_an_instruction_that_is_not_carried_into_the_csv_is_not
     run = subprocess.run([sys.executable, "-m", "verifier.export.ladder", str(il), "-o", str(tmp_path / "cell.csv")],
                          cwd=Path(__file__).resolve().parents[1], capture_output=True, text=True, encoding="utf-8")
     assert (run.returncode, run.stderr) == (0, notes[0] + "\n"), run
+
+
+def test_an_il_saved_as_utf16_or_big5_says_to_save_it_as_utf8(tmp_path, capsys):
+    """Notepad on a Traditional Chinese Windows saves "Unicode" (UTF-16) or "ANSI" (Big5): the
+    converter said "u16.il: line 1, column 1 (byte 0): not UTF-8 text", without what to do and
+    not as file:line:col, where a scenario or fault file says "save the file as UTF-8"."""
+    from verifier.export import ladder
+
+    text = "; R1 啟動\r\nLD X0\r\nOUT Y0\r\nEND\r\n"
+    u16, big5 = tmp_path / "u16.il", tmp_path / "b5.il"
+    u16.write_bytes(b"\xff\xfe" + text.encode("utf-16-le"))
+    big5.write_bytes(text.encode("big5"))
+    assert ladder.main([str(u16)]) == 1
+    assert capsys.readouterr().err == (f"{u16}:1:1: the file is UTF-16 (it starts with FF FE, UTF-16's byte order "
+                                       f"mark; an editor's \"Unicode\"), not UTF-8: save it as UTF-8\n")
+    assert ladder.main([str(big5)]) == 1
+    assert capsys.readouterr().err == f"{big5}:1:6: not UTF-8 text (byte 5): save the file as UTF-8\n"

@@ -278,7 +278,8 @@ def main(argv: list[str]) -> int:
     except UnreadableText as e:
         # a file that cannot be read at all is unusable input (2), as for `uitamr check`;
         # bytes that are not UTF-8 are a mistake at a line of it, as any other (1)
-        print(f"{shown_name(str(path))}: {e}", file=sys.stderr)
+        where = shown_name(str(path)) if e.place is None else Place(str(path), e.place.line, e.place.col)
+        print(f"{where}: {e.after_place()}", file=sys.stderr)
         return 1 if e.place is not None else 2
     if (why := structured_text(path, text)) is not None:
         print(f"{shown_name(str(path))}: {why}", file=sys.stderr)
