@@ -263,7 +263,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("il", metavar="FILE.il")
     parser.add_argument("-o", "--out", metavar="FILE.csv",
                         help="write the CSV to this file, only when the .il converts (default: stdout)")
-    parser.add_argument("--encoding", choices=list(ENCODINGS), default="utf-8",
+    parser.add_argument("--encoding", choices=list(ENCODINGS), default="utf-8", type=str.lower,
                         help="the CSV's encoding (default utf-8; utf-16 = UTF-16 LE with BOM; cp950 Traditional "
                              "Chinese, cp932/shift_jis Japanese Windows). Which one GX Works2 expects is "
                              "UNCONFIRMED: see docs/plc-library.md")
