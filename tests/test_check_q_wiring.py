@@ -156,3 +156,18 @@ def test_a_module_written_as_in_ladder_says_how_st_writes_it():
         (13, 17, "undefined label 'U2'; ST does not write a module as U2 (ladder's Un): G_OUTPUT and G_INPUT "
                  "take its start I/O number without the last digit (16#2 for the module at X/Y020), ZP_OPEN and "
                  "the other ZP_ instructions the string 'U2'; U2\\G150 is its buffer memory")]
+
+
+def test_a_word_of_a_module_the_program_drives_itself_is_not_judged():
+    """CH1 of the same QJ71C24N read by the program's own G_INPUT (a barcode reader) while the
+    robot's port drives CH2: its CH1 settings are no mistake."""
+    text = MAIN.format(w1="U2\\G150", w2="U2\\G324", w3="U2\\G325", req="X2A", err="X2B").replace(
+        "END_PROGRAM", "G_INPUT(X23, C24_UNIT, uIn[0], uData[0], bRead[0]);\nIF bRead[0] THEN uIn[1] := 0; END_IF;\n"
+                       "END_PROGRAM").replace(
+        "END_VAR\nVAR CONSTANT", "    uIn : ARRAY[0..3] OF WORD;\n    uData : ARRAY[0..7] OF WORD;\n"
+                                 "    bRead : ARRAY[0..1] OF BOOL;\nEND_VAR\nVAR CONSTANT")
+    files = [st.parse(text, "Main.st", "gxworks2")]
+    files += [st.parse(p.read_text(encoding="utf-8"), str(p), "gxworks2")
+              for d in ("core", "q") for p in sorted((ROOT / "plc" / d).glob("*.st"))]
+    found = [(d.line, d.col, d.message) for d in st.check(files, "gxworks2") if d.file == "Main.st"]
+    assert found == [], found

@@ -611,6 +611,11 @@ class Checker:
         if len(driven) != 1:
             return  # no port with constants here, or several: which one a word was meant for is not known
         (port_unit, port_channel), call = next(iter(driven.items()))
+        # modules the POU drives with its own G_OUTPUT / G_INPUT (another device on the other
+        # channel): their settings are its own business
+        own = {_constant_arg(node.args[1].value)[0] for node in ast.walk(info.pou.body)
+               if isinstance(node, ast.Call) and getattr(node.resolved, "kind", None) == "instruction"
+               and node.name.upper() in ("G_OUTPUT", "G_INPUT") and len(node.args) > 1}
         words = {addr: (channel, name) for channel, names in plcfacts.C24_BUFFER.items()
                  for name, addr in names.items()}
         for node in ast.walk(info.pou.body):
@@ -622,7 +627,7 @@ class Checker:
             if unit > 0xFF:
                 continue  # U3E0\G..: the CPU shared memory of a multiple CPU system, no module
             channel, name = words[dev.number]
-            if (unit, channel) in driven:
+            if (unit, channel) in driven or unit in own:
                 continue
             right = plcfacts.C24_BUFFER[port_channel][name]
             self.rep.warning(dev, (
