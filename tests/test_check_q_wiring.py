@@ -33,12 +33,17 @@ END_PROGRAM
 """
 
 
+def _library() -> list:
+    """plc/core and plc/q, parsed for GX Works2."""
+    return [st.parse(p.read_text(encoding="utf-8"), str(p), "gxworks2")
+            for d in ("core", "q") for p in sorted((ROOT / "plc" / d).glob("*.st"))]
+
+
 def _check(**devices: str) -> list[tuple[int, int, str]]:
     text = MAIN.format(**{"w1": "U2\\G310", "w2": "U2\\G324", "w3": "U2\\G325", "req": "X2A", "err": "X2B",
                           **devices})
     files = [st.parse(text, "Main.st", "gxworks2")]
-    files += [st.parse(p.read_text(encoding="utf-8"), str(p), "gxworks2")
-              for d in ("core", "q") for p in sorted((ROOT / "plc" / d).glob("*.st"))]
+    files += _library()
     return [(d.line, d.col, d.message) for d in st.check(files, "gxworks2") if d.file == "Main.st"]
 
 
@@ -91,8 +96,7 @@ END_PROGRAM
 def _check_tcp(open_signal: str, recv_signal: str) -> list[tuple[int, int, str]]:
     text = TCP.format(open=open_signal, recv=recv_signal)
     files = [st.parse(text, "MainTcp.st", "gxworks2")]
-    files += [st.parse(p.read_text(encoding="utf-8"), str(p), "gxworks2")
-              for d in ("core", "q") for p in sorted((ROOT / "plc" / d).glob("*.st"))]
+    files += _library()
     return [(d.line, d.col, d.message) for d in st.check(files, "gxworks2") if d.file == "MainTcp.st"]
 
 
@@ -167,7 +171,6 @@ def test_a_word_of_a_module_the_program_drives_itself_is_not_judged():
         "END_VAR\nVAR CONSTANT", "    uIn : ARRAY[0..3] OF WORD;\n    uData : ARRAY[0..7] OF WORD;\n"
                                  "    bRead : ARRAY[0..1] OF BOOL;\nEND_VAR\nVAR CONSTANT")
     files = [st.parse(text, "Main.st", "gxworks2")]
-    files += [st.parse(p.read_text(encoding="utf-8"), str(p), "gxworks2")
-              for d in ("core", "q") for p in sorted((ROOT / "plc" / d).glob("*.st"))]
+    files += _library()
     found = [(d.line, d.col, d.message) for d in st.check(files, "gxworks2") if d.file == "Main.st"]
     assert found == [], found
