@@ -174,3 +174,10 @@ def test_a_word_of_a_module_the_program_drives_itself_is_not_judged():
     files += _library()
     found = [(d.line, d.col, d.message) for d in st.check(files, "gxworks2") if d.file == "Main.st"]
     assert found == [], found
+
+
+def test_unread_completion_bits_are_warned_once_at_their_first_use():
+    text = RAW.format(handling="bBusy := bSend;\nG_INPUT(bSend, 16#0, uCtl[0], uSend[0], bDone[0]);")
+    files = [st.parse(text, "Raw.st", "gxworks2")]
+    found = [(d.line, d.col) for d in st.check(files, "gxworks2") if d.file == "Raw.st"]
+    assert found == [(13, 42)], found

@@ -674,8 +674,8 @@ class Checker:
         operands: list[tuple[ast.Call, ast.Expr, ast.VarDecl]] = []
         for node in ast.walk(info.pou.body):
             target = getattr(node, "resolved", None) if isinstance(node, ast.Call) else None
-            if getattr(target, "kind", None) != "instruction" or target.signature is None:
-                continue
+            if getattr(target, "kind", None) != "instruction" or target.signature is None or target.signature_errors:
+                continue  # an operand in error (one BOOL for two bits ...) is told once, as that
             for p, a in zip(target.signature.params, node.args):
                 root = a.value.base if isinstance(a.value, ast.Index) else a.value
                 decl = getattr(root, "symbol", None)
@@ -684,6 +684,7 @@ class Checker:
                     operands.append((node, a.value, decl))
         if not operands:
             return
+        operands.sort(key=lambda found: (found[1].span.line, found[1].span.col))  # warned at the first use
         mine = {id(n) for _c, op, _d in operands for n in ast.walk(op)}
         read = {id(n.symbol) for n in ast.walk(info.pou.body)
                 if isinstance(n, ast.Name) and id(n) not in written and id(n) not in mine}
