@@ -86,3 +86,14 @@ def test_an_unknown_encoding_is_a_usage_error(capsys):
     assert stop.value.code == 2
     assert "invalid choice: 'big-5' (choose from 'utf-8', 'utf-16', 'cp950', 'cp932', 'shift_jis')" in \
         capsys.readouterr().err
+
+
+def test_an_encoding_in_capitals_is_the_same_encoding(tmp_path):
+    """`--encoding UTF-16` (as Windows' own dialogs write it) or `CP950` was 'invalid choice';
+    `uitamr export --platform FX3U` takes any case too."""
+    il = tmp_path / "start.il"
+    il.write_text(IL_TEXT, encoding="utf-8")
+    for given, codec in (("UTF-16", "utf-16"), ("CP950", "cp950"), ("Utf-8", "utf-8")):
+        lower = _run(str(il), "--encoding", codec)
+        upper = _run(str(il), "--encoding", given)
+        assert (upper.returncode, upper.stdout) == (0, lower.stdout), upper.stderr
