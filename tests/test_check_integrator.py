@@ -482,9 +482,70 @@ END_PROGRAM
                                                           target="gxworks2")
              if "is outside" in d.message]
     assert found == [
-        (15, 37, "i_wChannel := RS2_CHANNEL (3, the VAR CONSTANT at 11:5) is outside 1..2, the range "
+        (15, 37, "i_wChannel := RS2_CHANNEL (3, the constant declared at 11:5) is outside 1..2, the range "
                  "UITAMR_PortFx3 accepts: it ends with o_bErr and o_uErrId 16#0304 instead of running (see "
                  "its header); give a value in 1..2"),
-        (16, 53, "i_wPoint := LAST_POINT (-1, the VAR CONSTANT at 12:5) is outside 1..21, the range "
+        (16, 53, "i_wPoint := LAST_POINT (-1, the constant declared at 12:5) is outside 1..21, the range "
                  "UITAMR_RunPoint accepts: it ends with o_bErr and o_uErrId 16#0301 instead of running (see "
                  "its header); give a value in 1..21")], found
+
+
+def test_a_constant_label_out_of_the_range_a_library_fb_checks_is_warned_with_its_declaration():
+    """UITAMR_ExampleQ passes its channel as a VAR CONSTANT label (`i_wChannel := C24_CHANNEL`),
+    and so did a program adapted from it: with `C24_CHANNEL : INT := 3` `uitamr check --platform
+    q` said 0 warnings (only a literal was judged) and verify only that nothing was sent. The
+    label's constant value is judged now, at the argument, naming the declaration to change;
+    a VAR label (not constant: the program may assign it) and a constant inside the range are not."""
+    text = """\
+PROGRAM Station
+VAR
+    fbPort : UITAMR_PortQC24;
+    fbRun : UITAMR_RunPoint;
+    uMbx : ARRAY[0..15] OF WORD;
+    uPort : ARRAY[0..39] OF WORD;
+    wPoint : INT := 30;
+END_VAR
+VAR CONSTANT
+    C24_CHANNEL : INT := 3;
+    LAST_POINT : INT := 21;
+END_VAR
+fbPort(i_bEN := TRUE, i_uUnit := 16#0, i_wChannel := C24_CHANNEL, i_bReadReq := X3, i_bRecvErr := X4,
+       io_uPort := uPort);
+fbRun(i_bEN := TRUE, i_bExecute := X20, i_wPoint := LAST_POINT, io_uMbx := uMbx);
+fbRun(i_bEN := TRUE, i_bExecute := X21, i_wPoint := wPoint, io_uMbx := uMbx);
+END_PROGRAM
+"""
+    found = [(d.line, d.col, d.message) for d in _check(text, ROOT / "plc" / "core", ROOT / "plc" / "q",
+                                                          target="gxworks2")
+             if "is outside" in d.message]
+    assert found == [
+        (13, 54, "i_wChannel := C24_CHANNEL (3, the constant declared at 10:5) is outside 1..2, the range "
+                 "UITAMR_PortQC24 accepts: it ends with o_bErr and o_uErrId 16#0304 instead of running "
+                 "(see its header); give a value in 1..2")], found
+
+
+def test_a_global_constant_out_of_range_is_named_with_the_file_that_declares_it():
+    """A VAR_GLOBAL CONSTANT (the global label file) used as a library FB's input: the
+    message gave its line:col only, read as a place in the program's own file."""
+    globals_text = "VAR_GLOBAL CONSTANT\n    G_CHANNEL : INT := 3;\nEND_VAR\n"
+    text = """\
+PROGRAM Station
+VAR
+    fbPort : UITAMR_PortFx3;
+    uPort : ARRAY[0..39] OF WORD;
+END_VAR
+VAR_EXTERNAL CONSTANT
+    G_CHANNEL : INT;
+END_VAR
+fbPort(i_bEN := TRUE, i_wChannel := G_CHANNEL, i_bRs232 := FALSE, io_uPort := uPort);
+END_PROGRAM
+"""
+    target = "gxworks2"
+    files = [st.parse(text, "Station.st", target), st.parse(globals_text, "GlobalLabels.st", target)]
+    files += [st.parse(p.read_text(encoding="utf-8"), str(p), target)
+              for d in (ROOT / "plc" / "core", ROOT / "plc" / "fx3") for p in sorted(d.glob("*.st"))]
+    found = [(d.file, d.line, d.col, d.message) for d in st.check(files, target) if "is outside" in d.message]
+    assert found == [
+        ("Station.st", 9, 37, "i_wChannel := G_CHANNEL (3, the constant declared at GlobalLabels.st:2:5) is "
+                              "outside 1..2, the range UITAMR_PortFx3 accepts: it ends with o_bErr and o_uErrId "
+                              "16#0304 instead of running (see its header); give a value in 1..2")], found

@@ -176,7 +176,7 @@ def test_the_regeneration_command_reports_mistakes_without_a_traceback(tmp_path)
     bad = tmp_path / "bad.il"
     bad.write_bytes(b"LD X0\nOUT Y0\xff\nEND\n")
     cases = [([str(tmp_path / "missing.il")], 2, "missing.il: cannot read"),
-             ([str(bad)], 1, "bad.il:2:7: not UTF-8 text (byte 12)"),
+             ([str(bad)], 1, "bad.il:2:7: not UTF-8 text (byte 12): save the file as UTF-8"),
              ([], 2, "usage: python -m verifier.export.ladder FILE.il")]
     for args, status, message in cases:
         run = subprocess.run([sys.executable, "-m", "verifier.export.ladder", *args], cwd=root,
@@ -514,3 +514,69 @@ def test_the_regeneration_command_names_an_st_file_as_one(tmp_path, capsys, name
     assert err.startswith(f"{source}: is structured text (ST), not an instruction list"), err
     assert "`uitamr check`" in err and "`uitamr export`" in err and "not an instruction this" not in err
     assert not csv.exists()
+
+
+@pytest.mark.parametrize("text, message", [
+    # each was converted without a word into a CSV GX Works2 refuses, or a program that does not run
+    ("LD X8\nOUT Y0\nEND\n", r"^x.il:1:4: device X8: X numbers are base 8 on the fx3u"),
+    ("LD X0\nOUT Y19\nEND\n", r"^x.il:2:5: device Y19: Y numbers are base 8 on the fx3u"),
+    ("LD X0\nMOV K1 D9000\nEND\n", r"^x.il:2:8: device D9000 does not exist on the fx3u: D runs D0..D8511"),
+    ("LD SM400\nOUT Y0\nEND\n", r"^x.il:1:4: device SM400: the fx3u has no SM devices; .* use M8000"),
+    ("LD X0\nOUT T600 K10\nEND\n", r"^x.il:2:5: device T600 does not exist on the FX3U: T runs T0..T511"),
+    ("LD X0\nOUT D0\nEND\n", r"^x.il:2:5: OUT takes a bit device \(Y, M, S\) or a timer or counter with its "
+                             r"preset; D0 is a word device"),
+    ("LD D0\nOUT Y0\nEND\n", r"^x.il:1:4: LD takes a bit device \(X, Y, M, S, T, C\); D0 is a word device: "
+                             r"compare a word with LD= D0 K\.\.\."),
+    ("LD X0\nMOV K1 K2\nEND\n", r"^x.il:2:8: MOV stores its result in K2, a constant: give a word device "
+                                r"\(D, R\) there"),
+    ("LD X0\nRS2 D200 K8 K0 K8 K1\nEND\n", r"^x.il:2:13: RS2 stores its result in K0, a constant"),
+])
+def test_an_operand_the_fx3u_does_not_have_or_of_the_wrong_kind_is_named_at_its_column(text, message):
+    """A technician who changed the example's devices (X8 for the ninth input, a D past
+    D8511, a word on OUT, a constant as MOV's destination) got a CSV without a word: the
+    converter only counted operands. The device rules are `uitamr check --platform fx3u`'s."""
+    with pytest.raises(IlError, match=message):
+        parse_il(text, "x.il")
+
+
+def test_the_operands_of_the_bundled_ladder_and_ordinary_ones_are_accepted(program):
+    parse_il("LD X0\nLDP X17\nORB\nOUT T0 K10\nOUT C255 K5\nRST D0\nRST T0\nMOV H1C81 D8400\nMOV K4M0 D0\n"
+             "LD= D0 K1\nMOV D0Z1 R100\nINC D0\nOUT M8000\nEND\n", "x.il")
+
+
+def test_a_comment_before_an_instruction_that_is_not_carried_into_the_csv_is_noted(tmp_path):
+    """`; 啟動按鈕` over a rung (no R and number) vanished from the CSV without a word: only
+    `; R5 ...` comments become line statements. The converter writes the CSV and says so at
+    the comment; comments that are not directly over an instruction (the file's header),
+    and one that continues an R comment, are not noted."""
+    import subprocess
+    import sys
+
+    il = tmp_path / "cell.il"
+    il.write_text("; my cell\n; devices: X10 start\n; R1 first scan\nLD M8002\nSET M100\n; 啟動按鈕\nLD X10\n"
+                  "SET M101\n; R2 停止\n; 第二行\nLD X11\nRST M101\nEND\n", encoding="utf-8")
+    notes: list[str] = []
+    program = parse_il(il.read_text(encoding="utf-8"), str(il), notes)
+    assert [i.statement for i in program if i.statement] == ["R1 first scan", "R2 停止"]
+    assert notes == [f"{il}:6:3: note: this comment is not carried into the CSV: only a comment that starts "
+                     f"with R and a number (; R5 ...) becomes the line statement of the instruction after it"]
+    run = subprocess.run([sys.executable, "-m", "verifier.export.ladder", str(il), "-o", str(tmp_path / "cell.csv")],
+                         cwd=Path(__file__).resolve().parents[1], capture_output=True, text=True, encoding="utf-8")
+    assert (run.returncode, run.stderr) == (0, notes[0] + "\n"), run
+
+
+def test_an_il_saved_as_utf16_or_big5_says_to_save_it_as_utf8(tmp_path, capsys):
+    """Notepad on a Traditional Chinese Windows saves "Unicode" (UTF-16) or "ANSI" (Big5): the
+    converter said "u16.il: line 1, column 1 (byte 0): not UTF-8 text", without what to do and
+    not as file:line:col, where a scenario or fault file says "save the file as UTF-8"."""
+    from verifier.export import ladder
+
+    text = "; R1 啟動\r\nLD X0\r\nOUT Y0\r\nEND\r\n"
+    u16, big5 = tmp_path / "u16.il", tmp_path / "b5.il"
+    u16.write_bytes(b"\xff\xfe" + text.encode("utf-16-le"))
+    big5.write_bytes(text.encode("big5"))
+    assert ladder.main([str(u16)]) == 1
+    assert capsys.readouterr().err == (f"{u16}:1:1: the file is UTF-16 (it starts with FF FE, UTF-16's byte order "
+                                       f"mark; an editor's \"Unicode\"), not UTF-8: save it as UTF-8\n")
+    assert ladder.main([str(big5)]) == 1
+    assert capsys.readouterr().err == f"{big5}:1:6: not UTF-8 text (byte 5): save the file as UTF-8\n"

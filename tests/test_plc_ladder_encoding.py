@@ -88,20 +88,12 @@ def test_an_unknown_encoding_is_a_usage_error(capsys):
         capsys.readouterr().err
 
 
-@pytest.mark.parametrize("codec, expected", [
-    ("cp950", ":1:6: not UTF-8 text (byte 5): the .il is read as UTF-8 (--encoding is the CSV's); "
-              "save it as UTF-8\n"),
-    ("utf-16", ":1:1: the file is UTF-16 (little-endian: it starts with the bytes FF FE, UTF-16's byte "
-               "order mark), not UTF-8; save it as UTF-8 (an editor's \"Unicode\" is UTF-16)\n")])
-def test_an_il_saved_in_big5_or_as_unicode_is_told_to_be_saved_as_utf8(tmp_path, codec, expected):
-    """review34: an .il with a Chinese rung comment saved by a Traditional Chinese Windows
-    editor (Big5) or as its "Unicode" (UTF-16), converted with --encoding cp950 as the page
-    shows for the CSV, said only 'x.il: line 1, column 6 (byte 5): not UTF-8 text': no
-    file:line:col, no word of what to do, and --encoding looked like the fix. Now the place,
-    that the .il is read as UTF-8 whatever --encoding (the CSV's) says, and what to do."""
-    il = tmp_path / "arm.il"
-    il.write_bytes(IL_TEXT.encode(codec))
-    run = _run(str(il), "--encoding", "cp950")
-    err = run.stderr.decode()
-    assert run.returncode == 1 and run.stdout == b"", err
-    assert err == f"{il}{expected}"
+def test_an_encoding_in_capitals_is_the_same_encoding(tmp_path):
+    """`--encoding UTF-16` (as Windows' own dialogs write it) or `CP950` was 'invalid choice';
+    `uitamr export --platform FX3U` takes any case too."""
+    il = tmp_path / "start.il"
+    il.write_text(IL_TEXT, encoding="utf-8")
+    for given, codec in (("UTF-16", "utf-16"), ("CP950", "cp950"), ("Utf-8", "utf-8")):
+        lower = _run(str(il), "--encoding", codec)
+        upper = _run(str(il), "--encoding", given)
+        assert (upper.returncode, upper.stdout) == (0, lower.stdout), upper.stderr

@@ -169,6 +169,17 @@ def test_token_soup_reads_as_the_reference_reads_it(tokens):
     assert_same("PROGRAM P\nVAR a, b, x : INT; END_VAR\n" + " ".join(tokens) + "\nEND_PROGRAM\n")
 
 
+@pytest.mark.parametrize("opening", ["(*\r(*\r\n c *)\n", "(* x\ry *)\n", "(* x\r\ry *)\n"])
+def test_a_lone_carriage_return_ends_a_line_on_both_paths(opening):
+    """The reference reads a lone CR (a classic Mac OS line end) as a line end; the fast
+    path, given the text as it came, counted a line fewer after one, so every span below
+    was one line off (found by the mutation test above: '(*\r(*\r\n ...', 32 != 33). Both
+    must answer, and alike."""
+    text = opening + "PROGRAM P\nVAR\n    a : INT;\nEND_VAR\na := 1;\nEND_PROGRAM\n"
+    for target in TARGETS:
+        assert assert_same(text, "cr.st", target), "the fast path did not answer"
+
+
 def test_deep_nesting_falls_back_to_the_reference():
     text = "PROGRAM P\nVAR x : INT; END_VAR\nx := " + "(" * 3000 + "1" + ")" * 3000 + ";\nEND_PROGRAM\n"
     assert_same(text)

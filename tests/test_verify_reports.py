@@ -539,3 +539,19 @@ def test_html_lists_the_rules_and_the_first_place_as_the_other_reports_do(tmp_pa
     assert not [p for p in good_section.iter("p") if p.get("class") == "first-finding"]  # a pass has none
     index = root.find(".//*[@id='index']")
     assert [(td.text or "") for td in index.iter("td") if "place" in (td.get("class") or "").split()] == ["", place]
+
+
+def test_the_console_shows_the_head_of_a_long_frame_and_where_the_whole_is():
+    """A G_OUTPUT held on by a level sent 400 stop frames back to back: verify printed them as
+    one 3200-byte frame, all 9,600 characters of it, twice (the CRC and the format rule). The
+    console shows its first 32 bytes and the count; --json, --trace and --html keep every byte."""
+    data = protocol.encode(STOP, S) * 400
+    trace = [TraceRecord(0, protocol.frame_time_us(len(data)), "tx", data, "Raw.st:18:1")]
+    result = _result("raw", trace, 5_000_000)
+    out = io.StringIO()
+    report_console.render([result], Console(file=out, width=400, color_system=None))
+    shown = [line for line in out.getvalue().splitlines() if "PLC→robot" in line]
+    head = " ".join(["01 06 01 A0 00 00 88 14"] * 4)
+    assert shown and all(f"PLC→robot {head} … (3200 bytes: every one in --json, --trace or --html)" in line
+                         for line in shown), shown
+    assert max(len(line) for line in out.getvalue().splitlines()) < 400

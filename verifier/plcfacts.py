@@ -34,6 +34,24 @@ FAMILY_CHANNELS = MappingProxyType({
 #: the QJ71C24N areas and the QJ71E71 status words (5000H, 5005H) the library uses.
 BUFFER_WORDS = 0x6000
 
+#: QJ71C24N, per channel: the buffer-memory words of the receive settings (received data
+#: count, receive end code, word/byte units; docs/instructions.md §9 with its sources) and
+#: the input signals' offsets from the module's start I/O (reception data read request
+#: X(n)3 / X(n)A, reception abnormal detection X(n)4 / X(n)B; C24 (Basic)). The simulator's
+#: module (verifier.sim.instructions.c24) and `uitamr check`'s wiring judgement both read them.
+C24_BUFFER = MappingProxyType({
+    1: MappingProxyType({"recv_count": 0xA4, "end_code": 0xA5, "unit": 0x96}),
+    2: MappingProxyType({"recv_count": 0x144, "end_code": 0x145, "unit": 0x136}),
+})
+C24_READ_REQUEST = MappingProxyType({1: 0x3, 2: 0xA})
+C24_ABNORMAL = MappingProxyType({1: 0x4, 2: 0xB})
+
+#: QJ71E71-100 buffer memory, bit n-1 for connection n: the open completion signal and the
+#: fixed buffer reception status signal (ASSUMPTION, docs/instructions.md §13). The
+#: simulator's module (verifier.sim.instructions.tcp) and `uitamr check` read them.
+E71_OPEN_SIGNAL = 0x5000
+E71_RECEIVE_SIGNAL = 0x5005
+
 
 def serial_channels(cpu_name: str) -> list[str]:
     """The serial channels of the CPU profile called `cpu_name` ("fx3u", "fx3g", "fx5u",

@@ -15,6 +15,8 @@ from typing import IO, Callable, Iterator
 from verifier.place import Place
 
 BOM = b"\xef\xbb\xbf"  # a UTF-8 byte order mark, as Windows editors write it: skipped
+#: UTF-16's byte order marks (little-, big-endian): what Windows editors call "Unicode"
+UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")
 
 #: the error handler of every text the tool writes (reports, traces, the console): a file
 #: or folder name that is not UTF-8 comes to Python with its bad bytes as lone surrogates
@@ -28,15 +30,19 @@ class UnreadableText(Exception):
     not UTF-8 text`; `place` (in the file its caller read: `Place.file` None) says where
     when the bytes are not text, `byte` which byte it is."""
 
-    def __init__(self, message: str, place: Place | None = None, byte: int | None = None):
+    def __init__(self, message: str, place: Place | None = None, byte: int | None = None,
+                 utf16: bytes | None = None):
         super().__init__(message)
-        self.place, self.byte = place, byte
+        self.place, self.byte, self.utf16 = place, byte, utf16
 
     def after_place(self) -> str:
         """The words to put after the file's `file:line:col: ` place (bytes that are not
         text), or after `file: ` (a file that cannot be read at all)."""
         if self.place is None:
             return str(self)
+        if self.utf16 is not None:
+            return (f"the file is UTF-16 (it starts with {self.utf16[0]:02X} {self.utf16[1]:02X}, UTF-16's byte "
+                    "order mark; an editor's \"Unicode\"), not UTF-8: save it as UTF-8")
         return f"not UTF-8 text (byte {self.byte}): save the file as UTF-8"
 
 
@@ -52,6 +58,9 @@ def read_utf8(path: Path) -> str:
         data = path.read_bytes()
     except OSError as exc:
         raise UnreadableText(f"cannot read: {exc.strerror or exc}") from None
+    if data.startswith(UTF16_BOMS):
+        raise UnreadableText("line 1, column 1 (byte 0): UTF-16 text, not UTF-8", Place(None, 1, 1), 0,
+                             utf16=data[:2])
     start = len(BOM) if data.startswith(BOM) else 0
     try:
         return data[start:].decode("utf-8")

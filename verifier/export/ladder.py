@@ -19,6 +19,7 @@ the chosen one cannot hold is named at its .il line and column.
 """
 from __future__ import annotations
 
+import re
 import sys
 from dataclasses import dataclass
 from typing import Callable
@@ -60,18 +61,31 @@ class Instruction:
     operand_cols: tuple[int, ...] = ()       # the .il column of each operand, on `line`
 
 
-def parse_il(text: str, name: str = "<il>") -> list[Instruction]:
+def parse_il(text: str, name: str = "<il>", notes: list[str] | None = None) -> list[Instruction]:
+    """The instructions of an .il; an IlError at the first mistake. `notes` (when given)
+    gets a line for each comment directly over an instruction that the CSV will not hold
+    (`; 啟動按鈕` with no R and number: no line statement, the comment would vanish)."""
     program: list[Instruction] = []
     pending, pending_at = "", (0, 0)
+    loose: tuple[int, int] | None = None  # where the comment on the line before starts, if not an R one
     for number, raw in enumerate(text_lines(text), 1):
         line = raw.strip()
         if not line:
+            loose = None
             continue
         if line.startswith(";"):
             comment = line[1:].strip()
             if comment[:1] == "R" and comment[1:2].isdigit():
                 pending, pending_at = comment, (number, raw.index(comment) + 1)
+                loose = None
+            else:
+                loose = (number, raw.index(comment) + 1) if comment else None
             continue
+        if loose is not None and not pending and notes is not None:
+            notes.append(f"{Place(name, *loose)}: note: this comment is not carried into the CSV: only a comment "
+                         "that starts with R and a number (; R5 ...) becomes the line statement of the "
+                         "instruction after it")
+        loose = None
         op, *operands = line.split()
         col = raw.index(op) + 1
         upper = op.upper()
@@ -100,6 +114,10 @@ def parse_il(text: str, name: str = "<il>") -> list[Instruction]:
             at = raw.index(o, at)
             cols.append(at + 1)
             at += len(o)
+        for k, (o, c) in enumerate(zip(operands, cols)):
+            why = _operand_problem(upper, k, o.upper())
+            if why:
+                raise IlError(f"{Place(name, number, c)}: {why}")
         program.append(Instruction(number, upper, tuple(o.upper() for o in operands), pending, pending_at,
                                    tuple(cols)))
         pending, pending_at = "", (0, 0)
@@ -111,6 +129,52 @@ def parse_il(text: str, name: str = "<il>") -> list[Instruction]:
         raise IlError(f"{Place(name, last.line, 1)}: the program must end with END: add END after this "
                       f"line ({' '.join((last.op, *last.operands))})")
     return program
+
+
+#: contacts and coils: their first operand is a bit (a word device there is refused by GX Works2)
+_BIT_OPERAND = {"LD", "LDI", "AND", "ANI", "OR", "ORI", "LDP", "LDF", "OUT", "SET"}
+#: instruction -> the position of the operand it stores its result in (MOV S D, CRC S D n,
+#: RS2 S m D n n1: FX3 programming manual operand orders, as the bundled ladder uses them)
+_RESULT_OPERAND = {"MOV": 1, "ADD": 2, "SUB": 2, "MUL": 2, "DIV": 2, "WAND": 2, "INC": 0, "CRC": 1, "RS2": 2}
+_CONSTANT = re.compile(r"K-?[0-9]+|H[0-9A-F]+")
+_PLAIN_DEVICE = re.compile(r"([A-Z]+)([0-9]+)")
+#: FX3U timer and counter numbers. ASSUMPTION (as remembered from the FX3 programming
+#: manual's device list, no page read): T0..T511, C0..C255 (C200..C255 32-bit).
+_TIMERS_COUNTERS = {"T": 511, "C": 255}
+
+
+def _operand_problem(op: str, k: int, operand: str) -> str | None:
+    """Why the k-th operand of `op` cannot stand in an FX3U program, or None: a device the
+    FX3U does not have (X8: octal; D9000; SM400), judged as `uitamr check --platform fx3u`
+    judges ST's devices; a word device or constant where a contact or coil takes a bit; a
+    constant where the instruction stores its result. Operands of other forms (K4M0, D0Z1,
+    D0.F) are left to GX Works2."""
+    from verifier.sim.cpu import PROFILES
+    from verifier.sim.devices import device_problem
+
+    constant = _CONSTANT.fullmatch(operand) is not None
+    device = None if constant else _PLAIN_DEVICE.fullmatch(operand)
+    if device is not None:
+        letters, number = device.group(1), int(device.group(2))
+        if letters in _TIMERS_COUNTERS:
+            if number > _TIMERS_COUNTERS[letters]:
+                return (f"device {operand} does not exist on the FX3U: {letters} runs "
+                        f"{letters}0..{letters}{_TIMERS_COUNTERS[letters]}")
+        elif letters not in ("V", "P", "I", "N"):  # index V0-V7, pointers, nesting: not judged
+            why = device_problem(operand, PROFILES["fx3u"])
+            if why:
+                return why
+    if k == 0 and op in _BIT_OPERAND and (constant or (device is not None and device.group(1) in ("D", "R", "Z", "V"))):
+        kind = "a constant" if constant else "a word device"
+        if op == "OUT":
+            return f"OUT takes a bit device (Y, M, S) or a timer or counter with its preset; {operand} is {kind}"
+        if op == "SET":
+            return f"SET takes a bit device (Y, M, S); {operand} is {kind}"
+        return (f"{op} takes a bit device (X, Y, M, S, T, C); {operand} is {kind}: compare a word with "
+                f"{op}= {operand} K...")
+    if constant and _RESULT_OPERAND.get(op) == k:
+        return f"{op} stores its result in {operand}, a constant: give a word device (D, R) there"
+    return None
 
 
 def steps(ins: Instruction) -> int:
@@ -191,19 +255,6 @@ def structured_text(path: Path, text: str) -> str | None:
             "and `uitamr export` (to import it into GX Works)")
 
 
-def _not_utf8(path: Path, byte: int | None) -> str:
-    """What to do with an .il that is not UTF-8: a Traditional Chinese Windows editor's Big5,
-    or its "Unicode" (UTF-16, named by its byte order mark). `--encoding` is the CSV's, not
-    the .il's: the message says so, as it looks like the fix."""
-    with open(path, "rb") as f:
-        head = f.read(2)
-    if head in (b"\xff\xfe", b"\xfe\xff"):
-        order = "little" if head == b"\xff\xfe" else "big"
-        return (f"the file is UTF-16 ({order}-endian: it starts with the bytes {head[0]:02X} {head[1]:02X}, "
-                "UTF-16's byte order mark), not UTF-8; save it as UTF-8 (an editor's \"Unicode\" is UTF-16)")
-    return f"not UTF-8 text (byte {byte}): the .il is read as UTF-8 (--encoding is the CSV's); save it as UTF-8"
-
-
 def main(argv: list[str]) -> int:
     import argparse
 
@@ -212,7 +263,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("il", metavar="FILE.il")
     parser.add_argument("-o", "--out", metavar="FILE.csv",
                         help="write the CSV to this file, only when the .il converts (default: stdout)")
-    parser.add_argument("--encoding", choices=list(ENCODINGS), default="utf-8",
+    parser.add_argument("--encoding", choices=list(ENCODINGS), default="utf-8", type=str.lower,
                         help="the CSV's encoding (default utf-8; utf-16 = UTF-16 LE with BOM; cp950 Traditional "
                              "Chinese, cp932/shift_jis Japanese Windows). Which one GX Works2 expects is "
                              "UNCONFIRMED: see docs/plc-library.md")
@@ -227,19 +278,20 @@ def main(argv: list[str]) -> int:
     except UnreadableText as e:
         # a file that cannot be read at all is unusable input (2), as for `uitamr check`;
         # bytes that are not UTF-8 are a mistake at a line of it, as any other (1)
-        if e.place is None:
-            print(f"{shown_name(str(path))}: {e}", file=sys.stderr)
-            return 2
-        print(f"{shown_name(str(path))}:{e.place.line}:{e.place.col}: {_not_utf8(path, e.byte)}", file=sys.stderr)
-        return 1
+        where = shown_name(str(path)) if e.place is None else Place(str(path), e.place.line, e.place.col)
+        print(f"{where}: {e.after_place()}", file=sys.stderr)
+        return 1 if e.place is not None else 2
     if (why := structured_text(path, text)) is not None:
         print(f"{shown_name(str(path))}: {why}", file=sys.stderr)
         return 2
+    notes: list[str] = []
     try:
-        csv = encode_csv(parse_il(text, str(path)), path.stem, args.encoding, str(path))
+        csv = encode_csv(parse_il(text, str(path), notes), path.stem, args.encoding, str(path))
     except IlError as e:
         print(e, file=sys.stderr)
         return 1
+    for note in notes:
+        print(note, file=sys.stderr)
     if args.out is None:
         sys.stdout.flush()
         sys.stdout.buffer.write(csv)

@@ -14,6 +14,7 @@ import re
 from pathlib import Path
 from dataclasses import dataclass, field
 
+from verifier import plcfacts
 from verifier.bundled import PLC_DIR, library_file
 from verifier.textfile import real_path
 from verifier.st import ast, library, melsec, structure
@@ -504,6 +505,9 @@ class Checker:
                 self._unused(info)
                 self._called_twice(info)
                 self._execute_calls(info)
+                self._c24_wiring(info)
+                self._e71_wiring(info)
+                self._completion_unread(info)
         self.pou = None
 
     def check_structure(self) -> None:
@@ -571,6 +575,128 @@ class Checker:
                                 f"{earlier.line}:{earlier.col}): an instance has one memory, so this call "
                                 f"overwrites the edges and outputs of the first; give the second use its own "
                                 f"instance (e.g. {name}2 : {target.name})")
+
+    def _c24_wiring(self, info: PouInfo) -> None:
+        """A UITAMR_PortQC24 call whose module (i_uUnit) and channel (i_wChannel) are constants
+        drives those: its i_bReadReq / i_bRecvErr given an X device of another channel or slot
+        (X3 kept from the example for CH2 of a module at X/Y020), and a write in this POU to a
+        receive-setting word (96H/A4H/A5H, 136H/144H/145H) of a module or channel no port here
+        drives (U2\\G150, CH1's, for a port on CH2), are the half-moved module that
+        docs/import-gxworks2.md section 5 lists the edits for: GX Works takes them, and on the
+        PLC the replies are never read or the frames go out in word units."""
+        driven: dict[tuple[int, int], ast.Call] = {}
+        for node in ast.walk(info.pou.body):
+            target = getattr(node, "resolved", None) if isinstance(node, ast.Call) else None
+            if getattr(target, "kind", None) != "fb" or target.name.upper() != "UITAMR_PORTQC24":
+                continue
+            args = {a.key: a for a in node.args if a.name is not None and not a.output}
+            unit = _constant_arg(args["I_UUNIT"].value, self.table)[0] if "I_UUNIT" in args else None
+            channel = _constant_arg(args["I_WCHANNEL"].value, self.table)[0] if "I_WCHANNEL" in args else None
+            if unit is None or channel not in plcfacts.C24_BUFFER:
+                continue
+            driven.setdefault((unit, channel), node)
+            for key, offsets, what in (("I_BREADREQ", plcfacts.C24_READ_REQUEST, "reception data read request"),
+                                       ("I_BRECVERR", plcfacts.C24_ABNORMAL, "reception abnormal detection")):
+                dev = args[key].value if key in args else None
+                if not (isinstance(dev, ast.Device) and dev.kind == "X" and dev.module is None
+                        and dev.bit is None and dev.digits is None and dev.index is None):
+                    continue
+                want = unit * 16 + offsets[channel]
+                if dev.number != want:
+                    right = f"X{want:X}"
+                    self.rep.warning(dev, (
+                        f"{args[key].name} := {dev.text or dev.key} is not the {what} of CH{channel} of the "
+                        f"QJ71C24N at U{unit:X} (X/Y{unit * 16:03X}, from i_uUnit and i_wChannel): that is "
+                        f"{right} (start + {offsets[channel]:X}H; C24 (Basic), docs/instructions.md §9); pass "
+                        f"{right}, or the port never reads what the module received"))
+        if len(driven) != 1:
+            return  # no port with constants here, or several: which one a word was meant for is not known
+        (port_unit, port_channel), call = next(iter(driven.items()))
+        # modules the POU drives with its own G_OUTPUT / G_INPUT (another device on the other
+        # channel): their settings are its own business
+        own = {_constant_arg(node.args[1].value, self.table)[0] for node in ast.walk(info.pou.body)
+               if isinstance(node, ast.Call) and getattr(node.resolved, "kind", None) == "instruction"
+               and node.name.upper() in ("G_OUTPUT", "G_INPUT") and len(node.args) > 1}
+        words = {addr: (channel, name) for channel, names in plcfacts.C24_BUFFER.items()
+                 for name, addr in names.items()}
+        for node in ast.walk(info.pou.body):
+            dev = node.target if isinstance(node, ast.Assign) else None
+            if not (isinstance(dev, ast.Device) and dev.module is not None and dev.kind == "G"
+                    and dev.number in words and dev.index is None and dev.bit is None):
+                continue
+            unit = int(dev.module, 16)
+            if unit > 0xFF:
+                continue  # U3E0\G..: the CPU shared memory of a multiple CPU system, no module
+            channel, name = words[dev.number]
+            if (unit, channel) in driven or unit in own:
+                continue
+            right = plcfacts.C24_BUFFER[port_channel][name]
+            self.rep.warning(dev, (
+                f"{dev.key} is the {_C24_SETTING[name]} ({dev.number:X}H) of CH{channel} of the QJ71C24N at "
+                f"U{unit:X}, but the port ({call.callee.name} at {call.span.line}:{call.span.col}) drives "
+                f"CH{port_channel} of U{port_unit:X}: write U{port_unit:X}\\G{right} ({right:X}H) instead"))
+
+    def _e71_wiring(self, info: PouInfo) -> None:
+        """A UITAMR_PortE71 call whose module (i_sUnit, `'U2'`) is a constant: a status word
+        passed that is not that module's open completion / reception status signal (U0\\G20480
+        kept when the module moved to U2, or the two words swapped) makes the port wait for a
+        connection or data another word shows; GX Works takes it without a word."""
+        for node in ast.walk(info.pou.body):
+            target = getattr(node, "resolved", None) if isinstance(node, ast.Call) else None
+            if getattr(target, "kind", None) != "fb" or target.name.upper() != "UITAMR_PORTE71":
+                continue
+            args = {a.key: a for a in node.args if a.name is not None and not a.output}
+            unit_arg = args.get("I_SUNIT")
+            text, shown = _constant_text(unit_arg.value, self.table) if unit_arg is not None else (None, "")
+            m = re.fullmatch(r"U([0-9A-F]{1,2})", (text or "").strip(), re.IGNORECASE)
+            if m is None:
+                continue
+            unit = int(m.group(1), 16)
+            for key, want, what in (("I_UOPENSIGNAL", plcfacts.E71_OPEN_SIGNAL, "open completion signal"),
+                                    ("I_URECVSIGNAL", plcfacts.E71_RECEIVE_SIGNAL,
+                                     "fixed buffer reception status signal")):
+                dev = args[key].value if key in args else None
+                if not (isinstance(dev, ast.Device) and dev.module is not None and dev.kind == "G"
+                        and dev.index is None and dev.bit is None):
+                    continue
+                if (int(dev.module, 16), dev.number) != (unit, want):
+                    self.rep.warning(dev, (
+                        f"{args[key].name} := {dev.key} is not the {what} ({want:X}H) of the QJ71E71 at "
+                        f"U{unit:X} (from {unit_arg.name} := {shown}): pass U{unit:X}\\G{want} (the library's "
+                        f"buffer addresses, docs/instructions.md §13)"))
+
+    def _completion_unread(self, info: PouInfo) -> None:
+        """The completion bits (done, error) of a dedicated instruction (G_OUTPUT, G_INPUT,
+        ZP_OPEN ... ADPRW on FX5: the BITS2 operands) given a label of this POU's own that
+        nothing in it reads: the program cannot know when the instruction completed, so a
+        send held on by a level starts again at each completion, and an error completion goes
+        unseen. A write to the label (`bDone[1] := FALSE`) is no reading of it."""
+        written = {id(n) for s in ast.walk(info.pou.body) if isinstance(s, ast.Assign) for n in ast.walk(s.target)}
+        operands: list[tuple[ast.Call, ast.Expr, ast.VarDecl]] = []
+        for node in ast.walk(info.pou.body):
+            target = getattr(node, "resolved", None) if isinstance(node, ast.Call) else None
+            if getattr(target, "kind", None) != "instruction" or target.signature is None or target.signature_errors:
+                continue  # an operand in error (one BOOL for two bits ...) is told once, as that
+            for p, a in zip(target.signature.params, node.args):
+                root = a.value.base if isinstance(a.value, ast.Index) else a.value
+                decl = getattr(root, "symbol", None)
+                if (p.accepts == "BITS2" and isinstance(root, ast.Name) and isinstance(decl, ast.VarDecl)
+                        and decl.section in ("VAR", "VAR_TEMP") and info.labels.get(decl.key, (None,))[0] is decl):
+                    operands.append((node, a.value, decl))
+        if not operands:
+            return
+        operands.sort(key=lambda found: (found[1].span.line, found[1].span.col))  # warned at the first use
+        mine = {id(n) for _c, op, _d in operands for n in ast.walk(op)}
+        read = {id(n.symbol) for n in ast.walk(info.pou.body)
+                if isinstance(n, ast.Name) and id(n) not in written and id(n) not in mine}
+        for call, op, decl in operands:
+            if id(decl) in read:
+                continue
+            self.rep.warning(op, (
+                f"{call.name}'s completion bits {decl.name} (done, error) are never read in {info.pou.name}: the "
+                f"program cannot tell when it has completed or whether it failed; wait for {decl.name}[0] (done) "
+                f"before starting the next one, and act on {decl.name}[1] (error)"))
+            read.add(id(decl))  # one warning per label
 
     def _execute_calls(self, info: PouInfo) -> None:
         """FB instances started by a rising edge of i_bExecute (or Execute), the library's
@@ -863,6 +989,13 @@ class Checker:
             return T.PouRef(info.pou.name)
         if re.fullmatch(r"E[0-9]+", e.name, re.IGNORECASE):
             self.rep.error(e, f"undefined label '{e.name}'; E constants are not read here: write the REAL as 1.5 or 1.0E3")
+        elif re.fullmatch(r"U[0-9A-F]{1,2}", e.name, re.IGNORECASE):
+            # G.OUTPUT U2 ... in ladder (docs/st-dialect.md: the ST operand forms of Un)
+            n = e.name[1:].upper()
+            self.rep.error(e, f"undefined label '{e.name}'; ST does not write a module as {e.name} (ladder's Un): "
+                              f"G_OUTPUT and G_INPUT take its start I/O number without the last digit (16#{n} for "
+                              f"the module at X/Y{int(n, 16) * 16:03X}), ZP_OPEN and the other ZP_ instructions the string '{e.name}'; "
+                              f"{e.name}\\G150 is its buffer memory")
         elif re.fullmatch(r"H[0-9A-F]+", e.name, re.IGNORECASE):
             self.rep.error(e, f"undefined label '{e.name}'; for the hex constant write 16#{e.name[1:]} (or H0{e.name[1:]})")
         else:
@@ -930,17 +1063,11 @@ class Checker:
         limits = library.LIBRARY_INPUT_RANGES.get((fb.name.upper(), a.key))
         if limits is None:
             return
-        value, given = _const_int(a.value), None
-        decl = getattr(a.value, "symbol", None) if isinstance(a.value, ast.Name) else None
-        if value is None and isinstance(decl, ast.VarDecl) and decl.constant and decl.init is not None:
-            # the usual form: a named constant (`RS2_CHANNEL : INT := 3;` in VAR CONSTANT)
-            value = _const_int(decl.init)
-            where = decl.span.place if decl.span.file != a.value.span.file else f"{decl.span.line}:{decl.span.col}"
-            given = f"{a.value.name} ({value}, the VAR CONSTANT at {where})"
+        value, shown = _constant_arg(a.value, self.table)
         if value is None or limits[0] <= value <= limits[1]:
             return
         lo, hi, code = limits
-        self.rep.warning(a.value, f"{a.name} := {given or value} is outside {lo}..{hi}, the range {fb.name} accepts: "
+        self.rep.warning(a.value, f"{a.name} := {shown or value} is outside {lo}..{hi}, the range {fb.name} accepts: "
                                   f"it ends with o_bErr and o_uErrId 16#{code:04X} instead of running "
                                   f"(see its header); give a value in {lo}..{hi}")
 
@@ -1478,6 +1605,54 @@ def _text(e) -> str:
 
 def _lit_text(e) -> str:
     return getattr(e, "text", "") or str(getattr(e, "value", "this constant"))
+
+
+#: the QJ71C24N receive settings' names in plcfacts.C24_BUFFER, in the manual's words
+_C24_SETTING = {"unit": "word/byte units", "recv_count": "received data count", "end_code": "receive end code"}
+
+
+def _constant_arg(e, table: SymbolTable) -> tuple[int | None, str]:
+    """The integer an argument always has, and how to show it: a literal (`3`, "3"), or a VAR
+    CONSTANT label with a literal value (`i_wChannel := C24_CHANNEL`, as UITAMR_ExampleQ
+    passes it: "C24_CHANNEL (3, the constant declared at 17:5)"); (None, "") otherwise."""
+    value = _const_int(e)
+    if value is not None:
+        return value, str(value)
+    decl = _declaration(e, table)
+    if isinstance(decl, ast.VarDecl) and decl.constant and decl.init is not None:
+        value = _const_int(decl.init)
+        if value is not None:
+            return value, f"{e.name} ({value}, the constant declared at {_declared_at(decl, e)})"
+    return None, ""
+
+
+def _constant_text(e, table: SymbolTable) -> tuple[str | None, str]:
+    """The STRING an argument always has, and how to show it: a literal (`'U2'`), or a VAR
+    CONSTANT label with one (`E71_UNIT, 'U2', the constant declared at 7:5`); (None, "")."""
+    if isinstance(e, ast.StringLiteral):
+        return e.value, f"'{e.value}'"
+    decl = _declaration(e, table)
+    if isinstance(decl, ast.VarDecl) and decl.constant and isinstance(decl.init, ast.StringLiteral):
+        return decl.init.value, f"{e.name}, '{decl.init.value}', the constant declared at {_declared_at(decl, e)}"
+    return None, ""
+
+
+def _declaration(e, table: SymbolTable) -> ast.VarDecl | None:
+    """The declaration that gives the label `e` its value: its own, or for a VAR_EXTERNAL
+    the VAR_GLOBAL it names (`VAR_EXTERNAL CONSTANT G_CHANNEL : INT;` holds no value)."""
+    decl = getattr(e, "symbol", None)
+    if isinstance(decl, ast.VarDecl) and decl.section == "VAR_EXTERNAL":
+        found = table.globals.get(decl.key)
+        return found[0] if found is not None else decl
+    return decl
+
+
+def _declared_at(decl: ast.VarDecl, use) -> str:
+    """Where a label is declared, for a message placed at `use`: line:col in the same file,
+    file:line:col in another (a VAR_GLOBAL CONSTANT of the global label file)."""
+    if decl.span.file != use.span.file:
+        return str(decl.span.place)
+    return f"{decl.span.line}:{decl.span.col}"
 
 
 def _const_int(e) -> int | None:

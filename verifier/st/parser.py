@@ -553,8 +553,7 @@ def parse(text: str, filename: str = "<string>", target: str = "gxworks2") -> as
     A lone carriage return (a classic Mac OS line end) ends a line, as in every editor."""
     from verifier.st import fastparse
 
-    text = lone_cr_as_line_feed(text)  # the lexers count lines at line feeds only
-    parser = get_parser()
+    parser = get_parser()  # both read a lone carriage return as a line end
     try:
         return fastparse.parse_fast(text, filename, target, parser)
     except (fastparse.Bail, RecursionError):

@@ -12,13 +12,12 @@ import stat
 from pathlib import Path
 
 from verifier.st.ast import Diagnostic
-from verifier.textfile import BOM, file_kind, place_of_byte
+from verifier.textfile import BOM, UTF16_BOMS, file_kind, place_of_byte
 
 ENCODINGS = ("utf-8-sig", "cp932")
 #: Python's cp932 decodes these single bytes to control or private-use characters that
 #: no editor writes; a file holding them is not Shift-JIS text.
 _NOT_SHIFT_JIS = frozenset("\x80\uf8f0\uf8f1\uf8f2\uf8f3")
-_UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")
 
 
 def read_source(path: str | Path) -> tuple[str, list[Diagnostic]]:
@@ -58,7 +57,7 @@ def decode_source(data: bytes, name: str = "<bytes>") -> tuple[str, list[Diagnos
         text = None
     if text is not None and not _NOT_SHIFT_JIS.intersection(text):
         return text, []
-    if data.startswith(_UTF16_BOMS):
+    if data.startswith(UTF16_BOMS):
         # what Windows editors call "Unicode": named, not read (the policy above)
         order = "little" if data.startswith(b"\xff\xfe") else "big"
         return "", [_error(name, 1, 1, f"the file is UTF-16 ({order}-endian: it starts with the bytes "

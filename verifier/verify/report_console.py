@@ -97,12 +97,26 @@ def _rule_block(found: list, console: Console, first: int) -> None:
     )
     for frame in violation.frames:
         arrow = "PLC→robot" if frame.direction == "tx" else "robot→PLC"
-        console.print(f"      {format_seconds(frame.t_us)} {arrow} {frame.hex}  [dim]{escape(frame.meaning)}[/]")
+        console.print(f"      {format_seconds(frame.t_us)} {arrow} {_head(frame.hex)}  [dim]{escape(frame.meaning)}[/]")
     more = [format_seconds(v.t_us) for v in found[1:first]]
     if more:
         rest = len(found) - 1 - len(more)
         tail = f" and {rest} more (see --json or --html)" if rest else ""
         console.print(f"      [dim]also at {', '.join(more)}{tail}[/]")
+
+
+#: bytes of a frame the console shows; a longer one (frames sent back to back with no gap,
+#: 400 of them from a G_OUTPUT held on) is cut there, the reports files keep every byte
+HEAD_BYTES = 32
+
+
+def _head(hex_text: str) -> str:
+    """`hex_text` ("01 06 ...") as the console shows it: whole up to HEAD_BYTES bytes, else
+    its first HEAD_BYTES bytes, the count and where the rest is."""
+    count = len(hex_text.split())
+    if count <= HEAD_BYTES:
+        return hex_text
+    return f"{hex_text[:HEAD_BYTES * 3 - 1]} … ({count} bytes: every one in --json, --trace or --html)"
 
 
 def _rule_table(results: list[ScenarioResult]) -> Table:

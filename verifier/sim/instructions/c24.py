@@ -6,15 +6,13 @@ Behaviour, buffer addresses and what is an ASSUMPTION: docs/instructions.md ("QJ
 """
 from __future__ import annotations
 
+from verifier.plcfacts import C24_ABNORMAL as ABNORMAL, C24_BUFFER as BUFFER, C24_READ_REQUEST as READ_REQUEST
+
 from ..datatypes import wrap16
 from ..refs import operand_key, pulse_keys
 
-# buffer memory (word addresses) per channel: receive data count, receive end code,
-# word/byte unit designation
-BUFFER = {
-    1: {"recv_count": 0xA4, "end_code": 0xA5, "unit": 0x96},
-    2: {"recv_count": 0x144, "end_code": 0x145, "unit": 0x136},
-}
+# BUFFER: buffer memory (word addresses) per channel: receive data count, receive end code,
+# word/byte unit designation (verifier.plcfacts)
 DEFAULTS = {"recv_count": 511, "end_code": 0x0D0A, "unit": 0}
 # configure()'s settings that are buffer-memory words, by the word's name in BUFFER
 SETTING_NAMES = {"byte_units": "unit", "receive_count": "recv_count", "end_code": "end_code"}
@@ -22,10 +20,8 @@ SETTING_NAMES = {"byte_units": "unit", "receive_count": "recv_count", "end_code"
 #: one is recorded (codegen), so that a setting for "the module the program drives" does
 #: not replace it
 SETTING_WORDS = frozenset(addr for words in BUFFER.values() for addr in words.values())
-# input signals (offset from the module's start I/O): reception data read request and
-# reception abnormal detection per channel
-READ_REQUEST = {1: 0x3, 2: 0xA}
-ABNORMAL = {1: 0x4, 2: 0xB}
+# READ_REQUEST, ABNORMAL: input signals (offset from the module's start I/O): reception data
+# read request and reception abnormal detection per channel (verifier.plcfacts)
 # result codes the simulator writes (ASSUMPTION: the module's own codes are not modelled)
 ERR_CHANNEL = 0x7FF1
 ERR_TOO_LONG = 0x7FF2

@@ -20,6 +20,8 @@ from __future__ import annotations
 
 from collections import deque
 
+from verifier.plcfacts import E71_OPEN_SIGNAL, E71_RECEIVE_SIGNAL
+
 from ..refs import operand_key, pulse_keys
 
 # completion status codes the simulator writes (ASSUMPTION: the modules' own codes are
@@ -349,8 +351,8 @@ class FixedBufferPort(TcpPort):
     """QJ71E71-100 fixed buffer communication, no procedure (ZP.OPEN/BUFSND/BUFRCV/CLOSE)."""
 
     coalesce = False
-    OPEN_SIGNAL = 0x5000  # open completion signal, bit n-1 (ASSUMPTION, docs/instructions.md)
-    RECEIVE_SIGNAL = 0x5005  # fixed buffer reception status signal, bit n-1 (ASSUMPTION)
+    OPEN_SIGNAL = E71_OPEN_SIGNAL  # open completion signal, bit n-1 (ASSUMPTION, docs/instructions.md)
+    RECEIVE_SIGNAL = E71_RECEIVE_SIGNAL  # fixed buffer reception status signal, bit n-1 (ASSUMPTION)
     FOR_RECEIVING = 0x0001  # application setting b0: fixed buffer for receiving
     PAIRING = 0x0080  # application setting b7: pairing open (n receives, n+1 sends)
     NO_PROCEDURE = 0x0200  # application setting b9: fixed buffer without procedure
