@@ -472,3 +472,31 @@ def test_ctrl_c_while_the_command_is_being_loaded_names_the_command(command):
     assert result.returncode == 130, (result.returncode, result.stderr)
     assert result.stderr.endswith(f"\nuitamr {command[0]}: interrupted (Ctrl-C) before it finished: no verdict\n"), result.stderr
     assert "Traceback" not in result.stderr
+
+
+#: the `uitamr` program (pyproject's console script) with a real SIGINT sent while
+#: `verifier.cli` itself imports (click, the package): before any handler of its exists
+CTRL_C_WHILE_THE_CLI_IMPORTS = """
+import os, signal, sys
+class CtrlC:
+    def find_spec(self, name, path=None, target=None):
+        if name == "verifier.cli":
+            os.kill(os.getpid(), signal.SIGINT)
+        return None
+sys.meta_path.insert(0, CtrlC())
+from importlib.metadata import entry_points
+(script,) = [e for e in entry_points(group="console_scripts") if e.name == "uitamr"]
+sys.argv[0] = "uitamr"
+script.load()()
+"""
+
+
+def test_ctrl_c_while_the_program_itself_starts_is_no_traceback():
+    """Ctrl-C in the first tenth of a second, while `verifier.cli` (click, the package) was
+    still being imported, ended in Python's KeyboardInterrupt traceback; now the installed
+    `uitamr` says it as any Ctrl-C, exit 130."""
+    import sys
+    result = procs.run([sys.executable, "-c", CTRL_C_WHILE_THE_CLI_IMPORTS, "verify", "--jobs", "2"], timeout=60,
+                       capture_output=True, text=True)
+    assert result.returncode == 130, (result.returncode, result.stderr)
+    assert result.stderr == "\nuitamr verify: interrupted (Ctrl-C) before it finished: no verdict\n", result.stderr

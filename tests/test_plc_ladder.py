@@ -580,3 +580,14 @@ def test_an_il_saved_as_utf16_or_big5_says_to_save_it_as_utf8(tmp_path, capsys):
                                        f"mark; an editor's \"Unicode\"), not UTF-8: save it as UTF-8\n")
     assert ladder.main([str(big5)]) == 1
     assert capsys.readouterr().err == f"{big5}:1:6: not UTF-8 text (byte 5): save the file as UTF-8\n"
+
+
+def test_every_rung_comment_of_the_bundled_ladder_is_whole_in_the_csv():
+    """The CSV carries a rung's `; Rn` line only, not the comment lines after it: R9's
+    statement ran on to a second line and arrived in GX Works2 cut mid-sentence,
+    "... no frame is arriving (D8403 counts". Each statement must read as a whole: its
+    brackets closed (the detail goes on a plain comment line of the .il)."""
+    statements = [i.statement for i in parse_il(IL.read_text(encoding="utf-8"), str(IL)) if i.statement]
+    assert len(statements) >= 25
+    cut = [s for s in statements if s.count("(") != s.count(")")]
+    assert not cut, cut

@@ -27,8 +27,9 @@ SUBCOMMANDS = {
 }
 
 
-#: the exit status of a command stopped by Ctrl-C before it finished (128 + SIGINT)
-EXIT_INTERRUPTED = 130
+#: the exit status of a command stopped by Ctrl-C before it finished (128 + SIGINT); the
+#: program's entry point says it of a Ctrl-C during this module's own import
+from verifier.entry import EXIT_INTERRUPTED  # noqa: E402
 
 
 class UnusablePath(click.ClickException):

@@ -250,6 +250,7 @@ class Checker:
         self.used: set[int] = set()
         #: (caller POU key, callee POU key, call) for every call of a user FB or FUNCTION
         self.calls: list[tuple[str, str, ast.Call]] = []
+        self.pou_calls: list[ast.Call] = []  # the calls of the POU body being checked (check_bodies)
         #: the bundled plc/ folder as the sources reach it (vendor/uitamr/plc), if they do
         self.plc_shown = _plc_as_given([f.filename for f in files])
 
@@ -493,6 +494,7 @@ class Checker:
         for info in self.table.pous.values():
             self.pou = info
             self.loop_depth = 0
+            self.pou_calls = []
             complete = True
             for s in info.pou.body:
                 try:
@@ -585,8 +587,8 @@ class Checker:
         docs/import-gxworks2.md section 5 lists the edits for: GX Works takes them, and on the
         PLC the replies are never read or the frames go out in word units."""
         driven: dict[tuple[int, int], ast.Call] = {}
-        for node in ast.walk(info.pou.body):
-            target = getattr(node, "resolved", None) if isinstance(node, ast.Call) else None
+        for node in self.pou_calls:
+            target = getattr(node, "resolved", None)
             if getattr(target, "kind", None) != "fb" or target.name.upper() != "UITAMR_PORTQC24":
                 continue
             args = {a.key: a for a in node.args if a.name is not None and not a.output}
@@ -614,8 +616,8 @@ class Checker:
         (port_unit, port_channel), call = next(iter(driven.items()))
         # modules the POU drives with its own G_OUTPUT / G_INPUT (another device on the other
         # channel): their settings are its own business
-        own = {_constant_arg(node.args[1].value, self.table)[0] for node in ast.walk(info.pou.body)
-               if isinstance(node, ast.Call) and getattr(node.resolved, "kind", None) == "instruction"
+        own = {_constant_arg(node.args[1].value, self.table)[0] for node in self.pou_calls
+               if getattr(node.resolved, "kind", None) == "instruction"
                and node.name.upper() in ("G_OUTPUT", "G_INPUT") and len(node.args) > 1}
         words = {addr: (channel, name) for channel, names in plcfacts.C24_BUFFER.items()
                  for name, addr in names.items()}
@@ -641,8 +643,8 @@ class Checker:
         passed that is not that module's open completion / reception status signal (U0\\G20480
         kept when the module moved to U2, or the two words swapped) makes the port wait for a
         connection or data another word shows; GX Works takes it without a word."""
-        for node in ast.walk(info.pou.body):
-            target = getattr(node, "resolved", None) if isinstance(node, ast.Call) else None
+        for node in self.pou_calls:
+            target = getattr(node, "resolved", None)
             if getattr(target, "kind", None) != "fb" or target.name.upper() != "UITAMR_PORTE71":
                 continue
             args = {a.key: a for a in node.args if a.name is not None and not a.output}
@@ -671,10 +673,9 @@ class Checker:
         nothing in it reads: the program cannot know when the instruction completed, so a
         send held on by a level starts again at each completion, and an error completion goes
         unseen. A write to the label (`bDone[1] := FALSE`) is no reading of it."""
-        written = {id(n) for s in ast.walk(info.pou.body) if isinstance(s, ast.Assign) for n in ast.walk(s.target)}
         operands: list[tuple[ast.Call, ast.Expr, ast.VarDecl]] = []
-        for node in ast.walk(info.pou.body):
-            target = getattr(node, "resolved", None) if isinstance(node, ast.Call) else None
+        for node in self.pou_calls:
+            target = getattr(node, "resolved", None)
             if getattr(target, "kind", None) != "instruction" or target.signature is None or target.signature_errors:
                 continue  # an operand in error (one BOOL for two bits ...) is told once, as that
             for p, a in zip(target.signature.params, node.args):
@@ -686,6 +687,7 @@ class Checker:
         if not operands:
             return
         operands.sort(key=lambda found: (found[1].span.line, found[1].span.col))  # warned at the first use
+        written = {id(n) for s in ast.walk(info.pou.body) if isinstance(s, ast.Assign) for n in ast.walk(s.target)}
         mine = {id(n) for _c, op, _d in operands for n in ast.walk(op)}
         read = {id(n.symbol) for n in ast.walk(info.pou.body)
                 if isinstance(n, ast.Name) and id(n) not in written and id(n) not in mine}
@@ -1159,6 +1161,10 @@ class Checker:
 
     # ------------------------------------------------------------- calls
     def call(self, c: ast.Call, statement: bool) -> T.Type:
+        # every call of the body, in the order checked: the wiring and completion-bit checks
+        # read these rather than walk each POU's tree again (three walks added a third to
+        # the check of the library)
+        self.pou_calls.append(c)
         name = c.key
         dotted = _ladder_spelling(c.callee, self.table, self.pou)
         if dotted is not None:  # SP.SOCOPEN(...): the ladder name of SP_SOCOPEN, not a member of a label 'SP'
