@@ -886,6 +886,32 @@ def test_gxworks3_label_tables_hold_only_the_classes_gx_works3_has(tmp_path):
     assert "gbStart := " not in (out / "Main.st").read_text() and "bRun := gbStart;" in (out / "Main.st").read_text()
 
 
+# MELSEC-Q/L/F Structured Programming Manual (Fundamentals), Table 4.3.3-1 "Label classes"
+# (the GX Works2 classes; VAR_GLOBAL / VAR_GLOBAL_CONSTANT are the global label editor's): no
+# VAR_EXTERNAL either.
+GX2_LOCAL_CLASSES = {"VAR", "VAR_CONSTANT", "VAR_RETAIN", "VAR_INPUT", "VAR_OUTPUT", "VAR_IN_OUT"}
+
+
+def test_gxworks2_label_tables_hold_only_the_classes_gx_works2_has(tmp_path):
+    """The GX Works3 fix above left GX Works2's tables with their VAR_EXTERNAL rows, a class
+    the GX Works2 manual does not list either: the same program exported for GX Works2
+    has them no more; the global is in GlobalLabels.labels.tsv."""
+    (tmp_path / "Globals.st").write_text("VAR_GLOBAL\n    gbStart AT X10 : BOOL; (* start *)\nEND_VAR\n")
+    (tmp_path / "Main.st").write_text(
+        "PROGRAM Main\nVAR_EXTERNAL\n    gbStart : BOOL;\nEND_VAR\nVAR\n    bRun : BOOL;\nEND_VAR\n"
+        "bRun := gbStart;\nEND_PROGRAM\n")
+    out = tmp_path / "gx2"
+    result = run("--target", "gxworks2", "--out", str(out), str(tmp_path / "Globals.st"), str(tmp_path / "Main.st"))
+    assert result.exit_code == 0, result.output
+    rows = [line.split("\t") for line in (out / "Main.labels.tsv").read_text().splitlines()[1:]]
+    assert [(r[0], r[1]) for r in rows] == [("VAR", "bRun")], rows
+    assert "gbStart" in (out / "GlobalLabels.labels.tsv").read_text()
+    assert run("--target", "gxworks2", "--out", str(tmp_path / "lib")).exit_code == 0
+    for table in (tmp_path / "lib").glob("*.labels.tsv"):
+        classes = {line.split("\t")[0] for line in table.read_text().splitlines()[1:]}
+        assert classes <= GX2_LOCAL_CLASSES, (table.name, classes - GX2_LOCAL_CLASSES)
+
+
 def test_the_bundled_gxworks3_export_uses_only_gx_works3_label_classes(tmp_path):
     assert run("--target", "gxworks3", "--out", str(tmp_path)).exit_code == 0
     for table in tmp_path.glob("*.labels.tsv"):

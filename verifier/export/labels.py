@@ -62,14 +62,12 @@ def initial_text(source_text: str, lines: list[str], decl: ast.VarDecl) -> str:
 
 
 def label_rows(pou: ast.Pou, source_text: str, target: str) -> list[LabelRow]:
-    """The rows of a POU's label table. GX Works3 has no VAR_EXTERNAL class (MELSEC iQ-F FX5
-    Programming Manual (Program Design) §4.2: a POU uses a global label by its name), so a
-    POU's VAR_EXTERNAL declarations, which the check matched against the VAR_GLOBAL blocks,
-    are no rows of it there: the globals are in the global label table."""
-    decls = pou.variables
-    if target == "gxworks3":
-        decls = [d for d in decls if d.section != "VAR_EXTERNAL"]
-    return rows_of(decls, source_text, target)
+    """The rows of a POU's label table. Neither editor has a VAR_EXTERNAL class (GX Works3:
+    MELSEC iQ-F FX5 Programming Manual (Program Design) §4.2; GX Works2: MELSEC-Q/L/F
+    Structured Programming Manual (Fundamentals), Table 4.3.3-1): a POU uses a global label
+    by its name, so its VAR_EXTERNAL declarations, which the check matched against the
+    VAR_GLOBAL blocks, are no rows of it: the globals are in the global label table."""
+    return rows_of([d for d in pou.variables if d.section != "VAR_EXTERNAL"], source_text, target)
 
 
 def rows_of(decls: list[ast.VarDecl], source_text: str, target: str) -> list[LabelRow]:
