@@ -185,7 +185,7 @@ def _execute_input(call: ast.Call) -> str | None:
     return next((n for n, _t in target.fb_type.inputs if n.upper() in _EXECUTE_INPUTS), None)
 
 
-def _always_calls(body: list[ast.Stmt], key: str) -> bool:
+def _always_calls(body: list[ast.Stmt], key: str, may_return: bool = True) -> bool:
     """Whether `body` calls the FB instance `key` on every run of it: a call in the body
     itself, or in every branch of an IF or CASE that has an ELSE (a loop may run no time),
     before any statement that may RETURN (the scans that take it do not reach the call)."""
@@ -194,12 +194,14 @@ def _always_calls(body: list[ast.Stmt], key: str) -> bool:
                 and s.call.callee.name.upper() == key):
             return True
         if isinstance(s, ast.If) and s.else_body is not None:
-            if all(_always_calls(b.body, key) for b in s.branches) and _always_calls(s.else_body, key):
+            if all(_always_calls(b.body, key, may_return) for b in s.branches) and \
+                    _always_calls(s.else_body, key, may_return):
                 return True
         if isinstance(s, ast.Case) and s.else_body is not None:
-            if all(_always_calls(c.body, key) for c in s.clauses) and _always_calls(s.else_body, key):
+            if all(_always_calls(c.body, key, may_return) for c in s.clauses) and \
+                    _always_calls(s.else_body, key, may_return):
                 return True
-        if _returns_in(s):
+        if may_return and _returns_in(s):  # (`may_return` False: the POU holds no RETURN)
             return False
     return False
 
@@ -251,6 +253,7 @@ class Checker:
         #: (caller POU key, callee POU key, call) for every call of a user FB or FUNCTION
         self.calls: list[tuple[str, str, ast.Call]] = []
         self.pou_calls: list[ast.Call] = []  # the calls of the POU body being checked (check_bodies)
+        self.pou_returns = False  # whether that body holds a RETURN: if not, none is looked for
         #: the bundled plc/ folder as the sources reach it (vendor/uitamr/plc), if they do
         self.plc_shown = _plc_as_given([f.filename for f in files])
 
@@ -495,6 +498,7 @@ class Checker:
             self.pou = info
             self.loop_depth = 0
             self.pou_calls = []
+            self.pou_returns = False  # a RETURN anywhere in the body (stmt); most POUs have none
             complete = True
             for s in info.pou.body:
                 try:
@@ -549,10 +553,11 @@ class Checker:
         returns: list[ast.Return] = []  # the conditional RETURNs met so far, in order
         seen_at: dict[str, int] = {}  # how many of them came before first[key]
         for s in info.pou.body:
-            if _always_returns(s):
+            if self.pou_returns and _always_returns(s):
                 break  # nothing after it runs
             if not isinstance(s, ast.CallStmt):
-                returns += _returns_in(s)
+                if self.pou_returns:  # (each statement walked for RETURNs was a third of the check)
+                    returns += _returns_in(s)
                 continue
             if not isinstance(s.call.callee, ast.Name):
                 continue
@@ -732,7 +737,7 @@ class Checker:
         for key, found in calls.items():
             first, depth = found[0]
             name, execute = first.call.callee.name, _execute_input(first.call)
-            if not _always_calls(info.pou.body, key):
+            if not _always_calls(info.pou.body, key, self.pou_returns):
                 # a call of the statement list itself that a RETURN before it may skip: the IF
                 # written as a guard (`IF NOT X1 THEN RETURN; END_IF; fbStop(...)`)
                 before = info.pou.body[:next(i for i, s in enumerate(info.pou.body) if s is first)] if depth == 0 else []
@@ -840,7 +845,9 @@ class Checker:
         elif isinstance(s, ast.Exit):
             if self.loop_depth == 0:
                 self.rep.error(s, "EXIT outside a FOR, WHILE or REPEAT loop")
-        elif isinstance(s, (ast.Return, ast.Empty)):
+        elif isinstance(s, ast.Return):
+            self.pou_returns = True
+        elif isinstance(s, ast.Empty):
             pass
 
     def _bool_cond(self, e: ast.Expr, what: str) -> None:
