@@ -549,3 +549,29 @@ END_PROGRAM
         ("Station.st", 9, 37, "i_wChannel := G_CHANNEL (3, the constant declared at GlobalLabels.st:2:5) is "
                               "outside 1..2, the range UITAMR_PortFx3 accepts: it ends with o_bErr and o_uErrId "
                               "16#0304 instead of running (see its header); give a value in 1..2")], found
+
+
+def test_a_pause_called_under_a_condition_is_told_it_can_block_the_stop():
+    """review34: UITAMR_Pause now posts to the priority slot, the stop's. Called only in a
+    manual-mode IF, a pause whose result came while the IF was false left it there, and
+    UITAMR_Stop then ended with 16#0303 after 30 s, unsent; check's warning said only that a
+    second press sends nothing. It now says what it does to the stop."""
+    text = """\
+PROGRAM Station
+VAR
+    fbPause : UITAMR_Pause;
+    fbStop : UITAMR_Stop;
+    uMbx : ARRAY[0..15] OF WORD;
+END_VAR
+IF X7 THEN
+    fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);
+    fbStop(i_bEN := TRUE, i_bExecute := X1, io_uMbx := uMbx);
+END_IF;
+END_PROGRAM
+"""
+    found = [d.message for d in _check(text, ROOT / "plc" / "core", target="gxworks2") if "only under" in d.message]
+    assert len(found) == 2, found
+    pause, stop = found
+    assert pause.endswith("; a UITAMR_Pause not called when its result comes keeps it in the priority slot, "
+                          "the stop's: UITAMR_Stop then ends with 16#0303 after 30 s, unsent"), pause
+    assert "16#0303" not in stop

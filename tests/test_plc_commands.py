@@ -515,3 +515,90 @@ def test_a_stop_pressed_while_a_pause_is_served_goes_out_right_after_it():
     assert robot.mode == "idle" and h.fbRun.o_uErrId == 0x0305 and h.fbPause.o_uErrId == 0
     page = " ".join((PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8").split())
     assert "(the pause's control command and status read: about 600 ms)" in page
+
+
+def test_the_resume_button_moves_nothing_when_no_point_runs():
+    """review34: UITAMR_CellFx3's resume (X4: UITAMR_Command kind 2 of the point) and the
+    page's wiring sent the point whenever pressed: with nothing paused - before X0, or after
+    the operator's stop had ended the paused point - the robot drove to the point with fbGo
+    idle (nobody following it, no 'reached', no fault from the run). The resume is now
+    asked only while the point's run is busy; while it is, it resumes as before."""
+    import re
+
+    from verifier.amr.config import RobotConfig as Config
+
+    page = (PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8")
+    section = page.split("### Pause and resume while a point runs", 1)[1].split("\n## ", 1)[0]
+    snippet = re.search(r"```iecst\n(.*?)```", section, re.S).group(1)
+    page_project = _cell("    fbRun : UITAMR_RunPoint;\n    fbPause : UITAMR_Pause;\n    fbResume : UITAMR_Command;\n"
+                         "    fbStop : UITAMR_Stop;\n    bPaused : BOOL;\n", snippet)
+    cell = verifier.load(PLC / "core", PLC / "fx3", PLC / "examples" / "fx3" / "UITAMR_CellFx3.st")
+    robot = Robot(config=Config(point_duration_s=8.0))
+    line = Line(robot)
+    cell.attach_serial("fx3:1", line)
+    cell_project = (cell, robot, line, lambda ms: cell.run_programs(["UITAMR_CellFx3"], ms=ms))
+    for project, robot, line, run in (page_project, cell_project):
+        _press(project, run, "X4", 2000)                      # resume with nothing run yet
+        run(2000)
+        assert robot.mode == "idle" and len(_controls_at(line)) == 1      # the power-on stop only
+        _press(project, run, "X0", 0)                         # the point ...
+        _press(project, run, "X3", 2000)                      # ... paused ...
+        _press(project, run, "X1", 2000)                      # ... and stopped
+        run(1000)
+        assert robot.mode == "idle"
+        _press(project, run, "X4", 1000)                      # resume after the stop
+        run(2000)
+        assert robot.mode == "idle"
+        assert [c[1] for c in _controls_at(line)][1:] == [POINT_3, PAUSE_FRAME, encode(ControlRequest(1, 1, 0xA0), SETTINGS)]
+
+
+def test_a_pause_that_comes_after_the_point_has_ended_waits_for_the_resume():
+    """review34: a pause pressed in the last 300 ms of a point reaches the robot after the
+    task has ended: the robot ignores it and reports idle, and the engine (which does not
+    let an 'idle' answer end a paused run, in case a robot reports a paused task idle)
+    keeps the run busy with o_bPaused on, TASK_TIMEOUT stopped. plc-library.md says so and
+    how it ends: the resume (the point again, already reached) ends it with o_bOK."""
+    project, robot, line, run = _run_point_cell(
+        "    fbResume : UITAMR_Command;\n    bDone : BOOL;\n",
+        "fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);\n"
+        "fbResume(i_bEN := TRUE, i_bExecute := X4 AND fbRun.o_bBusy, i_wKind := 2, i_wCode := 1, i_wCommand := 3,\n"
+        "         i_bParamErr := FALSE, i_bPriority := FALSE, io_uMbx := uMbx);\n"
+        "IF fbRun.o_bOK THEN\n    bDone := TRUE;\nEND_IF;\n")
+    h = project.program("T_Cell")
+    _press(project, run, "X0", 2000)                          # point 3 at 2.4 s, ends at ~10.4 s
+    _press(project, run, "X3", 8000)                          # pause at 10.3 s: sent at 10.46 s
+    run(20_000)
+    assert [c[1] for c in _controls_at(line)][1:] == [POINT_3, PAUSE_FRAME]
+    assert robot.mode == "idle" and h.fbEngine.o_bPaused and not h.fbEngine.o_bTaskRunning
+    assert h.fbRun.o_bBusy and not h.bDone and not h.fbRun.o_bErr
+    _press(project, run, "X4", 0)
+    run(10_000)
+    assert h.bDone and not h.fbRun.o_bBusy and not h.fbEngine.o_bPaused
+    page = " ".join((PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8").split())
+    assert "a pause that reaches the robot after the point has ended" in page
+
+
+def test_a_pause_during_a_relative_move_is_a_pause_too():
+    """review34: the pause overtakes every command that waits for its task, and the robot
+    pauses a relative move as it pauses a point (UITAMR_PanelFx3: X15 then X21). But the
+    engine counted a pause only over a code-1 command: o_bPaused stayed FALSE while the
+    robot stood paused, and TASK_TIMEOUT ran on, so an operator's pause of 10 min ended the
+    move with 16#0106 (the fault lamp). Now it is paused as a point is: o_bPaused, no
+    TASK_TIMEOUT; the stop ends it with 16#0305."""
+    project, robot, line, run = _cell(
+        "    fbMove : UITAMR_MoveRelative;\n    fbPause : UITAMR_Pause;\n    fbStop : UITAMR_Stop;\n",
+        "fbEngine(i_bEN := NOT M8002, i_wAddress := 1, i_bMonitor := TRUE, io_uMbx := uMbx, io_uPort := uPort);\n"
+        "fbMove(i_bEN := TRUE, i_bExecute := X0, i_wAxis := 1, i_eValue := 2.0, io_uMbx := uMbx);\n"
+        "fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);\n"
+        "fbStop(i_bEN := TRUE, i_bExecute := X1, io_uMbx := uMbx);\n")
+    h = project.program("T_Cell")
+    _press(project, run, "X0", 2000)
+    _press(project, run, "X3", 500)
+    run(1000)
+    assert robot.mode == "paused" and h.fbEngine.o_bPaused and h.fbMove.o_bBusy
+    run(11 * 60_000)
+    assert robot.mode == "paused" and h.fbMove.o_bBusy and h.fbMove.o_uErrId == 0 and not h.fbEngine.o_bErr
+    _press(project, run, "X1", 0)
+    run(1000)
+    assert robot.mode == "idle" and not h.fbMove.o_bBusy and h.fbMove.o_uErrId == 0x0305
+    assert not h.fbEngine.o_bPaused

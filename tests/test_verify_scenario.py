@@ -970,3 +970,22 @@ def test_a_duration_in_error_does_not_make_later_times_mistakes(tmp_path):
     with pytest.raises(ScenarioError) as caught:
         load_scenario(path)
     assert caught.value.key == "duration" and not hasattr(caught.value, "errors")
+
+
+def test_two_mistakes_in_one_fault_input_or_expectation_are_both_told(tmp_path):
+    """review34: scenarios.md says every mistake of a file is told in one run, but a table
+    of [[faults]], [[inputs]] or [[expect]] stopped at its first: a misspelt fault kind hid
+    `at` (for `at_s`) below it, a bare-number `at` hid the string given for a bit, an unknown
+    command to expect hid a bare-number `after` - three mistakes found a run after the
+    others. Now the independent keys of a table are each read and told."""
+    path = tmp_path / "s.toml"
+    path.write_text('duration = "20s"\n'
+                    '[[faults]]\nkind = "no_replyy"\nat = "5s"\n'
+                    '[[inputs]]\nat = 2\nset = { X0 = "yes", X1 = true }\n'
+                    '[[expect]]\nsent = "pausee"\nafter = 6\n', encoding="utf-8")
+    with pytest.raises(ScenarioError) as caught:
+        load_scenario(path)
+    assert [(e.key, e.place.line, e.place.col) for e in caught.value.errors] == [
+        ("faults[0].kind", 3, 8), ("faults[0].at", 4, 1), ("inputs[0].at", 6, 6), ("inputs[0].set.X0", 7, 14),
+        ("expect[0].sent", 9, 8), ("expect[0].after", 10, 9)]
+    assert "did you mean 'at_s'?" in caught.value.errors[1].message

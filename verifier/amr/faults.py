@@ -179,6 +179,18 @@ def faults_from_list(items: Any, path: str = "faults") -> list[Fault]:
     return [Fault.from_dict(item, schema.join(path, i)) for i, item in enumerate(items)]
 
 
+def keys_no_fault_has(data: Mapping[str, Any], path: str = "fault") -> list[schema.ConfigError]:
+    """The keys of a fault table that no fault kind takes (`at` for `at_s`), each its error:
+    told beside an unknown `kind`, which hides which keys that kind would take."""
+    known = list(dict.fromkeys(_COMMON_KEYS + tuple(k for keys in _KIND_KEYS.values() for k in keys)))
+    # the guess among the keys every fault takes first (`at`: 'at_s', not 'data')
+    return [schema.ConfigError(schema.join(path, str(key)),
+                               f"unknown key; expected one of {', '.join(known)}"
+                               f"{schema.did_you_mean(key, _COMMON_KEYS) or schema.did_you_mean(key, known)}",
+                               at_name=True)
+            for key in data if key not in known]
+
+
 def check_fault_addresses(faults: Iterable[Fault], own_address: int, path: str = "faults") -> None:
     """A ``wrong_address`` fault must name another address than the robot's own: a reply
     from the robot's own address is the normal reply, so the fault would test nothing.

@@ -175,6 +175,12 @@ def _constant(value: ast.Expr | None) -> bool | None:
     return value.value if isinstance(value, ast.BoolLiteral) else None
 
 
+#: what a UITAMR_Pause called only under a condition does besides: it shares the priority
+#: slot with the stop (docs/plc-library.md, "Pause and resume while a point runs")
+PAUSE_HOLDS_THE_STOP = ("; a UITAMR_Pause not called when its result comes keeps it in the priority slot, the "
+                        "stop's: UITAMR_Stop then ends with 16#0303 after 30 s, unsent")
+
+
 def _execute_input(call: ast.Call) -> str | None:
     """The name of the edge input that starts an FB instance's command (i_bExecute, or
     PLCopen's Execute), as its type declares it, or None for an FB without one (a timer,
@@ -752,7 +758,8 @@ class Checker:
                     f"falling edge included, and hands its result back only in the scans it is called, "
                     f"so after one command a new one gets no rising edge (a second press sends nothing); "
                     f"call it on every scan, {where}, and give the condition to {execute} "
-                    f"({execute} := <button>) (docs/plc-library.md: call every FB on every scan)"))
+                    f"({execute} := <button>) (docs/plc-library.md: call every FB on every scan)"
+                    + (PAUSE_HOLDS_THE_STOP if first.call.resolved.fb_type.name.upper() == "UITAMR_PAUSE" else "")))
                 continue
             for s, depth in found:
                 value = next((a.value for a in s.call.args if not a.output and a.key == execute.upper()), None)

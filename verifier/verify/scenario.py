@@ -14,7 +14,7 @@ from typing import Any, Callable, Iterator
 
 from verifier import protocol
 from verifier.amr.config import RobotConfig
-from verifier.amr.faults import Fault, check_fault_addresses
+from verifier.amr.faults import Fault, check_fault_addresses, keys_no_fault_has
 from verifier.amr.schema import ConfigError, unknown_key
 from verifier.digits import digit_problem
 from verifier.place import Place
@@ -847,26 +847,40 @@ class _Reader:
             except ConfigError as exc:  # noted, and the next fault read: every mistake of the file in one run
                 path = exc.path if exc.path.startswith("faults[") else f"faults[{i}]"
                 self.errors.append(self.fail(path, exc.message, at_name=exc.at_name))
+                if path == f"faults[{i}].kind" and isinstance(item, dict):  # and keys no kind takes
+                    self.errors += [self.fail(e.path, e.message, at_name=True)
+                                    for e in keys_no_fault_has(item, f"faults[{i}]")]
         return tuple(result)
 
-    def input_step(self, item: dict, key: str, duration: int) -> InputStep:
-        self.only(item, INPUT_KEYS, key)
+    def input_step(self, item: dict, key: str, duration: int) -> InputStep | None:
+        """The input; None when a mistake of it is noted in `self.errors` (its `at` and each
+        value are read on after one, so that all of the table's are told)."""
+        told = len(self.errors)
+        self.attempt(lambda: self.only(item, INPUT_KEYS, key))
         if "at" not in item or "set" not in item:
             raise self.fail(key, "an input needs 'at' (when) and 'set' (labels and values)")
-        at = self.duration(item["at"], f"{key}.at", positive=False)
-        if at >= duration:
-            raise self.fail(f"{key}.at", f"is at or after the end of the run ({format_duration(duration)}): "
-                                         "the input would never be applied; make 'duration' longer")
+
+        def read_at() -> int:
+            at = self.duration(item["at"], f"{key}.at", positive=False)
+            if at >= duration:
+                raise self.fail(f"{key}.at", f"is at or after the end of the run ({format_duration(duration)}): "
+                                             "the input would never be applied; make 'duration' longer")
+            return at
+        at = self.attempt(read_at)
         values = self.table(item["set"], f"{key}.set")
         if not values:
             raise self.fail(f"{key}.set", "sets nothing")
         checked: dict[str, Value] = {}
-        for name, value in values.items():
+
+        def read_value(name: str, value: Any) -> None:
             self.label(name, f"{key}.set", at=f"{key}.set.{name}")
-            if isinstance(value, (bool, int, float)):
-                checked[name] = value
-            else:
+            if not isinstance(value, (bool, int, float)):
                 raise self.fail(f"{key}.set.{name}", f"expected true/false or a number, got {shown(value)}")
+            checked[name] = value
+        for name, value in values.items():
+            self.attempt(lambda name=name, value=value: read_value(name, value))
+        if len(self.errors) > told:
+            return None
         pulse = self.duration(item["pulse"], f"{key}.pulse") if "pulse" in item else None
         if pulse is not None and not any(isinstance(v, bool) for v in checked.values()):
             bit_as_number = next((name for name, v in checked.items()
@@ -882,14 +896,23 @@ class _Reader:
                                             "or leave out the pulse")
         return InputStep(at, checked, pulse, key)
 
-    def expectation(self, item: dict, key: str, settings: protocol.Settings) -> Expectation:
-        self.only(item, EXPECT_KEYS, key)
+    def expectation(self, item: dict, key: str, settings: protocol.Settings) -> Expectation | None:
+        """The expectation; None when a mistake of it is noted in `self.errors` (its window
+        is read on after one, and what it expects after a mistake of the window)."""
+        told = len(self.errors)
+        self.attempt(lambda: self.only(item, EXPECT_KEYS, key))
         kinds = [kind for kind in KINDS if kind in item]
         if len(kinds) != 1:
             raise self.fail(key, f"give exactly one of {', '.join(KINDS)}")
         kind = kinds[0]
-        after = self.duration(item["after"], f"{key}.after", positive=False) if "after" in item else 0
-        within = self.duration(item["within"], f"{key}.within") if "within" in item else None
+        after = self.attempt(lambda: self.duration(item["after"], f"{key}.after", positive=False)
+                             if "after" in item else 0)
+        within = self.attempt(lambda: self.duration(item["within"], f"{key}.within") if "within" in item else None)
+        if len(self.errors) > told:
+            self.attempt(lambda: self.expectation({k: v for k, v in item.items()
+                                                   if k in EXPECT_KEYS and k not in ("after", "within")},
+                                                  key, settings))
+            return None
         value = item[kind]
         fields: dict[str, Any] = {}
         if kind in ("that", "always", "never"):
