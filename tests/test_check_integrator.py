@@ -452,44 +452,6 @@ END_PROGRAM
                  "o_uErrId 16#0301 instead of running (see its header); give a value in 1..21")], found
 
 
-def test_a_named_constant_out_of_the_range_a_library_fb_checks_is_warned_with_its_value():
-    """The examples give these inputs as named constants (`RS2_CHANNEL : INT := 1;` in VAR
-    CONSTANT): set to 3, the warning above stayed silent, as only a literal was judged. Now
-    the constant's value is judged, and the message names the label, its value and where it
-    is declared; a label that is not a constant is not judged (its value is the program's)."""
-    text = """\
-PROGRAM Station
-VAR
-    fbRun : UITAMR_RunPoint;
-    fbPort : UITAMR_PortFx3;
-    uMbx : ARRAY[0..15] OF WORD;
-    uPort : ARRAY[0..39] OF WORD;
-    bGo : BOOL;
-    wPoint : INT := 30;
-END_VAR
-VAR CONSTANT
-    RS2_CHANNEL : INT := 3;
-    LAST_POINT : INT := -1;
-    FIRST_POINT : INT := 21;
-END_VAR
-fbPort(i_bEN := TRUE, i_wChannel := RS2_CHANNEL, i_bRs232 := FALSE, io_uPort := uPort);
-fbRun(i_bEN := TRUE, i_bExecute := bGo, i_wPoint := LAST_POINT, io_uMbx := uMbx);
-fbRun(i_bEN := TRUE, i_bExecute := bGo, i_wPoint := FIRST_POINT, io_uMbx := uMbx);
-fbRun(i_bEN := TRUE, i_bExecute := bGo, i_wPoint := wPoint, io_uMbx := uMbx);
-END_PROGRAM
-"""
-    found = [(d.line, d.col, d.message) for d in _check(text, ROOT / "plc" / "core", ROOT / "plc" / "fx3",
-                                                          target="gxworks2")
-             if "is outside" in d.message]
-    assert found == [
-        (15, 37, "i_wChannel := RS2_CHANNEL (3, the constant declared at 11:5) is outside 1..2, the range "
-                 "UITAMR_PortFx3 accepts: it ends with o_bErr and o_uErrId 16#0304 instead of running (see "
-                 "its header); give a value in 1..2"),
-        (16, 53, "i_wPoint := LAST_POINT (-1, the constant declared at 12:5) is outside 1..21, the range "
-                 "UITAMR_RunPoint accepts: it ends with o_bErr and o_uErrId 16#0301 instead of running (see "
-                 "its header); give a value in 1..21")], found
-
-
 def test_a_constant_label_out_of_the_range_a_library_fb_checks_is_warned_with_its_declaration():
     """UITAMR_ExampleQ passes its channel as a VAR CONSTANT label (`i_wChannel := C24_CHANNEL`),
     and so did a program adapted from it: with `C24_CHANNEL : INT := 3` `uitamr check --platform

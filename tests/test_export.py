@@ -868,15 +868,20 @@ GX3_LOCAL_CLASSES = {"VAR", "VAR_CONSTANT", "VAR_RETAIN", "VAR_INPUT", "VAR_OUTP
                      "VAR_IN_OUT", "VAR_PUBLIC", "VAR_PUBLIC_RETAIN"}
 
 
+def _program_with_a_global(folder: Path) -> None:
+    """Globals.st (gbStart AT X10) and Main.st, which declares it VAR_EXTERNAL and reads it."""
+    (folder / "Globals.st").write_text("VAR_GLOBAL\n    gbStart AT X10 : BOOL; (* start *)\nEND_VAR\n")
+    (folder / "Main.st").write_text(
+        "PROGRAM Main\nVAR_EXTERNAL\n    gbStart : BOOL;\nEND_VAR\nVAR\n    bRun : BOOL;\nEND_VAR\n"
+        "bRun := gbStart;\nEND_PROGRAM\n")
+
+
 def test_gxworks3_label_tables_hold_only_the_classes_gx_works3_has(tmp_path):
     """An integrator's program that declares the global labels it uses in VAR_EXTERNAL (as
     `uitamr check` accepts and IEC 61131-3 writes it) was exported with VAR_EXTERNAL rows in
     its label table: GX Works3 has no such local label class, so the paste was refused. The
     globals are in GlobalLabels.labels.tsv, and the POU uses them by name."""
-    (tmp_path / "Globals.st").write_text("VAR_GLOBAL\n    gbStart AT X10 : BOOL; (* start *)\nEND_VAR\n")
-    (tmp_path / "Main.st").write_text(
-        "PROGRAM Main\nVAR_EXTERNAL\n    gbStart : BOOL;\nEND_VAR\nVAR\n    bRun : BOOL;\nEND_VAR\n"
-        "bRun := gbStart;\nEND_PROGRAM\n")
+    _program_with_a_global(tmp_path)
     out = tmp_path / "gx3"
     result = run("--target", "gxworks3", "--out", str(out), str(tmp_path / "Globals.st"), str(tmp_path / "Main.st"))
     assert result.exit_code == 0, result.output
@@ -896,10 +901,7 @@ def test_gxworks2_label_tables_hold_only_the_classes_gx_works2_has(tmp_path):
     """The GX Works3 fix above left GX Works2's tables with their VAR_EXTERNAL rows, a class
     the GX Works2 manual does not list either: the same program exported for GX Works2
     has them no more; the global is in GlobalLabels.labels.tsv."""
-    (tmp_path / "Globals.st").write_text("VAR_GLOBAL\n    gbStart AT X10 : BOOL; (* start *)\nEND_VAR\n")
-    (tmp_path / "Main.st").write_text(
-        "PROGRAM Main\nVAR_EXTERNAL\n    gbStart : BOOL;\nEND_VAR\nVAR\n    bRun : BOOL;\nEND_VAR\n"
-        "bRun := gbStart;\nEND_PROGRAM\n")
+    _program_with_a_global(tmp_path)
     out = tmp_path / "gx2"
     result = run("--target", "gxworks2", "--out", str(out), str(tmp_path / "Globals.st"), str(tmp_path / "Main.st"))
     assert result.exit_code == 0, result.output
