@@ -317,3 +317,13 @@ def test_a_misspelt_label_read_from_python_offers_the_label_meant():
         fb.zzz
     assert str(caught.value) == "FB_Delay has no label 'zzz'"
     assert not hasattr(fb, "zzz")
+
+
+def test_in_asks_whether_the_cpu_has_a_device():
+    """`"Y6" in project.devices` in a test ended in an AttributeError traceback ('int' object
+    has no attribute 'strip': Python tried devices[0], devices[1] ...); now True for a
+    device this CPU has, False for one it has not or a name that is none."""
+    project = verifier.load(sources={"P.st": "PROGRAM P\nY6 := X0;\nEND_PROGRAM\n"})
+    assert "Y6" in project.devices and "d100" in project.devices
+    assert "Y8" not in project.devices and "D9000" not in project.devices  # octal Y; past D8511 on the FX3U
+    assert "fbEngine" not in project.devices and 6 not in project.devices

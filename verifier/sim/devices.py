@@ -243,6 +243,17 @@ class DeviceMemory:
         a = self.address(name)
         return self.read(a)
 
+    def __contains__(self, name) -> bool:
+        """`"Y6" in project.devices`: whether this CPU has the device `name`. Without it Python
+        tried `mem[0]`, `mem[1]` ... and a test's `in` ended in an AttributeError traceback."""
+        if not isinstance(name, str):
+            return False
+        try:
+            self.address(name)
+        except DeviceError:
+            return False
+        return True
+
     def reader(self, name: str):
         """A function of no arguments reading device `name`, its address parsed once."""
         a = self.address(name)
