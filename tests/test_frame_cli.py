@@ -245,6 +245,10 @@ def test_a_command_byte_in_hex_without_0x_is_told_how_to_write_it():
     assert run("raw", "1", "0xA0").output.strip() == run("raw", "1", "160").output.strip() == stop
     assert "stop is raw 1 0xA0" in " ".join(run("--help").output.split())
     assert run("raw", "1", "16").output.strip() == run("run-point", "16").output.strip()
+    # no byte read as hex either (1e3 = 0x1E3 = 483): not offered as one to write
+    result = run("raw", "1", "1e3")
+    assert result.exit_code == 2 and "0x1E3" not in result.output, result.output
+    assert "must be a whole number (decimal, or hex as 0x..), got '1e3'" in " ".join(result.output.split())
 
 
 def test_help_lists_every_command_form():

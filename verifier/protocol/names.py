@@ -174,7 +174,7 @@ def _integer(text: str, what: str) -> int:
         pass
     # hex as the decoder prints it ("stop (01/A0)"), as GX Works writes it (HA0, 16#A0), or A0h
     written = re.fullmatch(r"(?:16#|[hH])?([0-9a-fA-F]+)[hH]?", text)
-    if written is not None:
+    if written is not None and int(written.group(1), 16) <= 0xFF:  # `1e3` is no byte in hex either
         digits = written.group(1).upper()
         raise CommandError(f"{what} {text!r} is hex: write it 0x{digits} (or {int(digits, 16)} in decimal); a "
                            f"number without 0x is read as decimal")
