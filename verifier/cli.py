@@ -29,7 +29,7 @@ SUBCOMMANDS = {
 
 #: the exit status of a command stopped by Ctrl-C before it finished (128 + SIGINT); the
 #: program's entry point says it of a Ctrl-C during this module's own import
-from verifier.entry import EXIT_INTERRUPTED  # noqa: E402
+from verifier.entry import EXIT_INTERRUPTED, interrupted  # noqa: E402
 
 
 class UnusablePath(click.ClickException):
@@ -119,8 +119,7 @@ class LazyGroup(click.Group):
             # as the shell reports a program that Ctrl-C stopped. (monitor and emulate take
             # Ctrl-C as their stop and finish their reports or summary.)
             name = ctx.invoked_subcommand or ctx.meta.get("uitamr.command")
-            click.echo(f"\nuitamr{' ' + name if name else ''}: interrupted (Ctrl-C) before it finished: "
-                       "no verdict", err=True)
+            click.echo(interrupted(name), err=True)
             sys.exit(EXIT_INTERRUPTED)
         except OSError as exc:
             # A path the file system refuses (a name too long, a folder that cannot be read,

@@ -9,9 +9,14 @@ from __future__ import annotations
 
 import sys
 
-#: 128 + SIGINT, as verifier.cli.EXIT_INTERRUPTED (not imported from there: that import is
-#: what a Ctrl-C may interrupt)
+#: 128 + SIGINT; verifier.cli takes it and `interrupted` from here (this module cannot import
+#: the CLI's: that import is what a Ctrl-C may interrupt)
 EXIT_INTERRUPTED = 130
+
+
+def interrupted(command: str | None) -> str:
+    """What a Ctrl-C before the command finished says (stderr), `command` the one typed."""
+    return f"\nuitamr{' ' + command if command else ''}: interrupted (Ctrl-C) before it finished: no verdict"
 
 
 def main() -> None:
@@ -19,7 +24,6 @@ def main() -> None:
         from verifier.cli import main as run
     except KeyboardInterrupt:
         typed = sys.argv[1] if len(sys.argv) > 1 and not sys.argv[1].startswith("-") else ""
-        sys.stderr.write(f"\nuitamr{' ' + typed if typed else ''}: interrupted (Ctrl-C) before it finished: "
-                         "no verdict\n")
+        sys.stderr.write(interrupted(typed) + "\n")
         sys.exit(EXIT_INTERRUPTED)
     run()
