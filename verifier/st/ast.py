@@ -64,13 +64,40 @@ def walk(*roots) -> Iterator:
     """Every node under `roots` (nodes, lists or tuples of them), the roots' own included,
     through their syntax fields; in no particular order."""
     stack = list(roots)
+    shape_of = _WALK_SHAPE
     while stack:
         node = stack.pop()
-        if isinstance(node, (list, tuple)):
+        shape = shape_of.get(type(node))
+        if shape is None:
+            shape = _walk_shape(node)
+        if shape is _LEAF:
+            continue
+        if shape is _SEQUENCE:
             stack.extend(node)
-        elif is_dataclass(node) and not isinstance(node, type):
-            yield node
-            stack.extend(syntax_fields(node))
+            continue
+        yield node
+        stack.extend([getattr(node, name) for name in shape])
+
+
+_LEAF, _SEQUENCE = object(), object()
+#: by class, what walk does with a value: skip it (_LEAF), descend into its items
+#: (_SEQUENCE), or yield it and descend into the syntax fields named (a node); the class
+#: tests once per class, not once per value (a tenth of `uitamr check`'s time was
+#: is_dataclass on every string and number of the tree)
+_WALK_SHAPE: dict[type, object] = {}
+
+
+def _walk_shape(value) -> object:
+    cls = type(value)
+    if isinstance(value, (list, tuple)):
+        shape = _SEQUENCE
+    elif is_dataclass(value) and not isinstance(value, type):
+        shape = _SYNTAX_FIELD_NAMES.get(cls) or tuple(f.name for f in fields(value) if f.compare)
+        _SYNTAX_FIELD_NAMES[cls] = shape
+    else:
+        shape = _LEAF
+    _WALK_SHAPE[cls] = shape
+    return shape
 
 
 @dataclass(slots=True)
