@@ -779,83 +779,95 @@ class Checker:
             self.stmt(s)
 
     def stmt(self, s: ast.Stmt) -> None:
-        if isinstance(s, ast.Assign):
-            tt = self.lvalue(s.target)
-            vt = self.expr(s.value)
-            if tt is not None:
-                self._assign_compat(s.value, tt, vt, "assignment")
-        elif isinstance(s, ast.CallStmt):
-            self.call(s.call, statement=True)
-        elif isinstance(s, ast.If):
-            if len(s.branches) > MAX_BRANCHES:
-                self.rep.error(s, f"IF with {len(s.branches) - 1} ELSIF branches: the simulator runs at most "
-                                  f"{MAX_BRANCHES - 1} in one statement; split it into several IF statements")
-            for b in s.branches:
-                self._bool_cond(b.cond, "IF condition")
-                self.stmts(b.body)
-            if s.else_body is not None:
-                self.stmts(s.else_body)
-        elif isinstance(s, ast.Case):
-            if len(s.clauses) > MAX_BRANCHES:
-                self.rep.error(s, f"CASE with {len(s.clauses)} branches: the simulator runs at most "
-                                  f"{MAX_BRANCHES} in one statement; split it into several CASE statements")
-            st = self.expr(s.selector)
-            if not (T.is_group(st, "int", "int-literal", "any16", "any32", "any")):
-                self.rep.error(s.selector, f"CASE needs an integer selector (INT or DINT), not {st}"
-                                           + self._convert(st, T.INT, "; convert it, e.g. {}(...)"))
-            seen: dict[int, ast.Node] = {}
-            for clause in s.clauses:
-                for label in clause.labels:
-                    values = [label] if not isinstance(label, ast.CaseRange) else [label.low, label.high]
-                    for v in values:
-                        self.expr(v)
-                    if isinstance(label, ast.CaseRange):
-                        lo, hi = label.low.value, label.high.value
-                        if lo > hi:
-                            self.rep.error(label, f"CASE range {lo}..{hi} is empty; write the lower bound first")
-                        rng = range(lo, hi + 1) if hi - lo < 100_000 else range(lo, lo + 1)
-                    else:
-                        rng = range(label.value, label.value + 1)
-                    for n in rng:
-                        if n in seen:
-                            self.rep.error(label, f"CASE value {n} appears twice")
-                            break
-                        seen[n] = label
-                self.stmts(clause.body)
-            if s.else_body is not None:
-                self.stmts(s.else_body)
-        elif isinstance(s, ast.For):
-            vt = self.lvalue(s.var)
-            if vt is not None and not T.is_group(vt, "int", "any16", "any32"):
-                self.rep.error(s.var, f"FOR variable must be INT or DINT, not {vt}")
-            for part, what in ((s.start, "start"), (s.end, "end"), (s.step, "step")):
-                if part is None:
-                    continue
-                pt = self.expr(part)
-                if vt is not None:
-                    self._assign_compat(part, vt, pt, f"FOR {what} value")
-            if isinstance(s.step, ast.IntLiteral) and s.step.value == 0:
-                self.rep.error(s.step, "FOR step 0 never ends the loop")
-            self.loop_depth += 1
-            self.stmts(s.body)
-            self.loop_depth -= 1
-        elif isinstance(s, ast.While):
-            self._bool_cond(s.cond, "WHILE condition")
-            self.loop_depth += 1
-            self.stmts(s.body)
-            self.loop_depth -= 1
-        elif isinstance(s, ast.Repeat):
-            self.loop_depth += 1
-            self.stmts(s.body)
-            self.loop_depth -= 1
-            self._bool_cond(s.until, "UNTIL condition")
-        elif isinstance(s, ast.Exit):
-            if self.loop_depth == 0:
-                self.rep.error(s, "EXIT outside a FOR, WHILE or REPEAT loop")
-        elif isinstance(s, ast.Return):
-            self.pou_returns = True
-        elif isinstance(s, ast.Empty):
-            pass
+        # by the statement's class (the node classes are disjoint): one dictionary look-up
+        # where a chain of isinstance tests took up to eleven
+        method = _STMT_METHODS.get(type(s))
+        if method is not None:
+            method(self, s)
+
+    def _assign(self, s: ast.Assign) -> None:
+        tt = self.lvalue(s.target)
+        vt = self.expr(s.value)
+        if tt is not None:
+            self._assign_compat(s.value, tt, vt, "assignment")
+
+    def _call_stmt(self, s: ast.CallStmt) -> None:
+        self.call(s.call, statement=True)
+
+    def _if(self, s: ast.If) -> None:
+        if len(s.branches) > MAX_BRANCHES:
+            self.rep.error(s, f"IF with {len(s.branches) - 1} ELSIF branches: the simulator runs at most "
+                              f"{MAX_BRANCHES - 1} in one statement; split it into several IF statements")
+        for b in s.branches:
+            self._bool_cond(b.cond, "IF condition")
+            self.stmts(b.body)
+        if s.else_body is not None:
+            self.stmts(s.else_body)
+
+    def _case(self, s: ast.Case) -> None:
+        if len(s.clauses) > MAX_BRANCHES:
+            self.rep.error(s, f"CASE with {len(s.clauses)} branches: the simulator runs at most "
+                              f"{MAX_BRANCHES} in one statement; split it into several CASE statements")
+        st = self.expr(s.selector)
+        if not (T.is_group(st, "int", "int-literal", "any16", "any32", "any")):
+            self.rep.error(s.selector, f"CASE needs an integer selector (INT or DINT), not {st}"
+                                       + self._convert(st, T.INT, "; convert it, e.g. {}(...)"))
+        seen: dict[int, ast.Node] = {}
+        for clause in s.clauses:
+            for label in clause.labels:
+                values = [label] if not isinstance(label, ast.CaseRange) else [label.low, label.high]
+                for v in values:
+                    self.expr(v)
+                if isinstance(label, ast.CaseRange):
+                    lo, hi = label.low.value, label.high.value
+                    if lo > hi:
+                        self.rep.error(label, f"CASE range {lo}..{hi} is empty; write the lower bound first")
+                    rng = range(lo, hi + 1) if hi - lo < 100_000 else range(lo, lo + 1)
+                else:
+                    rng = range(label.value, label.value + 1)
+                for n in rng:
+                    if n in seen:
+                        self.rep.error(label, f"CASE value {n} appears twice")
+                        break
+                    seen[n] = label
+            self.stmts(clause.body)
+        if s.else_body is not None:
+            self.stmts(s.else_body)
+
+    def _for(self, s: ast.For) -> None:
+        vt = self.lvalue(s.var)
+        if vt is not None and not T.is_group(vt, "int", "any16", "any32"):
+            self.rep.error(s.var, f"FOR variable must be INT or DINT, not {vt}")
+        for part, what in ((s.start, "start"), (s.end, "end"), (s.step, "step")):
+            if part is None:
+                continue
+            pt = self.expr(part)
+            if vt is not None:
+                self._assign_compat(part, vt, pt, f"FOR {what} value")
+        if isinstance(s.step, ast.IntLiteral) and s.step.value == 0:
+            self.rep.error(s.step, "FOR step 0 never ends the loop")
+        self.loop_depth += 1
+        self.stmts(s.body)
+        self.loop_depth -= 1
+
+    def _while(self, s: ast.While) -> None:
+        self._bool_cond(s.cond, "WHILE condition")
+        self.loop_depth += 1
+        self.stmts(s.body)
+        self.loop_depth -= 1
+
+    def _repeat(self, s: ast.Repeat) -> None:
+        self.loop_depth += 1
+        self.stmts(s.body)
+        self.loop_depth -= 1
+        self._bool_cond(s.until, "UNTIL condition")
+
+    def _exit(self, s: ast.Exit) -> None:
+        if self.loop_depth == 0:
+            self.rep.error(s, "EXIT outside a FOR, WHILE or REPEAT loop")
+
+    def _return(self, s: ast.Return) -> None:
+        self.pou_returns = True
 
     def _bool_cond(self, e: ast.Expr, what: str) -> None:
         t = self.expr(e)
@@ -931,62 +943,63 @@ class Checker:
         return t
 
     def _expr(self, e) -> T.Type:
-        if isinstance(e, ast.Name):  # the most common node first (node classes are disjoint)
-            return self._name(e)
-        if isinstance(e, ast.IntLiteral):
-            return T.int_literal(e.value)
-        if isinstance(e, ast.RealLiteral):
-            if not math.isfinite(e.value):
-                self.rep.error(e, f"{e.text} is outside the range of every real type (LREAL reaches about "
-                                  "±1.8E308)")
-            return T.real_literal(e.value)
-        if isinstance(e, ast.BoolLiteral):
-            return T.BOOL
-        if isinstance(e, ast.TimeLiteral):
-            if not -2**31 <= e.ms <= 2**31 - 1:
-                self.rep.error(e, f"{e.text} is outside the TIME range (32-bit milliseconds)")
-            return T.TIME
-        if isinstance(e, ast.StringLiteral):
-            if e.wide and self.target == "gxworks2":
-                self.rep.error(e, "GX Works2 has no WSTRING; write the string in single quotes")
-            return T.WSTRING if e.wide else T.STRING
-        if isinstance(e, ast.Device):
-            return self._device(e)
-        if isinstance(e, ast.Index):
-            return self._index(e)
-        if isinstance(e, ast.Member):
-            return self._member(e)
-        if isinstance(e, ast.BitAccess):
-            bt = self.expr(e.base)
-            w = T.width(bt)
-            if T.is_group(bt, "any"):
-                return T.ANY
-            if w < 16 or T.is_group(bt, "real", "time", "string"):
-                self.rep.error(e, f"'.{e.bit}' needs a WORD, INT, DWORD or DINT label, not {bt}")
-            elif e.bit >= w:
-                self.rep.error(e, f"bit {e.bit} does not exist in {bt} (bits 0..{w - 1})")
-            return T.BOOL
-        if isinstance(e, ast.UnaryOp):
-            ot = self.expr(e.operand)
-            if e.op == "NOT":
-                if not T.is_any_bit(ot) and ot is not T.ANY:
-                    self.rep.error(e, f"NOT needs BOOL, WORD or DWORD, not {ot}")
-                return ot
-            if not T.is_any_num(ot) or T.is_group(ot, "bits"):
-                if ot is not T.ANY:
-                    self.rep.error(e, f"'-' needs INT, DINT or REAL, not {ot}")
-            if T.is_group(ot, "int-literal"):
-                return T.int_literal(-ot.value if ot.value is not None else None)
-            if T.is_group(ot, "real-literal"):
-                return T.real_literal(-ot.value if ot.value is not None else None)
-            return ot
-        if isinstance(e, ast.BinaryOp):
-            return self._binary(e)
-        if isinstance(e, ast.Call):
-            return self.call(e, statement=False)
-        if isinstance(e, (ast.ArrayInit, ast.StructInit)):
-            self.rep.error(e, "an array or structure value is only allowed as an initial value")
+        # by the node's class (disjoint): one dictionary look-up for the chain of tests
+        method = _EXPR_METHODS.get(type(e))
+        return method(self, e) if method is not None else T.ANY
+
+    def _int_literal(self, e: ast.IntLiteral) -> T.Type:
+        return T.int_literal(e.value)
+
+    def _real_literal(self, e: ast.RealLiteral) -> T.Type:
+        if not math.isfinite(e.value):
+            self.rep.error(e, f"{e.text} is outside the range of every real type (LREAL reaches about "
+                              "±1.8E308)")
+        return T.real_literal(e.value)
+
+    def _bool_literal(self, e: ast.BoolLiteral) -> T.Type:
+        return T.BOOL
+
+    def _time_literal(self, e: ast.TimeLiteral) -> T.Type:
+        if not -2**31 <= e.ms <= 2**31 - 1:
+            self.rep.error(e, f"{e.text} is outside the TIME range (32-bit milliseconds)")
+        return T.TIME
+
+    def _string_literal(self, e: ast.StringLiteral) -> T.Type:
+        if e.wide and self.target == "gxworks2":
+            self.rep.error(e, "GX Works2 has no WSTRING; write the string in single quotes")
+        return T.WSTRING if e.wide else T.STRING
+
+    def _bit_access(self, e: ast.BitAccess) -> T.Type:
+        bt = self.expr(e.base)
+        w = T.width(bt)
+        if T.is_group(bt, "any"):
             return T.ANY
+        if w < 16 or T.is_group(bt, "real", "time", "string"):
+            self.rep.error(e, f"'.{e.bit}' needs a WORD, INT, DWORD or DINT label, not {bt}")
+        elif e.bit >= w:
+            self.rep.error(e, f"bit {e.bit} does not exist in {bt} (bits 0..{w - 1})")
+        return T.BOOL
+
+    def _unary(self, e: ast.UnaryOp) -> T.Type:
+        ot = self.expr(e.operand)
+        if e.op == "NOT":
+            if not T.is_any_bit(ot) and ot is not T.ANY:
+                self.rep.error(e, f"NOT needs BOOL, WORD or DWORD, not {ot}")
+            return ot
+        if not T.is_any_num(ot) or T.is_group(ot, "bits"):
+            if ot is not T.ANY:
+                self.rep.error(e, f"'-' needs INT, DINT or REAL, not {ot}")
+        if T.is_group(ot, "int-literal"):
+            return T.int_literal(-ot.value if ot.value is not None else None)
+        if T.is_group(ot, "real-literal"):
+            return T.real_literal(-ot.value if ot.value is not None else None)
+        return ot
+
+    def _call_expr(self, e: ast.Call) -> T.Type:
+        return self.call(e, statement=False)
+
+    def _initializer_expr(self, e) -> T.Type:
+        self.rep.error(e, "an array or structure value is only allowed as an initial value")
         return T.ANY
 
     def _name(self, e: ast.Name) -> T.Type:
@@ -1504,6 +1517,20 @@ class Checker:
             return None
         return T.assignable(expected, t, self.target)
 
+
+
+#: Checker.stmt and Checker._expr by the node's class (the syntax tree's node classes
+#: are disjoint: no class derives from another that is checked)
+_STMT_METHODS = {ast.Assign: Checker._assign, ast.CallStmt: Checker._call_stmt, ast.If: Checker._if,
+                 ast.Case: Checker._case, ast.For: Checker._for, ast.While: Checker._while,
+                 ast.Repeat: Checker._repeat, ast.Exit: Checker._exit, ast.Return: Checker._return}
+_EXPR_METHODS = {ast.Name: Checker._name, ast.IntLiteral: Checker._int_literal,
+                 ast.RealLiteral: Checker._real_literal, ast.BoolLiteral: Checker._bool_literal,
+                 ast.TimeLiteral: Checker._time_literal, ast.StringLiteral: Checker._string_literal,
+                 ast.Device: Checker._device, ast.Index: Checker._index, ast.Member: Checker._member,
+                 ast.BitAccess: Checker._bit_access, ast.UnaryOp: Checker._unary, ast.BinaryOp: Checker._binary,
+                 ast.Call: Checker._call_expr, ast.ArrayInit: Checker._initializer_expr,
+                 ast.StructInit: Checker._initializer_expr}
 
 # ----------------------------------------------------------------------------- helpers
 #: Why a FUNCTION call that leaves out an input is an error. IEC 61131-3 lets a formal
