@@ -155,26 +155,28 @@ def check_findings(paths: list[Path], target: str,
     under the rule it comes from (see check_formats). With `platform` (a CPU profile name),
     also the devices and instructions that CPU does not have."""
     from verifier.st import check, parse, read_source
+    from verifier.st.collector import collector_held
 
     files: list[SourceFile] = []
     findings: list[Finding] = []
-    for p in paths:
-        if p.suffix.lower() == ".toml":
-            findings += [Finding(d, "UITAMR-SCENARIO") for d in check_scenario(p, platform)]
-            continue
-        text, problems = read_source(p)
-        findings += [Finding(d, "UITAMR-ST-SOURCE") for d in problems]
-        if not problems:  # an unreadable file is reported once, not also as empty
-            files.append(parse(text, str(p), target))
-    findings += [Finding(d, "UITAMR-ST-SYNTAX") for f in files for d in f.diagnostics]
-    findings += [Finding(d, "UITAMR-ST-CHECK" if d.is_error else "UITAMR-ST-WARNING")
-                 for d in check(files, target, platform)]
-    if platform is not None:
-        from verifier.sim.cpucheck import on_cpu
+    with collector_held():
+        for p in paths:
+            if p.suffix.lower() == ".toml":
+                findings += [Finding(d, "UITAMR-SCENARIO") for d in check_scenario(p, platform)]
+                continue
+            text, problems = read_source(p)
+            findings += [Finding(d, "UITAMR-ST-SOURCE") for d in problems]
+            if not problems:  # an unreadable file is reported once, not also as empty
+                files.append(parse(text, str(p), target))
+        findings += [Finding(d, "UITAMR-ST-SYNTAX") for f in files for d in f.diagnostics]
+        findings += [Finding(d, "UITAMR-ST-CHECK" if d.is_error else "UITAMR-ST-WARNING")
+                     for d in check(files, target, platform)]
+        if platform is not None:
+            from verifier.sim.cpucheck import on_cpu
 
-        standing, found = on_cpu(files, PROFILES[platform], [f.diagnostic for f in findings])
-        kept = {id(d) for d in standing}
-        findings = [f for f in findings if id(f.diagnostic) in kept] + [Finding(d, "UITAMR-ST-CPU") for d in found]
+            standing, found = on_cpu(files, PROFILES[platform], [f.diagnostic for f in findings])
+            kept = {id(d) for d in standing}
+            findings = [f for f in findings if id(f.diagnostic) in kept] + [Finding(d, "UITAMR-ST-CPU") for d in found]
     order = {str(p): i for i, p in enumerate(paths)}
     findings.sort(key=lambda f: (order.get(f.diagnostic.file, len(order)), f.diagnostic.line, f.diagnostic.col))
     return files, findings
