@@ -722,3 +722,23 @@ def test_a_pause_called_every_scan_keeps_its_result_from_a_stop_called_before_it
     assert h.bPauseOk and h.uPauseErr == 0
     assert [c[1] for c in _controls_at(line)][1:] == [POINT_3, PAUSE_FRAME, STOP_FRAME]
     assert robot.mode == "idle" and h.fbRun.o_uErrId == 0x0305
+
+
+def test_a_priority_request_of_a_kind_out_of_range_is_refused_without_ending_the_run():
+    """In the priority slot the kind shares its word with the request's tag (bits 4..14):
+    UITAMR_Command refuses a kind outside 1..4 there itself, with the engine's 16#0301 and
+    the kind as detail, nothing posted. Before, the engine refused it only after taking it
+    as a stop: the running point ended with 16#0305."""
+    project, robot, line, run = _run_point_cell(
+        "    fbOdd : UITAMR_Command;\n    uOddErr : WORD;\n    uOddDetail : WORD;\n",
+        "fbOdd(i_bEN := TRUE, i_bExecute := X6, i_wKind := 17, i_wCode := 1, i_wCommand := 3,\n"
+        "      i_bParamErr := FALSE, i_bPriority := TRUE, io_uMbx := uMbx);\n"
+        "IF fbOdd.o_bErr THEN\n    uOddErr := fbOdd.o_uErrId;\n    uOddDetail := fbOdd.o_uErrDetail;\nEND_IF;\n")
+    h = project.program("T_Cell")
+    _press(project, run, "X0", 2000)
+    run(1000)
+    _press(project, run, "X6", 0)
+    run(1000)
+    assert (h.uOddErr, h.uOddDetail) == (0x0301, 17)
+    assert robot.mode == "running" and h.fbRun.o_bBusy and h.fbRun.o_uErrId == 0
+    assert [c[1] for c in _controls_at(line)][1:] == [POINT_3]
