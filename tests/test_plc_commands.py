@@ -494,15 +494,20 @@ def test_a_pause_pressed_with_the_start_goes_after_the_point_and_pauses_it():
     assert robot.mode == "paused" and h.fbEngine.o_bPaused and h.fbRun.o_bBusy
 
 
-def test_a_stop_pressed_while_a_pause_is_served_goes_out_right_after_it():
+@pytest.mark.parametrize("stop_first", [False, True], ids=["pause-called-first", "stop-called-first"])
+def test_a_stop_pressed_while_a_pause_is_served_goes_out_right_after_it(stop_first):
     """The pause holds the priority slot while it is served (its control command and its
     status read): a stop pressed 20 ms after the pause is the next control command after
     it, one pace after the pause's status read (plc-library.md: about 600 ms after the
-    pause), and ends the paused run with 16#0305."""
+    pause), and ends the paused run with 16#0305. The stop takes over only a result that
+    was already there, uncollected, at its call in the scan before: a pause called on
+    every scan collects its own (o_bOK, not 16#0316), also one called after the stop in
+    the program, which sees the pause's result first."""
+    calls = ["fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);\n",
+             "fbStop(i_bEN := TRUE, i_bExecute := X1, io_uMbx := uMbx);\n"]
     project, robot, line, run = _run_point_cell(
-        "    fbStop : UITAMR_Stop;\n",
-        "fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);\n"
-        "fbStop(i_bEN := TRUE, i_bExecute := X1, io_uMbx := uMbx);\n")
+        "    fbStop : UITAMR_Stop;\n    bPauseOk : BOOL;\n",
+        "".join(calls[::-1] if stop_first else calls) + "IF fbPause.o_bOK THEN\n    bPauseOk := TRUE;\nEND_IF;\n")
     h = project.program("T_Cell")
     _press(project, run, "X0", 2000)
     run(2700)
@@ -514,7 +519,7 @@ def test_a_stop_pressed_while_a_pause_is_served_goes_out_right_after_it():
     (pause_at, pause), (stop_at, stop) = _controls_at(line)[2:]
     assert pause == PAUSE_FRAME and stop == encode(ControlRequest(1, 1, 0xA0), SETTINGS)
     assert 0.55 <= stop_at - pause_at <= 0.7
-    assert robot.mode == "idle" and h.fbRun.o_uErrId == 0x0305 and h.fbPause.o_uErrId == 0
+    assert robot.mode == "idle" and h.fbRun.o_uErrId == 0x0305 and h.fbPause.o_uErrId == 0 and h.bPauseOk
     page = " ".join((PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8").split())
     assert "(the pause's control command and status read: about 600 ms)" in page
 
@@ -698,30 +703,6 @@ def test_a_forgotten_pause_called_again_does_not_take_another_request_s_result(w
         assert h.bPauseBOk and h.uPauseBErr == 0 and robot.mode == "paused" and h.fbEngine.o_bPaused
         assert h.fbRun.o_bBusy and not h.fbRun.o_bErr
     assert h.uMbx[8] == 0
-
-
-def test_a_pause_called_every_scan_keeps_its_result_from_a_stop_called_before_it():
-    """The stop takes over only a result that was already there, uncollected, at its call
-    in the scan before: a pause called on every scan - here after the stop in the program,
-    so the stop sees the pause's result before the pause does - still collects it (o_bOK,
-    not 16#0316), and the stop goes out right after it."""
-    project, robot, line, run = _run_point_cell(
-        "    fbStop : UITAMR_Stop;\n    bPauseOk : BOOL;\n    uPauseErr : WORD;\n",
-        "fbStop(i_bEN := TRUE, i_bExecute := X1, io_uMbx := uMbx);\n"
-        "fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);\n"
-        "IF fbPause.o_bOK THEN\n    bPauseOk := TRUE;\nEND_IF;\n"
-        "IF fbPause.o_bErr THEN\n    uPauseErr := fbPause.o_uErrId;\nEND_IF;\n")
-    h = project.program("T_Cell")
-    _press(project, run, "X0", 2000)
-    run(2700)
-    project.devices["X3"] = True
-    run(20)
-    _press(project, run, "X1", 0)
-    project.devices["X3"] = False
-    run(2000)
-    assert h.bPauseOk and h.uPauseErr == 0
-    assert [c[1] for c in _controls_at(line)][1:] == [POINT_3, PAUSE_FRAME, STOP_FRAME]
-    assert robot.mode == "idle" and h.fbRun.o_uErrId == 0x0305
 
 
 def test_a_priority_request_of_a_kind_out_of_range_is_refused_without_ending_the_run():
