@@ -513,11 +513,13 @@ END_PROGRAM
                               "16#0304 instead of running (see its header); give a value in 1..2")], found
 
 
-def test_a_pause_called_under_a_condition_is_told_it_can_block_the_stop():
-    """review34: UITAMR_Pause now posts to the priority slot, the stop's. Called only in a
+def test_a_pause_or_stop_called_under_a_condition_is_told_it_loses_its_result():
+    """review34: UITAMR_Pause posts to the priority slot, the stop's. Called only in a
     manual-mode IF, a pause whose result came while the IF was false left it there, and
-    UITAMR_Stop then ended with 16#0303 after 30 s, unsent; check's warning said only that a
-    second press sends nothing. It now says what it does to the stop."""
+    UITAMR_Stop then ended with 16#0303 after 30 s, unsent; check warned so. s35: the stop
+    now takes such a result over (test_plc_commands.py), so that warning told of a danger
+    that is gone; what is still true is said instead: a pause or a stop called so loses its
+    result to the next priority request and ends with 16#0316."""
     text = """\
 PROGRAM Station
 VAR
@@ -534,6 +536,8 @@ END_PROGRAM
     found = [d.message for d in _check(text, ROOT / "plc" / "core", target="gxworks2") if "only under" in d.message]
     assert len(found) == 2, found
     pause, stop = found
-    assert pause.endswith("; a UITAMR_Pause not called when its result comes keeps it in the priority slot, "
-                          "the stop's: UITAMR_Stop then ends with 16#0303 after 30 s, unsent"), pause
-    assert "16#0303" not in stop
+    assert pause.endswith("; a UITAMR_Pause not called when its result comes loses it to the next stop, pause "
+                          "or resume, which takes the priority slot over: it then ends with 16#0316"), pause
+    assert stop.endswith("; a UITAMR_Stop not called when its result comes loses it to the next stop, pause "
+                         "or resume, which takes the priority slot over: it then ends with 16#0316"), stop
+    assert "16#0303" not in pause + stop

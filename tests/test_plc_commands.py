@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 import verifier
 from verifier.amr import Robot
 from verifier.amr.config import RobotConfig
@@ -492,15 +494,20 @@ def test_a_pause_pressed_with_the_start_goes_after_the_point_and_pauses_it():
     assert robot.mode == "paused" and h.fbEngine.o_bPaused and h.fbRun.o_bBusy
 
 
-def test_a_stop_pressed_while_a_pause_is_served_goes_out_right_after_it():
+@pytest.mark.parametrize("stop_first", [False, True], ids=["pause-called-first", "stop-called-first"])
+def test_a_stop_pressed_while_a_pause_is_served_goes_out_right_after_it(stop_first):
     """The pause holds the priority slot while it is served (its control command and its
     status read): a stop pressed 20 ms after the pause is the next control command after
     it, one pace after the pause's status read (plc-library.md: about 600 ms after the
-    pause), and ends the paused run with 16#0305."""
+    pause), and ends the paused run with 16#0305. The stop takes over only a result that
+    was already there, uncollected, at its call in the scan before: a pause called on
+    every scan collects its own (o_bOK, not 16#0316), also one called after the stop in
+    the program, which sees the pause's result first."""
+    calls = ["fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);\n",
+             "fbStop(i_bEN := TRUE, i_bExecute := X1, io_uMbx := uMbx);\n"]
     project, robot, line, run = _run_point_cell(
-        "    fbStop : UITAMR_Stop;\n",
-        "fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);\n"
-        "fbStop(i_bEN := TRUE, i_bExecute := X1, io_uMbx := uMbx);\n")
+        "    fbStop : UITAMR_Stop;\n    bPauseOk : BOOL;\n",
+        "".join(calls[::-1] if stop_first else calls) + "IF fbPause.o_bOK THEN\n    bPauseOk := TRUE;\nEND_IF;\n")
     h = project.program("T_Cell")
     _press(project, run, "X0", 2000)
     run(2700)
@@ -512,7 +519,7 @@ def test_a_stop_pressed_while_a_pause_is_served_goes_out_right_after_it():
     (pause_at, pause), (stop_at, stop) = _controls_at(line)[2:]
     assert pause == PAUSE_FRAME and stop == encode(ControlRequest(1, 1, 0xA0), SETTINGS)
     assert 0.55 <= stop_at - pause_at <= 0.7
-    assert robot.mode == "idle" and h.fbRun.o_uErrId == 0x0305 and h.fbPause.o_uErrId == 0
+    assert robot.mode == "idle" and h.fbRun.o_uErrId == 0x0305 and h.fbPause.o_uErrId == 0 and h.bPauseOk
     page = " ".join((PLC.parent / "docs" / "plc-library.md").read_text(encoding="utf-8").split())
     assert "(the pause's control command and status read: about 600 ms)" in page
 
@@ -602,3 +609,117 @@ def test_a_pause_during_a_relative_move_is_a_pause_too():
     run(1000)
     assert robot.mode == "idle" and not h.fbMove.o_bBusy and h.fbMove.o_uErrId == 0x0305
     assert not h.fbEngine.o_bPaused
+
+
+_FORGOTTEN_PAUSE = (
+    "IF X7 THEN                                        (* manual mode: skipped when X7 is off *)\n"
+    "    fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);\n"
+    "END_IF;\n"
+    "fbPauseB(i_bEN := TRUE, i_bExecute := X5, io_uMbx := uMbx);\n"
+    "fbStop(i_bEN := TRUE, i_bExecute := X1, io_uMbx := uMbx);\n"
+    "IF fbPause.o_bOK THEN\n    bPauseOk := TRUE;\nEND_IF;\n"
+    "IF fbPause.o_bErr THEN\n    uPauseErr := fbPause.o_uErrId;\nEND_IF;\n"
+    "IF fbPauseB.o_bOK THEN\n    bPauseBOk := TRUE;\nEND_IF;\n"
+    "IF fbPauseB.o_bErr THEN\n    uPauseBErr := fbPauseB.o_uErrId;\nEND_IF;\n"
+    "IF fbStop.o_bOK THEN\n    bStopOk := TRUE;\nEND_IF;\n"
+    "IF fbStop.o_bErr THEN\n    uStopErr := fbStop.o_uErrId;\nEND_IF;\n")
+_FORGOTTEN_LABELS = ("    fbPauseB : UITAMR_Pause;\n    fbStop : UITAMR_Stop;\n    bPauseOk : BOOL;\n"
+                     "    uPauseErr : WORD;\n    bPauseBOk : BOOL;\n    uPauseBErr : WORD;\n    bStopOk : BOOL;\n"
+                     "    uStopErr : WORD;\n")
+STOP_FRAME = encode(ControlRequest(1, 1, 0xA0), SETTINGS)
+
+
+def _pause_forgotten_then_stop(project, robot, line, run):
+    """Point 3 runs; the manual-mode pause (X3 while X7) is pressed and X7 drops before its
+    result comes: the robot pauses, the result stays uncollected in the priority slot. Then
+    the stop (X1) is pressed: -> the time of the press and of the stop's frame, just sent."""
+    h = project.program("T_Cell")
+    _press(project, run, "X0", 2000)                          # point 3 from ~2.4 s, 8 s long
+    run(1000)
+    project.devices["X7"] = project.devices["X3"] = True
+    run(30)
+    project.devices["X7"] = project.devices["X3"] = False     # the section is skipped from now on
+    run(1500)
+    assert robot.mode == "paused" and h.fbEngine.o_bPaused
+    assert h.uMbx[8] == 3 and h.fbPause.o_bBusy               # its result waits, nobody collects it
+    pressed_at = project.now_us / 1e6
+    project.devices["X1"] = True
+    stops = []
+    while not stops and project.now_us / 1e6 < pressed_at + 1.0:
+        run(10)
+        stops = [t for t, frame in _controls_at(line) if frame == STOP_FRAME and t > pressed_at]
+    assert stops, "the stop was not sent"
+    assert h.fbStop.o_bBusy                                   # its status read is still to come
+    return pressed_at, stops[0]
+
+
+def test_a_pause_not_called_when_its_result_comes_does_not_block_the_stop():
+    """review34/s35: UITAMR_Pause posts to the stop's priority slot. Called in a manual-mode IF
+    that went false before its result came, it left the result there, and UITAMR_Stop pressed
+    afterwards never got the slot: it ended with 16#0303 after 30 s WITHOUT SENDING THE STOP.
+    The stop now takes over a result its owner did not collect within a scan: its frame
+    goes out at the next pace and it ends with o_bOK, the run with 16#0305."""
+    project, robot, line, run = _run_point_cell(_FORGOTTEN_LABELS, _FORGOTTEN_PAUSE)
+    h = project.program("T_Cell")
+    pressed_at, stop_at = _pause_forgotten_then_stop(project, robot, line, run)
+    assert stop_at <= pressed_at + 0.35                       # within one pace of the button
+    project.devices["X1"] = False
+    run(1000)
+    assert h.bStopOk and h.uStopErr == 0 and robot.mode == "idle"
+    assert h.fbRun.o_uErrId == 0x0305 and not h.fbRun.o_bBusy and not h.fbEngine.o_bPaused
+    assert h.uMbx[8] == 0
+
+
+
+@pytest.mark.parametrize("while_served", ["the stop", "a newer pause"])
+def test_a_forgotten_pause_called_again_does_not_take_another_request_s_result(while_served):
+    """The priority slot of a forgotten pause is reused (by the stop, then by any pause or
+    resume): called again while that other request is served, the old UITAMR_Pause must
+    not collect its result as its own - a pause writes the same kind and command as the
+    one before it. It ends with o_bErr 16#0316 (its result was taken over), and the owner
+    of the request gets its own result."""
+    project, robot, line, run = _run_point_cell(_FORGOTTEN_LABELS, _FORGOTTEN_PAUSE)
+    h = project.program("T_Cell")
+    _pause_forgotten_then_stop(project, robot, line, run)
+    if while_served == "a newer pause":
+        project.devices["X1"] = False
+        run(1000)
+        assert h.bStopOk and robot.mode == "idle"
+        _press(project, run, "X0", 0)                         # the point again
+        run(1000)
+        assert robot.mode == "running"
+        pressed_at = project.now_us / 1e6
+        project.devices["X5"] = True                          # the other pause (called every scan)
+        for _ in range(100):
+            run(10)
+            if [t for t, frame in _controls_at(line) if frame == PAUSE_FRAME and t > pressed_at]:
+                break
+    project.devices["X7"] = True                              # the old pause is called again while the
+    run(2000)                                                 # other is served, ahead of its owner
+    assert h.uPauseErr == 0x0316 and not h.bPauseOk and not h.fbPause.o_bBusy
+    if while_served == "the stop":
+        assert h.bStopOk and h.uStopErr == 0 and robot.mode == "idle"
+    else:
+        assert h.bPauseBOk and h.uPauseBErr == 0 and robot.mode == "paused" and h.fbEngine.o_bPaused
+        assert h.fbRun.o_bBusy and not h.fbRun.o_bErr
+    assert h.uMbx[8] == 0
+
+
+def test_a_priority_request_of_a_kind_out_of_range_is_refused_without_ending_the_run():
+    """In the priority slot the kind shares its word with the request's tag (bits 4..14):
+    UITAMR_Command refuses a kind outside 1..4 there itself, with the engine's 16#0301 and
+    the kind as detail, nothing posted. Before, the engine refused it only after taking it
+    as a stop: the running point ended with 16#0305."""
+    project, robot, line, run = _run_point_cell(
+        "    fbOdd : UITAMR_Command;\n    uOddErr : WORD;\n    uOddDetail : WORD;\n",
+        "fbOdd(i_bEN := TRUE, i_bExecute := X6, i_wKind := 17, i_wCode := 1, i_wCommand := 3,\n"
+        "      i_bParamErr := FALSE, i_bPriority := TRUE, io_uMbx := uMbx);\n"
+        "IF fbOdd.o_bErr THEN\n    uOddErr := fbOdd.o_uErrId;\n    uOddDetail := fbOdd.o_uErrDetail;\nEND_IF;\n")
+    h = project.program("T_Cell")
+    _press(project, run, "X0", 2000)
+    run(1000)
+    _press(project, run, "X6", 0)
+    run(1000)
+    assert (h.uOddErr, h.uOddDetail) == (0x0301, 17)
+    assert robot.mode == "running" and h.fbRun.o_bBusy and h.fbRun.o_uErrId == 0
+    assert [c[1] for c in _controls_at(line)][1:] == [POINT_3]

@@ -175,10 +175,12 @@ def _constant(value: ast.Expr | None) -> bool | None:
     return value.value if isinstance(value, ast.BoolLiteral) else None
 
 
-#: what a UITAMR_Pause called only under a condition does besides: it shares the priority
-#: slot with the stop (docs/plc-library.md, "Pause and resume while a point runs")
-PAUSE_HOLDS_THE_STOP = ("; a UITAMR_Pause not called when its result comes keeps it in the priority slot, the "
-                        "stop's: UITAMR_Stop then ends with 16#0303 after 30 s, unsent")
+#: what a UITAMR_Pause or UITAMR_Stop called only under a condition does besides: they share
+#: the priority slot, and a result left there uncollected is taken over by the next request
+#: (docs/plc-library.md, "The mailbox (io_uMbx)"; it no longer holds the stop back)
+PRIORITY_RESULT_LOST = ("; a {fb} not called when its result comes loses it to the next stop, pause or "
+                        "resume, which takes the priority slot over: it then ends with 16#0316")
+PRIORITY_FBS = ("UITAMR_PAUSE", "UITAMR_STOP")
 
 
 def _execute_input(call: ast.Call) -> str | None:
@@ -759,7 +761,8 @@ class Checker:
                     f"so after one command a new one gets no rising edge (a second press sends nothing); "
                     f"call it on every scan, {where}, and give the condition to {execute} "
                     f"({execute} := <button>) (docs/plc-library.md: call every FB on every scan)"
-                    + (PAUSE_HOLDS_THE_STOP if first.call.resolved.fb_type.name.upper() == "UITAMR_PAUSE" else "")))
+                    + (PRIORITY_RESULT_LOST.format(fb=first.call.resolved.fb_type.name)
+                       if first.call.resolved.fb_type.name.upper() in PRIORITY_FBS else "")))
                 continue
             for s, depth in found:
                 value = next((a.value for a in s.call.args if not a.output and a.key == execute.upper()), None)
