@@ -54,3 +54,36 @@ def test_a_string_is_converted_with_str_and_time_is_not_called_a_bit_string():
         "t.st:8:6: error: '+' needs INT, DINT or REAL operands, not TIME; arithmetic on TIME is not allowed "
         "(convert with TIME_TO_DINT, and back with DINT_TO_TIME)",
     ]
+
+
+MISSPELT = """TYPE Pose : STRUCT
+    wX : INT;
+    wHeading : INT;
+END_STRUCT END_TYPE
+PROGRAM Typos
+VAR
+    fbRun : TON;
+    bStart : BOOL;
+    stPose : Pose;
+    wOut : INT;
+END_VAR
+fbRun(IN := bStrat, PT := T#1s);
+wOut := TIME_TO_INT(fbRun.ETT);
+wOut := stPose.wHeadin;
+fbRn(IN := TRUE);
+wOut := wNothingLikeIt;
+END_PROGRAM
+"""
+
+
+def test_a_misspelt_label_member_or_instance_gets_the_name_meant():
+    """'undefined label' alone sent the integrator hunting through the VAR block for a
+    typo: the label, structure member, FB output or instance spelt nearly so is named."""
+    source = st.parse(MISSPELT, "typos.st", "gxworks2")
+    assert source.diagnostics == []
+    messages = {d.line: d.message for d in st.check([source], "gxworks2")}
+    assert messages[12] == "undefined label 'bStrat'; did you mean 'bStart'?"
+    assert messages[13] == "TON has no input or output 'ETT'; did you mean 'ET'?"
+    assert messages[14] == "structure Pose has no member 'wHeadin'; did you mean 'wHeading'?"
+    assert messages[15] == "unknown function or instruction 'fbRn'; did you mean 'fbRun'?"
+    assert messages[16] == "undefined label 'wNothingLikeIt'; declare it in a VAR block"

@@ -1031,8 +1031,19 @@ class Checker:
         elif re.fullmatch(r"H[0-9A-F]+", e.name, re.IGNORECASE):
             self.rep.error(e, f"undefined label '{e.name}'; for the hex constant write 16#{e.name[1:]} (or H0{e.name[1:]})")
         else:
-            self.rep.error(e, f"undefined label '{e.name}'; declare it in a VAR block")
+            guess = self._label_hint(e.name)
+            self.rep.error(e, f"undefined label '{e.name}'" + (guess or "; declare it in a VAR block"))
         return T.ANY
+
+    def _label_hint(self, name: str) -> str:
+        """'; did you mean 'fbRun'?' when a label this POU sees (its own, a global) or a POU
+        is spelt nearly as `name`, else "" (the error path only)."""
+        from verifier.amr.schema import did_you_mean
+
+        seen = [decl.name for decl, _t in (self.pou.labels.values() if self.pou is not None else ())]
+        seen += [decl.name for decl, _t in self.table.globals.values()]
+        seen += [info.pou.name for info in self.table.pous.values()]
+        return did_you_mean(name, seen)
 
     def _device(self, e: ast.Device) -> T.Type:
         if e.bit is not None:
@@ -1072,13 +1083,17 @@ class Checker:
         if isinstance(bt, T.StructOf):
             ft = bt.field(e.member)
             if ft is None:
-                self.rep.error(e, f"structure {bt} has no member '{e.member}'")
+                self.rep.error(e, f"structure {bt} has no member '{e.member}'"
+                                  + _did_you_mean(e.member, [n for n, _t in bt.fields]))
                 return T.ANY
             return ft
         if isinstance(bt, T.FbType):
             p = bt.param(e.member)
             if p is None:
-                self.rep.error(e, f"{bt} has no input or output '{e.member}'{self._internal_label(bt, e.member)}")
+                self.rep.error(e, f"{bt} has no input or output '{e.member}'"
+                                  + (self._internal_label(bt, e.member)
+                                     or _did_you_mean(e.member, [n for group in (bt.inputs, bt.outputs)
+                                                                 for n, _t in group])))
                 return T.ANY
             if p[0] == "in_out":
                 self.rep.error(e, f"'{e.member}' is a VAR_IN_OUT of {bt}; it cannot be read from outside")
@@ -1254,7 +1269,8 @@ class Checker:
             self._args_only(c)
             return T.ANY
         hint = _in_library(c.name, self.plc_shown)
-        self.rep.error(c.callee, f"unknown function or instruction '{c.name}'" + (f"; {hint}" if hint else ""))
+        self.rep.error(c.callee, f"unknown function or instruction '{c.name}'"
+                                 + (f"; {hint}" if hint else self._label_hint(c.name)))
         self._args_only(c)
         return T.ANY
 
@@ -1802,6 +1818,12 @@ def _ladder_spelling(callee: ast.Expr, table, pou) -> tuple[str, str] | None:
     if joined.upper() not in library.INSTRUCTIONS:
         return None
     return f"{callee.base.name}.{callee.member}", joined
+
+
+def _did_you_mean(name: str, candidates: list[str]) -> str:
+    from verifier.amr.schema import did_you_mean
+
+    return did_you_mean(name, candidates)
 
 
 def _parameter_hint(fb: T.FbType, name: str) -> str:
