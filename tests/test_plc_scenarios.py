@@ -304,3 +304,38 @@ def test_the_fx3u_adprw_port_paragraph_names_every_scenario_that_verifies_it():
     paragraph = paragraph.split("As for every ADPRW detail above", 1)[0]
     named = set(re.findall(r"`(fx3u-adprw-[a-z-]+)\.toml`", paragraph)) | {"fx3u-adprw-healthy"}
     assert named == {p.stem for p in SCENARIOS if p.stem.startswith("fx3u-adprw-")}
+
+
+#: the FX5U and Q examples with pause and resume: (scenario of that example, start, stop, pause, resume)
+PAUSE_EXAMPLES = {
+    "UITAMR_ExampleFx5": ("fx5u-pause-stop", "X0", "X1", "X3", "X4"),
+    "UITAMR_ExampleAdpFx5": ("fx5u-adprw-pause-resume", "X0", "X1", "X3", "X4"),
+    "UITAMR_ExampleTcpFx5": ("fx5u-tcp-pause-stop", "X0", "X1", "X3", "X4"),
+    "UITAMR_ExampleQ": ("q-pause-stop", "X20", "X21", "X23", "X24"),
+    "UITAMR_ExampleTcpQ": ("q-tcp-pause-stop", "X20", "X21", "X23", "X24"),
+}
+
+
+@pytest.mark.parametrize("example", sorted(PAUSE_EXAMPLES))
+def test_the_resume_button_of_an_fx5u_or_q_example_moves_nothing_when_no_point_runs(example):
+    """The FX5U and Q examples' resume is the point of the cycle sent again (UITAMR_Command
+    kind 2); sent with nothing paused it would be a new run that no UITAMR_RunPoint follows.
+    They ask it only while a point of the cycle runs: pressed before the start and after the
+    stop has ended the paused point, it sends nothing; the line carries the power-on stop,
+    point 1, the pause and the stop, and no rule is broken."""
+    from dataclasses import replace
+
+    from verifier.verify.scenario import InputStep
+
+    name, start, stop, pause, resume = PAUSE_EXAMPLES[example]
+    scenario = load_scenario(ROOT / "plc" / "scenarios" / f"{name}.toml")
+    assert scenario.program == example
+    steps = [(1.0, resume), (2.0, start), (4.0, pause), (7.0, stop), (9.0, resume)]
+    scenario = replace(scenario, duration_us=14_000_000, expectations=[],
+                       inputs=[InputStep(at_us=int(at * 1e6), values={device: True}, pulse_us=300_000, key=f"inputs[{i}]")
+                               for i, (at, device) in enumerate(steps)])
+    result = run_scenario(scenario)
+    assert result.aborted is None, result.aborted
+    assert [v.message for v in result.all_violations()] == []
+    controls = [f.data[2:4] for f in result.trace if f.direction == "tx" and f.data[1] == 0x06]
+    assert controls == [b"\x01\xa0", b"\x01\x01", b"\x01\x80", b"\x01\xa0"]   # stop, point 1, pause, stop

@@ -60,7 +60,7 @@ def test_every_bundled_scenario_replays_to_the_findings_verify_made(tmp_path):
     UITAMR-CYCLE finding at 3.03 s and FX3U bad CRC for 5 s a UITAMR-RESPONSE-HANDLING one at
     12.03 s (the program showed it in time), and every run ended at its last frame."""
     verified, replayed = verify_then_replay(tmp_path)
-    assert len(findings(verified)) == len(bundled_scenarios()) == 63
+    assert len(findings(verified)) == len(bundled_scenarios()) == 74
     assert differences(verified, replayed) == []
     assert ends(replayed) == ends(verified)
 

@@ -185,8 +185,8 @@ def test_matrix_runs_user_sources_under_the_bundled_robot_and_faults_of_their_pl
     """The platform is told from the sources (FX5 RS2/SM/SD); only that platform's bundled
     scenarios run; their example-specific inputs/expectations are left out and each result
     says so; scenarios that became the same run (healthy via RS2 and via ADPRW, and the stop
-    button during a run, whose only difference was the button) run once, and the one run
-    names the others."""
+    button during a run and the pause scenarios, whose only difference was the buttons) run
+    once, and the one run names the others."""
     from verifier.verify.scenario import load_scenario
 
     report = tmp_path / "m.json"
@@ -197,7 +197,10 @@ def test_matrix_runs_user_sources_under_the_bundled_robot_and_faults_of_their_pl
     fx5 = [s for s in map(load_scenario, bundled_scenarios()) if s.platform == "fx5u" and s.converter is None]
     names = [s["name"] for s in data["scenarios"]]
     merged = {note.split("'")[1] for s in data["scenarios"] for note in s["notes"] if "also stands for" in note}
-    assert merged == {"FX5U: power-on stop, then a cycle over points 1-3", "FX5U: the stop button during point 2"}
+    assert merged == {"FX5U: power-on stop, then a cycle over points 1-3", "FX5U: the stop button during point 2",
+                      "FX5U: point 1 of the cycle paused on the way and resumed",
+                      "FX5U: a paused point of the cycle stopped",
+                      "FX5U ADPRW: point 1 of the cycle paused on the way and resumed"}
     assert sorted(names + sorted(merged)) == sorted(s.name for s in fx5)
     for scenario in data["scenarios"]:
         assert scenario["platform"] == "fx5u" and scenario["program"] == "UITAMR_ExampleFx5"
@@ -223,8 +226,9 @@ def test_matrix_notes_name_a_bundled_scenario_as_its_headline_does(monkeypatch):
 
 def test_matrix_of_a_tcp_program_runs_the_converter_scenarios_only(tmp_path):
     """The FX5U TCP example (its library folder also holds the serial port FBs) runs under the
-    bundled FX5U converter scenarios, not the serial ones; a converter refusing connections at
-    first moves the power-on stop's window after the refusals."""
+    bundled FX5U converter scenarios, not the serial ones (the two pause scenarios, whose
+    only difference from the healthy one is the buttons, in its run); a converter refusing
+    connections at first moves the power-on stop's window after the refusals."""
     from verifier.verify.scenario import load_scenario
 
     report = tmp_path / "m.json"
@@ -234,7 +238,10 @@ def test_matrix_of_a_tcp_program_runs_the_converter_scenarios_only(tmp_path):
     assert result.exit_code == 0, result.output
     data = json.loads(report.read_text())
     tcp = {s.name for s in map(load_scenario, bundled_scenarios()) if s.platform == "fx5u" and s.converter}
-    assert {s["name"] for s in data["scenarios"]} == tcp and len(tcp) == 5
+    merged = {note.split("'")[1] for s in data["scenarios"] for note in s["notes"] if "also stands for" in note}
+    assert merged == {"FX5U over TCP: point 1 of the cycle paused on the way and resumed",
+                      "FX5U over TCP: a paused point of the cycle stopped"}
+    assert {s["name"] for s in data["scenarios"]} | merged == tcp and len(tcp) == 7
     refused = next(s for s in data["scenarios"] if "refuses" in s["name"])
     assert [e["expectation"] for e in refused["expectations"]] == ["sent stop within 5 s after 3 s"]
 
