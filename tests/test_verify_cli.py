@@ -40,6 +40,23 @@ def test_sources_without_a_scenario_run_a_healthy_robot(tmp_path):
     assert scenario["frames"]["tx"] >= 10  # the engine polls while idle
 
 
+def test_a_copied_bundled_scenario_runs_on_the_files_given_though_its_sources_are_not_beside_it(tmp_path):
+    """docs/scenarios.md: `uitamr verify FILES...` replaces the scenario's `sources`. A copy of
+    a bundled scenario (it names `../core/*.st`) ended with exit 2, "sources[0]: '../core/*.st'
+    matches no file", before the FILES given were used."""
+    copy = tmp_path / "fx3u-healthy.toml"
+    copy.write_text((PLC / "scenarios" / "fx3u-healthy.toml").read_text(encoding="utf-8"), encoding="utf-8")
+    assert '"../core/*.st"' in copy.read_text(encoding="utf-8")
+    report = tmp_path / "r.json"
+    result = invoke("--scenario", copy, *FX3_SOURCES, "--json", report)
+    assert result.exit_code == 0, result.output
+    assert json.loads(report.read_text())["verdict"] == "pass"
+    # without FILES the copy's sources are looked for, and named at their line
+    result = invoke("--scenario", copy)
+    assert result.exit_code == 2
+    assert "sources[0]: '../core/*.st' matches no file" in result.output
+
+
 def test_every_report_is_written(tmp_path):
     paths = {kind: tmp_path / f"out.{kind}" for kind in ("json", "junit", "trace", "html")}
     result = invoke(*FX3_SOURCES, "--program", "UITAMR_ExampleFx3", "--duration", "3s", "--scan", "5ms",

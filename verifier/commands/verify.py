@@ -126,13 +126,14 @@ def _unusable_after(messages: list[str], junit: tuple[bool, str] | None) -> None
     _unusable(*messages, said)
 
 
-def _read_scenarios(files, platform: str | None = None) -> list[Scenario]:
+def _read_scenarios(files, platform: str | None = None, sources_replaced: bool = False) -> list[Scenario]:
     """Every scenario file read; the mistakes of all of them reported together, as `uitamr
-    check` does (one at a time, a folder of scenarios took a run per mistake to clean up)."""
+    check` does (one at a time, a folder of scenarios took a run per mistake to clean up).
+    `sources_replaced`: SOURCES were given, their `sources` are not looked for."""
     read, mistakes = [], []
     for f in files:
         try:
-            read.append(load_scenario(f, platform))
+            read.append(load_scenario(f, platform, sources_replaced))
         except ScenarioError as exc:
             mistakes.append(exc)
     _raise_together(mistakes)
@@ -154,7 +155,7 @@ def _scenarios(sources, program, platform, channel, scenario_files, matrix, dura
     resolved = _source_files(sources) if sources else ()
     scenario_files = _scenario_files(scenario_files)
     given = {real_path(f) for f in scenario_files}
-    own = _read_scenarios(scenario_files, platform)  # --platform: the CPU they run on
+    own = _read_scenarios(scenario_files, platform, bool(resolved))  # --platform: the CPU they run on
     bundled_files: list[Path] = []
     if matrix or (not sources and not scenario_files):
         found = bundled_scenarios()

@@ -339,10 +339,13 @@ def scenario_power_on_stop(scenario: "Scenario") -> Expectation:
 # --- loading -------------------------------------------------------------------------------
 
 
-def load_scenario(path: Path | str, platform: str | None = None) -> Scenario:
+def load_scenario(path: Path | str, platform: str | None = None, sources_replaced: bool = False) -> Scenario:
     """The scenario file at `path`. `platform`: the CPU the run is on when the file names
     none (`--platform` of verify and check), else the default fx3u: its [converter],
-    [[c24]] and devices are judged for the CPU they will run on."""
+    [[c24]] and devices are judged for the CPU they will run on. `sources_replaced`: the
+    command's own ST files take the place of the file's `sources` (`uitamr verify FILES
+    --scenario`): those are read as names only, not looked for (a copy of a bundled
+    scenario names `../core/*.st`, which need not exist beside the copy)."""
     path = Path(path)
     try:
         if not path.exists():
@@ -355,10 +358,11 @@ def load_scenario(path: Path | str, platform: str | None = None) -> Scenario:
         text = read_utf8(path)
     except UnreadableText as exc:
         raise ScenarioError(path, "", exc.after_place(), exc.place) from None
-    return parse_scenario(text, path, platform)
+    return parse_scenario(text, path, platform, sources_replaced)
 
 
-def parse_scenario(text: str, path: Path | None = None, platform: str | None = None) -> Scenario:
+def parse_scenario(text: str, path: Path | None = None, platform: str | None = None,
+                   sources_replaced: bool = False) -> Scenario:
     try:
         data = tomllib.loads(text)
     except (ValueError, RecursionError) as exc:
@@ -367,7 +371,7 @@ def parse_scenario(text: str, path: Path | None = None, platform: str | None = N
 
         message, place = decode_error_position(exc, text)
         raise ScenarioError(path, "", f"not valid TOML: {message}{capture_instead(text, path)}", place) from None
-    return _Reader(text, path, platform).read(data)
+    return _Reader(text, path, platform, sources_replaced).read(data)
 
 
 #: how many characters follow the backslash of a TOML basic string's escape (`\t`: 1,
@@ -413,8 +417,9 @@ def _string_characters(lines: list[str], row: int, col: int, delimiter: str) -> 
 class _Reader:
     """Turns the parsed TOML into a Scenario; every error names its key and line."""
 
-    def __init__(self, text: str, path: Path | None, platform: str | None = None):
+    def __init__(self, text: str, path: Path | None, platform: str | None = None, sources_replaced: bool = False):
         self.lines = text_lines(text)
+        self.sources_replaced = sources_replaced  # the command's FILES stand in for `sources`
         self.path = path
         self.default_platform = platform.lower() if platform else DEFAULT_PLATFORM  # when the file names none
         self.platform_option = platform is not None  # that default is --platform's, not fx3u's
@@ -817,6 +822,8 @@ class _Reader:
         found: list[Path] = []
         for i, item in enumerate(value):
             name = self.string(item, f"sources[{i}]")
+            if self.sources_replaced:
+                continue  # replaced by the command's own files: not looked for
             try:
                 found += expand(name, self.base)
             except SourceError as exc:
