@@ -483,12 +483,15 @@ def log_time(line: str) -> float:
 
 def test_serial_reply_waits_for_t3_5_at_the_port_speed(pty_pair, start_emulator):
     """--turnaround-ms 0 at 1200 bit/s: the reply still waits t3.5 (29.2 ms) after the
-    request, as a slave must; it went out at once. Judged on the emulator's own log."""
+    request, as a slave must; it went out at once. Judged on the emulator's own log, which
+    says at the start that the turnaround asked is raised."""
     robot_end, master_end = pty_pair
     emulator = start_emulator("--serial", robot_end, "--baud", "1200", "--turnaround-ms", "0")
     with serial.Serial(master_end, 1200, timeout=WAIT_S) as port:
         port.write(STOP_FRAME)
         assert port.read(8) == STOP_FRAME
+    # and the log says so before the first request (it said nothing of the 0 ms asked)
+    emulator.wait_for(r"-- replies start 29.167 ms after a request, not 0 ms: never sooner than t3.5 at 1200 bit/s")
     request = emulator.wait_for(r"<- 01 06 01 A0").string
     reply = emulator.wait_for(r"-> 01 06 01 A0").string
     # t3.5 = 29.167 ms; the log counts whole ms, compared as whole ms (0.030 - 0.001 is
