@@ -20,11 +20,12 @@ def _bench_module():
 def test_the_bench_times_what_uitamr_check_reports(tmp_path):
     bench = _bench_module()
     chunks = bench._candidate_sources()[:6]
-    seconds, count = bench.time_check(chunks, repeat=1)
+    paths = bench.write_corpus(chunks, tmp_path)
+    assert [p.read_text(encoding="utf-8") for p in paths] == chunks
+    seconds, count = bench.time_check(paths, repeat=1)
     assert seconds > 0
-    for i, chunk in enumerate(chunks):
-        (tmp_path / f"bench{i:04}.st").write_text(chunk, encoding="utf-8")
     _files, findings = check_findings(sorted(tmp_path.glob("*.st")), "gxworks3")
     assert count == len(findings)
     assert not [f for f in findings if f.rule == "UITAMR-ST-SYNTAX"]
+    assert bench.time_command(tmp_path, repeat=1) > 0  # the whole command ran (exit 0 or 1)
 
