@@ -555,3 +555,16 @@ def test_the_console_shows_the_head_of_a_long_frame_and_where_the_whole_is():
     assert shown and all(f"PLC→robot {head} … (3200 bytes: every one in --json, --trace or --html)" in line
                          for line in shown), shown
     assert max(len(line) for line in out.getvalue().splitlines()) < 400
+
+
+def test_violations_of_the_same_moment_are_listed_in_the_rules_order_everywhere():
+    """The HTML and JSON lists broke a tie of time by the rule's name (HALF-DUPLEX before
+    PACING), the console and the JUnit report by the rules' own order (PACING first)."""
+    from verifier.verify.evidence import Violation
+
+    result = bad_result()
+    result.violations = {"UITAMR-PACING": [Violation("UITAMR-PACING", 500_000, "too soon")],
+                         "UITAMR-HALF-DUPLEX": [Violation("UITAMR-HALF-DUPLEX", 100_000, "earlier"),
+                                                Violation("UITAMR-HALF-DUPLEX", 500_000, "both talked")]}
+    assert [v.message for v in result.all_violations()] == ["earlier", "too soon", "both talked"]
+    assert [found[0].rule for found in result.broken_rules()] == ["UITAMR-HALF-DUPLEX", "UITAMR-PACING"]

@@ -335,7 +335,12 @@ class ScenarioResult:
         return CUT_SHORT if self.cut_short is not None else "pass"
 
     def all_violations(self) -> list[Violation]:
-        return sorted((v for found in self.violations.values() for v in found), key=lambda v: (v.t_us, v.rule))
+        """Every violation by time; those of the same time in the rules' own order, as
+        `broken_rules` and so the console and the JUnit report list them (the HTML and JSON
+        lists put them in the order of the rules' names: a PACING violation came after a
+        HALF-DUPLEX one of the same moment there, before it in the console)."""
+        order = {rule: i for i, rule in enumerate(self.violations)}
+        return sorted((v for found in self.violations.values() for v in found), key=lambda v: (v.t_us, order[v.rule]))
 
 
 def run_names(results: list[ScenarioResult]) -> list[str]:
