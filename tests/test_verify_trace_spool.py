@@ -157,14 +157,18 @@ def test_a_worker_batch_that_cannot_go_on_leaves_no_spool_file(tmp_path):
     assert list(out.iterdir()) == []
 
 
-def _spawn_matrix(out: Path):
+def _spawn_matrix(out: Path, duration: str = "600s", each_batch: bool = False):
     """`uitamr verify --matrix --jobs 2 --trace` long enough to be stopped midway, in a
-    process group of its own (as a CI job runs it)."""
+    process group of its own (as a CI job runs it). `each_batch`: a progress line on stderr
+    as each batch of scenarios comes back from its worker (the plain progress of a CI log,
+    shown at once instead of every 30 s), for the test to act on."""
     import subprocess
     import sys
 
-    return procs.spawn([sys.executable, "-m", "verifier.cli", "verify", "--matrix", "--duration", "600s",
-                             "--jobs", "2", "--trace", str(out / "t.jsonl")],
+    program = ["-m", "verifier.cli"] if not each_batch else [
+        "-c", "import verifier.commands.verify as v; v.PLAIN_PROGRESS_EVERY_S = 0; from verifier.cli import main; main()"]
+    return procs.spawn([sys.executable, *program, "verify", "--matrix", "--duration", duration,
+                        "--jobs", "2", "--trace", str(out / "t.jsonl")],
                        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
 
 
@@ -194,6 +198,83 @@ def test_a_ci_time_out_stops_the_run_and_leaves_nothing(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+def _first_line(proc, within_s: float = 120) -> bytes:
+    """The first line the process writes on stderr, read from the pipe itself (what
+    `communicate` reads later is not taken into a buffer here)."""
+    import os
+    import select
+
+    line = b""
+    while not line.endswith(b"\n"):
+        ready, _, _ = select.select([proc.stderr.fileno()], [], [], within_s)
+        assert ready, f"no line on stderr in {within_s} s"
+        byte = os.read(proc.stderr.fileno(), 1)
+        assert byte, f"stderr ended: {line!r}"
+        line += byte
+    return line
+
+
+def _workers(proc) -> list[int]:
+    return [int(pid) for pid in Path(f"/proc/{proc.pid}/task/{proc.pid}/children").read_text().split()]
+
+
+def _running(pid: int) -> bool:
+    """A process that is there and not a zombie (reaped or not, a killed worker runs nothing)."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except (FileNotFoundError, ProcessLookupError):
+        return False
+    return stat[stat.rindex(")") + 2] != "Z"
+
+
+def test_a_ci_time_out_just_after_a_batch_came_back_stops_the_run_and_leaves_nothing(tmp_path):
+    """SIGTERM to the job's process group just as a worker's batch came back, when the pool
+    holds batches that no worker has started: the command hung for good (SIGTERM raised its
+    exit inside the pool's wait, the clean-up cancelled those batches, the pool's thread then
+    failed on them and left its queue's feeder blocked, and the exit waits for that), or
+    printed "Exception in thread" with its traceback. Each time: exit 143, nothing left."""
+    import os
+    import signal
+
+    for attempt in range(3):  # before: most such signals hung it, here
+        out = tmp_path / str(attempt)
+        out.mkdir()
+        proc = _spawn_matrix(out, "60s", each_batch=True)
+        line = _first_line(proc)
+        assert line.startswith(b"verify: "), line  # the first batch came back
+        os.killpg(proc.pid, signal.SIGTERM)
+        _, stderr = procs.finish(proc, 60)
+        assert proc.returncode == 143, stderr.decode()
+        assert b"Traceback" not in stderr and b"Exception in thread" not in stderr, stderr.decode()
+        assert list(out.iterdir()) == []
+
+
+@pytest.mark.parametrize("stop", ["sigterm-to-the-command", "ctrl-c"])
+def test_a_stopped_command_stops_its_workers(tmp_path, stop):
+    """SIGTERM to the command alone (`kill PID`, `docker stop`): it waited for its workers,
+    which had not been signalled, to finish their batches (a day long here). Ctrl-C (to the
+    terminal's process group): each worker sent its KeyboardInterrupt back and went on with
+    the next batch the pool had queued. Now the workers are killed: exit 143 or 130 (with
+    its message), the workers gone, nothing left."""
+    import os
+    import signal
+
+    proc = _spawn_matrix(tmp_path, "24h")
+    _wait_for_spool(tmp_path, proc)
+    workers = _workers(proc)
+    assert workers, "the pool has no worker process"
+    if stop == "ctrl-c":
+        os.killpg(proc.pid, signal.SIGINT)
+    else:
+        os.kill(proc.pid, signal.SIGTERM)
+    _, stderr = procs.finish(proc, 60)
+    assert proc.returncode == (130 if stop == "ctrl-c" else 143), stderr.decode()
+    said = b"\nuitamr verify: interrupted (Ctrl-C) before it finished: no verdict\n" if stop == "ctrl-c" else b""
+    assert stderr == said
+    assert [pid for pid in workers if _running(pid)] == []
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_worker_killed_midway_is_said_and_leaves_nothing(tmp_path):
     """A worker process killed (the OOM killer): exit 2 with a message, no traceback, and
     no spool file left, although the worker could not remove its own."""
@@ -202,9 +283,9 @@ def test_a_worker_killed_midway_is_said_and_leaves_nothing(tmp_path):
 
     proc = _spawn_matrix(tmp_path)
     _wait_for_spool(tmp_path, proc)
-    children = Path(f"/proc/{proc.pid}/task/{proc.pid}/children").read_text().split()
+    children = _workers(proc)
     assert children, "the pool has no worker process"
-    os.kill(int(children[0]), signal.SIGKILL)
+    os.kill(children[0], signal.SIGKILL)
     _, stderr = procs.finish(proc, 120)
     assert proc.returncode == 2, stderr.decode()
     assert b"a worker process of --jobs 2 stopped without a word" in stderr and b"Traceback" not in stderr

@@ -11,7 +11,7 @@ import sys
 import time
 from contextlib import contextmanager
 from itertools import accumulate
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import replace
 from pathlib import Path
@@ -42,6 +42,7 @@ from verifier.verify.sources import SourceError, expand, st_files_in, unique
 EXIT_PASS, EXIT_FAIL, EXIT_UNUSABLE = 0, 1, 2
 SHOW_PROGRESS_AFTER_S = 0.5
 PLAIN_PROGRESS_EVERY_S = 30.0  # progress lines in CI logs (not a terminal)
+STOP_CHECK_EVERY_S = 0.2  # how soon a SIGTERM or Ctrl-C held while --jobs workers run is acted on
 
 
 def bundled_scenarios() -> list[Path]:
@@ -488,8 +489,13 @@ def _worker_started() -> None:
     the command's own SIGTERM handler (`_terminate_as_exit`), which raises SystemExit; the pool
     stops its workers with SIGTERM when one of them was killed, and a worker sending its
     results at that moment caught the SystemExit and sent them again, into a pipe nobody
-    read any more: the command hung for ever instead of saying a worker was lost."""
+    read any more: the command hung for ever instead of saying a worker was lost.
+
+    Ctrl-C is ignored: the terminal sends it to the workers too, and each then sent its
+    KeyboardInterrupt back as its batch's result and went on with the next batch; the command
+    stops its workers itself (`_HeldSignals`, `_stop_workers`)."""
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _batches(scenarios: list[Scenario], jobs: int) -> list[list[int]]:
@@ -570,39 +576,42 @@ def _run_all(scenarios: list[Scenario], jobs: int, progress: _LazyProgress,
     if jobs > 1 and len(scenarios) > 1:
         results: list[ScenarioResult | None] = [None] * len(scenarios)
         done = 0
-        batches = _batches(scenarios, jobs)
+        waiting = _batches(scenarios, jobs)  # not given to a worker yet, longest first
         # a worker per batch at most: the pool forks all its workers at once, and --jobs 5000
         # forked 5000 processes for two scenarios (the run never ended)
+        workers = min(jobs, len(waiting))
         mistakes: dict[int, Exception | None] = {}  # by the scenario's index: said in the scenarios' order
-        with ProcessPoolExecutor(max_workers=min(jobs, len(batches)), initializer=_worker_started) as pool:
-            futures = {pool.submit(_run_batch, [scenarios[i] for i in batch], every_scan, keep): batch
-                       for batch in batches}
+        # a batch goes to the pool only when a worker is free for it: the pool never holds one
+        # that the command would have to cancel (see _HeldSignals for what cancelling did)
+        with _HeldSignals() as held, ProcessPoolExecutor(max_workers=workers, initializer=_worker_started) as pool:
+            running: dict = {}
             try:
-                for future in as_completed(futures):
-                    if future.cancelled():
-                        continue
-                    try:
-                        batch_results = future.result()
-                    except (ScenarioError, UnusableInput) as exc:
-                        mistakes[min(futures[future])] = exc
-                        for other in futures:  # the batches not started: only set up, below
-                            other.cancel()
-                        continue
-                    for index, result in zip(futures[future], batch_results):
-                        results[index] = result
-                        done += scenarios[index].duration_us
-                    progress.update(done, f"{sum(r is not None for r in results)}/{len(scenarios)} scenarios")
-            except BrokenProcessPool:
-                raise UnusableInput(f"a worker process of --jobs {jobs} stopped without a word (killed, or out of "
-                                    "memory?): run again, or with fewer jobs") from None
-            except BaseException:
-                for future in futures:
-                    future.cancel()  # the batches not started yet: the command is ending
+                while running or (waiting and not mistakes):
+                    while waiting and not mistakes and len(running) < workers:
+                        batch = waiting.pop(0)
+                        running[pool.submit(_run_batch, [scenarios[i] for i in batch], every_scan, keep)] = batch
+                    finished, _ = wait(running, timeout=STOP_CHECK_EVERY_S, return_when=FIRST_COMPLETED)
+                    held.let_go()  # SIGTERM or Ctrl-C: raised here, where no lock of the pool is held
+                    for future in finished:
+                        batch = running.pop(future)
+                        try:
+                            batch_results = future.result()
+                        except (ScenarioError, UnusableInput) as exc:
+                            mistakes[min(batch)] = exc  # the batches still waiting: only set up, below
+                            continue
+                        for index, result in zip(batch, batch_results):
+                            results[index] = result
+                            done += scenarios[index].duration_us
+                        progress.update(done, f"{sum(r is not None for r in results)}/{len(scenarios)} scenarios")
+            except BaseException as exc:
+                _stop_workers(pool)  # the command is ending: the batches running are not waited for
+                if isinstance(exc, BrokenProcessPool):
+                    raise UnusableInput(f"a worker process of --jobs {jobs} stopped without a word (killed, or out "
+                                        "of memory?): run again, or with fewer jobs") from None
                 raise
         if mistakes:
-            for future, batch in futures.items():
-                if future.cancelled():
-                    mistakes.update((i, scenario_mistake(scenarios[i])) for i in batch)
+            for batch in waiting:
+                mistakes.update((i, scenario_mistake(scenarios[i])) for i in batch)
             _raise_together(_said_once([mistakes[i] for i in sorted(mistakes)]))
         return [r for r in results if r is not None]
     offsets = [0, *accumulate(s.duration_us for s in scenarios)]
@@ -622,6 +631,68 @@ def _spool_folder(report_path: str, report: str) -> str:
         return spool.make(folder)
     except OSError as exc:
         raise ReportError(f"cannot write the {report} in {folder}: {exc.strerror or exc}", report_path) from None
+
+
+class _HeldSignals:
+    """SIGTERM and Ctrl-C held while the main thread waits for the --jobs workers, and given
+    to the handlers they were held from (`_terminate_as_exit`'s SystemExit 143, Python's
+    KeyboardInterrupt) at `let_go`, where the main thread holds none of the pool's locks.
+
+    Raised from the handler, the SystemExit went off wherever the main thread was, inside
+    concurrent.futures' waiting; the clean-up then cancelled the batches the pool had not
+    handed out yet, and on Python 3.11 the pool's own thread, finding its workers gone (a CI
+    time-out signals the whole process group), failed on a cancelled batch
+    (InvalidStateError: "Exception in thread" on stderr) before it closed its queue of
+    batches; the thread feeding that queue stayed blocked on the full pipe, and the exit,
+    which waits for it, never came: a CI job's time-out hung for good (1 CI run in 12; most
+    runs signalled just after a batch came back). Only a handler Python code set is held:
+    an ignored signal stays ignored, one without a handler (SIG_DFL) still ends the process."""
+
+    SIGNALS = (signal.SIGTERM, signal.SIGINT)
+
+    def __init__(self) -> None:
+        self.previous: dict = {}
+        self.caught: list[int] = []
+
+    def __enter__(self) -> _HeldSignals:
+        try:
+            for sig in self.SIGNALS:
+                if callable(signal.getsignal(sig)):
+                    self.previous[sig] = signal.signal(sig, self._note)
+        except ValueError:  # not the main thread (an embedding application): no handler runs in this one
+            pass
+        return self
+
+    def _note(self, signum, frame) -> None:
+        self.caught.append(signum)
+
+    def let_go(self) -> None:
+        """The signals that came, each given to its own handler (`_terminate_as_exit`'s and
+        Python's raise: the first one ends the command)."""
+        caught, self.caught = self.caught, []
+        for signum in caught:
+            self.previous[signum](signum, None)
+
+    def __exit__(self, kind, value, traceback) -> None:
+        for sig, handler in self.previous.items():
+            signal.signal(sig, handler)
+        if kind is None:
+            self.let_go()  # one that came while the pool shut down
+
+
+def _stop_workers(pool) -> None:
+    """The pool's worker processes killed, with what they were running: the command is
+    ending (SIGTERM, Ctrl-C, a worker lost). Without it, `uitamr verify` sent SIGTERM alone
+    (not its process group: `kill PID`, `docker stop`) waited for its workers to finish their
+    batches, hours with a long --duration, and Ctrl-C for those the pool had queued. The pool
+    sees them gone and closes its queues itself. SIGKILL: a worker forked a moment ago has
+    the command's handlers still, not SIG_DFL. The processes are the pool's own (`_processes`,
+    in ProcessPoolExecutor since Python 3.2); a stand-in pool without them has nothing to stop."""
+    for process in list((getattr(pool, "_processes", None) or {}).values()):
+        try:
+            process.kill()
+        except (OSError, ValueError):  # gone already, or closed by the pool
+            pass
 
 
 @contextmanager
