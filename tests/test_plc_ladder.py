@@ -693,3 +693,16 @@ def test_ladder_a_silent_robot_while_paused_ends_in_the_fault_as_before(tmp_path
     assert result.passed, "\n".join(problems)
     pauses = [f for f in result.trace if f.direction == "tx" and f.data == encode(ControlRequest(1, 1, 0x80))]
     assert len(pauses) == 1
+
+
+def test_ladder_a_pause_pressed_with_the_start_waits_for_the_point_s_status_read(tmp_path, program):
+    """X3 just after X0, while point 1's control command is on its way: the pause is not sent
+    straight after that command (UITAMR-CYCLE: a control command's task status is read first,
+    M111) but in place of the next status read, and pauses point 1."""
+    result, problems = run_ladder(
+        tmp_path, program, "ladder: pause with the start", press("X3", "2020ms"),
+        table("expect", sent="pause", after="2s", within="1s"),
+        table("expect", always="Y6 AND D222 = 1", after="3s", within="8s"), duration="12s")
+    assert result.passed, "\n".join(problems)
+    control = [f for f in result.trace if f.direction == "tx" and f.data[1] == 6]
+    assert [f.data[3] for f in control] == [0xA0, 1, 0x80]
