@@ -28,6 +28,14 @@ def value(operand: str) -> str:
     return operand
 
 
+def word(operand: str) -> str:
+    """A compared operand: an H constant is a 16-bit word, so H8001 is compared as -32767,
+    the value MOV H8001 leaves in a D register (FX3U words are signed 16-bit)."""
+    if re.fullmatch(r"H[0-9A-F]+", operand) and int(operand[1:], 16) >= 0x8000:
+        return str(int(operand[1:], 16) - 0x10000)
+    return value(operand)
+
+
 def timer_ms(name: str, preset: str) -> int:
     unit = 10 if 200 <= int(name[1:]) <= 245 else 100     # FX3U: T200-T245 10 ms, T0-T199 100 ms
     return int(value(preset)) * unit
@@ -64,14 +72,14 @@ def translate(program, name: str) -> str:
                 body += [f"bAcc := {args[0]} AND NOT bEdge{edges};", f"bEdge{edges} := {args[0]};"]
                 edges += 1
             elif cmp:
-                body.append(f"bAcc := ({value(args[0])} {COMPARE[cmp.group(2)]} {value(args[1])});")
+                body.append(f"bAcc := ({word(args[0])} {COMPARE[cmp.group(2)]} {word(args[1])});")
             else:
                 body.append(f"bAcc := {'NOT ' if op == 'LDI' else ''}{contact(args[0])};")
             after_output = False
             continue
         if cmp:
             joiner = "AND" if cmp.group(1) == "AND" else "OR"
-            body.append(f"bAcc := bAcc {joiner} ({value(args[0])} {COMPARE[cmp.group(2)]} {value(args[1])});")
+            body.append(f"bAcc := bAcc {joiner} ({word(args[0])} {COMPARE[cmp.group(2)]} {word(args[1])});")
             continue
         simple = {"AND": "bAcc AND {}", "ANI": "bAcc AND NOT {}", "OR": "bAcc OR {}", "ORI": "bAcc OR NOT {}"}
         if op in simple:
@@ -591,3 +599,110 @@ def test_every_rung_comment_of_the_bundled_ladder_is_whole_in_the_csv():
     assert len(statements) >= 25
     cut = [s for s in statements if s.count("(") != s.count(")")]
     assert not cut, cut
+
+
+def pause_resume_parts(pause_at: str = "4s", resume_at: str = "10s"):
+    return (press("X3", pause_at), press("X4", resume_at),
+            table("expect", sent="run-point 1", after="2s", within="1s"),
+            table("expect", sent="pause", after=pause_at, within="350ms"),
+            table("expect", sent="run-point 1", after=resume_at, within="350ms"),
+            table("expect", never="Y3"))
+
+
+def test_ladder_pauses_the_running_point_and_resumes_it(tmp_path, program):
+    """X3 while point 1 runs: control 01/80 at the next pace (300 ms from the last frame's
+    start), between the point's status reads, which go on; Y6 lit while paused, the point
+    not counted reached (D222 stays 1) though it would have ended at 8.3 s unpaused; X4
+    sends point 1 again at the next pace, Y6 goes out, the robot finishes the point with
+    the paused time added and the cycle goes on to point 2. Before, the ladder had no pause:
+    X3 and X4 did nothing and point 1 was reached at 8.3 s."""
+    result, problems = run_ladder(
+        tmp_path, program, "ladder: pause and resume", *pause_resume_parts(),
+        table("expect", always="Y6 AND Y1 AND Y2 AND D222 = 1", after="4400ms", within="5500ms"),
+        table("expect", that="NOT Y6", after="10s", within="400ms"),
+        table("expect", always="D222 = 1 AND Y2", after="10s", within="3800ms"),
+        table("expect", reached_point=1, after="10s", within="7s"),
+        table("expect", sent="run-point 2", after="13800ms", within="1s"), duration="20s")
+    assert result.passed, "\n".join(problems)
+    tx = [f for f in result.trace if f.direction == "tx"]
+    pause = encode(ControlRequest(1, 1, 0x80))
+    paused = [f for f in tx if 4_000_000 < f.t_start_us < 10_000_000]
+    assert [f.data for f in paused].count(pause) == 1
+    assert {f.data for f in paused} == {pause, encode(StatusRequest(1, 0))}, "the status reads go on while paused"
+    assert all(b.t_start_us - a.t_start_us >= 300_000 for a, b in zip(tx, tx[1:]))
+
+
+def test_ladder_stop_overtakes_a_paused_point(tmp_path, program):
+    """X1 while point 1 is paused: the stop goes out at the next pace (after the status
+    read on its way), Y6 goes out with the stop's echo, no fault, the cycle ends and the
+    point is never sent again."""
+    result, problems = run_ladder(
+        tmp_path, program, "ladder: pause then stop",
+        press("X3", "4s"), press("X1", "7s"),
+        table("expect", sent="pause", after="4s", within="350ms"),
+        table("expect", that="Y6", after="4s", within="1s"),
+        table("expect", sent="stop", after="7s", within="700ms"),
+        table("expect", always="NOT Y6 AND NOT Y1 AND NOT Y2", after="8s"),
+        table("expect", never="Y3"), duration="14s")
+    assert result.passed, "\n".join(problems)
+    runs = [f for f in result.trace if f.direction == "tx" and f.data[1] == 6 and f.data[3] not in (0x80, 0xA0)]
+    assert len(runs) == 1 and runs[0].t_start_us < 3_000_000, [(f.t_start_us, f.data.hex(" ")) for f in runs]
+
+
+def test_ladder_resume_without_a_pause_and_a_pause_after_the_stop_send_nothing(tmp_path, program):
+    """X4 with nothing paused, X3 and X4 after the stop: no frame (no pause, no point sent
+    again that no step machine follows)."""
+    result, problems = run_ladder(
+        tmp_path, program, "ladder: buttons with nothing to pause",
+        press("X4", "4s"), press("X1", "6s"), press("X3", "8s"), press("X4", "9s"),
+        table("expect", never="Y6 OR Y3"), duration="12s")
+    assert result.passed, "\n".join(problems)
+    control = [f for f in result.trace if f.direction == "tx" and f.data[1] == 6]
+    assert [f.data[3] for f in control] == [0xA0, 1, 0xA0], [(f.t_start_us, f.data.hex(" ")) for f in control]
+
+
+def test_ladder_does_not_take_a_paused_task_reported_idle_as_the_point_reached(tmp_path, program):
+    """A pause that reaches the robot after the point has ended (pressed in its last status
+    read's pace) pauses nothing: the robot reports the task idle. The ladder cannot tell that
+    idle from a paused task reported idle, so while Y6 is lit the idle is not the point
+    reached (D222 stays, no next point); the resume sends the point again (the emulated robot
+    runs it anew: 6 s), and the cycle goes on once that run has ended."""
+    result, problems = run_ladder(
+        tmp_path, program, "ladder: pause as the point ends", *pause_resume_parts("8s", "11s"),
+        table("expect", always="Y6 AND D223 = 0 AND D222 = 1", after="9s", within="2s"),
+        table("expect", always="NOT Y6 AND D222 = 1", after="11400ms", within="5500ms"),
+        table("expect", sent="run-point 2", after="17s", within="1500ms"), duration="20s")
+    assert result.passed, "\n".join(problems)
+
+
+def test_ladder_a_silent_robot_while_paused_ends_in_the_fault_as_before(tmp_path, program):
+    """The robot falls silent while point 1 is paused: three unanswered status reads end in
+    the fault (Y3, D225 = 16#0101) as without the pause; Y6 stays lit (the robot was left
+    paused) until the acknowledge's stop is answered, and a new start runs point 1 again,
+    unpaused (no pause asked before the fault is left over)."""
+    result, problems = run_ladder(
+        tmp_path, program, "ladder: silent while paused",
+        press("X3", "4s"), table("faults", kind="no_reply", at_s=6.0, duration_s=3.0),
+        press("X2", "10s"), press("X0", "12s"),
+        table("expect", sent="pause", after="4s", within="350ms"),
+        table("expect", that="Y3 AND Y6 AND D225 = 16#0101", after="6s", within="3s"),
+        table("expect", sent="stop", after="10s", within="1s"),
+        table("expect", always="NOT Y6 AND NOT Y3", after="11s"),
+        table("expect", sent="run-point 1", after="12s", within="1s"),
+        table("expect", that="Y2", after="12500ms", within="1s"), duration="16s", signal="Y3")
+    assert result.passed, "\n".join(problems)
+    pauses = [f for f in result.trace if f.direction == "tx" and f.data == encode(ControlRequest(1, 1, 0x80))]
+    assert len(pauses) == 1
+
+
+def test_ladder_a_pause_pressed_with_the_start_waits_for_the_point_s_status_read(tmp_path, program):
+    """X3 just after X0, while point 1's control command is on its way: the pause is not sent
+    straight after that command (UITAMR-CYCLE: a control command's task status is read first,
+    M111) but in place of the next status read, and pauses point 1."""
+    result, problems = run_ladder(
+        tmp_path, program, "ladder: pause with the start", press("X3", "2020ms"),
+        table("expect", sent="pause", after="2s", within="1s"),
+        table("expect", always="Y6 AND D222 = 1", after="3s", within="8s"), duration="12s")
+    assert result.passed, "\n".join(problems)
+    control = [f for f in result.trace if f.direction == "tx" and f.data[1] == 6]
+    assert [f.data[3] for f in control] == [0xA0, 1, 0x80]

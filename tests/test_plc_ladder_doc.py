@@ -126,7 +126,8 @@ def test_every_device_of_the_il_is_explained():
     unexplained = {rung: sorted(_devices(" ".join(op for i in instructions for op in i.operands)) - named)
                    for rung, instructions in _rungs().items()}
     assert {rung: devices for rung, devices in unexplained.items() if devices} == {}
-    heading = "\n".join(line for line in IL.read_text(encoding="utf-8").splitlines()[:10] if line.startswith(";"))
+    lines = IL.read_text(encoding="utf-8").splitlines()
+    heading = "\n".join(lines[:next(n for n, line in enumerate(lines) if line.startswith("; R1 "))])
     assert listed == _devices(heading[heading.index("Devices:"):])
 
 
