@@ -181,3 +181,18 @@ def test_unread_completion_bits_are_warned_once_at_their_first_use():
     files = [st.parse(text, "Raw.st", "gxworks2")]
     found = [(d.line, d.col) for d in st.check(files, "gxworks2") if d.file == "Raw.st"]
     assert found == [(13, 42)], found
+
+
+def test_a_hex_device_written_without_its_leading_digit_says_how_to_write_it():
+    """The example's header and the port's label table said "XA (CH2)", as the QJ71C24N manual
+    names the signal, and `uitamr check` answered "undefined label 'XA'; declare it in a VAR
+    block": the device reader (and GX Works' ST) takes a hexadecimal device number only when
+    it starts with a digit, so CH2's read request is X0A."""
+    text = "PROGRAM P\nVAR b : BOOL; w : WORD; END_VAR\nb := XA;\nb := SB1F AND XB;\nw := W0;\nb := X0A;\nEND_PROGRAM\n"
+    files = [st.parse(text, "P.st", "gxworks2")]
+    found = [(d.line, d.col, d.message) for d in st.check(files, "gxworks2", platform="q") if d.file == "P.st"]
+    assert found == [
+        (3, 6, "undefined label 'XA'; for the device write X0A: a hexadecimal device number starts with a "
+               "digit (X0A, as 16#0A; docs/st-dialect.md)"),
+        (4, 15, "undefined label 'XB'; for the device write X0B: a hexadecimal device number starts with a "
+                "digit (X0B, as 16#0B; docs/st-dialect.md)")]

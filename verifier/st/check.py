@@ -1028,6 +1028,11 @@ class Checker:
                               f"G_OUTPUT and G_INPUT take its start I/O number without the last digit (16#{n} for "
                               f"the module at X/Y{int(n, 16) * 16:03X}), ZP_OPEN and the other ZP_ instructions the string '{e.name}'; "
                               f"{e.name}\\G150 is its buffer memory")
+        elif (m := re.fullmatch(r"(SB|SW|DX|DY|X|Y|B|W)([A-F][0-9A-F]*)", e.name, re.IGNORECASE)) is not None:
+            # the QJ71C24N manual's "XA", "XB": the device reader wants the digit first (as for H0FF)
+            dev = f"{m[1].upper()}0{m[2].upper()}"
+            self.rep.error(e, f"undefined label '{e.name}'; for the device write {dev}: a hexadecimal device "
+                              f"number starts with a digit ({dev}, as 16#0{m[2].upper()}; docs/st-dialect.md)")
         elif re.fullmatch(r"H[0-9A-F]+", e.name, re.IGNORECASE):
             self.rep.error(e, f"undefined label '{e.name}'; for the hex constant write 16#{e.name[1:]} (or H0{e.name[1:]})")
         else:
