@@ -262,3 +262,20 @@ def test_a_run_cut_while_a_frame_is_on_the_line_replays(tmp_path):
     assert frames[-1]["t"] < end["end"] == 0.235 < frames[-1]["t_end"]
     assert differences(verified, replayed) == []
     assert ends(replayed) == ends(verified) == [0.235]
+
+
+def test_a_request_to_another_slave_says_where_to_set_the_address(tmp_path):
+    """An integrator's second robot at address 2 (the program's ROBOT_ADDRESS changed, the
+    scenario copied as it was): UITAMR-FORMAT said only "addressed to slave 2, the robot is
+    slave 1", naming neither setting. It now names both: the scenario's [protocol] address
+    (monitor's and replay's --address) and the program's."""
+    text = (bundled_scenarios()[0].parent / "fx3u-healthy.toml").read_text(encoding="utf-8")
+    sources = bundled_scenarios()[0].parent.parent.as_posix()
+    scenario = tmp_path / "slave2.toml"
+    scenario.write_text(text.replace('"../', f'"{sources}/') + "\n[protocol]\naddress = 2\n", encoding="utf-8")
+    verified, replayed = verify_then_replay(tmp_path, "--scenario", scenario, "--duration", "2s")
+    messages = {message for rule, _, message in findings(verified)[0] if rule == "UITAMR-FORMAT"}
+    assert messages == {"byte 0: addressed to slave 1, the robot is slave 2: for a robot at 1 set address = 1 "
+                        "under [protocol] in the scenario (--address 1 for monitor and replay); else make the "
+                        "program send to 2 (the engine's i_wAddress)"}
+    assert differences(verified, replayed) == []

@@ -150,7 +150,10 @@ def _layout_problem(data: bytes, settings: protocol.Settings) -> str | None:
     except protocol.FrameError as exc:
         return str(exc)
     if request.address != settings.address:
-        return f"byte 0: addressed to slave {request.address}, the robot is slave {settings.address}"
+        sent, robot = request.address, settings.address
+        return (f"byte 0: addressed to slave {sent}, the robot is slave {robot}: for a robot at {sent} set "
+                f"address = {sent} under [protocol] in the scenario (--address {sent} for monitor and replay); "
+                f"else make the program send to {robot} (the engine's i_wAddress)")
     return None
 
 
