@@ -532,3 +532,34 @@ def test_a_send_error_is_signalled_when_a_stray_message_was_read_during_the_send
     # ... and so does the engine: the attempt failed and was repeated
     assert prog.fbEngine.o_wCommErrCount == 1 and prog.fbEngine.o_wRetryCount == 1
     assert not prog.fbEngine.o_bErr                          # the repeat got the robot's reply
+
+
+def test_a_pause_called_only_in_manual_mode_loses_its_result_and_blocks_no_stop():
+    """The examples' headers said that a pause whose FB is not called when its result comes
+    "blocks the stop". An integrator who moved fbPause into a manual-mode IF (left before
+    the pause's answer) sees otherwise, as docs/plc-library.md says: the stop takes the
+    priority slot over and goes out at the next pace; fbPause, called again, ends with
+    16#0316 (its result lost). The headers now say that."""
+    text = (PLC / "examples" / "q" / "UITAMR_ExampleQ.st").read_text(encoding="utf-8")
+    call = "fbPause(i_bEN := TRUE, i_bExecute := X23, io_uMbx := uMbx);"
+    assert call in text
+    text = text.replace(call, f"IF X25 THEN\n    {call}\nEND_IF;")
+    robot = Robot(Settings(), RobotConfig(point_duration_s=6.0), [])
+    line = Line(robot)
+    project = verifier.load(*SOURCES[:3], cpu="q", sources={"UITAMR_ExampleQ.st": text})
+    project.attach_serial("q:1", line)
+    prog = project.program("UITAMR_ExampleQ")
+
+    def manual(p):
+        now_ms = p.now_us // 1000
+        p.devices["X25"] = 1000 <= now_ms < 4010 or now_ms >= 9000
+    run(project, 12000, manual, pulse(project, "X20", 2000), pulse(project, "X23", 4000),
+        pulse(project, "X21", 7000))
+    sent = [(f.t_start_us, bytes(f.data).hex()) for f in line.trace if f.direction == "tx"]
+    assert any(4_000_000 <= t < 4_350_000 and data == "0106018000008" "9de" for t, data in sent)  # the pause
+    assert any(7_000_000 <= t < 7_350_000 and data == "010601a000008814" for t, data in sent)  # the stop
+    assert prog.fbPause.o_uErrId == 0x0316 and not prog.fbPause.o_bBusy
+    for example in sorted((PLC / "examples").glob("*/UITAMR_Example*.st")):
+        header = example.read_text(encoding="utf-8").split("*)", 1)[0]
+        if "fbPause" in example.read_text(encoding="utf-8"):
+            assert "blocks the stop" not in " ".join(header.split()), example.name
