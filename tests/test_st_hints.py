@@ -87,3 +87,15 @@ def test_a_misspelt_label_member_or_instance_gets_the_name_meant():
     assert messages[14] == "structure Pose has no member 'wHeadin'; did you mean 'wHeading'?"
     assert messages[15] == "unknown function or instruction 'fbRn'; did you mean 'fbRun'?"
     assert messages[16] == "undefined label 'wNothingLikeIt'; declare it in a VAR block"
+
+
+def test_a_misspelt_label_that_reads_like_a_hex_device_is_still_the_label_meant():
+    """A hex device written without its leading digit (`XA`) is told how to write it (X0A);
+    a misspelt label that happens to read so (`bEd` for bEnd, `BAD`) is not sent to a device."""
+    text = ("PROGRAM P\nVAR\n    bEnd : BOOL;\n    bOut : BOOL;\nEND_VAR\n"
+            "bOut := bEd;\nbOut := XA;\nbOut := Bad;\nEND_PROGRAM\n")
+    source = st.parse(text, "p.st", "gxworks2")
+    messages = {d.line: d.message for d in st.check([source], "gxworks2")}
+    assert messages[6] == "undefined label 'bEd'; did you mean 'bEnd'?"
+    assert messages[7].startswith("undefined label 'XA'; for the device write X0A")
+    assert messages[8] == "undefined label 'Bad'; declare it in a VAR block"

@@ -1019,7 +1019,10 @@ class Checker:
         if info is not None:
             e.symbol = info.pou
             return T.PouRef(info.pou.name)
-        if re.fullmatch(r"E[0-9]+", e.name, re.IGNORECASE):
+        guess = self._label_hint(e.name)  # a label spelt nearly so first: `bEd` is bEnd, not the device B0ED
+        if guess:
+            self.rep.error(e, f"undefined label '{e.name}'{guess}")
+        elif re.fullmatch(r"E[0-9]+", e.name, re.IGNORECASE):
             self.rep.error(e, f"undefined label '{e.name}'; E constants are not read here: write the REAL as 1.5 or 1.0E3")
         elif re.fullmatch(r"U[0-9A-F]{1,2}", e.name, re.IGNORECASE):
             # G.OUTPUT U2 ... in ladder (docs/st-dialect.md: the ST operand forms of Un)
@@ -1028,7 +1031,7 @@ class Checker:
                               f"G_OUTPUT and G_INPUT take its start I/O number without the last digit (16#{n} for "
                               f"the module at X/Y{int(n, 16) * 16:03X}), ZP_OPEN and the other ZP_ instructions the string '{e.name}'; "
                               f"{e.name}\\G150 is its buffer memory")
-        elif (m := re.fullmatch(r"(SB|SW|DX|DY|X|Y|B|W)([A-F][0-9A-F]*)", e.name, re.IGNORECASE)) is not None:
+        elif (m := re.fullmatch(r"(SB|SW|DX|DY|X|Y|B|W)([A-F][0-9A-F]*)", e.name)) is not None:
             # the QJ71C24N manual's "XA", "XB": the device reader wants the digit first (as for H0FF)
             dev = f"{m[1].upper()}0{m[2].upper()}"
             self.rep.error(e, f"undefined label '{e.name}'; for the device write {dev}: a hexadecimal device "
@@ -1036,8 +1039,7 @@ class Checker:
         elif re.fullmatch(r"H[0-9A-F]+", e.name, re.IGNORECASE):
             self.rep.error(e, f"undefined label '{e.name}'; for the hex constant write 16#{e.name[1:]} (or H0{e.name[1:]})")
         else:
-            guess = self._label_hint(e.name)
-            self.rep.error(e, f"undefined label '{e.name}'" + (guess or "; declare it in a VAR block"))
+            self.rep.error(e, f"undefined label '{e.name}'; declare it in a VAR block")
         return T.ANY
 
     def _label_hint(self, name: str) -> str:
