@@ -568,3 +568,17 @@ def test_violations_of_the_same_moment_are_listed_in_the_rules_order_everywhere(
                                                 Violation("UITAMR-HALF-DUPLEX", 500_000, "both talked")]}
     assert [v.message for v in result.all_violations()] == ["earlier", "too soon", "both talked"]
     assert [found[0].rule for found in result.broken_rules()] == ["UITAMR-HALF-DUPLEX", "UITAMR-PACING"]
+
+
+def test_a_monitored_port_is_named_once_in_the_console():
+    """`FAIL monitor /tmp/x (/tmp/x): the PLC on the line ...` named the port twice."""
+    from dataclasses import replace
+
+    from verifier.verify.result import LINE
+
+    result = replace(bad_result(), name="monitor /dev/ttyUSB0", file="/dev/ttyUSB0", platform=LINE)
+    out = io.StringIO()
+    report_console.render([result, good_result()], Console(file=out, width=200, color_system=None))
+    text = out.getvalue()
+    assert "FAIL monitor /dev/ttyUSB0: the PLC on the line" in text, text
+    assert "PASS healthy (plc/scenarios/healthy.toml): Main on fx3u" in text, text

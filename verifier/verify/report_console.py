@@ -52,7 +52,8 @@ def render(results: list[ScenarioResult], console: Console, *, first: int = FIRS
 def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
     color = {"pass": "green", "fail": "red"}.get(result.verdict, "yellow")  # yellow: UNVERIFIED
     mark = f"[{color}]{verdict_mark(result.verdict)}[/]"
-    where = f" ({escape(shown_name(result.file))})" if result.file else ""
+    # a monitored port is in the run's name already ("monitor /dev/ttyUSB0"): not twice
+    where = f" ({escape(shown_name(result.file))})" if result.file and result.file not in result.name else ""
     tx = result.tx_count
     failed = len(result.failed_expectations)
     expectations = (
