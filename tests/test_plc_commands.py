@@ -723,3 +723,39 @@ def test_a_priority_request_of_a_kind_out_of_range_is_refused_without_ending_the
     assert (h.uOddErr, h.uOddDetail) == (0x0301, 17)
     assert robot.mode == "running" and h.fbRun.o_bBusy and h.fbRun.o_uErrId == 0
     assert [c[1] for c in _controls_at(line)][1:] == [POINT_3]
+
+
+def test_a_stop_pressed_while_a_pause_waits_untaken_sends_nothing_asked_before_it():
+    """review s35: a pause waits untaken in the priority slot while a point waits in the
+    normal one (the engine sends the point's control command first, the pause after it).
+    A stop pressed in that moment could not post: the point went out after the stop was
+    pressed (the robot drove off), then the pause, and the stop ~940 ms after its button -
+    against UITAMR_Stop's 'nothing asked before the stop moves the robot after it'. A stop
+    now takes the place of a pause or a resume the engine has not taken yet: it goes out
+    first, the point ends with 16#0305 unsent, and the pause (never sent: the stop stops
+    the robot anyway) ends with 16#0305 as a normal request waiting does - no fault for
+    UITAMR_CellFx3's lamp, which leaves 16#0305 out."""
+    project, robot, line, run = _run_point_cell(
+        "    fbStop : UITAMR_Stop;\n    uPauseErr : WORD;\n    bStopOk : BOOL;\n",
+        "fbPause(i_bEN := TRUE, i_bExecute := X3, io_uMbx := uMbx);\n"
+        "fbStop(i_bEN := TRUE, i_bExecute := X1, io_uMbx := uMbx);\n"
+        "IF fbPause.o_bErr THEN\n    uPauseErr := fbPause.o_uErrId;\nEND_IF;\n"
+        "IF fbStop.o_bOK THEN\n    bStopOk := TRUE;\nEND_IF;\n")
+    h = project.program("T_Cell")
+    run(3000)
+    polls = len(line.trace)
+    while len(line.trace) == polls:                          # a monitor poll just went out:
+        run(10)                                              # the next frame waits for the pace
+    project.devices["X0"] = project.devices["X3"] = True     # start and pause together
+    run(10)
+    assert h.uMbx[0] == 1 and h.uMbx[8] == 1                 # both wait, untaken
+    pressed_at = project.now_us / 1e6
+    project.devices["X1"] = True                             # the stop, 10 ms later
+    run(2000)
+    after = [(t, frame) for t, frame in _controls_at(line) if t >= pressed_at]
+    assert [frame for _t, frame in after] == [STOP_FRAME]    # no point, no pause: the stop
+    assert after[0][0] <= pressed_at + 0.35                  # within one pace of the button
+    assert robot.mode == "idle" and h.bStopOk
+    assert h.fbRun.o_uErrId == 0x0305 and not h.fbRun.o_bBusy
+    assert h.uPauseErr == 0x0305 and not h.fbPause.o_bBusy
+    assert h.uMbx[0] == 0 and h.uMbx[8] == 0

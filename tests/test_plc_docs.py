@@ -460,3 +460,19 @@ def test_the_fx5_port_names_for_channel_2_the_board_the_rs2_model_has_there():
     assert "An FX5-485ADP is not channel 2 but 3 or 4, which this FB does not drive" in header
     section = " ".join(model.split("## 8. ", 1)[1].split("\n## ", 1)[0].split())
     assert "an FX5-485ADP needs a port FB with the ch3/ch4 devices" in section
+
+
+def test_an_example_with_a_pause_gives_the_reason_to_call_it_every_scan_the_library_gives():
+    """review s35: the FX5U/Q examples (pausewire35) told the integrator a pause not called
+    when its result comes 'blocks the stop' - true before 11060eb, merged alongside: the
+    stop now takes the priority slot over and the pause loses its result (16#0316), as
+    UITAMR_Pause's header says. An example copied for its comments must not teach the old
+    reason."""
+    examples = sorted((ROOT / "plc" / "examples").rglob("*.st"))
+    headers = {p.name: " ".join(p.read_text(encoding="utf-8").split("*)")[0].split()) for p in examples
+               if ": UITAMR_Pause;" in p.read_text(encoding="utf-8")}
+    assert len(headers) == 7              # UITAMR_CellFx3, PanelFx3 and the five FX5U/Q examples
+    for name, header in headers.items():
+        assert "blocks the stop" not in header, name
+        if "not called when its result comes" in header:
+            assert "16#0316" in header, name

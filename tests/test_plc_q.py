@@ -563,3 +563,24 @@ def test_a_pause_called_only_in_manual_mode_loses_its_result_and_blocks_no_stop(
         header = example.read_text(encoding="utf-8").split("*)", 1)[0]
         if "fbPause" in example.read_text(encoding="utf-8"):
             assert "blocks the stop" not in " ".join(header.split()), example.name
+
+
+def test_the_q_example_says_its_buttons_move_when_the_c24_takes_x020():
+    """review s35: with the pause (X23) and resume (X24) the example's buttons are the very
+    inputs its own relocation list gives the C24 at X/Y020 (read request X23, reception
+    abnormal detection X24; its X20..X22 are the start, stop and acknowledge). Following
+    the list alone, fbPause reads the read request: on a CPU whose inputs are refreshed
+    at END it sees it on with every reply and pauses the robot. The header and
+    import-gxworks2.md now say the buttons are the input module's and move with it."""
+    edited = moved_example(MOVE_TO_X020)
+    body = edited.split("PROGRAM UITAMR_ExampleQ", 1)[1]
+    port_inputs = set(re.findall(r"i_b(?:ReadReq|RecvErr) := (X\w+)", body))
+    buttons = set(re.findall(r"i_b(?:Execute|Start|Stop|Ack) := (X\w+)", body))
+    assert port_inputs == {"X23", "X24"} and port_inputs <= buttons       # the clash the note is for
+    note = "The buttons X20..X24 are the input module's: with the C24 at X/Y020 move them with it"
+    header = " ".join(EXAMPLE_Q.read_text().split("PROGRAM UITAMR_ExampleQ", 1)[0].split())
+    assert note in header
+    tcp = " ".join((PLC / "examples" / "q" / "UITAMR_ExampleTcpQ.st").read_text().split("PROGRAM", 1)[0].split())
+    assert "The buttons X20..X24 are the input module's: with the E71 at X/Y020 move them with it" in tcp
+    guide = " ".join((PLC.parent / "docs" / "import-gxworks2.md").read_text().split())
+    assert "The buttons `X20`–`X24` are the input module's" in guide

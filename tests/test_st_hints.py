@@ -99,3 +99,29 @@ def test_a_misspelt_label_that_reads_like_a_hex_device_is_still_the_label_meant(
     assert messages[6] == "undefined label 'bEd'; did you mean 'bEnd'?"
     assert messages[7].startswith("undefined label 'XA'; for the device write X0A")
     assert messages[8] == "undefined label 'Bad'; declare it in a VAR block"
+
+
+MISCALLED = """PROGRAM Calls
+VAR
+    bMove : BOOL;
+    wA : INT;
+    fbTimer : TON;
+END_VAR
+wA := MOVE2(wA);
+wA := INT_TO_WROD(wA);
+fbTimr(IN := bMove, PT := T#1s);
+END_PROGRAM
+"""
+
+
+def test_an_unknown_call_is_told_a_callable_name_never_a_plain_label():
+    """review s35: the did-you-mean of an unknown call looked among every label, so
+    MOVE2(...) got "did you mean 'bMove'?" - a BOOL, which cannot be called - while the
+    standard function the integrator mistyped (INT_TO_WROD) got no guess. Now a call is
+    told an FB instance, a FUNCTION, a standard function or an instruction of its editor."""
+    source = st.parse(MISCALLED, "calls.st", "gxworks2")
+    assert source.diagnostics == []
+    messages = {d.line: d.message for d in st.check([source], "gxworks2")}
+    assert messages[7] == "unknown function or instruction 'MOVE2'; did you mean 'MOVE'?"
+    assert messages[8] == "unknown function or instruction 'INT_TO_WROD'; did you mean 'INT_TO_WORD'?"
+    assert messages[9] == "unknown function or instruction 'fbTimr'; did you mean 'fbTimer'?"

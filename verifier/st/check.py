@@ -1052,6 +1052,20 @@ class Checker:
         seen += [info.pou.name for info in self.table.pous.values()]
         return did_you_mean(name, seen)
 
+    def _call_hint(self, name: str) -> str:
+        """'; did you mean 'MOVE'?' for an unknown call spelt nearly as something that can
+        be called here: an FB instance this POU sees, a FUNCTION, a standard function or an
+        instruction of the editor (never a plain label: 'bMove' cannot be called), else ""
+        (the error path only)."""
+        from verifier.amr.schema import did_you_mean
+
+        labels = list(self.pou.labels.values()) if self.pou is not None else []
+        seen = [decl.name for decl, t in labels + list(self.table.globals.values()) if isinstance(t, T.FbType)]
+        seen += [info.pou.name for info in self.table.pous.values() if info.pou.kind == "FUNCTION"]
+        seen += [n for n, sig in library.STANDARD_FUNCTIONS.items() if self.target in sig.targets]
+        seen += [n for n in library.INSTRUCTIONS if library.instruction(n, self.target) is not None]
+        return did_you_mean(name, seen)
+
     def _device(self, e: ast.Device) -> T.Type:
         if e.bit is not None:
             return T.BOOL
@@ -1277,7 +1291,7 @@ class Checker:
             return T.ANY
         hint = _in_library(c.name, self.plc_shown)
         self.rep.error(c.callee, f"unknown function or instruction '{c.name}'"
-                                 + (f"; {hint}" if hint else self._label_hint(c.name)))
+                                 + (f"; {hint}" if hint else self._call_hint(c.name)))
         self._args_only(c)
         return T.ANY
 
