@@ -91,6 +91,9 @@ TYPE_LETTERS = {"b": "Bit", "w": "Word[Signed]", "u": "Word[Unsigned]", "ud": "D
 _LETTERED = re.compile(r"(?:i|o|io)_([a-z]+)[A-Z0-9]")
 
 
+_EDITOR_TABLES = None  # verifier.export.types.TABLES, imported at the first use
+
+
 def type_letters_problem(name: str, t: T.Type, target: str = "gxworks2") -> str | None:
     """Why the type letters of an i_/o_/io_ label name (`o_uCount`) do not name its type
     (an INT), or None: for labels in the convention's form whose letters it lists, of an
@@ -98,8 +101,12 @@ def type_letters_problem(name: str, t: T.Type, target: str = "gxworks2") -> str 
     m = _LETTERED.match(name)
     if m is None or m.group(1) not in TYPE_LETTERS:
         return None
-    from verifier.export.types import TABLES  # the editor's type names (no import cycle at call time)
+    global _EDITOR_TABLES
+    if _EDITOR_TABLES is None:
+        from verifier.export.types import TABLES  # the editor's type names (no import cycle at call time)
 
+        _EDITOR_TABLES = TABLES
+    TABLES = _EDITOR_TABLES
     element = t.element if isinstance(t, T.ArrayOf) else t
     if not isinstance(element, T.Elementary):
         return None
