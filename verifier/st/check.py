@@ -533,9 +533,10 @@ class Checker:
 
     def check_structure(self) -> None:
         """Recursion through FB instances, structures and calls; storage sizes."""
-        findings, recursive = structure.recursive_types(self.table)
+        graph = structure.containment_edges(self.table)  # read by both, built once
+        findings, recursive = structure.recursive_types(self.table, graph)
         findings += structure.recursive_calls(self.table, self.calls, recursive)
-        findings += structure.oversized(self.table, self.target, recursive)
+        findings += structure.oversized(self.table, self.target, recursive, graph)
         for f in findings:
             self.rep.error(f.node, f.message)
 
@@ -707,9 +708,10 @@ class Checker:
         if not operands:
             return
         operands.sort(key=lambda found: (found[1].span.line, found[1].span.col))  # warned at the first use
-        written = {id(n) for s in ast.walk(info.pou.body) if isinstance(s, ast.Assign) for n in ast.walk(s.target)}
+        body = list(ast.walk(info.pou.body))  # walked once for both
+        written = {id(n) for s in body if isinstance(s, ast.Assign) for n in ast.walk(s.target)}
         mine = {id(n) for _c, op, _d in operands for n in ast.walk(op)}
-        read = {id(n.symbol) for n in ast.walk(info.pou.body)
+        read = {id(n.symbol) for n in body
                 if isinstance(n, ast.Name) and id(n) not in written and id(n) not in mine}
         for call, op, decl in operands:
             if id(decl) in read:
