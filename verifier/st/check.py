@@ -890,6 +890,8 @@ class Checker:
         if source is T.VOID:
             self.rep.error(node, f"{what}: this call gives no value")
             return
+        if target == source:
+            return  # assignable, and no literal to range-check (a literal's type is no Elementary)
         problem = T.assignable(target, source, self.target)
         if problem:
             self.rep.error(node, f"{what}: {problem}")
@@ -913,36 +915,44 @@ class Checker:
     # ------------------------------------------------------------- expressions
     def lvalue(self, e: ast.Expr) -> T.Type | None:
         """Type of an assignment target, reporting what cannot be written."""
-        if isinstance(e, _LITERALS):
-            self.expr(e)
-            self.rep.error(e, f"cannot assign to the constant {_lit_text(e)}")
-            return None
-        if isinstance(e, _EXPRESSIONS):
-            self.expr(e)
-            self.rep.error(e, "cannot assign to an expression; the left of ':=' must be a label or device")
-            return None
-        t = self.expr(e)
-        root = e
-        while isinstance(root, (ast.Index, ast.Member, ast.BitAccess)):
-            root = root.base
-        if isinstance(root, ast.Name) and isinstance(root.symbol, ast.VarDecl):
-            decl = root.symbol
+        # the node classes are disjoint (no subclasses): tested by type, a plain name (most
+        # targets) first
+        cls = type(e)
+        if cls is ast.Name:
+            t = self.expr(e)
+            root = e
+        else:
+            if isinstance(e, _LITERALS):
+                self.expr(e)
+                self.rep.error(e, f"cannot assign to the constant {_lit_text(e)}")
+                return None
+            if isinstance(e, _EXPRESSIONS):
+                self.expr(e)
+                self.rep.error(e, "cannot assign to an expression; the left of ':=' must be a label or device")
+                return None
+            t = self.expr(e)
+            root = e
+            while isinstance(root, (ast.Index, ast.Member, ast.BitAccess)):
+                root = root.base
+        symbol = root.symbol if type(root) is ast.Name else None
+        if isinstance(symbol, ast.VarDecl):
+            decl = symbol
             if decl.constant:
                 self.rep.error(e, f"'{decl.name}' is a constant (VAR CONSTANT); it cannot be assigned")
             elif decl.section == "VAR_INPUT" and e is root and self.pou is not None and self.pou.pou.kind == "FUNCTION_BLOCK":
                 self.rep.warning(e, f"'{decl.name}' is an input; writing it inside the FB hides the caller's value")
-        if isinstance(root, ast.Name) and isinstance(root.symbol, ast.Pou):
-            pou = root.symbol
+        elif isinstance(symbol, ast.Pou):
+            pou = symbol
             if self.pou is None or pou is not self.pou.pou:
                 self.rep.error(e, f"cannot assign to the POU name '{pou.name}' outside it")
-        if isinstance(e, ast.Member) and isinstance(e.base.type, T.FbType):
+        if cls is ast.Member and isinstance(e.base.type, T.FbType):
             kind = e.base.type.param(e.member)
             if kind and kind[0] == "output":
                 self.rep.error(e, f"'{e.member}' is an output of {e.base.type}; it cannot be assigned from outside")
         if isinstance(t, T.FbType):
             self.rep.error(e, f"'{_text(e)}' is a function block instance; it cannot be assigned "
                               "(assign its inputs in a call instead)")
-        if isinstance(e, ast.Device) and e.kind in ("X",) and e.bit is None:
+        if cls is ast.Device and e.kind in ("X",) and e.bit is None:
             self.rep.warning(e, f"writing input {e.text}: X devices are refreshed from the inputs each scan")
         return t
 
