@@ -91,6 +91,9 @@ TYPE_LETTERS = {"b": "Bit", "w": "Word[Signed]", "u": "Word[Unsigned]", "ud": "D
 _LETTERED = re.compile(r"(?:i|o|io)_([a-z]+)[A-Z0-9]")
 
 
+_EDITOR_TABLES = None  # verifier.export.types.TABLES, imported at the first use
+
+
 def type_letters_problem(name: str, t: T.Type, target: str = "gxworks2") -> str | None:
     """Why the type letters of an i_/o_/io_ label name (`o_uCount`) do not name its type
     (an INT), or None: for labels in the convention's form whose letters it lists, of an
@@ -98,8 +101,12 @@ def type_letters_problem(name: str, t: T.Type, target: str = "gxworks2") -> str 
     m = _LETTERED.match(name)
     if m is None or m.group(1) not in TYPE_LETTERS:
         return None
-    from verifier.export.types import TABLES  # the editor's type names (no import cycle at call time)
+    global _EDITOR_TABLES
+    if _EDITOR_TABLES is None:
+        from verifier.export.types import TABLES  # the editor's type names (no import cycle at call time)
 
+        _EDITOR_TABLES = TABLES
+    TABLES = _EDITOR_TABLES
     element = t.element if isinstance(t, T.ArrayOf) else t
     if not isinstance(element, T.Elementary):
         return None
@@ -526,9 +533,10 @@ class Checker:
 
     def check_structure(self) -> None:
         """Recursion through FB instances, structures and calls; storage sizes."""
-        findings, recursive = structure.recursive_types(self.table)
+        graph = structure.containment_edges(self.table)  # read by both, built once
+        findings, recursive = structure.recursive_types(self.table, graph)
         findings += structure.recursive_calls(self.table, self.calls, recursive)
-        findings += structure.oversized(self.table, self.target, recursive)
+        findings += structure.oversized(self.table, self.target, recursive, graph)
         for f in findings:
             self.rep.error(f.node, f.message)
 
@@ -700,9 +708,10 @@ class Checker:
         if not operands:
             return
         operands.sort(key=lambda found: (found[1].span.line, found[1].span.col))  # warned at the first use
-        written = {id(n) for s in ast.walk(info.pou.body) if isinstance(s, ast.Assign) for n in ast.walk(s.target)}
+        body = list(ast.walk(info.pou.body))  # walked once for both
+        written = {id(n) for s in body if isinstance(s, ast.Assign) for n in ast.walk(s.target)}
         mine = {id(n) for _c, op, _d in operands for n in ast.walk(op)}
-        read = {id(n.symbol) for n in ast.walk(info.pou.body)
+        read = {id(n.symbol) for n in body
                 if isinstance(n, ast.Name) and id(n) not in written and id(n) not in mine}
         for call, op, decl in operands:
             if id(decl) in read:
@@ -881,6 +890,8 @@ class Checker:
         if source is T.VOID:
             self.rep.error(node, f"{what}: this call gives no value")
             return
+        if target == source:
+            return  # assignable, and no literal to range-check (a literal's type is no Elementary)
         problem = T.assignable(target, source, self.target)
         if problem:
             self.rep.error(node, f"{what}: {problem}")
@@ -904,36 +915,44 @@ class Checker:
     # ------------------------------------------------------------- expressions
     def lvalue(self, e: ast.Expr) -> T.Type | None:
         """Type of an assignment target, reporting what cannot be written."""
-        if isinstance(e, _LITERALS):
-            self.expr(e)
-            self.rep.error(e, f"cannot assign to the constant {_lit_text(e)}")
-            return None
-        if isinstance(e, _EXPRESSIONS):
-            self.expr(e)
-            self.rep.error(e, "cannot assign to an expression; the left of ':=' must be a label or device")
-            return None
-        t = self.expr(e)
-        root = e
-        while isinstance(root, (ast.Index, ast.Member, ast.BitAccess)):
-            root = root.base
-        if isinstance(root, ast.Name) and isinstance(root.symbol, ast.VarDecl):
-            decl = root.symbol
+        # the node classes are disjoint (no subclasses): tested by type, a plain name (most
+        # targets) first
+        cls = type(e)
+        if cls is ast.Name:
+            t = self.expr(e)
+            root = e
+        else:
+            if isinstance(e, _LITERALS):
+                self.expr(e)
+                self.rep.error(e, f"cannot assign to the constant {_lit_text(e)}")
+                return None
+            if isinstance(e, _EXPRESSIONS):
+                self.expr(e)
+                self.rep.error(e, "cannot assign to an expression; the left of ':=' must be a label or device")
+                return None
+            t = self.expr(e)
+            root = e
+            while isinstance(root, (ast.Index, ast.Member, ast.BitAccess)):
+                root = root.base
+        symbol = root.symbol if type(root) is ast.Name else None
+        if isinstance(symbol, ast.VarDecl):
+            decl = symbol
             if decl.constant:
                 self.rep.error(e, f"'{decl.name}' is a constant (VAR CONSTANT); it cannot be assigned")
             elif decl.section == "VAR_INPUT" and e is root and self.pou is not None and self.pou.pou.kind == "FUNCTION_BLOCK":
                 self.rep.warning(e, f"'{decl.name}' is an input; writing it inside the FB hides the caller's value")
-        if isinstance(root, ast.Name) and isinstance(root.symbol, ast.Pou):
-            pou = root.symbol
+        elif isinstance(symbol, ast.Pou):
+            pou = symbol
             if self.pou is None or pou is not self.pou.pou:
                 self.rep.error(e, f"cannot assign to the POU name '{pou.name}' outside it")
-        if isinstance(e, ast.Member) and isinstance(e.base.type, T.FbType):
+        if cls is ast.Member and isinstance(e.base.type, T.FbType):
             kind = e.base.type.param(e.member)
             if kind and kind[0] == "output":
                 self.rep.error(e, f"'{e.member}' is an output of {e.base.type}; it cannot be assigned from outside")
         if isinstance(t, T.FbType):
             self.rep.error(e, f"'{_text(e)}' is a function block instance; it cannot be assigned "
                               "(assign its inputs in a call instead)")
-        if isinstance(e, ast.Device) and e.kind in ("X",) and e.bit is None:
+        if cls is ast.Device and e.kind in ("X",) and e.bit is None:
             self.rep.warning(e, f"writing input {e.text}: X devices are refreshed from the inputs each scan")
         return t
 

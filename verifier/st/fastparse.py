@@ -34,7 +34,7 @@ import gc
 import hashlib
 import re
 from itertools import accumulate, repeat
-from operator import sub
+from operator import add, sub
 
 from verifier.st import ast
 from verifier.st.devices import H_CONST_RE, K_CONST_RE, parse_device
@@ -214,11 +214,14 @@ class Tokenizer:
             last = text.rfind(opener)
             if last >= 0 and text.find(closer, last + 2) < 0:
                 raise Bail
-        if len(text) > LONG_LINE and any(len(line) > LONG_LINE and ("'" in line or '"' in line)
-                                         for line in text.split("\n")):
+        lines = text.split("\n")
+        widths = list(map(len, lines))
+        if max(widths) > LONG_LINE and any(len(line) > LONG_LINE and ("'" in line or '"' in line)
+                                           for line in lines):
             # likewise each quote of a string not closed on its line is tried to the line's
             # end: on a line of 40,000 characters, 8 s
             raise Bail
+        del lines
         parts = self.split(text)  # "", ignored, token, "", ignored, token, ..., "", ignored, "", ...
         if any(parts[0::3]):  # text no terminal reads
             raise Bail
@@ -231,7 +234,15 @@ class Tokenizer:
         starts = list(accumulate(map(len, parts[:3 * n])))[1::3]  # where each token starts
         LN = list(accumulate(map(str.count, skips, repeat("\n")), initial=1))
         del LN[0]
-        CL = list(map(sub, starts, map(text.rfind, repeat("\n"), repeat(0), starts)))
+        if LN[-1] == len(widths):
+            # no token holds a line feed (all of them are in the skipped text): the last one
+            # before a token is the one that ends the line before the token's line, found by
+            # the line number, not by a search per token (a twentieth of the parse)
+            before_line = list(accumulate(map(add, widths, repeat(1)), initial=-1))
+            before_line.insert(0, None)  # by line number: where the line before it ends
+            CL = list(map(sub, starts, map(before_line.__getitem__, LN)))
+        else:
+            CL = list(map(sub, starts, map(text.rfind, repeat("\n"), repeat(0), starts)))
         kinds = self.kinds
         K = list(map(kinds.get, V))
         if max(map(len, V)) > MAX_NUMBER_CHARS:

@@ -149,11 +149,12 @@ def containment_edges(table) -> tuple[list[str], dict[str, list[tuple[str, objec
     return nodes, edges, names
 
 
-def recursive_types(table) -> tuple[list[Finding], set[str]]:
+def recursive_types(table, graph=None) -> tuple[list[Finding], set[str]]:
     """A function block or structure that holds an instance of itself (directly or
     through others) has no finite size: one error per circle, at the label that starts
-    it. Also returns the keys of every type on such a circle."""
-    nodes, edges, names = containment_edges(table)
+    it. Also returns the keys of every type on such a circle. `graph`: the table's
+    `containment_edges`, when the caller has them."""
+    nodes, edges, names = graph or containment_edges(table)
     findings: list[Finding] = []
     bad: set[str] = set()
     for component in _cycles(nodes, edges):
@@ -277,10 +278,11 @@ def _post_order(nodes: list[str], edges: dict[str, list[tuple[str, object]]]) ->
     return order
 
 
-def oversized(table, target: str, recursive: set[str]) -> list[Finding]:
-    """Labels, and POU instances, that need more than MAX_WORDS words."""
+def oversized(table, target: str, recursive: set[str], graph=None) -> list[Finding]:
+    """Labels, and POU instances, that need more than MAX_WORDS words. `graph`: the
+    table's `containment_edges`, when the caller has them."""
     storage = Storage(table, target, recursive)
-    nodes, edges, _ = containment_edges(table)
+    nodes, edges, _ = graph or containment_edges(table)
     for key in _post_order(nodes, edges):  # innermost types first: no deep recursion below
         storage.of_named(key)
     findings: list[Finding] = []

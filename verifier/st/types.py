@@ -84,13 +84,21 @@ class FbType(Type):
     standard: bool = False
 
     def param(self, name: str) -> tuple[str, Type] | None:
-        key = name.upper()
-        for kind, group in (("input", self.inputs), ("output", self.outputs),
-                            ("in_out", self.in_outs), ("public", self.publics)):
-            for n, t in group:
-                if n.upper() == key:
-                    return kind, t
-        return None
+        """(kind, type) of the parameter spelt `name` (any case), the first in the order
+        inputs, outputs, in_outs, publics; None when there is none."""
+        groups = (self.inputs, self.outputs, self.in_outs, self.publics)
+        cached = self.__dict__.get("_param_index")
+        # the check looks parameters up once per call argument and member: an index built
+        # once per instance, rebuilt when the groups are not the ones it was built from
+        # (the collection fills a user FB's groups in after creating it, object.__setattr__)
+        if cached is None or cached[0] != groups:
+            index: dict[str, tuple[str, Type]] = {}
+            for kind, group in zip(("input", "output", "in_out", "public"), groups):
+                for n, t in group:
+                    index.setdefault(n.upper(), (kind, t))
+            cached = (groups, index)
+            object.__setattr__(self, "_param_index", cached)
+        return cached[1].get(name.upper())
 
 
 @dataclass(frozen=True)
