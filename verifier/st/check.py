@@ -19,7 +19,7 @@ from verifier.bundled import PLC_DIR, library_file
 from verifier.textfile import real_path
 from verifier.st import ast, library, melsec, structure
 from verifier.st import types as T
-from verifier.st.devices import looks_like_device
+from verifier.st.devices import HEX_DEVICES, looks_like_device
 
 REAL_MAX = 3.4028234663852886e38  # the largest 32-bit float
 # branches of one IF or CASE: the simulator's Python compiler gives up near 3,000
@@ -1050,7 +1050,7 @@ class Checker:
                               f"G_OUTPUT and G_INPUT take its start I/O number without the last digit (16#{n} for "
                               f"the module at X/Y{int(n, 16) * 16:03X}), ZP_OPEN and the other ZP_ instructions the string '{e.name}'; "
                               f"{e.name}\\G150 is its buffer memory")
-        elif (m := re.fullmatch(r"(SB|SW|DX|DY|X|Y|B|W)([A-F][0-9A-F]*)", e.name)) is not None:
+        elif (m := _HEX_DEVICE_WITHOUT_DIGIT.fullmatch(e.name)) is not None:
             # the QJ71C24N manual's "XA", "XB": the device reader wants the digit first (as for H0FF)
             dev = f"{m[1].upper()}0{m[2].upper()}"
             self.rep.error(e, f"undefined label '{e.name}'; for the device write {dev}: a hexadecimal device "
@@ -1064,26 +1064,22 @@ class Checker:
     def _label_hint(self, name: str) -> str:
         """'; did you mean 'fbRun'?' when a label this POU sees (its own, a global) or a POU
         is spelt nearly as `name`, else "" (the error path only)."""
-        from verifier.amr.schema import did_you_mean
-
         seen = [decl.name for decl, _t in (self.pou.labels.values() if self.pou is not None else ())]
         seen += [decl.name for decl, _t in self.table.globals.values()]
         seen += [info.pou.name for info in self.table.pous.values()]
-        return did_you_mean(name, seen)
+        return _did_you_mean(name, seen)
 
     def _call_hint(self, name: str) -> str:
         """'; did you mean 'MOVE'?' for an unknown call spelt nearly as something that can
         be called here: an FB instance this POU sees, a FUNCTION, a standard function or an
         instruction of the editor (never a plain label: 'bMove' cannot be called), else ""
         (the error path only)."""
-        from verifier.amr.schema import did_you_mean
-
         labels = list(self.pou.labels.values()) if self.pou is not None else []
         seen = [decl.name for decl, t in labels + list(self.table.globals.values()) if isinstance(t, T.FbType)]
         seen += [info.pou.name for info in self.table.pous.values() if info.pou.kind == "FUNCTION"]
         seen += [n for n, sig in library.STANDARD_FUNCTIONS.items() if self.target in sig.targets]
         seen += [n for n in library.INSTRUCTIONS if library.instruction(n, self.target) is not None]
-        return did_you_mean(name, seen)
+        return _did_you_mean(name, seen)
 
     def _device(self, e: ast.Device) -> T.Type:
         if e.bit is not None:
@@ -1860,7 +1856,15 @@ def _ladder_spelling(callee: ast.Expr, table, pou) -> tuple[str, str] | None:
     return f"{callee.base.name}.{callee.member}", joined
 
 
+#: a device numbered in hexadecimal written without its leading digit (`XA` for X0A), in
+#: the device's own capitals: the kinds are devices.py's, the longest tried first
+_HEX_DEVICE_WITHOUT_DIGIT = re.compile(
+    "(" + "|".join(sorted(HEX_DEVICES, key=len, reverse=True)) + ")([A-F][0-9A-F]*)")
+
+
 def _did_you_mean(name: str, candidates: list[str]) -> str:
+    """'; did you mean 'x'?' (verifier.amr.schema.did_you_mean, imported on the error
+    path only), else ""."""
     from verifier.amr.schema import did_you_mean
 
     return did_you_mean(name, candidates)
@@ -1870,9 +1874,7 @@ def _parameter_hint(fb: T.FbType, name: str) -> str:
     """What to write instead of a parameter `fb` does not have: the library's old run
     input `i_bEnable` by its new name `i_bEN` (docs/plc-library.md), else the parameter
     spelt nearly so."""
-    from verifier.amr.schema import did_you_mean
-
     if name.upper() == "I_BENABLE" and fb.param("i_bEN") is not None:
         return "; its run input is i_bEN (renamed from i_bEnable, docs/plc-library.md): write 'i_bEN := ...'"
     names = [n for group in (fb.inputs, fb.outputs, fb.in_outs) for n, _t in group]
-    return did_you_mean(name, names)
+    return _did_you_mean(name, names)
