@@ -52,8 +52,9 @@ def render(results: list[ScenarioResult], console: Console, *, first: int = FIRS
 def _scenario(result: ScenarioResult, console: Console, first: int) -> None:
     color = {"pass": "green", "fail": "red"}.get(result.verdict, "yellow")  # yellow: UNVERIFIED
     mark = f"[{color}]{verdict_mark(result.verdict)}[/]"
-    # a monitored port is in the run's name already ("monitor /dev/ttyUSB0"): not twice
-    where = f" ({escape(shown_name(result.file))})" if result.file and result.file not in result.name else ""
+    # a monitored port is a word of the run's name already ("monitor /dev/ttyUSB0"): not
+    # twice (a word, not any part: a file "h" is not in the name "fx3u healthy")
+    where = f" ({escape(shown_name(result.file))})" if result.file and result.file not in result.name.split() else ""
     tx = result.tx_count
     failed = len(result.failed_expectations)
     expectations = (
